@@ -1,0 +1,1 @@
+"""Barthel kiosk: patient-facing app, session core and channels."""

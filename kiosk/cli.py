@@ -1,0 +1,50 @@
+"""The `kiosk` command line: one sub-command per job, each owned by the module that does it.
+
+The dispatcher only routes: every sub-command module exposes ``main(argv: list[str]) -> int`` and
+parses its own arguments, so adding an option never touches this file. Modules are imported
+lazily, so `kiosk validate` does not pay for Textual or the speech stack.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from collections.abc import Sequence
+
+#: sub-command -> (module exposing main(argv), one-line description)
+COMMANDS: dict[str, tuple[str, str]] = {
+    "run": ("kiosk.app", "start the kiosk (the default when no sub-command is given)"),
+    "serve": ("kiosk.serve", "serve the kiosk to a browser on a touch display (localhost by default)"),
+    "replay": ("kiosk.replay", "run a scripted patient through the real session on a simulated clock"),
+    "validate": ("kiosk.validate", "check a questionnaire YAML file and list every problem"),
+    "results": ("kiosk.results", "list stored sessions, show one, or export it (FHIR JSON, CSV)"),
+    "devices": ("kiosk.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
+    "models": ("kiosk.speech.models", "install and list speech-recognition models"),
+    "qos": ("kiosk.qos_cli", "QoS tools: replay a context trace, print a session's trace"),
+}
+
+
+def _usage() -> str:
+    width = max(len(name) for name in COMMANDS)
+    lines = ["usage: kiosk [COMMAND] [ARGS...]", "", "commands:"]
+    lines += [f"  {name:<{width}}  {text}" for name, (_, text) in COMMANDS.items()]
+    lines += ["", "`kiosk COMMAND --help` describes a command's options."]
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the `kiosk` console script; returns the process exit status."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] in ("-h", "--help", "help"):
+        print(_usage())
+        return 0
+    name = "run" if not args or args[0].startswith("-") else args.pop(0)
+    if name not in COMMANDS:
+        print(f"kiosk: unknown command {name!r}\n\n{_usage()}", file=sys.stderr)
+        return 2
+    module = importlib.import_module(COMMANDS[name][0])
+    return int(module.main(args) or 0)
+
+
+if __name__ == "__main__":  # pragma: no cover - `python -m kiosk.cli`
+    sys.exit(main())

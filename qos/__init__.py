@@ -1,0 +1,1 @@
+"""In-process RoQME QoS engine."""

@@ -1,0 +1,41 @@
+"""The dependency arrows point one way: screens -> session -> qos. Neither the QoS engine nor the
+session core may drag Textual in, so they run the same under the UI, in replays and in tests."""
+
+from __future__ import annotations
+
+import pkgutil
+import subprocess
+import sys
+
+import qos
+
+#: the pure-Python parts of the kiosk (imported by module name; missing ones are an error)
+PURE_KIOSK_MODULES = ["kiosk.channels", "kiosk.cli"]
+
+
+def _modules_of(package) -> list[str]:
+    names = [package.__name__]
+    names += [m.name for m in pkgutil.walk_packages(package.__path__, package.__name__ + ".")
+              if not m.name.endswith("__main__")]
+    return names
+
+
+def _imported_after(modules: list[str]) -> set[str]:
+    code = (
+        "import importlib, sys\n"
+        f"for name in {modules!r}: importlib.import_module(name)\n"
+        "print('\\n'.join(sorted(sys.modules)))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return set(out.stdout.split())
+
+
+def test_qos_never_imports_textual_or_kiosk():
+    loaded = _imported_after(_modules_of(qos))
+    assert "textual" not in loaded
+    assert not any(name == "kiosk" or name.startswith("kiosk.") for name in loaded)
+
+
+def test_session_core_never_imports_textual():
+    loaded = _imported_after(PURE_KIOSK_MODULES)
+    assert "textual" not in loaded
