@@ -1,0 +1,426 @@
+"""Audio in: microphones, WAV files, and an energy endpointer that cuts speech into utterances.
+
+Everything the recogniser hears goes through one :class:`UtterancePipeline`: 16 kHz mono
+16-bit PCM in, one :class:`Utterance` out per stretch of speech. A microphone
+(:class:`MicrophoneStream`, PortAudio via sounddevice) and a WAV file (:func:`feed_wav`) feed the
+same pipeline, which is how the tests and ``bench/asr.py`` exercise the real path without a
+sound card. Times are positions in the audio stream (seconds of samples fed), not wall time, so
+a file replays the same way every time.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import queue
+import threading
+import time
+import wave
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+#: what every recogniser in the kiosk takes: 16 kHz, mono, signed 16-bit little-endian
+SAMPLE_RATE = 16_000
+#: the endpointer's analysis frame: 30 ms, a usual speech frame length
+FRAME_SAMPLES = 480
+
+
+class AudioUnavailable(RuntimeError):
+    """Audio input cannot work on this machine; the message is one sentence for the UI."""
+
+
+@dataclass(frozen=True)
+class InputDevice:
+    """One audio input as `kiosk devices` shows it."""
+
+    index: int
+    name: str
+    #: PortAudio's default input: the one the kiosk uses unless configured otherwise
+    default: bool
+    #: the device's own default sample rate (the kiosk records at 16 kHz regardless)
+    sample_rate: float
+    #: whether 16 kHz mono 16-bit recording is accepted by the device
+    usable: bool
+    #: why not, when not usable
+    reason: str = ""
+
+
+def _sounddevice():
+    """Import sounddevice, turning a missing PortAudio library into one clear sentence."""
+    try:
+        import sounddevice
+    except OSError as exc:  # sounddevice raises OSError when libportaudio cannot be loaded
+        raise AudioUnavailable(f"PortAudio is not installed (libportaudio2): {exc}") from None
+    return sounddevice
+
+
+def describe_input(info: dict, default_index: int, check: Callable[[int], None]) -> InputDevice:
+    """Turn one of sounddevice's device dicts into an :class:`InputDevice`.
+
+    ``check(index)`` raises if the device refuses 16 kHz mono int16 (sounddevice's
+    ``check_input_settings``); its message becomes the reason.
+    """
+    try:
+        check(info["index"])
+        usable, reason = True, ""
+    except Exception as exc:  # PortAudio reports every refusal as its own error type
+        usable, reason = False, f"cannot record 16 kHz mono: {exc}"
+    return InputDevice(
+        index=info["index"],
+        name=info["name"],
+        default=info["index"] == default_index,
+        sample_rate=float(info["default_samplerate"]),
+        usable=usable,
+        reason=reason,
+    )
+
+
+def list_input_devices() -> list[InputDevice]:
+    """Every audio input PortAudio knows (empty on a machine without one).
+
+    Raises :class:`AudioUnavailable` when PortAudio itself cannot be loaded.
+    """
+    sd = _sounddevice()
+
+    def check(index: int) -> None:
+        sd.check_input_settings(device=index, channels=1, dtype="int16", samplerate=SAMPLE_RATE)
+
+    default_index = sd.default.device[0]
+    return [
+        describe_input(info, default_index, check)
+        for info in sd.query_devices()
+        if info["max_input_channels"] > 0
+    ]
+
+
+def default_input_device() -> InputDevice:
+    """The input the kiosk would record from, or :class:`AudioUnavailable` saying why none."""
+    devices = [d for d in list_input_devices() if d.usable]
+    if not devices:
+        raise AudioUnavailable("no microphone found")
+    return next((d for d in devices if d.default), devices[0])
+
+
+# --- WAV files -------------------------------------------------------------------------------
+
+
+def resample(samples: np.ndarray, rate: int, target: int = SAMPLE_RATE) -> np.ndarray:
+    """Resample mono int16 audio to ``target`` Hz (windowed-sinc low-pass, then interpolation).
+
+    Good enough for speech recognition, which ignores everything above ~7 kHz anyway; it keeps
+    the kiosk free of a SciPy dependency.
+    """
+    if rate == target:
+        return samples.astype(np.int16, copy=False)
+    x = samples.astype(np.float64)
+    if target < rate:  # remove what would alias above the new Nyquist frequency
+        cutoff = 0.95 * (target / 2) / rate
+        taps = np.arange(-32, 33)
+        kernel = np.sinc(2 * cutoff * taps) * np.hamming(len(taps))
+        x = np.convolve(x, kernel / kernel.sum(), mode="same")
+    n = int(len(x) * target / rate)
+    y = np.interp(np.arange(n) * (rate / target), np.arange(len(x)), x)
+    return np.clip(np.round(y), -32768, 32767).astype(np.int16)
+
+
+def read_wav(path: str | Path) -> np.ndarray:
+    """A 16-bit PCM WAV file as 16 kHz mono int16 samples (channels averaged, resampled).
+
+    Raises ``ValueError`` naming the file for anything else (8-bit, float, not a WAV).
+    """
+    try:
+        with wave.open(str(path), "rb") as wav:
+            if wav.getsampwidth() != 2:
+                raise ValueError(f"{path}: {8 * wav.getsampwidth()}-bit WAV, expected 16-bit PCM")
+            channels, rate = wav.getnchannels(), wav.getframerate()
+            data = np.frombuffer(wav.readframes(wav.getnframes()), dtype="<i2")
+    except (wave.Error, EOFError) as exc:
+        raise ValueError(f"{path}: not a PCM WAV file ({exc})") from None
+    if channels > 1:
+        data = data.reshape(-1, channels).mean(axis=1).astype(np.int16)
+    return resample(data, rate)
+
+
+# --- endpointing -----------------------------------------------------------------------------
+
+
+def frame_level_db(frame: np.ndarray) -> float:
+    """RMS level of int16 samples in dB relative to full scale (-100 for digital silence)."""
+    if len(frame) == 0:
+        return -100.0
+    rms = math.sqrt(float(np.mean(frame.astype(np.float64) ** 2))) / 32768.0
+    return max(-100.0, 20 * math.log10(rms)) if rms > 0 else -100.0
+
+
+@dataclass(frozen=True)
+class EndpointerSettings:
+    """How the endpointer decides where speech starts and ends."""
+
+    #: a frame this loud (dBFS) or louder may be speech ...
+    min_speech_db: float = -45.0
+    #: ... if it is also this far above the running noise floor
+    margin_db: float = 12.0
+    #: this much continuous speech starts an utterance (short clicks do not)
+    start_ms: int = 90
+    #: this much quiet ends it. Older speakers pause inside an answer; with ~0.2 s of
+    #: recognition after it the kiosk still replies inside the ~0.75 s that feels natural.
+    hangover_ms: int = 500
+    #: audio kept from before the start, so the recogniser hears the first consonant
+    preroll_ms: int = 300
+    #: an utterance longer than this is cut (a radio, a conversation in the room)
+    max_utterance_s: float = 10.0
+
+
+class Endpointer:
+    """Energy-based speech start/end detection with hangover, frame by frame.
+
+    ``push(frame)`` returns ``"start"``, ``"end"`` or ``None``. A running noise floor (tracked
+    while nobody speaks) raises the threshold in a noisy room.
+    """
+
+    def __init__(self, settings: EndpointerSettings | None = None) -> None:
+        self.settings = settings or EndpointerSettings()
+        frame_ms = 1000 * FRAME_SAMPLES / SAMPLE_RATE
+        self._start_frames = max(1, round(self.settings.start_ms / frame_ms))
+        self._end_frames = max(1, round(self.settings.hangover_ms / frame_ms))
+        self._max_frames = round(self.settings.max_utterance_s * 1000 / frame_ms)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget any speech in progress (after a mute, or between questions)."""
+        self.in_speech = False
+        self._voiced_run = 0
+        self._quiet_run = 0
+        self._speech_frames = 0
+        self.noise_db = -70.0
+
+    def is_voiced(self, level_db: float) -> bool:
+        """Whether a frame at ``level_db`` counts as speech given the current noise floor."""
+        return level_db >= max(self.settings.min_speech_db, self.noise_db + self.settings.margin_db)
+
+    def push(self, frame: np.ndarray) -> str | None:
+        """Classify one frame of :data:`FRAME_SAMPLES` samples; report a start or an end."""
+        level = frame_level_db(frame)
+        voiced = self.is_voiced(level)
+        if not self.in_speech:
+            if voiced:
+                self._voiced_run += 1
+                if self._voiced_run >= self._start_frames:
+                    self.in_speech, self._quiet_run = True, 0
+                    self._speech_frames = self._voiced_run
+                    return "start"
+            else:
+                self._voiced_run = 0
+                # the floor follows quiet frames slowly, and drops at once when it gets quieter
+                self.noise_db = min(level, 0.95 * self.noise_db + 0.05 * level)
+                self.noise_db = max(self.noise_db, -90.0)
+            return None
+        self._speech_frames += 1
+        self._quiet_run = 0 if voiced else self._quiet_run + 1
+        if self._quiet_run >= self._end_frames or self._speech_frames >= self._max_frames:
+            self.in_speech, self._voiced_run = False, 0
+            return "end"
+        return None
+
+    @property
+    def quiet_frames(self) -> int:
+        """Quiet frames since the last voiced one while in speech (the hangover so far)."""
+        return self._quiet_run
+
+
+# --- the pipeline ----------------------------------------------------------------------------
+
+
+class StreamingRecogniser(Protocol):
+    """What the pipeline needs from a recogniser (see :mod:`kiosk.speech.asr`)."""
+
+    def reset(self) -> None:
+        """Start a new utterance."""
+
+    def accept(self, pcm: bytes) -> object:
+        """Take more audio of the current utterance."""
+
+    def finish(self) -> object:
+        """End the utterance and return the final result."""
+
+
+@dataclass(frozen=True)
+class Utterance:
+    """One stretch of speech and what the recogniser made of it."""
+
+    #: the recogniser's final result (a :class:`kiosk.speech.asr.Recognition`)
+    result: object
+    #: stream time (s) of the first voiced frame and of the last one
+    speech_start: float
+    speech_end: float
+    #: stream time (s) the endpointer decided the utterance was over (speech_end + hangover)
+    endpoint: float
+    #: seconds of processor time the recogniser took for its final result after the endpoint
+    #: (a measurement for ``bench/asr.py``; no decision depends on it)
+    finish_seconds: float
+
+
+class UtterancePipeline:
+    """16 kHz PCM → endpointer → recogniser → one :class:`Utterance` per stretch of speech.
+
+    Not thread-safe: one thread feeds it (the microphone worker, or the caller of
+    :func:`feed_wav`). ``muted`` drops audio (the kiosk is talking) and forgets any
+    utterance in progress.
+    """
+
+    def __init__(
+        self,
+        recogniser: StreamingRecogniser,
+        on_utterance: Callable[[Utterance], None],
+        settings: EndpointerSettings | None = None,
+    ) -> None:
+        self.recogniser = recogniser
+        self.on_utterance = on_utterance
+        self.endpointer = Endpointer(settings)
+        self._preroll: deque[bytes] = deque(
+            maxlen=max(1, round(self.endpointer.settings.preroll_ms * SAMPLE_RATE / 1000 / FRAME_SAMPLES))
+        )
+        self._pending = b""
+        self._samples = 0  # samples fed so far: the stream clock
+        self._start = 0.0
+        self._muted = False
+
+    @property
+    def muted(self) -> bool:
+        """Whether audio is currently being thrown away."""
+        return self._muted
+
+    @muted.setter
+    def muted(self, value: bool) -> None:
+        if value and not self._muted:
+            self._drop_utterance()
+        self._muted = value
+
+    def _drop_utterance(self) -> None:
+        self.endpointer.reset()
+        self._preroll.clear()
+        self._pending = b""
+        self.recogniser.reset()
+
+    @property
+    def stream_time(self) -> float:
+        """Seconds of audio fed so far."""
+        return self._samples / SAMPLE_RATE
+
+    def feed(self, pcm: bytes) -> None:
+        """Take any amount of 16 kHz mono int16 audio."""
+        if self._muted:
+            self._samples += len(pcm) // 2
+            return
+        data = self._pending + pcm
+        step = 2 * FRAME_SAMPLES
+        whole = len(data) - len(data) % step
+        self._pending = data[whole:]
+        for offset in range(0, whole, step):
+            self._frame(data[offset:offset + step])
+
+    def _frame(self, chunk: bytes) -> None:
+        self._samples += FRAME_SAMPLES
+        event = self.endpointer.push(np.frombuffer(chunk, dtype="<i2"))
+        if event is None:
+            if self.endpointer.in_speech:
+                self.recogniser.accept(chunk)
+            else:
+                self._preroll.append(chunk)
+            return
+        frame_s = FRAME_SAMPLES / SAMPLE_RATE
+        if event == "start":
+            # the run of voiced frames that triggered the start is already in the pre-roll
+            self._start = self.stream_time - self.endpointer._start_frames * frame_s
+            self.recogniser.reset()
+            self.recogniser.accept(b"".join(self._preroll) + chunk)
+            self._preroll.clear()
+            return
+        # "end": the recogniser has heard the speech and the hangover; finish it now
+        self.recogniser.accept(chunk)
+        endpoint = self.stream_time
+        began = time.perf_counter()
+        result = self.recogniser.finish()
+        finish_seconds = time.perf_counter() - began
+        speech_end = endpoint - self.endpointer.quiet_frames * frame_s
+        self.on_utterance(
+            Utterance(
+                result=result,
+                speech_start=self._start,
+                speech_end=speech_end,
+                endpoint=endpoint,
+                finish_seconds=finish_seconds,
+            )
+        )
+
+
+def feed_wav(path: str | Path, pipeline: UtterancePipeline, chunk_ms: int = 100) -> float:
+    """Play a WAV file into ``pipeline`` as a microphone would deliver it; returns its length (s).
+
+    The file is followed by a second of silence, as a room falls quiet after an answer, so the
+    endpointer can close the last utterance.
+    """
+    samples = read_wav(path)
+    tail = np.zeros(SAMPLE_RATE, dtype=np.int16)
+    pcm = np.concatenate([samples, tail]).tobytes()
+    step = 2 * SAMPLE_RATE * chunk_ms // 1000
+    for offset in range(0, len(pcm), step):
+        pipeline.feed(pcm[offset:offset + step])
+    return len(samples) / SAMPLE_RATE
+
+
+class MicrophoneStream:
+    """Records 16 kHz mono int16 from a PortAudio input into a pipeline, on its own thread.
+
+    PortAudio's callback only queues the audio; a worker thread runs the pipeline (and so the
+    recogniser), which must never block the audio callback.
+    """
+
+    def __init__(self, pipeline: UtterancePipeline, device: int | None = None) -> None:
+        self.pipeline = pipeline
+        self.device = device
+        self._queue: queue.Queue[bytes | None] = queue.Queue()
+        self._stream = None
+        self._worker: threading.Thread | None = None
+
+    def start(self) -> None:
+        """Open the input and start feeding; :class:`AudioUnavailable` if there is none."""
+        sd = _sounddevice()
+        device = self.device if self.device is not None else default_input_device().index
+        try:
+            self._stream = sd.RawInputStream(
+                samplerate=SAMPLE_RATE, channels=1, dtype="int16", blocksize=FRAME_SAMPLES,
+                device=device, callback=self._on_audio,
+            )
+            self._stream.start()
+        except Exception as exc:  # PortAudio errors: busy device, unplugged, refused format
+            raise AudioUnavailable(f"cannot open microphone {device}: {exc}") from None
+        self._worker = threading.Thread(target=self._drain, name="kiosk-microphone", daemon=True)
+        self._worker.start()
+
+    def _on_audio(self, indata, frames, time_info, status) -> None:
+        if status:
+            log.debug("audio input status: %s", status)
+        self._queue.put(bytes(indata))
+
+    def _drain(self) -> None:
+        while (chunk := self._queue.get()) is not None:
+            self.pipeline.feed(chunk)
+
+    def stop(self) -> None:
+        """Close the input and stop the worker; safe to call twice."""
+        if self._stream is not None:
+            self._stream.stop()
+            self._stream.close()
+            self._stream = None
+        if self._worker is not None:
+            self._queue.put(None)
+            self._worker.join(timeout=2)
+            self._worker = None
