@@ -1,0 +1,1 @@
+"""Reusable display pieces of the kiosk: answer buttons, progress, channel and adaptation bars."""

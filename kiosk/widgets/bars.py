@@ -1,0 +1,88 @@
+"""The bars around every patient screen: progress, channels, adaptation notice and controls."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.containers import Horizontal
+from textual.message import Message
+from textual.widgets import Button, Static
+
+from kiosk.channels import Command
+from kiosk.widgets.text import ui_text
+
+
+@dataclass(frozen=True)
+class ChannelLine:
+    """How one channel is shown: its name, a word for its state, and whether it takes input now."""
+
+    name: str
+    state: str
+    live: bool
+    #: why it is off, for the clinician standing by ("no microphone found")
+    reason: str = ""
+
+
+class ChannelBar(Static):
+    """Which channels are live (speaking, listening, remote connected) and which are off."""
+
+    def show(self, lines: Sequence[ChannelLine]) -> None:
+        """Replace the shown channel states."""
+        text = Text()
+        for index, line in enumerate(lines):
+            if index:
+                text.append("   ")
+            text.append(f"{line.name}: ", style="bold")
+            text.append(line.state, style="bold #0b5d1e" if line.live else "bold #8b0000")
+            if line.reason and not line.live:
+                text.append(f" ({line.reason})")
+        self.update(text)
+
+
+class AdaptationBanner(Static):
+    """A notice of how the kiosk changed itself, e.g. "voice answers paused — touch or press".
+
+    Hidden while there is nothing to say.
+    """
+
+    def show(self, message: str | None) -> None:
+        """Show ``message``, or hide the banner when it is None or empty."""
+        self.update(message or "")
+        self.display = bool(message)
+
+
+class ControlBar(Horizontal):
+    """Pause, Repeat and Call-doctor, always visible at the bottom of the patient's screens."""
+
+    class Commanded(Message):
+        """The patient touched one of the control buttons."""
+
+        def __init__(self, command: Command) -> None:
+            self.command = command
+            """What the patient asked for."""
+            super().__init__()
+
+    def __init__(self, language: str, *, paused: bool = False) -> None:
+        """Label the buttons in ``language``; while ``paused`` the pause button resumes."""
+        super().__init__(id="controls")
+        self.language = language
+        self.paused = paused
+
+    def compose(self) -> ComposeResult:
+        """Pause (or Continue), Repeat and Call doctor, each with its key letter."""
+        if self.paused:
+            yield Button(ui_text(self.language, "resume"), id="resume", classes="control")
+        else:
+            yield Button(ui_text(self.language, "pause"), id="pause", classes="control")
+            yield Button(ui_text(self.language, "repeat"), id="repeat", classes="control")
+        yield Button(ui_text(self.language, "call_doctor"), id="call-doctor", classes="control")
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        """Turn a touched control into the command it stands for."""
+        event.stop()
+        command = {"pause": Command.PAUSE, "resume": Command.RESUME, "repeat": Command.REPEAT,
+                   "call-doctor": Command.CALL_DOCTOR}[event.button.id or ""]
+        self.post_message(self.Commanded(command))
