@@ -1,0 +1,320 @@
+"""Device profiles for big-button remotes: which device to look for and what its buttons send.
+
+The built-in profiles live in ``kiosk/remote/devices.yaml``. A site may add or change profiles
+in its own file (named by the kiosk's config) with the same layout: a profile whose ``name``
+matches a built-in one overrides just the fields it gives (``enabled: false`` turns one off),
+any other name adds a profile. Everything is validated before anything is used; the first
+problem raises :class:`ProfileError` with one sentence naming the file, the profile and the field.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
+from kiosk.remote.decoders import ReportMatch
+
+#: the profiles shipped with the kiosk
+BUILTIN_PROFILES = Path(__file__).with_name("devices.yaml")
+
+KINDS = ("serial", "hid", "keyboard")
+
+#: every field each kind of profile may have (a misspelt field is an error, not silently ignored)
+_FIELDS = {
+    "serial": {"name", "kind", "enabled", "description", "port", "baud", "max_line", "lines"},
+    "hid": {"name", "kind", "enabled", "description", "vendor_id", "product_id", "report_id",
+            "debounce_ms", "buttons"},
+    "keyboard": {"name", "kind", "enabled", "description", "keys"},
+}
+
+
+class ProfileError(ValueError):
+    """A device profile file cannot be used; the message names the file, profile and field."""
+
+
+@dataclass(frozen=True)
+class SerialProfile:
+    """A remote on a serial port that sends one text line per press, e.g. ``BTN 3``."""
+
+    name: str
+    #: a device path or a glob such as ``/dev/ttyUSB*``; the first port that opens is used
+    port: str
+    baud: int
+    #: exact line text (without the newline) -> button
+    lines: Mapping[str, Button]
+    max_line: int = 64
+    enabled: bool = True
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class HidProfile:
+    """A USB HID remote, found by vendor and product id, whose input reports encode buttons."""
+
+    name: str
+    vendor_id: int
+    product_id: int
+    buttons: Mapping[Button, ReportMatch]
+    #: first byte of every report this remote sends, if it numbers its reports
+    report_id: int | None = None
+    debounce_ms: float = 30.0
+    enabled: bool = True
+    description: str = ""
+
+    @property
+    def usb_id(self) -> str:
+        """``vvvv:pppp`` in hex, the way ``lsusb`` prints it."""
+        return f"{self.vendor_id:04x}:{self.product_id:04x}"
+
+
+@dataclass(frozen=True)
+class KeyboardProfile:
+    """A remote that presents itself as a keyboard; ``keys`` maps Textual key names to buttons."""
+
+    name: str
+    keys: Mapping[str, Button]
+    enabled: bool = True
+    description: str = ""
+
+
+Profile = SerialProfile | HidProfile | KeyboardProfile
+
+
+@dataclass(frozen=True)
+class Profiles:
+    """All known profiles, in file order (built-in first, then the site's additions)."""
+
+    all: tuple[Profile, ...] = field(default_factory=tuple)
+
+    @property
+    def serial(self) -> list[SerialProfile]:
+        """Enabled serial profiles."""
+        return [p for p in self.all if isinstance(p, SerialProfile) and p.enabled]
+
+    @property
+    def hid(self) -> list[HidProfile]:
+        """Enabled HID profiles."""
+        return [p for p in self.all if isinstance(p, HidProfile) and p.enabled]
+
+    @property
+    def keyboard(self) -> list[KeyboardProfile]:
+        """Enabled keyboard-emulating profiles."""
+        return [p for p in self.all if isinstance(p, KeyboardProfile) and p.enabled]
+
+
+def load_profiles(user_path: str | Path | None = None) -> Profiles:
+    """Load the built-in profiles, apply the site's file ``user_path`` if given, and validate."""
+    merged: dict[str, dict[str, Any]] = {}
+    # which file each field of each profile came from, so an error names the right file
+    origin: dict[str, dict[str, Path]] = {}
+    for path in [BUILTIN_PROFILES] + ([Path(user_path)] if user_path is not None else []):
+        for raw in _read_file(path):
+            name = raw["name"]
+            merged.setdefault(name, {}).update(raw)
+            origin.setdefault(name, {}).update({key: path for key in raw})
+    profiles = tuple(_build(raw, origin[name]) for name, raw in merged.items())
+    _check_keyboard_clashes(profiles, origin)
+    return Profiles(profiles)
+
+
+def _read_file(path: Path) -> list[dict[str, Any]]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ProfileError(f"{path}: device profile file not found") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ProfileError(f"{path}: cannot read device profiles: {error}") from None
+    try:
+        document = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f", line {mark.line + 1}" if mark is not None else ""
+        problem = getattr(error, "problem", None) or str(error)
+        raise ProfileError(f"{path}{where}: not valid YAML: {problem}") from None
+    if document is None:
+        return []
+    if not isinstance(document, dict) or set(document) != {"profiles"}:
+        raise ProfileError(f"{path}: expected a mapping with one key, 'profiles', holding a list")
+    entries = document["profiles"] or []
+    if not isinstance(entries, list):
+        raise ProfileError(f"{path}: 'profiles' must be a list of profiles")
+    seen: set[str] = set()
+    for index, entry in enumerate(entries, start=1):
+        if not isinstance(entry, dict):
+            raise ProfileError(f"{path}: profile #{index} must be a mapping of fields")
+        name = entry.get("name")
+        if not isinstance(name, str) or not name.strip():
+            raise ProfileError(f"{path}: profile #{index}, field 'name': must be a non-empty text")
+        if name in seen:
+            raise ProfileError(f"{path}: profile {name!r}, field 'name': appears twice in this file")
+        seen.add(name)
+    return entries
+
+
+class _Fields:
+    """Reads one merged profile's fields, raising a ProfileError naming file, profile and field."""
+
+    def __init__(self, raw: dict[str, Any], origin: dict[str, Path]) -> None:
+        self.raw = raw
+        self.origin = origin
+        self.name = raw["name"]
+
+    def fail(self, key: str, problem: str, sub: str = "") -> ProfileError:
+        path = self.origin.get(key, self.origin["name"])
+        return ProfileError(f"{path}: profile {self.name!r}, field '{key}{sub}': {problem}")
+
+    def get(self, key: str, default: Any = ...) -> Any:
+        if key not in self.raw:
+            if default is ...:
+                raise self.fail(key, "is required")
+            return default
+        return self.raw[key]
+
+    def integer(self, key: str, default: Any = ..., low: int = 0, high: int | None = None) -> Any:
+        value = self.get(key, default)
+        if value is None and default is None:
+            return None
+        return self.check_int(key, value, low, high)
+
+    def check_int(self, key: str, value: Any, low: int, high: int | None, sub: str = "") -> int:
+        if isinstance(value, str):
+            try:
+                value = int(value, 0)  # "0x1209" as well as 4617
+            except ValueError:
+                pass
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.fail(key, f"must be a whole number, got {value!r}", sub)
+        if value < low or (high is not None and value > high):
+            bounds = f"from {low} to {high}" if high is not None else f"at least {low}"
+            raise self.fail(key, f"must be {bounds}, got {value}", sub)
+        return value
+
+    def text(self, key: str, default: Any = ...) -> str:
+        value = self.get(key, default)
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(key, f"must be a non-empty text, got {value!r}")
+        return value
+
+    def flag(self, key: str, default: bool) -> bool:
+        value = self.get(key, default)
+        if not isinstance(value, bool):
+            raise self.fail(key, f"must be true or false, got {value!r}")
+        return value
+
+    def mapping(self, key: str) -> dict[Any, Any]:
+        value = self.get(key)
+        if not isinstance(value, dict) or not value:
+            raise self.fail(key, "must be a non-empty mapping")
+        return value
+
+    def button(self, key: str, value: Any, sub: str) -> Button:
+        try:
+            return parse_button(value)
+        except ValueError as error:
+            raise self.fail(key, str(error), sub) from None
+
+
+def _build(raw: dict[str, Any], origin: dict[str, Path]) -> Profile:
+    fields = _Fields(raw, origin)
+    kind = fields.get("kind")
+    if kind not in KINDS:
+        raise fields.fail("kind", f"must be one of {', '.join(KINDS)}, got {kind!r}")
+    unknown = sorted(set(raw) - _FIELDS[kind], key=str)
+    if unknown:
+        allowed = ", ".join(sorted(_FIELDS[kind]))
+        raise fields.fail(str(unknown[0]), f"is not a field of a {kind} profile (fields: {allowed})")
+    common = {
+        "name": fields.name,
+        "enabled": fields.flag("enabled", True),
+        "description": fields.get("description", ""),
+    }
+    if not isinstance(common["description"], str):
+        raise fields.fail("description", "must be text")
+    if kind == "serial":
+        return _build_serial(fields, common)
+    if kind == "hid":
+        return _build_hid(fields, common)
+    return _build_keyboard(fields, common)
+
+
+def _build_serial(fields: _Fields, common: dict[str, Any]) -> SerialProfile:
+    max_line = fields.integer("max_line", 64, low=1, high=4096)
+    lines: dict[str, Button] = {}
+    for text, value in fields.mapping("lines").items():
+        sub = f".{text}"
+        if not isinstance(text, str) or not text.strip():
+            raise fields.fail("lines", "each line must be a non-empty text", sub)
+        if text != text.strip(" \t\r") or "\n" in text:
+            raise fields.fail("lines", "a line may not start or end with spaces or hold a newline", sub)
+        if len(text.encode("utf-8")) > max_line:
+            raise fields.fail("lines", f"is longer than max_line ({max_line} bytes)", sub)
+        lines[text] = fields.button("lines", value, sub)
+    return SerialProfile(
+        port=fields.text("port"),
+        baud=fields.integer("baud", 9600, low=1),
+        lines=lines,
+        max_line=max_line,
+        **common,
+    )
+
+
+def _build_hid(fields: _Fields, common: dict[str, Any]) -> HidProfile:
+    buttons: dict[Button, ReportMatch] = {}
+    for key, spec in fields.mapping("buttons").items():
+        sub = f".{key}"
+        button = fields.button("buttons", key, sub)
+        if button in buttons:
+            raise fields.fail("buttons", "names the same button twice", sub)
+        if not isinstance(spec, dict) or not {"byte"} <= set(spec) <= {"byte", "mask", "value"} \
+                or len(spec) != 2:
+            raise fields.fail("buttons", "must be {byte: N, mask: M} or {byte: N, value: V}", sub)
+        byte = fields.check_int("buttons", spec["byte"], 0, 63, f"{sub}.byte")
+        kind = "mask" if "mask" in spec else "value"
+        number = fields.check_int("buttons", spec[kind], 1 if kind == "mask" else 0, 255, f"{sub}.{kind}")
+        buttons[button] = ReportMatch(byte=byte, **{kind: number})
+    debounce = fields.get("debounce_ms", 30)
+    if isinstance(debounce, bool) or not isinstance(debounce, int | float) or debounce < 0:
+        raise fields.fail("debounce_ms", f"must be a number of milliseconds, 0 or more, got {debounce!r}")
+    return HidProfile(
+        vendor_id=fields.integer("vendor_id", high=0xFFFF),
+        product_id=fields.integer("product_id", high=0xFFFF),
+        report_id=fields.integer("report_id", None, high=255),
+        debounce_ms=float(debounce),
+        buttons=buttons,
+        **common,
+    )
+
+
+def _build_keyboard(fields: _Fields, common: dict[str, Any]) -> KeyboardProfile:
+    keys: dict[str, Button] = {}
+    for key, value in fields.mapping("keys").items():
+        sub = f".{key}"
+        if not isinstance(key, str) or not key.strip():
+            raise fields.fail("keys", "each key must be a Textual key name such as 'f13' or 'pageup'", sub)
+        if key.lower() in KIOSK_KEYS:
+            raise fields.fail("keys", f"key {key!r} is one of the kiosk's own keys "
+                              f"({', '.join(sorted(KIOSK_KEYS))}); pick another", sub)
+        keys[key] = fields.button("keys", value, sub)
+    return KeyboardProfile(keys=keys, **common)
+
+
+def _check_keyboard_clashes(profiles: tuple[Profile, ...], origin: dict[str, dict[str, Path]]) -> None:
+    """Two enabled keyboard remotes may not give one key two meanings."""
+    owner: dict[str, tuple[KeyboardProfile, Button]] = {}
+    for profile in profiles:
+        if not (isinstance(profile, KeyboardProfile) and profile.enabled):
+            continue
+        for key, button in profile.keys.items():
+            if key in owner and owner[key][1] != button:
+                other, theirs = owner[key]
+                raise ProfileError(
+                    f"{origin[profile.name]['keys']}: profile {profile.name!r}, field 'keys.{key}': "
+                    f"means {button_name(button)!r} here but {button_name(theirs)!r} in enabled "
+                    f"profile {other.name!r}"
+                )
+            owner[key] = (profile, button)
