@@ -1,0 +1,242 @@
+"""What the patient said → an answer option or a command, in English, Spanish or French.
+
+The vocabulary for one question is the question's option labels and voice synonyms, numbers and
+ordinals up to the number of options ("two", "number two", "the second", "la dos", "deux",
+"option 2"), and the kiosk's commands (repeat, pause, continue, call the doctor, louder,
+quieter). Matching ignores case and accents. Anything else -- an unsure recognition, a word
+that fits two options, noise the recogniser turned into "[unk]" -- is *no match* with a reason:
+speech noise is never an answer.
+
+:meth:`Matcher.phrases` lists every phrase the matcher understands, and is what
+:mod:`kiosk.speech.grammar` turns into a recogniser grammar, so the recogniser can only ever
+hear things the matcher knows.
+"""
+
+from __future__ import annotations
+
+import re
+import unicodedata
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from kiosk.channels import Command
+
+LANGUAGES = ("en", "es", "fr")
+
+#: below this recogniser confidence an utterance is not an answer (see asr.py for the scale)
+DEFAULT_MIN_CONFIDENCE = 0.6
+
+#: cardinal words per language, 1..10; the first form of each is the one put in grammars first
+CARDINALS: dict[str, list[tuple[str, ...]]] = {
+    "en": [("one",), ("two",), ("three",), ("four",), ("five",), ("six",), ("seven",),
+           ("eight",), ("nine",), ("ten",)],
+    "es": [("uno", "una", "un"), ("dos",), ("tres",), ("cuatro",), ("cinco",), ("seis",),
+           ("siete",), ("ocho",), ("nueve",), ("diez",)],
+    "fr": [("un", "une"), ("deux",), ("trois",), ("quatre",), ("cinq",), ("six",), ("sept",),
+           ("huit",), ("neuf",), ("dix",)],
+}
+
+#: ordinal words per language, 1st..10th
+ORDINALS: dict[str, list[tuple[str, ...]]] = {
+    "en": [("first",), ("second",), ("third",), ("fourth",), ("fifth",), ("sixth",),
+           ("seventh",), ("eighth",), ("ninth",), ("tenth",)],
+    "es": [("primero", "primera", "primer"), ("segundo", "segunda"),
+           ("tercero", "tercera", "tercer"), ("cuarto", "cuarta"), ("quinto", "quinta"),
+           ("sexto", "sexta"), ("séptimo", "séptima"), ("octavo", "octava"),
+           ("noveno", "novena"), ("décimo", "décima")],
+    "fr": [("premier", "première"), ("deuxième", "second", "seconde"), ("troisième",),
+           ("quatrième",), ("cinquième",), ("sixième",), ("septième",), ("huitième",),
+           ("neuvième",), ("dixième",)],
+}
+
+#: how a number is said around the number word: "{n}" is a cardinal, "{o}" an ordinal
+NUMBER_FORMS: dict[str, tuple[str, ...]] = {
+    "en": ("{n}", "number {n}", "option {n}", "{o}", "the {o}", "the {o} one"),
+    "es": ("{n}", "la {n}", "el {n}", "número {n}", "opción {n}", "la {o}", "el {o}", "{o}"),
+    "fr": ("{n}", "le {n}", "numéro {n}", "option {n}", "le {o}", "la {o}", "{o}"),
+}
+
+#: words that may surround a number without changing it ("it's number two please")
+NUMBER_FILLERS: dict[str, frozenset[str]] = {
+    "en": frozenset("number option answer the it its is it's i say please um uh er".split()),
+    "es": frozenset("la el numero opcion respuesta es por favor eh pues".split()),
+    "fr": frozenset("le la l numero option reponse c est s il vous plait euh".split()),
+}
+
+#: spoken commands per language (accents as spoken; matching ignores them)
+COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
+    "en": {
+        Command.REPEAT: ("repeat", "repeat that", "say again", "say that again", "pardon", "again"),
+        Command.PAUSE: ("pause", "wait", "stop"),
+        Command.RESUME: ("continue", "resume", "go on"),
+        Command.CALL_DOCTOR: ("call the doctor", "doctor", "call the nurse", "nurse"),
+        Command.VOLUME_UP: ("louder", "speak up", "volume up"),
+        Command.VOLUME_DOWN: ("quieter", "softer", "volume down"),
+    },
+    "es": {
+        Command.REPEAT: ("repite", "repita", "repetir", "otra vez", "cómo"),
+        Command.PAUSE: ("pausa", "espera", "espere"),
+        Command.RESUME: ("continuar", "continúa", "continúe", "sigue", "siga", "seguir"),
+        Command.CALL_DOCTOR: ("llama al médico", "llame al médico", "médico", "doctor",
+                              "enfermera"),
+        Command.VOLUME_UP: ("más alto", "sube el volumen", "suba el volumen"),
+        Command.VOLUME_DOWN: ("más bajo", "baja el volumen", "baje el volumen"),
+    },
+    "fr": {
+        Command.REPEAT: ("répète", "répétez", "répéter", "encore", "pardon", "comment"),
+        Command.PAUSE: ("pause", "attendez", "attends"),
+        Command.RESUME: ("continue", "continuez", "continuer", "reprenez", "reprendre"),
+        Command.CALL_DOCTOR: ("appelez le médecin", "appelle le médecin", "médecin", "docteur",
+                              "infirmière"),
+        Command.VOLUME_UP: ("plus fort", "montez le son", "monte le son"),
+        Command.VOLUME_DOWN: ("moins fort", "plus bas", "baissez le son", "baisse le son"),
+    },
+}
+
+#: what recognisers emit for sounds outside their grammar
+UNKNOWN_TOKENS = frozenset({"[unk]", "<unk>"})
+
+
+def normalise(text: str) -> str:
+    """Lower-case, accents removed, punctuation to spaces, single spaces ("¿Número dos?" → "numero dos")."""
+    decomposed = unicodedata.normalize("NFKD", text.casefold())
+    plain = "".join(c for c in decomposed if not unicodedata.combining(c))
+    return " ".join(re.sub(r"[^\w\[\]]+", " ", plain).split())
+
+
+def spoken_label(label: str) -> str:
+    """The part of an option label a patient would say: without its parenthesised detail.
+
+    "independent (bath or shower, unsupervised)" → "independent".
+    """
+    return " ".join(re.sub(r"\([^)]*\)", " ", label).split()).strip(" ,;:.")
+
+
+@dataclass(frozen=True)
+class OptionWords:
+    """What may be said to choose one answer option, in one language."""
+
+    label: str
+    synonyms: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Match:
+    """The outcome of matching one utterance: an option, a command, or neither and why."""
+
+    option: int | None = None
+    command: Command | None = None
+    #: why there is no match (empty when there is one)
+    reason: str = ""
+
+    @property
+    def matched(self) -> bool:
+        """Whether the utterance was an answer or a command."""
+        return self.option is not None or self.command is not None
+
+
+def _tokens(phrase: str) -> tuple[str, ...]:
+    return tuple(normalise(phrase).split())
+
+
+def _find(needle: tuple[str, ...], haystack: tuple[str, ...]) -> int:
+    """Start of ``needle`` as a run of whole words in ``haystack``, or -1."""
+    n = len(needle)
+    return next((i for i in range(len(haystack) - n + 1) if haystack[i:i + n] == needle), -1)
+
+
+class Matcher:
+    """Matches utterances against one question's options in one language."""
+
+    def __init__(
+        self,
+        options: Sequence[OptionWords],
+        language: str,
+        min_confidence: float = DEFAULT_MIN_CONFIDENCE,
+    ) -> None:
+        if language not in LANGUAGES:
+            raise ValueError(f"no speech vocabulary for language {language!r} (have {', '.join(LANGUAGES)})")
+        if not 1 <= len(options) <= len(CARDINALS[language]):
+            raise ValueError(f"a question needs 1 to {len(CARDINALS[language])} options, got {len(options)}")
+        self.options = tuple(options)
+        self.language = language
+        self.min_confidence = min_confidence
+        #: phrase tokens → what it selects; options first, so a clash is detected, not hidden
+        self._targets: dict[tuple[str, ...], set[int | Command]] = {}
+        for number, option in enumerate(self.options, start=1):
+            for phrase in (spoken_label(option.label), *option.synonyms):
+                if _tokens(phrase):
+                    self._targets.setdefault(_tokens(phrase), set()).add(number)
+        for command, phrases in COMMAND_PHRASES[language].items():
+            for phrase in phrases:
+                self._targets.setdefault(_tokens(phrase), set()).add(command)
+        self._numbers: dict[str, int] = {}
+        for table in (CARDINALS, ORDINALS):
+            for number, words in enumerate(table[language][: len(self.options)], start=1):
+                for word in words:
+                    self._numbers[normalise(word)] = number
+        self._numbers.update({str(n): n for n in range(1, len(self.options) + 1)})
+        self._all_numbers = {normalise(word): number
+                             for table in (CARDINALS, ORDINALS)
+                             for number, words in enumerate(table[language], start=1)
+                             for word in words}
+
+    def phrases(self) -> list[str]:
+        """Every phrase this matcher understands, as written (accents kept), without repeats.
+
+        Option labels and synonyms, every number form up to the number of options, and the
+        commands; this is the recogniser's grammar for the question.
+        """
+        out: list[str] = []
+        for option in self.options:
+            out += [spoken_label(option.label), *option.synonyms]
+        forms = NUMBER_FORMS[self.language]
+        for number in range(len(self.options)):
+            for form in forms:
+                words = CARDINALS[self.language][number] if "{n}" in form else ORDINALS[self.language][number]
+                out += [form.format(n=w, o=w) for w in words]
+        for phrases in COMMAND_PHRASES[self.language].values():
+            out += phrases
+        seen: set[str] = set()
+        return [p for p in out if p and not (normalise(p) in seen or seen.add(normalise(p)))]
+
+    def _number(self, tokens: tuple[str, ...]) -> int | None:
+        rest = [t for t in tokens if t not in NUMBER_FILLERS[self.language]]
+        if self.language == "en" and len(rest) == 2 and rest[1] == "one" and rest[0] in self._numbers:
+            rest = rest[:1]  # "the second one"
+        if len(rest) == 1 and rest[0] in self._numbers:
+            return self._numbers[rest[0]]
+        if len(rest) == 1 and rest[0] in self._all_numbers:
+            return -self._all_numbers[rest[0]]  # a number, but not one of this question's
+        return None
+
+    def match(self, utterance: str, confidence: float | None = None) -> Match:
+        """Match one recognised utterance; ``confidence`` is the recogniser's, if it has one."""
+        if confidence is not None and confidence < self.min_confidence:
+            return Match(reason=f"unsure recognition of {utterance!r} "
+                                f"(confidence {confidence:.2f} < {self.min_confidence:.2f})")
+        tokens = tuple(t for t in normalise(utterance).split() if t not in UNKNOWN_TOKENS)
+        if not tokens:
+            return Match(reason="nothing recognisable was said")
+        number = self._number(tokens)
+        if number is not None and number < 0:
+            return Match(reason=f"there is no option {-number} on this question ({len(self.options)} options)")
+        if number is not None:
+            return Match(option=number)
+        spans = []  # (start, end, targets) of every known phrase heard
+        for phrase, targets in self._targets.items():
+            start = _find(phrase, tokens)
+            if start >= 0:
+                spans.append((start, start + len(phrase), targets))
+        # a phrase heard inside a longer one ("help" in "minor help") does not count on its own
+        spans = [s for s in spans
+                 if not any(o is not s and o[0] <= s[0] and s[1] <= o[1] and o[1] - o[0] > s[1] - s[0]
+                            for o in spans)]
+        found: set[int | Command] = set().union(*(t for *_, t in spans)) if spans else set()
+        if not found:
+            return Match(reason=f"{utterance!r} is not an answer or a command here")
+        if len(found) > 1:
+            names = ", ".join(sorted(f"option {t}" if isinstance(t, int) else t.value for t in found))
+            return Match(reason=f"{utterance!r} is ambiguous ({names})")
+        (target,) = found
+        return Match(command=target) if isinstance(target, Command) else Match(option=target)
