@@ -1,1 +1,50 @@
-"""In-process RoQME QoS engine."""
+"""In-process RoQME QoS engine.
+
+Load a model, feed an :class:`Engine` batches of context updates, read the property metrics::
+
+    from qos import load_model, Engine
+    engine = Engine(load_model("clarc"))
+    result = engine.update(10, set={"PersonDetected": True})
+    result.metrics, result.fired
+
+Context traces (recorded sessions, hand-written scenarios) are loaded with :func:`load_trace` and
+replayed with :func:`replay`, or from the shell with ``python -m qos replay TRACE``.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from qos.engine import Engine, UpdateResult
+from qos.errors import ContextError, ModelError, QosError, TraceError
+from qos.model import Context, EnumType, Model, Observation, Property
+from qos.parser import load_model_file, parse_model
+from qos.trace import Trace, TraceEvent, TraceRecorder, dump_trace, load_trace, replay
+
+__all__ = [
+    "Context", "ContextError", "Engine", "EnumType", "Model", "ModelError", "Observation", "Property",
+    "QosError", "Trace", "TraceError", "TraceEvent", "TraceRecorder", "UpdateResult", "bundled_models",
+    "dump_trace", "load_model", "load_trace", "parse_model", "replay",
+]
+
+
+def bundled_models() -> list[str]:
+    """Names of the models shipped inside the package (``qos/models/NAME.roqme``)."""
+    folder = resources.files("qos") / "models"
+    return sorted(entry.name[: -len(".roqme")] for entry in folder.iterdir() if entry.name.endswith(".roqme"))
+
+
+def load_model(name_or_path: str | Path) -> Model:
+    """Load a bundled model by name (``"clarc"``) or a ``.roqme`` file by path.
+
+    Raises :class:`ModelError` with file, line and column when the model is malformed.
+    """
+    text = str(name_or_path)
+    if isinstance(name_or_path, Path) or text.endswith(".roqme") or "/" in text or "\\" in text:
+        return load_model_file(name_or_path)
+    if text not in bundled_models():
+        raise ModelError(f"no bundled model named {text!r} (bundled: {', '.join(bundled_models())}); "
+                         "give a path to a .roqme file instead")
+    resource = resources.files("qos") / "models" / f"{text}.roqme"
+    return parse_model(resource.read_text(encoding="utf-8"), f"{text}.roqme")

@@ -1,0 +1,283 @@
+"""Context traces: what a session told the QoS engine, with times (see the trace format doc).
+
+A trace is YAML or JSON::
+
+    model: clarc
+    events:
+      - {t: 10, set: {PersonDetected: true}}
+      - {t: 260, emit: [CallingDoctor]}
+
+Events with the same ``t`` form one batch. :func:`load_trace` checks everything (structure, times,
+context names, types, enum literals) against the model before anything is replayed, and names the
+file and the event index of the first problem.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import statistics
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from qos.engine import Engine, UpdateResult, check_batch
+from qos.errors import ContextError, TraceError
+from qos.model import Model
+
+_EVENT_KEYS = ("t", "set", "emit")
+_TRACE_KEYS = ("model", "events", "description")
+
+
+@dataclass
+class TraceEvent:
+    """One entry of a trace: at time ``t`` (seconds), set these contexts and emit these eventtypes."""
+
+    t: float
+    set: dict[str, object] = field(default_factory=dict)
+    emit: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, object]:
+        """The event as it is written in a trace file (empty ``set``/``emit`` left out)."""
+        data: dict[str, object] = {"t": self.t}
+        if self.set:
+            data["set"] = dict(self.set)
+        if self.emit:
+            data["emit"] = list(self.emit)
+        return data
+
+
+@dataclass
+class Trace:
+    """A context trace: the model it was recorded with and its events (in file order)."""
+
+    #: a bundled model name or a path to a .roqme file (relative to the trace's folder)
+    model: str
+    events: list[TraceEvent] = field(default_factory=list)
+    description: str | None = None
+    #: the file it was loaded from, for messages and relative model paths
+    source: Path | None = None
+
+    @property
+    def name(self) -> str:
+        """How messages name this trace."""
+        return str(self.source) if self.source is not None else "<trace>"
+
+    def load_model(self) -> Model:
+        """Load the trace's model (a bundled name, or a path relative to the trace's folder)."""
+        from qos import load_model  # the package function, which knows the bundled models
+
+        model = self.model
+        if self.source is not None and (model.endswith(".roqme") or "/" in model):
+            model = str(self.source.parent / model)
+        return load_model(model)
+
+    def check(self, model: Model | None = None) -> Model:
+        """Validate every event against the model; raise :class:`TraceError` on the first problem."""
+        model = model or self.load_model()
+        setters: dict[tuple[float, str], int] = {}
+        for index, event in enumerate(self.events):
+            where = f"{self.name}: events[{index}]"
+            try:
+                check_batch(model, event.set, event.emit)
+            except ContextError as exc:
+                raise TraceError(f"{where}: {exc}") from None
+            for context in event.set:
+                first = setters.setdefault((float(event.t), context), index)
+                if first != index:
+                    raise TraceError(f"{where}: events[{first}] already sets {context} at t={event.t}; "
+                                     "one batch can set a context only once")
+        return model
+
+    def batches(self) -> list[tuple[float, dict[str, object], list[str]]]:
+        """The events merged into batches of equal time, in time order (a stable sort)."""
+        merged: dict[float, tuple[float, dict[str, object], list[str]]] = {}
+        for event in sorted(self.events, key=lambda e: float(e.t)):
+            t, values, emitted = merged.setdefault(float(event.t), (event.t, {}, []))
+            values.update(event.set)
+            emitted.extend(name for name in event.emit if name not in emitted)
+        return list(merged.values())
+
+    def to_dict(self) -> dict[str, object]:
+        """The trace as plain data (what :func:`load_trace` reads)."""
+        data: dict[str, object] = {"model": self.model}
+        if self.description:
+            data["description"] = self.description
+        data["events"] = [event.to_dict() for event in self.events]
+        return data
+
+    def to_yaml(self, header: str | None = None) -> str:
+        """The trace as YAML, one event per line; ``header`` becomes leading ``#`` comment lines."""
+        lines = [f"# {line}".rstrip() for line in header.splitlines()] if header else []
+        lines.append(f"model: {_flow(self.model)}")
+        if self.description:
+            lines.append(f"description: {_flow(self.description)}")
+        lines.append("events:" if self.events else "events: []")
+        lines += [f"  - {_flow(event.to_dict())}" for event in self.events]
+        return "\n".join(lines) + "\n"
+
+    def to_json(self) -> str:
+        """The trace as JSON."""
+        return json.dumps(self.to_dict(), indent=1)
+
+
+def _flow(value: object) -> str:
+    return yaml.safe_dump(value, default_flow_style=True, sort_keys=False, width=math.inf,
+                          allow_unicode=True).strip().removesuffix("...").strip()
+
+
+def dump_trace(trace: Trace, path: str | Path, header: str | None = None) -> None:
+    """Write a trace to a file (JSON when the name ends in .json, else YAML), readable by its owner only."""
+    path = Path(path)
+    text = trace.to_json() + "\n" if path.suffix == ".json" else trace.to_yaml(header)
+    descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(descriptor, "w", encoding="utf-8") as handle:
+        handle.write(text)
+
+
+def _parse_event(raw: object, where: str) -> TraceEvent:
+    if not isinstance(raw, Mapping):
+        raise TraceError(f"{where}: an event must be a mapping with t and set and/or emit, not {raw!r}")
+    unknown = [key for key in raw if key not in _EVENT_KEYS]
+    if unknown:
+        raise TraceError(f"{where}: unknown key {unknown[0]!r} (an event has t, set and emit)")
+    if "t" not in raw:
+        raise TraceError(f"{where}: missing time 't'")
+    t = raw["t"]
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        raise TraceError(f"{where}: time t must be a number of seconds, not {t!r}")
+    if t < 0:
+        raise TraceError(f"{where}: time t must not be negative, got {t!r}")
+    if "set" not in raw and "emit" not in raw:
+        raise TraceError(f"{where}: an event needs 'set' or 'emit'")
+    values = raw.get("set") or {}
+    if not isinstance(values, Mapping):
+        raise TraceError(f"{where}: 'set' must map context names to values, not {values!r}")
+    emitted = raw.get("emit") or []
+    if not isinstance(emitted, list) or not all(isinstance(name, str) for name in emitted):
+        raise TraceError(f"{where}: 'emit' must be a list of eventtype names, not {emitted!r}")
+    return TraceEvent(t, dict(values), list(emitted))
+
+
+def trace_from_data(data: object, source: Path | None = None) -> Trace:
+    """Build a trace from parsed YAML/JSON, checking its structure (not yet its contexts)."""
+    name = str(source) if source is not None else "<trace>"
+    if not isinstance(data, Mapping):
+        raise TraceError(f"{name}: a trace must be a mapping with 'model' and 'events'")
+    unknown = [key for key in data if key not in _TRACE_KEYS]
+    if unknown:
+        raise TraceError(f"{name}: unknown key {unknown[0]!r} (a trace has model, events and description)")
+    model = data.get("model")
+    if not isinstance(model, str) or not model:
+        raise TraceError(f"{name}: 'model' must name a bundled model or a .roqme file, not {model!r}")
+    events = data.get("events")
+    if not isinstance(events, list):
+        raise TraceError(f"{name}: 'events' must be a list, not {events!r}")
+    description = data.get("description")
+    if description is not None and not isinstance(description, str):
+        raise TraceError(f"{name}: 'description' must be text")
+    parsed = [_parse_event(raw, f"{name}: events[{index}]") for index, raw in enumerate(events)]
+    return Trace(model, parsed, description, source)
+
+
+def load_trace(path: str | Path) -> Trace:
+    """Read a YAML or JSON trace and check it against its model.
+
+    Raises :class:`TraceError` naming the file and the event index of the first problem
+    (or :class:`~qos.errors.ModelError` when the model itself is malformed).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise TraceError(f"{path}: cannot read the trace ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise TraceError(f"{path}: the trace is not UTF-8 text (byte {exc.start})") from None
+    if path.suffix == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise TraceError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+    else:
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+            problem = getattr(exc, "problem", None) or "malformed"
+            raise TraceError(f"{where}: invalid YAML: {problem}") from None
+    trace = trace_from_data(data, path)
+    trace.check()
+    return trace
+
+
+class TraceRecorder:
+    """Records every batch an engine applies, as a trace that :func:`replay` reproduces.
+
+    Replay merges events of equal time into one batch, so a caller that wants a faithful recording
+    publishes one batch per instant.
+    """
+
+    def __init__(self, engine: Engine, model: str):
+        self.model = model
+        self.events: list[TraceEvent] = []
+        self._unsubscribe = engine.subscribe(self._record)
+
+    def _record(self, result: UpdateResult) -> None:
+        t = int(result.t) if float(result.t).is_integer() else result.t
+        self.events.append(TraceEvent(t, dict(result.set), list(result.emit)))
+
+    @property
+    def trace(self) -> Trace:
+        """The trace recorded so far."""
+        return Trace(self.model, list(self.events))
+
+    def stop(self) -> None:
+        """Stop recording (the recorded events stay available)."""
+        self._unsubscribe()
+
+
+def _statistics(samples: list[float]) -> dict[str, float]:
+    return {
+        "min": min(samples),
+        "max": max(samples),
+        "avg": statistics.fmean(samples),
+        "sd": statistics.pstdev(samples),
+        "last": samples[-1],
+    }
+
+
+def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> dict:
+    """Replay a trace through a fresh engine and summarise it as trace-format.md specifies.
+
+    Returns ``{"metrics": {property: {min, max, avg, sd, last}}, "fired": [{t, observations}]}``:
+    statistics over samples at t = 0, period, 2·period, … up to the last event's time, each taken
+    after the events at times ≤ t; one ``fired`` entry per batch that fired something.
+    """
+    if isinstance(sample_period, bool) or not isinstance(sample_period, (int, float)) \
+            or not math.isfinite(sample_period) or sample_period <= 0:
+        raise ValueError(f"the sample period must be a positive number of seconds, not {sample_period!r}")
+    if not isinstance(trace, Trace):
+        trace = load_trace(trace)
+    model = trace.check(model)
+    engine = Engine(model)
+    batches = trace.batches()
+    last_t = float(batches[-1][0]) if batches else 0.0
+    count = math.floor(last_t / sample_period + 1e-9) + 1
+    samples: dict[str, list[float]] = {name: [] for name in model.properties}
+    fired: list[dict[str, object]] = []
+    upcoming = 0
+    for k in range(count):
+        now = k * sample_period
+        while upcoming < len(batches) and float(batches[upcoming][0]) <= now + 1e-9:
+            t, values, emitted = batches[upcoming]
+            result = engine.update(float(t), set=values, emit=emitted)
+            if result.fired:
+                fired.append({"t": t, "observations": result.fired})
+            upcoming += 1
+        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
+            samples[name].append(value)
+    return {"metrics": {name: _statistics(values) for name, values in samples.items()}, "fired": fired}
