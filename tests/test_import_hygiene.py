@@ -10,7 +10,7 @@ import sys
 import qos
 
 #: the pure-Python parts of the kiosk (imported by module name; missing ones are an error)
-PURE_KIOSK_MODULES = ["kiosk.channels", "kiosk.cli"]
+PURE_KIOSK_MODULES = ["kiosk.channels", "kiosk.cli", "kiosk.clock", "kiosk.questionnaire", "kiosk.session"]
 
 
 def _modules_of(package) -> list[str]:
