@@ -20,12 +20,14 @@ from qos.engine import Engine, UpdateResult
 from qos.errors import ContextError, ModelError, QosError, TraceError
 from qos.model import Context, EnumType, Model, Observation, Property
 from qos.parser import load_model_file, parse_model
-from qos.trace import Trace, TraceEvent, TraceRecorder, dump_trace, load_trace, replay
+from qos.trace import (
+    ReplaySamples, Trace, TraceEvent, TraceRecorder, dump_trace, load_trace, replay, sample_trace,
+)
 
 __all__ = [
     "Context", "ContextError", "Engine", "EnumType", "Model", "ModelError", "Observation", "Property",
-    "QosError", "Trace", "TraceError", "TraceEvent", "TraceRecorder", "UpdateResult", "bundled_models",
-    "dump_trace", "load_model", "load_trace", "parse_model", "replay",
+    "QosError", "ReplaySamples", "Trace", "TraceError", "TraceEvent", "TraceRecorder", "UpdateResult", "bundled_models",
+    "dump_trace", "load_model", "load_trace", "parse_model", "replay", "sample_trace",
 ]
 
 

@@ -250,12 +250,24 @@ def _statistics(samples: list[float]) -> dict[str, float]:
     }
 
 
-def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> dict:
-    """Replay a trace through a fresh engine and summarise it as trace-format.md specifies.
+@dataclass
+class ReplaySamples:
+    """A replayed trace: every property sampled over time, and what fired in which batch."""
 
-    Returns ``{"metrics": {property: {min, max, avg, sd, last}}, "fired": [{t, observations}]}``:
-    statistics over samples at t = 0, period, 2·period, … up to the last event's time, each taken
-    after the events at times ≤ t; one ``fired`` entry per batch that fired something.
+    times: list[float]
+    #: property name -> metric at each of ``times``
+    series: dict[str, list[float]]
+    #: one entry per batch that fired something: {"t": time as in the trace, "observations": [...]}
+    fired: list[dict[str, object]]
+
+
+def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
+                 model: Model | None = None) -> ReplaySamples:
+    """Replay a trace through a fresh engine, sampling every property.
+
+    Samples are taken at t = 0, period, 2·period, … up to and including the last event's time, each
+    after the events at times ≤ t. Raises :class:`TraceError` (or ModelError) before replaying
+    anything when the trace or its model is bad.
     """
     if isinstance(sample_period, bool) or not isinstance(sample_period, (int, float)) \
             or not math.isfinite(sample_period) or sample_period <= 0:
@@ -267,17 +279,33 @@ def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model |
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
-    samples: dict[str, list[float]] = {name: [] for name in model.properties}
-    fired: list[dict[str, object]] = []
+    samples = ReplaySamples([], {name: [] for name in model.properties}, [])
     upcoming = 0
     for k in range(count):
         now = k * sample_period
+        # a small tolerance so that samples at k·0.1 s still see the events written at that time
         while upcoming < len(batches) and float(batches[upcoming][0]) <= now + 1e-9:
             t, values, emitted = batches[upcoming]
             result = engine.update(float(t), set=values, emit=emitted)
             if result.fired:
-                fired.append({"t": t, "observations": result.fired})
+                samples.fired.append({"t": t, "observations": result.fired})
             upcoming += 1
+        samples.times.append(now)
         for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
-            samples[name].append(value)
-    return {"metrics": {name: _statistics(values) for name, values in samples.items()}, "fired": fired}
+            samples.series[name].append(value)
+    return samples
+
+
+def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> dict:
+    """Replay a trace and summarise it as trace-format.md specifies.
+
+    Returns ``{"metrics": {property: {min, max, avg, sd, last}}, "fired": [{t, observations}]}``
+    (``sd`` is the population standard deviation); see :func:`sample_trace` for the sampling.
+    """
+    return summarise(sample_trace(trace, sample_period, model))
+
+
+def summarise(samples: ReplaySamples) -> dict:
+    """The replay result of trace-format.md from a replay's samples."""
+    return {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
+            "fired": samples.fired}

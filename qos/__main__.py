@@ -1,0 +1,7 @@
+"""``python -m qos replay TRACE [--json] [--sample-period S] [--plot FILE.png]``."""
+
+import sys
+
+from qos.cli import main
+
+sys.exit(main())

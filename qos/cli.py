@@ -1,0 +1,103 @@
+"""``python -m qos replay TRACE`` (also ``kiosk qos replay``): replay a context trace, print the figures."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from qos.errors import QosError
+from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, not {text}")
+    return value
+
+
+def build_parser(prog: str, epilog: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the replay tool (``prog`` names it in usage lines)."""
+    parser = argparse.ArgumentParser(prog=prog, description="QoS engine tools.", epilog=epilog)
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    replay = commands.add_parser("replay", help="replay a context trace and print the metrics",
+                                 description="Replay a context trace (YAML or JSON) through its model and "
+                                             "print min/max/avg/sd/last of every property and the "
+                                             "observations fired over time.")
+    replay.add_argument("trace", type=Path, metavar="TRACE", help="the trace file (.yaml, .yml or .json)")
+    replay.add_argument("--json", action="store_true", help="print one JSON object (trace-format.md)")
+    replay.add_argument("--sample-period", type=_positive_seconds, default=1.0, metavar="S",
+                        help="seconds between metric samples (default 1)")
+    replay.add_argument("--plot", type=Path, metavar="FILE.png", help="also draw the metrics over time")
+    return parser
+
+
+def format_table(result: dict) -> str:
+    """The replay result for people: a statistics table, then the observations over time."""
+    metrics = result["metrics"]
+    width = max(len("property"), *(len(name) for name in metrics))
+    lines = [f"{'property':<{width}}  " + "  ".join(f"{column:>6}" for column in ("min", "max", "avg", "sd", "last"))]
+    for name, stats in metrics.items():
+        lines.append(f"{name:<{width}}  " + "  ".join(f"{stats[key]:6.4f}" for key in ("min", "max", "avg", "sd", "last")))
+    lines += ["", "fired observations:" if result["fired"] else "no observation fired"]
+    for entry in result["fired"]:
+        lines.append(f"  t={entry['t']:>8g} s  {' '.join(entry['observations'])}")
+    return "\n".join(lines)
+
+
+def plot(samples: ReplaySamples, path: Path, title: str) -> None:
+    """Draw every property over time into a PNG (matplotlib, imported only when asked for)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import pyplot
+
+    figure, axes = pyplot.subplots(figsize=(10, 5), dpi=100)
+    for name, values in samples.series.items():
+        axes.plot(samples.times, values, label=name, linewidth=1.8)
+    for entry in samples.fired:
+        axes.axvline(float(entry["t"]), color="0.85", linewidth=0.8, zorder=0)
+    axes.set_xlabel("time since the session started (s)")
+    axes.set_ylabel("metric")
+    axes.set_ylim(-0.02, 1.02)
+    axes.set_title(title)
+    axes.grid(True, axis="y", alpha=0.3)
+    axes.legend(loc="best")
+    figure.tight_layout()
+    try:
+        figure.savefig(path, format="png")
+    finally:
+        pyplot.close(figure)
+
+
+def main(argv: Sequence[str] | None = None, prog: str = "python -m qos", epilog: str | None = None) -> int:
+    """Run the tool; returns 0, or 2 after one line on stderr for a bad trace, model or plot path."""
+    args = build_parser(prog, epilog).parse_args(list(sys.argv[1:] if argv is None else argv))
+    try:
+        trace = load_trace(args.trace)
+        samples = sample_trace(trace, args.sample_period)
+    except QosError as exc:
+        print(f"{prog} replay: {exc}", file=sys.stderr)
+        return 2
+    result = summarise(samples)
+    if args.plot is not None:
+        try:
+            plot(samples, args.plot, trace.description or args.trace.name)
+        except OSError as exc:
+            print(f"{prog} replay: cannot write the plot {args.plot}: {exc.strerror or exc}", file=sys.stderr)
+            return 2
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"{trace.description or args.trace.name}\nmodel: {trace.model}\n")
+        print(format_table(result))
+        if args.plot is not None:
+            print(f"\nplot written to {args.plot}")
+    return 0
