@@ -142,7 +142,7 @@ _TERMINAL_TEXT = {
 _NAME_AFTER = {
     "roqme": "a model name", "property": "a property name", "context": "a context name",
     "type": "a type name", "observation": "an observation name", "reinforces": "a property name",
-    "undermines": "a property name", "::": "an enum literal",
+    "undermines": "a property name", "::": "an enum literal", "{": "an enum literal",
 }
 _DECLARATION_START = {"TYPE", "PROPERTY", "CONTEXT", "OBSERVATION"}
 
@@ -199,6 +199,8 @@ class _Source:
                               f"unexpected end of file: expected {_describe_expected(set(exc.expected), None)}")
         assert isinstance(exc, UnexpectedToken)
         token = exc.token
+        if token.type != "$END" and self.text.startswith("/*", token.start_pos):
+            return self.at(token, "unterminated comment: '/*' without '*/'")
         for word_token in (token, previous):
             if word_token is not None and word_token.type == "NAME" and str(word_token) in UNSUPPORTED_WORDS:
                 return self.at(word_token, UNSUPPORTED_WORDS[str(word_token)])
@@ -264,7 +266,9 @@ class _Checker:
 
     def _declare(self, name: Token, what: str) -> None:
         if str(name) in self.declared:
-            raise self.error(name, f"{name} is already declared as a {self.declared[str(name)]}")
+            what = self.declared[str(name)]
+            article = "an" if what[0] in "aeiou" else "a"
+            raise self.error(name, f"{name} is already declared as {article} {what}")
         self.declared[str(name)] = what
 
     def _enum(self, name: Token, tree: Tree) -> EnumType:

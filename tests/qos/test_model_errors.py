@@ -1,0 +1,105 @@
+"""Malformed models: each is rejected with one message naming file, line, column and the problem."""
+
+from __future__ import annotations
+
+import pytest
+
+from qos import ModelError, load_model, parse_model
+
+#: a valid header the observation cases build on (observations start on line 7)
+HEAD = ("roqme M\nproperty P\ncontext B : boolean\ncontext N : number\ncontext E : eventtype\n"
+        "context S : enum {ON, OFF}\n")
+
+CASES = [
+    ("", "m.roqme:1:1: expected 'roqme', found the end of the file"),
+    ("property P", "m.roqme:1:1: expected 'roqme', found 'property'"),
+    ("roqme", "m.roqme:1:6: expected a model name after 'roqme', found the end of the file"),
+    ("roqme M\nproperty", "m.roqme:2:9: expected a property name after 'property', found the end of the file"),
+    ("roqme M\nproperty P reference", "m.roqme:2:21: expected a number after 'reference', found the end of the file"),
+    ("roqme M\nproperty P reference 1.5", "m.roqme:2:22: reference 1.5 of property P is outside [0, 1]"),
+    ("roqme M\nproperty P survival 100",
+     "m.roqme:2:21: expected a time such as 100min, 30 sec or 2h after 'survival', found '100'"),
+    ("roqme M\nproperty P survival 0min", "m.roqme:2:21: survival of property P must be positive"),
+    ("roqme M\nproperty P reference 0.5 reference 0.4", "m.roqme:2:26: reference is given twice for property P"),
+    ("roqme M\ncontext B : boolean", "m.roqme:1:7: model M declares no property"),
+    ("roqme M\nproperty P\nproperty P", "m.roqme:3:10: P is already declared as a property"),
+    ("roqme M\nproperty P\ncontext C : colour",
+     "m.roqme:3:13: unknown type colour (declare it with 'type colour : enum {…}' before this context)"),
+    ("roqme M\nproperty P\ncontext C : enum {A, A}", "m.roqme:3:22: enum literal A appears twice in C"),
+    ("roqme M\nproperty P\ncontext C : enum {}", "m.roqme:3:19: expected an enum literal after '{', found '}'"),
+    ("roqme M\nproperty P\ntimer T : 30sec", "m.roqme:3:1: timer declarations are not supported"),
+    ("roqme M\nimport other.roqme\nproperty P", "m.roqme:2:1: imports are not supported"),
+    (HEAD + "observation O : avg(N, 30sec) > 2 reinforces P",
+     "m.roqme:7:17: the aggregate function avg(…) is not supported"),
+    (HEAD + "observation O : foo(N) reinforces P",
+     "m.roqme:7:17: the function foo(…) is not supported (patterns may use update(…) and eventWhen(…))"),
+    (HEAD + "observation O : every B reinforces P",
+     "m.roqme:7:17: the 'every' pattern operator is not supported (observations re-arm after every match anyway)"),
+    (HEAD + "observation O : B reinforces Q", "m.roqme:7:30: observation O reinforces unknown property Q"),
+    (HEAD + "observation O : B reinforces P medium",
+     "m.roqme:7:32: expected an intensity (verylow, low, high, veryhigh) after 'P', found 'medium'"),
+    (HEAD + "observation O : B reinforces",
+     "m.roqme:7:29: expected a property name after 'reinforces', found the end of the file"),
+    (HEAD + "observation O : B",
+     "m.roqme:7:18: expected an operator, or 'reinforces' or 'undermines' and a property after 'B', "
+     "found the end of the file"),
+    (HEAD + "observation O : X reinforces P", "m.roqme:7:17: unknown context X"),
+    (HEAD + "observation O : N + 1 reinforces P",
+     "m.roqme:7:17: a number value cannot stand as a pattern: use update(…) or compare it"),
+    (HEAD + "observation O : eventWhen(N) reinforces P", "m.roqme:7:27: eventWhen needs a boolean, but N is number"),
+    (HEAD + "observation O : !update(B) reinforces P",
+     "m.roqme:7:18: the pattern operator 'update' cannot be used in a value; only values and & | ! "
+     "comparisons and arithmetic can"),
+    (HEAD + "observation O : B while(N) reinforces P", "m.roqme:7:25: the while condition must be boolean, not number"),
+    (HEAD + "observation O : B while(B and B) reinforces P",
+     "m.roqme:7:25: the pattern operator 'and' cannot be used in the while condition; only values and & | ! "
+     "comparisons and arithmetic can"),
+    (HEAD + "observation O : B repeat(0) reinforces P", "m.roqme:7:26: repeat needs a whole number of times ≥ 1, not 0"),
+    (HEAD + "observation O : B repeat(1.5) reinforces P",
+     "m.roqme:7:26: repeat needs a whole number of times ≥ 1, not 1.5"),
+    (HEAD + "observation O : S = S::MAYBE reinforces P", "m.roqme:7:24: S has no literal MAYBE (expected one of ON, OFF)"),
+    (HEAD + "observation O : S = T::ON reinforces P", "m.roqme:7:21: T is not an enum type"),
+    (HEAD + "observation O : S = N reinforces P", "m.roqme:7:17: '=' compares enum S with number"),
+    (HEAD + "observation O : N > B reinforces P", "m.roqme:7:21: '>' needs a number operand, not boolean"),
+    (HEAD + "observation O : E & B reinforces P",
+     "m.roqme:7:17: E is an eventtype and has no value: use it as a pattern or in update()"),
+    (HEAD + "observation O : B and reinforces P",
+     "m.roqme:7:23: expected a pattern or a value after 'and', found 'reinforces'"),
+    (HEAD + "observation O : (B reinforces P", "m.roqme:7:20: expected ')' or '->' after 'B', found 'reinforces'"),
+    (HEAD + "observation O : B @ B reinforces P", "m.roqme:7:19: unexpected character '@'"),
+    (HEAD + "observation O : B reinforces P\nobservation O : B reinforces P",
+     "m.roqme:8:13: O is already declared as an observation"),
+    (HEAD + "observation O : B reinforces P /* unterminated", "m.roqme:7:32: unterminated comment: '/*' without '*/'"),
+    (HEAD + "observation P : B reinforces P", "m.roqme:7:13: P is already declared as a property"),
+]
+
+
+@pytest.mark.parametrize(("text", "message"), CASES, ids=[f"case{i}" for i in range(len(CASES))])
+def test_malformed_model_is_rejected_with_its_message(text, message):
+    with pytest.raises(ModelError) as caught:
+        parse_model(text, "m.roqme")
+    assert str(caught.value) == message
+
+
+def test_errors_in_a_model_file_name_the_file(tmp_path):
+    path = tmp_path / "broken.roqme"
+    path.write_text("roqme M\nproperty P\ncontext C : boolean\nobservation O : C reinforces\n", encoding="utf-8")
+    with pytest.raises(ModelError, match=r"^broken\.roqme:4:29: expected a property name after 'reinforces'"):
+        load_model(path)
+
+
+def test_missing_model_file_and_unknown_bundled_name(tmp_path):
+    with pytest.raises(ModelError, match=r"missing\.roqme: cannot read the model"):
+        load_model(tmp_path / "missing.roqme")
+    with pytest.raises(ModelError, match=r"no bundled model named 'nope' \(bundled: clarc\)"):
+        load_model("nope")
+
+
+def test_comments_units_and_reference_bounds_are_read():
+    model = parse_model(
+        "// line comment\nroqme M /* block\n comment */\n"
+        "property A reference 1 survival 30 sec\nproperty B reference 0 survival 2h\n"
+        "property C survival 500ms\nproperty D\n", "m.roqme")
+    assert [model.properties[name].survival for name in "ABCD"] == [30.0, 7200.0, 0.5, None]
+    assert model.properties["A"].prior == 0.99 and model.properties["B"].prior == 0.01
+    assert model.properties["D"].reference == 0.5
