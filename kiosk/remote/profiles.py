@@ -133,9 +133,9 @@ def _read_file(path: Path) -> list[dict[str, Any]]:
         document = yaml.safe_load(text)
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
-        where = f", line {mark.line + 1}" if mark is not None else ""
+        where = f" line {mark.line + 1}:" if mark is not None else ""
         problem = getattr(error, "problem", None) or str(error)
-        raise ProfileError(f"{path}{where}: not valid YAML: {problem}") from None
+        raise ProfileError(f"{path}:{where} not valid YAML: {problem}") from None
     if document is None:
         return []
     if not isinstance(document, dict) or set(document) != {"profiles"}:
