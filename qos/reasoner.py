@@ -57,17 +57,14 @@ class PropertyBelief:
         self._series_live = False
 
     def add(self, t: float, likelihood_ratio: float) -> None:
-        """Record a firing at time t (not before any earlier firing)."""
+        """Record a firing at time t; times of successive calls must not decrease.
+
+        Lone firings that have faded to ``|u·d| ≤ FOLD_AT`` by t are folded into the series here,
+        so that reading a metric stays a pure function of time.
+        """
         if self._rate == 0.0:
             self._lasting -= math.log(likelihood_ratio)
             return
-        self._recent.append((t, (1.0 - likelihood_ratio) / (1.0 + likelihood_ratio)))
-
-    def log_odds(self, t: float) -> float:
-        """The log-odds at time t (≥ every recorded firing), folding aged firings on the way."""
-        total = self._prior + self._lasting
-        if self._rate == 0.0:
-            return total
         keep: list[tuple[float, float]] = []
         for fired_at, u in self._recent:
             x = u * math.exp(-self._rate * (t - fired_at))
@@ -75,8 +72,16 @@ class PropertyBelief:
                 self._fold(t, x)
             else:
                 keep.append((fired_at, u))
-                total += 2.0 * math.atanh(x)
+        keep.append((t, (1.0 - likelihood_ratio) / (1.0 + likelihood_ratio)))
         self._recent = keep
+
+    def log_odds(self, t: float) -> float:
+        """The log-odds at time t (≥ the last firing)."""
+        total = self._prior + self._lasting
+        if self._rate == 0.0:
+            return total
+        for fired_at, u in self._recent:
+            total += 2.0 * math.atanh(u * math.exp(-self._rate * (t - fired_at)))
         return total + self._series_value(t)
 
     def metric(self, t: float) -> float:
@@ -97,12 +102,18 @@ class PropertyBelief:
 
     def _fold(self, t: float, x: float) -> None:
         self._rebase(t)
+        if self._series_live and self._series_bound() < PRUNE:
+            self._series = [0.0] * SERIES_TERMS  # everything folded so far has faded out
         x2, power = x * x, x
         series = self._series
         for k in range(SERIES_TERMS):
             series[k] += 2.0 * power / (2 * k + 1)
             power *= x2
         self._series_live = True
+
+    def _series_bound(self) -> float:
+        """An upper bound of the series' contribution now (at its reference time)."""
+        return sum(abs(coefficient) for coefficient in self._series)
 
     def _series_value(self, t: float) -> float:
         if not self._series_live:
@@ -115,11 +126,7 @@ class PropertyBelief:
             value += term
             bound += abs(term)
             power *= x2
-        if bound < PRUNE:
-            self._series = [0.0] * SERIES_TERMS
-            self._series_live = False
-            return 0.0
-        return value
+        return value if bound >= PRUNE else 0.0
 
     @property
     def live_firings(self) -> int:
