@@ -18,8 +18,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import jsonschema
-import yaml
+from kiosk.yamlmarks import Problem, describe, parse, schema_problems
 
 #: where the bundled questionnaire and its schema live
 _PACKAGE_DIR = "kiosk.questionnaires"
@@ -29,19 +28,6 @@ SCHEMA_FILE = "questionnaire.schema.json"
 
 # --------------------------------------------------------------------------------------------
 # Errors with positions
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One thing wrong with a questionnaire file, at a 1-based line and column."""
-
-    file: str
-    line: int
-    column: int
-    message: str
-
-    def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.column}: {self.message}"
 
 
 class QuestionnaireError(ValueError):
@@ -297,93 +283,18 @@ def check_questionnaire_file(path: str | Path) -> list[Problem]:
     return check_questionnaire_text(text, str(path))[1]
 
 
-class _Positions:
-    """Maps a path inside the YAML document (keys and indexes) to where it was written."""
-
-    def __init__(self, root: yaml.Node) -> None:
-        self._marks: dict[tuple[Any, ...], tuple[int, int]] = {}
-        self._key_marks: dict[tuple[Any, ...], tuple[int, int]] = {}
-        self.duplicate_keys: list[tuple[tuple[Any, ...], str, tuple[int, int]]] = []
-        self._walk(root, ())
-
-    @staticmethod
-    def _mark(node: yaml.Node) -> tuple[int, int]:
-        return node.start_mark.line + 1, node.start_mark.column + 1
-
-    def _walk(self, node: yaml.Node, path: tuple[Any, ...]) -> None:
-        self._marks[path] = self._mark(node)
-        if isinstance(node, yaml.MappingNode):
-            seen: set[str] = set()
-            for key_node, value_node in node.value:
-                key = key_node.value
-                if key in seen:
-                    self.duplicate_keys.append((path, key, self._mark(key_node)))
-                seen.add(key)
-                self._key_marks[path + (key,)] = self._mark(key_node)
-                self._walk(value_node, path + (key,))
-        elif isinstance(node, yaml.SequenceNode):
-            for index, child in enumerate(node.value):
-                self._walk(child, path + (index,))
-
-    def of(self, path: tuple[Any, ...], *, key: bool = False) -> tuple[int, int]:
-        """Position of the value at ``path`` (or of its key), falling back to the nearest parent."""
-        if key and path in self._key_marks:
-            return self._key_marks[path]
-        while path not in self._marks and path:
-            path = path[:-1]
-        return self._marks.get(path, (1, 1))
-
-
-def _describe(path: tuple[Any, ...]) -> str:
-    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p)) for i, p in enumerate(path))
-
-
 def check_questionnaire_text(text: str, filename: str) -> tuple[Any, list[Problem]]:
     """Parse and check questionnaire YAML; returns (data, problems). Data is None on a syntax error."""
-    loader = yaml.SafeLoader(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:
-            return None, [Problem(filename, 1, 1, "the file is empty")]
-        data = loader.construct_document(node)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-        return None, [Problem(filename, line, col, f"YAML syntax: {exc.problem or exc.context}")]
-    except yaml.YAMLError as exc:
-        return None, [Problem(filename, 1, 1, f"YAML syntax: {exc}")]
-    finally:
-        loader.dispose()
-
-    positions = _Positions(node)
-    problems: list[Problem] = []
+    data, positions, problems = parse(text, filename)
+    if positions is None:
+        return None, problems
 
     def add(path: tuple[Any, ...], message: str, *, key: bool = False) -> None:
         line, col = positions.of(path, key=key)
         problems.append(Problem(filename, line, col, message))
 
-    for path, key, (line, col) in positions.duplicate_keys:
-        where = f" in {_describe(path)}" if path else ""
-        problems.append(Problem(filename, line, col, f"duplicate key {key!r}{where}"))
-
-    validator = jsonschema.Draft202012Validator(_schema())
-    for error in validator.iter_errors(data):
-        path = tuple(error.absolute_path)
-        if error.validator == "additionalProperties":
-            extra = sorted(set(error.instance) - set(error.schema.get("properties", {})))
-            for name in extra:
-                add(path + (name,), f"unknown key {name!r}" + (f" in {_describe(path)}" if path else ""), key=True)
-            continue
-        if error.validator == "required":
-            missing = error.message.split("'")[1] if "'" in error.message else error.message
-            add(path, f"{_describe(path) or 'the file'} is missing {missing!r}")
-            continue
-        if error.validator == "multipleOf":
-            add(path, f"{_describe(path)}: points must be a multiple of 5, got {error.instance!r}")
-            continue
-        add(path, f"{_describe(path) or 'the file'}: {error.message}")
-
-    if isinstance(data, dict) and not problems:
+    schema_problems(data, _schema(), positions, add)
+    if isinstance(data, dict):
         _check_semantics(data, add)
     problems.sort(key=lambda p: (p.line, p.column, p.message))
     return data, problems
@@ -392,71 +303,87 @@ def check_questionnaire_text(text: str, filename: str) -> tuple[Any, list[Proble
 def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
     """Rules a JSON Schema cannot say: translations, unique ids, distinct points, band coverage.
 
-    Only run on a file that already matches the schema, so the structure can be trusted here.
+    Runs even when the schema found problems, so every error is reported in one go; parts with
+    the wrong shape (already reported by the schema) are skipped.
     """
-    languages: list[str] = data["languages"]
+    def dicts(value: Any) -> list[tuple[int, dict[str, Any]]]:
+        return [(i, v) for i, v in enumerate(value) if isinstance(v, dict)] if isinstance(value, list) else []
+
+    languages = [x for x in data.get("languages", []) if isinstance(x, str)] if isinstance(
+        data.get("languages"), list) else []
     if len(set(languages)) != len(languages):
         add(("languages",), "a language is listed twice in 'languages'")
 
-    def texts(path: tuple[Any, ...], value: Mapping[str, Any]) -> None:
+    def texts(path: tuple[Any, ...], value: Any) -> None:
+        if not isinstance(value, dict):
+            return
         for lang in languages:
             if lang not in value:
-                add(path, f"{_describe(path)} has no {lang!r} translation")
+                add(path, f"{describe(path)} has no {lang!r} translation")
         for lang in value:
-            if lang not in languages:
-                add(path + (lang,), f"{_describe(path)} has a {lang!r} text but {lang!r} is not in 'languages'", key=True)
+            if languages and lang not in languages:
+                add(path + (lang,), f"{describe(path)} has a {lang!r} text but {lang!r} is not in 'languages'",
+                    key=True)
 
-    for key in ("title",):
-        texts((key,), data[key])
-    for name, value in data.get("messages", {}).items():
+    texts(("title",), data.get("title"))
+    messages = data.get("messages")
+    for name, value in (messages.items() if isinstance(messages, dict) else ()):
         texts(("messages", name), value)
 
-    def options(path: tuple[Any, ...], opts: list[dict[str, Any]], scored: bool) -> None:
-        for i, option in enumerate(opts):
-            texts(path + (i, "label"), option["label"])
-            for lang in option.get("synonyms", {}):
-                if lang not in languages:
+    def options(path: tuple[Any, ...], value: Any, scored: bool) -> None:
+        seen: set[Any] = set()
+        for i, option in dicts(value):
+            texts(path + (i, "label"), option.get("label"))
+            synonyms = option.get("synonyms")
+            for lang in (synonyms if isinstance(synonyms, dict) else ()):
+                if languages and lang not in languages:
                     add(path + (i, "synonyms", lang), f"synonyms in {lang!r}, which is not in 'languages'", key=True)
-            if scored and "points" not in option:
-                add(path + (i,), f"{_describe(path + (i,))} has no points")
-        if scored:
-            seen: set[int] = set()
-            for i, option in enumerate(opts):
-                if option.get("points") in seen:
-                    add(path + (i, "points"), f"two options of {_describe(path[:-1])} score {option['points']} points")
-                seen.add(option.get("points"))
+            points = option.get("points")
+            if scored and isinstance(points, int):
+                if points in seen:
+                    add(path + (i, "points"), f"two options of {describe(path[:-1])} score {points} points")
+                seen.add(points)
 
     ids: dict[str, tuple[Any, ...]] = {}
     for section in ("items", "familiarisation"):
-        for i, entry in enumerate(data.get(section, [])):
+        for i, entry in dicts(data.get(section)):
             path = (section, i)
-            if entry["id"] in ids:
-                add(path + ("id",), f"duplicate id {entry['id']!r} (also used at {_describe(ids[entry['id']])})")
-            else:
-                ids[entry["id"]] = path
-            texts(path + ("text",), entry["text"])
-            texts(path + ("spoken",), entry["spoken"])
-            options(path + ("options",), entry["options"], scored=section == "items")
-            if section == "familiarisation" and entry["expected"] > len(entry["options"]):
-                add(path + ("expected",), f"expected option {entry['expected']} but there are only {len(entry['options'])} options")
+            entry_id = entry.get("id")
+            if isinstance(entry_id, str) and entry_id in ids:
+                add(path + ("id",), f"duplicate id {entry_id!r} (also used at {describe(ids[entry_id])})")
+            elif isinstance(entry_id, str):
+                ids[entry_id] = path
+            texts(path + ("text",), entry.get("text"))
+            texts(path + ("spoken",), entry.get("spoken"))
+            options(path + ("options",), entry.get("options"), scored=section == "items")
+            expected, opts = entry.get("expected"), entry.get("options")
+            if section == "familiarisation" and isinstance(expected, int) and isinstance(opts, list) \
+                    and expected > len(opts):
+                add(path + ("expected",), f"expected option {expected} but there are only {len(opts)} options")
 
-    bands = data["bands"]["ranges"]
+    bands_block = data.get("bands")
+    bands = dicts(bands_block.get("ranges")) if isinstance(bands_block, dict) else []
     band_ids: set[str] = set()
-    for i, band in enumerate(bands):
-        texts(("bands", "ranges", i, "label"), band["label"])
-        if band["id"] in band_ids:
+    for i, band in bands:
+        texts(("bands", "ranges", i, "label"), band.get("label"))
+        if band.get("id") in band_ids:
             add(("bands", "ranges", i, "id"), f"duplicate band id {band['id']!r}")
-        band_ids.add(band["id"])
+        band_ids.add(band.get("id"))
+    if not bands or not all(isinstance(b.get("min"), int) and isinstance(b.get("max"), int) for _, b in bands):
+        return
+    for i, band in bands:
         if band["min"] > band["max"]:
-            add(("bands", "ranges", i), f"band {band['id']!r} has min {band['min']} above max {band['max']}")
-    top = sum(max((o.get("points", 0) for o in item["options"]), default=0) for item in data["items"])
+            add(("bands", "ranges", i), f"band {band.get('id')!r} has min {band['min']} above max {band['max']}")
+    top = sum(max((o.get("points", 0) for _, o in dicts(item.get("options")) if isinstance(o.get("points"), int)),
+                  default=0) for _, item in dicts(data.get("items")))
     expected_low = 0
-    for i, band in sorted(enumerate(bands), key=lambda ib: ib[1]["min"]):
+    for i, band in sorted(bands, key=lambda ib: ib[1]["min"]):
         if band["min"] != expected_low:
             kind = "a gap" if band["min"] > expected_low else "an overlap"
-            add(("bands", "ranges", i, "min"), f"bands leave {kind} before {band['min']} (expected the next band to start at {expected_low})")
+            add(("bands", "ranges", i, "min"),
+                f"bands leave {kind} before {band['min']} (expected the next band to start at {expected_low})")
         expected_low = band["max"] + 1
-    if bands and expected_low != top + 1:
+    if expected_low != top + 1:
         add(("bands", "ranges"), f"bands end at {expected_low - 1} but the highest possible total is {top}")
 
 

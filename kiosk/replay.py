@@ -1,0 +1,486 @@
+"""Scripted patients: run the real session core on a simulated clock (`kiosk replay FILE`).
+
+A script (``recordings/patients/*.yaml``, format in ``recordings/patients/README.md``) says what a
+simulated patient does: when they start, what they answer on which attempt and through which
+channel, and the incidents (pause/resume, call doctor/continue, person lost/back, repeat). The
+driver here feeds those inputs to a real :class:`~kiosk.session.Session` with a real QoS engine,
+lets the session's own time-outs happen on a :class:`~kiosk.clock.SimClock`, and checks that what
+the script declared really happened under the session's rules -- an answer declared on attempt 1
+that would arrive after attempt 1 timed out is an error, not a silently different session.
+
+Times in a script are relative: an action happens ``after`` seconds counted from the later of
+the opening of the attempt it names and the previous action of the same question.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from kiosk.channels import Channel, ChannelInput, Command
+from kiosk.clock import SimClock
+from kiosk.questionnaire import Item, PracticeQuestion, Questionnaire, QuestionnaireError, load_questionnaire
+from kiosk.session import (
+    AnswerRecorded,
+    AttemptOpened,
+    AttemptTimedOut,
+    Phase,
+    PhaseChanged,
+    QuestionNotAnswered,
+    Session,
+    SessionEvent,
+)
+from kiosk.yamlmarks import Positions, Problem, describe, parse, schema_problems
+
+#: the QoS model scripted sessions are watched by
+MODEL = "clarc"
+
+#: incidents that are commands a patient gives through a channel
+_COMMANDS = {"pause": Command.PAUSE, "resume": Command.RESUME, "call_doctor": Command.CALL_DOCTOR,
+             "repeat": Command.REPEAT}
+
+
+class ScriptError(ValueError):
+    """A script is malformed, or declares something that does not happen under the session's rules."""
+
+
+@cache
+def _schema() -> dict[str, Any]:
+    return json.loads(resources.files("kiosk").joinpath("patient.schema.json").read_text(encoding="utf-8"))
+
+
+# ---------------------------------------------------------------------------------------------
+# The script
+
+
+@dataclass(frozen=True)
+class Step:
+    """One timed action of a script: an answer, an incident, or a practice answer."""
+
+    #: "answer", "practice" or the incident ("pause", "continue", ...)
+    kind: str
+    #: the attempt this step is counted from (None: from the previous step of its question)
+    attempt: int | None
+    after: float
+    channel: Channel | None = None
+    option: int | None = None
+    say: str | None = None
+    #: where it is written, for messages: "file:line:col: questions[2].incidents[0]"
+    where: str = ""
+
+
+@dataclass(frozen=True)
+class Question:
+    """What the patient does on one question: incidents, then an answer (or none)."""
+
+    item: Item
+    #: 1, 2, or None when the patient never answers
+    attempt: int | None
+    steps: tuple[Step, ...]
+    where: str
+
+
+@dataclass(frozen=True)
+class Script:
+    """A validated scripted patient."""
+
+    source: str
+    patient: str
+    description: str
+    language: str
+    answered_by: str
+    adaptation: bool
+    start_at: float
+    acknowledge_after: float
+    timing: dict[str, float]
+    practice: tuple[Step, ...] | None
+    questions: tuple[Question, ...]
+
+
+def load_script(path: str | Path, questionnaire: Questionnaire | None = None) -> Script:
+    """Read and check a scripted patient; :class:`ScriptError` lists every problem with its position."""
+    questionnaire = questionnaire or load_questionnaire()
+    name = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ScriptError(f"{name}:1:1: cannot read the script: {reason}") from None
+    data, positions, problems = parse(text, name)
+    if positions is None or not isinstance(data, dict):
+        problems = problems or [Problem(name, 1, 1, "a script is a mapping (patient:, questions:, ...)")]
+        raise ScriptError("\n".join(map(str, problems)))
+
+    def where(p: tuple[Any, ...], key: bool = False) -> str:
+        line, col = positions.of(p, key=key)
+        return f"{name}:{line}:{col}"
+
+    def add(p: tuple[Any, ...], message: str, *, key: bool = False) -> None:
+        line, col = positions.of(p, key=key)
+        problems.append(Problem(name, line, col, message))
+
+    schema_problems(data, _schema(), positions, add)
+    if problems:
+        raise ScriptError("\n".join(map(str, sorted(problems, key=lambda p: (p.line, p.column)))))
+
+    language = data.get("language", "en")
+    if language not in questionnaire.languages:
+        add(("language",), f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
+    try:
+        questionnaire.timing.with_overrides(data.get("timing"))
+    except ValueError as exc:
+        add(("timing",), str(exc))
+    if len(data["questions"]) != len(questionnaire.items):
+        add(("questions",), f"the script has {len(data['questions'])} questions; "
+                            f"the questionnaire has {len(questionnaire.items)}")
+    if problems:
+        raise ScriptError("\n".join(map(str, problems)))
+
+    def answer_step(p: tuple[Any, ...], entry: dict[str, Any], question: Item | PracticeQuestion,
+                    kind: str, attempt: int | None) -> Step | None:
+        if "option" in entry and "say" in entry:
+            add(p, f"{describe(p)} gives both 'option' and 'say'; give one")
+            return None
+        if "option" not in entry and "say" not in entry:
+            add(p, f"{describe(p)} answers on attempt {attempt} but gives no 'option' or 'say'")
+            return None
+        if "channel" not in entry:
+            add(p, f"{describe(p)} answers but gives no 'channel'")
+            return None
+        channel = Channel(entry["channel"])
+        option = entry.get("option")
+        if option is not None and option > len(question.options):
+            add(p + ("option",), f"{question.id!r} has {len(question.options)} options, not {option}")
+            return None
+        if "say" in entry:
+            if channel is not Channel.VOICE:
+                add(p + ("say",), f"'say' needs channel voice, not {channel.value}")
+                return None
+            option = _match(question, language, entry["say"])
+            if isinstance(option, str):
+                add(p + ("say",), option)
+                return None
+        return Step(kind, attempt, float(entry.get("after", 0)), channel, option, entry.get("say"), where(p))
+
+    practice: tuple[Step, ...] | None = None
+    if isinstance(data.get("familiarisation"), list):
+        steps = []
+        entries = data["familiarisation"]
+        if len(entries) != len(questionnaire.familiarisation):
+            add(("familiarisation",), f"the script answers {len(entries)} practice questions; "
+                                      f"the questionnaire has {len(questionnaire.familiarisation)}")
+        for i, (entry, pq) in enumerate(zip(entries, questionnaire.familiarisation)):
+            step = answer_step(("familiarisation", i), entry, pq, "practice", 1)
+            if step:
+                steps.append(step)
+        practice = tuple(steps)
+
+    questions = []
+    for i, (entry, item) in enumerate(zip(data["questions"], questionnaire.items)):
+        p = ("questions", i)
+        if "item" in entry and entry["item"] != item.id:
+            add(p + ("item",), f"question {i + 1} of the questionnaire is {item.id!r}, not {entry['item']!r}")
+        attempt = None if entry["attempt"] == "none" else int(entry["attempt"])
+        steps = []
+        for j, incident in enumerate(entry.get("incidents", [])):
+            ip = p + ("incidents", j)
+            if "channel" in incident and incident["do"] not in _COMMANDS:
+                add(ip + ("channel",), f"{incident['do']!r} is not given through a channel")
+            anchor = incident.get("attempt", 1 if j == 0 else None)
+            channel = Channel(incident.get("channel", "touch"))
+            steps.append(Step(incident["do"], anchor, float(incident.get("after", 0)), channel, where=where(ip)))
+        if attempt is None:
+            for key in ("option", "say", "channel", "after"):
+                if key in entry:
+                    add(p + (key,), f"{describe(p)} is not answered (attempt: none) but gives {key!r}", key=True)
+        else:
+            step = answer_step(p, entry, item, "answer", attempt)
+            if step:
+                steps.append(step)
+        questions.append(Question(item, attempt, tuple(steps), where(p)))
+    if problems:
+        raise ScriptError("\n".join(map(str, problems)))
+    return Script(
+        source=name, patient=data["patient"], description=data.get("description", ""), language=language,
+        answered_by=data.get("answered_by", "patient"), adaptation=data.get("adaptation", True),
+        start_at=float(data.get("start_at", 0)), acknowledge_after=float(data.get("acknowledge_after", 0)),
+        timing=dict(data.get("timing", {})), practice=practice, questions=tuple(questions),
+    )
+
+
+def _match(question: Item | PracticeQuestion, language: str, utterance: str) -> int | str:
+    """The option an utterance selects, with the speech helper's matcher; a message if none."""
+    from kiosk.speech.matching import Matcher, OptionWords
+
+    matcher = Matcher([OptionWords(o.label_in(language), o.synonyms_in(language)) for o in question.options],
+                      language)
+    match = matcher.match(utterance)
+    if match.option is None:
+        return f"on {question.id!r}, {match.reason or repr(utterance) + ' is a command, not an answer'}"
+    return match.option
+
+
+# ---------------------------------------------------------------------------------------------
+# Running a script
+
+
+@dataclass
+class ReplayResult:
+    """What a replay produced: the finished session, its context trace and the QoS statistics."""
+
+    script: Script
+    session: Session
+    #: the session's context trace, as ``qos.Trace``
+    trace: Any
+    #: ``qos.replay`` of that trace: {"metrics": {...}, "fired": [...]}
+    qos: dict[str, Any]
+    #: simulated seconds from the session's creation to its end
+    simulated_s: float
+    events: list[SessionEvent] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result as JSON-ready data (what ``kiosk replay --json`` prints)."""
+        score = self.session.score()
+        return {
+            "script": self.script.source,
+            "patient": self.script.patient,
+            "language": self.script.language,
+            "answered_by": self.script.answered_by,
+            "score": {"total": score.total, "complete": score.complete, "max_total": score.max_total,
+                      "band": score.band.id if score.band else None},
+            "answers": [
+                {"item": a.item_id, "option": a.option, "points": a.points, "attempt": a.attempt,
+                 "channel": a.channel.value, "t": _num(a.t)}
+                for a in sorted(self.session.answers.values(), key=lambda a: a.t)
+            ],
+            "not_answered": list(self.session.snapshot().not_answered),
+            "adaptations": [
+                {"t": _num(e.t), "name": e.name, "active": e.active, "reason": e.reason}
+                for e in self.events if type(e).__name__ == "AdaptationChanged"
+            ],
+            "qos": self.qos,
+            "simulated_s": _num(self.simulated_s),
+        }
+
+
+def _num(value: float) -> float | int:
+    return int(value) if float(value).is_integer() else round(value, 6)
+
+
+class _Driver:
+    """Arms each step once what it is counted from has happened, and checks what happened."""
+
+    def __init__(self, script: Script, session: Session, clock: SimClock) -> None:
+        self.script = script
+        self.session = session
+        self.clock = clock
+        self.armed: list[tuple[float, int, Callable[[], None]]] = []
+        self.seq = 0
+        self.errors: list[str] = []
+        self.opened: dict[tuple[int, int], float] = {}
+        self.next_step = [0] * len(script.questions)
+        self.last_time: list[float | None] = [None] * len(script.questions)
+        self.waiting = [False] * len(script.questions)
+        self.events: list[SessionEvent] = []
+        session.subscribe(self._on_event)
+
+    def arm(self, due: float, action: Callable[[], None]) -> None:
+        self.seq += 1
+        self.armed.append((due, self.seq, action))
+
+    # events
+
+    def _on_event(self, event: SessionEvent) -> None:
+        self.events.append(event)
+        now = self.clock.now()
+        if isinstance(event, PhaseChanged) and event.phase is Phase.EXPLANATION:
+            self.arm(now + self.script.acknowledge_after, self.session.acknowledge)
+        elif isinstance(event, AttemptOpened) and event.practice:
+            if self.script.practice is not None and event.attempt == 1 and event.number <= len(self.script.practice):
+                step = self.script.practice[event.number - 1]
+                self.arm(now + step.after, lambda s=step: self._give_answer(s, None))
+        elif isinstance(event, AttemptOpened):
+            index = event.number - 1
+            self.opened[(index, event.attempt)] = now
+            self._try_arm(index)
+        elif isinstance(event, AttemptTimedOut) and not event.practice:
+            index = event.number - 1
+            question = self.script.questions[index]
+            pending = question.steps[self.next_step[index]:]
+            if pending and pending[0].kind == "answer" and pending[0].attempt == event.attempt:
+                self.errors.append(
+                    f"{pending[0].where}: the answer declared on attempt {event.attempt} "
+                    f"({pending[0].after:g} s after it opened) never happened: attempt {event.attempt} "
+                    f"timed out at t={_num(event.t)} s under the session's rules")
+        elif isinstance(event, (AnswerRecorded, QuestionNotAnswered)):
+            index = event.number - 1
+            question = self.script.questions[index]
+            pending = question.steps[self.next_step[index]:]
+            if pending:
+                self.errors.append(f"{pending[0].where}: the declared {pending[0].kind} never happened: "
+                                   f"question {event.number} ({question.item.id}) ended at t={_num(event.t)} s")
+            elif isinstance(event, QuestionNotAnswered) and question.attempt is not None:
+                self.errors.append(f"{question.where}: declared answered on attempt {question.attempt} "
+                                   f"but the question was not answered")
+
+    def _try_arm(self, index: int) -> None:
+        question = self.script.questions[index]
+        k = self.next_step[index]
+        if self.waiting[index] or k >= len(question.steps):
+            return
+        step = question.steps[k]
+        base = self.last_time[index]
+        if step.attempt is not None:
+            opened = self.opened.get((index, step.attempt))
+            if opened is None:
+                return  # armed once that attempt opens
+            base = opened if base is None else max(base, opened)
+        if base is None:
+            return
+        self.waiting[index] = True
+        self.arm(base + step.after, lambda: self._run_step(index, step))
+
+    def _run_step(self, index: int, step: Step) -> None:
+        self.waiting[index] = False
+        self.next_step[index] += 1
+        self.last_time[index] = self.clock.now()
+        if step.kind == "answer":
+            self._give_answer(step, index)
+        elif step.kind in _COMMANDS:
+            assert step.channel is not None
+            self.session.handle(ChannelInput(step.channel, command=_COMMANDS[step.kind], detail="script"))
+        elif step.kind == "continue":
+            self.session.clinician_continue()
+        elif step.kind == "person_lost":
+            self.session.person_lost()
+        elif step.kind == "person_back":
+            self.session.person_back()
+        self._try_arm(index)
+
+    def _give_answer(self, step: Step, index: int | None) -> None:
+        assert step.channel is not None and step.option is not None
+        if index is not None:
+            item = self.session.current_item
+            if self.session.current_attempt != step.attempt or item is None or item.number != index + 1:
+                state = (f"question {item.number} attempt {self.session.current_attempt}" if item
+                         else f"phase {self.session.phase.value}")
+                self.errors.append(f"{step.where}: the answer declared on attempt {step.attempt} came when the "
+                                   f"session was at {state}")
+                return
+        self.session.handle(ChannelInput(step.channel, option=step.option, detail=step.say or "script"))
+
+    # the loop
+
+    def run(self) -> None:
+        self.arm(self.script.start_at, lambda: self.session.start(self.script.answered_by))
+        for _ in range(100_000):  # a bound, so a script/session bug cannot loop forever
+            if self.errors:
+                raise ScriptError(self.errors[0])
+            if self.session.finished:
+                return
+            self.armed.sort()
+            deadline = self.session.next_deadline()
+            # an input at the same instant as a time-out goes first (the window includes its end)
+            if self.armed and (deadline is None or self.armed[0][0] <= deadline):
+                due, _, action = self.armed.pop(0)
+                self.clock.set(max(due, self.clock.now()))
+                action()
+            elif deadline is not None:
+                self.clock.set(max(deadline, self.clock.now()))
+                self.session.poll()
+            else:
+                raise ScriptError(f"{self.script.source}: the script ends while the session waits "
+                                  f"({self._waiting_for()}) at t={_num(self.session.now())} s")
+        raise ScriptError(f"{self.script.source}: the replay did not finish")
+
+    def _waiting_for(self) -> str:
+        s = self.session
+        if s.halted:
+            return "doctor called, no clinician continue"
+        if s.paused:
+            return "paused, never resumed"
+        if not s.snapshot().person_present:
+            return "person lost, never back"
+        return f"phase {s.phase.value}"
+
+
+def run_script(script: Script, questionnaire: Questionnaire | None = None, *, store: Any = None,
+               model: Any = None) -> ReplayResult:
+    """Run a script through a real Session and QoS engine on a simulated clock."""
+    from kiosk.adaptation import Adaptation, load_policy
+    from qos import Engine, Trace, TraceEvent, load_model, replay
+
+    questionnaire = questionnaire or load_questionnaire()
+    model = model or load_model(MODEL)
+    clock = SimClock()
+    session = Session(
+        questionnaire, clock=clock, engine=Engine(model), store=store, patient_id=script.patient,
+        language=script.language, answered_by=script.answered_by, timing=script.timing,
+        adaptation=Adaptation(load_policy()) if script.adaptation else None,
+        familiarisation=script.practice is not None,
+    )
+    driver = _Driver(script, session, clock)
+    driver.run()
+    trace = Trace(MODEL, [TraceEvent(_num(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
+                          for e in session.trace])
+    return ReplayResult(script, session, trace, replay(trace, model=model), session.now(), driver.events)
+
+
+def _print_human(result: ReplayResult) -> None:
+    data = result.to_dict()
+    score = data["score"]
+    band = f", {score['band']}" if score["band"] else ""
+    status = "complete" if score["complete"] else f"incomplete ({len(data['not_answered'])} not answered)"
+    print(f"{data['script']}: patient {data['patient']} ({data['language']}, answered by {data['answered_by']})")
+    print(f"score {score['total']}/{score['max_total']} {status}{band}; simulated {data['simulated_s']} s")
+    for answer in data["answers"]:
+        print(f"  {answer['item']:<10} option {answer['option']}  {answer['points']:>2} points  "
+              f"attempt {answer['attempt']}  {answer['channel']:<8} t={answer['t']}")
+    for item in data["not_answered"]:
+        print(f"  {item:<10} not answered")
+    for adaptation in data["adaptations"]:
+        state = "on" if adaptation["active"] else "off"
+        print(f"  adaptation {adaptation['name']} {state} at t={adaptation['t']}: {adaptation['reason']}")
+    print("QoS        min     max     avg     sd      last")
+    for name, stats in data["qos"]["metrics"].items():
+        print(f"  {name:<24} " + " ".join(f"{stats[k]:.4f}" for k in ("min", "max", "avg", "sd", "last")))
+
+
+def main(argv: list[str]) -> int:
+    """`kiosk replay FILE... [--json] [--trace OUT]`; exit 0, or 2 on a bad script."""
+    parser = argparse.ArgumentParser(prog="kiosk replay", description=__doc__.splitlines()[0])
+    parser.add_argument("files", nargs="+", metavar="FILE", help="scripted patient YAML file(s)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object per script")
+    parser.add_argument("--trace", metavar="OUT", help="write the context trace (one script only)")
+    args = parser.parse_args(argv)
+    if args.trace and len(args.files) != 1:
+        parser.error("--trace takes one script")
+    try:
+        questionnaire = load_questionnaire()
+    except QuestionnaireError as exc:
+        print(f"kiosk replay: the questionnaire is invalid: {exc}", file=sys.stderr)
+        return 2
+    results = []
+    for file in args.files:
+        try:
+            results.append(run_script(load_script(file, questionnaire), questionnaire))
+        except ScriptError as exc:
+            print(exc, file=sys.stderr)
+            return 2
+    if args.trace:
+        from qos import dump_trace
+
+        dump_trace(results[0].trace, args.trace, header=f"context trace of {results[0].script.source}")
+    for result in results:
+        if args.json:
+            print(json.dumps(result.to_dict(), ensure_ascii=False))
+        else:
+            _print_human(result)
+    return 0

@@ -1,0 +1,29 @@
+"""`kiosk validate FILE...`: list every problem of a questionnaire file as ``file:line:col: problem``.
+
+Exit status 0 when every file is valid, 1 when any has a problem, 2 on bad usage. The same checks
+run when the kiosk loads a questionnaire, so a file this command accepts is one the kiosk starts with.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from kiosk.questionnaire import check_questionnaire_file
+
+
+def main(argv: list[str]) -> int:
+    """Validate questionnaire files; returns the exit status."""
+    parser = argparse.ArgumentParser(prog="kiosk validate", description=__doc__.splitlines()[0])
+    parser.add_argument("files", nargs="+", metavar="FILE", help="questionnaire YAML file(s)")
+    args = parser.parse_args(argv)
+    bad = False
+    for file in args.files:
+        problems = check_questionnaire_file(file)
+        for problem in problems:
+            print(problem)
+        if problems:
+            bad = True
+        else:
+            print(f"{file}: ok", file=sys.stderr)
+    return 1 if bad else 0
