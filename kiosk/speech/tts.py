@@ -1,0 +1,286 @@
+"""The kiosk's voice: questions read aloud by espeak-ng, in en, es or fr.
+
+All synthesis and playback happen on one worker thread. :class:`Speaker` reports when it
+starts and stops talking (``on_speech(True/False)``) so the recogniser can be muted: the kiosk
+must never take its own voice for an answer.
+
+Why not plain pyttsx3: its espeak driver (2.99) proved unreliable here. Its ``say`` plays by
+shelling out to ``aplay`` with no error, no way to stop and no end-of-playback signal; after a
+``save_to_file`` it keeps writing later ``say`` calls to that file; it prints "Audio saved to
+..." on stdout (over the Textual screen); and, measured in this repository, ``save_to_file``
+now and then writes an empty WAV (1 phrase in 90) and applies the rate and volume set for one
+phrase to another (in 40 alternating-rate calls about half came out at the wrong rate): libespeak
+applies parameters asynchronously to its run loop (see also nateshmbhat/pyttsx3#194, #219).
+Setting the properties on the driver directly did not help: libespeak itself applied them late.
+So :class:`Synthesiser` runs the ``espeak-ng`` program once per phrase -- the same engine and
+voices, with voice, rate and volume passed per call, writing a WAV. Each phrase
+is then played through PortAudio (sounddevice) by a :class:`Player`, which knows when playback
+ends and can be stopped.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import queue
+import shutil
+import subprocess
+import tempfile
+import threading
+import wave
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from kiosk.channels import Channel, ChannelState, ChannelStatus
+
+log = logging.getLogger(__name__)
+
+#: espeak-ng voice per kiosk language
+VOICES = {"en": "gmw/en-us", "es": "roa/es", "fr": "roa/fr"}
+#: words per minute: older listeners rate 150-200 wpm most comfortable, slower is harder
+DEFAULT_RATE = 160
+#: volume as espeak-ng's amplitude / 100 (0-200 %): the patient steps it with louder/quieter
+DEFAULT_VOLUME, VOLUME_STEP, MIN_VOLUME, MAX_VOLUME = 1.0, 0.25, 0.25, 2.0
+#: how long one phrase may take to synthesise before voice out is declared broken
+SYNTH_TIMEOUT_S = 30.0
+
+
+class TtsUnavailable(RuntimeError):
+    """Voice out cannot work here; the message is one sentence for the UI."""
+
+
+class Synthesiser:
+    """espeak-ng, text → WAV file (22.05 kHz mono 16-bit). Thread-safe: one process per phrase."""
+
+    backend = "espeak-ng"
+
+    def __init__(self) -> None:
+        self._command = shutil.which("espeak-ng")
+        if self._command is None:
+            raise TtsUnavailable("espeak-ng is not installed")
+        listing = subprocess.run([self._command, "--voices"], capture_output=True, text=True,
+                                 timeout=SYNTH_TIMEOUT_S).stdout
+        # columns: Pty Language Age/Gender VoiceName File Other; File is the voice id
+        available = {line.split()[4].lower() for line in listing.splitlines()[1:] if len(line.split()) > 4}
+        self.languages = tuple(lang for lang, voice in VOICES.items() if voice in available)
+
+    def synthesise(self, text: str, language: str, path: str | Path,
+                   rate: int = DEFAULT_RATE, volume: float = DEFAULT_VOLUME) -> Path:
+        """Speak ``text`` in ``language`` into the WAV file ``path``."""
+        if language not in self.languages:
+            raise TtsUnavailable(f"espeak-ng has no voice for language {language!r}")
+        amplitude = str(int(round(volume * 100)))  # espeak-ng's 0-200 % amplitude
+        subprocess.run(
+            [self._command, "-v", VOICES[language], "-s", str(rate), "-a", amplitude,
+             "-w", str(path), "--", text],
+            check=True, capture_output=True, timeout=SYNTH_TIMEOUT_S,
+        )
+        if not _has_audio(path):
+            raise TtsUnavailable(f"espeak-ng produced no audio for {text[:40]!r}")
+        return Path(path)
+
+
+def _has_audio(path: str | Path) -> bool:
+    """Whether a WAV file holds any samples (a bare 44-byte header does not)."""
+    return Path(path).is_file() and Path(path).stat().st_size > 44
+
+
+class Player(Protocol):
+    """Plays audio to the patient; ``play`` blocks until done or stopped."""
+
+    name: str
+
+    def play(self, samples: np.ndarray, rate: int) -> None:
+        """Play mono int16 samples at ``rate`` Hz and return when done or stopped."""
+
+    def stop(self) -> None:
+        """Cut the current playback short (called from another thread)."""
+
+
+class PortAudioPlayer:
+    """The default audio output through sounddevice."""
+
+    name = "portaudio"
+
+    def __init__(self) -> None:
+        try:
+            import sounddevice
+        except OSError as exc:
+            raise TtsUnavailable(f"PortAudio is not installed (libportaudio2): {exc}") from None
+        if sounddevice.default.device[1] < 0 and not any(
+            d["max_output_channels"] > 0 for d in sounddevice.query_devices()
+        ):
+            raise TtsUnavailable("no audio output found")
+        self._sd = sounddevice
+
+    def play(self, samples: np.ndarray, rate: int) -> None:
+        """Play and wait (``sounddevice.wait`` returns early when :meth:`stop` is called)."""
+        self._sd.play(samples, rate)
+        self._sd.wait()
+
+    def stop(self) -> None:
+        """Stop sounddevice's current playback."""
+        self._sd.stop()
+
+
+@dataclass(frozen=True)
+class _Job:
+    text: str
+    language: str
+    path: Path | None = None  # save here instead of playing
+    done: threading.Event | None = None
+
+
+class Speaker:
+    """Reads phrases aloud on a worker thread; the session calls :meth:`say` and returns at once.
+
+    ``on_status`` receives one :class:`ChannelStatus` for voice out (ON, or OFF with the reason);
+    ``on_speech(True)`` is called just before the kiosk starts talking and ``on_speech(False)``
+    right after it stops, from the worker thread.
+    """
+
+    source = "espeak-ng"
+
+    def __init__(
+        self,
+        on_status: Callable[[ChannelStatus], None] = lambda status: None,
+        on_speech: Callable[[bool], None] = lambda speaking: None,
+        player_factory: Callable[[], Player] = PortAudioPlayer,
+        rate: int = DEFAULT_RATE,
+    ) -> None:
+        self.on_status = on_status
+        self.on_speech = on_speech
+        self._player_factory = player_factory
+        self.rate = rate
+        self.volume = DEFAULT_VOLUME
+        self._jobs: queue.Queue[_Job | None] = queue.Queue()
+        self._player: Player | None = None
+        self._worker: threading.Thread | None = None
+        self._ready = threading.Event()
+        self.available = False
+        self.reason = ""
+        self._errors: dict[int, Exception] = {}
+
+    # -- lifecycle ---------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start the worker; it reports ON or OFF through ``on_status``. Does not block."""
+        self._worker = threading.Thread(target=self._run, name="kiosk-tts", daemon=True)
+        self._worker.start()
+
+    def wait_ready(self, timeout: float = 10.0) -> bool:
+        """Wait until the worker knows whether voice out works; returns ``available``."""
+        self._ready.wait(timeout)
+        return self.available
+
+    def close(self) -> None:
+        """Stop talking and end the worker; safe to call twice."""
+        if self._worker is not None:
+            self.stop_speaking()
+            self._jobs.put(None)
+            self._worker.join(timeout=SYNTH_TIMEOUT_S)
+            self._worker = None
+
+    # -- what the session asks for -----------------------------------------------------------
+
+    def say(self, text: str, language: str) -> None:
+        """Queue a phrase to be read aloud; ignored (and logged) when voice out is off."""
+        if self._ready.is_set() and not self.available:
+            log.info("voice out is off (%s); not saying %r", self.reason, text[:40])
+            return
+        self._jobs.put(_Job(text, language))
+
+    def stop_speaking(self) -> None:
+        """Cut the current phrase short and drop queued ones (the patient already answered)."""
+        with contextlib.suppress(queue.Empty):
+            while True:
+                job = self._jobs.get_nowait()
+                if job is None:  # keep a pending shutdown
+                    self._jobs.put(None)
+                    break
+                if job.done is not None:  # a save waits on it; never drop it
+                    self._jobs.put(job)
+                    break
+        if self._player is not None:
+            self._player.stop()
+
+    def volume_up(self) -> float:
+        """One step louder (from the next phrase on); returns the new volume."""
+        self.volume = min(MAX_VOLUME, self.volume + VOLUME_STEP)
+        return self.volume
+
+    def volume_down(self) -> float:
+        """One step quieter (from the next phrase on); returns the new volume."""
+        self.volume = max(MIN_VOLUME, self.volume - VOLUME_STEP)
+        return self.volume
+
+    def save_to_file(self, text: str, language: str, path: str | Path,
+                     timeout: float = SYNTH_TIMEOUT_S) -> Path:
+        """Synthesise ``text`` to a WAV file on the worker (works without an audio output)."""
+        done = threading.Event()
+        job = _Job(text, language, Path(path), done)
+        self._jobs.put(job)
+        if not done.wait(timeout):
+            raise TtsUnavailable(f"espeak-ng did not finish within {timeout:.0f} s")
+        if (error := self._errors.pop(id(job), None)) is not None:
+            raise error
+        return Path(path)
+
+    # -- the worker --------------------------------------------------------------------------
+
+    def _run(self) -> None:
+        synth = self._start_synthesiser()
+        while (job := self._jobs.get()) is not None:
+            if synth is None:
+                if job.done is not None:
+                    self._errors[id(job)] = TtsUnavailable(self.reason)
+                    job.done.set()
+                continue
+            try:
+                if job.path is not None:
+                    synth.synthesise(job.text, job.language, job.path, self.rate, self.volume)
+                else:
+                    self._speak(synth, job)
+            except Exception as exc:  # one bad phrase must not end the kiosk's voice
+                log.warning("voice out failed for %r: %s", job.text[:40], exc)
+                self._errors[id(job)] = exc if isinstance(exc, TtsUnavailable) else TtsUnavailable(str(exc))
+            finally:
+                if job.done is not None:
+                    job.done.set()
+
+    def _start_synthesiser(self) -> Synthesiser | None:
+        synth = None
+        try:
+            synth = Synthesiser()
+            self._player = self._player_factory()
+            self.available, state = True, ChannelState.ON
+        except TtsUnavailable as exc:
+            self.reason, state = str(exc), ChannelState.OFF
+        self._ready.set()
+        self.on_status(ChannelStatus(Channel.VOICE, state, source=self.source,
+                                     reason=self.reason and f"voice out off: {self.reason}"))
+        # synthesis to files still works without an audio output
+        return synth
+
+    def _speak(self, synth: Synthesiser, job: _Job) -> None:
+        if self._player is None:
+            return
+        fd, name = tempfile.mkstemp(suffix=".wav", prefix="kiosk-tts-")
+        os.close(fd)
+        try:
+            synth.synthesise(job.text, job.language, name, self.rate, self.volume)
+            with wave.open(name, "rb") as wav:
+                rate = wav.getframerate()
+                samples = np.frombuffer(wav.readframes(wav.getnframes()), dtype="<i2")
+        finally:
+            os.unlink(name)
+        self.on_speech(True)
+        try:
+            self._player.play(samples, rate)
+        finally:
+            self.on_speech(False)
