@@ -126,6 +126,11 @@ class Engine:
         """Current context values (contexts never set are absent)."""
         return dict(self._values)
 
+    @property
+    def live_firings(self) -> dict[str, int]:
+        """Per property, how many firings the reasoner still keeps on their own (a bounded number)."""
+        return {name: belief.live_firings for name, belief in self._beliefs.items()}
+
     def update(self, t: float, set: Mapping[str, object] | None = None,
                emit: Iterable[str] | None = None) -> UpdateResult:
         """Apply one batch at time t and return the metrics and fired observations.

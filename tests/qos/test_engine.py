@@ -71,7 +71,7 @@ def test_long_runs_keep_a_bounded_state():
     engine = Engine(CLARC)
     for minute in range(10 * 60):
         engine.update(minute * 60, set={"FirstAttemptAnswered": minute % 3 != 0}, emit=["CallingDoctor"])
-    assert max(belief.live_firings for belief in engine._beliefs.values()) < 60
+    assert max(engine.live_firings.values()) < 60
 
 
 def test_reference_is_clamped_and_no_survival_means_no_decay():
