@@ -14,7 +14,7 @@ from typing import Protocol
 
 from kiosk.channels import ChannelState
 from kiosk.remote.decoders import Press, ReportDecoder
-from kiosk.remote.profiles import HidProfile
+from kiosk.remote.profiles import HidProfile, usb_id
 from kiosk.remote.reconnect import Backoff, DeviceLost, DeviceUnavailable, ReconnectingReader, Wait, wait_or_stop
 
 #: how long one read waits for a report; bounds how quickly stop() is noticed
@@ -36,8 +36,8 @@ class HidDeviceInfo:
 
     @property
     def usb_id(self) -> str:
-        """``vvvv:pppp`` in hex, the way ``lsusb`` prints it."""
-        return f"{self.vendor_id:04x}:{self.product_id:04x}"
+        """The device's ids, as :func:`~kiosk.remote.profiles.usb_id` writes them."""
+        return usb_id(self.vendor_id, self.product_id)
 
 
 class HidDevice(Protocol):

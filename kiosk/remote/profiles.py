@@ -68,8 +68,13 @@ class HidProfile:
 
     @property
     def usb_id(self) -> str:
-        """``vvvv:pppp`` in hex, the way ``lsusb`` prints it."""
-        return f"{self.vendor_id:04x}:{self.product_id:04x}"
+        """The ids the profile looks for, as :func:`usb_id` writes them."""
+        return usb_id(self.vendor_id, self.product_id)
+
+
+def usb_id(vendor_id: int, product_id: int) -> str:
+    """``vvvv:pppp`` in hex, the way ``lsusb`` prints a USB device's ids."""
+    return f"{vendor_id:04x}:{product_id:04x}"
 
 
 @dataclass(frozen=True)

@@ -90,11 +90,6 @@ class ReconnectingReader:
         self._thread: threading.Thread | None = None
         self._state: ChannelState | None = None
 
-    @property
-    def state(self) -> ChannelState | None:
-        """The last state reported (None before the first attempt)."""
-        return self._state
-
     def connect(self) -> Connection:
         """Find and open the device, or raise :class:`DeviceUnavailable`."""
         raise NotImplementedError
