@@ -931,8 +931,6 @@ class Session:
         self._context(t, {name: True, "UserInteraction": USER_INTERACTION[event.channel]})
         self._emit(AnswerRecorded(t, item.id, item.number, option.number, option.points, attempt,
                                   event.channel, self._answered_by, event.detail))
-        if self.adaptation is not None:
-            self.adaptation.note_answer(event.channel)
         self._update_listening(t)
         self._schedule_next_item(t, self.timing.between_questions_s)
 

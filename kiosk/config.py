@@ -1,0 +1,164 @@
+"""The kiosk's configuration: one frozen dataclass, from a YAML file plus environment overrides.
+
+Where the file is: ``$KIOSK_CONFIG`` if set (it must exist), else
+``<user config dir>/kiosk/config.yaml`` if present (``platformdirs.user_config_dir("kiosk")``),
+else built-in defaults. Environment variables override the file: ``KIOSK_DATA_DIR``,
+``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``.
+
+Example ``config.yaml`` (every key optional)::
+
+    data_dir: /var/lib/kiosk          # default: platformdirs.user_data_dir("kiosk")
+    language: es                      # default language on the welcome screen
+    clinician_pin: "4821"             # CHANGE IT: the default "1234" is public
+    adaptation: true                  # live adaptation on/off
+    adaptation_policy: /etc/kiosk/adaptation.yaml
+    questionnaire: /etc/kiosk/barthel.yaml
+    familiarisation: true             # practice questions before the questionnaire
+    timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
+    vosk_model: /opt/vosk/vosk-model-small-es-0.42
+    remote_profiles: /etc/kiosk/remotes.yaml
+
+A bad file is one :class:`ConfigError` naming the file, line and column and what is wrong.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import platformdirs
+
+from kiosk.questionnaire import Timing
+from kiosk.yamlmarks import Problem, parse
+
+#: the PIN a fresh install uses; the clinician screens warn while it is unchanged
+DEFAULT_PIN = "1234"
+LANGUAGES = ("en", "es", "fr")
+
+
+class ConfigError(ValueError):
+    """The configuration file (or an environment override) is unusable."""
+
+
+@dataclass(frozen=True)
+class Config:
+    """Settings of one kiosk. Build with :func:`load_config`."""
+
+    #: where the SQLite database (and nothing else of the patients') lives; created 0700
+    data_dir: Path = field(default_factory=lambda: Path(platformdirs.user_data_dir("kiosk")))
+    #: default language on the welcome screen
+    language: str = "en"
+    #: the clinician screens' PIN; the default must be changed on a real kiosk
+    clinician_pin: str = DEFAULT_PIN
+    #: live adaptation (the clinician can still switch it off per session)
+    adaptation: bool = True
+    #: an adaptation policy file (None: the bundled kiosk/adaptation.yaml)
+    adaptation_policy: Path | None = None
+    #: a questionnaire file (None: the bundled Barthel questionnaire)
+    questionnaire: Path | None = None
+    #: practice questions before the questionnaire
+    familiarisation: bool = True
+    #: overrides of the questionnaire's timing (attempt_window_s, between_questions_s, ...)
+    timing: Mapping[str, float] = field(default_factory=dict)
+    #: a Vosk model directory (None: pocketsphinx fallback / voice in off)
+    vosk_model: Path | None = None
+    #: user overrides of the remote-control profiles
+    remote_profiles: Path | None = None
+    #: the file this was read from (None: defaults only)
+    source: Path | None = None
+
+    @property
+    def database(self) -> Path:
+        """The SQLite file inside the data directory."""
+        return self.data_dir / "kiosk.sqlite3"
+
+    @property
+    def default_pin(self) -> bool:
+        """The PIN is still the public default."""
+        return self.clinician_pin == DEFAULT_PIN
+
+
+_PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
+_BOOLS = {"adaptation", "familiarisation"}
+_KEYS = {f.name for f in fields(Config)} - {"source"}
+
+
+def default_config_path() -> Path:
+    """``<user config dir>/kiosk/config.yaml``."""
+    return Path(platformdirs.user_config_dir("kiosk")) / "config.yaml"
+
+
+def load_config(path: str | Path | None = None, environ: Mapping[str, str] | None = None) -> Config:
+    """Read the configuration (see the module docstring for where from); ConfigError if unusable."""
+    env = os.environ if environ is None else environ
+    if path is None and env.get("KIOSK_CONFIG"):
+        path = Path(env["KIOSK_CONFIG"])
+        if not path.is_file():
+            raise ConfigError(f"KIOSK_CONFIG names {path}, which is not a file")
+    if path is None and default_config_path().is_file():
+        path = default_config_path()
+    values: dict[str, Any] = {}
+    if path is not None:
+        values = _read(Path(path))
+    overrides = {"KIOSK_DATA_DIR": "data_dir", "KIOSK_LANGUAGE": "language", "KIOSK_VOSK_MODEL": "vosk_model"}
+    for var, key in overrides.items():
+        if env.get(var):
+            values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
+    if values.get("language", "en") not in LANGUAGES:
+        raise ConfigError(f"language {values['language']!r} is not one of {', '.join(LANGUAGES)}")
+    return Config(**values, source=Path(path) if path is not None else None)
+
+
+def _read(path: Path) -> dict[str, Any]:
+    name = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ConfigError(f"{name}: cannot read the configuration: {reason}") from None
+    data, positions, problems = parse(text, name)
+    if problems:
+        raise ConfigError(str(problems[0]))
+    if data is None:
+        return {}
+    assert positions is not None
+
+    def fail(key: tuple[Any, ...], message: str) -> ConfigError:
+        line, col = positions.of(key, key=True)
+        return ConfigError(str(Problem(name, line, col, message)))
+
+    if not isinstance(data, dict):
+        raise fail((), "the configuration is a mapping of settings (key: value)")
+    values: dict[str, Any] = {}
+    for key, value in data.items():
+        if key not in _KEYS:
+            raise fail((key,), f"unknown setting {key!r} (known: {', '.join(sorted(_KEYS))})")
+        if key in _PATHS:
+            if not isinstance(value, str) or not value:
+                raise fail((key,), f"{key} must be a path")
+            value = Path(value).expanduser()
+            if not value.is_absolute():  # relative paths are relative to the config file
+                value = path.parent / value
+        elif key in _BOOLS:
+            if not isinstance(value, bool):
+                raise fail((key,), f"{key} must be true or false")
+        elif key == "timing":
+            if not isinstance(value, dict):
+                raise fail((key,), "timing must be a mapping such as {attempt_window_s: 30}")
+            try:
+                Timing().with_overrides(value)
+            except ValueError as exc:
+                raise fail((key,), str(exc)) from None
+            value = dict(value)
+        elif key == "clinician_pin":
+            if isinstance(value, int) and not isinstance(value, bool):
+                raise fail((key,), 'write the PIN in quotes ("0123"), or leading zeros are lost')
+            if not isinstance(value, str) or not value.isdigit() or not 4 <= len(value) <= 12:
+                raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
+        elif key == "language" and not isinstance(value, str):
+            raise fail((key,), "language must be en, es or fr")
+        values[key] = value
+    return values
