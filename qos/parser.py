@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 from lark import Lark, Token, Tree
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from qos.errors import ModelError
 from qos.model import (
@@ -136,7 +136,7 @@ _TERMINAL_TEXT = {
     "NAME": "a name", "NUMBER": "a number", "TIME": "a time such as 100min, 30 sec or 2h",
     "COLON": "':'", "LBRACE": "'{'", "RBRACE": "'}'", "COMMA": "','", "LPAR": "'('", "RPAR": "')'",
     "REINFORCES": "'reinforces'", "UNDERMINES": "'undermines'", "COMPARE": "a comparison", "ADD": "'+' or '-'",
-    "MUL": "'*' or '/'", "BAR": "'|'", "AMP": "'&'", "ENUM": "'enum'", "MODEL": "'roqme'", "__ANON_0": "'->'",
+    "MUL": "'*' or '/'", "BAR": "'|'", "AMP": "'&'", "ENUM": "'enum'", "MODEL": "'roqme'",
 }
 #: what a NAME means right after a keyword
 _NAME_AFTER = {
@@ -170,10 +170,6 @@ def _describe_expected(expected: set[str], previous: str | None) -> str:
     return " or ".join(texts[:6]) or "the end of the file"
 
 
-def _found(token: Token) -> str:
-    return "the end of the file" if token.type == "$END" else repr(str(token))
-
-
 class _Source:
     """The text of a model and the name used for it in messages."""
 
@@ -193,10 +189,6 @@ class _Source:
         if isinstance(exc, UnexpectedCharacters):
             char = self.text[exc.pos_in_stream]
             return self.error(exc.line, exc.column, f"unexpected character {char!r}")
-        if isinstance(exc, UnexpectedEOF):
-            lines = self.text.splitlines() or [""]
-            return self.error(len(lines), len(lines[-1]) + 1,
-                              f"unexpected end of file: expected {_describe_expected(set(exc.expected), None)}")
         assert isinstance(exc, UnexpectedToken)
         token = exc.token
         if token.type != "$END" and self.text.startswith("/*", token.start_pos):
@@ -209,7 +201,7 @@ class _Source:
         if token.type == "$END":
             lines = self.text.splitlines() or [""]
             return self.error(len(lines), len(lines[-1]) + 1, f"expected {expected}{after}, found the end of the file")
-        return self.at(token, f"expected {expected}{after}, found {_found(token)}")
+        return self.at(token, f"expected {expected}{after}, found {str(token)!r}")
 
 
 def parse_model(text: str, filename: str = "<string>") -> Model:
@@ -405,8 +397,6 @@ class _Checker:
                         "while_": "while", "repeat": "repeat", "update": "update", "event_when": "eventWhen"}
             raise self.error(node, f"the pattern operator '{operator[node.data]}' cannot be used in {role}; "
                                    "only values and & | ! comparisons and arithmetic can")
-        if isinstance(node, Token):  # a bare NUMBER or keyword never reaches here unwrapped
-            raise self.error(node, f"unexpected {node}")
         kind = node.data
         if kind == "var":
             context = self._context(node.children[0])
