@@ -1,0 +1,158 @@
+"""Export stored sessions: FHIR R4 Questionnaire / QuestionnaireResponse (JSON) and CSV.
+
+Item scores ride on each answer option with the ``itemWeight`` extension (the weight belongs to
+the item's option, never to a shared answer code), and the total is an SDC calculatedExpression
+item. Totals are always recomputed from the answers' option numbers against the questionnaire;
+a stored total or stored points are never trusted.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from kiosk.questionnaire import Questionnaire, Score
+from kiosk.storage import StoredSession
+
+ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
+CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
+PATIENT_SYSTEM = "urn:kiosk:patient"
+TOTAL_LINK = "total"
+
+
+class ExportError(ValueError):
+    """A stored session does not fit the questionnaire (unknown item, option or points)."""
+
+
+def questionnaire_url(q: Questionnaire) -> str:
+    """The canonical URL the responses point at."""
+    return f"urn:kiosk:questionnaire:{q.id}"
+
+
+def _coding(code: Any, display: str) -> dict[str, str]:
+    return {"system": code.system, "code": code.code, "display": display}
+
+
+def _option_system(q: Questionnaire, item_id: str) -> str:
+    return f"{questionnaire_url(q)}:{item_id}"
+
+
+def fhir_questionnaire(q: Questionnaire, language: str = "en") -> dict[str, Any]:
+    """The questionnaire as a FHIR R4 Questionnaire resource."""
+    items = []
+    for item in q.items:
+        entry: dict[str, Any] = {"linkId": item.id, "text": item.text[language], "type": "choice", "required": True}
+        if item.code:
+            entry["code"] = [_coding(item.code, item.text[language])]
+        entry["answerOption"] = [
+            {
+                "extension": [{"url": ITEM_WEIGHT, "valueDecimal": option.points}],
+                "valueCoding": {"system": _option_system(q, item.id), "code": str(option.number),
+                                "display": option.label_in(language)},
+            }
+            for option in item.options
+        ]
+        items.append(entry)
+    total: dict[str, Any] = {
+        "linkId": TOTAL_LINK, "text": "Total", "type": "integer", "readOnly": True,
+        "extension": [{"url": CALCULATED, "valueExpression": {
+            "language": "text/fhirpath",
+            "expression": f"%resource.item.where(linkId != '{TOTAL_LINK}').answer.value.weight().sum()",
+        }}],
+    }
+    if q.total_code:
+        total["code"] = [_coding(q.total_code, "Total score")]
+    items.append(total)
+    resource: dict[str, Any] = {
+        "resourceType": "Questionnaire", "id": q.id, "url": questionnaire_url(q), "version": q.version,
+        "name": "".join(w.capitalize() for w in q.title["en"].split()), "title": q.title[language],
+        "status": "draft", "language": language, "item": items,
+    }
+    if q.code:
+        resource["code"] = [_coding(q.code, q.title["en"])]
+    return resource
+
+
+def rescore(q: Questionnaire, stored: StoredSession) -> Score:
+    """The score recomputed from the stored option numbers (ExportError if they do not fit)."""
+    points = {}
+    for answer in stored.answers:
+        try:
+            option = q.item(answer.item_id).option(answer.option)
+        except KeyError as exc:
+            raise ExportError(f"session {stored.id}: {exc.args[0]}") from None
+        if option.points != answer.points:
+            raise ExportError(f"session {stored.id}: {answer.item_id} option {answer.option} is worth "
+                              f"{option.points} points in {q.id}, but {answer.points} were stored")
+        assert option.points is not None
+        points[answer.item_id] = option.points
+    return q.score(points)
+
+
+def fhir_response(q: Questionnaire, stored: StoredSession) -> dict[str, Any]:
+    """A stored session as a FHIR R4 QuestionnaireResponse (total recomputed)."""
+    score = rescore(q, stored)
+    language = stored.language
+    answers = {a.item_id: a for a in stored.answers}
+    items = []
+    for item in q.items:
+        entry: dict[str, Any] = {"linkId": item.id, "text": item.text[language]}
+        if item.id in answers:
+            option = item.option(answers[item.id].option)
+            entry["answer"] = [{"valueCoding": {"system": _option_system(q, item.id), "code": str(option.number),
+                                                "display": option.label_in(language)}}]
+        items.append(entry)
+    items.append({"linkId": TOTAL_LINK, "text": "Total", "answer": [{"valueInteger": score.total}]})
+    patient = {"identifier": {"system": PATIENT_SYSTEM, "value": stored.patient_id}}
+    source = patient | {"type": "Patient"} if stored.answered_by.value == "patient" else {
+        "type": "RelatedPerson", "display": stored.answered_by.value}
+    return {
+        "resourceType": "QuestionnaireResponse", "id": stored.id,
+        "questionnaire": f"{questionnaire_url(q)}|{q.version}",
+        # a finished session is completed even with unanswered items (they carry no answer)
+        "status": {"finished": "completed", "abandoned": "stopped"}.get(stored.status, "in-progress"),
+        "subject": patient, "authored": stored.finished_at or stored.started_at, "source": source,
+        "language": language, "item": items,
+    }
+
+
+CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
+               "attempt", "channel", "answered_by", "t"]
+
+
+def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
+    """One row per item of each session (blank option when not answered) plus a recomputed total row."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    for stored in sessions:
+        score = rescore(q, stored)
+        answers = {a.item_id: a for a in stored.answers}
+        head = [stored.id, stored.patient_id, stored.started_at, stored.status, stored.language]
+        for item in q.items:
+            a = answers.get(item.id)
+            if a is None:
+                writer.writerow(head + [item.id, "", "not answered", "", "", "", "", ""])
+            else:
+                label = item.option(a.option).label_in(stored.language)
+                writer.writerow(head + [item.id, a.option, label, a.points, a.attempt, a.channel.value,
+                                        a.answered_by.value, f"{a.t:g}"])
+        band = score.band.id if score.band else ("incomplete" if not score.complete else "")
+        writer.writerow(head + [TOTAL_LINK, "", band, score.total, "", "", "", ""])
+    return out.getvalue()
+
+
+def write_private(path: str | Path, text: str) -> None:
+    """Write an export readable by its owner only (it holds patient data)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w", encoding="utf-8") as handle:
+        handle.write(text)
+
+
+def write_json(path: str | Path, resource: dict[str, Any]) -> None:
+    """Write a FHIR resource as JSON, owner-only."""
+    write_private(path, json.dumps(resource, indent=2, ensure_ascii=False) + "\n")

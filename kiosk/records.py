@@ -1,0 +1,63 @@
+"""Session records shared by the command-line tools: opening the store, a stored session's trace.
+
+``kiosk qos trace SESSION`` (dispatched here by ``kiosk.qos_cli``) prints a stored session's QoS
+context trace in the trace format of ``python -m qos replay``, which then reproduces the metrics
+the session recorded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from kiosk.config import ConfigError, load_config
+from kiosk.storage import StorageError, Store, StoredSession
+
+MODEL = "clarc"
+
+
+def open_store(data_dir: str | None) -> Store:
+    """The store in ``data_dir``, or in the configured data directory (ConfigError/StorageError)."""
+    return Store.open(Path(data_dir) if data_dir else load_config().data_dir)
+
+
+def session_trace(stored: StoredSession):  # -> qos.Trace
+    """A stored session's context trace as a ``qos.Trace``."""
+    from qos import Trace, TraceEvent
+
+    def num(t: float) -> float | int:
+        return int(t) if float(t).is_integer() else t
+
+    return Trace(MODEL, [TraceEvent(num(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
+                         for e in stored.trace],
+                 description=f"session {stored.id} (patient {stored.patient_id}, started {stored.started_at})")
+
+
+def trace_main(argv: list[str]) -> int:
+    """`kiosk qos trace SESSION [--json] [-o FILE] [--data-dir DIR]`; exit 2 on an unknown session."""
+    parser = argparse.ArgumentParser(prog="kiosk qos trace",
+                                     description="print a stored session's QoS context trace")
+    parser.add_argument("session", help="session id (or a unique prefix of it)")
+    parser.add_argument("--json", action="store_true", help="JSON instead of YAML")
+    parser.add_argument("-o", "--output", metavar="FILE", help="write to FILE (owner-only) instead of stdout")
+    parser.add_argument("--data-dir", help="data directory (default: from the kiosk configuration)")
+    args = parser.parse_args(argv)
+    try:
+        with open_store(args.data_dir) as store:
+            stored = store.session(args.session)
+    except (ConfigError, StorageError) as exc:
+        print(f"kiosk qos trace: {exc}", file=sys.stderr)
+        return 2
+    except KeyError as exc:
+        print(f"kiosk qos trace: {exc.args[0]}", file=sys.stderr)
+        return 2
+    trace = session_trace(stored)
+    text = trace.to_json() + "\n" if args.json else trace.to_yaml()
+    if args.output:
+        from kiosk.export import write_private
+
+        write_private(args.output, text)
+    else:
+        sys.stdout.write(text)
+    return 0

@@ -1,0 +1,84 @@
+"""`kiosk results [SESSION] [--fhir FILE] [--fhir-questionnaire FILE] [--csv FILE]`.
+
+Without SESSION: list stored sessions. With SESSION (an id or a unique prefix): show its answers,
+the total recomputed from them, band and completeness, adaptations and QoS metrics at the end.
+Exports are written readable by their owner only. Exit 2 on an unknown session or unusable store.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from kiosk.config import ConfigError, load_config
+from kiosk.export import ExportError, csv_text, fhir_questionnaire, fhir_response, rescore, write_json, write_private
+from kiosk.questionnaire import QuestionnaireError, load_questionnaire
+from kiosk.records import open_store
+from kiosk.storage import StorageError, StoredSession
+
+
+def _show(q, stored: StoredSession) -> None:
+    score = rescore(q, stored)
+    print(f"session {stored.id}  patient {stored.patient_id}  {stored.status}  language {stored.language}  "
+          f"answered by {stored.answered_by.value}")
+    print(f"started {stored.started_at}" + (f"  finished {stored.finished_at}" if stored.finished_at else ""))
+    answers = {a.item_id: a for a in stored.answers}
+    for item in q.items:
+        a = answers.get(item.id)
+        if a is None:
+            outcome = "not answered" if item.id in stored.not_answered else "-"
+            print(f"  {item.number:>2} {item.id:<10} {outcome}")
+        else:
+            label = item.option(a.option).label_in(stored.language)
+            print(f"  {item.number:>2} {item.id:<10} option {a.option} {a.points:>3} points  attempt {a.attempt}  "
+                  f"{a.channel.value:<8} {label}")
+    band = score.band.label["en"] if score.band else "no band (incomplete)"
+    completeness = "complete" if score.complete else f"incomplete, missing {', '.join(score.missing)}"
+    print(f"total {score.total}/{score.max_total} ({completeness}); {band}")
+    for record in stored.adaptations:
+        print(f"  adaptation {record.name} {'on' if record.active else 'off'} at t={record.t:g}: {record.reason}")
+    if stored.metrics:
+        last = stored.metrics[-1]
+        print("QoS at the end: " + ", ".join(f"{k} {v:.3f}" for k, v in last.metrics.items()))
+
+
+def main(argv: list[str]) -> int:
+    """List, show or export stored sessions; returns the exit status."""
+    parser = argparse.ArgumentParser(prog="kiosk results", description=__doc__.splitlines()[0])
+    parser.add_argument("session", nargs="?", help="session id or unique prefix (default: list sessions)")
+    parser.add_argument("--fhir", metavar="FILE", help="write the session as a FHIR R4 QuestionnaireResponse")
+    parser.add_argument("--fhir-questionnaire", metavar="FILE", help="write the FHIR R4 Questionnaire")
+    parser.add_argument("--csv", metavar="FILE", help="write the session (or, without SESSION, all) as CSV")
+    parser.add_argument("--data-dir", help="data directory (default: from the kiosk configuration)")
+    args = parser.parse_args(argv)
+    if args.fhir and not args.session:
+        parser.error("--fhir needs a SESSION")
+    try:
+        config = load_config()
+        q = load_questionnaire(config.questionnaire)
+        with open_store(args.data_dir) as store:
+            if args.fhir_questionnaire:
+                write_json(args.fhir_questionnaire, fhir_questionnaire(q))
+            if args.session is None:
+                summaries = store.sessions()
+                if args.csv:
+                    write_private(args.csv, csv_text(q, [store.session(s.id) for s in summaries]))
+                if not summaries:
+                    print("no sessions stored", file=sys.stderr)
+                for s in summaries:
+                    print(f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.status:<9} {s.language}  "
+                          f"{s.answered} answered, {s.not_answered} not answered")
+                return 0
+            stored = store.session(args.session)
+            if args.fhir:
+                write_json(args.fhir, fhir_response(q, stored))
+            if args.csv:
+                write_private(args.csv, csv_text(q, [stored]))
+            _show(q, stored)
+    except (ConfigError, StorageError, QuestionnaireError, ExportError) as exc:
+        print(f"kiosk results: {exc}", file=sys.stderr)
+        return 2
+    except KeyError as exc:
+        print(f"kiosk results: {exc.args[0]}", file=sys.stderr)
+        return 2
+    return 0
