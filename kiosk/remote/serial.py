@@ -2,7 +2,7 @@
 
 The port is given by the profile as a path or a glob (``/dev/ttyUSB*``); on every connection
 attempt the first matching port that opens is used, so a box that comes back under another
-number is found again. Each connection gets a fresh :class:`~kiosk.remote.decoders.LineDecoder`:
+number is found again, and a port already held by another reader is skipped. Each connection gets a fresh :class:`~kiosk.remote.decoders.LineDecoder`:
 half a line from an unplugged box never joins the first line of the next one.
 """
 
@@ -72,7 +72,8 @@ class SerialRemote(ReconnectingReader):
         problems = []
         for port in ports:
             try:
-                device = serial.Serial(port, baudrate=self.profile.baud, timeout=READ_TIMEOUT)
+                # exclusive: a second reader on the same port would split one press between two
+                device = serial.Serial(port, baudrate=self.profile.baud, timeout=READ_TIMEOUT, exclusive=True)
             except (serial.SerialException, OSError, ValueError) as error:
                 problems.append(f"{port}: {error}")
                 continue

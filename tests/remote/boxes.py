@@ -84,6 +84,12 @@ class Collector:
         assert isinstance(item, ChannelStatus) and item.state == state, f"expected {state}, got {item}"
         return item
 
+    def status_any(self) -> ChannelStatus:
+        """Wait for the next item, which must be a status."""
+        item = self.next()
+        assert isinstance(item, ChannelStatus), f"expected a status, got {item}"
+        return item
+
     def inputs(self, count: int) -> list[ChannelInput]:
         """Wait for the next ``count`` items, which must all be inputs."""
         items = [self.next() for _ in range(count)]

@@ -129,3 +129,23 @@ def test_stop_releases_the_port(remote_dir, remote_reader):
     assert not remote_reader._thread.is_alive()
     assert open_files().count(box.slave_name) == 1  # only the box's own end is still open
     box.unplug()
+
+
+def test_two_profiles_matching_one_port_never_both_read_it(remote_dir, remote_profile):
+    box = ButtonBox(remote_dir / "ttyUSB-test0")
+    readers = [SerialRemote(replace(remote_profile, name=name), backoff=FAST) for name in ("one", "two")]
+    sink = Collector()
+    try:
+        for reader in readers:
+            reader.start(sink)
+        states = sorted(sink.status_any().state.value for _ in readers)
+        assert states == ["connecting", "on"]  # the second finds the port locked
+        busy = next(s for s in sink.received if s.state is ChannelState.CONNECTING)
+        assert "ttyUSB-test0" in busy.reason and "lock" in busy.reason
+        box.write(b"BTN 1\nBTN 2\n")
+        assert options(sink.inputs(2)) == [1, 2]  # each press once
+        assert sink.pending() == []
+    finally:
+        for reader in readers:
+            reader.stop()
+        box.unplug()
