@@ -21,7 +21,7 @@ from kiosk.remote.serial import matching_ports
 
 def main(argv: list[str]) -> int:
     """Print the devices report; exit status 2 if the profile file is unusable."""
-    parser = argparse.ArgumentParser(prog="kiosk devices", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="kiosk devices", description="List remotes (HID, serial) and audio inputs, and what the kiosk would use.")
     parser.add_argument("--profiles", metavar="PATH",
                         help="the site's device profile file (adds to or overrides the built-in ones)")
     args = parser.parse_args(argv)
