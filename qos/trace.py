@@ -266,7 +266,8 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     """Replay a trace through a fresh engine, sampling every property.
 
     Samples are taken at t = 0, period, 2·period, … up to and including the last event's time, each
-    after the events at times ≤ t. Raises :class:`TraceError` (or ModelError) before replaying
+    after the events at times ≤ t; when the last event falls between two of those, one more sample
+    is taken at its time. Raises :class:`TraceError` (or ModelError) before replaying
     anything when the trace or its model is bad.
     """
     if isinstance(sample_period, bool) or not isinstance(sample_period, (int, float)) \
@@ -292,6 +293,16 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
             upcoming += 1
         samples.times.append(now)
         for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
+            samples.series[name].append(value)
+    if upcoming < len(batches):
+        # the last event falls between two samples: apply the rest and sample at that time too,
+        # so that every batch is counted and `last` is the value after the last event
+        for t, values, emitted in batches[upcoming:]:
+            result = engine.update(float(t), set=values, emit=emitted)
+            if result.fired:
+                samples.fired.append({"t": t, "observations": result.fired})
+        samples.times.append(last_t)
+        for name, value in engine.metrics(last_t).items():
             samples.series[name].append(value)
     return samples
 

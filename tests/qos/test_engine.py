@@ -146,3 +146,40 @@ def test_engines_of_one_model_are_independent():
     first, second = Engine(CLARC), Engine(CLARC)
     first.update(1, set={"PersonDetected": False})
     assert second.update(1, set={"PersonDetected": False}).fired == ["O6", "O11"]
+
+
+def _clarc_batches():
+    from hypothesis import strategies as st
+
+    values = {name: (st.booleans() if context.kind == "boolean" else st.sampled_from(context.literals))
+              for name, context in CLARC.contexts.items() if context.kind != "eventtype"}
+    batch = st.tuples(st.floats(0, 60), st.dictionaries(st.sampled_from(sorted(values)), st.none(), max_size=4),
+                      st.booleans())
+    return st.lists(batch, max_size=25).flatmap(
+        lambda batches: st.tuples(*[st.fixed_dictionaries({name: values[name] for name in chosen})
+                                    for _, chosen, _ in batches]).map(
+            lambda sets: [(gap, chosen, doctor) for (gap, _, doctor), chosen in zip(batches, sets)]))
+
+
+def test_any_valid_session_keeps_metrics_in_range_and_replays_identically():
+    from hypothesis import given, settings
+
+    from qos import TraceRecorder, replay
+
+    @settings(max_examples=60, deadline=None)
+    @given(_clarc_batches())
+    def check(batches):
+        engine = Engine(CLARC)
+        recorder = TraceRecorder(engine, "clarc")
+        t, fired = 0.0, []
+        for gap, values, doctor in batches:
+            t += gap
+            result = engine.update(t, set=values, emit=["CallingDoctor"] if doctor else [])
+            assert all(0.0 <= value <= 1.0 for value in result.metrics.values())
+            assert result.fired == sorted(result.fired, key=lambda name: int(name[1:]))
+            if result.fired:
+                fired.append(result.fired)
+        if recorder.events and len({event.t for event in recorder.events}) == len(recorder.events):
+            assert [entry["observations"] for entry in replay(recorder.trace)["fired"]] == fired
+
+    check()

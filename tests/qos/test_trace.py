@@ -105,6 +105,12 @@ def test_statistics_sample_every_period_up_to_the_last_event():
     # a 2 s period samples t = 0, 2, 4 only
     assert replay(trace, sample_period=2)["metrics"]["Interaction"]["avg"] == pytest.approx(
         (expected[0] + expected[2] + expected[4]) / 3)
+    # an event between two samples is still applied, and sampled at its own time
+    late = Trace("clarc", [TraceEvent(2.5, {"PersonDetected": True})])
+    engine = Engine(load_model("clarc"))
+    assert replay(late)["fired"] == [{"t": 2.5, "observations": ["O2", "O8"]}]
+    assert replay(late)["metrics"]["Interaction"]["last"] == engine.update(2.5, set={"PersonDetected": True}).metrics[
+        "Interaction"]
     with pytest.raises(ValueError, match="sample period must be a positive"):
         replay(trace, sample_period=0)
 
