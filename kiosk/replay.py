@@ -31,6 +31,7 @@ from kiosk.session import (
     AnswerRecorded,
     AttemptOpened,
     AttemptTimedOut,
+    InputIgnored,
     Phase,
     PhaseChanged,
     QuestionNotAnswered,
@@ -49,6 +50,13 @@ _COMMANDS = {"pause": Command.PAUSE, "resume": Command.RESUME, "call_doctor": Co
 
 class ScriptError(ValueError):
     """A script is malformed, or declares something that does not happen under the session's rules."""
+
+
+def _script_error(problems: list[Problem]) -> ScriptError:
+    """One message: the first problem in file order, and how many more there are."""
+    first = min(problems, key=lambda p: (p.line, p.column))
+    more = f" (and {len(problems) - 1} more problems)" if len(problems) > 1 else ""
+    return ScriptError(f"{first}{more}")
 
 
 @cache
@@ -116,7 +124,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
     data, positions, problems = parse(text, name)
     if positions is None or not isinstance(data, dict):
         problems = problems or [Problem(name, 1, 1, "a script is a mapping (patient:, questions:, ...)")]
-        raise ScriptError("\n".join(map(str, problems)))
+        raise _script_error(problems)
 
     def where(p: tuple[Any, ...], key: bool = False) -> str:
         line, col = positions.of(p, key=key)
@@ -128,7 +136,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
 
     schema_problems(data, _schema(), positions, add)
     if problems:
-        raise ScriptError("\n".join(map(str, sorted(problems, key=lambda p: (p.line, p.column)))))
+        raise _script_error(problems)
 
     language = data.get("language", "en")
     if language not in questionnaire.languages:
@@ -141,7 +149,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
         add(("questions",), f"the script has {len(data['questions'])} questions; "
                             f"the questionnaire has {len(questionnaire.items)}")
     if problems:
-        raise ScriptError("\n".join(map(str, problems)))
+        raise _script_error(problems)
 
     def answer_step(p: tuple[Any, ...], entry: dict[str, Any], question: Item | PracticeQuestion,
                     kind: str, attempt: int | None) -> Step | None:
@@ -206,7 +214,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
                 steps.append(step)
         questions.append(Question(item, attempt, tuple(steps), where(p)))
     if problems:
-        raise ScriptError("\n".join(map(str, problems)))
+        raise _script_error(problems)
     return Script(
         source=name, patient=data["patient"], description=data.get("description", ""), language=language,
         answered_by=data.get("answered_by", "patient"), adaptation=data.get("adaptation", True),
@@ -374,7 +382,13 @@ class _Driver:
                 self.errors.append(f"{step.where}: the answer declared on attempt {step.attempt} came when the "
                                    f"session was at {state}")
                 return
-        self.session.handle(ChannelInput(step.channel, option=step.option, detail=step.say or "script"))
+        given = ChannelInput(step.channel, option=step.option, detail=step.say or "script")
+        self.session.handle(given)
+        ignored = [e for e in self.events if isinstance(e, InputIgnored) and e.input is given]
+        if ignored:
+            what = "practice answer" if index is None else f"answer declared on attempt {step.attempt}"
+            self.errors.append(f"{step.where}: the session ignored the {what} ({ignored[0].reason.value}) "
+                               f"at t={_num(self.session.now())} s")
 
     # the loop
 
