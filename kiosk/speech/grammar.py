@@ -1,0 +1,64 @@
+"""Per-question recogniser grammars, built from the matcher's phrases.
+
+The recogniser is constrained to what the current question can mean (its options' labels and
+synonyms, number words, commands, see :meth:`kiosk.speech.matching.Matcher.phrases`), which is
+what makes short answers from older voices recognisable at all. Every word must be known to the
+recogniser's dictionary; a phrase with an unknown word is left out and the reason logged, since
+the recogniser could never hear it anyway.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+log = logging.getLogger(__name__)
+
+
+def recogniser_words(phrase: str) -> list[str]:
+    """A phrase as recognisers write it: lower case, accents and apostrophes kept, no punctuation."""
+    return re.sub(r"[^\w' -]+", " ", phrase.lower()).replace("-", " ").split()
+
+
+@dataclass(frozen=True)
+class Grammar:
+    """The phrases a recogniser will listen for, and those left out (phrase, why)."""
+
+    phrases: tuple[str, ...]
+    dropped: tuple[tuple[str, str], ...] = ()
+
+
+def build_grammar(phrases: Sequence[str], known: Callable[[str], bool], recogniser: str) -> Grammar:
+    """Keep the phrases whose every word ``known`` accepts; log and list the others."""
+    kept: list[str] = []
+    dropped: list[tuple[str, str]] = []
+    for phrase in phrases:
+        words = recogniser_words(phrase)
+        unknown = [w for w in words if not known(w)]
+        if not words:
+            continue
+        if unknown:
+            reason = f"{', '.join(repr(w) for w in unknown)} not in the {recogniser} dictionary"
+            log.info("grammar: leaving out %r: %s", phrase, reason)
+            dropped.append((phrase, reason))
+            continue
+        text = " ".join(words)
+        if text not in kept:
+            kept.append(text)
+    return Grammar(tuple(kept), tuple(dropped))
+
+
+def to_jsgf(grammar: Grammar, name: str = "answer") -> str:
+    """A JSGF grammar (pocketsphinx) accepting exactly one of the phrases."""
+    if not grammar.phrases:
+        raise ValueError("a grammar needs at least one phrase the recogniser knows")
+    body = " | ".join(grammar.phrases)
+    return f"#JSGF V1.0;\ngrammar {name};\npublic <{name}> = {body} ;\n"
+
+
+def to_vosk(grammar: Grammar) -> str:
+    """A Vosk grammar: a JSON list of phrases plus "[unk]", so other speech has somewhere to go."""
+    return json.dumps([*grammar.phrases, "[unk]"], ensure_ascii=False)
