@@ -115,19 +115,41 @@ class ReconnectingReader:
                 connection = self.connect()
             except DeviceUnavailable as missing:
                 self._report(sink, ChannelState.LOST if was_connected else missing.state, missing.reason)
-                self._wait(next(delays), self._stopping)
-                continue
-            delays = self._backoff.delays()
-            was_connected = True
-            self._report(sink, ChannelState.ON, connection.description)
-            try:
-                while not self._stopping.is_set():
-                    for press in connection.read():
-                        self._deliver(sink, to_input(press.button, f"{connection.label}: {press.frame}"))
-            except DeviceLost as lost:
-                self._report(sink, ChannelState.LOST, str(lost))
-            finally:
-                connection.close()
+            except Exception as error:  # drivers also fail in undocumented ways: log it, retry
+                log.exception("%s: unexpected error while connecting", self.name)
+                self._report(sink, ChannelState.LOST if was_connected else ChannelState.CONNECTING,
+                             f"cannot open the remote: {error}")
+            else:
+                was_connected = True
+                if self._read_until_lost(sink, connection):
+                    delays = self._backoff.delays()
+            self._wait(next(delays), self._stopping)
+
+    def _read_until_lost(self, sink: Sink, connection: Connection) -> bool:
+        """Deliver presses until the device fails or the reader stops; report the loss.
+
+        Returns whether the device ever read successfully: only then does the backoff start
+        over, so a device that opens but fails at once is retried ever more slowly.
+        """
+        self._report(sink, ChannelState.ON, connection.description)
+        healthy = False
+        reason = ""
+        try:
+            while not self._stopping.is_set():
+                presses = connection.read()
+                healthy = True
+                for press in presses:
+                    self._deliver(sink, to_input(press.button, f"{connection.label}: {press.frame}"))
+        except DeviceLost as lost:
+            reason = str(lost)
+        except Exception as error:  # as above: a broken driver must not silently end the reader
+            log.exception("%s: unexpected error while reading", self.name)
+            reason = f"the remote failed: {error}"
+        finally:
+            connection.close()
+        if reason:
+            self._report(sink, ChannelState.LOST, reason)
+        return healthy
 
     def _report(self, sink: Sink, state: ChannelState, reason: str) -> None:
         # one status per change of state: retries while a device stays away are not news

@@ -126,3 +126,31 @@ def test_other_devices_on_the_bus_are_not_used(hid_bus, hid_wait, hid_reader):
     sink = Collector()
     hid_reader.start(sink)
     sink.status(ChannelState.OFF)
+
+
+def test_an_undocumented_driver_failure_is_reported_lost_and_the_reader_carries_on(hid_bus, hid_wait, hid_reader,
+                                                                                   caplog):
+    device = hid_bus.plug(VID, PID)
+    sink = Collector()
+    hid_reader.start(sink)
+    sink.status(ChannelState.ON)
+
+    def broken(timeout: float) -> bytes:
+        raise RuntimeError("hidapi fell over")
+
+    device.read = broken
+    lost = sink.status(ChannelState.LOST)
+    assert lost.reason == "the remote failed: hidapi fell over"
+    assert "unexpected error while reading" in caplog.text
+    assert hid_wait.next_delay() == 0.5  # it waits before trying again, even though still plugged
+    hid_wait.proceed()
+    sink.status(ChannelState.ON)
+    sink.status(ChannelState.LOST)  # the same broken device again
+    assert hid_wait.next_delay() == 1.0  # never read well, so the backoff keeps growing
+
+    hid_bus.unplug(device)
+    device = hid_bus.plug(VID, PID)  # a working one
+    hid_wait.proceed()
+    sink.status(ChannelState.ON)
+    device.send(report(0x01), at=1.0)
+    assert sink.inputs(1)[0].option == 1
