@@ -1,0 +1,185 @@
+"""The bundled Barthel questionnaire, scoring, and `kiosk validate` on every kind of mistake."""
+
+from __future__ import annotations
+
+import json
+
+import jsonschema
+import pytest
+
+from kiosk.questionnaire import (
+    QuestionnaireError,
+    Timing,
+    bundled_path,
+    check_questionnaire_file,
+    load_questionnaire,
+)
+from kiosk.validate import main as validate_main
+
+Q = load_questionnaire()
+TEXT = bundled_path().read_text(encoding="utf-8")
+
+
+def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
+    assert [i.id for i in Q.items] == ["feeding", "bathing", "grooming", "dressing", "bowels", "bladder",
+                                       "toilet", "transfers", "mobility", "stairs"]
+    assert Q.languages == ("en", "es", "fr")
+    assert sorted(len(i.options) for i in Q.items) == [2, 2, 3, 3, 3, 3, 3, 3, 4, 4]
+    for item in Q.items:
+        for lang in Q.languages:
+            assert item.text[lang] and item.spoken[lang]
+            assert all(o.label_in(lang) and o.synonyms_in(lang) for o in item.options)
+        assert [o.number for o in item.options] == list(range(1, len(item.options) + 1))
+        assert item.code is not None and item.code.system == "http://loinc.org"
+    assert Q.item("transfers").points == {0, 5, 10, 15}
+    assert [b.id for b in Q.bands] == ["total", "severe", "moderate", "slight", "independent"]
+    assert Q.timing == Timing(20, 2, 10, 5, 5)
+    assert len(Q.familiarisation) >= 2 and {p.checks for p in Q.familiarisation} >= {"hear", "read"}
+
+
+def test_the_loinc_codes_are_marked_for_verification():
+    assert TEXT.count("verify before shipping") >= 12
+
+
+def test_scoring_edge_cases():
+    lowest = Q.score({i.id: 0 for i in Q.items})
+    assert (lowest.total, lowest.complete, lowest.band.id) == (0, True, "total")
+    highest = Q.score({i.id: i.max_points for i in Q.items})
+    assert (highest.total, highest.band.id, highest.max_total) == (100, "independent", 100)
+    partial = Q.score({"feeding": 10, "stairs": 5})
+    assert (partial.total, partial.complete, partial.band) == (15, False, None)
+    assert partial.missing == tuple(i.id for i in Q.items if i.id not in ("feeding", "stairs"))
+    with pytest.raises(ValueError, match="7 points is not an option of item 'feeding'"):
+        Q.score({"feeding": 7})
+    with pytest.raises(ValueError, match="15 points is not an option of item 'stairs'"):
+        Q.score({"stairs": 15})
+    with pytest.raises(ValueError, match="unknown item 'walking'"):
+        Q.score({"walking": 5})
+    with pytest.raises(ValueError):
+        Q.score({"bathing": True})
+
+
+@pytest.mark.parametrize(("total", "band"), [(20, "total"), (21, "severe"), (60, "severe"), (61, "moderate"),
+                                             (90, "moderate"), (95, "slight"), (100, "independent")])
+def test_bands_follow_shah(total, band):
+    assert Q.band_for(total).id == band
+
+
+def test_timing_overrides_are_checked():
+    assert Q.timing.with_overrides({"attempt_window_s": 30}).attempt_window_s == 30
+    with pytest.raises(ValueError, match="unknown timing setting 'window'"):
+        Q.timing.with_overrides({"window": 3})
+    with pytest.raises(ValueError, match="must be a number of seconds >= 0"):
+        Q.timing.with_overrides({"closing_s": -1})
+
+
+def test_the_schema_is_a_valid_json_schema_that_accepts_the_bundled_file():
+    import yaml
+
+    schema = json.loads(bundled_path("questionnaire.schema.json").read_text())
+    jsonschema.Draft202012Validator.check_schema(schema)
+    jsonschema.validate(yaml.safe_load(TEXT), schema)
+
+
+class Where(str):
+    """'line:col'; adding n moves the column right (to point past a leading space)."""
+
+    def __add__(self, n):
+        line, col = self.split(":")
+        return Where(f"{line}:{int(col) + n}")
+
+
+def position(text: str, needle: str, nth: int = 0) -> Where:
+    """'line:col' of the nth occurrence of needle."""
+    index = -1
+    for _ in range(nth + 1):
+        index = text.index(needle, index + 1)
+    line = text.count("\n", 0, index) + 1
+    return Where(f"{line}:{index - text.rfind(chr(10), 0, index)}")
+
+
+def broken(tmp_path, old: str, new: str, count: int = 1):
+    assert old in TEXT, old
+    text = TEXT.replace(old, new, count)
+    path = tmp_path / "barthel.yaml"
+    path.write_text(text, encoding="utf-8")
+    return path, text
+
+
+def test_duplicate_ids(tmp_path):
+    path, text = broken(tmp_path, "  - id: bathing", "  - id: feeding")
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, 'feeding', 1)}: duplicate id 'feeding' (also used at items[0])"]
+
+
+def test_missing_translation(tmp_path):
+    path, text = broken(tmp_path, "      fr: Comment faites-vous pour vous habiller, y compris les boutons, les "
+                                  "fermetures et les lacets ?\n", "")
+    spoken = text.index("spoken:", text.index("id: dressing"))
+    line = text.count("\n", 0, spoken) + 1
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{line + 1}:7: items[3].spoken has no 'fr' translation"]
+
+
+def test_option_without_points(tmp_path):
+    path, text = broken(tmp_path, "      - points: 0\n        label: {en: \"Unable\"",
+                        "      - label: {en: \"Unable\"")
+    where = position(text, 'label: {en: "Unable"')
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{where}: items[0].options[0] is missing 'points'"]
+
+
+def test_points_not_a_multiple_of_five(tmp_path):
+    path, text = broken(tmp_path, "      - points: 15\n        label: {en: \"Independent\"",
+                        "      - points: 12\n        label: {en: \"Independent\"")
+    # the wrong points also make the bands stop short of the highest possible total
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, '- id: total')}: bands end at 100 but the highest possible total is 97",
+        f"{path}:{position(text, ' 12') + 1}: items[7].options[3].points: must be a multiple of 5, got 12"]
+
+
+def test_unknown_keys(tmp_path):
+    path, text = broken(tmp_path, "  - id: grooming\n", "  - id: grooming\n    colour: blue\n")
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, 'colour')}: unknown key 'colour' in items[2]"]
+
+
+def test_yaml_syntax(tmp_path):
+    path, text = broken(tmp_path, "languages: [en, es, fr]", "languages: [en, es, fr")
+    (problem,) = check_questionnaire_file(path)
+    assert str(problem).startswith(f"{path}:") and "YAML syntax" in problem.message
+
+
+def test_duplicate_keys_are_not_silently_merged(tmp_path):
+    path, text = broken(tmp_path, "id: barthel\n", "id: barthel\nid: barthel2\n")
+    assert [str(p) for p in check_questionnaire_file(path)] == [f"{path}:{position(text, 'id: barthel2')}: "
+                                                                "duplicate key 'id'"]
+
+
+def test_bands_with_a_gap(tmp_path):
+    path, text = broken(tmp_path, "      min: 61", "      min: 65")
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, ' 65') + 1}: bands leave a gap before 65 (expected the next band to start at 61)"]
+
+
+def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path, capsys):
+    text = (TEXT.replace("  - id: bathing", "  - id: feeding")
+            .replace("  - id: grooming\n", "  - id: grooming\n    colour: blue\n")
+            .replace("      - points: 5\n        label: {en: \"Occasional accident\"",
+                     "      - points: 6\n        label: {en: \"Occasional accident\"", 1))
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    assert validate_main([str(path)]) == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 3
+    assert any("duplicate id" in line for line in lines) and any("colour" in line for line in lines)
+    assert any("multiple of 5" in line for line in lines)
+    with pytest.raises(QuestionnaireError) as caught:
+        load_questionnaire(path)
+    assert len(caught.value.problems) == 3 and "and 2 more problems" in str(caught.value)
+
+
+def test_validate_accepts_the_bundled_file_and_reports_unreadable_ones(tmp_path, capsys):
+    assert validate_main([str(bundled_path())]) == 0
+    assert validate_main([str(tmp_path / "missing.yaml")]) == 1
+    assert "missing.yaml:1:1: cannot read the file" in capsys.readouterr().out
