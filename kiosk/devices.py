@@ -12,6 +12,7 @@ import sys
 
 import serial.tools.list_ports
 
+from kiosk.config import ConfigError, load_config
 from kiosk.remote.buttons import button_name
 from kiosk.remote.hid import HidapiBackend, HidDeviceInfo
 from kiosk.remote.profiles import (BUILTIN_PROFILES, HidProfile, KeyboardProfile, Profile, ProfileError,
@@ -23,11 +24,14 @@ def main(argv: list[str]) -> int:
     """Print the devices report; exit status 2 if the profile file is unusable."""
     parser = argparse.ArgumentParser(prog="kiosk devices", description="List remotes (HID, serial) and audio inputs, and what the kiosk would use.")
     parser.add_argument("--profiles", metavar="PATH",
-                        help="the site's device profile file (adds to or overrides the built-in ones)")
+                        help="the site's device profile file, adding to or overriding the built-in ones "
+                             "(default: remote_profiles from the kiosk's config)")
     args = parser.parse_args(argv)
     try:
+        if args.profiles is None:
+            args.profiles = load_config().remote_profiles
         profiles = load_profiles(args.profiles)
-    except ProfileError as error:
+    except (ConfigError, ProfileError) as error:
         print(f"kiosk devices: {error}", file=sys.stderr)
         return 2
 

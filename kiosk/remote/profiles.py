@@ -1,10 +1,11 @@
 """Device profiles for big-button remotes: which device to look for and what its buttons send.
 
 The built-in profiles live in ``kiosk/remote/devices.yaml``. A site may add or change profiles
-in its own file (named by the kiosk's config) with the same layout: a profile whose ``name``
+in its own file (the config's ``remote_profiles``) with the same layout: a profile whose ``name``
 matches a built-in one overrides just the fields it gives (``enabled: false`` turns one off),
 any other name adds a profile. Everything is validated before anything is used; the first
-problem raises :class:`ProfileError` with one sentence naming the file, the profile and the field.
+problem raises :class:`ProfileError`: one sentence naming the file, line and column, the profile
+and the field.
 """
 
 from __future__ import annotations
@@ -14,10 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
 from kiosk.remote.decoders import ReportMatch
+from kiosk.yamlmarks import Positions, Problem, parse
 
 #: the profiles shipped with the kiosk
 BUILTIN_PROFILES = Path(__file__).with_name("devices.yaml")
@@ -114,64 +114,83 @@ class Profiles:
 
 def load_profiles(user_path: str | Path | None = None) -> Profiles:
     """Load the built-in profiles, apply the site's file ``user_path`` if given, and validate."""
-    merged: dict[str, dict[str, Any]] = {}
-    # which file each field of each profile came from, so an error names the right file
-    origin: dict[str, dict[str, Path]] = {}
+    merged: dict[str, _Fields] = {}
     for path in [BUILTIN_PROFILES] + ([Path(user_path)] if user_path is not None else []):
-        for raw in _read_file(path):
-            name = raw["name"]
-            merged.setdefault(name, {}).update(raw)
-            origin.setdefault(name, {}).update({key: path for key in raw})
-    profiles = tuple(_build(raw, origin[name]) for name, raw in merged.items())
-    _check_keyboard_clashes(profiles, origin)
+        for entry in _read_file(path):
+            name = entry.raw["name"]
+            if name in merged:
+                merged[name].override(entry)
+            else:
+                merged[name] = entry
+    profiles = tuple(_build(fields) for fields in merged.values())
+    _check_keyboard_clashes(profiles, merged)
     return Profiles(profiles)
 
 
-def _read_file(path: Path) -> list[dict[str, Any]]:
+class _Where:
+    """Where one profile was written: the file, its positions, and the profile's list index."""
+
+    def __init__(self, path: Path, positions: Positions, index: int) -> None:
+        self.path, self.positions, self.index = path, positions, index
+
+    def problem(self, keys: tuple[Any, ...], message: str) -> ProfileError:
+        line, column = self.positions.of(("profiles", self.index) + keys, key=True)
+        return ProfileError(str(Problem(str(self.path), line, column, message)))
+
+
+def _read_file(path: Path) -> list[_Fields]:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ProfileError(f"{path}: device profile file not found") from None
     except (OSError, UnicodeDecodeError) as error:
         raise ProfileError(f"{path}: cannot read device profiles: {error}") from None
-    try:
-        document = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" line {mark.line + 1}:" if mark is not None else ""
-        problem = getattr(error, "problem", None) or str(error)
-        raise ProfileError(f"{path}:{where} not valid YAML: {problem}") from None
-    if document is None:
-        return []
+    document, positions, problems = parse(text, str(path))
+    if problems:
+        raise ProfileError(str(problems[0]))
+    assert positions is not None
     if not isinstance(document, dict) or set(document) != {"profiles"}:
-        raise ProfileError(f"{path}: expected a mapping with one key, 'profiles', holding a list")
+        line, column = positions.of(())
+        raise ProfileError(str(Problem(str(path), line, column,
+                                       "expected a mapping with one key, 'profiles', holding a list")))
     entries = document["profiles"] or []
     if not isinstance(entries, list):
-        raise ProfileError(f"{path}: 'profiles' must be a list of profiles")
+        line, column = positions.of(("profiles",))
+        raise ProfileError(str(Problem(str(path), line, column, "'profiles' must be a list of profiles")))
+    read: list[_Fields] = []
     seen: set[str] = set()
-    for index, entry in enumerate(entries, start=1):
+    for index, entry in enumerate(entries):
+        where = _Where(path, positions, index)
         if not isinstance(entry, dict):
-            raise ProfileError(f"{path}: profile #{index} must be a mapping of fields")
+            raise where.problem((), f"profile #{index + 1} must be a mapping of fields")
         name = entry.get("name")
         if not isinstance(name, str) or not name.strip():
-            raise ProfileError(f"{path}: profile #{index}, field 'name': must be a non-empty text")
+            raise where.problem(("name",), f"profile #{index + 1}, field 'name': must be a non-empty text")
         if name in seen:
-            raise ProfileError(f"{path}: profile {name!r}, field 'name': appears twice in this file")
+            raise where.problem(("name",), f"profile {name!r}, field 'name': appears twice in this file")
         seen.add(name)
-    return entries
+        read.append(_Fields(entry, where))
+    return read
 
 
 class _Fields:
-    """Reads one merged profile's fields, raising a ProfileError naming file, profile and field."""
+    """One profile's fields, merged over the files that set them; reading a field checks it, and
+    a problem becomes a ProfileError naming the file, line, profile and field."""
 
-    def __init__(self, raw: dict[str, Any], origin: dict[str, Path]) -> None:
-        self.raw = raw
-        self.origin = origin
+    def __init__(self, raw: dict[str, Any], where: _Where) -> None:
+        self.raw = dict(raw)
         self.name = raw["name"]
+        # which file set each field, so an error points at the line that is wrong
+        self.origin = {key: where for key in raw}
 
-    def fail(self, key: str, problem: str, sub: str = "") -> ProfileError:
-        path = self.origin.get(key, self.origin["name"])
-        return ProfileError(f"{path}: profile {self.name!r}, field '{key}{sub}': {problem}")
+    def override(self, other: _Fields) -> None:
+        self.raw.update(other.raw)
+        self.origin.update(other.origin)
+
+    def fail(self, key: str, problem: str, sub: tuple[Any, ...] = ()) -> ProfileError:
+        where = self.origin.get(key, self.origin["name"])
+        dotted = ".".join([key, *map(str, sub)])
+        return where.problem((key, *map(str, sub)), f"profile {self.name!r}, field '{dotted}': {problem}")
 
     def get(self, key: str, default: Any = ...) -> Any:
         if key not in self.raw:
@@ -186,7 +205,7 @@ class _Fields:
             return None
         return self.check_int(key, value, low, high)
 
-    def check_int(self, key: str, value: Any, low: int, high: int | None, sub: str = "") -> int:
+    def check_int(self, key: str, value: Any, low: int, high: int | None, sub: tuple[Any, ...] = ()) -> int:
         if isinstance(value, str):
             try:
                 value = int(value, 0)  # "0x1209" as well as 4617
@@ -217,15 +236,15 @@ class _Fields:
             raise self.fail(key, "must be a non-empty mapping")
         return value
 
-    def button(self, key: str, value: Any, sub: str) -> Button:
+    def button(self, key: str, value: Any, sub: tuple[Any, ...]) -> Button:
         try:
             return parse_button(value)
         except ValueError as error:
             raise self.fail(key, str(error), sub) from None
 
 
-def _build(raw: dict[str, Any], origin: dict[str, Path]) -> Profile:
-    fields = _Fields(raw, origin)
+def _build(fields: _Fields) -> Profile:
+    raw = fields.raw
     kind = fields.get("kind")
     if kind not in KINDS:
         raise fields.fail("kind", f"must be one of {', '.join(KINDS)}, got {kind!r}")
@@ -251,7 +270,7 @@ def _build_serial(fields: _Fields, common: dict[str, Any]) -> SerialProfile:
     max_line = fields.integer("max_line", 64, low=1, high=4096)
     lines: dict[str, Button] = {}
     for text, value in fields.mapping("lines").items():
-        sub = f".{text}"
+        sub = (text,)
         if not isinstance(text, str) or not text.strip():
             raise fields.fail("lines", "each line must be a non-empty text", sub)
         if text != text.strip(" \t\r") or "\n" in text:
@@ -271,16 +290,16 @@ def _build_serial(fields: _Fields, common: dict[str, Any]) -> SerialProfile:
 def _build_hid(fields: _Fields, common: dict[str, Any]) -> HidProfile:
     buttons: dict[Button, ReportMatch] = {}
     for key, spec in fields.mapping("buttons").items():
-        sub = f".{key}"
+        sub = (key,)
         button = fields.button("buttons", key, sub)
         if button in buttons:
             raise fields.fail("buttons", "names the same button twice", sub)
         if not isinstance(spec, dict) or not {"byte"} <= set(spec) <= {"byte", "mask", "value"} \
                 or len(spec) != 2:
             raise fields.fail("buttons", "must be {byte: N, mask: M} or {byte: N, value: V}", sub)
-        byte = fields.check_int("buttons", spec["byte"], 0, 63, f"{sub}.byte")
+        byte = fields.check_int("buttons", spec["byte"], 0, 63, (*sub, "byte"))
         kind = "mask" if "mask" in spec else "value"
-        number = fields.check_int("buttons", spec[kind], 1 if kind == "mask" else 0, 255, f"{sub}.{kind}")
+        number = fields.check_int("buttons", spec[kind], 1 if kind == "mask" else 0, 255, (*sub, kind))
         buttons[button] = ReportMatch(byte=byte, **{kind: number})
     debounce = fields.get("debounce_ms", 30)
     if isinstance(debounce, bool) or not isinstance(debounce, int | float) or debounce < 0:
@@ -298,7 +317,7 @@ def _build_hid(fields: _Fields, common: dict[str, Any]) -> HidProfile:
 def _build_keyboard(fields: _Fields, common: dict[str, Any]) -> KeyboardProfile:
     keys: dict[str, Button] = {}
     for key, value in fields.mapping("keys").items():
-        sub = f".{key}"
+        sub = (key,)
         if not isinstance(key, str) or not key.strip():
             raise fields.fail("keys", "each key must be a Textual key name such as 'f13' or 'pageup'", sub)
         if key.lower() in KIOSK_KEYS:
@@ -308,7 +327,7 @@ def _build_keyboard(fields: _Fields, common: dict[str, Any]) -> KeyboardProfile:
     return KeyboardProfile(keys=keys, **common)
 
 
-def _check_keyboard_clashes(profiles: tuple[Profile, ...], origin: dict[str, dict[str, Path]]) -> None:
+def _check_keyboard_clashes(profiles: tuple[Profile, ...], fields: dict[str, _Fields]) -> None:
     """Two enabled keyboard remotes may not give one key two meanings."""
     owner: dict[str, tuple[KeyboardProfile, Button]] = {}
     for profile in profiles:
@@ -317,9 +336,6 @@ def _check_keyboard_clashes(profiles: tuple[Profile, ...], origin: dict[str, dic
         for key, button in profile.keys.items():
             if key in owner and owner[key][1] != button:
                 other, theirs = owner[key]
-                raise ProfileError(
-                    f"{origin[profile.name]['keys']}: profile {profile.name!r}, field 'keys.{key}': "
-                    f"means {button_name(button)!r} here but {button_name(theirs)!r} in enabled "
-                    f"profile {other.name!r}"
-                )
+                raise fields[profile.name].fail("keys", f"means {button_name(button)!r} here but "
+                                                f"{button_name(theirs)!r} in enabled profile {other.name!r}", (key,))
             owner[key] = (profile, button)

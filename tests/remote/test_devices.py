@@ -3,10 +3,18 @@
 from __future__ import annotations
 
 import hid
+import pytest
 
 from kiosk.cli import main
 
 from .boxes import ButtonBox
+
+
+@pytest.fixture(autouse=True)
+def devices_config_home(tmp_path, monkeypatch):
+    """No kiosk config unless a test writes one: keep the developer's own config out."""
+    monkeypatch.delenv("KIOSK_CONFIG", raising=False)
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config-home"))
 
 
 def section(out: str, title: str) -> list[str]:
@@ -54,11 +62,23 @@ def test_devices_shows_which_port_a_site_profile_would_take(tmp_path, capsys):
     assert f"{box.link} -> remote, profile serial-usb" in section(out, "Serial ports:")
 
 
+def test_the_site_file_named_in_the_config_is_used(tmp_path, capsys, monkeypatch):
+    site = tmp_path / "site.yaml"
+    site.write_text("profiles:\n  - name: presenter\n    enabled: true\n")
+    config = tmp_path / "config.yaml"
+    config.write_text(f"remote_profiles: {site}\n")
+    monkeypatch.setenv("KIOSK_CONFIG", str(config))
+    assert main(["devices"]) == 0
+    out = capsys.readouterr().out
+    assert f"Remote profiles (built-in devices.yaml + {site}):" in out
+    assert "presenter: keyboard keys pageup=1, pagedown=2, f5=repeat, b=pause -> read from key presses" in out
+
+
 def test_a_bad_profile_file_is_one_line_and_exit_status_2(tmp_path, capsys):
     site = tmp_path / "site.yaml"
     site.write_text("profiles:\n  - name: serial-usb\n    baud: -3\n")
     assert main(["devices", "--profiles", str(site)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert captured.err == (f"kiosk devices: {site}: profile 'serial-usb', field 'baud': "
+    assert captured.err == (f"kiosk devices: {site}:3:5: profile 'serial-usb', field 'baud': "
                             "must be at least 1, got -3\n")

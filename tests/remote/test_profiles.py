@@ -74,7 +74,8 @@ profiles:
         ("profiles:\n  - kind: serial\n", "profile #1, field 'name': must be a non-empty text"),
         ("profiles:\n  - name: a\n    kind: keyboard\n    keys: {f1: 1}\n  - name: a\n",
          "profile 'a', field 'name': appears twice in this file"),
-        ("profiles: [\n", "line 2: not valid YAML"),
+        ("profiles: [\n", ":2:1: YAML syntax: expected the node content"),
+        ("profiles:\n  - name: serial-usb\n    baud: 1\n    baud: 2\n", ":4:5: duplicate key 'baud'"),
         ("- just a list\n", "expected a mapping with one key, 'profiles'"),
     ],
 )
@@ -90,8 +91,24 @@ def test_a_mistake_is_one_message_naming_file_profile_and_field(tmp_path, text, 
 def test_an_error_in_a_builtin_field_names_the_builtin_file(tmp_path):
     # the override changes the kind; the built-in's serial fields are now the wrong ones
     path = write(tmp_path, "profiles:\n  - name: serial-usb\n    kind: keyboard\n    keys: {f1: 1}\n")
-    with pytest.raises(ProfileError, match=f"^{BUILTIN_PROFILES}: profile 'serial-usb', field "):
+    with pytest.raises(ProfileError, match=f"^{BUILTIN_PROFILES}:[0-9]+:5: profile 'serial-usb', "
+                                           "field 'baud': is not a field of a keyboard profile"):
         load_profiles(path)
+
+
+def test_the_message_points_at_the_line_and_column_of_the_field(tmp_path):
+    path = write(tmp_path, """profiles:
+  - name: serial-usb
+    port: /dev/ttyUSB*
+  - name: hid-bigbutton
+    buttons:
+      1: {byte: 1, mask: 1}
+      2: {byte: 99, mask: 2}
+""")
+    with pytest.raises(ProfileError) as caught:
+        load_profiles(path)
+    assert str(caught.value) == (f"{path}:7:11: profile 'hid-bigbutton', field 'buttons.2.byte': "
+                                 "must be from 0 to 63, got 99")
 
 
 def test_a_missing_site_file_is_named(tmp_path):
@@ -99,5 +116,7 @@ def test_a_missing_site_file_is_named(tmp_path):
         load_profiles(tmp_path / "nowhere.yaml")
 
 
-def test_an_empty_site_file_changes_nothing(tmp_path):
-    assert load_profiles(write(tmp_path, "")) == load_profiles()
+def test_an_empty_site_file_is_named_and_an_empty_list_changes_nothing(tmp_path):
+    with pytest.raises(ProfileError, match="my-devices.yaml:1:1: the file is empty"):
+        load_profiles(write(tmp_path, "# nothing yet\n"))
+    assert load_profiles(write(tmp_path, "profiles: []\n")) == load_profiles()
