@@ -71,8 +71,8 @@ def load_policy(path: str | Path | None = None) -> Policy:
     if problems or positions is None:
         raise PolicyError("\n".join(map(str, problems)))
 
-    def fail(p: tuple[Any, ...], message: str) -> PolicyError:
-        line, col = positions.of(p)
+    def fail(p: tuple[Any, ...], message: str, key: bool = False) -> PolicyError:
+        line, col = positions.of(p, key=key)
         return PolicyError(str(Problem(name, line, col, message)))
 
     if not isinstance(data, dict) or set(data) != {"rules"} or not isinstance(data["rules"], list):
@@ -84,7 +84,7 @@ def load_policy(path: str | Path | None = None) -> Policy:
             raise fail(p, "each rule is a mapping")
         unknown = set(raw) - _RULE_KEYS
         if unknown:
-            raise fail(p + (sorted(unknown)[0],), f"unknown key {sorted(unknown)[0]!r} in a rule")
+            raise fail(p + (sorted(unknown)[0],), f"unknown key {sorted(unknown)[0]!r} in a rule", key=True)
         missing = _RULE_KEYS - {"speech_rate"} - set(raw)
         if missing:
             raise fail(p, f"rule is missing {sorted(missing)[0]!r}")
