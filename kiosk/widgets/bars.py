@@ -27,7 +27,8 @@ class ChannelLine:
 
 
 class ChannelBar(Static):
-    """Which channels are live (speaking, listening, remote connected) and which are off."""
+    """Which channels are live (speaking, listening, remote connected) and which are off; the
+    reasons would not fit on one line, so the welcome and clinician screens list them."""
 
     def show(self, lines: Sequence[ChannelLine]) -> None:
         """Replace the shown channel states."""
@@ -37,9 +38,13 @@ class ChannelBar(Static):
                 text.append("   ")
             text.append(f"{line.name}: ", style="bold")
             text.append(line.state, style="bold #0b5d1e" if line.live else "bold #8b0000")
-            if line.reason and not line.live:
-                text.append(f" ({line.reason})")
         self.update(text)
+
+
+def channel_reasons(lines: Sequence[ChannelLine]) -> str:
+    """One line per channel that is not live, with why (for whoever sets the kiosk up)."""
+    return "\n".join(f"{line.name}: {line.state} ({line.reason})" for line in lines
+                     if not line.live and line.reason)
 
 
 class AdaptationBanner(Static):

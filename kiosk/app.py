@@ -1,0 +1,466 @@
+"""The kiosk's Textual app: wires the session, the channels and the QoS engine to the screens.
+
+Nothing is decided here. The app
+
+* forwards every input -- a touch, a key, a remote press or a voice answer -- to the
+  :class:`~kiosk.session.Session` as a :class:`~kiosk.channels.ChannelInput`;
+* calls :meth:`Session.poll` from a timer, so the session's own time-outs happen (the session
+  reads time from its injected clock; tests use a :class:`~kiosk.clock.SimClock`);
+* reacts to the session's events: speaks prompts, tells the recogniser when to listen, and
+  switches to the screen the session's :meth:`~kiosk.session.Session.snapshot` calls for.
+
+Channels run on their own threads and only ever call :meth:`KioskApp.channel_sink`, which posts a
+small message to the UI thread; no thread touches a widget. A channel that is missing (no
+microphone, no espeak-ng, no remote) is shown as off with its reason and the session goes on.
+
+`kiosk run` (also plain `kiosk`) is :func:`main`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from textual.app import App
+from textual.binding import Binding
+from textual.message import Message
+
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
+from kiosk.questionnaire import Questionnaire
+from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView
+from kiosk.screens.clinician_home import ClinicianHomeScreen
+from kiosk.screens.doctor_called import DoctorCalledScreen
+from kiosk.screens.explanation import ExplanationScreen
+from kiosk.screens.familiarisation import FamiliarisationScreen
+from kiosk.screens.paused import PausedScreen
+from kiosk.screens.pin import PinScreen
+from kiosk.screens.question import QuestionScreen
+from kiosk.screens.summary import SummaryScreen
+from kiosk.screens.welcome import WelcomeScreen
+from kiosk.session import (
+    AdaptationChanged,
+    AnswerRecorded,
+    DoctorCalled,
+    ListeningChanged,
+    Paused,
+    Phase,
+    Prompt,
+    Session,
+    SessionEvent,
+    VolumeChanged,
+)
+from kiosk.storage import Store
+from kiosk.widgets.answer_button import AnswerButton
+from kiosk.widgets.bars import ControlBar
+from kiosk.widgets.channel_board import ChannelBoard
+from kiosk.widgets.text import ui_text
+
+#: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
+KIOSK_SIZE = (100, 32)
+#: the clinician screens open with this chord, then ask for the PIN
+CLINICIAN_CHORD = "ctrl+k"
+#: the kiosk's own keys (channel KEYBOARD): answers 1-4 and the remote's command buttons
+KIOSK_KEYS: dict[str, int | Command] = {
+    "1": 1, "2": 2, "3": 3, "4": 4,
+    "p": Command.PAUSE, "d": Command.CALL_DOCTOR, "r": Command.REPEAT,
+}
+#: how often the session is polled for time-outs (seconds); it fires them at their own due time
+POLL_INTERVAL = 0.1
+#: the source name the voice-out statuses carry when no speaker is wired
+VOICE_OUT_SOURCE = "espeak-ng"
+
+
+@dataclass
+class ChannelReceived(Message):
+    """A channel thread delivered an input or a status change (posted, never handled on that thread)."""
+
+    item: ChannelInput | ChannelStatus
+
+
+@dataclass
+class SpeechActivity(Message):
+    """Voice out started (True) or stopped (False) talking."""
+
+    speaking: bool
+
+
+class KioskApp(App[int]):
+    """The patient's kiosk, with the clinician screens behind a key chord and a PIN.
+
+    ``session`` is a fresh (not yet started) session. ``speaker`` is a ``kiosk.speech.tts.Speaker``
+    or None (voice out off); ``voice`` a voice-in source, ``sources`` the remotes' input sources
+    (all started with :meth:`channel_sink` on mount and stopped on exit). ``statuses`` are channel
+    states known before start-up, such as "voice in off: no microphone found". ``keyboard`` is a
+    ``kiosk.remote.KeyboardRemote`` for remotes that type keys.
+    """
+
+    CSS_PATH = "kiosk.tcss"
+    TITLE = "Barthel kiosk"
+    BINDINGS = [Binding(CLINICIAN_CHORD, "clinician", "Clinician", show=False, priority=True)]
+
+    def __init__(
+        self,
+        session: Session,
+        *,
+        clinician_pin: str,
+        store: Store | None = None,
+        speaker: Any = None,
+        voice: InputSource | None = None,
+        sources: Iterable[InputSource] = (),
+        keyboard: Any = None,
+        statuses: Iterable[ChannelStatus] = (),
+        export_dir: Path | None = None,
+        poll_interval: float = POLL_INTERVAL,
+    ) -> None:
+        super().__init__()
+        self.session = session
+        self.questionnaire: Questionnaire = session.questionnaire
+        self.store = store
+        self.clinician_pin = clinician_pin
+        self.speaker = speaker
+        self.voice = voice
+        self.sources = list(sources)
+        self.keyboard = keyboard
+        self.export_dir = export_dir
+        self.poll_interval = poll_interval
+        self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
+        if speaker is None:
+            self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE, "voice out turned off"))
+        for status in statuses:
+            self.board.update(status)
+        #: every session event the app received, in order (the clinician screens and tests read it)
+        self.events: list[SessionEvent] = []
+        self._screen_key: tuple[type, object] | None = None
+        self._dirty = False
+        self.session.subscribe(self._on_session_event)
+
+    # -- start and stop -------------------------------------------------------------------------
+
+    def on_mount(self) -> None:
+        """Start the channels and the poll timer, and show the welcome screen."""
+        if self.speaker is not None:
+            self.speaker.start()
+        for source in self._input_sources():
+            source.start(self.channel_sink)
+        self.set_interval(self.poll_interval, self.poll_session)
+        self._render()
+
+    def on_unmount(self) -> None:
+        """Stop every channel (each stop is safe to call twice)."""
+        for source in self._input_sources():
+            source.stop()
+        if self.speaker is not None:
+            self.speaker.close()
+
+    def _input_sources(self) -> list[InputSource]:
+        return self.sources + ([self.voice] if self.voice is not None else [])
+
+    # -- from the channels' threads ---------------------------------------------------------------
+
+    def channel_sink(self, item: ChannelInput | ChannelStatus) -> None:
+        """The sink every channel delivers to, from its own thread: posts to the UI thread."""
+        self.post_message(ChannelReceived(item))
+
+    def speaker_status(self, status: ChannelStatus) -> None:
+        """The speaker's status callback (worker thread)."""
+        self.post_message(ChannelReceived(status))
+
+    def speaker_activity(self, speaking: bool) -> None:
+        """The speaker's speech start/end callback (worker thread)."""
+        self.post_message(SpeechActivity(speaking))
+
+    def on_channel_received(self, message: ChannelReceived) -> None:
+        """An input goes to the session; a status change to the channel bar."""
+        if isinstance(message.item, ChannelStatus):
+            self.board.update(message.item)
+            self._render()
+        else:
+            self.forward(message.item)
+
+    def on_speech_activity(self, message: SpeechActivity) -> None:
+        """Show "speaking", mute the recogniser meanwhile, and tell the session a repeat was said."""
+        self.board.speaking = message.speaking
+        if hasattr(self.voice, "set_muted"):
+            self.voice.set_muted(message.speaking)  # type: ignore[union-attr]
+        if not message.speaking:
+            self._drive(self.session.prompt_delivered)
+        else:
+            self._render()
+
+    # -- from the screens (UI thread) -------------------------------------------------------------
+
+    def patient_key(self, key: str) -> bool:
+        """A key pressed on a patient screen; True if it meant something to the kiosk."""
+        item = self.keyboard.translate(key) if self.keyboard is not None else None
+        if item is None and key in KIOSK_KEYS:
+            meaning = KIOSK_KEYS[key]
+            detail = f"key {key}"
+            item = (ChannelInput(Channel.KEYBOARD, command=meaning, detail=detail) if isinstance(meaning, Command)
+                    else ChannelInput(Channel.KEYBOARD, option=meaning, detail=detail))
+        if item is None:
+            return False
+        self.forward(item)
+        return True
+
+    def on_answer_button_chosen(self, message: AnswerButton.Chosen) -> None:
+        """A touched answer is a touch input."""
+        self.forward(ChannelInput(Channel.TOUCH, option=message.option, detail="screen"))
+
+    def on_control_bar_commanded(self, message: ControlBar.Commanded) -> None:
+        """A touched Pause/Continue/Repeat/Call-doctor is a touch command."""
+        self.forward(ChannelInput(Channel.TOUCH, command=message.command, detail="screen"))
+
+    def on_welcome_screen_language_chosen(self, message: WelcomeScreen.LanguageChosen) -> None:
+        """Start in the language the patient touched."""
+        self._start(message.language)
+
+    def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
+        """The patient touched Start under the explanation."""
+        self._drive(self.session.acknowledge)
+
+    def forward(self, item: ChannelInput) -> None:
+        """Hand an input to the session. On the welcome screen an answer number picks the language
+        (the buttons are numbered like the remote's), and under the explanation it means "start"."""
+        phase = self.session.phase
+        if item.option is not None and phase is Phase.WELCOME:
+            languages = self.questionnaire.languages
+            if item.option <= len(languages):
+                self._start(languages[item.option - 1])
+        elif item.option is not None and phase is Phase.EXPLANATION:
+            self._drive(self.session.acknowledge)
+        else:
+            self._drive(self.session.handle, item)
+
+    def _start(self, language: str) -> None:
+        def start() -> None:
+            self.session.choose_language(language)
+            self.session.start()
+
+        self._drive(start)
+
+    def poll_session(self) -> None:
+        """Let the session's due time-outs happen (the poll timer calls this)."""
+        self._drive(self.session.poll)
+
+    # -- the session's events ----------------------------------------------------------------------
+
+    def _drive(self, operation: Callable[..., object], *args: object) -> None:
+        """Run a session operation, then redraw if it published anything."""
+        operation(*args)
+        if self._dirty:
+            self._dirty = False
+            self._render()
+
+    def _on_session_event(self, event: SessionEvent) -> None:
+        """Carry out what an event asks of the channels; the redraw follows the operation."""
+        self.events.append(event)
+        self._dirty = True
+        if isinstance(event, Prompt):
+            self._speak(event)
+            if hasattr(self.voice, "expect"):
+                self.voice.expect(event)  # type: ignore[union-attr]
+        elif isinstance(event, ListeningChanged):
+            self.board.listening = event.listening
+            if hasattr(self.voice, "listen"):
+                self.voice.listen(event.listening)  # type: ignore[union-attr]
+        elif isinstance(event, (AnswerRecorded, Paused, DoctorCalled)):
+            if self.speaker is not None:
+                self.speaker.stop_speaking()
+        elif isinstance(event, VolumeChanged) and self.speaker is not None:
+            (self.speaker.volume_up if event.step > 0 else self.speaker.volume_down)()
+
+    def _speak(self, prompt: Prompt) -> None:
+        if self.speaker is None or not prompt.spoken:
+            return
+        from kiosk.speech.tts import DEFAULT_RATE
+
+        self.speaker.rate = round(DEFAULT_RATE * prompt.speech_rate)
+        self.speaker.say(prompt.spoken, prompt.language)
+
+    # -- drawing -------------------------------------------------------------------------------
+
+    def _view(self) -> PatientView:
+        snap = self.session.snapshot()
+        notices = []
+        if not snap.person_present:
+            notices.append(ui_text(snap.language, "person_lost"))
+        for name in sorted(snap.adaptations):
+            notices.append(self.questionnaire.message(name, snap.language) or ui_text(snap.language, name))
+        return PatientView(snap, self.questionnaire, self.board.lines(snap.language),
+                           " ".join(notices) or None)
+
+    @staticmethod
+    def _screen_class(view: PatientView) -> type[PatientScreen]:
+        snap = view.snapshot
+        if snap.halted:
+            return DoctorCalledScreen
+        if snap.paused:
+            return PausedScreen
+        return {
+            Phase.WELCOME: WelcomeScreen,
+            Phase.FAMILIARISATION: FamiliarisationScreen,
+            Phase.EXPLANATION: ExplanationScreen,
+            Phase.QUESTIONS: QuestionScreen,
+            Phase.SUMMARY: SummaryScreen,
+        }[snap.phase]
+
+    def _render(self) -> None:
+        """Show the screen the session's state calls for, or refresh the one shown."""
+        if not self.is_running or self.clinician_open:
+            return
+        view = self._view()
+        cls = self._screen_class(view)
+        key = (cls, cls.key(view))
+        screen = self.screen
+        if key == self._screen_key and isinstance(screen, cls):
+            screen.show(view)
+            return
+        self._screen_key = key
+        if isinstance(screen, PatientScreen):
+            self.switch_screen(cls(view))
+        else:
+            self.push_screen(cls(view))
+
+    # -- the clinician side -------------------------------------------------------------------
+
+    @property
+    def clinician_open(self) -> bool:
+        """A clinician screen (or the PIN prompt) is on top of the patient's screen."""
+        return any(isinstance(s, ClinicianScreen) for s in self.screen_stack)
+
+    def action_clinician(self) -> None:
+        """The chord: ask for the PIN, then open the clinician screens."""
+        if self.clinician_open:
+            return
+
+        def unlocked(ok: bool | None) -> None:
+            if ok:
+                self.push_screen(ClinicianHomeScreen())
+
+        self.push_screen(PinScreen(self.clinician_pin), unlocked)
+
+    def close_clinician(self) -> None:
+        """Leave the clinician screens and show the patient's screen as the session now is."""
+        while self.clinician_open:
+            self.pop_screen()
+        self._screen_key = None
+        self.call_after_refresh(self._render)
+
+    def clinician_continue(self) -> None:
+        """A clinician continues a session halted by call-doctor (or paused)."""
+        self._drive(self.session.clinician_continue)
+
+    def set_adaptation(self, enabled: bool) -> None:
+        """A clinician switches live adaptation on or off for this session."""
+        self._drive(self.session.set_adaptation_enabled, enabled)
+
+
+# ---------------------------------------------------------------------------------------------
+# `kiosk run`
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="kiosk run", description="Start the kiosk (a patient session).")
+    parser.add_argument("--data-dir", type=Path, help="where sessions are stored (default: from the configuration)")
+    parser.add_argument("--config", type=Path, help="configuration file (default: $KIOSK_CONFIG or the user's)")
+    parser.add_argument("--patient", help="the patient's pseudonymous id (default: a new random one)")
+    parser.add_argument("--no-voice", action="store_true", help="no spoken prompts and no voice answers")
+    parser.add_argument("--no-remote", action="store_true", help="do not look for remote controls")
+    return parser
+
+
+class SetupError(Exception):
+    """The kiosk cannot start: a bad configuration, questionnaire, data directory or profile file."""
+
+
+def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, patient_id: str | None = None,
+              voice: bool = True, remote: bool = True) -> tuple[KioskApp, Callable[[], None]]:
+    """The kiosk as configured, with whatever channels this machine has, and a function that
+    closes what it opened. Raises :class:`SetupError` (one sentence) for a user's mistake."""
+    from kiosk.adaptation import Adaptation, PolicyError, load_policy
+    from kiosk.clock import SystemClock
+    from kiosk.config import ConfigError, load_config
+    from kiosk.questionnaire import QuestionnaireError, load_questionnaire
+    from kiosk.records import MODEL
+    from kiosk.storage import StorageError, new_patient_id
+    from qos import Engine, load_model
+
+    try:
+        config = load_config(config_path)
+        questionnaire = load_questionnaire(config.questionnaire)
+        policy = load_policy(config.adaptation_policy) if config.adaptation else None
+        store = Store.open(data_dir or config.data_dir)
+    except QuestionnaireError as error:
+        problems = getattr(error, "problems", None)
+        raise SetupError("\n".join(str(p) for p in problems) if problems else str(error)) from None
+    except (ConfigError, PolicyError, StorageError) as error:
+        raise SetupError(str(error)) from None
+    statuses: list[ChannelStatus] = []
+    keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
+    speaker = _speaker() if voice else None
+    voice_in = _voice_in(config, voice, statuses)
+    try:
+        session = Session(questionnaire, clock=SystemClock(), engine=Engine(load_model(MODEL)),
+                          patient_id=patient_id or new_patient_id(), store=store, language=config.language,
+                          timing=config.timing, adaptation=Adaptation(policy) if policy else None,
+                          familiarisation=config.familiarisation)
+    except ValueError as error:  # a bad --patient id
+        store.close()
+        raise SetupError(str(error)) from None
+    app = KioskApp(session, clinician_pin=config.clinician_pin, store=store, speaker=speaker, voice=voice_in,
+                   sources=sources, keyboard=keyboard, statuses=statuses,
+                   export_dir=(data_dir or config.data_dir) / "exports")
+    if speaker is not None:
+        speaker.on_status, speaker.on_speech = app.speaker_status, app.speaker_activity
+    return app, store.close
+
+
+def _remotes(profiles: Path | None, wanted: bool, statuses: list[ChannelStatus],
+             store: Store) -> tuple[Any, list[InputSource]]:
+    """The keyboard-remote key map and the serial/HID sources, or the reason there are none."""
+    if not wanted:
+        statuses.append(ChannelStatus(Channel.REMOTE, ChannelState.OFF, "remote", "turned off (--no-remote)"))
+        return None, []
+    from kiosk.remote import ProfileError, keyboard_remote, open_sources
+
+    try:
+        return keyboard_remote(profiles), open_sources(profiles)
+    except ProfileError as error:
+        store.close()
+        raise SetupError(str(error)) from None
+
+
+def _speaker() -> Any:
+    """espeak-ng voice out; it reports on or off (with the reason) once its worker has looked."""
+    from kiosk.speech.tts import Speaker
+
+    return Speaker()
+
+
+def _voice_in(config: Any, wanted: bool, statuses: list[ChannelStatus]) -> InputSource | None:
+    """The voice-in channel, or None with the reason it is off."""
+    if not wanted:
+        statuses.append(ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "turned off (--no-voice)"))
+        return None
+    statuses.append(ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "voice answers are not available yet"))
+    return None
+
+
+def main(argv: list[str]) -> int:
+    """`kiosk run`: build the session and channels from the configuration and run the app."""
+    args = _parser().parse_args(argv)
+    try:
+        app, close = build_app(config_path=args.config, data_dir=args.data_dir, patient_id=args.patient,
+                               voice=not args.no_voice, remote=not args.no_remote)
+    except SetupError as error:
+        print(f"kiosk run: {error}", file=sys.stderr)
+        return 2
+    try:
+        app.run()
+    finally:
+        close()
+    return app.return_code or 0

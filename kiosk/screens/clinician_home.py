@@ -1,0 +1,83 @@
+"""The clinician's first screen: the running session (continue it, adaptation on/off), the channel
+states with their reasons, and the list of stored sessions."""
+
+from __future__ import annotations
+
+from textual import on
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Button, DataTable, Label, Static, Switch
+
+from kiosk.config import DEFAULT_PIN
+from kiosk.screens.base import ClinicianScreen
+from kiosk.screens.session_detail import SessionDetailScreen
+
+
+class ClinicianHomeScreen(ClinicianScreen):
+    """Reads the app's session and store; every action goes back through the app."""
+
+    def compose(self) -> ComposeResult:
+        """The running session, channels, stored sessions, and the way back."""
+        app = self.app
+        session = app.session  # type: ignore[attr-defined]
+        with Vertical(classes="clinician"):
+            yield Static("Clinician", classes="heading")
+            if app.clinician_pin == DEFAULT_PIN:  # type: ignore[attr-defined]
+                yield Label("The clinician PIN is still the public default: set clinician_pin in the "
+                            "configuration.", id="pin-warning")
+            yield Label(self._session_line(), id="current")
+            with Horizontal(id="current-actions"):
+                yield Button("Continue the session", id="continue", variant="primary",
+                             disabled=not (session.halted or session.paused))
+                yield Label(" Live adaptation ")
+                yield Switch(value=session.adaptation is not None and session.adaptation.enabled,
+                             id="adaptation", disabled=session.adaptation is None)
+                yield Button("Back to the patient", id="back")
+            yield Label(self._channels_text(), id="channel-reasons")
+            yield Label("Stored sessions (Enter or click to open):")
+            yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        """Fill the session list from the store."""
+        table = self.query_one("#sessions", DataTable)
+        table.add_columns("session", "patient", "started", "status", "language", "answered", "not answered")
+        store = self.app.store  # type: ignore[attr-defined]
+        for s in store.sessions() if store is not None else []:
+            table.add_row(s.id, s.patient_id, s.started_at[:19], s.status, s.language, str(s.answered),
+                          str(s.not_answered), key=s.id)
+
+    def _session_line(self) -> str:
+        session = self.app.session  # type: ignore[attr-defined]
+        state = "waiting for a clinician (doctor called)" if session.halted else (
+            "paused" if session.paused else session.phase.value)
+        return (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
+                f"{len(session.answers)} of {len(session.questionnaire.items)} answered.")
+
+    def _channels_text(self) -> str:
+        lines = self.app.board.lines("en")  # type: ignore[attr-defined]
+        return "Channels: " + "; ".join(
+            f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
+            for line in lines)
+
+    @on(Button.Pressed, "#continue")
+    def _continue(self) -> None:
+        self.app.clinician_continue()  # type: ignore[attr-defined]
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#back")
+    def _back(self) -> None:
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Switch.Changed, "#adaptation")
+    def _adaptation(self, event: Switch.Changed) -> None:
+        self.app.set_adaptation(event.value)  # type: ignore[attr-defined]
+
+    @on(DataTable.RowSelected, "#sessions")
+    def _open(self, event: DataTable.RowSelected) -> None:
+        store = self.app.store  # type: ignore[attr-defined]
+        stored = store.session(str(event.row_key.value))
+        self.app.push_screen(SessionDetailScreen(stored))
+
+    def action_close(self) -> None:
+        """Escape from here goes back to the patient."""
+        self.app.close_clinician()  # type: ignore[attr-defined]

@@ -1,0 +1,44 @@
+"""Familiarisation: practice questions checking the patient can hear, read and choose."""
+
+from __future__ import annotations
+
+from collections.abc import Hashable
+
+from textual.app import ComposeResult
+from textual.widgets import Static
+
+from kiosk.screens.base import PatientScreen, PatientView
+from kiosk.widgets.bars import ControlBar
+from kiosk.widgets.question_panel import QuestionPanel
+from kiosk.widgets.text import ui_text
+
+
+class FamiliarisationScreen(PatientScreen):
+    """A practice question laid out exactly like a real one, so the real ones feel familiar."""
+
+    @classmethod
+    def key(cls, view: PatientView) -> Hashable:
+        """A new screen per practice question and language."""
+        practice = view.snapshot.practice
+        return (practice.id if practice else None, view.snapshot.language)
+
+    def compose(self) -> ComposeResult:
+        """Bars, the practice question with its answers (or the introduction), and the controls."""
+        yield from self.compose_bars()
+        practice = self.view.snapshot.practice
+        if practice is None:
+            yield Static(self.view.questionnaire.message("familiarisation", self.language),
+                         classes="heading")
+        else:
+            yield QuestionPanel(practice.text[self.language],
+                                [o.label_in(self.language) for o in practice.options])
+        yield ControlBar(self.language)
+
+    def progress_text(self, view: PatientView) -> str:
+        """"Practice 1 of 3"."""
+        practice = view.snapshot.practice
+        questions = view.questionnaire.familiarisation
+        if practice is None:
+            return super().progress_text(view)
+        return ui_text(self.language, "practice_of", number=questions.index(practice) + 1,
+                       total=len(questions))

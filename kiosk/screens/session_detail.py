@@ -1,0 +1,109 @@
+"""One stored session for the clinician: per-item answers, total, band, completeness, the QoS
+metrics over time, and exports (FHIR JSON, CSV, the plot as PNG)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual import on
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Button, DataTable, Label, Static
+
+from kiosk.export import ExportError, csv_text, fhir_response, rescore, write_json, write_private
+from kiosk.screens.base import ClinicianScreen
+from kiosk.storage import StoredSession
+from kiosk.widgets.metrics_plot import MetricsPlot, plot_data, save_png
+
+
+class SessionDetailScreen(ClinicianScreen):
+    """The answers table above the metrics plot; export buttons at the bottom."""
+
+    def __init__(self, stored: StoredSession) -> None:
+        """Show ``stored`` (read from the store when the clinician opened it)."""
+        super().__init__()
+        self.stored = stored
+
+    def compose(self) -> ComposeResult:
+        """Header, answers, total line, plot and export buttons."""
+        s = self.stored
+        with Vertical(classes="clinician"):
+            yield Static(f"Session {s.id}  patient {s.patient_id}  {s.status}  language {s.language}  "
+                         f"answered by {s.answered_by.value}", classes="heading")
+            yield DataTable(id="answers-table", zebra_stripes=True, cursor_type="row")
+            yield Label(self._total_line(), id="total")
+            yield MetricsPlot(plot_data(s), id="metrics-plot")
+            yield Label("", id="export-result")
+        with Horizontal(id="detail-actions"):
+            yield Button("Export FHIR", id="export-fhir")
+            yield Button("Export CSV", id="export-csv")
+            yield Button("Save plot (PNG)", id="export-png")
+            yield Button("Back", id="back")
+
+    def on_mount(self) -> None:
+        """One row per item, in questionnaire order, answered or not."""
+        q = self.app.questionnaire  # type: ignore[attr-defined]
+        table = self.query_one("#answers-table", DataTable)
+        table.add_columns("#", "item", "option", "answer", "points", "attempt", "channel")
+        answers = {a.item_id: a for a in self.stored.answers}
+        for item in q.items:
+            a = answers.get(item.id)
+            if a is None:
+                outcome = "not answered" if item.id in self.stored.not_answered else "-"
+                table.add_row(str(item.number), item.id, "", outcome, "", "", "")
+            else:
+                table.add_row(str(item.number), item.id, str(a.option),
+                              item.option(a.option).label_in(self.stored.language), str(a.points),
+                              str(a.attempt), a.channel.value)
+
+    def _total_line(self) -> str:
+        q = self.app.questionnaire  # type: ignore[attr-defined]
+        try:
+            score = rescore(q, self.stored)
+        except ExportError as error:
+            return f"Cannot score: {error}"
+        band = score.band.label["en"] if score.band else "no band (incomplete)"
+        done = "complete" if score.complete else f"incomplete: {len(score.missing)} of {len(q.items)} missing"
+        return f"Total {score.total} of {score.max_total} ({done}); {band}"
+
+    def _export_path(self, suffix: str) -> Path:
+        folder: Path = self.app.export_dir  # type: ignore[attr-defined]
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        return folder / f"session-{self.stored.id}{suffix}"
+
+    def _done(self, text: str) -> None:
+        self.query_one("#export-result", Label).update(text)
+
+    @on(Button.Pressed, "#export-fhir")
+    def _fhir(self) -> None:
+        try:
+            path = self._export_path(".fhir.json")
+            write_json(path, fhir_response(self.app.questionnaire, self.stored))  # type: ignore[attr-defined]
+        except (ExportError, OSError) as error:
+            self._done(f"FHIR export failed: {error}")
+            return
+        self._done(f"FHIR QuestionnaireResponse written to {path}")
+
+    @on(Button.Pressed, "#export-csv")
+    def _csv(self) -> None:
+        try:
+            path = self._export_path(".csv")
+            write_private(path, csv_text(self.app.questionnaire, [self.stored]))  # type: ignore[attr-defined]
+        except (ExportError, OSError) as error:
+            self._done(f"CSV export failed: {error}")
+            return
+        self._done(f"CSV written to {path}")
+
+    @on(Button.Pressed, "#export-png")
+    def _png(self) -> None:
+        try:
+            path = save_png(plot_data(self.stored), self._export_path(".metrics.png"),
+                            f"Session {self.stored.id}, patient {self.stored.patient_id}")
+        except OSError as error:
+            self._done(f"Saving the plot failed: {error}")
+            return
+        self._done(f"Plot saved to {path}")
+
+    @on(Button.Pressed, "#back")
+    def _back(self) -> None:
+        self.dismiss()

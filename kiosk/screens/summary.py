@@ -1,0 +1,28 @@
+"""Summary: thanks, and the total the session recomputed from the recorded answers."""
+
+from __future__ import annotations
+
+from textual.app import ComposeResult
+from textual.widgets import Static
+
+from kiosk.screens.base import PatientScreen
+from kiosk.widgets.text import ui_text
+
+
+class SummaryScreen(PatientScreen):
+    """Thank-you, the total out of the maximum, the band, and how many items went unanswered."""
+
+    def compose(self) -> ComposeResult:
+        """Bars, thanks, the total and band."""
+        yield from self.compose_bars()
+        yield Static(ui_text(self.language, "summary_title"), classes="heading")
+        yield Static(self.view.questionnaire.message("finished", self.language)
+                     or ui_text(self.language, "summary_text"), classes="notice")
+        score = self.view.snapshot.score
+        if score is not None:
+            lines = [ui_text(self.language, "summary_total", total=score.total, maximum=score.max_total)]
+            if score.band is not None:
+                lines.append(score.band.label[self.language])
+            if score.missing:
+                lines.append(ui_text(self.language, "summary_incomplete", missing=len(score.missing)))
+            yield Static("\n".join(lines), id="summary-total")

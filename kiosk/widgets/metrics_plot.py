@@ -1,0 +1,106 @@
+"""The QoS story of one session: Performance, Interaction and VoiceInteractionQuality over time,
+with incidents (pause, call doctor, patient away...) and adaptations marked.
+
+Drawn in the terminal with textual-plotext, and saved as a PNG with matplotlib for the record.
+Both draw the same :func:`plot_data`, so the terminal and the PNG never tell different stories.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from textual_plotext import PlotextPlot
+
+from kiosk.storage import StoredSession
+
+#: the metrics of the CLARC model, in the order they are drawn, with one colour each
+METRICS = ("Performance", "Interaction", "VoiceInteractionQuality")
+_COLOURS = {"Performance": "blue", "Interaction": "green", "VoiceInteractionQuality": "magenta"}
+#: log entries worth a mark on the plot (the rest -- ignored inputs, time-outs -- would crowd it)
+INCIDENTS = ("pause", "resume", "call_doctor", "clinician_continue", "person_lost", "person_back", "repeat")
+
+
+@dataclass(frozen=True)
+class Mark:
+    """A vertical mark on the plot: an incident or an adaptation switching on or off."""
+
+    t: float
+    label: str
+    #: "incident" or "adaptation"
+    kind: str
+
+
+@dataclass(frozen=True)
+class PlotData:
+    """What a metrics plot draws: one time series per metric, and the marks."""
+
+    series: dict[str, tuple[list[float], list[float]]]
+    marks: tuple[Mark, ...]
+
+
+def plot_data(stored: StoredSession) -> PlotData:
+    """The metric samples and marks of a stored session."""
+    series: dict[str, tuple[list[float], list[float]]] = {}
+    for name in METRICS:
+        samples = [(s.t, s.metrics[name]) for s in stored.metrics if name in s.metrics]
+        series[name] = ([t for t, _ in samples], [v for _, v in samples])
+    marks = [Mark(e.t, e.kind.replace("_", " "), "incident") for e in stored.log if e.kind in INCIDENTS]
+    marks += [Mark(a.t, f"{a.name.replace('_', ' ')} {'on' if a.active else 'off'}", "adaptation")
+              for a in stored.adaptations]
+    return PlotData(series, tuple(sorted(marks, key=lambda m: m.t)))
+
+
+class MetricsPlot(PlotextPlot):
+    """The three metrics in the terminal; incidents as grey lines, adaptations as red lines."""
+
+    def __init__(self, data: PlotData, *, id: str | None = None) -> None:
+        """Draw ``data`` (from :func:`plot_data`)."""
+        super().__init__(id=id)
+        self.data = data
+
+    def on_mount(self) -> None:
+        """Draw once: a stored session does not change while it is shown."""
+        plt = self.plt
+        plt.title("QoS metrics (grey: incidents, red: adaptations)")
+        plt.xlabel("session time (s)")
+        plt.ylim(0, 1)
+        for name, (times, values) in self.data.series.items():
+            if times:
+                plt.plot(times, values, label=name, color=_COLOURS[name], marker="braille")
+        for mark in self.data.marks:
+            plt.vline(mark.t, "gray" if mark.kind == "incident" else "red")
+
+
+def save_png(data: PlotData, path: str | Path, title: str) -> Path:
+    """Write the plot as a PNG (owner-only, it belongs to a patient's record); returns the path."""
+    import os
+
+    import matplotlib
+
+    matplotlib.use("Agg")  # no display on a kiosk's service shell
+    from matplotlib import pyplot
+
+    figure, axes = pyplot.subplots(figsize=(10, 5), dpi=100)
+    try:
+        for name, (times, values) in data.series.items():
+            if times:
+                axes.step(times, values, where="post", label=name, color=_COLOURS[name], linewidth=2)
+        for index, mark in enumerate(data.marks):
+            colour = "0.5" if mark.kind == "incident" else "tab:red"
+            axes.axvline(mark.t, color=colour, linestyle="--", linewidth=1)
+            axes.annotate(mark.label, (mark.t, 1.0 - 0.06 * (index % 4)), rotation=0, fontsize=8,
+                          color=colour, xytext=(3, -10), textcoords="offset points")
+        axes.set_ylim(0, 1.05)
+        axes.set_xlabel("session time (s)")
+        axes.set_ylabel("metric")
+        axes.set_title(title)
+        axes.legend(loc="lower left")
+        axes.grid(alpha=0.3)
+        path = Path(path)
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        with os.fdopen(fd, "wb") as handle:
+            figure.savefig(handle, format="png", bbox_inches="tight")
+    finally:
+        pyplot.close(figure)
+    return path

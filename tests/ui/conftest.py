@@ -1,0 +1,75 @@
+"""A real kiosk for UI tests: the real session core, QoS engine, adaptation and SQLite store, on a
+simulated clock that only moves when a test advances it. No channel threads are started; tests
+deliver remote and voice inputs through the app's sink from a real thread, as the channels do."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from kiosk.adaptation import Adaptation, load_policy
+from kiosk.app import KioskApp
+from kiosk.channels import Channel, ChannelState, ChannelStatus
+from kiosk.clock import SimClock
+from kiosk.questionnaire import load_questionnaire
+from kiosk.records import MODEL
+from kiosk.session import Session
+from kiosk.storage import Store
+from qos import Engine, load_model
+
+#: the PIN the test kiosks use (not the public default, so no warning on the clinician screen)
+UI_PIN = "2468"
+#: fixed ids so snapshots do not change from run to run
+UI_SESSION_ID = "5e55a0000001"
+UI_PATIENT_ID = "P-TEST01"
+
+
+class UiKiosk:
+    """A kiosk app with its clock and store, and helpers to move simulated time."""
+
+    def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
+                 language: str = "en") -> None:
+        self.clock = SimClock()
+        self.questionnaire = load_questionnaire()
+        self.store = Store.open(tmp_path / "data")
+        self.session = Session(
+            self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)), patient_id=UI_PATIENT_ID,
+            store=self.store, language=language, session_id=UI_SESSION_ID,
+            adaptation=Adaptation(load_policy()) if adaptation else None, familiarisation=familiarisation,
+        )
+        self.app = KioskApp(
+            self.session, clinician_pin=UI_PIN, store=self.store, export_dir=tmp_path / "exports",
+            statuses=[ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
+                      ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*")],
+            # the timer still runs, but tests drive time themselves: a tick never finds anything due
+            poll_interval=3600,
+        )
+
+    def advance(self, seconds: float) -> None:
+        """Move simulated time on and let the app poll, as its timer would."""
+        self.clock.advance(seconds)
+        self.app.poll_session()
+
+    def to_next_deadline(self) -> None:
+        """Jump to the session's next time-out and let the app poll."""
+        deadline = self.session.next_deadline()
+        assert deadline is not None, "nothing is pending"
+        self.clock.set(deadline)
+        self.app.poll_session()
+
+
+@pytest.fixture
+def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
+    """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language)."""
+    made: list[UiKiosk] = []
+
+    def make(**options: object) -> UiKiosk:
+        kiosk = UiKiosk(tmp_path, **options)  # type: ignore[arg-type]
+        made.append(kiosk)
+        return kiosk
+
+    yield make
+    for kiosk in made:
+        kiosk.store.close()
