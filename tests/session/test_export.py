@@ -1,0 +1,99 @@
+"""FHIR R4 / CSV export and `kiosk results`, on sessions stored in a real SQLite database."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import sqlite3
+from pathlib import Path
+
+import pytest
+
+from kiosk.export import ITEM_WEIGHT, ExportError, csv_text, fhir_questionnaire, fhir_response, rescore
+from kiosk.replay import load_script, run_script
+from kiosk.results import main as results_main
+from kiosk.storage import Store
+
+from .helpers import QUESTIONNAIRE
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture
+def export_store(tmp_path):
+    store = Store.open(tmp_path / "data")
+    for name in ("barthel1", "barthel4"):
+        run_script(load_script(ROOT / f"recordings/patients/{name}.yaml"), store=store)
+    yield store
+    store.close()
+
+
+def by_patient(store: Store, patient: str):
+    return next(store.session(s.id) for s in store.sessions() if s.patient_id == patient)
+
+
+def test_the_fhir_questionnaire_puts_each_items_points_on_its_options():
+    resource = fhir_questionnaire(QUESTIONNAIRE)
+    assert resource["resourceType"] == "Questionnaire" and resource["code"][0]["code"] == "96762-0"
+    items = {i["linkId"]: i for i in resource["item"]}
+    weights = [[o["extension"][0]["valueDecimal"] for o in items[i.id]["answerOption"]] for i in QUESTIONNAIRE.items]
+    assert weights == [[o.points for o in i.options] for i in QUESTIONNAIRE.items]
+    assert all(o["extension"][0]["url"] == ITEM_WEIGHT for i in QUESTIONNAIRE.items
+               for o in items[i.id]["answerOption"])
+    assert items["feeding"]["code"][0]["code"] == "83184-2"
+    assert items["total"]["readOnly"] and "calculatedExpression" in items["total"]["extension"][0]["url"]
+    json.dumps(resource)  # serialisable as is
+
+
+def test_the_fhir_response_recomputes_the_total(export_store):
+    complete = fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0001"))
+    assert complete["status"] == "completed"
+    assert complete["subject"]["identifier"]["value"] == "TB-0001"
+    total = [i for i in complete["item"] if i["linkId"] == "total"][0]["answer"][0]["valueInteger"]
+    assert total == 100
+    partial = fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0004"))
+    answered = [i for i in partial["item"] if "answer" in i and i["linkId"] != "total"]
+    assert len(answered) == 8
+    assert [i for i in partial["item"] if i["linkId"] == "total"][0]["answer"][0]["valueInteger"] == 65
+
+
+def test_a_tampered_stored_total_is_ignored_and_tampered_points_are_refused(export_store):
+    db = sqlite3.connect(export_store.path)
+    with db:
+        db.execute("UPDATE sessions SET total = 3")
+    stored = by_patient(export_store, "TB-0001")
+    assert rescore(QUESTIONNAIRE, stored).total == 100
+    with db:
+        db.execute("UPDATE answers SET points = 15 WHERE item_id = 'feeding'")
+    with pytest.raises(ExportError, match="feeding option 3 is worth 10 points in barthel, but 15 were stored"):
+        fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0001"))
+
+
+def test_csv_has_a_row_per_item_and_a_recomputed_total(export_store):
+    stored = by_patient(export_store, "TB-0004")
+    rows = list(csv.DictReader(io.StringIO(csv_text(QUESTIONNAIRE, [stored]))))
+    assert [r["item"] for r in rows] == [i.id for i in QUESTIONNAIRE.items] + ["total"]
+    grooming = rows[2]
+    assert (grooming["option"], grooming["label"]) == ("", "not answered")
+    assert (rows[-1]["points"], rows[-1]["label"]) == ("65", "incomplete")
+    assert rows[0]["channel"] == "voice" and rows[0]["attempt"] == "1"
+
+
+def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path, capsys):
+    data = str(export_store.path.parent)
+    assert results_main(["--data-dir", data]) == 0
+    listing = capsys.readouterr().out.splitlines()
+    assert len(listing) == 2 and all("finished" in line for line in listing)
+    session_id = by_patient(export_store, "TB-0004").id
+    fhir, table = tmp_path / "r.json", tmp_path / "r.csv"
+    assert results_main([session_id[:6], "--data-dir", data, "--fhir", str(fhir), "--csv", str(table)]) == 0
+    shown = capsys.readouterr().out
+    assert "total 65/100 (incomplete, missing grooming, bladder)" in shown
+    assert json.loads(fhir.read_text())["resourceType"] == "QuestionnaireResponse"
+    assert fhir.stat().st_mode & 0o777 == 0o600 and table.stat().st_mode & 0o777 == 0o600
+
+
+def test_kiosk_results_for_an_unknown_session_is_exit_2(export_store, capsys):
+    assert results_main(["zzz", "--data-dir", str(export_store.path.parent)]) == 2
+    assert capsys.readouterr().err.strip() == "kiosk results: no session 'zzz'"
