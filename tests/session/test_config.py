@@ -1,0 +1,72 @@
+"""Configuration: defaults, file, environment overrides, and one clear message for a bad file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from kiosk.clock import SimClock, SystemClock
+from kiosk.config import DEFAULT_PIN, ConfigError, load_config
+
+
+def test_defaults_without_a_file(tmp_path, monkeypatch):
+    monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
+    config = load_config(environ={})
+    assert config.source is None and config.language == "en" and config.adaptation and config.familiarisation
+    assert config.clinician_pin == DEFAULT_PIN and config.default_pin
+    assert config.database.name == "kiosk.sqlite3"
+
+
+def test_file_and_environment(tmp_path):
+    path = tmp_path / "config.yaml"
+    path.write_text('data_dir: data\nlanguage: es\nclinician_pin: "0420"\nadaptation: false\n'
+                    "timing: {attempt_window_s: 45}\nvosk_model: /opt/vosk\n")
+    config = load_config(environ={"KIOSK_CONFIG": str(path)})
+    assert config.data_dir == tmp_path / "data"  # relative to the config file
+    assert (config.language, config.clinician_pin, config.adaptation) == ("es", "0420", False)
+    assert config.timing == {"attempt_window_s": 45} and config.vosk_model == Path("/opt/vosk")
+    assert not config.default_pin
+    env = {"KIOSK_CONFIG": str(path), "KIOSK_DATA_DIR": str(tmp_path / "elsewhere"), "KIOSK_VOSK_MODEL": "/m",
+           "KIOSK_LANGUAGE": "fr"}
+    config = load_config(environ=env)
+    assert (config.data_dir, config.vosk_model, config.language) == (tmp_path / "elsewhere", Path("/m"), "fr")
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("colour: red\n", ":1:1: unknown setting 'colour'"),
+    ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("0123")'),
+    ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 4 to 12 digits"),
+    ("adaptation: maybe\n", ":1:1: adaptation must be true or false"),
+    ("timing: {attempt_window_s: -3}\n", ":1:1: timing setting 'attempt_window_s' must be a number"),
+    ("timing: {window: 3}\n", ":1:1: unknown timing setting 'window'"),
+    ("data_dir: [1]\n", ":1:1: data_dir must be a path"),
+    ("language: en\nlanguage: es\n", ":2:1: duplicate key 'language'"),
+    ("language: [\n", ":2:1: YAML syntax"),
+])
+def test_a_bad_config_is_one_message_naming_file_line_and_column(tmp_path, text, message):
+    path = tmp_path / "config.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as caught:
+        load_config(path, environ={})
+    assert str(caught.value).startswith(f"{path}{message}")
+
+
+def test_bad_environment(tmp_path, monkeypatch):
+    monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
+    with pytest.raises(ConfigError, match="KIOSK_CONFIG names .* which is not a file"):
+        load_config(environ={"KIOSK_CONFIG": str(tmp_path / "missing.yaml")})
+    with pytest.raises(ConfigError, match="language 'de' is not one of en, es, fr"):
+        load_config(environ={"KIOSK_CONFIG": "", "KIOSK_LANGUAGE": "de"})
+
+
+def test_clocks():
+    clock = SimClock(5)
+    clock.advance(2.5)
+    assert clock.now() == 7.5 and clock.wall().isoformat() == "2026-01-01T00:00:07.500000+00:00"
+    with pytest.raises(ValueError, match="back in time"):
+        clock.set(7)
+    with pytest.raises(ValueError, match="back in time"):
+        clock.advance(-1)
+    system = SystemClock()
+    assert system.now() <= system.now() and system.wall().tzinfo is not None
