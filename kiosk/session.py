@@ -97,6 +97,9 @@ class IgnoreReason(str, Enum):
     UNKNOWN_LANGUAGE = "unknown_language"
 
 
+#: how much later a second context batch at the same instant is recorded (see ``Session._flush``)
+SAME_INSTANT_STEP_S = 0.001
+
 #: the CLARC model's UserInteraction literal for each channel (keyboard: see module docstring)
 USER_INTERACTION: Mapping[Channel, str] = {
     Channel.VOICE: "VOICE_RECOGNITION",
@@ -496,7 +499,8 @@ class Session:
         session = cls(
             questionnaire, clock=clock, engine=engine, store=store, patient_id=stored.patient_id,
             language=stored.language, answered_by=stored.answered_by, session_id=stored.id,
-            t_offset=max((e["t"] for e in stored.trace), default=0.0),
+            # the crash took some time: resumed batches come a second after the stored ones
+            t_offset=max((e["t"] for e in stored.trace), default=0.0) + 1.0,
             resume_answers={a.item_id: a for a in stored.answers},
             resume_not_answered=tuple(stored.not_answered), familiarisation=False, **kwargs,
         )
@@ -1138,6 +1142,12 @@ class Session:
         batch, self._batch = self._batch, None
         if batch is None:
             return
+        if self.trace and batch.t <= self.trace[-1]["t"]:
+            # Two operations at one instant (say pause and resume in the same tick) cannot share a
+            # batch once the first went to the engine; a replay would merge them and fire
+            # observations differently. Recording the second a millisecond later keeps the trace
+            # exactly what the engine saw.
+            batch.t = round(self.trace[-1]["t"] + SAME_INSTANT_STEP_S, 6)
         event: dict[str, Any] = {"t": batch.t}
         if batch.set:
             event["set"] = dict(batch.set)

@@ -318,3 +318,22 @@ def test_without_an_engine_the_trace_is_still_kept():
 def test_channel_input_contract_is_respected():
     with pytest.raises(ValueError):
         ChannelInput(Channel.TOUCH)
+
+
+def test_two_operations_at_one_instant_are_recorded_as_the_engine_saw_them():
+    from qos import Engine, Trace, TraceEvent
+
+    from .helpers import MODEL
+
+    rig = started()
+    rig.at(40)
+    rig.session.pause()
+    rig.session.resume()  # same tick: the first batch already went to the engine
+    rig.session.person_lost()
+    assert [e["t"] for e in rig.session.trace[-3:]] == [40, 40.001, 40.002]
+    # a replay of the recorded trace gives every live update exactly
+    live = [(u.t, dict(u.metrics), u.fired) for u in rig.of(MetricsUpdated)]
+    trace = Trace("clarc", [TraceEvent(e["t"], e.get("set", {}), e.get("emit", [])) for e in rig.session.trace])
+    engine = Engine(MODEL)
+    replayed = [(t, engine.update(t, set=v, emit=em)) for t, v, em in trace.batches()]
+    assert [(t, r.metrics, tuple(r.fired)) for t, r in replayed] == live

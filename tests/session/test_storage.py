@@ -155,13 +155,13 @@ def test_sigkill_mid_session_loses_no_answer_and_the_session_resumes_at_the_firs
                                   timing=TIMING)
     rig = Rig(session, clock)
     session.subscribe(rig.events.append)
-    assert session.now() == last_t
+    assert session.now() == last_t + 1
     session.start()
     session.acknowledge()
-    rig.run_until(last_t + 15)
+    rig.run_until(last_t + 1 + 15)
     first = rig.of(AttemptOpened)[0]
     assert (first.item_id, first.attempt) == ("bowels", 1)
-    assert session.trace[-1] == {"t": last_t, "set": {"PersonDetected": True, "TestState": "RESTARTED"}}
+    assert session.trace[-1] == {"t": last_t + 1, "set": {"PersonDetected": True, "TestState": "RESTARTED"}}
     for _ in range(6):
         rig.at(session.now() + 2)
         rig.answer(1)
