@@ -30,6 +30,8 @@ Timing rules (all values from :class:`~kiosk.questionnaire.Timing`):
   ``person_back_grace_s``. The gap between questions and the closing delay freeze likewise.
 * After an answer or an unanswered question the next attempt 1 opens ``between_questions_s``
   later; after the last question FINISHED comes ``closing_s`` later.
+* An answer while the patient is reported lost is still taken (a touch proves someone is there);
+  PersonDetected stays the presence source's business, and the next question waits for it.
 
 QoS contexts (one batch per instant; practice answers are never published):
 start -> ``PersonDetected: true, TestState: STARTED``; answer on attempt 1 ->
