@@ -289,7 +289,8 @@ class KioskApp(App[int]):
         if not snap.person_present:
             notices.append(ui_text(snap.language, "person_lost"))
         for name in sorted(snap.adaptations):
-            notices.append(self.questionnaire.message(name, snap.language) or ui_text(snap.language, name))
+            notices.append(self.questionnaire.message(name, snap.language)
+                           or ui_text(snap.language, name, default=name.replace("_", " ")))
         return PatientView(snap, self.questionnaire, self.board.lines(snap.language),
                            " ".join(notices) or None)
 

@@ -21,8 +21,13 @@ def _table() -> dict[str, dict[str, str]]:
     return yaml.safe_load(text)
 
 
-def ui_text(language: str, key: str, **values: object) -> str:
-    """The words for ``key`` in ``language`` (English if missing), with ``values`` filled in."""
+def ui_text(language: str, key: str, default: str | None = None, **values: object) -> str:
+    """The words for ``key`` in ``language`` (English if missing), with ``values`` filled in.
+
+    A key no language has gives ``default``; without one it is a KeyError (a typo in a screen).
+    """
     table = _table()
-    words = table.get(language, {}).get(key) or table[FALLBACK][key]
+    words = table.get(language, {}).get(key) or table[FALLBACK].get(key, default)
+    if words is None:
+        raise KeyError(f"no screen text {key!r}")
     return words.format(**values) if values else words

@@ -1,0 +1,69 @@
+"""Driving a kiosk through Pilot: waiting for the app to settle, moving through whole sessions."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Awaitable, Callable
+
+from textual.pilot import Pilot
+
+from kiosk.channels import ChannelInput, ChannelStatus
+from kiosk.session import Phase
+
+from .conftest import UiKiosk
+
+#: event-loop turns to wait for something the app must do (a message from a thread, a new screen)
+TURNS = 200
+
+
+async def settle(pilot: Pilot, until: Callable[[], bool] = lambda: True) -> None:
+    """Let the app process its messages until ``until()`` holds (a bounded number of turns)."""
+    for _ in range(TURNS):
+        await pilot.pause()
+        if until():
+            return
+    raise AssertionError("the app never reached the expected state")
+
+
+def deliver_from_thread(kiosk: UiKiosk, item: ChannelInput | ChannelStatus) -> None:
+    """Deliver an input the way a channel does: calling the app's sink from another thread."""
+    thread = threading.Thread(target=kiosk.app.channel_sink, args=(item,))
+    thread.start()
+    thread.join(timeout=5)
+
+
+def screen_name(kiosk: UiKiosk) -> str:
+    """The class name of the screen on top."""
+    return type(kiosk.app.screen).__name__
+
+
+async def start_in_english(kiosk: UiKiosk, pilot: Pilot) -> None:
+    """Press 1 (English) on the welcome screen and get through practice and explanation by keys."""
+    await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+    await pilot.press("1")
+    await settle(pilot)
+    while kiosk.session.phase is Phase.FAMILIARISATION:
+        practice = kiosk.session.snapshot().practice
+        if practice is not None and kiosk.session.current_attempt is not None:
+            await pilot.press(str(practice.expected))
+        else:
+            kiosk.to_next_deadline()
+        await settle(pilot)
+    assert screen_name(kiosk) == "ExplanationScreen"
+    await pilot.press("1")
+    await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
+
+
+async def answer_every_question(kiosk: UiKiosk, pilot: Pilot,
+                                answer: Callable[[int, int], Awaitable[None]]) -> None:
+    """For each of the ten questions: wait until it is open on screen, then ``answer(number, option)``
+    with the last option (always allowed); finally wait for the summary."""
+    for number in range(1, len(kiosk.questionnaire.items) + 1):
+        kiosk.to_next_deadline()  # the gap before the question opens
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        assert kiosk.session.snapshot().number == number
+        item = kiosk.session.current_item
+        await answer(number, len(item.options))
+        await settle(pilot, lambda: item.id in kiosk.session.answers)
+    kiosk.to_next_deadline()  # closing
+    await settle(pilot, lambda: screen_name(kiosk) == "SummaryScreen")

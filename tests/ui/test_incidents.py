@@ -1,0 +1,121 @@
+"""Pause and resume, call doctor and the clinician's continue, attempts timing out on the simulated
+clock, and a live adaptation reaching the screen -- all through the real app and session."""
+
+from __future__ import annotations
+
+from textual.widgets import Input, Label
+
+from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
+from kiosk.channels import Channel
+from kiosk.session import AttemptTimedOut, Phase, QuestionNotAnswered
+from kiosk.widgets.bars import AdaptationBanner
+
+from .conftest import UI_PIN
+from .helpers import settle, screen_name, start_in_english
+
+
+def _text(widget) -> str:
+    return str(widget.render())
+
+
+async def _first_question(kiosk, pilot) -> None:
+    await start_in_english(kiosk, pilot)
+    kiosk.to_next_deadline()
+    await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+
+
+async def test_pause_freezes_the_attempt_and_continue_comes_back_to_the_question(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _first_question(kiosk, pilot)
+        await pilot.press("p")
+        await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
+        kiosk.advance(120)  # far past the 20 s window: a paused attempt never times out
+        await pilot.press("2")  # answers are not taken while paused
+        await settle(pilot)
+        assert screen_name(kiosk) == "PausedScreen" and kiosk.session.answers == {}
+        await pilot.click("#resume")
+        await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+        assert _text(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
+        await pilot.press("2")
+        await settle(pilot, lambda: "feeding" in kiosk.session.answers)
+        assert kiosk.session.answers["feeding"].attempt == 1
+        log = [e.kind for e in kiosk.store.session(kiosk.session.id).log]
+        assert log[:4] == ["start", "pause", "input_ignored", "resume"]  # the "2" while paused is logged
+
+
+async def test_call_doctor_halts_until_a_clinician_continues_behind_the_pin(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _first_question(kiosk, pilot)
+        await pilot.click("#call-doctor")
+        await settle(pilot, lambda: screen_name(kiosk) == "DoctorCalledScreen")
+        await pilot.press("p", "1")  # the patient's keys do nothing while halted
+        await settle(pilot)
+        assert kiosk.session.halted and kiosk.session.answers == {}
+
+        await pilot.press(CLINICIAN_CHORD)
+        await settle(pilot, lambda: screen_name(kiosk) == "PinScreen")
+        await pilot.press("9", "9", "9", "9", "enter")
+        await settle(pilot)
+        assert screen_name(kiosk) == "PinScreen"
+        assert _text(kiosk.app.screen.query_one("#pin-error", Label)) == "Wrong PIN."
+        assert kiosk.app.screen.query_one(Input).value == ""
+        await pilot.press(*UI_PIN, "enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        assert "waiting for a clinician" in _text(kiosk.app.screen.query_one("#current", Label))
+        await pilot.click("#continue")
+        await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+        assert not kiosk.session.halted
+        await pilot.press("3")
+        await settle(pilot, lambda: "feeding" in kiosk.session.answers)
+        kinds = [e.kind for e in kiosk.store.session(kiosk.session.id).log]
+        assert kinds.index("call_doctor") < kinds.index("clinician_continue")
+
+
+async def test_an_attempt_times_out_twice_and_the_next_question_comes(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _first_question(kiosk, pilot)
+        attempt = kiosk.app.screen.query_one("#attempt", Label)
+        assert _text(attempt) == "Attempt 1 of 2"
+        kiosk.advance(19.9)
+        await settle(pilot)
+        assert _text(attempt) == "Attempt 1 of 2"
+        kiosk.advance(0.2)
+        await settle(pilot, lambda: _text(attempt) == "Attempt 2 of 2")
+        kiosk.advance(20.1)
+        await settle(pilot, lambda: any(isinstance(e, QuestionNotAnswered) for e in kiosk.app.events))
+        assert [e.attempt for e in kiosk.app.events if isinstance(e, AttemptTimedOut)] == [1, 2]
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: _text(kiosk.app.screen.query_one("#progress", Label)) == "Question 2 of 10")
+        assert _text(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
+        assert kiosk.store.session(kiosk.session.id).not_answered == ("feeding",)
+
+
+async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        banner = None
+        # late touch answers (after the first attempt ran out) drag VoiceInteractionQuality down
+        for _ in range(8):
+            kiosk.to_next_deadline()
+            await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+            kiosk.to_next_deadline()
+            await settle(pilot, lambda: kiosk.session.current_attempt == 2)
+            kiosk.advance(3)
+            item = kiosk.session.current_item
+            await pilot.click("#answer-1")
+            await settle(pilot, lambda: item.id in kiosk.session.answers)
+            banner = kiosk.app.screen.query_one(AdaptationBanner)
+            if banner.display:
+                break
+        assert banner is not None and banner.display
+        assert "touch your answer or press its number" in _text(banner)
+        assert kiosk.session.answers[item.id].channel is Channel.TOUCH
+        # it stays on the next question's screen too
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        assert kiosk.app.screen.query_one(AdaptationBanner).display
+        assert kiosk.session.phase is Phase.QUESTIONS

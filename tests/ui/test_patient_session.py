@@ -1,0 +1,90 @@
+"""Whole sessions through the real app (Pilot): answered by keys, by touch, by remote and by voice
+messages delivered from another thread, with the answers checked in the SQLite store."""
+
+from __future__ import annotations
+
+import pytest
+from textual.widgets import Label, Static
+
+from kiosk.app import KIOSK_SIZE
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
+from kiosk.session import Phase
+from kiosk.widgets.bars import ChannelBar
+
+from .helpers import answer_every_question, deliver_from_thread, screen_name, settle, start_in_english
+
+
+def _text(widget) -> str:
+    return str(widget.render())
+
+
+def _stored_channels(kiosk) -> set[str]:
+    return {a.channel.value for a in kiosk.store.session(kiosk.session.id).answers}
+
+
+async def test_a_whole_session_answered_with_the_number_keys(ui_kiosk):
+    kiosk = ui_kiosk()
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+
+        async def by_key(number: int, option: int) -> None:
+            progress = kiosk.app.screen.query_one("#progress", Label)
+            assert _text(progress) == f"Question {number} of 10"
+            await pilot.press(str(option))
+
+        await answer_every_question(kiosk, pilot, by_key)
+        stored = kiosk.store.session(kiosk.session.id)
+        assert len(stored.answers) == 10 and {a.channel for a in stored.answers} == {Channel.KEYBOARD}
+        assert "Total: 100 of 100" in _text(kiosk.app.screen.query_one("#summary-total", Static))
+
+
+async def test_a_whole_session_answered_by_touching_the_buttons(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.click("#language-es")
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        await pilot.click("#understood")
+        await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
+
+        async def by_touch(number: int, option: int) -> None:
+            assert _text(kiosk.app.screen.query_one("#progress", Label)) == f"Pregunta {number} de 10"
+            await pilot.click(f"#answer-{option}")
+
+        await answer_every_question(kiosk, pilot, by_touch)
+        assert _stored_channels(kiosk) == {"touch"}
+        assert kiosk.store.session(kiosk.session.id).language == "es"
+
+
+@pytest.mark.parametrize("channel, detail", [(Channel.REMOTE, "BTN {option}"), (Channel.VOICE, "number {option}")])
+async def test_a_whole_session_answered_through_channel_messages_from_a_thread(ui_kiosk, channel, detail):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        # the remote's "1" picks the first language and starts, as its label says
+        deliver_from_thread(kiosk, ChannelInput(channel, option=1, detail="start"))
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        deliver_from_thread(kiosk, ChannelInput(channel, option=1, detail="start"))
+        await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
+
+        async def by_message(number: int, option: int) -> None:
+            confidence = 0.9 if channel is Channel.VOICE else None
+            deliver_from_thread(kiosk, ChannelInput(channel, option=option, detail=detail.format(option=option),
+                                                    confidence=confidence))
+
+        await answer_every_question(kiosk, pilot, by_message)
+        assert _stored_channels(kiosk) == {channel.value}
+
+
+async def test_a_remote_plugged_in_shows_as_connected_and_unplugged_as_lost(ui_kiosk):
+    kiosk = ui_kiosk()
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        bar = kiosk.app.screen.query_one(ChannelBar)
+        await settle(pilot, lambda: "Remote: off" in _text(bar))
+        deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.ON, "serial", "connected to /dev/ttyUSB0"))
+        await settle(pilot, lambda: "Remote: on" in _text(bar))
+        deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.LOST, "serial", "unplugged"))
+        await settle(pilot, lambda: "Remote: lost" in _text(bar))
+        assert "Listening: off" in _text(bar) and "Touch: on" in _text(bar)
+        reasons = _text(kiosk.app.screen.query_one("#channel-reasons", Static))
+        assert "no microphone found" in reasons and "unplugged" in reasons
