@@ -38,7 +38,7 @@ from kiosk.session import (
     Session,
     SessionEvent,
 )
-from kiosk.yamlmarks import Positions, Problem, describe, parse, schema_problems
+from kiosk.yamlmarks import Problem, describe, parse, schema_problems
 
 #: the QoS model scripted sessions are watched by
 MODEL = "clarc"

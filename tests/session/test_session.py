@@ -104,6 +104,7 @@ def test_pause_freezes_the_attempt_clock_and_resume_leaves_the_grace_period():
     rig.at(30)
     rig.session.pause(Channel.TOUCH)
     assert rig.session.paused and rig.session.next_deadline() is None
+    assert rig.of(Paused)[-1].channel is Channel.TOUCH
     rig.at(500)
     assert not rig.of(AttemptTimedOut)
     assert rig.session.remaining() == 25
