@@ -468,11 +468,13 @@ def _print_human(result: ReplayResult) -> None:
 
 
 def main(argv: list[str]) -> int:
-    """`kiosk replay FILE... [--json] [--trace OUT]`; exit 0, or 2 on a bad script."""
+    """`kiosk replay FILE... [--json] [--trace OUT] [--data-dir DIR]`; exit 0, or 2 on a bad script."""
     parser = argparse.ArgumentParser(prog="kiosk replay", description=__doc__.splitlines()[0])
     parser.add_argument("files", nargs="+", metavar="FILE", help="scripted patient YAML file(s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object per script")
     parser.add_argument("--trace", metavar="OUT", help="write the context trace (one script only)")
+    parser.add_argument("--data-dir", metavar="DIR",
+                        help="also store the replayed sessions in this data directory (see `kiosk results`)")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
@@ -481,13 +483,25 @@ def main(argv: list[str]) -> int:
     except QuestionnaireError as exc:
         print(f"kiosk replay: the questionnaire is invalid: {exc}", file=sys.stderr)
         return 2
-    results = []
-    for file in args.files:
+    store = None
+    if args.data_dir:
+        from kiosk.storage import StorageError, Store
+
         try:
-            results.append(run_script(load_script(file, questionnaire), questionnaire))
-        except ScriptError as exc:
-            print(exc, file=sys.stderr)
+            store = Store.open(args.data_dir)
+        except StorageError as exc:
+            print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
+    results = []
+    try:
+        for file in args.files:
+            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store))
+    except ScriptError as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    finally:
+        if store is not None:
+            store.close()
     if args.trace:
         from qos import dump_trace
 

@@ -161,3 +161,16 @@ def test_the_script_schema_is_a_valid_json_schema():
 
     schema = json.loads((ROOT / "kiosk/patient.schema.json").read_text())
     jsonschema.Draft202012Validator.check_schema(schema)
+
+
+def test_replays_can_be_stored_for_kiosk_results(tmp_path, capsys):
+    from kiosk.storage import Store
+
+    data = tmp_path / "data"
+    assert main([str(ROOT / "recordings/patients/barthel2.yaml"), "--data-dir", str(data), "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    with Store.open(data) as store:
+        (summary,) = store.sessions()
+        assert (summary.patient_id, summary.status, summary.answered) == ("TB-0002", "finished", 10)
+        assert [(a.item_id, a.option) for a in store.session(summary.id).answers] == [
+            (a["item"], a["option"]) for a in printed["answers"]]
