@@ -361,7 +361,14 @@ class UtterancePipeline:
         )
 
 
-def feed_wav(path: str | Path, pipeline: UtterancePipeline, chunk_ms: int = 100) -> float:
+class PcmConsumer(Protocol):
+    """Anything that takes 16 kHz mono int16 audio: a pipeline, a voice channel."""
+
+    def feed(self, pcm: bytes) -> None:
+        """Take more audio."""
+
+
+def feed_wav(path: str | Path, pipeline: PcmConsumer, chunk_ms: int = 100) -> float:
     """Play a WAV file into ``pipeline`` as a microphone would deliver it; returns its length (s).
 
     The file is followed by a second of silence, as a room falls quiet after an answer, so the

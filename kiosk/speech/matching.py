@@ -146,7 +146,10 @@ def _find(needle: tuple[str, ...], haystack: tuple[str, ...]) -> int:
 
 
 class Matcher:
-    """Matches utterances against one question's options in one language."""
+    """Matches utterances against one question's options in one language.
+
+    With no options (the session is paused, say) only the commands are understood.
+    """
 
     def __init__(
         self,
@@ -156,8 +159,8 @@ class Matcher:
     ) -> None:
         if language not in LANGUAGES:
             raise ValueError(f"no speech vocabulary for language {language!r} (have {', '.join(LANGUAGES)})")
-        if not 1 <= len(options) <= len(CARDINALS[language]):
-            raise ValueError(f"a question needs 1 to {len(CARDINALS[language])} options, got {len(options)}")
+        if len(options) > len(CARDINALS[language]):
+            raise ValueError(f"at most {len(CARDINALS[language])} options can be spoken, got {len(options)}")
         self.options = tuple(options)
         self.language = language
         self.min_confidence = min_confidence

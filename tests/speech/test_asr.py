@@ -1,0 +1,66 @@
+"""Recognisers and grammars: dictionary checks, grammar formats, real decoding of espeak-ng audio."""
+
+from __future__ import annotations
+
+import json
+import logging
+import subprocess
+
+import pytest
+
+from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser
+from kiosk.speech.audio import UtterancePipeline, feed_wav
+from kiosk.speech.grammar import Grammar, build_grammar, recogniser_words, to_jsgf, to_vosk
+
+
+def test_build_grammar_leaves_out_unknown_words_and_says_why(caplog):
+    known = {"needs", "help", "two", "doctor"}.__contains__
+    with caplog.at_level(logging.INFO, logger="kiosk.speech.grammar"):
+        grammar = build_grammar(["Needs help", "two", "zorblax two", "Doctor!", "two"], known, "test")
+    assert grammar.phrases == ("needs help", "two", "doctor")
+    assert grammar.dropped == (("zorblax two", "'zorblax' not in the test dictionary"),)
+    assert "leaving out 'zorblax two'" in caplog.text
+
+
+def test_grammar_formats():
+    grammar = Grammar(("número dos", "l'option", "two"))
+    assert to_jsgf(grammar) == ("#JSGF V1.0;\ngrammar answer;\n"
+                                "public <answer> = número dos | l'option | two ;\n")
+    assert json.loads(to_vosk(grammar)) == ["número dos", "l'option", "two", "[unk]"]
+    assert recogniser_words("Sube el volumen, ¿vale?") == ["sube", "el", "volumen", "vale"]
+    with pytest.raises(ValueError, match="at least one phrase"):
+        to_jsgf(Grammar(()))
+
+
+def test_pocketsphinx_checks_its_real_dictionary():
+    recogniser = PocketSphinxRecogniser("en")
+    grammar = recogniser.set_grammar(["independent", "needs help", "independiente", "number two"])
+    assert grammar.phrases == ("independent", "needs help", "number two")
+    assert grammar.dropped[0][0] == "independiente"
+
+
+def test_pocketsphinx_is_english_only():
+    with pytest.raises(AsrUnavailable, match="pocketsphinx only ships English; install one with "
+                                             "`kiosk models install fr`"):
+        PocketSphinxRecogniser("fr")
+
+
+def test_pocketsphinx_needs_a_grammar_first():
+    with pytest.raises(RuntimeError, match="set_grammar"):
+        PocketSphinxRecogniser("en").accept(b"\0\0" * 160)
+
+
+def test_pocketsphinx_decodes_speech_and_scores_it(tmp_path):
+    recogniser = PocketSphinxRecogniser("en")
+    recogniser.set_grammar(["unable", "needs help", "independent", "one", "two", "three", "repeat"])
+    heard = []
+    pipeline = UtterancePipeline(recogniser, heard.append)
+    for text in ("independent", "the weather is nice today"):
+        path = tmp_path / f"{len(text)}.wav"
+        subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", "160", "-w", str(path), text], check=True)
+        feed_wav(path, pipeline)
+    answer, sentence = (u.result for u in heard)
+    assert answer.text == "independent" and answer.confidence > 0.9
+    # a sentence is forced onto the grammar too, but mostly into silence: low confidence
+    assert sentence.confidence < 0.3
+    assert recogniser.finish().text == ""  # nothing in progress

@@ -1,0 +1,206 @@
+"""End to end with real audio: espeak-ng speaks an answer, the audio pipeline and a real
+recogniser hear it under the question's grammar, and the real session records it as a voice answer.
+
+Runs with pocketsphinx (bundled English model) everywhere, and with vosk when a model is
+present (``KIOSK_VOSK_MODEL``, or ``../shared/models`` beside the repository).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command
+from kiosk.clock import SimClock
+from kiosk.questionnaire import load_questionnaire
+from kiosk.session import DoctorCalled, Paused, Prompt, Resumed, Session
+from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser, VoskRecogniser, open_recogniser
+from kiosk.speech.audio import feed_wav, list_input_devices
+from kiosk.speech.models import find_model
+from kiosk.speech.tts import VOICES
+from kiosk.speech.voice import VoiceChannel
+
+QUESTIONNAIRE = load_questionnaire()
+DEVELOPER_MODELS = Path(__file__).resolve().parents[2].parent / "shared" / "models"
+
+
+def _vosk_model(language: str) -> Path | None:
+    """A developer's vosk model for ``language``: configured, installed, or in ../shared/models."""
+    if "KIOSK_VOSK_MODEL" in os.environ or not DEVELOPER_MODELS.is_dir():
+        return find_model(language)
+    os.environ["KIOSK_VOSK_MODEL"] = str(DEVELOPER_MODELS)
+    try:
+        return find_model(language)
+    finally:
+        del os.environ["KIOSK_VOSK_MODEL"]
+
+
+def _backends(language: str):
+    params = []
+    if language == "en":
+        params.append(pytest.param(lambda lang: PocketSphinxRecogniser(lang), id="pocketsphinx"))
+    model = _vosk_model(language)
+    params.append(pytest.param(
+        lambda lang, model=model: VoskRecogniser(model, lang), id="vosk",
+        marks=pytest.mark.skipif(model is None, reason=f"no vosk model for {language!r}: set "
+                                 "KIOSK_VOSK_MODEL or put one in ../shared/models (none can be downloaded here)"),
+    ))
+    return params
+
+
+@pytest.fixture(scope="module")
+def spoken(tmp_path_factory):
+    """say(text, language) → a WAV of espeak-ng saying it (cached per module)."""
+    folder = tmp_path_factory.mktemp("answers")
+
+    def say(text: str, language: str = "en") -> Path:
+        path = folder / f"{language}-{text.replace(' ', '_')}.wav"
+        if not path.exists():
+            subprocess.run(["espeak-ng", "-v", VOICES[language], "-s", "160", "-w", str(path), text], check=True)
+        return path
+
+    return say
+
+
+class _Kiosk:
+    """The real session on a simulated clock, with a voice channel attached the way the app does."""
+
+    def __init__(self, recogniser_factory, language: str = "en") -> None:
+        self.clock = SimClock()
+        self.session = Session(QUESTIONNAIRE, clock=self.clock, engine=None, patient_id="P-0042",
+                               language=language, familiarisation=False)
+        self.events: list[object] = []
+        self.statuses: list[ChannelStatus] = []
+        self.unmatched: list[tuple[str, str]] = []
+        self.voice = VoiceChannel(language, recogniser_factory=recogniser_factory,
+                                  on_unmatched=lambda u, r: self.unmatched.append((u, r)))
+        self.session.subscribe(self.events.append)
+        self.session.subscribe(self.voice.on_session_event)
+        self.available = self.voice.attach(self._sink)
+
+    def _sink(self, item: ChannelInput | ChannelStatus) -> None:
+        # the app's sink hops to the UI thread; here the test thread is that thread
+        if isinstance(item, ChannelStatus):
+            self.statuses.append(item)
+        else:
+            self.session.handle(item)
+
+    def to_question(self, item_id: str) -> None:
+        self.session.start()
+        self.session.acknowledge()
+        while self.session.current_item is None or self.session.current_item.id != item_id \
+                or not self.session.listening:
+            if self.session.current_item is not None and self.session.listening:
+                self.session.handle(ChannelInput(Channel.TOUCH, option=1))
+            self.clock.advance(0.5)
+            self.session.poll()
+
+    def say(self, wav: Path) -> None:
+        feed_wav(wav, self.voice)
+
+
+ANSWERS_EN = [
+    ("feeding", "independent", 3),
+    ("feeding", "two", 2),
+    ("feeding", "by myself", 3),
+    ("dressing", "number three", 3),
+    ("bathing", "yes", 2),
+    ("stairs", "needs help", 2),
+    ("transfers", "four", 4),
+]
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+@pytest.mark.parametrize("item_id,utterance,option", ANSWERS_EN)
+def test_spoken_answer_is_recorded_as_a_voice_answer(backend, spoken, item_id, utterance, option):
+    kiosk = _Kiosk(backend)
+    kiosk.to_question(item_id)
+    kiosk.say(spoken(utterance))
+    answer = kiosk.session.answers[item_id]
+    assert (answer.option, answer.channel) == (option, Channel.VOICE)
+    recorded = [e for e in kiosk.events if type(e).__name__ == "AnswerRecorded" and e.item_id == item_id]
+    assert recorded[0].detail == utterance
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+def test_spoken_commands_reach_the_session(backend, spoken):
+    kiosk = _Kiosk(backend)
+    kiosk.to_question("feeding")
+    kiosk.say(spoken("repeat"))
+    assert any(isinstance(e, Prompt) and e.key == "feeding" and e.repeat for e in kiosk.events)
+    # "stop", one of the pause words: pocketsphinx mishears espeak-ng's "pause" (see bench/asr.py)
+    kiosk.say(spoken("stop"))
+    assert any(isinstance(e, Paused) and e.channel is Channel.VOICE for e in kiosk.events)
+    # while paused only commands are listened for: an answer is not taken, "continue" is
+    kiosk.say(spoken("independent"))
+    assert "feeding" not in kiosk.session.answers
+    kiosk.say(spoken("continue"))
+    assert any(isinstance(e, Resumed) for e in kiosk.events)
+    kiosk.say(spoken("call the doctor"))
+    assert any(isinstance(e, DoctorCalled) and e.channel is Channel.VOICE for e in kiosk.events)
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+@pytest.mark.parametrize("noise", ["the weather is nice today", "banana split"])
+def test_other_speech_is_never_an_answer(backend, spoken, noise):
+    kiosk = _Kiosk(backend)
+    kiosk.to_question("feeding")
+    kiosk.say(spoken(noise))
+    assert kiosk.session.answers == {}
+    assert len(kiosk.unmatched) == 1
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+def test_the_kiosks_own_voice_and_closed_attempts_are_not_heard(backend, spoken):
+    kiosk = _Kiosk(backend)
+    kiosk.session.start()
+    kiosk.say(spoken("independent"))  # no question open yet: the session is not listening
+    kiosk.to_question("feeding")
+    kiosk.voice.speaking(True)  # the kiosk reads the question aloud
+    kiosk.say(spoken("independent"))
+    assert kiosk.session.answers == {}
+    kiosk.voice.speaking(False)
+    kiosk.say(spoken("independent"))
+    assert kiosk.session.answers["feeding"].option == 3
+
+
+def test_no_recogniser_for_the_language_turns_voice_off_and_the_session_goes_on(monkeypatch, tmp_path):
+    monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
+    kiosk = _Kiosk(open_recogniser, language="es")
+    assert not kiosk.available
+    (status,) = kiosk.statuses
+    assert (status.channel, status.state) == (Channel.VOICE, ChannelState.OFF)
+    assert "no speech model for language 'es'" in status.reason
+    kiosk.to_question("bathing")  # answered feeding by touch on the way
+    assert kiosk.session.answers["feeding"].channel is Channel.TOUCH
+
+
+def test_no_microphone_turns_voice_off_with_a_reason():
+    if any(d.usable for d in list_input_devices()):
+        pytest.skip("this machine has a microphone")
+    statuses = []
+    voice = VoiceChannel("en")
+    voice.start(statuses.append)
+    voice.stop()
+    assert statuses == [ChannelStatus(Channel.VOICE, ChannelState.OFF, source="microphone",
+                                      reason="voice answers off: no microphone found")]
+
+
+def test_language_change_follows_the_prompts(spoken):
+    opened = []
+
+    def factory(language):
+        opened.append(language)
+        if language != "en":
+            raise AsrUnavailable(f"no model for {language}")
+        return PocketSphinxRecogniser(language)
+
+    kiosk = _Kiosk(factory)
+    kiosk.to_question("feeding")
+    kiosk.session.choose_language("fr")
+    assert opened == ["en", "fr"]
+    assert kiosk.statuses[-1].state is ChannelState.OFF
