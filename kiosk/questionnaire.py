@@ -263,14 +263,23 @@ def _schema() -> dict[str, Any]:
 def load_questionnaire(path: str | Path | None = None) -> Questionnaire:
     """Load and validate a questionnaire (default: the bundled Barthel file).
 
-    Raises :class:`QuestionnaireError` listing every problem, or ``OSError`` if unreadable.
+    Raises :class:`QuestionnaireError` listing every problem (an unreadable file is one problem).
     """
     file = Path(path) if path is not None else bundled_path()
-    text = file.read_text(encoding="utf-8")
-    data, problems = check_questionnaire_text(text, str(path if path is not None else file))
+    name = str(path if path is not None else file)
+    try:
+        text = file.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise QuestionnaireError([_unreadable(name, exc)]) from None
+    data, problems = check_questionnaire_text(text, name)
     if problems:
         raise QuestionnaireError(problems)
     return _build(data, str(file))
+
+
+def _unreadable(name: str, exc: OSError | UnicodeDecodeError) -> Problem:
+    reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+    return Problem(name, 1, 1, f"cannot read the file: {reason}")
 
 
 def check_questionnaire_file(path: str | Path) -> list[Problem]:
@@ -278,8 +287,7 @@ def check_questionnaire_file(path: str | Path) -> list[Problem]:
     try:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        return [Problem(str(path), 1, 1, f"cannot read the file: {reason}")]
+        return [_unreadable(str(path), exc)]
     return check_questionnaire_text(text, str(path))[1]
 
 

@@ -183,3 +183,8 @@ def test_validate_accepts_the_bundled_file_and_reports_unreadable_ones(tmp_path,
     assert validate_main([str(bundled_path())]) == 0
     assert validate_main([str(tmp_path / "missing.yaml")]) == 1
     assert "missing.yaml:1:1: cannot read the file" in capsys.readouterr().out
+
+
+def test_loading_a_missing_file_is_a_questionnaire_error(tmp_path):
+    with pytest.raises(QuestionnaireError, match="missing.yaml:1:1: cannot read the file"):
+        load_questionnaire(tmp_path / "missing.yaml")
