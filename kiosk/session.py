@@ -423,7 +423,8 @@ class Session:
     ``store`` commits every answer as it happens (``None``: nothing is stored).
     ``timing`` overrides the questionnaire's timing values. ``adaptation`` is a
     :class:`kiosk.adaptation.Adaptation` (``None``: no live adaptation).
-    ``resume_items`` (used by :meth:`resume`) are item ids already done, skipped by this session.
+    ``session_id``, ``t_offset``, ``resume_answers`` and ``resume_not_answered`` are for
+    :meth:`from_stored` (continuing a stored session); other callers leave them alone.
     """
 
     def __init__(
