@@ -56,7 +56,7 @@ from kiosk.session import (
 from kiosk.storage import Store
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar
-from kiosk.widgets.channel_board import ChannelBoard
+from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
 from kiosk.widgets.text import ui_text
 
 #: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
@@ -117,6 +117,8 @@ class KioskApp(App[int]):
         poll_interval: float = POLL_INTERVAL,
     ) -> None:
         super().__init__()
+        # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
+        self.theme = "textual-light"
         self.session = session
         self.questionnaire: Questionnaire = session.questionnaire
         self.store = store
@@ -289,6 +291,8 @@ class KioskApp(App[int]):
         if not snap.person_present:
             notices.append(ui_text(snap.language, "person_lost"))
         for name in sorted(snap.adaptations):
+            if name == "voice_off" and self.board.state(VOICE_IN)[0] is not ChannelState.ON:
+                continue  # "I am having trouble hearing you" is untrue when voice in never ran
             notices.append(self.questionnaire.message(name, snap.language)
                            or ui_text(snap.language, name, default=name.replace("_", " ")))
         return PatientView(snap, self.questionnaire, self.board.lines(snap.language),

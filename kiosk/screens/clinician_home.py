@@ -16,6 +16,9 @@ from kiosk.screens.session_detail import SessionDetailScreen
 class ClinicianHomeScreen(ClinicianScreen):
     """Reads the app's session and store; every action goes back through the app."""
 
+    #: the session list has the keys: arrows pick a session, Enter opens it
+    AUTO_FOCUS = "#sessions"
+
     def compose(self) -> ComposeResult:
         """The running session, channels, stored sessions, and the way back."""
         app = self.app
@@ -23,9 +26,9 @@ class ClinicianHomeScreen(ClinicianScreen):
         with Vertical(classes="clinician"):
             yield Static("Clinician", classes="heading")
             if app.clinician_pin == DEFAULT_PIN:  # type: ignore[attr-defined]
-                yield Label("The clinician PIN is still the public default: set clinician_pin in the "
+                yield Static("The clinician PIN is still the public default: set clinician_pin in the "
                             "configuration.", id="pin-warning")
-            yield Label(self._session_line(), id="current")
+            yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
                 yield Button("Continue the session", id="continue", variant="primary",
                              disabled=not (session.halted or session.paused))
@@ -33,7 +36,7 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Switch(value=session.adaptation is not None and session.adaptation.enabled,
                              id="adaptation", disabled=session.adaptation is None)
                 yield Button("Back to the patient", id="back")
-            yield Label(self._channels_text(), id="channel-reasons")
+            yield Static(self._channels_text(), id="channel-reasons")
             yield Label("Stored sessions (Enter or click to open):")
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
 

@@ -2,15 +2,21 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from textual.app import ComposeResult
 from textual.widgets import Static
 
-from kiosk.screens.base import PatientScreen
+from kiosk.screens.base import PatientScreen, PatientView
 from kiosk.widgets.text import ui_text
 
 
 class SummaryScreen(PatientScreen):
     """Thank-you, the total out of the maximum, the band, and how many items went unanswered."""
+
+    def show(self, view: PatientView) -> None:
+        """No notices once it is over: what the kiosk adapted no longer concerns the patient."""
+        super().show(replace(view, banner=None))
 
     def compose(self) -> ComposeResult:
         """Bars, thanks, the total and band."""

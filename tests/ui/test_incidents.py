@@ -3,15 +3,15 @@ clock, and a live adaptation reaching the screen -- all through the real app and
 
 from __future__ import annotations
 
-from textual.widgets import Input, Label
+from textual.widgets import Input, Label, Static
 
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
-from kiosk.channels import Channel
+from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.session import AttemptTimedOut, Phase, QuestionNotAnswered
 from kiosk.widgets.bars import AdaptationBanner
 
 from .conftest import UI_PIN
-from .helpers import settle, screen_name, start_in_english
+from .helpers import deliver_from_thread, screen_name, settle, start_in_english
 
 
 def _text(widget) -> str:
@@ -63,7 +63,7 @@ async def test_call_doctor_halts_until_a_clinician_continues_behind_the_pin(ui_k
         assert kiosk.app.screen.query_one(Input).value == ""
         await pilot.press(*UI_PIN, "enter")
         await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
-        assert "waiting for a clinician" in _text(kiosk.app.screen.query_one("#current", Label))
+        assert "waiting for a clinician" in _text(kiosk.app.screen.query_one("#current", Static))
         await pilot.click("#continue")
         await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
         assert not kiosk.session.halted
@@ -96,6 +96,8 @@ async def test_an_attempt_times_out_twice_and_the_next_question_comes(ui_kiosk):
 async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        # voice in works on this kiosk (so "I am having trouble hearing you" is true)
+        deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.ON, "voice in", "pocketsphinx"))
         await start_in_english(kiosk, pilot)
         banner = None
         # late touch answers (after the first attempt ran out) drag VoiceInteractionQuality down

@@ -1,0 +1,153 @@
+"""Snapshots of every screen at the kiosk's size (`pytest --snapshot-update` after a deliberate
+change, then look at the SVGs). Deterministic: a simulated clock, fixed session and patient ids,
+no blinking cursor, no focus on the patient's screens, channel states given by the test."""
+
+from __future__ import annotations
+
+from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
+from kiosk.channels import Channel, ChannelInput
+
+from .conftest import UI_PIN
+from .helpers import deliver_from_thread, screen_name, settle, start_in_english
+
+
+async def _question(kiosk, pilot) -> None:
+    await start_in_english(kiosk, pilot)
+    kiosk.to_next_deadline()
+    await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+
+
+def test_welcome(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk()
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_familiarisation(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk()
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.press("3")  # Français
+        await settle(pilot, lambda: kiosk.session.snapshot().practice is not None)
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_explanation(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.press("2")  # Español
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_question(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _question(kiosk, pilot)
+        kiosk.to_next_deadline()  # attempt 2 shows in the top bar
+        await settle(pilot, lambda: kiosk.session.current_attempt == 2)
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_question_answered_by_the_remote(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _question(kiosk, pilot)
+        deliver_from_thread(kiosk, ChannelInput(Channel.REMOTE, option=2, detail="BTN 2"))
+        await settle(pilot, lambda: "feeding" in kiosk.session.answers)
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_paused(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _question(kiosk, pilot)
+        await pilot.press("p")
+        await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_doctor_called(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _question(kiosk, pilot)
+        await pilot.press("d")
+        await settle(pilot, lambda: screen_name(kiosk) == "DoctorCalledScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+async def _finish(kiosk, pilot) -> None:
+    await _question(kiosk, pilot)
+    for index in range(10):
+        if index:
+            kiosk.to_next_deadline()
+            await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        if index == 4:  # one question left unanswered: the summary says so
+            kiosk.to_next_deadline()
+            kiosk.to_next_deadline()
+            continue
+        item = kiosk.session.current_item
+        await pilot.press(str(len(item.options) - index % 2))
+        await settle(pilot, lambda: item.id in kiosk.session.answers)
+    kiosk.to_next_deadline()
+    await settle(pilot, lambda: screen_name(kiosk) == "SummaryScreen")
+
+
+def test_summary(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _finish(kiosk, pilot)
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_pin(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk()
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.press(CLINICIAN_CHORD, "1", "2")
+        await settle(pilot, lambda: screen_name(kiosk) == "PinScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_clinician_home(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _question(kiosk, pilot)
+        await pilot.press("d", CLINICIAN_CHORD, *UI_PIN, "enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+def test_session_detail(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await _finish(kiosk, pilot)
+        await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        await pilot.press("enter")  # the session list has the focus; open its first row
+        await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
