@@ -654,6 +654,7 @@ class Session:
             if language == self._language:
                 return
             self._language = language
+            self._log(t, "language", language)
             self._emit(LanguageChanged(t, language))
             if self._phase is Phase.WELCOME:
                 self._message(t, "welcome")

@@ -207,6 +207,7 @@ def test_the_store_keeps_the_session_log_and_not_answered_questions(tmp_path):
     rig = stored_rig(store)
     rig.at(10)
     rig.session.start(answered_by="caregiver")
+    rig.session.choose_language("fr")
     rig.session.acknowledge()
     rig.run_until(26)
     rig.session.pause()
@@ -216,6 +217,7 @@ def test_the_store_keeps_the_session_log_and_not_answered_questions(tmp_path):
     stored = store.session(rig.session.id)
     assert stored.not_answered == ("feeding", "bathing")
     assert stored.answered_by.value == "caregiver"
-    assert [entry.kind for entry in stored.log][:3] == ["start", "pause", "resume"]
+    assert [(e.kind, e.detail) for e in stored.log][:4] == [
+        ("start", "answered by caregiver"), ("language", "fr"), ("pause", ""), ("resume", "")]
     assert stored.timing["attempt_window_s"] == 30
     assert [s.id for s in store.sessions()] == [rig.session.id]
