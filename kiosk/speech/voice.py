@@ -4,7 +4,7 @@
 events on the UI thread (:meth:`VoiceChannel.on_session_event`): each ``Prompt`` with options
 sets the grammar for that question in the prompt's language, ``ListeningChanged`` opens and
 closes the microphone gate, and while the session is paused only commands are listened for, so
-"continue" works. The kiosk's own voice mutes it (:meth:`VoiceChannel.speaking`, wired to
+"continue" works. The kiosk's own voice mutes it (:meth:`VoiceChannel.set_muted`, wired to
 :class:`kiosk.speech.tts.Speaker`'s ``on_speech``). Audio arrives on the microphone's thread;
 answers and status changes go to the sink from that thread, as the channel contract says.
 
@@ -104,16 +104,21 @@ class VoiceChannel:
     # -- what the session and the voice out tell it (UI / TTS threads) ------------------------
 
     def on_session_event(self, event: Any) -> None:
-        """Follow the session: question grammars, the listening gate, pause, language."""
+        """Follow every session event: grammars, the listening gate, and pause (commands only)."""
         kind = type(event).__name__
-        if kind == "Prompt" and event.options:
-            self.set_question(option_words(event.options), event.language)
+        if kind == "Prompt":
+            self.expect(event)
         elif kind == "ListeningChanged":
-            self.set_listening(event.listening)
+            self.listen(event.listening)
         elif kind == "Paused":
             self._set_paused(True)
         elif kind in ("Resumed", "Finished"):
             self._set_paused(False)
+
+    def expect(self, prompt: Any) -> None:
+        """A session ``Prompt``: a question's options become the grammar (messages change nothing)."""
+        if prompt.options:
+            self.set_question(option_words(prompt.options), prompt.language)
 
     def set_question(self, options: Sequence[OptionWords], language: str) -> None:
         """Listen for this question's answers (and the commands) in ``language``."""
@@ -125,14 +130,14 @@ class VoiceChannel:
                     return
             self._apply_grammar()
 
-    def set_listening(self, listening: bool) -> None:
+    def listen(self, listening: bool) -> None:
         """Open or close the gate (the session's ``ListeningChanged``)."""
         with self._lock:
             self._listening = listening
             self._gate()
 
-    def speaking(self, speaking: bool) -> None:
-        """The kiosk started or stopped talking (wire to ``Speaker(on_speech=...)``)."""
+    def set_muted(self, speaking: bool) -> None:
+        """The kiosk started (True) or stopped (False) talking: ``Speaker``'s ``on_speech``."""
         with self._lock:
             self._speaking = speaking
             self._gate()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import threading
 from pathlib import Path
 
 import pytest
@@ -16,11 +17,11 @@ import pytest
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command
 from kiosk.clock import SimClock
 from kiosk.questionnaire import load_questionnaire
-from kiosk.session import DoctorCalled, Paused, Prompt, Resumed, Session
+from kiosk.session import DoctorCalled, ListeningChanged, Paused, Prompt, Resumed, Session
 from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser, VoskRecogniser, open_recogniser
-from kiosk.speech.audio import feed_wav, list_input_devices
+from kiosk.speech.audio import feed_wav, list_input_devices, resample
 from kiosk.speech.models import find_model
-from kiosk.speech.tts import VOICES
+from kiosk.speech.tts import VOICES, Speaker
 from kiosk.speech.voice import VoiceChannel
 
 QUESTIONNAIRE = load_questionnaire()
@@ -68,7 +69,7 @@ def spoken(tmp_path_factory):
 class _Kiosk:
     """The real session on a simulated clock, with a voice channel attached the way the app does."""
 
-    def __init__(self, recogniser_factory, language: str = "en") -> None:
+    def __init__(self, recogniser_factory, language: str = "en", app_style: bool = False) -> None:
         self.clock = SimClock()
         self.session = Session(QUESTIONNAIRE, clock=self.clock, engine=None, patient_id="P-0042",
                                language=language, familiarisation=False)
@@ -78,8 +79,15 @@ class _Kiosk:
         self.voice = VoiceChannel(language, recogniser_factory=recogniser_factory,
                                   on_unmatched=lambda u, r: self.unmatched.append((u, r)))
         self.session.subscribe(self.events.append)
-        self.session.subscribe(self.voice.on_session_event)
+        self.session.subscribe(self._app_forward if app_style else self.voice.on_session_event)
         self.available = self.voice.attach(self._sink)
+
+    def _app_forward(self, event: object) -> None:
+        """What kiosk.app does with session events for voice in."""
+        if isinstance(event, Prompt):
+            self.voice.expect(event)
+        elif isinstance(event, ListeningChanged):
+            self.voice.listen(event.listening)
 
     def _sink(self, item: ChannelInput | ChannelStatus) -> None:
         # the app's sink hops to the UI thread; here the test thread is that thread
@@ -159,10 +167,10 @@ def test_the_kiosks_own_voice_and_closed_attempts_are_not_heard(backend, spoken)
     kiosk.session.start()
     kiosk.say(spoken("independent"))  # no question open yet: the session is not listening
     kiosk.to_question("feeding")
-    kiosk.voice.speaking(True)  # the kiosk reads the question aloud
+    kiosk.voice.set_muted(True)  # the kiosk reads the question aloud
     kiosk.say(spoken("independent"))
     assert kiosk.session.answers == {}
-    kiosk.voice.speaking(False)
+    kiosk.voice.set_muted(False)
     kiosk.say(spoken("independent"))
     assert kiosk.session.answers["feeding"].option == 3
 
@@ -204,3 +212,39 @@ def test_language_change_follows_the_prompts(spoken):
     kiosk.session.choose_language("fr")
     assert opened == ["en", "fr"]
     assert kiosk.statuses[-1].state is ChannelState.OFF
+
+
+def test_the_kiosk_reading_options_aloud_into_its_own_microphone_records_nothing(spoken):
+    """The speaker's start/end events mute voice in: its own "Independent" is not an answer."""
+    kiosk = _Kiosk(lambda lang: PocketSphinxRecogniser(lang))
+    kiosk.to_question("feeding")
+    done = threading.Event()
+
+    class EchoingPlayer:
+        """No loudspeaker here: what would be played goes straight into the microphone path."""
+
+        name = "echo"
+
+        def play(self, samples, rate):
+            kiosk.voice.feed(resample(samples, rate).tobytes() + bytes(32000))
+
+        def stop(self):
+            pass
+
+    speaker = Speaker(on_speech=lambda s: (kiosk.voice.set_muted(s), None if s else done.set()),
+                      player_factory=EchoingPlayer)
+    speaker.start()
+    speaker.say("Independent", "en")
+    assert done.wait(10)
+    speaker.close()
+    assert kiosk.session.answers == {}
+    kiosk.say(spoken("independent"))  # the patient, after the kiosk stopped talking
+    assert kiosk.session.answers["feeding"].option == 3
+
+
+def test_the_apps_calls_drive_the_channel(spoken):
+    """The app forwards only Prompt (expect) and ListeningChanged (listen); that is enough."""
+    kiosk = _Kiosk(lambda lang: PocketSphinxRecogniser(lang), app_style=True)
+    kiosk.to_question("feeding")
+    kiosk.say(spoken("two"))
+    assert kiosk.session.answers["feeding"].option == 2
