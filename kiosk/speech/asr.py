@@ -218,7 +218,7 @@ class VoskRecogniser:
 
     def set_grammar(self, phrases: Sequence[str]) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]")."""
-        grammar = build_grammar(phrases, lambda w: self._model.find_word(w) >= 0, self.name)
+        grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name)
         if not grammar.phrases:
             raise ValueError("a grammar needs at least one phrase the recogniser knows")
         self._recogniser = self._vosk.KaldiRecognizer(self._model, SAMPLE_RATE, to_vosk(grammar))
@@ -250,7 +250,10 @@ class VoskRecogniser:
         return Recognition(partial, 0.0, final=False) if partial else None
 
     def finish(self) -> Recognition:
-        """End the utterance; confidence is the lowest word confidence ("[unk]" counts as 0)."""
+        """End the utterance; confidence is the lowest word confidence.
+
+        Any "[unk]" makes it 0: the unknown word may have been "not" in "not independent".
+        """
         if self._recogniser is None:
             return Recognition("", 0.0)
         self._collect(self._recogniser.FinalResult())
