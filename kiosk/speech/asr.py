@@ -213,8 +213,8 @@ class VoskRecogniser:
         self.language = language
         self.model_path = path
         self._recogniser = None
-        self._texts: list[str] = []
-        self._confidences: list[float] = []
+        #: Vosk's JSON results for the segments of the current utterance
+        self._segments: list[str] = []
 
     def set_grammar(self, phrases: Sequence[str]) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]")."""
@@ -230,39 +230,44 @@ class VoskRecogniser:
         """Drop any utterance in progress."""
         if self._recogniser is not None:
             self._recogniser.Reset()
-        self._texts, self._confidences = [], []
-
-    def _collect(self, result_json: str) -> None:
-        result = json.loads(result_json)
-        words = [w for w in result.get("result", []) if w.get("word") != "[unk]"]
-        if result.get("text"):
-            self._texts.append(result["text"])
-        self._confidences += [float(w.get("conf", 0.0)) for w in words]
+        self._segments = []
 
     def accept(self, pcm: bytes) -> Recognition | None:
         """Decode more audio; Vosk may close a segment at its own pause detection."""
         if self._recogniser is None:
             raise RuntimeError("set_grammar must be called before recognising")
         if self._recogniser.AcceptWaveform(pcm):
-            self._collect(self._recogniser.Result())
+            self._segments.append(self._recogniser.Result())
             return None
         partial = json.loads(self._recogniser.PartialResult()).get("partial", "")
         return Recognition(partial, 0.0, final=False) if partial else None
 
     def finish(self) -> Recognition:
-        """End the utterance; confidence is the lowest word confidence.
-
-        Any "[unk]" makes it 0: the unknown word may have been "not" in "not independent".
-        """
+        """End the utterance and combine its segments (see :func:`vosk_recognition`)."""
         if self._recogniser is None:
             return Recognition("", 0.0)
-        self._collect(self._recogniser.FinalResult())
-        text = " ".join(self._texts).strip()
-        confidence = min(self._confidences) if self._confidences else 0.0
-        if "[unk]" in text.split():
-            confidence = 0.0
-        self._texts, self._confidences = [], []
-        return Recognition(text, confidence if text else 0.0)
+        segments = [*self._segments, self._recogniser.FinalResult()]
+        self._segments = []
+        return vosk_recognition(segments)
+
+
+def vosk_recognition(results: Sequence[str]) -> Recognition:
+    """One utterance from Vosk's JSON results (``{"text": ..., "result": [{"word", "conf"}...]}``).
+
+    The confidence is the lowest word confidence; any "[unk]" makes it 0, because the unknown
+    word may have been "not" in "not independent".
+    """
+    texts: list[str] = []
+    confidences: list[float] = []
+    for raw in results:
+        result = json.loads(raw)
+        if result.get("text"):
+            texts.append(result["text"])
+        confidences += [float(w.get("conf", 0.0)) for w in result.get("result", [])]
+    text = " ".join(texts).strip()
+    if not text or "[unk]" in text.split() or not confidences:
+        return Recognition(text, 0.0)
+    return Recognition(text, min(confidences))
 
 
 # --- choosing one ----------------------------------------------------------------------------

@@ -8,7 +8,13 @@ import subprocess
 
 import pytest
 
-from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser
+from kiosk.speech.asr import (
+    AsrUnavailable,
+    PocketSphinxRecogniser,
+    Recognition,
+    VoskRecogniser,
+    vosk_recognition,
+)
 from kiosk.speech.audio import UtterancePipeline, feed_wav
 from kiosk.speech.grammar import Grammar, build_grammar, recogniser_words, to_jsgf, to_vosk
 
@@ -64,3 +70,20 @@ def test_pocketsphinx_decodes_speech_and_scores_it(tmp_path):
     # a sentence is forced onto the grammar too, but mostly into silence: low confidence
     assert sentence.confidence < 0.3
     assert recogniser.finish().text == ""  # nothing in progress
+
+
+def test_vosk_results_are_combined_and_unknown_words_are_not_answers():
+    """Vosk's JSON (as KaldiRecognizer.Result/FinalResult print it with SetWords(True))."""
+    two = '{"result": [{"conf": 0.93, "end": 1.2, "start": 0.9, "word": "two"}], "text": "two"}'
+    number = '{"result": [{"conf": 0.71, "end": 0.8, "start": 0.4, "word": "number"}], "text": "number"}'
+    unk = ('{"result": [{"conf": 1.0, "end": 0.5, "start": 0.2, "word": "[unk]"}, '
+           '{"conf": 0.98, "end": 1.0, "start": 0.6, "word": "independent"}], "text": "[unk] independent"}')
+    assert vosk_recognition([number, two]) == Recognition("number two", 0.71)
+    assert vosk_recognition([two, '{"text": ""}']) == Recognition("two", 0.93)
+    assert vosk_recognition([unk]) == Recognition("[unk] independent", 0.0)
+    assert vosk_recognition(['{"text": ""}']) == Recognition("", 0.0)
+
+
+def test_vosk_backend_reports_a_missing_model_clearly(tmp_path):
+    with pytest.raises(AsrUnavailable, match=f"vosk model {tmp_path / 'none'} does not exist"):
+        VoskRecogniser(tmp_path / "none", "es")
