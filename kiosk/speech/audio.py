@@ -188,7 +188,8 @@ class Endpointer:
     def __init__(self, settings: EndpointerSettings | None = None) -> None:
         self.settings = settings or EndpointerSettings()
         frame_ms = 1000 * FRAME_SAMPLES / SAMPLE_RATE
-        self._start_frames = max(1, round(self.settings.start_ms / frame_ms))
+        #: voiced frames in a row that start an utterance
+        self.start_frames = max(1, round(self.settings.start_ms / frame_ms))
         self._end_frames = max(1, round(self.settings.hangover_ms / frame_ms))
         self._max_frames = round(self.settings.max_utterance_s * 1000 / frame_ms)
         self.reset()
@@ -212,7 +213,7 @@ class Endpointer:
         if not self.in_speech:
             if voiced:
                 self._voiced_run += 1
-                if self._voiced_run >= self._start_frames:
+                if self._voiced_run >= self.start_frames:
                     self.in_speech, self._quiet_run = True, 0
                     self._speech_frames = self._voiced_run
                     return "start"
@@ -280,8 +281,10 @@ class UtterancePipeline:
         recogniser: StreamingRecogniser,
         on_utterance: Callable[[Utterance], None],
         settings: EndpointerSettings | None = None,
+        timer: Callable[[], float] = time.perf_counter,
     ) -> None:
         self.recogniser = recogniser
+        self._timer = timer
         self.on_utterance = on_utterance
         self.endpointer = Endpointer(settings)
         self._preroll: deque[bytes] = deque(
@@ -338,7 +341,7 @@ class UtterancePipeline:
         frame_s = FRAME_SAMPLES / SAMPLE_RATE
         if event == "start":
             # the run of voiced frames that triggered the start is already in the pre-roll
-            self._start = self.stream_time - self.endpointer._start_frames * frame_s
+            self._start = self.stream_time - self.endpointer.start_frames * frame_s
             self.recogniser.reset()
             self.recogniser.accept(b"".join(self._preroll) + chunk)
             self._preroll.clear()
@@ -346,9 +349,9 @@ class UtterancePipeline:
         # "end": the recogniser has heard the speech and the hangover; finish it now
         self.recogniser.accept(chunk)
         endpoint = self.stream_time
-        began = time.perf_counter()
+        began = self._timer()
         result = self.recogniser.finish()
-        finish_seconds = time.perf_counter() - began
+        finish_seconds = self._timer() - began
         speech_end = endpoint - self.endpointer.quiet_frames * frame_s
         self.on_utterance(
             Utterance(

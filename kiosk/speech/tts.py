@@ -128,12 +128,13 @@ class PortAudioPlayer:
         self._sd.stop()
 
 
-@dataclass(frozen=True)
+@dataclass
 class _Job:
     text: str
     language: str
     path: Path | None = None  # save here instead of playing
     done: threading.Event | None = None
+    error: Exception | None = None
 
 
 class Speaker:
@@ -164,7 +165,6 @@ class Speaker:
         self._ready = threading.Event()
         self.available = False
         self.reason = ""
-        self._errors: dict[int, Exception] = {}
 
     # -- lifecycle ---------------------------------------------------------------------------
 
@@ -227,8 +227,8 @@ class Speaker:
         self._jobs.put(job)
         if not done.wait(timeout):
             raise TtsUnavailable(f"espeak-ng did not finish within {timeout:.0f} s")
-        if (error := self._errors.pop(id(job), None)) is not None:
-            raise error
+        if job.error is not None:
+            raise job.error
         return Path(path)
 
     # -- the worker --------------------------------------------------------------------------
@@ -238,7 +238,7 @@ class Speaker:
         while (job := self._jobs.get()) is not None:
             if synth is None:
                 if job.done is not None:
-                    self._errors[id(job)] = TtsUnavailable(self.reason)
+                    job.error = TtsUnavailable(self.reason)
                     job.done.set()
                 continue
             try:
@@ -248,7 +248,7 @@ class Speaker:
                     self._speak(synth, job)
             except Exception as exc:  # one bad phrase must not end the kiosk's voice
                 log.warning("voice out failed for %r: %s", job.text[:40], exc)
-                self._errors[id(job)] = exc if isinstance(exc, TtsUnavailable) else TtsUnavailable(str(exc))
+                job.error = exc if isinstance(exc, TtsUnavailable) else TtsUnavailable(str(exc))
             finally:
                 if job.done is not None:
                     job.done.set()
