@@ -53,9 +53,11 @@ class _Timed:
         self.inner, self.seconds = inner, 0.0
 
     def reset(self) -> None:
+        """Forward."""
         self.inner.reset()
 
     def accept(self, pcm: bytes):
+        """Forward, timed."""
         began = time.perf_counter()
         try:
             return self.inner.accept(pcm)
@@ -63,6 +65,7 @@ class _Timed:
             self.seconds += time.perf_counter() - began
 
     def finish(self):
+        """Forward, timed."""
         began = time.perf_counter()
         try:
             return self.inner.finish()
@@ -94,6 +97,7 @@ def _answers(options, language: str) -> list[tuple[str, object]]:
 
 
 def run(backend_name: str, make, language: str, items, folder: Path, hangover_ms: int) -> dict:
+    """Every question's answers and non-answers through one recogniser; the figures as a dict."""
     recogniser = make(language)
     timed = _Timed(recogniser)
     results: list = []

@@ -90,6 +90,7 @@ def list_input_devices() -> list[InputDevice]:
     sd = _sounddevice()
 
     def check(index: int) -> None:
+        """Raise unless the device takes 16 kHz mono int16."""
         sd.check_input_settings(device=index, channels=1, dtype="int16", samplerate=SAMPLE_RATE)
 
     default_index = sd.default.device[0]
@@ -302,6 +303,7 @@ class UtterancePipeline:
 
     @muted.setter
     def muted(self, value: bool) -> None:
+        """Muting forgets the utterance in progress."""
         if value and not self._muted:
             self._drop_utterance()
         self._muted = value
