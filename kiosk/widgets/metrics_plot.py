@@ -95,7 +95,7 @@ def save_png(data: PlotData, path: str | Path, title: str) -> Path:
         axes.set_xlabel("session time (s)")
         axes.set_ylabel("metric")
         axes.set_title(title)
-        axes.legend(loc="lower left")
+        axes.legend(loc="best")
         axes.grid(alpha=0.3)
         path = Path(path)
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)

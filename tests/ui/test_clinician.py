@@ -1,0 +1,83 @@
+"""The clinician's side: a finished session's answers, total and band, the metrics plot, exports
+(FHIR JSON, CSV, PNG) written owner-only, and the adaptation switch."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import stat
+
+from textual.widgets import DataTable, Label, Switch
+
+from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
+from kiosk.session import AdaptationChanged
+from kiosk.widgets.metrics_plot import MetricsPlot
+
+from .conftest import UI_PIN
+from .helpers import answer_every_question, screen_name, settle, start_in_english
+
+
+def _text(widget) -> str:
+    return str(widget.render())
+
+
+async def _open_clinician(kiosk, pilot) -> None:
+    await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")
+    await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+
+
+async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk, tmp_path):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+
+        async def first_option_then_last(number: int, option: int) -> None:
+            await pilot.press("1" if number <= 2 else str(option))
+
+        await answer_every_question(kiosk, pilot, first_option_then_last)
+        await _open_clinician(kiosk, pilot)
+        await pilot.press("enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
+        screen = kiosk.app.screen
+        table = screen.query_one("#answers-table", DataTable)
+        assert table.row_count == 10
+        assert table.get_row_at(0) == ["1", "feeding", "1", "Unable", "0", "1", "keyboard"]
+        assert table.get_row_at(9)[:5] == ["10", "stairs", "3", "Independent", "10"]
+        # feeding and bathing scored 0: 100 - 10 - 5
+        assert _text(screen.query_one("#total", Label)) == "Total 85 of 100 (complete); Moderate dependence"
+        plot = screen.query_one(MetricsPlot)
+        assert {name for name, (times, _) in plot.data.series.items() if times} == {
+            "Performance", "Interaction", "VoiceInteractionQuality"}
+
+        exports = tmp_path / "exports"
+        for button, name in [("#export-fhir", "fhir.json"), ("#export-csv", "csv"), ("#export-png", "metrics.png")]:
+            await pilot.click(button)
+            path = exports / f"session-{kiosk.session.id}.{name}"
+            await settle(pilot, lambda: path.exists())
+            assert str(path) in _text(screen.query_one("#export-result", Label))
+            assert stat.S_IMODE(path.stat().st_mode) == 0o600
+        response = json.loads((exports / f"session-{kiosk.session.id}.fhir.json").read_text())
+        assert response["resourceType"] == "QuestionnaireResponse" and response["status"] == "completed"
+        rows = list(csv.DictReader(io.StringIO((exports / f"session-{kiosk.session.id}.csv").read_text())))
+        assert len(rows) == 11 and rows[-1]["points"] == "85"
+        assert (exports / f"session-{kiosk.session.id}.metrics.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+        await pilot.press("escape")
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        await pilot.press("escape")
+        await settle(pilot, lambda: screen_name(kiosk) == "SummaryScreen")
+
+
+async def test_the_clinician_switches_live_adaptation_off(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        await _open_clinician(kiosk, pilot)
+        switch = kiosk.app.screen.query_one("#adaptation", Switch)
+        assert switch.value
+        await pilot.click("#adaptation")
+        await settle(pilot, lambda: not kiosk.session.adaptation.enabled)
+        await pilot.click("#back")
+        await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+        assert not [e for e in kiosk.app.events if isinstance(e, AdaptationChanged) and e.active]
