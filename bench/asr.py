@@ -13,7 +13,7 @@ matcher). Prints one JSON document:
 - ``finish_ms``: endpoint decision → result (goal < 300 ms); ``speech_end_to_answer_ms`` adds
   the endpointer's hangover (the silence it waits for before deciding the patient is done).
 
-    uv run python bench/asr.py [--languages en es fr] [--items N]
+    uv run python bench/asr.py [--languages en es fr] [--items N] [--hangover-ms MS]
 """
 
 from __future__ import annotations
@@ -171,10 +171,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--languages", nargs="+", default=["en", "es", "fr"])
     parser.add_argument("--items", type=int, default=10, help="how many questions (default all)")
+    parser.add_argument("--hangover-ms", type=int, default=EndpointerSettings().hangover_ms,
+                        help="the endpointer's end-of-speech silence (default: the kiosk's)")
     args = parser.parse_args(argv)
     questionnaire = load_questionnaire()
     items = questionnaire.items[: args.items]
-    hangover = EndpointerSettings().hangover_ms
+    hangover = args.hangover_ms
     report = {"goals": {"rtf": 0.2, "finish_ms": 300}, "hangover_ms": hangover, "runs": [], "skipped": []}
     with tempfile.TemporaryDirectory() as tmp:
         for language in args.languages:

@@ -248,6 +248,9 @@ class Speaker:
                     self._speak(synth, job)
             except Exception as exc:  # one bad phrase must not end the kiosk's voice
                 log.warning("voice out failed for %r: %s", job.text[:40], exc)
+                if job.path is None:  # the patient did not hear it: the UI must say so
+                    self.on_status(ChannelStatus(Channel.VOICE, ChannelState.LOST, source=self.source,
+                                                 reason=f"voice out failed: {exc}"))
                 job.error = exc if isinstance(exc, TtsUnavailable) else TtsUnavailable(str(exc))
             finally:
                 if job.done is not None:

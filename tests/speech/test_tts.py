@@ -141,3 +141,26 @@ def test_no_audio_output_turns_voice_out_off_without_crashing(tmp_path):
 def test_unknown_language_is_a_clear_error(tts_speaker, tmp_path):
     with pytest.raises(TtsUnavailable, match="no voice for language 'xx'"):
         tts_speaker.save_to_file("Hallo", "xx", tmp_path / "x.wav")
+
+
+def test_a_failing_loudspeaker_is_reported_and_the_next_phrase_still_plays():
+    class FlakyPlayer(_RecordingPlayer):
+        def play(self, samples, rate):
+            if not self.played:
+                self.played.append(None)
+                raise OSError("PortAudio: device unavailable")
+            super().play(samples, rate)
+
+    player = FlakyPlayer()
+    statuses = []
+    ended = threading.Semaphore(0)
+    speaker = Speaker(on_status=statuses.append, player_factory=lambda: player,
+                      on_speech=lambda s: None if s else ended.release())
+    speaker.start()
+    speaker.say("First", "en")
+    speaker.say("Second", "en")
+    assert ended.acquire(timeout=10) and ended.acquire(timeout=10)
+    speaker.close()
+    assert [s.state for s in statuses] == [ChannelState.ON, ChannelState.LOST]
+    assert statuses[1].reason == "voice out failed: PortAudio: device unavailable"
+    assert len(player.played) == 2 and player.played[1] is not None

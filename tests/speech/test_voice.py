@@ -133,6 +133,25 @@ def test_spoken_answer_is_recorded_as_a_voice_answer(backend, spoken, item_id, u
     assert recorded[0].detail == utterance
 
 
+ANSWERS_OTHER = [
+    ("es", "feeding", "independiente", 3), ("es", "feeding", "dos", 2), ("es", "feeding", "la segunda", 2),
+    ("fr", "feeding", "autonome", 3), ("fr", "feeding", "deux", 2), ("fr", "feeding", "le premier", 1),
+]
+
+
+@pytest.mark.parametrize(
+    "language,item_id,utterance,option,backend",
+    [pytest.param(lang, item, utt, opt, *backend.values, marks=backend.marks, id=f"{lang}-{utt}-{backend.id}")
+     for lang, item, utt, opt in ANSWERS_OTHER for backend in _backends(lang)],
+)
+def test_spoken_answer_in_spanish_and_french(spoken, language, item_id, utterance, option, backend):
+    kiosk = _Kiosk(backend, language=language)
+    kiosk.to_question(item_id)
+    kiosk.say(spoken(utterance, language))
+    answer = kiosk.session.answers[item_id]
+    assert (answer.option, answer.channel) == (option, Channel.VOICE)
+
+
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_spoken_commands_reach_the_session(backend, spoken):
     kiosk = _Kiosk(backend)
