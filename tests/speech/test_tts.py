@@ -8,7 +8,7 @@ import wave
 import numpy as np
 import pytest
 
-from kiosk.channels import Channel, ChannelState
+from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.questionnaire import load_questionnaire
 from kiosk.speech.audio import frame_level_db
 from kiosk.speech.tts import DEFAULT_RATE, Speaker, Synthesiser, TtsUnavailable
@@ -164,3 +164,17 @@ def test_a_failing_loudspeaker_is_reported_and_the_next_phrase_still_plays():
     assert [s.state for s in statuses] == [ChannelState.ON, ChannelState.LOST]
     assert statuses[1].reason == "voice out failed: PortAudio: device unavailable"
     assert len(player.played) == 2 and player.played[1] is not None
+
+
+def test_without_espeak_ng_voice_out_is_off_and_says_why(monkeypatch, tmp_path):
+    monkeypatch.setenv("PATH", str(tmp_path))  # a machine where espeak-ng is not installed
+    statuses = []
+    speaker = Speaker(on_status=statuses.append, player_factory=_RecordingPlayer)
+    speaker.start()
+    assert not speaker.wait_ready()
+    speaker.say("Hello", "en")  # ignored, not an error
+    with pytest.raises(TtsUnavailable, match="espeak-ng is not installed"):
+        speaker.save_to_file("Hello", "en", tmp_path / "x.wav")
+    speaker.close()
+    assert statuses == [ChannelStatus(Channel.VOICE, ChannelState.OFF, source="espeak-ng",
+                                      reason="voice out off: espeak-ng is not installed")]
