@@ -389,13 +389,14 @@ def feed_wav(path: str | Path, pipeline: PcmConsumer, chunk_ms: int = 100) -> fl
 
 
 class MicrophoneStream:
-    """Records 16 kHz mono int16 from a PortAudio input into a pipeline, on its own thread.
+    """Records 16 kHz mono int16 from a PortAudio input into a pipeline (or a voice channel,
+    which locks around it), on its own thread.
 
     PortAudio's callback only queues the audio; a worker thread runs the pipeline (and so the
     recogniser), which must never block the audio callback.
     """
 
-    def __init__(self, pipeline: UtterancePipeline, device: int | None = None) -> None:
+    def __init__(self, pipeline: PcmConsumer, device: int | None = None) -> None:
         self.pipeline = pipeline
         self.device = device
         self._queue: queue.Queue[bytes | None] = queue.Queue()

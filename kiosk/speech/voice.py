@@ -21,7 +21,7 @@ from typing import Any
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
 from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
-from kiosk.speech.audio import AudioUnavailable, MicrophoneStream, Utterance, UtterancePipeline
+from kiosk.speech.audio import AudioUnavailable, MicrophoneStream, PcmConsumer, Utterance, UtterancePipeline
 from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords
 
 log = logging.getLogger(__name__)
@@ -43,7 +43,7 @@ class VoiceChannel:
         language: str = "en",
         *,
         recogniser_factory: Callable[[str], Recogniser] = open_recogniser,
-        microphone_factory: Callable[[UtterancePipeline], Any] = MicrophoneStream,
+        microphone_factory: Callable[[PcmConsumer], Any] = MicrophoneStream,
         min_confidence: float = DEFAULT_MIN_CONFIDENCE,
         on_unmatched: Callable[[str, str], None] = lambda utterance, reason: None,
     ) -> None:
@@ -65,24 +65,33 @@ class VoiceChannel:
     # -- InputSource -------------------------------------------------------------------------
 
     def start(self, sink: Sink) -> None:
-        """Load the recogniser and open the microphone; reports ON, or OFF with the reason."""
+        """Open the microphone and load the recogniser; reports ON, or OFF with the reason.
+
+        The microphone stays open when only the recogniser is missing: choosing a language
+        that has one turns voice answers on.
+        """
         self._sink = sink
-        if not self._open_recogniser(self.language):
-            return
-        self._microphone = self._microphone_factory(self._pipeline)
+        self._microphone = self._microphone_factory(self)
         try:
             self._microphone.start()
         except AudioUnavailable as exc:
             self._microphone = None
             self._status(ChannelState.OFF, "microphone", str(exc))
             return
-        self._status(ChannelState.ON, self._recogniser.name)
+        if self._open_recogniser(self.language):
+            self._status(ChannelState.ON, self._recogniser.name)
+            with self._lock:
+                self._apply_grammar()
 
     def attach(self, sink: Sink) -> bool:
         """Like :meth:`start` without a microphone: audio comes from :meth:`feed` (WAV files,
         tests, the benchmark). Returns whether a recogniser is available."""
         self._sink = sink
-        return self._open_recogniser(self.language)
+        if not self._open_recogniser(self.language):
+            return False
+        with self._lock:
+            self._apply_grammar()
+        return True
 
     def stop(self) -> None:
         """Close the microphone; safe to call twice."""
@@ -124,10 +133,11 @@ class VoiceChannel:
         """Listen for this question's answers (and the commands) in ``language``."""
         with self._lock:
             self._options = list(options)
-            if language != self.language or self._recogniser is None:
+            if language != self.language:
                 self.language = language
-                if self._sink is not None and not self._open_recogniser(language):
-                    return
+                # before start() the language is only noted; a failure is reported once, not per question
+                if self._sink is not None and self._open_recogniser(language) and self._microphone is not None:
+                    self._status(ChannelState.ON, self._recogniser.name)
             self._apply_grammar()
 
     def listen(self, listening: bool) -> None:
@@ -163,16 +173,18 @@ class VoiceChannel:
             if self._pipeline is None:
                 self._pipeline = UtterancePipeline(recogniser, self._on_utterance)
             else:
+                self._pipeline.muted = True  # drop an utterance the old recogniser was hearing
                 self._pipeline.recogniser = recogniser
             self._gate()
         return True
 
     def _apply_grammar(self) -> None:
-        if self._recogniser is None:
+        if self._recogniser is None or not (self._options or self._paused):
             return
         options = [] if self._paused else self._options
         self._matcher = Matcher(options, self.language, self.min_confidence)
         self._recogniser.set_grammar(self._matcher.phrases())
+        self._gate()
 
     def _gate(self) -> None:
         if self._pipeline is not None:

@@ -69,7 +69,8 @@ def spoken(tmp_path_factory):
 class _Kiosk:
     """The real session on a simulated clock, with a voice channel attached the way the app does."""
 
-    def __init__(self, recogniser_factory, language: str = "en", app_style: bool = False) -> None:
+    def __init__(self, recogniser_factory, language: str = "en", app_style: bool = False,
+                 microphone=None) -> None:
         self.clock = SimClock()
         self.session = Session(QUESTIONNAIRE, clock=self.clock, engine=None, patient_id="P-0042",
                                language=language, familiarisation=False)
@@ -77,10 +78,14 @@ class _Kiosk:
         self.statuses: list[ChannelStatus] = []
         self.unmatched: list[tuple[str, str]] = []
         self.voice = VoiceChannel(language, recogniser_factory=recogniser_factory,
-                                  on_unmatched=lambda u, r: self.unmatched.append((u, r)))
+                                  on_unmatched=lambda u, r: self.unmatched.append((u, r)),
+                                  **({"microphone_factory": microphone} if microphone else {}))
         self.session.subscribe(self.events.append)
         self.session.subscribe(self._app_forward if app_style else self.voice.on_session_event)
-        self.available = self.voice.attach(self._sink)
+        if microphone is None:
+            self.available = self.voice.attach(self._sink)
+        else:
+            self.voice.start(self._sink)
 
     def _app_forward(self, event: object) -> None:
         """What kiosk.app does with session events for voice in."""
@@ -267,3 +272,40 @@ def test_the_apps_calls_drive_the_channel(spoken):
     kiosk.to_question("feeding")
     kiosk.say(spoken("two"))
     assert kiosk.session.answers["feeding"].option == 2
+
+
+class _WavMicrophone:
+    """Stands in for the sound card (none here): a thread plays WAV files into the channel,
+    the way MicrophoneStream's thread delivers recorded audio."""
+
+    def __init__(self, consumer) -> None:
+        self.consumer = consumer
+        self.files: list[Path] = []
+        self.thread: threading.Thread | None = None
+
+    def start(self) -> None:
+        def play() -> None:
+            for path in self.files:
+                feed_wav(path, self.consumer)
+
+        self.thread = threading.Thread(target=play)
+
+    def stop(self) -> None:
+        pass
+
+
+def test_started_channel_hears_its_microphone_thread_and_follows_language_changes(spoken, monkeypatch, tmp_path):
+    monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
+    kiosk = _Kiosk(open_recogniser, language="es", microphone=_WavMicrophone)
+    (off,) = kiosk.statuses  # the microphone works; Spanish has no recogniser here
+    assert off.state is ChannelState.OFF and "no speech model for language 'es'" in off.reason
+    kiosk.to_question("bathing")
+    kiosk.session.choose_language("en")  # the prompt comes again, in English
+    assert [(s.state, s.source) for s in kiosk.statuses[1:]] == [(ChannelState.ON, "pocketsphinx")]
+    microphone = kiosk.voice._microphone
+    microphone.files.append(spoken("independent"))
+    microphone.thread.start()
+    microphone.thread.join(timeout=30)
+    assert kiosk.session.answers["bathing"].option == 2
+    assert kiosk.session.answers["bathing"].channel is Channel.VOICE
