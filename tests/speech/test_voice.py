@@ -297,13 +297,15 @@ class _WavMicrophone:
 def test_started_channel_hears_its_microphone_thread_and_follows_language_changes(spoken, monkeypatch, tmp_path):
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
-    kiosk = _Kiosk(open_recogniser, language="es", microphone=_WavMicrophone)
+    microphones: list[_WavMicrophone] = []
+    kiosk = _Kiosk(open_recogniser, language="es",
+                   microphone=lambda consumer: microphones.append(_WavMicrophone(consumer)) or microphones[-1])
     (off,) = kiosk.statuses  # the microphone works; Spanish has no recogniser here
     assert off.state is ChannelState.OFF and "no speech model for language 'es'" in off.reason
     kiosk.to_question("bathing")
     kiosk.session.choose_language("en")  # the prompt comes again, in English
     assert [(s.state, s.source) for s in kiosk.statuses[1:]] == [(ChannelState.ON, "pocketsphinx")]
-    microphone = kiosk.voice._microphone
+    (microphone,) = microphones
     microphone.files.append(spoken("independent"))
     microphone.thread.start()
     microphone.thread.join(timeout=30)
