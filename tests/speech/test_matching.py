@@ -128,3 +128,21 @@ def test_normalise_and_spoken_label():
 def test_unknown_language_is_one_clear_error():
     with pytest.raises(ValueError, match="no speech vocabulary for language 'de'"):
         Matcher(FEEDING["en"], "de")
+
+
+def test_every_label_and_synonym_of_the_bundled_questionnaire_selects_its_own_option():
+    """A clinician editing barthel.yaml could give two options the same word; that would make
+    a spoken answer ambiguous (never recorded). The bundled file has no such clash."""
+    from kiosk.questionnaire import load_questionnaire
+
+    questionnaire = load_questionnaire()
+    clashes = []
+    for question in (*questionnaire.items, *questionnaire.familiarisation):
+        for language in questionnaire.languages:
+            matcher = Matcher([OptionWords(o.label_in(language), o.synonyms_in(language))
+                               for o in question.options], language)
+            for option in question.options:
+                for phrase in (option.label_in(language), *option.synonyms_in(language)):
+                    if (got := matcher.match(phrase)).option != option.number:
+                        clashes.append((question.id, language, phrase, got))
+    assert clashes == []
