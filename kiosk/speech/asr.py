@@ -80,7 +80,7 @@ class Recogniser(Protocol):
 PS_COST_MIDPOINT, PS_COST_SPREAD = 6.7, 0.25
 
 #: lattice entries that are not words the patient said
-_FILLERS = {"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]"}
+_FILLERS = {"<s>", "</s>", "<sil>", "(NULL)", "[NOISE]", "[SPEECH]"}
 
 
 class PocketSphinxRecogniser:
