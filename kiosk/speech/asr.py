@@ -276,12 +276,13 @@ def vosk_recognition(results: Sequence[str]) -> Recognition:
 def open_recogniser(language: str, model_path: str | Path | None = None) -> Recogniser:
     """The best recogniser for ``language`` on this machine.
 
-    Vosk with ``model_path`` or an installed/configured model (see :mod:`kiosk.speech.models`);
+    Vosk with the model ``model_path`` (a model or a folder of models, see
+    :func:`kiosk.speech.models.find_model`) or an installed one;
     else PocketSphinx for English; else :class:`AsrUnavailable` saying why voice in is off.
     """
     from kiosk.speech.models import find_model
 
-    path = Path(model_path) if model_path is not None else find_model(language)
+    path = find_model(language, model_path)
     if path is not None:
         return VoskRecogniser(path, language)
     return PocketSphinxRecogniser(language)

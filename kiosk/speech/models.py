@@ -70,9 +70,14 @@ def installed_model(language: str) -> Path | None:
     return path if is_vosk_model(path) else None
 
 
-def find_model(language: str) -> Path | None:
-    """The Vosk model to use for ``language``: ``KIOSK_VOSK_MODEL`` first, then the installed one."""
-    if configured := os.environ.get("KIOSK_VOSK_MODEL"):
+def find_model(language: str, configured: str | Path | None = None) -> Path | None:
+    """The Vosk model to use for ``language``, or None.
+
+    ``configured`` (the config's ``vosk_model``, else ``KIOSK_VOSK_MODEL``) is a model folder,
+    used only if its name does not say it is for another language, or a folder of models; then
+    the model `kiosk models install` put in place.
+    """
+    if configured := configured or os.environ.get("KIOSK_VOSK_MODEL"):
         root = Path(configured)
         if is_vosk_model(root) and model_language(root) in (language, None):
             return root

@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
@@ -42,13 +43,16 @@ class VoiceChannel:
         self,
         language: str = "en",
         *,
-        recogniser_factory: Callable[[str], Recogniser] = open_recogniser,
+        vosk_model: str | Path | None = None,
+        recogniser_factory: Callable[[str], Recogniser] | None = None,
         microphone_factory: Callable[[PcmConsumer], Any] = MicrophoneStream,
         min_confidence: float = DEFAULT_MIN_CONFIDENCE,
         on_unmatched: Callable[[str, str], None] = lambda utterance, reason: None,
     ) -> None:
         self.language = language
-        self._recogniser_factory = recogniser_factory
+        #: language → recogniser; by default vosk with ``vosk_model`` (the config's) or an
+        #: installed model, else pocketsphinx for English
+        self._recogniser_factory = recogniser_factory or (lambda lang: open_recogniser(lang, vosk_model))
         self._microphone_factory = microphone_factory
         self.min_confidence = min_confidence
         #: called with (utterance, reason) when speech was heard but was not an answer

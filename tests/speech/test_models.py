@@ -161,3 +161,15 @@ def test_kiosk_vosk_model_points_at_a_model_or_a_folder_of_models(tmp_path, monk
     monkeypatch.setenv("KIOSK_VOSK_MODEL", str(shelf / "vosk-model-small-fr-0.22"))
     assert models.find_model("fr") == shelf / "vosk-model-small-fr-0.22"
     assert models.find_model("en") is None  # a French model is not used for English
+
+
+def test_configured_model_is_only_used_for_its_own_language(tmp_path, monkeypatch):
+    monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path / "none"))
+    monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
+    spanish = tmp_path / "vosk-model-small-es-0.42"
+    (spanish / "am").mkdir(parents=True)
+    (spanish / "am" / "final.mdl").write_bytes(b"x")
+    (spanish / "conf").mkdir()
+    assert models.find_model("es", spanish) == spanish
+    assert models.find_model("fr", spanish) is None
+    assert isinstance(open_recogniser("en", spanish), PocketSphinxRecogniser)
