@@ -57,8 +57,6 @@ class TtsUnavailable(RuntimeError):
 class Synthesiser:
     """espeak-ng, text → WAV file (22.05 kHz mono 16-bit). Thread-safe: one process per phrase."""
 
-    backend = "espeak-ng"
-
     def __init__(self) -> None:
         self._command = shutil.which("espeak-ng")
         if self._command is None:
@@ -93,8 +91,6 @@ def _has_audio(path: str | Path) -> bool:
 class Player(Protocol):
     """Plays audio to the patient; ``play`` blocks until done or stopped."""
 
-    name: str
-
     def play(self, samples: np.ndarray, rate: int) -> None:
         """Play mono int16 samples at ``rate`` Hz and return when done or stopped."""
 
@@ -104,8 +100,6 @@ class Player(Protocol):
 
 class PortAudioPlayer:
     """The default audio output through sounddevice."""
-
-    name = "portaudio"
 
     def __init__(self) -> None:
         try:

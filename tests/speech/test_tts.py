@@ -24,8 +24,6 @@ def _wav(path) -> tuple[np.ndarray, int]:
 class _RecordingPlayer:
     """Stands in for the sound card (none here): keeps what would have been played."""
 
-    name = "recording"
-
     def __init__(self) -> None:
         self.played: list[tuple[np.ndarray, int]] = []
         self.stopped = threading.Event()

@@ -247,8 +247,6 @@ def test_the_kiosk_reading_options_aloud_into_its_own_microphone_records_nothing
     class EchoingPlayer:
         """No loudspeaker here: what would be played goes straight into the microphone path."""
 
-        name = "echo"
-
         def play(self, samples, rate):
             kiosk.voice.feed(resample(samples, rate).tobytes() + bytes(32000))
 
