@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from functools import partial
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -92,7 +93,8 @@ class KioskApp(App[int]):
     """The patient's kiosk, with the clinician screens behind a key chord and a PIN.
 
     ``session`` is a fresh (not yet started) session. ``speaker`` is a ``kiosk.speech.tts.Speaker``
-    or None (voice out off); ``voice`` a voice-in source, ``sources`` the remotes' input sources
+    or None (voice out off); ``voice`` a ``kiosk.speech.voice.VoiceChannel`` (an input source that
+    also follows the session's events) or None; ``sources`` the remotes' input sources
     (all started with :meth:`channel_sink` on mount and stopped on exit). ``statuses`` are channel
     states known before start-up, such as "voice in off: no microphone found". ``keyboard`` is a
     ``kiosk.remote.KeyboardRemote`` for remotes that type keys.
@@ -109,7 +111,7 @@ class KioskApp(App[int]):
         clinician_pin: str,
         store: Store | None = None,
         speaker: Any = None,
-        voice: InputSource | None = None,
+        voice: Any = None,
         sources: Iterable[InputSource] = (),
         keyboard: Any = None,
         statuses: Iterable[ChannelStatus] = (),
@@ -147,7 +149,9 @@ class KioskApp(App[int]):
         if self.speaker is not None:
             self.speaker.start()
         for source in self._input_sources():
-            source.start(self.channel_sink)
+            # loading a speech model or probing a device can take a while: never on the UI thread
+            self.run_worker(partial(source.start, self.channel_sink), thread=True,
+                            name=f"start {source.name}", group="channels")
         self.set_interval(self.poll_interval, self.poll_session)
         self._render()
 
@@ -172,7 +176,10 @@ class KioskApp(App[int]):
         self.post_message(ChannelReceived(status))
 
     def speaker_activity(self, speaking: bool) -> None:
-        """The speaker's speech start/end callback (worker thread)."""
+        """The speaker's speech start/end callback (worker thread). The recogniser is muted right
+        here, not after the hop to the UI thread, so none of the kiosk's own voice reaches it."""
+        if self.voice is not None:
+            self.voice.set_muted(speaking)
         self.post_message(SpeechActivity(speaking))
 
     def on_channel_received(self, message: ChannelReceived) -> None:
@@ -186,8 +193,6 @@ class KioskApp(App[int]):
     def on_speech_activity(self, message: SpeechActivity) -> None:
         """Show "speaking", mute the recogniser meanwhile, and tell the session a repeat was said."""
         self.board.speaking = message.speaking
-        if hasattr(self.voice, "set_muted"):
-            self.voice.set_muted(message.speaking)  # type: ignore[union-attr]
         if not message.speaking:
             self._drive(self.session.prompt_delivered)
         else:
@@ -261,14 +266,12 @@ class KioskApp(App[int]):
         """Carry out what an event asks of the channels; the redraw follows the operation."""
         self.events.append(event)
         self._dirty = True
+        if self.voice is not None:  # its grammar follows the prompts, its gate the listening state
+            self.voice.on_session_event(event)
         if isinstance(event, Prompt):
             self._speak(event)
-            if hasattr(self.voice, "expect"):
-                self.voice.expect(event)  # type: ignore[union-attr]
         elif isinstance(event, ListeningChanged):
             self.board.listening = event.listening
-            if hasattr(self.voice, "listen"):
-                self.voice.listen(event.listening)  # type: ignore[union-attr]
         elif isinstance(event, (AnswerRecorded, Paused, DoctorCalled)):
             if self.speaker is not None:
                 self.speaker.stop_speaking()
@@ -391,8 +394,12 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     from kiosk.config import ConfigError, load_config
     from kiosk.questionnaire import QuestionnaireError, load_questionnaire
     from kiosk.records import MODEL
-    from kiosk.storage import StorageError, new_patient_id
+    from kiosk.storage import PATIENT_ID, StorageError, new_patient_id
     from qos import Engine, load_model
+
+    if patient_id is not None and not PATIENT_ID.match(patient_id):
+        raise SetupError(f"--patient {patient_id!r} is not a pseudonymous id: use letters, digits, '-' "
+                         "and '_' only (2 to 64 characters), never a name")
 
     try:
         config = load_config(config_path)
@@ -408,14 +415,10 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
     speaker = _speaker() if voice else None
     voice_in = _voice_in(config, voice, statuses)
-    try:
-        session = Session(questionnaire, clock=SystemClock(), engine=Engine(load_model(MODEL)),
-                          patient_id=patient_id or new_patient_id(), store=store, language=config.language,
-                          timing=config.timing, adaptation=Adaptation(policy) if policy else None,
-                          familiarisation=config.familiarisation)
-    except ValueError as error:  # a bad --patient id
-        store.close()
-        raise SetupError(str(error)) from None
+    session = Session(questionnaire, clock=SystemClock(), engine=Engine(load_model(MODEL)),
+                      patient_id=patient_id or new_patient_id(), store=store, language=config.language,
+                      timing=config.timing, adaptation=Adaptation(policy) if policy else None,
+                      familiarisation=config.familiarisation)
     app = KioskApp(session, clinician_pin=config.clinician_pin, store=store, speaker=speaker, voice=voice_in,
                    sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports")
@@ -446,13 +449,16 @@ def _speaker() -> Any:
     return Speaker()
 
 
-def _voice_in(config: Any, wanted: bool, statuses: list[ChannelStatus]) -> InputSource | None:
-    """The voice-in channel, or None with the reason it is off."""
+def _voice_in(config: Any, wanted: bool, statuses: list[ChannelStatus]) -> Any:
+    """The voice-in channel (it reports on, or off with the reason, once started), or None."""
     if not wanted:
         statuses.append(ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "turned off (--no-voice)"))
         return None
-    statuses.append(ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "voice answers are not available yet"))
-    return None
+    from kiosk.speech.asr import open_recogniser
+    from kiosk.speech.voice import VoiceChannel
+
+    model = config.vosk_model
+    return VoiceChannel(config.language, recogniser_factory=lambda language: open_recogniser(language, model))
 
 
 def main(argv: list[str]) -> int:
