@@ -1,0 +1,177 @@
+"""How fast the kiosk's UI is, headless: a whole session and the latency of a key press.
+
+* ``session_s``: a full session through the real app (headless ``run_test``, at the kiosk's size):
+  language, the practice questions, the explanation and all 10 questions answered by keys, up to
+  the summary screen. The session runs on a simulated clock (the 2 s gaps between questions cost
+  nothing), with the real QoS engine, adaptation and a SQLite store. Goal: under 3 s.
+* ``key_to_screen_ms``: from a key event reaching the app until the next screen is mounted and has
+  been drawn once (``call_after_refresh``):
+  ``pause`` (P: question -> paused screen), ``resume`` (P: paused -> question screen),
+  ``next_question`` (an answer key, then the app's poll once the gap is over -> the next question
+  screen), and ``answer_marked`` (an answer key -> the chosen answer highlighted on the same screen).
+  Goal: median under 50 ms.
+
+Prints JSON. Run: uv run python bench/ui_session.py [--rounds N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import statistics
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from textual import events
+
+from kiosk.adaptation import Adaptation, load_policy
+from kiosk.app import KIOSK_SIZE, KioskApp
+from kiosk.clock import SimClock
+from kiosk.questionnaire import load_questionnaire
+from kiosk.records import MODEL
+from kiosk.session import Phase, Session
+from kiosk.storage import Store
+from qos import Engine, load_model
+
+GOAL_SESSION_S = 3.0
+GOAL_MEDIAN_MS = 50.0
+
+
+def build(data_dir: Path) -> tuple[KioskApp, SimClock, Store]:
+    """A kiosk as `kiosk run` builds it, but on a simulated clock and without device channels."""
+    clock = SimClock()
+    questionnaire = load_questionnaire()
+    store = Store.open(data_dir)
+    session = Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)), patient_id="P-BENCH1",
+                      store=store, adaptation=Adaptation(load_policy()))
+    return KioskApp(session, clinician_pin="2468", store=store, poll_interval=3600), clock, store
+
+
+async def until(condition: Callable[[], object]) -> None:
+    """Let the app's event loop run until ``condition()`` holds."""
+    for _ in range(100_000):
+        if condition():
+            return
+        await asyncio.sleep(0)
+    raise RuntimeError("the app never got there")
+
+
+async def press(app: KioskApp, key: str) -> None:
+    """Send a key the way the terminal driver does (Pilot's press also waits for the CPU to go
+    idle after each key, which would measure Pilot's heuristics instead of the app)."""
+    app.post_message(events.Key(key, key))
+    await asyncio.sleep(0)
+
+
+async def painted(app: KioskApp) -> None:
+    """Wait until the screen has been refreshed (drawn) once more."""
+    done = asyncio.Event()
+    app.call_after_refresh(done.set)
+    await done.wait()
+
+
+def to_deadline(app: KioskApp, clock: SimClock) -> None:
+    """Jump the clock to the session's next time-out and poll, as the app's timer would."""
+    clock.set(app.session.next_deadline())
+    app.poll_session()
+
+
+def drawn(app: KioskApp, name: str) -> bool:
+    """The screen on top is ``name`` and has been laid out (it is on the display)."""
+    screen = app.screen
+    return type(screen).__name__ == name and screen.is_mounted and screen.size.area > 0
+
+
+async def one_session(data_dir: Path, latencies: dict[str, list[float]]) -> float:
+    """Run a whole session; returns its wall time and adds key latencies (ms) to ``latencies``."""
+    app, clock, store = build(data_dir)
+    began = time.perf_counter()
+    async with app.run_test(size=KIOSK_SIZE):
+        session = app.session
+        await until(lambda: drawn(app, "WelcomeScreen"))
+        await press(app, "1")
+        await until(lambda: session.phase is not Phase.WELCOME)
+        while session.phase is Phase.FAMILIARISATION:
+            practice = session.snapshot().practice
+            if practice is not None and session.current_attempt is not None:
+                answered = len(app.events)
+                await press(app, str(practice.expected))
+                await until(lambda: len(app.events) > answered)
+            else:
+                to_deadline(app, clock)
+        await until(lambda: drawn(app, "ExplanationScreen"))
+        await press(app, "1")
+        await until(lambda: session.phase is Phase.QUESTIONS)
+        to_deadline(app, clock)
+        for index, item in enumerate(session.questionnaire.items):
+            await until(lambda: session.current_attempt == 1 and drawn(app, "QuestionScreen"))
+            if index % 3 == 0:  # pause and resume on some questions
+                start = time.perf_counter()
+                await press(app, "p")
+                await until(lambda: drawn(app, "PausedScreen"))
+                await painted(app)
+                latencies["pause"].append((time.perf_counter() - start) * 1000)
+                start = time.perf_counter()
+                await press(app, "p")
+                await until(lambda: drawn(app, "QuestionScreen"))
+                await painted(app)
+                latencies["resume"].append((time.perf_counter() - start) * 1000)
+            start = time.perf_counter()
+            await press(app, str(len(item.options)))
+            await until(lambda: app.screen.query(".-chosen"))
+            await painted(app)
+            latencies["answer_marked"].append((time.perf_counter() - start) * 1000)
+            to_deadline(app, clock)  # the gap between questions (or the closing) is over
+            if index + 1 < len(session.questionnaire.items):
+                nxt = session.questionnaire.items[index + 1]
+                await until(lambda: session.current_item == nxt and drawn(app, "QuestionScreen")
+                            and not app.screen.query(".-chosen"))
+                await painted(app)
+                latencies["next_question"].append((time.perf_counter() - start) * 1000)
+        await until(lambda: drawn(app, "SummaryScreen"))
+        await painted(app)
+        assert len(store.session(session.id).answers) == 10
+    elapsed = time.perf_counter() - began
+    store.close()
+    return elapsed
+
+
+def summary(values: list[float]) -> dict[str, float]:
+    """Median, 95th percentile and maximum, rounded."""
+    ordered = sorted(values)
+    return {"median": round(statistics.median(ordered), 2),
+            "p95": round(ordered[min(len(ordered) - 1, int(0.95 * len(ordered)))], 2),
+            "max": round(ordered[-1], 2), "n": len(ordered)}
+
+
+def main(argv: list[str]) -> int:
+    """Run the rounds and print the JSON figures."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=5, help="sessions to run (default %(default)s)")
+    args = parser.parse_args(argv)
+    latencies: dict[str, list[float]] = {"pause": [], "resume": [], "next_question": [], "answer_marked": []}
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for round_ in range(args.rounds):
+            times.append(asyncio.run(one_session(Path(tmp) / str(round_), latencies)))
+    all_keys = [v for values in latencies.values() for v in values]
+    print(json.dumps({
+        "terminal_size": list(KIOSK_SIZE),
+        "rounds": args.rounds,
+        "session_s": {"best": round(min(times), 3), "median": round(statistics.median(times), 3),
+                      "worst": round(max(times), 3), "goal": GOAL_SESSION_S,
+                      "met": statistics.median(times) < GOAL_SESSION_S},
+        "key_to_screen_ms": {name: summary(values) for name, values in latencies.items()},
+        "key_to_screen_median_ms": round(statistics.median(all_keys), 2),
+        "key_goal_median_ms": GOAL_MEDIAN_MS,
+        "key_goal_met": statistics.median(all_keys) < GOAL_MEDIAN_MS,
+    }, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
