@@ -302,36 +302,46 @@ class KioskApp(App[int]):
                            " ".join(notices) or None)
 
     @staticmethod
-    def _screen_class(view: PatientView) -> type[PatientScreen]:
+    def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:
+        """The screen of the session's phase, and the one covering it while paused or halted."""
         snap = view.snapshot
-        if snap.halted:
-            return DoctorCalledScreen
-        if snap.paused:
-            return PausedScreen
-        return {
+        base = {
             Phase.WELCOME: WelcomeScreen,
             Phase.FAMILIARISATION: FamiliarisationScreen,
             Phase.EXPLANATION: ExplanationScreen,
             Phase.QUESTIONS: QuestionScreen,
             Phase.SUMMARY: SummaryScreen,
         }[snap.phase]
+        overlay = DoctorCalledScreen if snap.halted else PausedScreen if snap.paused else None
+        return base, overlay
 
     def _render(self) -> None:
-        """Show the screen the session's state calls for, or refresh the one shown."""
+        """Show the screens the session's state calls for, or refresh the ones shown.
+
+        The phase's screen stays mounted under a paused or doctor-called screen, so resuming
+        only uncovers it; it is rebuilt only when its :meth:`PatientScreen.key` changes.
+        """
         if not self.is_running or self.clinician_open:
             return
         view = self._view()
-        cls = self._screen_class(view)
-        key = (cls, cls.key(view))
-        screen = self.screen
-        if key == self._screen_key and isinstance(screen, cls):
-            screen.show(view)
-            return
-        self._screen_key = key
-        if isinstance(screen, PatientScreen):
-            self.switch_screen(cls(view))
+        base_cls, overlay_cls = self._screen_classes(view)
+        shown = [s for s in self.screen_stack if isinstance(s, PatientScreen)]
+        base, overlay = (shown + [None, None])[:2]
+        key = (base_cls, base_cls.key(view))
+        if overlay is not None and (type(overlay) is not overlay_cls or key != self._screen_key):
+            self.pop_screen()
+            overlay = None
+        if base is None:
+            self.push_screen(base_cls(view))
+        elif key != self._screen_key:
+            self.switch_screen(base_cls(view))
         else:
-            self.push_screen(cls(view))
+            base.show(view)
+        self._screen_key = key
+        if overlay is not None:
+            overlay.show(view)
+        elif overlay_cls is not None:
+            self.push_screen(overlay_cls(view))
 
     # -- the clinician side -------------------------------------------------------------------
 

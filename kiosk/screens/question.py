@@ -15,26 +15,46 @@ from kiosk.widgets.text import ui_text
 class QuestionScreen(PatientScreen):
     """One scored item. Touching an answer posts ``AnswerButton.Chosen``; the app forwards it."""
 
+    def __init__(self, view: PatientView) -> None:
+        """Build the screen for ``view``'s item."""
+        super().__init__(view)
+        #: the item whose panel is on screen
+        self._item_id: str | None = None
+
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
-        """A new screen per item and language."""
-        snap = view.snapshot
-        return (snap.item.id if snap.item else None, snap.language)
+        """One screen for all the items of a language: the next item only swaps the panel."""
+        return view.snapshot.language
 
     def compose(self) -> ComposeResult:
         """Bars, the question with its answers, and the controls."""
         yield from self.compose_bars()
-        item = self.view.snapshot.item
-        if item is not None:
-            answer = self.view.snapshot.answers.get(item.id)
-            yield QuestionPanel(item.text[self.language], [o.label_in(self.language) for o in item.options],
-                                chosen=answer.option if answer else None)
+        if (panel := self._panel(self.view)) is not None:
+            yield panel
         yield ControlBar(self.language)
 
-    def show(self, view: PatientView) -> None:
-        """Also mark the recorded answer once there is one."""
-        super().show(view)
+    def _panel(self, view: PatientView) -> QuestionPanel | None:
+        """The question and answers of the view's item (None between the explanation and item 1)."""
         item = view.snapshot.item
+        self._item_id = item.id if item else None
+        if item is None:
+            return None
+        answer = view.snapshot.answers.get(item.id)
+        return QuestionPanel(item.text[self.language], [o.label_in(self.language) for o in item.options],
+                             chosen=answer.option if answer else None)
+
+    def show(self, view: PatientView) -> None:
+        """Refresh the bars; swap in the next item's panel, or mark the recorded answer."""
+        super().show(view)
+        if not self.is_mounted:  # compose has not run yet: it will draw this view
+            return
+        item = view.snapshot.item
+        if (item.id if item else None) != self._item_id:
+            for old in self.query(QuestionPanel):
+                old.remove()
+            if (panel := self._panel(view)) is not None:
+                self.mount(panel, before=self.query_one(ControlBar))
+            return
         answer = view.snapshot.answers.get(item.id) if item else None
         for panel in self.query(QuestionPanel):
             panel.mark_chosen(answer.option if answer else None)

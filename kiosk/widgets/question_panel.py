@@ -16,7 +16,7 @@ class QuestionPanel(Vertical):
 
     def __init__(self, question: str, options: Sequence[str], *, chosen: int | None = None) -> None:
         """Show ``question`` and the ``options`` labels (option 1 first); mark ``chosen`` if set."""
-        super().__init__(id="panel")
+        super().__init__(classes="panel")
         self.question = question
         self.options = tuple(options)
         self.chosen = chosen
