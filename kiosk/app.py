@@ -54,7 +54,7 @@ from kiosk.session import (
     SessionEvent,
     VolumeChanged,
 )
-from kiosk.storage import Store
+from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar
 from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
@@ -97,7 +97,9 @@ class KioskApp(App[int]):
     also follows the session's events) or None; ``sources`` the remotes' input sources
     (all started with :meth:`channel_sink` on mount and stopped on exit). ``statuses`` are channel
     states known before start-up, such as "voice in off: no microphone found". ``keyboard`` is a
-    ``kiosk.remote.KeyboardRemote`` for remotes that type keys.
+    ``kiosk.remote.KeyboardRemote`` for remotes that type keys. ``resumable`` is an interrupted
+    stored session the welcome screen offers to continue, through ``resume`` (which builds the
+    session continuing it, ``Session.from_stored``).
     """
 
     CSS_PATH = "kiosk.tcss"
@@ -117,6 +119,8 @@ class KioskApp(App[int]):
         statuses: Iterable[ChannelStatus] = (),
         export_dir: Path | None = None,
         poll_interval: float = POLL_INTERVAL,
+        resumable: StoredSession | None = None,
+        resume: Callable[[StoredSession], Session] | None = None,
     ) -> None:
         super().__init__()
         # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
@@ -131,6 +135,8 @@ class KioskApp(App[int]):
         self.keyboard = keyboard
         self.export_dir = export_dir
         self.poll_interval = poll_interval
+        self.resumable = resumable if resume is not None else None
+        self._resume = resume
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is None:
             self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE, "voice out turned off"))
@@ -140,7 +146,7 @@ class KioskApp(App[int]):
         self.events: list[SessionEvent] = []
         self._screen_key: tuple[type, object] | None = None
         self._dirty = False
-        self.session.subscribe(self._on_session_event)
+        self._unsubscribe = self.session.subscribe(self._on_session_event)
 
     # -- start and stop -------------------------------------------------------------------------
 
@@ -225,6 +231,16 @@ class KioskApp(App[int]):
         """Start in the language the patient touched."""
         self._start(message.language)
 
+    def on_welcome_screen_resume_chosen(self, message: WelcomeScreen.ResumeChosen) -> None:
+        """Continue the interrupted session instead of the fresh one (which was never started)."""
+        if self.resumable is None or self._resume is None or self.session.phase is not Phase.WELCOME:
+            return
+        self._unsubscribe()
+        self.session = self._resume(self.resumable)
+        self.resumable = None
+        self._unsubscribe = self.session.subscribe(self._on_session_event)
+        self._drive(self.session.start)
+
     def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
         """The patient touched Start under the explanation."""
         self._drive(self.session.acknowledge)
@@ -298,8 +314,12 @@ class KioskApp(App[int]):
                 continue  # "I am having trouble hearing you" is untrue when voice in never ran
             notices.append(self.questionnaire.message(name, snap.language)
                            or ui_text(snap.language, name, default=name.replace("_", " ")))
+        offer = None
+        if self.resumable is not None and snap.phase is Phase.WELCOME:
+            offer = ui_text(snap.language, "resume_offer", answered=len(self.resumable.answers),
+                            total=len(self.questionnaire.items))
         return PatientView(snap, self.questionnaire, self.board.lines(snap.language),
-                           " ".join(notices) or None)
+                           " ".join(notices) or None, offer)
 
     @staticmethod
     def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:
@@ -425,13 +445,23 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
     speaker = _speaker() if voice else None
     voice_in = _voice_in(config, voice, statuses)
-    session = Session(questionnaire, clock=SystemClock(), engine=Engine(load_model(MODEL)),
+    clock = SystemClock()
+    session = Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)),
                       patient_id=patient_id or new_patient_id(), store=store, language=config.language,
                       timing=config.timing, adaptation=Adaptation(policy) if policy else None,
                       familiarisation=config.familiarisation)
+
+    def resume(stored: StoredSession) -> Session:
+        return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(load_model(MODEL)),
+                                   store=store, timing=config.timing,
+                                   adaptation=Adaptation(policy) if policy else None)
+
+    # a kiosk restarted after a crash offers the interrupted session (not when told whom to test)
+    unfinished = store.unfinished_sessions() if patient_id is None else []
     app = KioskApp(session, clinician_pin=config.clinician_pin, store=store, speaker=speaker, voice=voice_in,
                    sources=sources, keyboard=keyboard, statuses=statuses,
-                   export_dir=(data_dir or config.data_dir) / "exports")
+                   export_dir=(data_dir or config.data_dir) / "exports",
+                   resumable=unfinished[0] if unfinished else None, resume=resume)
     if speaker is not None:
         speaker.on_status, speaker.on_speech = app.speaker_status, app.speaker_activity
     return app, store.close

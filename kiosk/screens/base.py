@@ -27,6 +27,8 @@ class PatientView:
     channels: tuple[ChannelLine, ...]
     #: a notice to show above the answers (an adaptation, "we cannot see you"), or None
     banner: str | None = None
+    #: on the welcome screen: how far an interrupted session got, when it can be continued
+    resume_offer: str | None = None
 
 
 class PatientScreen(Screen):

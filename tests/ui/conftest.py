@@ -30,22 +30,29 @@ class UiKiosk:
     """A kiosk app with its clock and store, and helpers to move simulated time."""
 
     def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
-                 language: str = "en") -> None:
+                 language: str = "en", session_id: str = UI_SESSION_ID, offer_resume: bool = False) -> None:
         self.clock = SimClock()
         self.questionnaire = load_questionnaire()
         self.store = Store.open(tmp_path / "data")
         self.session = Session(
             self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)), patient_id=UI_PATIENT_ID,
-            store=self.store, language=language, session_id=UI_SESSION_ID,
+            store=self.store, language=language, session_id=session_id,
             adaptation=Adaptation(load_policy()) if adaptation else None, familiarisation=familiarisation,
         )
+        unfinished = self.store.unfinished_sessions() if offer_resume else []
         self.app = KioskApp(
             self.session, clinician_pin=UI_PIN, store=self.store, export_dir=tmp_path / "exports",
             statuses=[ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
                       ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*")],
             # the timer still runs, but tests drive time themselves: a tick never finds anything due
             poll_interval=3600,
+            resumable=unfinished[0] if unfinished else None, resume=self._resume,
         )
+
+    def _resume(self, stored) -> Session:
+        """The session continuing ``stored``, as `kiosk run` builds it."""
+        return Session.from_stored(self.questionnaire, stored, clock=self.clock, engine=Engine(load_model(MODEL)),
+                                   store=self.store, adaptation=Adaptation(load_policy()))
 
     def advance(self, seconds: float) -> None:
         """Move simulated time on and let the app poll, as its timer would."""
@@ -54,7 +61,11 @@ class UiKiosk:
 
     def to_next_deadline(self) -> None:
         """Jump to the session's next time-out and let the app poll."""
-        deadline = self.session.next_deadline()
+        self.to_next_deadline_of(self.session)
+
+    def to_next_deadline_of(self, session: Session) -> None:
+        """The same for ``session`` (the app's session after it continued an interrupted one)."""
+        deadline = session.next_deadline()
         assert deadline is not None, "nothing is pending"
         self.clock.set(deadline)
         self.app.poll_session()
@@ -62,7 +73,8 @@ class UiKiosk:
 
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
-    """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language)."""
+    """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
+    offer_resume)."""
     made: list[UiKiosk] = []
 
     def make(**options: object) -> UiKiosk:

@@ -88,3 +88,39 @@ async def test_a_remote_plugged_in_shows_as_connected_and_unplugged_as_lost(ui_k
         assert "Listening: off" in _text(bar) and "Touch: on" in _text(bar)
         reasons = _text(kiosk.app.screen.query_one("#channel-reasons", Static))
         assert "no microphone found" in reasons and "unplugged" in reasons
+
+
+async def test_a_kiosk_restarted_mid_session_offers_to_continue_at_the_first_unanswered_question(ui_kiosk):
+    first = ui_kiosk(familiarisation=False)
+    async with first.app.run_test(size=KIOSK_SIZE) as pilot:  # the kiosk dies after three answers
+        await settle(pilot, lambda: screen_name(first) == "WelcomeScreen")
+        await pilot.press("1")
+        await settle(pilot)
+        await pilot.press("1")
+        for _ in range(3):
+            first.to_next_deadline()
+            await settle(pilot, lambda: first.session.current_attempt == 1)
+            item = first.session.current_item
+            await pilot.press("1")
+            await settle(pilot, lambda: item.id in first.session.answers)
+
+    again = ui_kiosk(familiarisation=False, session_id="5e55a0000002", offer_resume=True)
+    async with again.app.run_test(size=KIOSK_SIZE) as pilot:
+        await settle(pilot, lambda: screen_name(again) == "WelcomeScreen")
+        offer = again.app.screen.query_one("#resume-session")
+        assert "3 of 10 answered" in str(offer.label)
+        await pilot.click("#resume-session")
+        await settle(pilot, lambda: again.app.session.id == first.session.id)
+        await settle(pilot, lambda: screen_name(again) == "ExplanationScreen")
+        await pilot.press("1")
+        await settle(pilot, lambda: again.app.session.phase is Phase.QUESTIONS)
+        again.to_next_deadline_of(again.app.session)
+        await settle(pilot, lambda: again.app.session.current_attempt == 1)
+        assert again.app.session.current_item.id == "dressing"
+        assert _text(again.app.screen.query_one("#progress", Label)) == "Question 4 of 10"
+        await pilot.press("2")
+        await settle(pilot, lambda: "dressing" in again.app.session.answers)
+    stored = again.store.session(first.session.id)
+    assert [a.item_id for a in stored.answers] == ["feeding", "bathing", "grooming", "dressing"]
+    assert again.store.sessions()[0].id == first.session.id  # the fresh session was never stored
+    assert len(again.store.sessions()) == 1
