@@ -1,0 +1,79 @@
+"""The app wired to the real voice channel: espeak-ng speaks an answer into a WAV file, a thread
+plays it into the channel the way the microphone's thread delivers audio (no sound card here),
+pocketsphinx recognises it with the grammar the app set from the question's prompt, and the answer
+reaches the session through the app's sink -- recorded with channel voice."""
+
+from __future__ import annotations
+
+import asyncio
+import shutil
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from kiosk.app import KIOSK_SIZE
+from kiosk.channels import Channel, ChannelState
+from kiosk.speech.audio import feed_wav
+from kiosk.speech.tts import VOICES
+from kiosk.speech.voice import VoiceChannel
+from kiosk.widgets.channel_board import VOICE_IN
+
+from .helpers import settle, start_in_english
+
+PATIENCE_S = 30.0
+
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")]
+
+
+class WavMicrophone:
+    """Plays WAV files into the voice channel's pipeline from its own thread, as a sound card would."""
+
+    def __init__(self, consumer) -> None:
+        self.consumer = consumer
+        self.threads: list[threading.Thread] = []
+
+    def start(self) -> None:
+        """Nothing to open."""
+
+    def stop(self) -> None:
+        """Wait for audio still playing."""
+        for thread in self.threads:
+            thread.join(timeout=PATIENCE_S)
+
+    def play(self, path: Path) -> None:
+        """Deliver the file's audio from another thread."""
+        thread = threading.Thread(target=feed_wav, args=(path, self.consumer))
+        self.threads.append(thread)
+        thread.start()
+
+
+async def _until(condition) -> None:
+    deadline = time.monotonic() + PATIENCE_S
+    while not condition():
+        assert time.monotonic() < deadline, "timed out waiting for the voice channel"
+        await asyncio.sleep(0.02)  # real threads (recogniser, audio) are working
+
+
+async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp_path):
+    wav = tmp_path / "independent.wav"
+    subprocess.run(["espeak-ng", "-v", VOICES["en"], "-s", "160", "-w", str(wav), "independent"], check=True)
+    microphones: list[WavMicrophone] = []
+    voice = VoiceChannel(
+        "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
+    kiosk = ui_kiosk(familiarisation=False, voice=voice)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _until(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON)
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_item is not None and kiosk.session.listening)
+        assert kiosk.session.current_item.id == "feeding"
+        assert "Listening: listening" in str(kiosk.app.screen.query_one("#channels").render())
+        microphones[0].play(wav)
+        await _until(lambda: "feeding" in kiosk.session.answers)
+        await settle(pilot)
+    answer = kiosk.store.session(kiosk.session.id).answers[0]
+    assert (answer.item_id, answer.option, answer.channel) == ("feeding", 3, Channel.VOICE)
