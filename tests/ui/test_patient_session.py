@@ -124,3 +124,21 @@ async def test_a_kiosk_restarted_mid_session_offers_to_continue_at_the_first_una
     assert [a.item_id for a in stored.answers] == ["feeding", "bathing", "grooming", "dressing"]
     assert again.store.sessions()[0].id == first.session.id  # the fresh session was never stored
     assert len(again.store.sessions()) == 1
+
+
+async def test_a_keypad_remote_typing_function_keys_answers_and_pauses_as_the_remote(ui_kiosk):
+    from kiosk.remote import keyboard_remote
+
+    kiosk = ui_kiosk(familiarisation=False, keyboard=keyboard_remote())  # the bundled F13-F21 keypad
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        await pilot.press("f18")  # the keypad's pause button
+        await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
+        await pilot.press("f18")
+        await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+        await pilot.press("f14")
+        await settle(pilot, lambda: "feeding" in kiosk.session.answers)
+        answer = kiosk.session.answers["feeding"]
+        assert (answer.option, answer.channel, answer.detail) == (2, Channel.REMOTE, "key f14 (keypad-f13)")
