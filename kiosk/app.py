@@ -494,11 +494,9 @@ def _voice_in(config: Any, wanted: bool, statuses: list[ChannelStatus]) -> Any:
     if not wanted:
         statuses.append(ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "turned off (--no-voice)"))
         return None
-    from kiosk.speech.asr import open_recogniser
     from kiosk.speech.voice import VoiceChannel
 
-    model = config.vosk_model
-    return VoiceChannel(config.language, recogniser_factory=lambda language: open_recogniser(language, model))
+    return VoiceChannel(config.language, vosk_model=config.vosk_model)
 
 
 def main(argv: list[str]) -> int:
