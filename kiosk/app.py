@@ -99,7 +99,8 @@ class KioskApp(App[int]):
     states known before start-up, such as "voice in off: no microphone found". ``keyboard`` is a
     ``kiosk.remote.KeyboardRemote`` for remotes that type keys. ``resumable`` is an interrupted
     stored session the welcome screen offers to continue, through ``resume`` (which builds the
-    session continuing it, ``Session.from_stored``).
+    session continuing it, ``Session.from_stored``). ``new_session`` builds a fresh session for
+    the next patient (the clinician's "New session").
     """
 
     CSS_PATH = "kiosk.tcss"
@@ -121,6 +122,7 @@ class KioskApp(App[int]):
         poll_interval: float = POLL_INTERVAL,
         resumable: StoredSession | None = None,
         resume: Callable[[StoredSession], Session] | None = None,
+        new_session: Callable[[], Session] | None = None,
     ) -> None:
         super().__init__()
         # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
@@ -137,6 +139,7 @@ class KioskApp(App[int]):
         self.poll_interval = poll_interval
         self.resumable = resumable if resume is not None else None
         self._resume = resume
+        self._new_session = new_session
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is None:
             self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE, "voice out turned off"))
@@ -235,11 +238,14 @@ class KioskApp(App[int]):
         """Continue the interrupted session instead of the fresh one (which was never started)."""
         if self.resumable is None or self._resume is None or self.session.phase is not Phase.WELCOME:
             return
+        self._replace_session(self._resume(self.resumable))
+        self._drive(self.session.start)
+
+    def _replace_session(self, session: Session) -> None:
         self._unsubscribe()
-        self.session = self._resume(self.resumable)
+        self.session = session
         self.resumable = None
         self._unsubscribe = self.session.subscribe(self._on_session_event)
-        self._drive(self.session.start)
 
     def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
         """The patient touched Start under the explanation."""
@@ -392,6 +398,22 @@ class KioskApp(App[int]):
         """A clinician continues a session halted by call-doctor (or paused)."""
         self._drive(self.session.clinician_continue)
 
+    @property
+    def can_start_new_session(self) -> bool:
+        """A fresh session for the next patient can be built."""
+        return self._new_session is not None
+
+    def start_new_session(self) -> None:
+        """The clinician starts over for the next patient. A started, unfinished session is marked
+        abandoned (its answers stay stored) so a restart does not offer it again."""
+        if self._new_session is None:
+            return
+        old = self.session
+        if self.store is not None and old.phase is not Phase.WELCOME and not old.finished:
+            self.store.abandon(old.id)
+        self._replace_session(self._new_session())
+        self.close_clinician()
+
     def set_adaptation(self, enabled: bool) -> None:
         """A clinician switches live adaptation on or off for this session."""
         self._drive(self.session.set_adaptation_enabled, enabled)
@@ -446,10 +468,12 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     speaker = _speaker() if voice else None
     voice_in = _voice_in(config, voice, statuses)
     clock = SystemClock()
-    session = Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)),
-                      patient_id=patient_id or new_patient_id(), store=store, language=config.language,
-                      timing=config.timing, adaptation=Adaptation(policy) if policy else None,
-                      familiarisation=config.familiarisation)
+
+    def fresh(patient: str | None = None) -> Session:
+        return Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)),
+                       patient_id=patient or new_patient_id(), store=store, language=config.language,
+                       timing=config.timing, adaptation=Adaptation(policy) if policy else None,
+                       familiarisation=config.familiarisation)
 
     def resume(stored: StoredSession) -> Session:
         return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(load_model(MODEL)),
@@ -458,10 +482,10 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
 
     # a kiosk restarted after a crash offers the interrupted session (not when told whom to test)
     unfinished = store.unfinished_sessions() if patient_id is None else []
-    app = KioskApp(session, clinician_pin=config.clinician_pin, store=store, speaker=speaker, voice=voice_in,
-                   sources=sources, keyboard=keyboard, statuses=statuses,
+    app = KioskApp(fresh(patient_id), clinician_pin=config.clinician_pin, store=store, speaker=speaker,
+                   voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports",
-                   resumable=unfinished[0] if unfinished else None, resume=resume)
+                   resumable=unfinished[0] if unfinished else None, resume=resume, new_session=fresh)
     if speaker is not None:
         speaker.on_status, speaker.on_speech = app.speaker_status, app.speaker_activity
     return app, store.close

@@ -35,6 +35,8 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Label(" Live adaptation ")
                 yield Switch(value=session.adaptation is not None and session.adaptation.enabled,
                              id="adaptation", disabled=session.adaptation is None)
+                yield Button("New patient", id="new-session",
+                             disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
                 yield Button("Back to the patient", id="back")
             yield Static(self._channels_text(), id="channel-reasons")
             yield Label("Stored sessions (Enter or click to open):")
@@ -66,6 +68,10 @@ class ClinicianHomeScreen(ClinicianScreen):
     def _continue(self) -> None:
         self.app.clinician_continue()  # type: ignore[attr-defined]
         self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#new-session")
+    def _new_session(self) -> None:
+        self.app.start_new_session()  # type: ignore[attr-defined]
 
     @on(Button.Pressed, "#back")
     def _back(self) -> None:

@@ -48,8 +48,13 @@ class UiKiosk:
                       ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*")],
             # the timer still runs, but tests drive time themselves: a tick never finds anything due
             poll_interval=3600,
-            resumable=unfinished[0] if unfinished else None, resume=self._resume,
+            resumable=unfinished[0] if unfinished else None, resume=self._resume, new_session=self._fresh,
         )
+
+    def _fresh(self) -> Session:
+        """A session for the next patient, as `kiosk run` builds it (a new id, so it can be stored)."""
+        return Session(self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)),
+                       patient_id="P-TEST02", store=self.store, adaptation=Adaptation(load_policy()))
 
     def _resume(self, stored) -> Session:
         """The session continuing ``stored``, as `kiosk run` builds it."""

@@ -81,3 +81,23 @@ async def test_the_clinician_switches_live_adaptation_off(ui_kiosk):
         await pilot.click("#back")
         await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
         assert not [e for e in kiosk.app.events if isinstance(e, AdaptationChanged) and e.active]
+
+
+async def test_a_new_patient_after_a_halted_session_abandons_it_and_welcomes_the_next(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        await pilot.press("1", "d")
+        await settle(pilot, lambda: screen_name(kiosk) == "DoctorCalledScreen")
+        await _open_clinician(kiosk, pilot)
+        await pilot.click("#new-session")
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        assert kiosk.app.session is not kiosk.session and kiosk.app.session.patient_id == "P-TEST02"
+        await pilot.press("2")  # the next patient starts in Spanish, with the practice questions
+        await settle(pilot, lambda: screen_name(kiosk) == "FamiliarisationScreen")
+        assert kiosk.app.session.language == "es"
+    statuses = {s.id: (s.status, s.answered) for s in kiosk.store.sessions()}
+    assert statuses[kiosk.session.id] == ("abandoned", 1)  # the first answer stays stored
+    assert statuses[kiosk.app.session.id] == ("running", 0)
