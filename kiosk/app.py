@@ -253,12 +253,12 @@ class KioskApp(App[int]):
 
     def forward(self, item: ChannelInput) -> None:
         """Hand an input to the session. On the welcome screen an answer number picks the language
-        (the buttons are numbered like the remote's), and under the explanation it means "start"."""
+        (the start buttons are numbered like the remote's; a higher number starts in the language
+        shown, as "press any button" promises), and under the explanation it means "start"."""
         phase = self.session.phase
         if item.option is not None and phase is Phase.WELCOME:
             languages = self.questionnaire.languages
-            if item.option <= len(languages):
-                self._start(languages[item.option - 1])
+            self._start(languages[item.option - 1] if item.option <= len(languages) else self.session.language)
         elif item.option is not None and phase is Phase.EXPLANATION:
             self._drive(self.session.acknowledge)
         else:

@@ -14,8 +14,8 @@ from kiosk.screens.base import PatientScreen, PatientView
 from kiosk.widgets.bars import channel_reasons
 from kiosk.widgets.text import ui_text
 
-#: how each language names itself on its button
-LANGUAGE_NAMES = {"en": "English", "es": "Español", "fr": "Français"}
+#: each language's start button, in that language: choosing the language starts the test
+START_IN = {"en": "Start in English", "es": "Empezar en español", "fr": "Commencer en français"}
 
 
 class WelcomeScreen(PatientScreen):
@@ -48,8 +48,7 @@ class WelcomeScreen(PatientScreen):
         yield Static(ui_text(self.language, "choose_language"), classes="notice")
         with Vertical(id="languages"):
             for number, language in enumerate(q.languages, start=1):
-                name = LANGUAGE_NAMES.get(language, language)
-                yield Button(f"{number}  {name}", id=f"language-{language}")
+                yield Button(f"{number}  {START_IN.get(language, language)}", id=f"language-{language}")
         yield Static(channel_reasons(self.view.channels), id="channel-reasons")
 
     def show(self, view: PatientView) -> None:

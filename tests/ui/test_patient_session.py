@@ -142,3 +142,12 @@ async def test_a_keypad_remote_typing_function_keys_answers_and_pauses_as_the_re
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         answer = kiosk.session.answers["feeding"]
         assert (answer.option, answer.channel, answer.detail) == (2, Channel.REMOTE, "key f14 (keypad-f13)")
+
+
+async def test_any_other_remote_button_on_the_welcome_screen_starts_in_the_language_shown(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False, language="fr")
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        deliver_from_thread(kiosk, ChannelInput(Channel.REMOTE, option=4, detail="BTN 4"))
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        assert kiosk.session.language == "fr"
