@@ -43,7 +43,6 @@ from kiosk.screens.question import QuestionScreen
 from kiosk.screens.summary import SummaryScreen
 from kiosk.screens.welcome import WelcomeScreen
 from kiosk.session import (
-    AdaptationChanged,
     AnswerRecorded,
     DoctorCalled,
     ListeningChanged,
