@@ -93,31 +93,41 @@ async def test_an_attempt_times_out_twice_and_the_next_question_comes(ui_kiosk):
         assert kiosk.store.session(kiosk.session.id).not_answered == ("feeding",)
 
 
+async def _late_touch_answers_until_voice_off(kiosk, pilot) -> None:
+    """Late touch answers (after the first attempt ran out) drag VoiceInteractionQuality down."""
+    for _ in range(8):
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 2)
+        kiosk.advance(3)
+        item = kiosk.session.current_item
+        await pilot.click("#answer-1")
+        await settle(pilot, lambda: item.id in kiosk.session.answers)
+        if "voice_off" in kiosk.session.snapshot().adaptations:
+            return
+    raise AssertionError("voice_off never switched on")
+
+
 async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         # voice in works on this kiosk (so "I am having trouble hearing you" is true)
         deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.ON, "voice in", "pocketsphinx"))
         await start_in_english(kiosk, pilot)
-        banner = None
-        # late touch answers (after the first attempt ran out) drag VoiceInteractionQuality down
-        for _ in range(8):
-            kiosk.to_next_deadline()
-            await settle(pilot, lambda: kiosk.session.current_attempt == 1)
-            kiosk.to_next_deadline()
-            await settle(pilot, lambda: kiosk.session.current_attempt == 2)
-            kiosk.advance(3)
-            item = kiosk.session.current_item
-            await pilot.click("#answer-1")
-            await settle(pilot, lambda: item.id in kiosk.session.answers)
-            banner = kiosk.app.screen.query_one(AdaptationBanner)
-            if banner.display:
-                break
-        assert banner is not None and banner.display
-        assert "touch your answer or press its number" in _text(banner)
-        assert kiosk.session.answers[item.id].channel is Channel.TOUCH
+        await _late_touch_answers_until_voice_off(kiosk, pilot)
+        banner = kiosk.app.screen.query_one(AdaptationBanner)
+        assert banner.display and "touch your answer or press its number" in _text(banner)
         # it stays on the next question's screen too
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         assert kiosk.app.screen.query_one(AdaptationBanner).display
         assert kiosk.session.phase is Phase.QUESTIONS
+
+
+async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)  # voice in is off: no microphone
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        await _late_touch_answers_until_voice_off(kiosk, pilot)
+        assert "trouble hearing" not in _text(kiosk.app.screen.query_one(AdaptationBanner))
