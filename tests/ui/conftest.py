@@ -31,7 +31,7 @@ class UiKiosk:
 
     def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
                  language: str = "en", session_id: str = UI_SESSION_ID, offer_resume: bool = False,
-                 voice=None, keyboard=None, sources=()) -> None:
+                 voice=None, keyboard=None, sources=(), poll_interval: float = 3600) -> None:
         self.clock = SimClock()
         self.questionnaire = load_questionnaire()
         self.store = Store.open(tmp_path / "data")
@@ -46,8 +46,9 @@ class UiKiosk:
             keyboard=keyboard, sources=sources,
             statuses=[ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
                       ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*")],
-            # the timer still runs, but tests drive time themselves: a tick never finds anything due
-            poll_interval=3600,
+            # by default tests drive time themselves (the timer's callback, `advance`), so a tick
+            # of the real timer never finds anything due
+            poll_interval=poll_interval,
             resumable=unfinished[0] if unfinished else None, resume=self._resume, new_session=self._fresh,
         )
 
@@ -81,7 +82,7 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    offer_resume, voice, keyboard, sources)."""
+    offer_resume, voice, keyboard, sources, poll_interval)."""
     made: list[UiKiosk] = []
 
     def make(**options: object) -> UiKiosk:

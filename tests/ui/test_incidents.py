@@ -3,6 +3,8 @@ clock, and a live adaptation reaching the screen -- all through the real app and
 
 from __future__ import annotations
 
+import time
+
 from textual.widgets import Input, Label, Static
 
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
@@ -131,3 +133,15 @@ async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
         await start_in_english(kiosk, pilot)
         await _late_touch_answers_until_voice_off(kiosk, pilot)
         assert "trouble hearing" not in _text(kiosk.app.screen.query_one(AdaptationBanner))
+
+
+async def test_the_apps_own_timer_polls_the_session(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False, poll_interval=0.01)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        kiosk.clock.advance(kiosk.session.timing.between_questions_s)  # nobody polls but the timer
+        deadline = time.monotonic() + 10
+        while kiosk.session.current_attempt != 1:
+            assert time.monotonic() < deadline, "the poll timer never fired"
+            await pilot.pause(0.01)
+        await settle(pilot, lambda: _text(kiosk.app.screen.query_one("#progress", Label)) == "Question 1 of 10")
