@@ -55,8 +55,11 @@ class ClinicianHomeScreen(ClinicianScreen):
         session = self.app.session  # type: ignore[attr-defined]
         state = "waiting for a clinician (doctor called)" if session.halted else (
             "paused" if session.paused else session.phase.value)
-        return (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
+        line = (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
                 f"{len(session.answers)} of {len(session.questionnaire.items)} answered.")
+        if session.metrics:
+            line += " QoS now: " + ", ".join(f"{name} {value:.2f}" for name, value in session.metrics.items())
+        return line
 
     def _channels_text(self) -> str:
         lines = self.app.board.lines("en")  # type: ignore[attr-defined]
