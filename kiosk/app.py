@@ -70,6 +70,8 @@ KIOSK_KEYS: dict[str, int | Command] = {
 }
 #: how often the session is polled for time-outs (seconds); it fires them at their own due time
 POLL_INTERVAL = 0.1
+#: messages about hearing the patient, meaningless while voice in is off
+VOICE_IN_MESSAGES = ("voice_off", "voice_on")
 #: the source name the voice-out statuses carry when no speaker is wired
 VOICE_OUT_SOURCE = "espeak-ng"
 
@@ -140,14 +142,19 @@ class KioskApp(App[int]):
         self._resume = resume
         self._new_session = new_session
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
-        if speaker is None:
-            self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE, "voice out turned off"))
+        if speaker is not None:  # its worker thread reports through these (it starts on mount)
+            speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
+        else:
+            self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE,
+                                            "voice out turned off"))
         for status in statuses:
             self.board.update(status)
         #: every session event the app received, in order (the clinician screens and tests read it)
         self.events: list[SessionEvent] = []
         self._screen_key: tuple[type, object] | None = None
         self._dirty = False
+        #: a repeated prompt on its way through the speaker: "queued", then "speaking"
+        self._repeat: str | None = None
         self._unsubscribe = self.session.subscribe(self._on_session_event)
 
     # -- start and stop -------------------------------------------------------------------------
@@ -199,12 +206,17 @@ class KioskApp(App[int]):
             self.forward(message.item)
 
     def on_speech_activity(self, message: SpeechActivity) -> None:
-        """Show "speaking", mute the recogniser meanwhile, and tell the session a repeat was said."""
+        """Show "speaking", and tell the session once a repeated prompt has been said (the speaker
+        works through its phrases in order, so the repeat is the phrase that starts after it was
+        queued; a phrase cut short for it ends before)."""
         self.board.speaking = message.speaking
-        if not message.speaking:
+        if message.speaking and self._repeat == "queued":
+            self._repeat = "speaking"
+        elif not message.speaking and self._repeat == "speaking":
+            self._repeat = None
             self._drive(self.session.prompt_delivered)
-        else:
-            self._render()
+            return
+        self._render()
 
     # -- from the screens (UI thread) -------------------------------------------------------------
 
@@ -302,10 +314,18 @@ class KioskApp(App[int]):
     def _speak(self, prompt: Prompt) -> None:
         if self.speaker is None or not prompt.spoken:
             return
+        if prompt.kind == "message" and prompt.key in VOICE_IN_MESSAGES and not self._voice_in_works():
+            return  # "I am having trouble hearing you" is untrue when voice in never ran
         from kiosk.speech.tts import DEFAULT_RATE
 
+        if prompt.repeat:  # asked again: what was still queued is superseded
+            self.speaker.stop_speaking()
+            self._repeat = "queued"
         self.speaker.rate = round(DEFAULT_RATE * prompt.speech_rate)
         self.speaker.say(prompt.spoken, prompt.language)
+
+    def _voice_in_works(self) -> bool:
+        return self.board.state(VOICE_IN)[0] is ChannelState.ON
 
     # -- drawing -------------------------------------------------------------------------------
 
@@ -315,7 +335,7 @@ class KioskApp(App[int]):
         if not snap.person_present:
             notices.append(ui_text(snap.language, "person_lost"))
         for name in sorted(snap.adaptations):
-            if name == "voice_off" and self.board.state(VOICE_IN)[0] is not ChannelState.ON:
+            if name == "voice_off" and not self._voice_in_works():
                 continue  # "I am having trouble hearing you" is untrue when voice in never ran
             notices.append(self.questionnaire.message(name, snap.language)
                            or ui_text(snap.language, name, default=name.replace("_", " ")))
@@ -485,8 +505,6 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports",
                    resumable=unfinished[0] if unfinished else None, resume=resume, new_session=fresh)
-    if speaker is not None:
-        speaker.on_status, speaker.on_speech = app.speaker_status, app.speaker_activity
     return app, store.close
 
 

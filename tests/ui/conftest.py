@@ -31,7 +31,7 @@ class UiKiosk:
 
     def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
                  language: str = "en", session_id: str = UI_SESSION_ID, offer_resume: bool = False,
-                 voice=None, keyboard=None, sources=(), poll_interval: float = 3600) -> None:
+                 voice=None, keyboard=None, sources=(), poll_interval: float = 3600, speaker=None) -> None:
         self.clock = SimClock()
         self.questionnaire = load_questionnaire()
         self.store = Store.open(tmp_path / "data")
@@ -43,7 +43,7 @@ class UiKiosk:
         unfinished = self.store.unfinished_sessions() if offer_resume else []
         self.app = KioskApp(
             self.session, clinician_pin=UI_PIN, store=self.store, export_dir=tmp_path / "exports", voice=voice,
-            keyboard=keyboard, sources=sources,
+            keyboard=keyboard, sources=sources, speaker=speaker,
             statuses=[ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
                       ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*")],
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
@@ -82,7 +82,7 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    offer_resume, voice, keyboard, sources, poll_interval)."""
+    offer_resume, voice, keyboard, sources, poll_interval, speaker)."""
     made: list[UiKiosk] = []
 
     def make(**options: object) -> UiKiosk:

@@ -1,0 +1,81 @@
+"""The app wired to the real voice out: espeak-ng synthesises every prompt on the speaker's worker
+thread; a recording player stands in for the sound card (none here). The bar shows "speaking",
+a repeat is reported back to the session once spoken, and "I am having trouble hearing you" is
+never said while voice in is off."""
+
+from __future__ import annotations
+
+import asyncio
+import shutil
+import threading
+import time
+
+import pytest
+
+from kiosk.app import KIOSK_SIZE
+from kiosk.channels import ChannelState
+from kiosk.session import Prompt
+from kiosk.speech.tts import Speaker
+from kiosk.widgets.channel_board import VOICE_OUT
+
+from .helpers import settle, start_in_english
+from .test_incidents import _late_touch_answers_until_voice_off
+
+PATIENCE_S = 30.0
+
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")]
+
+
+class RecordingPlayer:
+    """Stands in for the sound card: keeps how many phrases would have been played."""
+
+    def __init__(self) -> None:
+        self.played = 0
+        self.lock = threading.Lock()
+
+    def play(self, samples, rate) -> None:
+        """Count the phrase; a real card would block for its duration."""
+        with self.lock:
+            self.played += 1
+
+    def stop(self) -> None:
+        """Nothing is playing."""
+
+
+async def _until(condition) -> None:
+    deadline = time.monotonic() + PATIENCE_S
+    while not condition():
+        assert time.monotonic() < deadline, "the speaker's worker never got there"
+        await asyncio.sleep(0.02)  # espeak-ng is synthesising on the worker thread
+
+
+async def test_prompts_are_spoken_and_a_spoken_repeat_is_reported_to_the_session(ui_kiosk):
+    player = RecordingPlayer()
+    kiosk = ui_kiosk(familiarisation=False, speaker=Speaker(player_factory=lambda: player))
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _until(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON)
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        spoken = sum(1 for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken)
+        await _until(lambda: player.played >= spoken)  # welcome, explanation, the first question
+        states = lambda: [e["set"]["TestState"] for e in kiosk.session.trace if "TestState" in e.get("set", {})]
+        await pilot.press("r")  # repeat: TestState REPEATING until the repeat has been said
+        await _until(lambda: states()[-2:] == ["REPEATING", "STARTED"])
+        assert player.played >= spoken + 1
+
+
+async def test_trouble_hearing_is_never_said_while_voice_in_is_off(ui_kiosk):
+    player = RecordingPlayer()
+    kiosk = ui_kiosk(familiarisation=False, speaker=Speaker(player_factory=lambda: player))
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _until(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON)
+        await start_in_english(kiosk, pilot)
+        await _late_touch_answers_until_voice_off(kiosk, pilot)
+        prompts = [e for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken]
+        assert any(p.key == "voice_off" for p in prompts)  # the session asked for it...
+        expected = sum(1 for p in prompts if p.key != "voice_off")
+        await _until(lambda: player.played >= expected)
+        await settle(pilot)
+        assert player.played == expected  # ...and the app did not say it
