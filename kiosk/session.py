@@ -99,6 +99,10 @@ class IgnoreReason(str, Enum):
     UNKNOWN_LANGUAGE = "unknown_language"
 
 
+#: attempts per question: the question is asked, then asked again, then it is not answered. Fixed
+#: by the CLARC model, whose contexts are FirstAttemptAnswered and SecondAttemptAnswered.
+ATTEMPTS = 2
+
 #: how much later a second context batch at the same instant is recorded (see ``Session._flush``)
 SAME_INSTANT_STEP_S = 0.001
 
@@ -573,7 +577,7 @@ class Session:
 
     @property
     def current_attempt(self) -> int | None:
-        """1 or 2 while an attempt is open, else None."""
+        """The open attempt's number (1 to :data:`ATTEMPTS`), else None."""
         return self._open.attempt if self._open and self._open.outcome is None else None
 
     def now(self) -> float:
@@ -879,8 +883,8 @@ class Session:
             self._context(t, {name: False})
         self._log(t, "attempt_timed_out", f"{key} attempt {attempt}")
         self._emit(AttemptTimedOut(t, key, number, attempt, self._open.practice))
-        if attempt == 1:
-            self._open_attempt(t, 2)
+        if attempt < ATTEMPTS:
+            self._open_attempt(t, attempt + 1)
             return
         self._open.outcome = "not_answered"
         if self._open.practice:

@@ -12,7 +12,7 @@ from textual.screen import Screen
 from textual.widgets import Label
 
 from kiosk.questionnaire import Questionnaire
-from kiosk.session import Snapshot
+from kiosk.session import ATTEMPTS, Snapshot
 from kiosk.widgets.bars import AdaptationBanner, ChannelBar, ChannelLine
 from kiosk.widgets.text import ui_text
 
@@ -76,7 +76,7 @@ class PatientScreen(Screen):
         for progress in self.query("#progress").results(Label):
             progress.update(self.progress_text(view))
         for attempt in self.query("#attempt").results(Label):
-            attempt.update(ui_text(self.language, "attempt_of", number=snap.attempt, total=2)
+            attempt.update(ui_text(self.language, "attempt_of", number=snap.attempt, total=ATTEMPTS)
                            if snap.attempt else "")
         for bar in self.query(ChannelBar):
             bar.show(view.channels)
