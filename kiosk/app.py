@@ -263,17 +263,8 @@ class KioskApp(App[int]):
         self._drive(self.session.acknowledge)
 
     def forward(self, item: ChannelInput) -> None:
-        """Hand an input to the session. On the welcome screen an answer number picks the language
-        (the start buttons are numbered like the remote's; a higher number starts in the language
-        shown, as "press any button" promises), and under the explanation it means "start"."""
-        phase = self.session.phase
-        if item.option is not None and phase is Phase.WELCOME:
-            languages = self.questionnaire.languages
-            self._start(languages[item.option - 1] if item.option <= len(languages) else self.session.language)
-        elif item.option is not None and phase is Phase.EXPLANATION:
-            self._drive(self.session.acknowledge)
-        else:
-            self._drive(self.session.handle, item)
+        """Hand an input to the session (what a number means on each screen is the session's call)."""
+        self._drive(self.session.handle, item)
 
     def _start(self, language: str) -> None:
         def start() -> None:

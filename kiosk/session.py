@@ -83,7 +83,7 @@ class AnsweredBy(str, Enum):
 class IgnoreReason(str, Enum):
     """Why an input did not change anything (published with :class:`InputIgnored`)."""
 
-    NOT_STARTED = "not_started"  # nothing to answer yet (welcome screen)
+    NOT_STARTED = "not_started"  # a command on the welcome screen (a number there starts)
     FINISHED = "finished"  # the session is over
     NO_OPEN_ATTEMPT = "no_open_attempt"  # between questions, closing, explanation
     ALREADY_ANSWERED = "already_answered"  # another answer already won this attempt
@@ -624,48 +624,12 @@ class Session:
     def start(self, answered_by: AnsweredBy | str | None = None) -> None:
         """The patient started at the welcome screen (publishes PersonDetected and TestState)."""
         with _Op(self) as t:
-            if self._phase is not Phase.WELCOME:
-                self._ignore(t, None, IgnoreReason.FINISHED if self.finished else IgnoreReason.NO_OPEN_ATTEMPT,
-                             "start")
-                return
-            if answered_by is not None:
-                self._answered_by = AnsweredBy(answered_by)
-            if self.store is not None and not self._resuming:
-                self.store.create_session(
-                    session_id=self.id, patient_id=self.patient_id, questionnaire_id=self.questionnaire.id,
-                    language=self._language, answered_by=self._answered_by.value,
-                    started_at=self.clock.wall().isoformat(), timing=vars(self.timing),
-                )
-                self._stored = True
-            self._person_present = True
-            state = "RESTARTED" if self._resuming else "STARTED"
-            self._context(t, {"PersonDetected": True, "TestState": state})
-            self._log(t, "start", f"answered by {self._answered_by.value}")
-            if self._familiarisation:
-                self._set_phase(t, Phase.FAMILIARISATION)
-                self._message(t, "familiarisation")
-                self._open = _Open(practice=True, index=0)
-                self._open_attempt(t, 1)
-            else:
-                self._to_explanation(t)
+            self._start(t, answered_by)
 
     def choose_language(self, language: str) -> None:
         """Switch the language of prompts; the current prompt is given again in it."""
         with _Op(self) as t:
-            if language not in self.questionnaire.languages:
-                self._ignore(t, None, IgnoreReason.UNKNOWN_LANGUAGE, f"choose_language {language}")
-                return
-            if language == self._language:
-                return
-            self._language = language
-            self._log(t, "language", language)
-            self._emit(LanguageChanged(t, language))
-            if self._phase is Phase.WELCOME:
-                self._message(t, "welcome")
-            elif self._phase is Phase.EXPLANATION:
-                self._message(t, "explanation")
-            elif self.current_attempt is not None:
-                self._prompt_question(t, repeat=False)
+            self._choose_language(t, language)
 
     def skip_familiarisation(self) -> None:
         """Leave the practice questions (a clinician's or the patient's choice)."""
@@ -678,17 +642,23 @@ class Session:
     def acknowledge(self) -> None:
         """The patient acknowledged the explanation; the first question comes next."""
         with _Op(self) as t:
-            if self._phase is not Phase.EXPLANATION:
-                self._ignore(t, None, IgnoreReason.NO_OPEN_ATTEMPT, "acknowledge")
-                return
-            self._set_phase(t, Phase.QUESTIONS)
-            self._schedule_next_item(t, after=self.timing.between_questions_s)
+            self._acknowledge(t)
 
     def handle(self, event: ChannelInput) -> None:
-        """An input from a channel: an answer option or a command."""
+        """An input from a channel: an answer option or a command.
+
+        Before the questions an answer number means what the screen says: on the welcome screen
+        option n starts in the questionnaire's n-th language (a higher number starts in the current
+        language, as "press any button" promises); under the explanation any number acknowledges
+        it (unless paused or halted).
+        """
         with _Op(self) as t:
             if event.command is not None:
                 self._command(t, event)
+            elif self._phase is Phase.WELCOME:
+                self._start_by_number(t, event)
+            elif self._phase is Phase.EXPLANATION and not (self.paused or self.halted):
+                self._acknowledge(t)
             else:
                 self._answer(t, event)
 
@@ -779,6 +749,66 @@ class Session:
         """Let every time-out due by now happen (call at or after :meth:`next_deadline`)."""
         with _Op(self, inclusive=True):
             pass
+
+    # -- internals: the steps before the questions ------------------------------------------------
+
+    def _start(self, t: float, answered_by: AnsweredBy | str | None) -> None:
+        if self._phase is not Phase.WELCOME:
+            self._ignore(t, None, IgnoreReason.FINISHED if self.finished else IgnoreReason.NO_OPEN_ATTEMPT,
+                         "start")
+            return
+        if answered_by is not None:
+            self._answered_by = AnsweredBy(answered_by)
+        if self.store is not None and not self._resuming:
+            self.store.create_session(
+                session_id=self.id, patient_id=self.patient_id, questionnaire_id=self.questionnaire.id,
+                language=self._language, answered_by=self._answered_by.value,
+                started_at=self.clock.wall().isoformat(), timing=vars(self.timing),
+            )
+            self._stored = True
+        self._person_present = True
+        state = "RESTARTED" if self._resuming else "STARTED"
+        self._context(t, {"PersonDetected": True, "TestState": state})
+        self._log(t, "start", f"answered by {self._answered_by.value}")
+        if self._familiarisation:
+            self._set_phase(t, Phase.FAMILIARISATION)
+            self._message(t, "familiarisation")
+            self._open = _Open(practice=True, index=0)
+            self._open_attempt(t, 1)
+        else:
+            self._to_explanation(t)
+
+    def _choose_language(self, t: float, language: str) -> None:
+        if language not in self.questionnaire.languages:
+            self._ignore(t, None, IgnoreReason.UNKNOWN_LANGUAGE, f"choose_language {language}")
+            return
+        if language == self._language:
+            return
+        self._language = language
+        self._log(t, "language", language)
+        self._emit(LanguageChanged(t, language))
+        if self._phase is Phase.WELCOME:
+            self._message(t, "welcome")
+        elif self._phase is Phase.EXPLANATION:
+            self._message(t, "explanation")
+        elif self.current_attempt is not None:
+            self._prompt_question(t, repeat=False)
+
+    def _start_by_number(self, t: float, event: ChannelInput) -> None:
+        """An answer number on the welcome screen: the n-th language's start button (any other
+        number starts in the language shown)."""
+        assert event.option is not None
+        languages = self.questionnaire.languages
+        if event.option <= len(languages):
+            self._choose_language(t, languages[event.option - 1])
+        self._start(t, None)
+
+    def _acknowledge(self, t: float) -> None:
+        if self._phase is not Phase.EXPLANATION:
+            self._ignore(t, None, IgnoreReason.NO_OPEN_ATTEMPT, "acknowledge")
+            return
+        self._set_phase(t, Phase.QUESTIONS)
+        self._schedule_next_item(t, after=self.timing.between_questions_s)
 
     # -- internals: time ---------------------------------------------------------------------------
 
@@ -947,8 +977,6 @@ class Session:
         self._schedule_next_item(t, self.timing.between_questions_s)
 
     def _answer_blocked(self, event: ChannelInput) -> IgnoreReason | None:
-        if self._phase is Phase.WELCOME:
-            return IgnoreReason.NOT_STARTED
         if self._phase is Phase.SUMMARY:
             return IgnoreReason.FINISHED
         if self.halted:

@@ -6,9 +6,10 @@ from __future__ import annotations
 from textual.widgets import Label
 
 from kiosk.app import KIOSK_SIZE
-from kiosk.session import ATTEMPTS
+from kiosk.channels import Channel, ChannelInput
+from kiosk.session import ATTEMPTS, Phase
 
-from .helpers import settle, start_in_english
+from .helpers import deliver_from_thread, screen_name, settle, start_in_english
 
 
 def _text(widget) -> str:
@@ -24,3 +25,16 @@ async def test_the_attempt_indicator_counts_up_to_the_sessions_attempts(ui_kiosk
             await settle(pilot, lambda: kiosk.session.current_attempt == attempt)
             label = kiosk.app.screen.query_one("#attempt", Label)
             await settle(pilot, lambda: _text(label) == f"Attempt {attempt} of {ATTEMPTS}")
+
+
+async def test_number_keys_before_the_questions_start_in_that_language_and_acknowledge(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.press("2")  # the second start button: Spanish
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        assert kiosk.session.language == "es"
+        deliver_from_thread(kiosk, ChannelInput(Channel.REMOTE, option=4, detail="BTN 4"))
+        await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
+        assert kiosk.session.trace == [{"t": 0, "set": {"PersonDetected": True, "TestState": "STARTED"}}]
+        assert kiosk.store.session(kiosk.session.id).language == "es"
