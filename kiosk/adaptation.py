@@ -113,6 +113,8 @@ class Adaptation:
         self.enabled = enabled
         self._low: dict[str, int] = {rule.name: 0 for rule in policy.rules}
         self._active: set[str] = set()
+        #: adaptations whose evidence means nothing now (voice_off while voice in is unavailable)
+        self._held: set[str] = set()
 
     @property
     def active(self) -> frozenset[str]:
@@ -132,7 +134,7 @@ class Adaptation:
         changes = []
         for rule in self.policy.rules:
             value = metrics.get(rule.metric)
-            if value is None:
+            if value is None or rule.name in self._held:
                 continue
             if rule.name in self._active:
                 if value > rule.recover_above:
@@ -151,6 +153,20 @@ class Adaptation:
                                                 f"{rule.metric} {value:.2f} < {rule.below:g} for "
                                                 f"{self._low[rule.name]} {readings} in a row"))
         return changes
+
+    def hold(self, name: str, held: bool, reason: str) -> list[AdaptationChange]:
+        """Keep ``name`` from switching on while ``held`` (readings do not count), or let it count
+        again. Holding lifts it if it is in force, with ``reason``; released, it needs fresh evidence."""
+        if not held:
+            self._held.discard(name)
+            return []
+        self._held.add(name)
+        if name in self._low:
+            self._low[name] = 0
+        if name not in self._active:
+            return []
+        self._active.discard(name)
+        return [AdaptationChange(name, False, reason)]
 
     def patient_requests_voice(self) -> list[AdaptationChange]:
         """The patient asked to answer by voice again: lift voice_off (it needs fresh evidence to return)."""

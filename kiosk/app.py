@@ -70,8 +70,6 @@ KIOSK_KEYS: dict[str, int | Command] = {
 }
 #: how often the session is polled for time-outs (seconds); it fires them at their own due time
 POLL_INTERVAL = 0.1
-#: messages about hearing the patient, meaningless while voice in is off
-VOICE_IN_MESSAGES = ("voice_off", "voice_on")
 #: the source name the voice-out statuses carry when no speaker is wired
 VOICE_OUT_SOURCE = "espeak-ng"
 
@@ -156,6 +154,7 @@ class KioskApp(App[int]):
         #: a repeated prompt on its way through the speaker: "queued", then "speaking"
         self._repeat: str | None = None
         self._unsubscribe = self.session.subscribe(self._on_session_event)
+        self._tell_voice_available()
 
     # -- start and stop -------------------------------------------------------------------------
 
@@ -201,6 +200,8 @@ class KioskApp(App[int]):
         """An input goes to the session; a status change to the channel bar."""
         if isinstance(message.item, ChannelStatus):
             self.board.update(message.item)
+            if self.board.indicator(message.item) == VOICE_IN:
+                self._drive(self._tell_voice_available)
             self._render()
         else:
             self.forward(message.item)
@@ -257,6 +258,7 @@ class KioskApp(App[int]):
         self.session = session
         self.resumable = None
         self._unsubscribe = self.session.subscribe(self._on_session_event)
+        self._tell_voice_available()
 
     def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
         """The patient touched Start under the explanation."""
@@ -305,8 +307,6 @@ class KioskApp(App[int]):
     def _speak(self, prompt: Prompt) -> None:
         if self.speaker is None or not prompt.spoken:
             return
-        if prompt.kind == "message" and prompt.key in VOICE_IN_MESSAGES and not self._voice_in_works():
-            return  # "I am having trouble hearing you" is untrue when voice in never ran
         from kiosk.speech.tts import DEFAULT_RATE
 
         if prompt.repeat:  # asked again: what was still queued is superseded
@@ -315,8 +315,9 @@ class KioskApp(App[int]):
         self.speaker.rate = round(DEFAULT_RATE * prompt.speech_rate)
         self.speaker.say(prompt.spoken, prompt.language)
 
-    def _voice_in_works(self) -> bool:
-        return self.board.state(VOICE_IN)[0] is ChannelState.ON
+    def _tell_voice_available(self) -> None:
+        """Tell the session whether voice in is on (it decides what that means for adaptation)."""
+        self.session.set_voice_available(self.board.state(VOICE_IN)[0] is ChannelState.ON)
 
     # -- drawing -------------------------------------------------------------------------------
 
@@ -326,8 +327,6 @@ class KioskApp(App[int]):
         if not snap.person_present:
             notices.append(ui_text(snap.language, "person_lost"))
         for name in sorted(snap.adaptations):
-            if name == "voice_off" and not self._voice_in_works():
-                continue  # "I am having trouble hearing you" is untrue when voice in never ran
             notices.append(self.questionnaire.message(name, snap.language)
                            or ui_text(snap.language, name, default=name.replace("_", " ")))
         offer = None

@@ -475,6 +475,8 @@ class Session:
         self._answers: dict[str, Answer] = dict(resume_answers or {})
         self._not_answered: list[str] = list(resume_not_answered)
         self._person_present = True
+        #: whether voice in works on this kiosk (see set_voice_available)
+        self._voice_available = True
         self._repeating = False
         self._listening = False
         self._score: Score | None = None
@@ -736,6 +738,24 @@ class Session:
         with _Op(self) as t:
             if self.adaptation is not None:
                 for change in self.adaptation.patient_requests_voice():
+                    self._apply_adaptation(t, change)
+
+    def set_voice_available(self, available: bool) -> None:
+        """Whether voice in works on this kiosk (the UI knows it from the voice-in channel's status).
+
+        Assumed True until told otherwise, so sessions without a UI (replays, tests) behave as
+        the policy says. While False, the voice_off adaptation is neither switched on nor
+        announced -- "I am having trouble hearing you" is untrue when voice in is not running --
+        and one in force is lifted (recorded with that reason) without a voice_on message. The
+        QoS contexts and the listening state are not affected.
+        """
+        with _Op(self) as t:
+            if available == self._voice_available:
+                return
+            self._voice_available = available
+            self._log(t, "voice_in", "available" if available else "unavailable")
+            if self.adaptation is not None:
+                for change in self.adaptation.hold("voice_off", not available, "voice in is unavailable"):
                     self._apply_adaptation(t, change)
 
     def set_adaptation_enabled(self, enabled: bool) -> None:
@@ -1137,7 +1157,8 @@ class Session:
             self.store.record_adaptation(self.id, t=t, name=change.name, active=change.active, reason=change.reason)
         self._emit(AdaptationChanged(t, change.name, change.active, change.reason))
         if change.name == "voice_off":
-            self._message(t, "voice_off" if change.active else "voice_on")
+            if self._voice_available:  # hearing the patient again means nothing without voice in
+                self._message(t, "voice_off" if change.active else "voice_on")
             self._update_listening(t)
         elif change.name == "slow_speech" and change.active and self.current_attempt is not None:
             self._prompt_question(t, repeat=True)

@@ -3,9 +3,11 @@ explanation screens, voice-in availability, and the latest prompt in the snapsho
 
 from __future__ import annotations
 
+from kiosk.adaptation import Adaptation, load_policy
 from kiosk.channels import Channel, ChannelInput, Command
 from kiosk.session import (
     ATTEMPTS,
+    AdaptationChanged,
     AttemptOpened,
     AttemptTimedOut,
     IgnoreReason,
@@ -15,6 +17,7 @@ from kiosk.session import (
     Prompt,
     QuestionNotAnswered,
 )
+from kiosk.storage import Store
 
 from .helpers import QUESTIONNAIRE, make_rig, started
 
@@ -74,3 +77,60 @@ def test_a_number_under_the_explanation_acknowledges_it_unless_paused():
     assert rig.session.phase is Phase.QUESTIONS
     rig.run_until(25)  # the first question opens after the usual gap; the "3" answered nothing
     assert rig.session.current_attempt == 1 and not rig.session.answers
+
+
+def _late_touch_answers(rig, count: int) -> None:
+    """Touch answers given only on attempt 2: VoiceInteractionQuality sinks with each."""
+    for _ in range(count):
+        rig.run_until(rig.session.now() + 15)  # the gap; attempt 1 opens
+        rig.run_until(rig.session.now() + 30)  # attempt 1 runs out
+        rig.at(rig.session.now() + 3)
+        rig.answer(1, Channel.TOUCH)
+
+
+def _voice_messages(rig) -> list[str]:
+    return [p.key for p in rig.of(Prompt) if p.key in ("voice_off", "voice_on")]
+
+
+def test_without_voice_in_the_voice_off_adaptation_neither_switches_on_nor_is_announced(tmp_path):
+    store = Store.open(tmp_path)
+    rig = started(adaptation=Adaptation(load_policy()), store=store)
+    rig.session.set_voice_available(False)
+    _late_touch_answers(rig, 6)
+    rule = next(r for r in rig.session.adaptation.policy.rules if r.name == "voice_off")
+    assert rig.session.metrics[rule.metric] < rule.below  # the evidence that would switch it on is there
+    assert "voice_off" not in rig.session.snapshot().adaptations
+    assert not [e for e in rig.of(AdaptationChanged) if e.name == "voice_off"]
+    assert _voice_messages(rig) == []
+    assert [a.name for a in store.session(rig.session.id).adaptations if a.name == "voice_off"] == []
+
+
+def test_the_same_patient_with_voice_in_gets_voice_off_and_the_qos_trace_is_the_same():
+    without = started(adaptation=Adaptation(load_policy()))
+    without.session.set_voice_available(False)
+    _late_touch_answers(without, 6)
+    with_voice = started(adaptation=Adaptation(load_policy()))
+    _late_touch_answers(with_voice, 6)  # available is the default
+    assert "voice_off" in with_voice.session.snapshot().adaptations
+    assert _voice_messages(with_voice) == ["voice_off"]
+    assert with_voice.session.trace == without.session.trace  # availability never reaches the QoS engine
+
+
+def test_voice_in_lost_while_voice_off_is_in_force_lifts_it_silently_and_truthfully(tmp_path):
+    store = Store.open(tmp_path)
+    rig = started(adaptation=Adaptation(load_policy()), store=store)
+    _late_touch_answers(rig, 6)
+    assert "voice_off" in rig.session.snapshot().adaptations
+    rig.session.set_voice_available(False)  # the microphone was unplugged
+    change = rig.of(AdaptationChanged)[-1]
+    assert (change.name, change.active, change.reason) == ("voice_off", False, "voice in is unavailable")
+    assert _voice_messages(rig) == ["voice_off"]  # no "I can hear you again"
+    stored = store.session(rig.session.id)
+    assert [(a.name, a.active, a.reason) for a in stored.adaptations if a.name == "voice_off"][-1] == (
+        "voice_off", False, "voice in is unavailable")
+    assert [e.detail for e in stored.log if e.kind == "voice_in"] == ["unavailable"]
+    # voice in back: voice_off needs fresh low readings after answers to come back
+    rig.session.set_voice_available(True)
+    assert "voice_off" not in rig.session.snapshot().adaptations
+    _late_touch_answers(rig, 1)
+    assert "voice_off" not in rig.session.snapshot().adaptations

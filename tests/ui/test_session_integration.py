@@ -6,10 +6,12 @@ from __future__ import annotations
 from textual.widgets import Label
 
 from kiosk.app import KIOSK_SIZE
-from kiosk.channels import Channel, ChannelInput
-from kiosk.session import ATTEMPTS, Phase
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
+from kiosk.session import ATTEMPTS, Phase, Prompt
+from kiosk.widgets.bars import AdaptationBanner
 
 from .helpers import deliver_from_thread, screen_name, settle, start_in_english
+from .test_incidents import _late_touch_answers_until_voice_off
 
 
 def _text(widget) -> str:
@@ -38,3 +40,23 @@ async def test_number_keys_before_the_questions_start_in_that_language_and_ackno
         await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
         assert kiosk.session.trace == [{"t": 0, "set": {"PersonDetected": True, "TestState": "STARTED"}}]
         assert kiosk.store.session(kiosk.session.id).language == "es"
+
+
+async def test_voice_in_status_reaches_the_session_and_a_lost_microphone_lifts_voice_off(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.ON, "voice in", "pocketsphinx"))
+        await start_in_english(kiosk, pilot)
+        await _late_touch_answers_until_voice_off(kiosk, pilot)
+        banner = kiosk.app.screen.query_one(AdaptationBanner)
+        assert banner.display and "trouble hearing" in _text(banner)
+        deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.LOST, "voice in", "microphone unplugged"))
+        await settle(pilot, lambda: "voice_off" not in kiosk.session.snapshot().adaptations)
+        await settle(pilot, lambda: not kiosk.app.screen.query_one(AdaptationBanner).display)
+        voice_prompts = [e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
+        assert voice_prompts == ["voice_off"]  # no "I can hear you again" with the microphone gone
+        stored = kiosk.store.session(kiosk.session.id)
+        assert [(a.name, a.active, a.reason) for a in stored.adaptations][-1] == (
+            "voice_off", False, "voice in is unavailable")
+        # "available" came before the start, when there was no stored session to log it in
+        assert [e.detail for e in stored.log if e.kind == "voice_in"] == ["unavailable"]
