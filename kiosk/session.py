@@ -384,6 +384,9 @@ class Snapshot:
     answers: Mapping[str, Answer]
     not_answered: tuple[str, ...]
     score: Score | None
+    #: the latest prompt published (question, practice or message; None before the first), so a
+    #: screen rebuilt later can show what was last said without having kept the event
+    prompt: Prompt | None = None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -477,6 +480,7 @@ class Session:
         self._person_present = True
         #: whether voice in works on this kiosk (see set_voice_available)
         self._voice_available = True
+        self._prompt: Prompt | None = None
         self._repeating = False
         self._listening = False
         self._score: Score | None = None
@@ -618,7 +622,7 @@ class Session:
             paused=self.paused, halted=self.halted, person_present=self._person_present,
             listening=self._listening, adaptations=self._active_adaptations(),
             speech_rate=self._speech_rate(), answers=dict(self._answers),
-            not_answered=tuple(self._not_answered), score=self._score,
+            not_answered=tuple(self._not_answered), score=self._score, prompt=self._prompt,
         )
 
     # -- inputs ------------------------------------------------------------------------------------
@@ -1123,7 +1127,8 @@ class Session:
     def _message(self, t: float, name: str) -> None:
         text = self.questionnaire.message(name, self._language)
         if text:
-            self._emit(Prompt(t, "message", name, text, text, self._language, speech_rate=self._speech_rate()))
+            self._publish_prompt(Prompt(t, "message", name, text, text, self._language,
+                                        speech_rate=self._speech_rate()))
 
     def _prompt_question(self, t: float, repeat: bool) -> None:
         assert self._open is not None
@@ -1135,8 +1140,13 @@ class Session:
         spoken = question.spoken[lang]
         if repeat and self.questionnaire.message("repeat", lang):
             spoken = f"{self.questionnaire.message('repeat', lang)} {spoken}"
-        self._emit(Prompt(t, "practice" if self._open.practice else "question", question.id, question.text[lang],
-                          spoken, lang, options, repeat, self._open.attempt, self._speech_rate()))
+        self._publish_prompt(Prompt(t, "practice" if self._open.practice else "question", question.id,
+                                    question.text[lang], spoken, lang, options, repeat, self._open.attempt,
+                                    self._speech_rate()))
+
+    def _publish_prompt(self, prompt: Prompt) -> None:
+        self._prompt = prompt
+        self._emit(prompt)
 
     def _update_listening(self, t: float) -> None:
         listening = (self.current_attempt is not None and not self._freezes

@@ -134,3 +134,23 @@ def test_voice_in_lost_while_voice_off_is_in_force_lifts_it_silently_and_truthfu
     assert "voice_off" not in rig.session.snapshot().adaptations
     _late_touch_answers(rig, 1)
     assert "voice_off" not in rig.session.snapshot().adaptations
+
+
+def test_the_snapshot_carries_the_latest_prompt():
+    rig = make_rig()
+    assert rig.session.snapshot().prompt is None
+    rig.at(10)
+    rig.session.handle(ChannelInput(Channel.TOUCH, option=3))  # starts in French
+    explanation = rig.session.snapshot().prompt
+    assert (explanation.kind, explanation.key, explanation.language) == ("message", "explanation", "fr")
+    assert explanation.text == QUESTIONNAIRE.message("explanation", "fr")
+    rig.answer(1)
+    rig.run_until(25)
+    assert rig.session.snapshot().prompt == rig.of(Prompt)[-1]
+    assert (rig.session.snapshot().prompt.key, rig.session.snapshot().prompt.attempt) == ("feeding", 1)
+    rig.command(Command.PAUSE)
+    assert rig.session.snapshot().prompt.key == "paused"
+    rig.command(Command.PAUSE)  # resumes: the question is asked again
+    prompt = rig.session.snapshot().prompt
+    assert (prompt.kind, prompt.key, prompt.repeat) == ("question", "feeding", True)
+    assert prompt is rig.of(Prompt)[-1]
