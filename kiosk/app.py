@@ -407,6 +407,14 @@ class KioskApp(App[int]):
         """A clinician continues a session halted by call-doctor (or paused)."""
         self._drive(self.session.clinician_continue)
 
+    def person_lost(self) -> None:
+        """A clinician says the patient left the kiosk (it has no presence sensor)."""
+        self._drive(self.session.person_lost)
+
+    def person_back(self) -> None:
+        """A clinician says the patient is back in front of the kiosk."""
+        self._drive(self.session.person_back)
+
     @property
     def can_start_new_session(self) -> bool:
         """A fresh session for the next patient can be built."""

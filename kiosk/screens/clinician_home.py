@@ -1,5 +1,5 @@
-"""The clinician's first screen: the running session (continue it, adaptation on/off), the channel
-states with their reasons, and the list of stored sessions."""
+"""The clinician's first screen: the running session (continue it, adaptation on/off, patient left or
+back), the channel states with their reasons, and the list of stored sessions."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from textual.widgets import Button, DataTable, Label, Static, Switch
 from kiosk.config import DEFAULT_PIN
 from kiosk.screens.base import ClinicianScreen
 from kiosk.screens.session_detail import SessionDetailScreen
+from kiosk.session import Phase
 
 
 class ClinicianHomeScreen(ClinicianScreen):
@@ -38,6 +39,12 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
                 yield Button("Back to the patient", id="back")
+            # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
+            running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
+            present = session.snapshot().person_present
+            with Horizontal(id="presence-actions"):
+                yield Button("Patient left", id="person-lost", disabled=not (running and present))
+                yield Button("Patient back", id="person-back", disabled=not (running and not present))
             yield Static(self._channels_text(), id="channel-reasons")
             yield Label("Stored sessions (Enter or click to open):")
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
@@ -55,6 +62,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         session = self.app.session  # type: ignore[attr-defined]
         state = "waiting for a clinician (doctor called)" if session.halted else (
             "paused" if session.paused else session.phase.value)
+        if not session.snapshot().person_present:
+            state += ", patient away"
         line = (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
                 f"{len(session.answers)} of {len(session.questionnaire.items)} answered.")
         if session.metrics:
@@ -70,6 +79,16 @@ class ClinicianHomeScreen(ClinicianScreen):
     @on(Button.Pressed, "#continue")
     def _continue(self) -> None:
         self.app.clinician_continue()  # type: ignore[attr-defined]
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#person-lost")
+    def _person_lost(self) -> None:
+        self.app.person_lost()  # type: ignore[attr-defined]
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#person-back")
+    def _person_back(self) -> None:
+        self.app.person_back()  # type: ignore[attr-defined]
         self.app.close_clinician()  # type: ignore[attr-defined]
 
     @on(Button.Pressed, "#new-session")

@@ -5,11 +5,13 @@ from __future__ import annotations
 
 from textual.widgets import Label
 
-from kiosk.app import KIOSK_SIZE
+from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
-from kiosk.session import ATTEMPTS, Phase, Prompt
+from kiosk.session import ATTEMPTS, AttemptTimedOut, Phase, Prompt
 from kiosk.widgets.bars import AdaptationBanner
+from kiosk.widgets.text import ui_text
 
+from .conftest import UI_PIN
 from .helpers import deliver_from_thread, screen_name, settle, start_in_english
 from .test_incidents import _late_touch_answers_until_voice_off
 
@@ -60,3 +62,46 @@ async def test_voice_in_status_reaches_the_session_and_a_lost_microphone_lifts_v
             "voice_off", False, "voice in is unavailable")
         # "available" came before the start, when there was no stored session to log it in
         assert [e.detail for e in stored.log if e.kind == "voice_in"] == ["unavailable"]
+
+
+async def _clinician_presses(kiosk, pilot, button: str) -> None:
+    """Open the clinician screens behind the PIN, press ``button`` and get back to the patient."""
+    await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")
+    await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+    await pilot.click(button)
+    await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+
+
+async def test_the_clinician_marks_the_patient_left_and_back_and_the_attempt_clock_follows(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    timing = kiosk.session.timing
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        left_with = 3.0
+        assert left_with < timing.person_back_grace_s
+        kiosk.advance(timing.attempt_window_s - left_with)
+
+        await _clinician_presses(kiosk, pilot, "#person-lost")
+        notice = ui_text("en", "person_lost")
+        await settle(pilot, lambda: notice in _text(kiosk.app.screen.query_one(AdaptationBanner)))
+        kiosk.advance(10 * timing.attempt_window_s)  # far past the deadline: the clock is frozen
+        await settle(pilot)
+        assert not [e for e in kiosk.app.events if isinstance(e, AttemptTimedOut)]
+        assert kiosk.session.current_attempt == 1 and kiosk.session.remaining() == left_with
+        assert notice in _text(kiosk.app.screen.query_one(AdaptationBanner))
+
+        await _clinician_presses(kiosk, pilot, "#person-back")
+        await settle(pilot, lambda: not kiosk.app.screen.query_one(AdaptationBanner).display)
+        assert kiosk.session.remaining() == timing.person_back_grace_s  # at least the grace is left
+        kiosk.advance(timing.person_back_grace_s - 0.1)
+        await settle(pilot)
+        assert kiosk.session.current_attempt == 1
+        await pilot.press("2")  # the patient answers the attempt that was waiting for them
+        await settle(pilot, lambda: "feeding" in kiosk.session.answers)
+        assert kiosk.session.answers["feeding"].attempt == 1
+
+    presence = [e["set"]["PersonDetected"] for e in kiosk.store.session(kiosk.session.id).trace
+                if "PersonDetected" in e.get("set", {})]
+    assert presence == [True, False, True]  # the start, the clinician's "left", then "back"
