@@ -43,7 +43,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"kiosk: unknown command {name!r}\n\n{_usage()}", file=sys.stderr)
         return 2
     module = importlib.import_module(COMMANDS[name][0])
-    return int(module.main(args) or 0)
+    from qos.cli import run_command
+
+    return run_command(lambda: int(module.main(args) or 0))
 
 
 if __name__ == "__main__":  # pragma: no cover - `python -m kiosk.cli`

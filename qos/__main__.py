@@ -2,6 +2,6 @@
 
 import sys
 
-from qos.cli import main
+from qos.cli import main, run_command
 
-sys.exit(main())
+sys.exit(run_command(main))

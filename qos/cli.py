@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from qos.errors import QosError
@@ -101,3 +102,18 @@ def main(argv: Sequence[str] | None = None, prog: str = "python -m qos", epilog:
         if args.plot is not None:
             print(f"\nplot written to {args.plot}")
     return 0
+
+
+def run_command(entry: Callable[[], int]) -> int:
+    """Run a command-line entry point and return its exit status.
+
+    A reader that stops early (``python -m qos replay T --json | head``) closes the pipe; that is
+    the reader's choice, not an error, so it ends quietly instead of with a BrokenPipeError traceback.
+    """
+    try:
+        status = entry()
+        sys.stdout.flush()  # surface a closed pipe here, not in the interpreter's exit flush
+        return status
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0

@@ -87,3 +87,13 @@ def test_kiosk_qos_trace_hands_its_arguments_to_the_session_records(monkeypatch)
     monkeypatch.setitem(sys.modules, "kiosk.records", records)
     assert qos_cli.main(["trace", "S1", "--json"]) == 0
     assert calls == [["S1", "--json"]]
+
+
+@pytest.mark.parametrize("command", [["-m", "qos"], ["-m", "kiosk", "qos"]])
+def test_a_reader_closing_the_pipe_early_is_not_an_error(command):
+    """`… | head -c 0`: the reader is gone before anything is written; no traceback, exit 0."""
+    child = subprocess.Popen([sys.executable, *command, "replay", str(TABLE4)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+    child.stdout.close()
+    assert child.wait(timeout=60) == 0
+    assert child.stderr.read() == b""
