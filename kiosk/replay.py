@@ -469,7 +469,7 @@ def _print_human(result: ReplayResult) -> None:
 
 def main(argv: list[str]) -> int:
     """`kiosk replay FILE... [--json] [--trace OUT] [--data-dir DIR]`; exit 0, or 2 on a bad script."""
-    parser = argparse.ArgumentParser(prog="kiosk replay", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="kiosk replay", description="Run scripted patients through the real session core and QoS engine on a simulated clock.")
     parser.add_argument("files", nargs="+", metavar="FILE", help="scripted patient YAML file(s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object per script")
     parser.add_argument("--trace", metavar="OUT", help="write the context trace (one script only)")

@@ -44,7 +44,7 @@ def _show(q, stored: StoredSession) -> None:
 
 def main(argv: list[str]) -> int:
     """List, show or export stored sessions; returns the exit status."""
-    parser = argparse.ArgumentParser(prog="kiosk results", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="kiosk results", description="List stored sessions, show one, or export it as FHIR R4 JSON or CSV (totals recomputed from the answers).")
     parser.add_argument("session", nargs="?", help="session id or unique prefix (default: list sessions)")
     parser.add_argument("--fhir", metavar="FILE", help="write the session as a FHIR R4 QuestionnaireResponse")
     parser.add_argument("--fhir-questionnaire", metavar="FILE", help="write the FHIR R4 Questionnaire")

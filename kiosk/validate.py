@@ -14,7 +14,7 @@ from kiosk.questionnaire import check_questionnaire_file
 
 def main(argv: list[str]) -> int:
     """Validate questionnaire files; returns the exit status."""
-    parser = argparse.ArgumentParser(prog="kiosk validate", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="kiosk validate", description="List every problem of questionnaire files, one per line as file:line:col: problem; exit 1 if any.")
     parser.add_argument("files", nargs="+", metavar="FILE", help="questionnaire YAML file(s)")
     args = parser.parse_args(argv)
     bad = False
