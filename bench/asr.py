@@ -110,7 +110,7 @@ def run(backend_name: str, make, language: str, items, folder: Path, hangover_ms
     for item in items:
         options = option_words([_Opt(o, language) for o in item.options])
         matcher = Matcher(options, language)
-        recogniser.set_grammar(matcher.phrases())
+        recogniser.set_grammar(matcher.phrases(), matcher.meaning)
         cases = _answers([_Opt(o, language) for o in item.options], language)
         cases += [(text, None) for text in NOT_ANSWERS[language]]
         for text, expected in cases:

@@ -8,13 +8,21 @@ in [0, 1]:
   ``KIOSK_VOSK_MODEL``), grammar as a JSON phrase list with "[unk]"; confidence is the lowest
   word confidence Vosk reports.
 - :class:`PocketSphinxRecogniser`: the English model in the pocketsphinx wheel, grammar as JSGF.
-  A grammar decoder always returns *some* phrase, so its confidence is the lowest of three
+  A grammar decoder always returns *some* phrase, so its confidence is the lowest of four
   checks: a whole phrase was reached (else 0); the recognised words cover the utterance's voiced
   audio (a sentence forced onto the grammar goes mostly into "silence": 5-45 % covered, an
   answer 80-100 %); and the acoustic cost per voiced frame is low. PocketSphinx scores every
   frame against the best-matching sound in that frame, so the path's cost measures how far the
   grammar had to bend the audio: 3.9-6.5 for answers, 6.6-7.9 for other short words on
   espeak-ng audio here. :data:`PS_COST_MIDPOINT` and :data:`PS_COST_SPREAD` map it to [0, 1].
+  Some words the model cannot tell apart at all (:data:`PS_CONFUSABLE_WORDS`): espeak-ng's
+  "the first one" was heard as "the third one" on every question that has a third option, and
+  decoded against each phrase alone, "the third one" even fits it better, so no score margin
+  can separate them. Such a phrase gets confidence 0 wherever its partner selects another
+  answer (:func:`kiosk.speech.grammar.confusable_phrases`): the patient is asked again, and
+  says "one" or "number one", instead of the kiosk inventing option 3. (espeak-ng's "number
+  one" is rejected for a safe reason: the model's silence fits its "number" better than the
+  word does, so "one" covers a third of the voiced audio.)
 
 :func:`open_recogniser` picks Vosk when a model for the language is installed, else
 PocketSphinx for English, else raises :class:`AsrUnavailable` with the reason voice in is off.
@@ -25,7 +33,7 @@ from __future__ import annotations
 import json
 import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -33,7 +41,7 @@ from typing import Protocol
 import numpy as np
 
 from kiosk.speech.audio import SAMPLE_RATE
-from kiosk.speech.grammar import Grammar, build_grammar, to_jsgf, to_vosk
+from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, to_jsgf, to_vosk
 
 log = logging.getLogger(__name__)
 
@@ -60,8 +68,13 @@ class Recogniser(Protocol):
     name: str
     language: str
 
-    def set_grammar(self, phrases: Sequence[str]) -> Grammar:
-        """Listen only for these phrases from the next utterance on; returns what was kept."""
+    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
+        """Listen only for these phrases from the next utterance on; returns what was kept.
+
+        ``meaning(phrase)`` says what a phrase selects (an option number, a command): phrases
+        with the same meaning are not rivals of one another (see :class:`PocketSphinxRecogniser`).
+        Without it every phrase means only itself.
+        """
 
     def reset(self) -> None:
         """Forget the current utterance and get ready for a new one."""
@@ -78,6 +91,8 @@ class Recogniser(Protocol):
 #: acoustic cost per voiced frame where confidence is 0.5, and how fast it falls around it;
 #: with the matcher's 0.6 threshold, a cost above ~6.6 is not an answer (see the docstring)
 PS_COST_MIDPOINT, PS_COST_SPREAD = 6.7, 0.25
+#: words the wheel's English model cannot tell apart on espeak-ng speech (see the docstring)
+PS_CONFUSABLE_WORDS: tuple[frozenset[str], ...] = (frozenset({"first", "third"}),)
 
 #: lattice entries that are not words the patient said
 _FILLERS = {"<s>", "</s>", "<sil>", "(NULL)", "[NOISE]", "[SPEECH]"}
@@ -103,12 +118,18 @@ class PocketSphinxRecogniser:
         self._in_utterance = False
         self._grammar: Grammar | None = None
         self._grammars = 0
+        #: phrases holding a word confusable with one in a phrase of another meaning
+        self._confusable: frozenset[str] = frozenset()
         self._pcm = bytearray()
         #: the parts of the last confidence (coverage, cost), for the benchmark's report
         self.last_scores: dict[str, float] = {}
 
-    def set_grammar(self, phrases: Sequence[str]) -> Grammar:
-        """Compile the phrases the dictionary knows to JSGF and make it the active search."""
+    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
+        """Compile the phrases the dictionary knows to JSGF and make it the active search.
+
+        ``meaning`` groups phrases that select the same thing: "the first one" is only
+        confusable where "the third one" selects something else.
+        """
         grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name)
         self._end()
         # a fresh search name each time: pocketsphinx keeps searches by name
@@ -119,6 +140,7 @@ class PocketSphinxRecogniser:
         if self._grammars > 1:
             self._decoder.remove_search(f"q{self._grammars - 1}")
         self._grammar = grammar
+        self._confusable = confusable_phrases(grammar.phrases, meaning or (lambda p: p), PS_CONFUSABLE_WORDS)
         return grammar
 
     def _end(self) -> None:
@@ -166,11 +188,22 @@ class PocketSphinxRecogniser:
         for seg in words:
             in_words[seg.start_frame:seg.end_frame + 1] = True
         coverage = float((voiced & in_words).sum() / voiced.sum())
-        # hyp.score is logmath.exp of the path score (log base 1.0001): back to a cost
-        cost = -math.log(hyp.score) * 1000 / voiced.sum() if hyp.score > 0 else math.inf
-        acoustic = 1 / (1 + math.exp(min(50.0, (cost - PS_COST_MIDPOINT) / PS_COST_SPREAD)))
-        self.last_scores = {"coverage": coverage, "cost": cost}
-        return Recognition(hyp.hypstr, min(coverage, acoustic))
+        cost = _cost(hyp.score, voiced)
+        acoustic = _sigmoid((PS_COST_MIDPOINT - cost) / PS_COST_SPREAD)
+        # a phrase the model cannot tell from another answer's is never taken as either
+        distinct = 0.0 if hyp.hypstr in self._confusable else 1.0
+        self.last_scores = {"coverage": coverage, "cost": cost, "distinct": distinct}
+        return Recognition(hyp.hypstr, min(coverage, acoustic, distinct))
+
+
+def _cost(score: float, voiced: np.ndarray) -> float:
+    """A path score (pocketsphinx's logmath.exp of log base 1.0001) as cost per voiced frame."""
+    return -math.log(score) * 1000 / voiced.sum() if score > 0 else math.inf
+
+
+def _sigmoid(x: float) -> float:
+    """Logistic function, clamped so that exp never overflows."""
+    return 1 / (1 + math.exp(-max(-50.0, min(50.0, x))))
 
 
 def _voiced_frames(pcm: bytes) -> np.ndarray:
@@ -216,8 +249,11 @@ class VoskRecogniser:
         #: Vosk's JSON results for the segments of the current utterance
         self._segments: list[str] = []
 
-    def set_grammar(self, phrases: Sequence[str]) -> Grammar:
-        """Make a recogniser limited to the phrases the model knows (plus "[unk]")."""
+    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
+        """Make a recogniser limited to the phrases the model knows (plus "[unk]").
+
+        ``meaning`` is not needed: Vosk's own word confidences tell confusable words apart.
+        """
         grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name)
         if not grammar.phrases:
             raise ValueError("a grammar needs at least one phrase the recogniser knows")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import logging
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 
 log = logging.getLogger(__name__)
@@ -49,6 +49,25 @@ def build_grammar(phrases: Sequence[str], known: Callable[[str], bool], recognis
         if text not in kept:
             kept.append(text)
     return Grammar(tuple(kept), tuple(dropped))
+
+
+def confusable_phrases(phrases: Sequence[str], meaning: Callable[[str], Hashable],
+                       confusable: Sequence[frozenset[str]]) -> frozenset[str]:
+    """The phrases a recogniser cannot be trusted on: they hold a word of one of the
+    ``confusable`` sets, and a phrase of another meaning holds another word of that set.
+
+    "the first one" is confusable where "the third one" selects another option, not where the
+    question has only two options or both words select the same thing.
+    """
+    words = {p: set(p.split()) for p in phrases}
+    out = set()
+    for phrase in phrases:
+        for group in confusable:
+            mine = words[phrase] & group
+            if mine and any(meaning(other) != meaning(phrase) and words[other] & (group - mine)
+                            for other in phrases):
+                out.add(phrase)
+    return frozenset(out)
 
 
 def to_jsgf(grammar: Grammar, name: str = "answer") -> str:

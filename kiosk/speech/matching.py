@@ -203,6 +203,12 @@ class Matcher:
         seen: set[str] = set()
         return [p for p in out if p and not (normalise(p) in seen or seen.add(normalise(p)))]
 
+    def meaning(self, phrase: str) -> int | Command | str:
+        """What saying ``phrase`` selects: an option number, a command, or else the phrase itself
+        (the recogniser's ``set_grammar`` groups its phrases by this)."""
+        match = self.match(phrase)
+        return match.option if match.option is not None else (match.command or phrase)
+
     def _number(self, tokens: tuple[str, ...]) -> int | None:
         rest = [t for t in tokens if t not in NUMBER_FILLERS[self.language]]
         if self.language == "en" and len(rest) == 2 and rest[1] == "one" and rest[0] in self._numbers:

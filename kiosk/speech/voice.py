@@ -187,7 +187,7 @@ class VoiceChannel:
             return
         options = [] if self._paused else self._options
         self._matcher = Matcher(options, self.language, self.min_confidence)
-        self._recogniser.set_grammar(self._matcher.phrases())
+        self._recogniser.set_grammar(self._matcher.phrases(), self._matcher.meaning)
         self._gate()
 
     def _gate(self) -> None:

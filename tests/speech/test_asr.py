@@ -16,7 +16,8 @@ from kiosk.speech.asr import (
     vosk_recognition,
 )
 from kiosk.speech.audio import UtterancePipeline, feed_wav
-from kiosk.speech.grammar import Grammar, build_grammar, recogniser_words, to_jsgf, to_vosk
+from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, recogniser_words, to_jsgf, to_vosk
+from kiosk.speech.matching import Matcher, OptionWords
 
 
 def test_build_grammar_leaves_out_unknown_words_and_says_why(caplog):
@@ -87,3 +88,35 @@ def test_vosk_results_are_combined_and_unknown_words_are_not_answers():
 def test_vosk_backend_reports_a_missing_model_clearly(tmp_path):
     with pytest.raises(AsrUnavailable, match=f"vosk model {tmp_path / 'none'} does not exist"):
         VoskRecogniser(tmp_path / "none", "es")
+
+
+def test_confusable_phrases_only_where_the_partner_means_something_else():
+    first_third = (frozenset({"first", "third"}),)
+    three = ["the first one", "first", "the second one", "the third one", "one", "repeat"]
+    meaning = {"the first one": 1, "first": 1, "one": 1, "the second one": 2, "the third one": 3,
+               "repeat": "repeat"}.__getitem__
+    assert confusable_phrases(three, meaning, first_third) == {"the first one", "first", "the third one"}
+    two = [p for p in three if p != "the third one"]
+    assert confusable_phrases(two, meaning, first_third) == frozenset()
+    # both words selecting the same thing are not a risk
+    assert confusable_phrases(["first", "third"], lambda p: 1, first_third) == frozenset()
+    # without meanings every phrase means only itself
+    assert confusable_phrases(["first", "third"], lambda p: p, first_third) == {"first", "third"}
+
+
+def test_pocketsphinx_never_turns_first_into_third(tmp_path):
+    """espeak-ng's "the first one" sounds like "the third one" to the wheel's model: with a third
+    option it is not an answer (asked again), with two options it is understood."""
+    path = tmp_path / "first.wav"
+    subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", "160", "-w", str(path), "the first one"], check=True)
+    recogniser = PocketSphinxRecogniser("en")
+    heard = []
+    pipeline = UtterancePipeline(recogniser, heard.append)
+    for options in (3, 2):
+        matcher = Matcher([OptionWords(w) for w in ("unable", "needs help", "independent")[:options]], "en")
+        recogniser.set_grammar(matcher.phrases(), matcher.meaning)
+        feed_wav(path, pipeline)
+    with_third, with_two = (u.result for u in heard)
+    assert not matcher.match(with_third.text, with_third.confidence).matched
+    assert with_third.confidence == 0.0
+    assert matcher.match(with_two.text, with_two.confidence).option == 1
