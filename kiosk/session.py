@@ -30,6 +30,9 @@ Timing rules (all values from :class:`~kiosk.questionnaire.Timing`):
   ``person_back_grace_s``. The gap between questions and the closing delay freeze likewise.
 * After an answer or an unanswered question the next attempt 1 opens ``between_questions_s``
   later; after the last question FINISHED comes ``closing_s`` later.
+* While a gap runs, :attr:`Snapshot.interlude` names what to show meanwhile ("next question...").
+* Practice questions that check hearing are skipped while voice out is unavailable
+  (:meth:`Session.set_voice_out_available`); practice outcomes are stored for the clinician.
 * An answer while the patient is reported lost is still taken (a touch proves someone is there);
   PersonDetected stays the presence source's business, and the next question waits for it.
 
@@ -130,6 +133,8 @@ class SessionStore(Protocol):
     def record_answer(self, session_id: str, *, item_id: str, option: int, points: int, attempt: int,
                       channel: str, answered_by: str, t: float, at: str, detail: str = "") -> None: ...
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None: ...
+    def record_practice(self, session_id: str, *, question_id: str, checks: str, outcome: str, option: int | None,
+                        channel: str | None, t: float, at: str, detail: str = "") -> None: ...
     def record_context(self, session_id: str, *, t: float, set: Mapping[str, Any], emit: list[str]) -> None: ...
     def record_metrics(self, session_id: str, *, t: float, metrics: Mapping[str, float], fired: list[str]) -> None: ...
     def record_adaptation(self, session_id: str, *, t: float, name: str, active: bool, reason: str) -> None: ...
@@ -231,6 +236,16 @@ class PracticeAnswered(SessionEvent):
     option: int | None
     correct: bool
     channel: Channel | None
+
+
+@dataclass(frozen=True)
+class PracticeSkipped(SessionEvent):
+    """A familiarisation question was not asked, e.g. a hearing check while voice out is off."""
+
+    question_id: str
+    #: what it would have checked: "hear", "read" or "select"
+    checks: str
+    reason: str
 
 
 @dataclass(frozen=True)
@@ -387,6 +402,14 @@ class Snapshot:
     #: the latest prompt published (question, practice or message; None before the first), so a
     #: screen rebuilt later can show what was last said without having kept the event
     prompt: Prompt | None = None
+    #: during the gap before a question (or the summary) opens, the message to show meanwhile so
+    #: the screen is never empty: "first_question", "next_question", "not_answered" or
+    #: "last_question" (a questionnaire message name, or a screen word); None outside a gap
+    interlude: str | None = None
+    #: "Practice k of n" during familiarisation, counting only the practice questions asked here
+    #: (a hearing check skipped without voice out is not counted); None outside a practice question
+    practice_number: int | None = None
+    practice_count: int = 0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -480,6 +503,10 @@ class Session:
         self._person_present = True
         #: whether voice in works on this kiosk (see set_voice_available)
         self._voice_available = True
+        #: whether voice out works on this kiosk (see set_voice_out_available)
+        self._voice_out_available = True
+        #: ids of the practice questions skipped before they were shown (see set_voice_out_available)
+        self._practice_unasked: set[str] = set()
         self._prompt: Prompt | None = None
         self._repeating = False
         self._listening = False
@@ -623,7 +650,32 @@ class Session:
             listening=self._listening, adaptations=self._active_adaptations(),
             speech_rate=self._speech_rate(), answers=dict(self._answers),
             not_answered=tuple(self._not_answered), score=self._score, prompt=self._prompt,
+            interlude=self._interlude(), **self._practice_progress(),
         )
+
+    def _practice_progress(self) -> dict[str, Any]:
+        """The open practice question's place among those asked (or still to ask) on this kiosk."""
+        if self._open is None or not self._open.practice:
+            return {}
+        current = self._open.index
+        asked = [i for i, question in enumerate(self.questionnaire.familiarisation)
+                 if question.id not in self._practice_unasked
+                 and (i <= current or self._practice_skip_reason(question) is None)]
+        return {"practice_number": asked.index(current) + 1, "practice_count": len(asked)}
+
+    def _interlude(self) -> str | None:
+        """What to show while the next question (or the summary) is being waited for."""
+        if self._phase is not Phase.QUESTIONS or self._timer is None:
+            return None
+        if self._timer.kind == "finish":
+            return "last_question"
+        if self._timer.kind != "open":
+            return None
+        if self._open is not None and self._open.outcome == "not_answered":
+            return "not_answered"
+        if self._open is None and not (self._answers or self._not_answered):
+            return "first_question"
+        return "next_question"
 
     # -- inputs ------------------------------------------------------------------------------------
 
@@ -762,6 +814,28 @@ class Session:
                 for change in self.adaptation.hold("voice_off", not available, "voice in is unavailable"):
                     self._apply_adaptation(t, change)
 
+    def set_voice_out_available(self, available: bool) -> None:
+        """Whether voice out works on this kiosk (the UI knows it from the voice-out channel's status).
+
+        Assumed True until told otherwise, like :meth:`set_voice_available`. While False, practice
+        questions that check hearing are skipped (logged and stored as skipped, published as
+        :class:`PracticeSkipped`): asking "which word did you hear?" when nothing was said only
+        upsets the patient. One open when voice out is lost is skipped at once; one skipped is not
+        asked again when voice out comes back. QoS contexts are not affected.
+        """
+        with _Op(self) as t:
+            if available == self._voice_out_available:
+                return
+            self._voice_out_available = available
+            self._log(t, "voice_out", "available" if available else "unavailable")
+            open_ = self._open
+            if open_ is not None and open_.practice and self.current_attempt is not None:
+                question = self.questionnaire.familiarisation[open_.index]
+                if (reason := self._practice_skip_reason(question)) is not None:
+                    self._timer = None
+                    self._skip_practice(t, question, reason, shown=True)
+                    self._open_practice(t, open_.index + 1)
+
     def set_adaptation_enabled(self, enabled: bool) -> None:
         """The clinician turns live adaptation on or off (off lifts every active adaptation)."""
         with _Op(self) as t:
@@ -797,8 +871,7 @@ class Session:
         if self._familiarisation:
             self._set_phase(t, Phase.FAMILIARISATION)
             self._message(t, "familiarisation")
-            self._open = _Open(practice=True, index=0)
-            self._open_attempt(t, 1)
+            self._open_practice(t, 0)
         else:
             self._to_explanation(t)
 
@@ -942,6 +1015,8 @@ class Session:
             return
         self._open.outcome = "not_answered"
         if self._open.practice:
+            question = self.questionnaire.familiarisation[self._open.index]
+            self._record_practice(t, question, "not_answered")
             self._emit(PracticeAnswered(t, key, None, False, None))
             self._next_practice(t)
             return
@@ -955,14 +1030,46 @@ class Session:
 
     def _next_practice(self, t: float) -> None:
         assert self._open is not None
-        nxt = self._open.index + 1
-        if nxt < len(self.questionnaire.familiarisation):
-            self._open = _Open(practice=True, index=nxt)
+        self._open_practice(t, self._open.index + 1)
+
+    def _open_practice(self, t: float, index: int) -> None:
+        """Ask the first practice question from ``index`` on that can be asked here (skipping the
+        others, logged and stored); after the last, the explanation."""
+        questions = self.questionnaire.familiarisation
+        while index < len(questions) and (reason := self._practice_skip_reason(questions[index])) is not None:
+            self._skip_practice(t, questions[index], reason)
+            index += 1
+        if index < len(questions):
+            self._open = _Open(practice=True, index=index)
             self._open_attempt(t, 1)
         else:
             self._open = None
             self._timer = None
             self._to_explanation(t)
+
+    def _skip_practice(self, t: float, question: PracticeQuestion, reason: str, shown: bool = False) -> None:
+        """Leave ``question`` out (logged, stored and published); one never ``shown`` is not
+        counted in "Practice k of n"."""
+        if not shown:
+            self._practice_unasked.add(question.id)
+        self._log(t, "practice_skipped", f"{question.id}: {reason}")
+        self._record_practice(t, question, "skipped", detail=reason)
+        self._emit(PracticeSkipped(t, question.id, question.checks, reason))
+
+    def _practice_skip_reason(self, question: PracticeQuestion) -> str | None:
+        """Why ``question`` cannot be asked on this kiosk now, or None if it can."""
+        if question.checks == "hear" and not self._voice_out_available:
+            return "no voice out"
+        return None
+
+    def _record_practice(self, t: float, question: PracticeQuestion, outcome: str, *, option: int | None = None,
+                         channel: Channel | None = None, detail: str = "") -> None:
+        """Store a practice question's outcome ("right", "wrong", "not_answered" or "skipped") for
+        the clinician; practice never reaches the QoS engine."""
+        if self.store is not None and self._stored:
+            self.store.record_practice(self.id, question_id=question.id, checks=question.checks, outcome=outcome,
+                                       option=option, channel=channel.value if channel else None, t=t, at=self._wall(t),
+                                       detail=detail)
 
     def _answer(self, t: float, event: ChannelInput) -> None:
         reason = self._answer_blocked(event)
@@ -977,6 +1084,8 @@ class Session:
         if open_.practice:
             question = self.questionnaire.familiarisation[open_.index]
             correct = event.option == question.expected
+            self._record_practice(t, question, "right" if correct else "wrong", option=event.option,
+                                  channel=event.channel, detail=event.detail)
             self._emit(PracticeAnswered(t, question.id, event.option, correct, event.channel))
             self._message(t, "practice_right" if correct else "practice_wrong")
             self._next_practice(t)

@@ -7,7 +7,8 @@ in :meth:`Store.unfinished_sessions` and can continue it at the first question w
 (:meth:`kiosk.session.Session.from_stored`).
 
 Stored per session: the patient's pseudonymous id (never a name), answers (item, option, points,
-attempt, channel, who answered, time), questions not answered, the QoS context trace, a metric
+attempt, channel, who answered, time), questions not answered, the familiarisation's practice
+outcomes (right, wrong, not answered, skipped; never part of the QoS trace), the QoS context trace, a metric
 sample after each QoS update, adaptation events and the session log (incidents, ignored inputs).
 A stored total is kept for listing only; results always recompute it from the answers.
 """
@@ -69,6 +70,19 @@ CREATE TABLE IF NOT EXISTS not_answered (
     t REAL NOT NULL,
     at TEXT NOT NULL,
     PRIMARY KEY (session_id, item_id)
+);
+CREATE TABLE IF NOT EXISTS practice (
+    session_id TEXT NOT NULL REFERENCES sessions(id),
+    seq INTEGER NOT NULL,
+    question_id TEXT NOT NULL,
+    checks TEXT NOT NULL,
+    outcome TEXT NOT NULL CHECK (outcome IN ('right', 'wrong', 'not_answered', 'skipped')),
+    option INTEGER,
+    channel TEXT,
+    t REAL NOT NULL,
+    at TEXT NOT NULL,
+    detail TEXT NOT NULL DEFAULT '',
+    PRIMARY KEY (session_id, seq)
 );
 CREATE TABLE IF NOT EXISTS contexts (
     session_id TEXT NOT NULL REFERENCES sessions(id),
@@ -150,6 +164,23 @@ class AdaptationRecord:
 
 
 @dataclass(frozen=True)
+class PracticeRecord:
+    """How one familiarisation question went: it checks whether the patient can hear, read or choose."""
+
+    question_id: str
+    #: "hear", "read" or "select"
+    checks: str
+    #: "right", "wrong", "not_answered" or "skipped"
+    outcome: str
+    #: the option chosen (None when not answered or skipped)
+    option: int | None
+    channel: Channel | None
+    t: float
+    #: the input's detail for an answer; why it was skipped ("no voice out")
+    detail: str = ""
+
+
+@dataclass(frozen=True)
 class LogEntry:
     """A line of the session log (start, pause, ignored input, ...)."""
 
@@ -178,6 +209,8 @@ class StoredSession:
     metrics: tuple[MetricSample, ...]
     adaptations: tuple[AdaptationRecord, ...]
     log: tuple[LogEntry, ...]
+    #: the familiarisation's outcomes, in the order they happened (empty without practice)
+    practice: tuple[PracticeRecord, ...] = ()
 
 
 def _secure_dir(path: Path) -> None:
@@ -267,6 +300,13 @@ class Store:
         """Commit that both attempts of a question timed out."""
         self._write("INSERT INTO not_answered VALUES (?, ?, ?, ?)", (session_id, item_id, t, at))
 
+    def record_practice(self, session_id: str, *, question_id: str, checks: str, outcome: str, option: int | None,
+                        channel: str | None, t: float, at: str, detail: str = "") -> None:
+        """Commit a practice question's outcome ("right", "wrong", "not_answered" or "skipped")."""
+        self._write("INSERT INTO practice VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (session_id, self._next_seq("practice", session_id), question_id, checks, outcome, option,
+                     channel, t, at, detail))
+
     def record_context(self, session_id: str, *, t: float, set: Mapping[str, Any], emit: list[str]) -> None:
         """Commit one batch of the session's QoS context trace."""
         self._write("INSERT INTO contexts VALUES (?, ?, ?, ?, ?)",
@@ -354,8 +394,14 @@ class Store:
             "SELECT t, name, active, reason FROM adaptations WHERE session_id = ? ORDER BY seq", (session_id,)))
         log = tuple(LogEntry(*r) for r in self._db.execute(
             "SELECT t, kind, detail FROM events WHERE session_id = ? ORDER BY seq", (session_id,)))
+        practice = tuple(
+            PracticeRecord(q, c, o, opt, Channel(ch) if ch else None, t, d)
+            for q, c, o, opt, ch, t, d in self._db.execute(
+                "SELECT question_id, checks, outcome, option, channel, t, detail FROM practice"
+                " WHERE session_id = ? ORDER BY seq", (session_id,)))
         return StoredSession(
             id=row[0], patient_id=row[1], questionnaire_id=row[2], language=row[3], answered_by=AnsweredBy(row[4]),
             timing=json.loads(row[5]), started_at=row[6], status=row[7], finished_at=row[8], answers=answers,
             not_answered=not_answered, trace=tuple(trace), metrics=metrics, adaptations=adaptations, log=log,
+            practice=practice,
         )
