@@ -10,10 +10,14 @@ matcher). Prints one JSON document:
   one (the dangerous error); ``rejected``: heard but not taken (the patient is asked again);
 - ``false_accepts``: non-answers taken as an answer or command;
 - ``rtf``: recogniser processing time / audio duration (goal < 0.2);
-- ``finish_ms``: endpoint decision → result (goal < 300 ms); ``speech_end_to_answer_ms`` adds
-  the endpointer's hangover (the silence it waits for before deciding the patient is done).
+- ``finish_ms``: endpoint decision → result; ``speech_end_to_answer_ms``: end of speech →
+  result (goal < 300 ms), which adds the silence the endpointer waited for: the short hangover
+  when the recogniser's partial result was already a whole answer (``complete``), the long one
+  otherwise (``incomplete``, the patient may still be in mid-answer); ``complete_share`` is how
+  many utterances ended early.
 
     uv run python bench/asr.py [--languages en es fr] [--items N] [--hangover-ms MS]
+                               [--complete-hangover-ms MS]
 """
 
 from __future__ import annotations
@@ -96,15 +100,21 @@ def _answers(options, language: str) -> list[tuple[str, object]]:
     return cases
 
 
-def run(backend_name: str, make, language: str, items, folder: Path, hangover_ms: int) -> dict:
+def _p50_ms(seconds: list[float]) -> float | None:
+    return round(1000 * statistics.median(seconds), 1) if seconds else None
+
+
+def run(backend_name: str, make, language: str, items, folder: Path, settings: EndpointerSettings) -> dict:
     """Every question's answers and non-answers through one recogniser; the figures as a dict."""
     recogniser = make(language)
     timed = _Timed(recogniser)
     results: list = []
-    pipeline = UtterancePipeline(timed, results.append, EndpointerSettings(hangover_ms=hangover_ms))
+    pipeline = UtterancePipeline(timed, results.append, settings)
     right = wrong = rejected = false_accepts = n_not = 0
     audio_seconds = 0.0
     finish = []
+    #: end of speech → result (s), for utterances closed early (complete) and late
+    latency: dict[bool, list[float]] = {True: [], False: []}
     mistakes = []
     missed: list[str] = []
     for item in items:
@@ -117,6 +127,8 @@ def run(backend_name: str, make, language: str, items, folder: Path, hangover_ms
             results.clear()
             audio_seconds += feed_wav(_say(folder, text, language), pipeline) + 1.0
             finish += [u.finish_seconds for u in results]
+            for u in results:
+                latency[u.complete].append(u.endpoint - u.speech_end + u.finish_seconds)
             got = None
             for utterance in results:
                 match = matcher.match(utterance.result.text, utterance.result.confidence)
@@ -151,7 +163,12 @@ def run(backend_name: str, make, language: str, items, folder: Path, hangover_ms
         "finish_ms": {"p50": round(statistics.median(finish_ms), 1),
                       "p95": round(finish_ms[int(0.95 * (len(finish_ms) - 1))], 1),
                       "max": round(finish_ms[-1], 1)},
-        "speech_end_to_answer_ms_p50": round(hangover_ms + statistics.median(finish_ms), 1),
+        "speech_end_to_answer_ms": {
+            "p50": _p50_ms(latency[True] + latency[False]),
+            "complete_p50": _p50_ms(latency[True]),
+            "incomplete_p50": _p50_ms(latency[False]),
+            "complete_share": round(len(latency[True]) / max(1, len(latency[True]) + len(latency[False])), 3),
+        },
         "mistakes": mistakes,
         "rejected_most": sorted(set(missed), key=missed.count, reverse=True)[:12],
     }
@@ -172,12 +189,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--languages", nargs="+", default=["en", "es", "fr"])
     parser.add_argument("--items", type=int, default=10, help="how many questions (default all)")
     parser.add_argument("--hangover-ms", type=int, default=EndpointerSettings().hangover_ms,
-                        help="the endpointer's end-of-speech silence (default: the kiosk's)")
+                        help="the endpointer's end-of-speech silence mid-answer (default: the kiosk's)")
+    parser.add_argument("--complete-hangover-ms", type=int, default=EndpointerSettings().complete_hangover_ms,
+                        help="its silence after a whole answer (default: the kiosk's)")
     args = parser.parse_args(argv)
     questionnaire = load_questionnaire()
     items = questionnaire.items[: args.items]
-    hangover = args.hangover_ms
-    report = {"goals": {"rtf": 0.2, "finish_ms": 300}, "hangover_ms": hangover, "runs": [], "skipped": []}
+    settings = EndpointerSettings(hangover_ms=args.hangover_ms, complete_hangover_ms=args.complete_hangover_ms)
+    report = {"goals": {"rtf": 0.2, "speech_end_to_answer_ms": 300}, "hangover_ms": settings.hangover_ms,
+              "complete_hangover_ms": settings.complete_hangover_ms, "runs": [], "skipped": []}
     with tempfile.TemporaryDirectory() as tmp:
         for language in args.languages:
             backends = []
@@ -191,7 +211,7 @@ def main(argv: list[str] | None = None) -> int:
                                           "reason": "no vosk model installed (kiosk models install)"})
             for name, make in backends:
                 try:
-                    report["runs"].append(run(name, make, language, items, Path(tmp), hangover))
+                    report["runs"].append(run(name, make, language, items, Path(tmp), settings))
                 except AsrUnavailable as exc:
                     report["skipped"].append({"backend": name, "language": language, "reason": str(exc)})
     json.dump(report, sys.stdout, indent=2, ensure_ascii=False)

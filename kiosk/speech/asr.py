@@ -41,7 +41,7 @@ from typing import Protocol
 import numpy as np
 
 from kiosk.speech.audio import SAMPLE_RATE
-from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, to_jsgf, to_vosk
+from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, final_phrases, to_jsgf, to_vosk
 
 log = logging.getLogger(__name__)
 
@@ -59,6 +59,9 @@ class Recognition:
     confidence: float
     #: False for a partial result while the patient is still speaking
     final: bool = True
+    #: for a partial result: it already is a whole answer (one of the grammar's
+    #: :func:`~kiosk.speech.grammar.final_phrases`), so the endpointer need not wait long
+    complete: bool = False
 
 
 class Recogniser(Protocol):
@@ -91,6 +94,9 @@ class Recogniser(Protocol):
 #: acoustic cost per voiced frame where confidence is 0.5, and how fast it falls around it;
 #: with the matcher's 0.6 threshold, a cost above ~6.6 is not an answer (see the docstring)
 PS_COST_MIDPOINT, PS_COST_SPREAD = 6.7, 0.25
+#: 10 ms frames of quiet after the last voiced one that the final decode scores: the long
+#: hangover's worth (see :func:`_fixed_tail`)
+PS_TRAILING_FRAMES = 50
 #: words the wheel's English model cannot tell apart on espeak-ng speech (see the docstring)
 PS_CONFUSABLE_WORDS: tuple[frozenset[str], ...] = (frozenset({"first", "third"}),)
 
@@ -120,6 +126,10 @@ class PocketSphinxRecogniser:
         self._grammars = 0
         #: phrases holding a word confusable with one in a phrase of another meaning
         self._confusable: frozenset[str] = frozenset()
+        #: phrases that are a whole answer once heard (partial results say so)
+        self._final: frozenset[str] = frozenset()
+        #: whether a whole utterance has been decoded (see :meth:`accept`)
+        self._settled = False
         self._pcm = bytearray()
         #: the parts of the last confidence (coverage, cost), for the benchmark's report
         self.last_scores: dict[str, float] = {}
@@ -140,7 +150,9 @@ class PocketSphinxRecogniser:
         if self._grammars > 1:
             self._decoder.remove_search(f"q{self._grammars - 1}")
         self._grammar = grammar
-        self._confusable = confusable_phrases(grammar.phrases, meaning or (lambda p: p), PS_CONFUSABLE_WORDS)
+        meaning = meaning or (lambda p: p)
+        self._confusable = confusable_phrases(grammar.phrases, meaning, PS_CONFUSABLE_WORDS)
+        self._final = final_phrases(grammar.phrases, meaning)
         return grammar
 
     def _end(self) -> None:
@@ -163,7 +175,14 @@ class PocketSphinxRecogniser:
         self._pcm += pcm
         self._decoder.process_raw(pcm, False, False)
         hyp = self._decoder.hyp()
-        return Recognition(hyp.hypstr, 0.0, final=False) if hyp is not None and hyp.hypstr else None
+        if hyp is None or not hyp.hypstr:
+            return None
+        # A fresh decoder's cepstral mean has not settled on the voice and room yet: its first
+        # utterance closed early scored far better than it should ("banana split" as "number
+        # three": cost 6.4 against 6.7 after the long hangover, 7.1 once settled), so the
+        # first utterance always gets the long hangover.
+        complete = self._settled and hyp.hypstr in self._final
+        return Recognition(hyp.hypstr, 0.0, final=False, complete=complete)
 
     def finish(self) -> Recognition:
         """End the utterance and score it (see the module docstring)."""
@@ -172,6 +191,9 @@ class PocketSphinxRecogniser:
         pcm = bytes(self._pcm)
         voiced = _voiced_frames(pcm)
         self._end()
+        self._settled = True
+        if voiced.any():
+            pcm, voiced = _fixed_tail(pcm, voiced)
         # Decode the utterance once more: live cepstral mean normalisation only settles on a
         # voice after hearing it, and a fresh decoder's first utterance was misheard ("pause"
         # as "cannot"). The second pass starts from the means of this very utterance.
@@ -194,6 +216,22 @@ class PocketSphinxRecogniser:
         distinct = 0.0 if hyp.hypstr in self._confusable else 1.0
         self.last_scores = {"coverage": coverage, "cost": cost, "distinct": distinct}
         return Recognition(hyp.hypstr, min(coverage, acoustic, distinct))
+
+
+def _fixed_tail(pcm: bytes, voiced: np.ndarray) -> tuple[bytes, np.ndarray]:
+    """The utterance with exactly :data:`PS_TRAILING_FRAMES` of quiet after its last voiced frame.
+
+    The cost per voiced frame also counts the quiet after the speech, so an utterance the
+    endpointer closed early (a whole answer after a short pause) would score better than the
+    same one closed after the long hangover. Cutting a longer tail, and lengthening a shorter
+    one by repeating the quiet actually heard (the room's own noise), scores both alike.
+    """
+    step = 2 * SAMPLE_RATE // 100  # bytes per 10 ms frame
+    end = (int(np.flatnonzero(voiced)[-1]) + 1) * step
+    tail = pcm[end:end + PS_TRAILING_FRAMES * step] or b"\0" * step
+    tail = (tail * (PS_TRAILING_FRAMES * step // len(tail) + 1))[:PS_TRAILING_FRAMES * step]
+    out = pcm[:end] + tail
+    return out, np.concatenate([voiced[:end // step], np.zeros(PS_TRAILING_FRAMES, dtype=bool)])
 
 
 def _cost(score: float, voiced: np.ndarray) -> float:
@@ -248,6 +286,8 @@ class VoskRecogniser:
         self._recogniser = None
         #: Vosk's JSON results for the segments of the current utterance
         self._segments: list[str] = []
+        #: phrases that are a whole answer once heard (partial results say so)
+        self._final: frozenset[str] = frozenset()
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]").
@@ -259,6 +299,7 @@ class VoskRecogniser:
             raise ValueError("a grammar needs at least one phrase the recogniser knows")
         self._recogniser = self._vosk.KaldiRecognizer(self._model, SAMPLE_RATE, to_vosk(grammar))
         self._recogniser.SetWords(True)
+        self._final = final_phrases(grammar.phrases, meaning or (lambda p: p))
         self.reset()
         return grammar
 
@@ -269,14 +310,18 @@ class VoskRecogniser:
         self._segments = []
 
     def accept(self, pcm: bytes) -> Recognition | None:
-        """Decode more audio; Vosk may close a segment at its own pause detection."""
+        """Decode more audio; Vosk may close a segment at its own pause detection. The partial
+        result is the text of the whole utterance so far."""
         if self._recogniser is None:
             raise RuntimeError("set_grammar must be called before recognising")
         if self._recogniser.AcceptWaveform(pcm):
             self._segments.append(self._recogniser.Result())
-            return None
-        partial = json.loads(self._recogniser.PartialResult()).get("partial", "")
-        return Recognition(partial, 0.0, final=False) if partial else None
+            partial = ""
+        else:
+            partial = json.loads(self._recogniser.PartialResult()).get("partial", "")
+        text = " ".join([*(json.loads(s).get("text", "") for s in self._segments), partial]).split()
+        heard = " ".join(text)
+        return Recognition(heard, 0.0, final=False, complete=heard in self._final) if heard else None
 
     def finish(self) -> Recognition:
         """End the utterance and combine its segments (see :func:`vosk_recognition`)."""

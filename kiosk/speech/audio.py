@@ -170,9 +170,14 @@ class EndpointerSettings:
     margin_db: float = 12.0
     #: this much continuous speech starts an utterance (short clicks do not)
     start_ms: int = 90
-    #: this much quiet ends it. Older speakers pause inside an answer; with ~0.2 s of
-    #: recognition after it the kiosk still replies inside the ~0.75 s that feels natural.
+    #: this much quiet ends it while what was heard is not yet a whole answer: older speakers
+    #: pause inside an answer ("needs ... help"), and the kiosk still replies inside the ~0.75 s
+    #: that feels natural
     hangover_ms: int = 500
+    #: this much quiet ends it once the recogniser's partial result is a whole phrase that
+    #: nothing of another meaning continues (see :func:`kiosk.speech.grammar.final_phrases`):
+    #: "independent" needs no half-second wait, and the reply comes well under 0.3 s
+    complete_hangover_ms: int = 240
     #: audio kept from before the start, so the recogniser hears the first consonant
     preroll_ms: int = 300
     #: an utterance longer than this is cut (a radio, a conversation in the room)
@@ -182,8 +187,10 @@ class EndpointerSettings:
 class Endpointer:
     """Energy-based speech start/end detection with hangover, frame by frame.
 
-    ``push(frame)`` returns ``"start"``, ``"end"`` or ``None``. A running noise floor (tracked
-    while nobody speaks) raises the threshold in a noisy room.
+    ``push(frame, complete)`` returns ``"start"``, ``"end"`` or ``None``; ``complete`` says
+    whether what was heard so far is already a whole answer, which ends it after the shorter
+    ``complete_hangover_ms``. A running noise floor (tracked while nobody speaks) raises the
+    threshold in a noisy room.
     """
 
     def __init__(self, settings: EndpointerSettings | None = None) -> None:
@@ -192,6 +199,7 @@ class Endpointer:
         #: voiced frames in a row that start an utterance
         self.start_frames = max(1, round(self.settings.start_ms / frame_ms))
         self._end_frames = max(1, round(self.settings.hangover_ms / frame_ms))
+        self._complete_end_frames = max(1, round(self.settings.complete_hangover_ms / frame_ms))
         self._max_frames = round(self.settings.max_utterance_s * 1000 / frame_ms)
         self.reset()
 
@@ -207,7 +215,7 @@ class Endpointer:
         """Whether a frame at ``level_db`` counts as speech given the current noise floor."""
         return level_db >= max(self.settings.min_speech_db, self.noise_db + self.settings.margin_db)
 
-    def push(self, frame: np.ndarray) -> str | None:
+    def push(self, frame: np.ndarray, complete: bool = False) -> str | None:
         """Classify one frame of :data:`FRAME_SAMPLES` samples; report a start or an end."""
         level = frame_level_db(frame)
         voiced = self.is_voiced(level)
@@ -226,7 +234,8 @@ class Endpointer:
             return None
         self._speech_frames += 1
         self._quiet_run = 0 if voiced else self._quiet_run + 1
-        if self._quiet_run >= self._end_frames or self._speech_frames >= self._max_frames:
+        end_frames = self._complete_end_frames if complete else self._end_frames
+        if self._quiet_run >= end_frames or self._speech_frames >= self._max_frames:
             self.in_speech, self._voiced_run = False, 0
             return "end"
         return None
@@ -247,7 +256,8 @@ class StreamingRecogniser(Protocol):
         """Start a new utterance."""
 
     def accept(self, pcm: bytes) -> object:
-        """Take more audio of the current utterance."""
+        """Take more audio of the current utterance; may return a partial result whose
+        ``complete`` attribute says it is already a whole answer."""
 
     def finish(self) -> object:
         """End the utterance and return the final result."""
@@ -267,6 +277,8 @@ class Utterance:
     #: seconds of processor time the recogniser took for its final result after the endpoint
     #: (a measurement for ``bench/asr.py``; no decision depends on it)
     finish_seconds: float
+    #: whether the utterance ended after the short hangover, its partial result being a whole answer
+    complete: bool = False
 
 
 class UtterancePipeline:
@@ -295,6 +307,8 @@ class UtterancePipeline:
         self._samples = 0  # samples fed so far: the stream clock
         self._start = 0.0
         self._muted = False
+        #: whether the recogniser's latest partial result is a whole answer
+        self._complete = False
 
     @property
     def muted(self) -> bool:
@@ -310,6 +324,7 @@ class UtterancePipeline:
 
     def _drop_utterance(self) -> None:
         self.endpointer.reset()
+        self._complete = False
         self._preroll.clear()
         self._pending = b""
         self.recogniser.reset()
@@ -333,10 +348,10 @@ class UtterancePipeline:
 
     def _frame(self, chunk: bytes) -> None:
         self._samples += FRAME_SAMPLES
-        event = self.endpointer.push(np.frombuffer(chunk, dtype="<i2"))
+        event = self.endpointer.push(np.frombuffer(chunk, dtype="<i2"), self._complete)
         if event is None:
             if self.endpointer.in_speech:
-                self.recogniser.accept(chunk)
+                self._hear(chunk)
             else:
                 self._preroll.append(chunk)
             return
@@ -345,11 +360,14 @@ class UtterancePipeline:
             # the run of voiced frames that triggered the start is already in the pre-roll
             self._start = self.stream_time - self.endpointer.start_frames * frame_s
             self.recogniser.reset()
-            self.recogniser.accept(b"".join(self._preroll) + chunk)
+            self._complete = False
+            self._hear(b"".join(self._preroll) + chunk)
             self._preroll.clear()
             return
         # "end": the recogniser has heard the speech and the hangover; finish it now
-        self.recogniser.accept(chunk)
+        complete = self._complete
+        self._hear(chunk)
+        self._complete = False
         endpoint = self.stream_time
         began = self._timer()
         result = self.recogniser.finish()
@@ -362,8 +380,14 @@ class UtterancePipeline:
                 speech_end=speech_end,
                 endpoint=endpoint,
                 finish_seconds=finish_seconds,
+                complete=complete,
             )
         )
+
+    def _hear(self, chunk: bytes) -> None:
+        """Pass audio of the utterance to the recogniser and note whether it is a whole answer."""
+        partial = self.recogniser.accept(chunk)
+        self._complete = bool(getattr(partial, "complete", False))
 
 
 class PcmConsumer(Protocol):

@@ -70,6 +70,22 @@ def confusable_phrases(phrases: Sequence[str], meaning: Callable[[str], Hashable
     return frozenset(out)
 
 
+def final_phrases(phrases: Sequence[str], meaning: Callable[[str], Hashable]) -> frozenset[str]:
+    """The phrases that are a whole answer as soon as they are heard: no longer phrase of
+    another meaning goes on from them.
+
+    "needs" is no phrase at all; "help" is final unless, say, "help me up" selected another
+    option; "the second" is final although "the second one" goes on from it, since both select
+    option 2. Hearing a final phrase lets the endpointer stop waiting early.
+    """
+    words = {p: p.split() for p in phrases}
+    return frozenset(
+        p for p in phrases
+        if not any(len(words[o]) > len(words[p]) and words[o][:len(words[p])] == words[p]
+                   and meaning(o) != meaning(p) for o in phrases)
+    )
+
+
 def to_jsgf(grammar: Grammar, name: str = "answer") -> str:
     """A JSGF grammar (pocketsphinx) accepting exactly one of the phrases."""
     if not grammar.phrases:

@@ -16,7 +16,15 @@ from kiosk.speech.asr import (
     vosk_recognition,
 )
 from kiosk.speech.audio import UtterancePipeline, feed_wav
-from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, recogniser_words, to_jsgf, to_vosk
+from kiosk.speech.grammar import (
+    Grammar,
+    build_grammar,
+    confusable_phrases,
+    final_phrases,
+    recogniser_words,
+    to_jsgf,
+    to_vosk,
+)
 from kiosk.speech.matching import Matcher, OptionWords
 
 
@@ -120,3 +128,28 @@ def test_pocketsphinx_never_turns_first_into_third(tmp_path):
     assert not matcher.match(with_third.text, with_third.confidence).matched
     assert with_third.confidence == 0.0
     assert matcher.match(with_two.text, with_two.confidence).option == 1
+
+
+def test_final_phrases_are_those_nothing_of_another_meaning_continues():
+    meaning = {"the second": 2, "the second one": 2, "help": 2, "help me up": 1, "one": 1,
+               "repeat": "repeat", "repeat that": "repeat"}.__getitem__
+    phrases = ["the second", "the second one", "help", "help me up", "one", "repeat", "repeat that"]
+    assert final_phrases(phrases, meaning) == {"the second", "the second one", "help me up", "one",
+                                               "repeat", "repeat that"}
+
+
+def test_pocketsphinx_says_when_a_whole_answer_was_heard(tmp_path):
+    """A whole answer ends after the short hangover, once the decoder has settled on a voice."""
+    path = tmp_path / "independent.wav"
+    subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", "160", "-w", str(path), "independent"], check=True)
+    recogniser = PocketSphinxRecogniser("en")
+    matcher = Matcher([OptionWords(w) for w in ("unable", "needs help", "independent")], "en")
+    recogniser.set_grammar(matcher.phrases(), matcher.meaning)
+    heard = []
+    pipeline = UtterancePipeline(recogniser, heard.append)
+    feed_wav(path, pipeline)
+    feed_wav(path, pipeline)
+    first, second = heard
+    assert not first.complete  # a fresh decoder: the long hangover
+    assert second.complete and second.result.text == "independent" and second.result.confidence > 0.9
+    assert second.endpoint - second.speech_end < first.endpoint - first.speech_end

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from kiosk.speech import audio
+from kiosk.speech.asr import Recognition
 from kiosk.speech.audio import (
     FRAME_SAMPLES,
     SAMPLE_RATE,
@@ -81,6 +82,34 @@ def test_endpointer_finds_one_utterance_with_hangover():
     start, end = events[0][1], events[1][1]
     assert 1.0 < start < 1.15  # 90 ms of speech needed to start
     assert end == pytest.approx(1.6 + 0.5, abs=0.04)  # speech end + 500 ms hangover
+
+
+def test_endpointer_ends_early_only_after_a_whole_answer():
+    """After a whole answer 240 ms of quiet end the utterance; mid-answer it waits 500 ms."""
+    signal = np.concatenate([_silence(1.0), _tone(0.6, -20), _silence(1.0)])
+    for complete, hangover in ((True, 0.24), (False, 0.5)):
+        ep = Endpointer()
+        ends = [(i + FRAME_SAMPLES) / SAMPLE_RATE
+                for i in range(0, len(signal) - FRAME_SAMPLES + 1, FRAME_SAMPLES)
+                if ep.push(signal[i:i + FRAME_SAMPLES], complete) == "end"]
+        assert ends == [pytest.approx(1.6 + hangover, abs=0.04)], complete
+
+
+def test_pipeline_ends_early_when_the_recogniser_has_a_whole_answer():
+    class WholeAnswer(_Recorder):
+        """Says its partial result is a whole answer once it has heard 0.4 s."""
+
+        def accept(self, pcm: bytes):
+            super().accept(pcm)
+            return Recognition("independent", 0.0, final=False,
+                               complete=len(self.heard) > 0.4 * 2 * SAMPLE_RATE)
+
+    got = []
+    pipe = UtterancePipeline(WholeAnswer(), got.append)
+    pipe.feed(np.concatenate([_silence(1.0), _tone(0.5, -20), _silence(1.0)]).tobytes())
+    (utt,) = got
+    assert utt.complete
+    assert utt.endpoint - utt.speech_end == pytest.approx(0.24, abs=0.04)
 
 
 def test_endpointer_ignores_a_click_and_quiet_hum():
