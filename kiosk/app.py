@@ -56,7 +56,7 @@ from kiosk.session import (
 from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar
-from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
+from kiosk.widgets.channel_board import VOICE_IN, VOICE_OUT, ChannelBoard
 from kiosk.widgets.text import ui_text
 
 #: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
@@ -200,7 +200,7 @@ class KioskApp(App[int]):
         """An input goes to the session; a status change to the channel bar."""
         if isinstance(message.item, ChannelStatus):
             self.board.update(message.item)
-            if self.board.indicator(message.item) == VOICE_IN:
+            if self.board.indicator(message.item) in (VOICE_IN, VOICE_OUT):
                 self._drive(self._tell_voice_available)
             self._render()
         else:
@@ -316,8 +316,10 @@ class KioskApp(App[int]):
         self.speaker.say(prompt.spoken, prompt.language)
 
     def _tell_voice_available(self) -> None:
-        """Tell the session whether voice in is on (it decides what that means for adaptation)."""
+        """Tell the session whether voice in and voice out are on (it decides what that means for
+        adaptation and for the practice questions)."""
         self.session.set_voice_available(self.board.state(VOICE_IN)[0] is ChannelState.ON)
+        self.session.set_voice_out_available(self.board.state(VOICE_OUT)[0] is ChannelState.ON)
 
     # -- drawing -------------------------------------------------------------------------------
 

@@ -35,10 +35,8 @@ class FamiliarisationScreen(PatientScreen):
         yield ControlBar(self.language)
 
     def progress_text(self, view: PatientView) -> str:
-        """"Practice 1 of 3"."""
-        practice = view.snapshot.practice
-        questions = view.questionnaire.familiarisation
-        if practice is None:
+        """"Practice 1 of 3" (of those asked on this kiosk, as the session counts them)."""
+        snap = view.snapshot
+        if snap.practice_number is None:
             return super().progress_text(view)
-        return ui_text(self.language, "practice_of", number=questions.index(practice) + 1,
-                       total=len(questions))
+        return ui_text(self.language, "practice_of", number=snap.practice_number, total=snap.practice_count)
