@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Hashable
 
 from textual.app import ComposeResult
+from textual.widgets import Static
 
 from kiosk.screens.base import PatientScreen, PatientView
 from kiosk.widgets.bars import ControlBar
@@ -13,7 +14,12 @@ from kiosk.widgets.text import ui_text
 
 
 class QuestionScreen(PatientScreen):
-    """One scored item. Touching an answer posts ``AnswerButton.Chosen``; the app forwards it."""
+    """One scored item. Touching an answer posts ``AnswerButton.Chosen``; the app forwards it.
+
+    Between questions the last item stays on screen (with its answer marked) under a calm line
+    such as "Thank you. Next question…", as the session's :attr:`Snapshot.interlude` says, so the
+    patient never faces an empty screen while the next question comes.
+    """
 
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``'s item."""
@@ -27,8 +33,9 @@ class QuestionScreen(PatientScreen):
         return view.snapshot.language
 
     def compose(self) -> ComposeResult:
-        """Bars, the question with its answers, and the controls."""
+        """Bars, the between-questions line, the question with its answers, and the controls."""
         yield from self.compose_bars()
+        yield Static("", id="interlude", classes="interlude")
         if (panel := self._panel(self.view)) is not None:
             yield panel
         yield ControlBar(self.language)
@@ -44,8 +51,14 @@ class QuestionScreen(PatientScreen):
                              chosen=answer.option if answer else None)
 
     def show(self, view: PatientView) -> None:
-        """Refresh the bars; swap in the next item's panel, or mark the recorded answer."""
+        """Refresh the bars and the between-questions line; swap in the next item's panel, or mark
+        the recorded answer."""
         super().show(view)
+        key = view.snapshot.interlude
+        for line in self.query("#interlude").results(Static):
+            line.update(view.questionnaire.message(key, self.language) or ui_text(self.language, key)
+                        if key else "")
+            line.display = bool(key)
         if not self.is_mounted:  # compose has not run yet: it will draw this view
             return
         item = view.snapshot.item
