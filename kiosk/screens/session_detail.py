@@ -13,7 +13,10 @@ from textual.widgets import Button, DataTable, Label, Static
 from kiosk.export import ExportError, csv_text, fhir_response, rescore, write_json, write_private
 from kiosk.screens.base import ClinicianScreen
 from kiosk.storage import StoredSession
-from kiosk.widgets.metrics_plot import MetricsPlot, plot_data, save_png
+from kiosk.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png
+
+#: what each kind of practice question checks, as the clinician reads it
+PRACTICE_CHECKS = {"hear": "hearing", "read": "reading", "select": "choosing"}
 
 
 class SessionDetailScreen(ClinicianScreen):
@@ -32,6 +35,8 @@ class SessionDetailScreen(ClinicianScreen):
                          f"answered by {s.answered_by.value}", classes="heading")
             yield DataTable(id="answers-table", zebra_stripes=True, cursor_type="row")
             yield Label(self._total_line(), id="total")
+            yield Label(self._practice_line(), id="practice")
+            yield Static(metrics_key(), id="metrics-key")
             yield MetricsPlot(plot_data(s), id="metrics-plot")
             yield Label("", id="export-result")
         with Horizontal(id="detail-actions"):
@@ -66,13 +71,38 @@ class SessionDetailScreen(ClinicianScreen):
         done = "complete" if score.complete else f"incomplete: {len(score.missing)} of {len(q.items)} missing"
         return f"Total {score.total} of {score.max_total} ({done}); {band}"
 
+    def _practice_line(self) -> str:
+        """How the familiarisation went: "Practice: hearing skipped (no voice out) / reading ✓"."""
+        if not self.stored.practice:
+            return "Practice: none (no practice questions in this session)"
+        q = self.app.questionnaire  # type: ignore[attr-defined]
+        questions = {p.id: p for p in q.familiarisation}
+        parts = []
+        for record in self.stored.practice:
+            what = PRACTICE_CHECKS.get(record.checks, record.checks)
+            if record.outcome == "right":
+                parts.append(f"{what} ✓")
+            elif record.outcome == "wrong":
+                question = questions.get(record.question_id)
+                chosen = (question.option(record.option).label_in(self.stored.language)
+                          if question is not None and record.option is not None
+                          and 1 <= record.option <= len(question.options) else f"option {record.option}")
+                parts.append(f"{what} ✗ (chose {chosen})")
+            elif record.outcome == "not_answered":
+                parts.append(f"{what} ✗ (no answer)")
+            else:
+                parts.append(f"{what} skipped ({record.detail})" if record.detail else f"{what} skipped")
+        return "Practice: " + " / ".join(parts)
+
     def _export_path(self, suffix: str) -> Path:
         folder: Path = self.app.export_dir  # type: ignore[attr-defined]
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         return folder / f"session-{self.stored.id}{suffix}"
 
     def _done(self, text: str) -> None:
-        self.query_one("#export-result", Label).update(text)
+        result = self.query_one("#export-result", Label)
+        result.update(text)
+        result.display = True  # hidden until there is something to say: the plot needs the row
 
     @on(Button.Pressed, "#export-fhir")
     def _fhir(self) -> None:

@@ -3,13 +3,18 @@ with incidents (pause, call doctor, patient away...) and adaptations marked.
 
 Drawn in the terminal with textual-plotext, and saved as a PNG with matplotlib for the record.
 Both draw the same :func:`plot_data`, so the terminal and the PNG never tell different stories.
+Neither puts its legend over the data: the first seconds of a session matter as much as the rest,
+so the terminal shows a coloured key line (:func:`metrics_key`) above the plot and the PNG puts
+its legend below the axes.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from rich.text import Text
 from textual_plotext import PlotextPlot
 
 from kiosk.storage import StoredSession
@@ -17,6 +22,10 @@ from kiosk.storage import StoredSession
 #: the metrics of the CLARC model, in the order they are drawn, with one colour each
 METRICS = ("Performance", "Interaction", "VoiceInteractionQuality")
 _COLOURS = {"Performance": "blue", "Interaction": "green", "VoiceInteractionQuality": "magenta"}
+#: the colours of the marks: (terminal, matplotlib)
+_MARK_COLOURS = {"incident": ("gray", "0.5"), "adaptation": ("red", "tab:red")}
+#: Rich's name for the ANSI colour plotext calls "gray" (the others share their names)
+_RICH_NAMES = {"gray": "bright_black"}
 #: log entries worth a mark on the plot (the rest -- ignored inputs, time-outs -- would crowd it)
 INCIDENTS = ("pause", "resume", "call_doctor", "clinician_continue", "person_lost", "person_back", "repeat")
 
@@ -51,8 +60,25 @@ def plot_data(stored: StoredSession) -> PlotData:
     return PlotData(series, tuple(sorted(marks, key=lambda m: m.t)))
 
 
+def metrics_key() -> Text:
+    """The terminal plot's key, one line in the plot's colours (it replaces plotext's legend,
+    which is drawn inside the plot and hides the first seconds of the curves)."""
+    key = Text("QoS: ", style="bold")
+    for name in METRICS:
+        key.append("━ ", style=f"bold {_RICH_NAMES.get(_COLOURS[name], _COLOURS[name])}")
+        key.append(f"{name}  ")
+    for kind, (colour, _) in _MARK_COLOURS.items():
+        key.append("│ ", style=f"bold {_RICH_NAMES.get(colour, colour)}")
+        key.append(f"{kind}s  ")
+    key.rstrip()
+    return key
+
+
 class MetricsPlot(PlotextPlot):
-    """The three metrics in the terminal; incidents as grey lines, adaptations as red lines."""
+    """The three metrics in the terminal; incidents as grey lines, adaptations as red lines.
+
+    It has no legend of its own: show :func:`metrics_key` beside it.
+    """
 
     def __init__(self, data: PlotData, *, id: str | None = None) -> None:
         """Draw ``data`` (from :func:`plot_data`)."""
@@ -62,41 +88,56 @@ class MetricsPlot(PlotextPlot):
     def on_mount(self) -> None:
         """Draw once: a stored session does not change while it is shown."""
         plt = self.plt
-        plt.title("QoS metrics (grey: incidents, red: adaptations)")
         plt.xlabel("session time (s)")
         plt.ylim(0, 1)
         for name, (times, values) in self.data.series.items():
-            if times:
-                plt.plot(times, values, label=name, color=_COLOURS[name], marker="braille")
+            if times:  # no label: plotext would draw its legend box over the first seconds
+                plt.plot(times, values, color=_COLOURS[name], marker="braille")
         for mark in self.data.marks:
-            plt.vline(mark.t, "gray" if mark.kind == "incident" else "red")
+            plt.vline(mark.t, _MARK_COLOURS[mark.kind][0])
+
+
+def metrics_figure(data: PlotData, title: str) -> Any:
+    """The plot as a matplotlib Figure (the caller closes it): the metrics as steps, the marks as
+    dashed lines, and the legend below the axes, where it cannot cover a curve."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # no display on a kiosk's service shell
+    from matplotlib import pyplot
+    from matplotlib.lines import Line2D
+
+    figure, axes = pyplot.subplots(figsize=(10, 5), dpi=100)
+    for name, (times, values) in data.series.items():
+        if times:
+            axes.step(times, values, where="post", label=name, color=_COLOURS[name], linewidth=2)
+    for index, mark in enumerate(data.marks):
+        colour = _MARK_COLOURS[mark.kind][1]
+        axes.axvline(mark.t, color=colour, linestyle="--", linewidth=1)
+        axes.annotate(mark.label, (mark.t, 1.0 - 0.06 * (index % 4)), rotation=0, fontsize=8,
+                      color=colour, xytext=(3, -10), textcoords="offset points")
+    axes.set_ylim(0, 1.05)
+    axes.set_xlabel("session time (s)")
+    axes.set_ylabel("metric")
+    axes.set_title(title)
+    handles, _ = axes.get_legend_handles_labels()
+    kinds = {m.kind for m in data.marks}
+    handles += [Line2D([], [], color=_MARK_COLOURS[k][1], linestyle="--", linewidth=1, label=f"{k}s")
+                for k in _MARK_COLOURS if k in kinds]
+    if handles:
+        axes.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=len(handles),
+                    frameon=False)
+    axes.grid(alpha=0.3)
+    return figure
 
 
 def save_png(data: PlotData, path: str | Path, title: str) -> Path:
     """Write the plot as a PNG (owner-only, it belongs to a patient's record); returns the path."""
     import os
 
-    import matplotlib
-
-    matplotlib.use("Agg")  # no display on a kiosk's service shell
     from matplotlib import pyplot
 
-    figure, axes = pyplot.subplots(figsize=(10, 5), dpi=100)
+    figure = metrics_figure(data, title)
     try:
-        for name, (times, values) in data.series.items():
-            if times:
-                axes.step(times, values, where="post", label=name, color=_COLOURS[name], linewidth=2)
-        for index, mark in enumerate(data.marks):
-            colour = "0.5" if mark.kind == "incident" else "tab:red"
-            axes.axvline(mark.t, color=colour, linestyle="--", linewidth=1)
-            axes.annotate(mark.label, (mark.t, 1.0 - 0.06 * (index % 4)), rotation=0, fontsize=8,
-                          color=colour, xytext=(3, -10), textcoords="offset points")
-        axes.set_ylim(0, 1.05)
-        axes.set_xlabel("session time (s)")
-        axes.set_ylabel("metric")
-        axes.set_title(title)
-        axes.legend(loc="best")
-        axes.grid(alpha=0.3)
         path = Path(path)
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         with os.fdopen(fd, "wb") as handle:

@@ -141,7 +141,7 @@ def test_clinician_home(snap_compare, ui_kiosk):
 
 
 def test_session_detail(snap_compare, ui_kiosk):
-    kiosk = ui_kiosk(familiarisation=False)
+    kiosk = ui_kiosk()  # with the practice questions: their outcomes are on the detail screen
 
     async def run_before(pilot) -> None:
         await _finish(kiosk, pilot)
