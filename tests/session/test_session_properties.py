@@ -25,6 +25,9 @@ actions = st.one_of(
                                                  "prompt_delivered", "acknowledge", "skip_familiarisation",
                                                  "start", "request_voice"])),
     st.tuples(st.just("language"), st.sampled_from(["en", "es", "fr", "de"])),
+    # a speaker or microphone that comes and goes (the app's channel statuses)
+    st.tuples(st.just("voice_out"), st.booleans()),
+    st.tuples(st.just("voice_in"), st.booleans()),
 )
 
 
@@ -38,8 +41,20 @@ def step(rig, action) -> None:
         rig.session.handle(ChannelInput(arg[0], command=arg[1]))
     elif kind == "call":
         getattr(rig.session, arg)()
+    elif kind == "voice_out":
+        rig.session.set_voice_out_available(arg)
+        rig.voice_out = arg
+    elif kind == "voice_in":
+        rig.session.set_voice_available(arg)
     else:
         rig.session.choose_language(arg)
+    snap = rig.session.snapshot()
+    # a gap's line only between questions; "Practice k of n" always makes sense
+    assert snap.interlude is None or (snap.phase is Phase.QUESTIONS and snap.attempt is None)
+    assert (snap.practice_number is None) == (snap.practice is None)
+    assert snap.practice_number is None or 1 <= snap.practice_number <= snap.practice_count
+    if not getattr(rig, "voice_out", True):  # nothing to hear: no hearing check on screen
+        assert snap.practice is None or snap.practice.checks != "hear"
 
 
 @settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
