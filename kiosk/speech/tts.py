@@ -16,14 +16,37 @@ So :class:`Synthesiser` runs the ``espeak-ng`` program once per phrase -- the sa
 voices, with voice, rate and volume passed per call, writing a WAV. Each phrase
 is then played through PortAudio (sounddevice) by a :class:`Player`, which knows when playback
 ends and can be stopped.
+
+Slower speech is pauses, not slower words. Speech around 150-200 words per minute was rated
+most comfortable by older listeners, and slowing synthetic speech further made its words harder
+to identify; full sentences are better than isolated words. So :func:`delivery` maps a
+requested rate (the app asks for ``DEFAULT_RATE`` times the session's ``speech_rate``: 0.85 while
+the ``slow_speech`` adaptation is on, 136 wpm) to:
+
+- words spoken at ``max(MIN_RATE, rate)``, never below 150 wpm;
+- the time the requested rate would have added, ``words * (60/rate - 60/MIN_RATE)`` seconds,
+  placed as longer breaks where the sentence already pauses: after each sentence end (two
+  shares) and comma (one share), on top of :data:`SENTENCE_BREAK_MS` / :data:`COMMA_BREAK_MS`
+  (SSML ``<break>``, which replaces espeak-ng's own pause there). "Let me ask again. How do
+  you manage eating your meals?" keeps its words whole and gains time between its sentences.
+
+Not used: a gap between every word (espeak-ng's ``-g``, or a ``<break>`` after each word).
+Measured here, espeak-ng then lengthens each word as if it ended a phrase: the words' own pace
+(words per voiced second) fell from 211 to 176-192 wpm-equivalent, as slow as asking for
+136 wpm outright -- isolated words, which the reference advises against. A prompt with no
+sentence end or comma inside is therefore only slowed to 150 wpm.
+
+A rate of 150 wpm or more is spoken as asked, with espeak-ng's own pauses.
 """
 
 from __future__ import annotations
 
 import contextlib
+import html
 import logging
 import os
 import queue
+import re
 import shutil
 import subprocess
 import tempfile
@@ -44,6 +67,11 @@ log = logging.getLogger(__name__)
 VOICES = {"en": "gmw/en-us", "es": "roa/es", "fr": "roa/fr"}
 #: words per minute: older listeners rate 150-200 wpm most comfortable, slower is harder
 DEFAULT_RATE = 160
+#: words per minute never spoken slower than this: slower is made of pauses (see the docstring)
+MIN_RATE = 150
+#: a slowed prompt's break after a sentence end and after a comma before its share of the
+#: added time (ms): about espeak-ng's own pauses there at 150 wpm, which a <break> replaces
+SENTENCE_BREAK_MS, COMMA_BREAK_MS = 400, 150
 #: volume as espeak-ng's amplitude / 100 (0-200 %): the patient steps it with louder/quieter
 DEFAULT_VOLUME, VOLUME_STEP, MIN_VOLUME, MAX_VOLUME = 1.0, 0.25, 0.25, 2.0
 #: how long one phrase may take to synthesise before voice out is declared broken
@@ -52,6 +80,45 @@ SYNTH_TIMEOUT_S = 30.0
 
 class TtsUnavailable(RuntimeError):
     """Voice out cannot work here; the message is one sentence for the UI."""
+
+
+#: a sentence end or a comma followed by more words: where a slowed prompt pauses longer
+_BOUNDARY = re.compile(r"([.?!;:,])(\s+)(?=\S)")
+
+
+@dataclass(frozen=True)
+class Delivery:
+    """How espeak-ng says one phrase for a requested rate (see the module docstring)."""
+
+    #: espeak-ng's -s: the words' own pace
+    words_per_minute: int
+    #: break after a sentence end and after a comma inside the phrase (ms); 0: espeak-ng's own
+    sentence_break_ms: int = 0
+    comma_break_ms: int = 0
+
+    def markup(self, text: str) -> str:
+        """``text`` as SSML with the breaks (escaped, so "<" or "&" are read as text)."""
+        out, done = [], 0
+        for m in _BOUNDARY.finditer(text):
+            ms = self.comma_break_ms if m.group(1) == "," else self.sentence_break_ms
+            out += [html.escape(text[done:m.end(1)], quote=False),
+                    f'<break time="{ms}ms"/>' if ms else "", m.group(2)]
+            done = m.end()
+        return f"<speak>{''.join(out)}{html.escape(text[done:], quote=False)}</speak>"
+
+
+def delivery(rate: int, text: str) -> Delivery:
+    """The :class:`Delivery` of ``text`` for a requested rate in words per minute: as asked from
+    MIN_RATE up; below it words at MIN_RATE and the time the slower rate would take as pauses."""
+    if rate >= MIN_RATE:
+        return Delivery(rate)
+    added_ms = 1000 * len(text.split()) * (60 / max(rate, 1) - 60 / MIN_RATE)
+    marks = [m.group(1) for m in _BOUNDARY.finditer(text)]
+    shares = sum(1 if mark == "," else 2 for mark in marks)
+    if not shares:
+        return Delivery(MIN_RATE)
+    share = added_ms / shares
+    return Delivery(MIN_RATE, round(SENTENCE_BREAK_MS + 2 * share), round(COMMA_BREAK_MS + share))
 
 
 class Synthesiser:
@@ -69,13 +136,15 @@ class Synthesiser:
 
     def synthesise(self, text: str, language: str, path: str | Path,
                    rate: int = DEFAULT_RATE, volume: float = DEFAULT_VOLUME) -> Path:
-        """Speak ``text`` in ``language`` into the WAV file ``path``."""
+        """Speak ``text`` in ``language`` into the WAV file ``path`` at the requested ``rate``
+        (words per minute, see :func:`delivery`)."""
         if language not in self.languages:
             raise TtsUnavailable(f"espeak-ng has no voice for language {language!r}")
         amplitude = str(int(round(volume * 100)))  # espeak-ng's 0-200 % amplitude
+        how = delivery(rate, text)
         subprocess.run(
-            [self._command, "-v", VOICES[language], "-s", str(rate), "-a", amplitude,
-             "-w", str(path), "--", text],
+            [self._command, "-v", VOICES[language], "-s", str(how.words_per_minute), "-a", amplitude,
+             "-m", "-w", str(path), "--", how.markup(text)],
             check=True, capture_output=True, timeout=SYNTH_TIMEOUT_S,
         )
         if not _has_audio(path):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 import threading
 import wave
 
@@ -11,7 +12,7 @@ import pytest
 from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.questionnaire import load_questionnaire
 from kiosk.speech.audio import frame_level_db
-from kiosk.speech.tts import DEFAULT_RATE, Speaker, Synthesiser, TtsUnavailable
+from kiosk.speech.tts import DEFAULT_RATE, MIN_RATE, Delivery, Speaker, Synthesiser, TtsUnavailable, delivery
 
 QUESTIONNAIRE = load_questionnaire()
 
@@ -88,6 +89,53 @@ def test_rate_and_volume_change_the_speech(tmp_path):
     speaker.close()
     assert frame_level_db(quiet) < frame_level_db(normal) - 3
     assert len(fast) < 0.8 * len(normal)
+
+
+def _voiced_words_per_minute(samples: np.ndarray, rate: int, words: int) -> float:
+    """Words per minute of voiced audio (20 ms frames above -40 dBFS): the words' own pace."""
+    frame = rate // 50
+    voiced = sum(frame_level_db(samples[i:i + frame]) > -40 for i in range(0, len(samples) - frame, frame))
+    return words * 60 / (voiced * 0.02)
+
+
+def test_slower_speech_is_pauses_not_slower_words(tmp_path):
+    """slow_speech asks for 0.85 x 160 = 136 wpm: the prompt takes longer, its words do not."""
+    text = f"{QUESTIONNAIRE.message('repeat', 'en')} {QUESTIONNAIRE.items[0].spoken['en']}"
+    words = len(text.split())
+    speaker = Speaker()
+    speaker.start()
+    normal = _wav(speaker.save_to_file(text, "en", tmp_path / "normal.wav"))
+    speaker.rate = round(DEFAULT_RATE * 0.85)
+    slow = _wav(speaker.save_to_file(text, "en", tmp_path / "slow.wav"))
+    speaker.close()
+    # espeak-ng asked for 136 wpm outright: what the kiosk no longer does
+    plain = _wav(_espeak(text, 136, tmp_path / "136.wav"))
+    assert len(slow[0]) / slow[1] > len(normal[0]) / normal[1] + 0.4  # longer, by pauses
+    slow_pace = _voiced_words_per_minute(*slow, words)
+    assert slow_pace >= MIN_RATE
+    assert slow_pace > _voiced_words_per_minute(*plain, words) + 10  # words kept at their pace
+
+
+def _espeak(text: str, rate: int, path):
+    """espeak-ng's own slowing: the words themselves at ``rate``."""
+    subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", str(rate), "-w", str(path), "--", text], check=True)
+    return path
+
+
+def test_delivery_maps_slow_rates_to_pauses():
+    assert delivery(DEFAULT_RATE, "Hello. How are you?") == Delivery(DEFAULT_RATE)
+    assert delivery(MIN_RATE, "Hello. How are you?") == Delivery(MIN_RATE)
+    # no sentence end or comma inside: only the words' pace can slow, and not below 150 wpm
+    assert delivery(100, "How do you manage eating your meals?") == Delivery(MIN_RATE)
+    # 7 words at 136 instead of 150 wpm: 288 ms more, 2 shares after "again." and 1 after ","
+    slow = delivery(136, "Let me ask again. Eating, with help?")
+    assert slow.words_per_minute == MIN_RATE
+    assert slow.sentence_break_ms - 400 == pytest.approx(2 * (slow.comma_break_ms - 150), abs=1)
+    assert (slow.sentence_break_ms - 400) + (slow.comma_break_ms - 150) == pytest.approx(
+        1000 * 7 * (60 / 136 - 60 / 150), abs=2)
+    assert slow.markup("Fish & chips, <now>. Yes") == (
+        '<speak>Fish &amp; chips,<break time="%dms"/> &lt;now&gt;.<break time="%dms"/> Yes</speak>'
+        % (slow.comma_break_ms, slow.sentence_break_ms))
 
 
 def test_volume_steps_stay_in_range():
