@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Hashable
 
 from textual.app import ComposeResult
+from textual.widget import Widget
 from textual.widgets import Static
 
 from kiosk.screens.base import PatientScreen, PatientView
@@ -16,9 +17,9 @@ from kiosk.widgets.text import ui_text
 class QuestionScreen(PatientScreen):
     """One scored item. Touching an answer posts ``AnswerButton.Chosen``; the app forwards it.
 
-    Between questions the last item stays on screen (with its answer marked) under a calm line
-    such as "Thank you. Next question…", as the session's :attr:`Snapshot.interlude` says, so the
-    patient never faces an empty screen while the next question comes.
+    Between questions the last item (before the first, the explanation) stays on screen, its answer
+    marked, under a calm line such as "Thank you. Next question…", as the session's
+    :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile.
     """
 
     def __init__(self, view: PatientView) -> None:
@@ -40,12 +41,14 @@ class QuestionScreen(PatientScreen):
             yield panel
         yield ControlBar(self.language)
 
-    def _panel(self, view: PatientView) -> QuestionPanel | None:
-        """The question and answers of the view's item (None between the explanation and item 1)."""
+    def _panel(self, view: PatientView) -> Widget | None:
+        """The question and answers of the view's item; between the explanation and item 1 the
+        explanation the patient just read stays (None if the questionnaire has none)."""
         item = view.snapshot.item
         self._item_id = item.id if item else None
         if item is None:
-            return None
+            explanation = view.questionnaire.message("explanation", self.language)
+            return Static(explanation, classes="notice", id="recap") if explanation else None
         answer = view.snapshot.answers.get(item.id)
         return QuestionPanel(item.text[self.language], [o.label_in(self.language) for o in item.options],
                              chosen=answer.option if answer else None)
@@ -63,7 +66,7 @@ class QuestionScreen(PatientScreen):
             return
         item = view.snapshot.item
         if (item.id if item else None) != self._item_id:
-            for old in self.query(QuestionPanel):
+            for old in self.query("QuestionPanel, #recap"):
                 old.remove()
             if (panel := self._panel(view)) is not None:
                 self.mount(panel, before=self.query_one(ControlBar))

@@ -79,10 +79,12 @@ async def test_every_gap_between_questions_shows_a_calm_line_over_the_last_conte
         # between Start and question 1: not an empty screen
         assert _interlude(kiosk) == "Thank you. Here is the first question…"
         assert not kiosk.app.screen.query(QuestionPanel)
+        assert _text(kiosk.app.screen.query_one("#recap", Static)).startswith("I will ask you ten questions")
 
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         await settle(pilot, lambda: _interlude(kiosk) is None)
+        assert not kiosk.app.screen.query("#recap")
         await pilot.press("2")
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         # after an answer: the question stays with its answer marked, under "next question"

@@ -48,6 +48,16 @@ def test_explanation(snap_compare, ui_kiosk):
     assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
 
 
+def test_before_the_first_question(snap_compare, ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await start_in_english(kiosk, pilot)  # Start pressed; question 1 comes between_questions_s later
+        await settle(pilot, lambda: kiosk.app.screen.query("#interlude") and kiosk.app.screen.query_one("#interlude").display)
+
+    assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
 def test_question(snap_compare, ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
 
