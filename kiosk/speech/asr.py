@@ -8,21 +8,32 @@ in [0, 1]:
   ``KIOSK_VOSK_MODEL``), grammar as a JSON phrase list with "[unk]"; confidence is the lowest
   word confidence Vosk reports.
 - :class:`PocketSphinxRecogniser`: the English model in the pocketsphinx wheel, grammar as JSGF.
-  A grammar decoder always returns *some* phrase, so its confidence is the lowest of four
-  checks: a whole phrase was reached (else 0); the recognised words cover the utterance's voiced
-  audio (a sentence forced onto the grammar goes mostly into "silence": 5-45 % covered, an
-  answer 80-100 %); and the acoustic cost per voiced frame is low. PocketSphinx scores every
-  frame against the best-matching sound in that frame, so the path's cost measures how far the
-  grammar had to bend the audio: 3.9-6.5 for answers, 6.6-7.9 for other short words on
-  espeak-ng audio here. :data:`PS_COST_MIDPOINT` and :data:`PS_COST_SPREAD` map it to [0, 1].
-  Some words the model cannot tell apart at all (:data:`PS_CONFUSABLE_WORDS`): espeak-ng's
-  "the first one" was heard as "the third one" on every question that has a third option, and
-  decoded against each phrase alone, "the third one" even fits it better, so no score margin
-  can separate them. Such a phrase gets confidence 0 wherever its partner selects another
-  answer (:func:`kiosk.speech.grammar.confusable_phrases`): the patient is asked again, and
-  says "one" or "number one", instead of the kiosk inventing option 3. (espeak-ng's "number
-  one" is rejected for a safe reason: the model's silence fits its "number" better than the
-  word does, so "one" covers a third of the voiced audio.)
+  A grammar decoder always returns *some* phrase, so its confidence is the lowest of these
+  checks, each simple enough to explain to a clinician:
+
+  1. a whole phrase was reached (else 0);
+  2. coverage: the recognised words cover the utterance's voiced audio (a sentence forced
+     onto the grammar goes mostly into "silence": 5-45 % covered, an answer 80-100 %);
+  3. fit: the acoustic cost per voiced frame is low. PocketSphinx scores every frame against
+     the best-matching sound in that frame, so the path's cost measures how far the grammar
+     had to bend the audio: 3.9-6.5 for answers, 6.6-7.9 for other short words on espeak-ng
+     audio here. :data:`PS_COST_MIDPOINT` and :data:`PS_COST_SPREAD` map it to [0, 1]. The
+     utterance is scored with a fixed quiet tail (:func:`_fixed_tail`), so one the endpointer
+     closed early is scored like one closed late;
+  4. no confusable word (:data:`PS_CONFUSABLE_WORDS`): espeak-ng's "the first one" was heard
+     as "the third one" on every question with a third option, and decoded against each phrase
+     alone "the third one" even fits it better, so no score margin separates them. Such a
+     phrase is 0 wherever its partner selects another answer
+     (:func:`kiosk.speech.grammar.confusable_phrases`): the patient is asked again and can say
+     "one", instead of the kiosk inventing option 3.
+
+  Not used: a margin over the best phrase of another meaning (the utterance decoded again
+  under a grammar without the recognised phrase's meaning). Measured here it rejected right
+  answers and commands ("call the doctor", a first "independent") because the smaller
+  grammar's search found rivals such as "go on" that the full search had pruned, even from
+  the same cepstral mean; on the benchmark it traded 9 right answers for 2 wrong ones.
+  espeak-ng's "number one" is rejected for a safe reason: the model's silence fits its
+  "number" better than the word does, so the decoded "one" covers a third of the voiced audio.
 
 :func:`open_recogniser` picks Vosk when a model for the language is installed, else
 PocketSphinx for English, else raises :class:`AsrUnavailable` with the reason voice in is off.
