@@ -119,6 +119,15 @@ def test_every_grammar_phrase_matches_something_or_is_ambiguous_by_design(langua
         assert matcher.match(phrase).matched, phrase
 
 
+def test_meaning_groups_phrases_by_what_they_select():
+    """What the recognisers group grammar phrases by (confusable words, whole answers)."""
+    matcher = Matcher(TRANSFERS_EN, "en")
+    assert [matcher.meaning(p) for p in ("the first one", "one", "unable", "the third one", "minor help")] == \
+        [1, 1, 1, 3, 3]
+    assert matcher.meaning("call the nurse") == matcher.meaning("doctor") == Command.CALL_DOCTOR
+    assert matcher.meaning("help") == "help"  # fits two options: it means only itself
+
+
 def test_normalise_and_spoken_label():
     assert normalise("¿Número DOS?") == "numero dos"
     assert normalise("l'option") == "l option"
