@@ -7,7 +7,8 @@ are not answers; each WAV goes through the real audio pipeline (endpointer → r
 matcher). Prints one JSON document:
 
 - ``accuracy``: answers matched to the right option/command; ``wrong``: matched to another
-  one (the dangerous error); ``rejected``: heard but not taken (the patient is asked again);
+  one (the dangerous error), of which ``invented_answers`` were taken as another *option* (the
+  rest as a command); ``rejected``: heard but not taken (the patient is asked again);
 - ``false_accepts``: non-answers taken as an answer or command;
 - ``rtf``: recogniser processing time / audio duration (goal < 0.2);
 - ``finish_ms``: endpoint decision → result; ``speech_end_to_answer_ms``: end of speech →
@@ -110,7 +111,7 @@ def run(backend_name: str, make, language: str, items, folder: Path, settings: E
     timed = _Timed(recogniser)
     results: list = []
     pipeline = UtterancePipeline(timed, results.append, settings)
-    right = wrong = rejected = false_accepts = n_not = 0
+    right = wrong = invented = rejected = false_accepts = n_not = 0
     audio_seconds = 0.0
     finish = []
     #: end of speech → result (s), for utterances closed early (complete) and late
@@ -147,6 +148,7 @@ def run(backend_name: str, make, language: str, items, folder: Path, settings: E
                 missed.append(text)
             else:
                 wrong += 1
+                invented += isinstance(got, int)
                 mistakes.append((item.id, text, str(got)))
     answers = right + wrong + rejected
     finish_ms = sorted(1000 * f for f in finish)
@@ -156,6 +158,7 @@ def run(backend_name: str, make, language: str, items, folder: Path, settings: E
         "answers": answers,
         "accuracy": round(right / answers, 3),
         "wrong": round(wrong / answers, 3),
+        "invented_answers": round(invented / answers, 3),
         "rejected": round(rejected / answers, 3),
         "not_answers": n_not,
         "false_accepts": round(false_accepts / n_not, 3),
