@@ -32,17 +32,22 @@ def test_without_voice_out_the_hearing_check_is_skipped_logged_and_stored(tmp_pa
     rig.session.start()
     snap = rig.session.snapshot()
     assert snap.phase is Phase.FAMILIARISATION
-    assert snap.practice.id == "practice_read" and (snap.practice_number, snap.practice_count) == (1, 1)
+    assert snap.practice.id == "practice_read" and (snap.practice_number, snap.practice_count) == (1, 2)
     assert [(e.question_id, e.checks, e.reason) for e in rig.of(PracticeSkipped)] == [
         ("practice_hear", "hear", "no voice out")]
     assert "practice_hear" not in {p.key for p in rig.of(Prompt)}  # never shown nor spoken
     assert [e.item_id for e in rig.of(AttemptOpened)] == ["practice_read"]
     rig.at(7)
     rig.answer(1, Channel.TOUCH)
+    snap = rig.session.snapshot()
+    assert snap.practice.id == "practice_select" and (snap.practice_number, snap.practice_count) == (2, 2)
+    rig.at(9)
+    rig.answer(3, Channel.REMOTE)  # "choose answer number 3"
     assert rig.session.phase is Phase.EXPLANATION
     assert _practice(store, rig.session.id) == [
         ("practice_hear", "hear", "skipped", None, None, "no voice out"),
         ("practice_read", "read", "right", 1, Channel.TOUCH, ""),
+        ("practice_select", "select", "right", 3, Channel.REMOTE, ""),
     ]
     log = [(e.kind, e.detail) for e in store.session(rig.session.id).log]
     assert ("practice_skipped", "practice_hear: no voice out") in log
@@ -55,17 +60,21 @@ def test_with_voice_out_every_practice_outcome_is_stored(tmp_path):
     rig.at(5)
     rig.session.start()
     snap = rig.session.snapshot()
-    assert snap.practice.id == "practice_hear" and (snap.practice_number, snap.practice_count) == (1, 2)
+    assert snap.practice.id == "practice_hear" and (snap.practice_number, snap.practice_count) == (1, 3)
     rig.at(6)
     rig.answer(1, Channel.VOICE)  # "chair": the patient did not hear "apple"
-    assert (rig.session.snapshot().practice_number, rig.session.snapshot().practice_count) == (2, 2)
+    assert (rig.session.snapshot().practice_number, rig.session.snapshot().practice_count) == (2, 3)
     rig.run_until(6 + 2 * TIMING["attempt_window_s"])  # the reading check gets no answer at all
+    assert (rig.session.snapshot().practice.id, rig.session.snapshot().practice_number) == ("practice_select", 3)
+    rig.at(rig.session.now() + 3)
+    rig.answer(2, Channel.TOUCH)  # touched "green", not answer number 3
     assert rig.session.phase is Phase.EXPLANATION
     assert [(p.question_id, p.option, p.correct) for p in rig.of(PracticeAnswered)] == [
-        ("practice_hear", 1, False), ("practice_read", None, False)]
+        ("practice_hear", 1, False), ("practice_read", None, False), ("practice_select", 2, False)]
     assert _practice(store, rig.session.id) == [
         ("practice_hear", "hear", "wrong", 1, Channel.VOICE, ""),
         ("practice_read", "read", "not_answered", None, None, ""),
+        ("practice_select", "select", "wrong", 2, Channel.TOUCH, ""),
     ]
     assert not rig.of(PracticeSkipped)
 
@@ -80,11 +89,12 @@ def test_voice_out_lost_during_the_hearing_check_skips_it_and_its_return_does_no
     rig.session.set_voice_out_available(False)  # espeak-ng failed while saying the word
     snap = rig.session.snapshot()
     assert snap.practice.id == "practice_read" and snap.attempt == 1
-    assert (snap.practice_number, snap.practice_count) == (2, 2)  # the hearing check was shown
+    assert (snap.practice_number, snap.practice_count) == (2, 3)  # the hearing check was shown
     assert rig.session.remaining() == TIMING["attempt_window_s"]
     rig.session.set_voice_out_available(True)
     assert rig.session.snapshot().practice.id == "practice_read"
     rig.answer(1)
+    assert rig.session.snapshot().practice.id == "practice_select"
     assert [p[2] for p in _practice(store, rig.session.id)] == ["skipped", "right"]
     log = [(e.kind, e.detail) for e in store.session(rig.session.id).log]
     assert [d for k, d in log if k == "voice_out"] == ["unavailable", "available"]

@@ -34,7 +34,22 @@ def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
     assert Q.item("transfers").points == {0, 5, 10, 15}
     assert [b.id for b in Q.bands] == ["total", "severe", "moderate", "slight", "independent"]
     assert Q.timing == Timing(20, 2, 10, 5, 5)
-    assert len(Q.familiarisation) >= 2 and {p.checks for p in Q.familiarisation} >= {"hear", "read"}
+    assert [p.checks for p in Q.familiarisation] == ["hear", "read", "select"]
+
+
+def test_the_selecting_check_asks_for_answer_number_3_on_screen_and_aloud():
+    select = next(p for p in Q.familiarisation if p.checks == "select")
+    assert select.expected == 3 and len(select.options) == 3
+    for lang, three in (("en", "three"), ("es", "tres"), ("fr", "trois")):
+        assert "3" in select.text[lang] and three in select.spoken[lang]
+        assert all(o.label_in(lang) for o in select.options)
+
+
+def test_a_practice_question_checking_anything_else_is_refused(tmp_path):
+    path, text = broken(tmp_path, "    checks: select", "    checks: count")
+    (problem,) = check_questionnaire_file(path)
+    assert str(problem).startswith(f"{path}:{position(text, 'count')}: familiarisation[2].checks:")
+    assert "'hear', 'read', 'select'" in problem.message
 
 
 def test_the_loinc_codes_are_marked_for_verification():

@@ -77,6 +77,9 @@ def test_spanish_voice_patient_answers_through_the_speech_matcher():
     assert answers["mobility"].option == 4  # "la cuarta"
     assert answers["dressing"].option == 2
     assert result.session.language == "es"
+    # "la tres" on the selecting check is answer number 3, as asked
+    assert [(e.question_id, e.option, e.correct) for e in result.events if type(e).__name__ == "PracticeAnswered"] == [
+        ("practice_hear", 2, True), ("practice_read", 1, True), ("practice_select", 3, True)]
 
 
 def test_adaptation_switches_voice_off_but_never_changes_the_qos_trace():

@@ -251,8 +251,11 @@ def test_familiarisation_answers_are_checked_but_never_sent_to_qos():
     rig.answer(2, Channel.VOICE)
     rig.at(9)
     rig.answer(2, Channel.TOUCH)  # the reading check expects "yes", option 1
+    assert rig.session.snapshot().practice.id == "practice_select"
+    rig.at(11)
+    rig.answer(3, Channel.REMOTE)  # "choose answer number 3"
     assert [(p.question_id, p.correct) for p in rig.of(PracticeAnswered)] == [
-        ("practice_hear", True), ("practice_read", False)]
+        ("practice_hear", True), ("practice_read", False), ("practice_select", True)]
     assert rig.session.phase is Phase.EXPLANATION
     assert rig.session.trace == [{"t": 5, "set": {"PersonDetected": True, "TestState": "STARTED"}}]
     assert not rig.session.answers
