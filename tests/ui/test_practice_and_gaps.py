@@ -43,11 +43,15 @@ async def test_a_kiosk_without_voice_out_never_asks_which_word_was_heard(ui_kios
         await settle(pilot, lambda: kiosk.session.snapshot().practice is not None)
         assert screen_name(kiosk) == "FamiliarisationScreen"
         assert _question_text(kiosk) == "Please choose the answer that says yes."
-        assert _progress(kiosk) == "Practice 1 of 1"
+        assert _progress(kiosk) == "Practice 1 of 2"
         await pilot.press("1")
+        await settle(pilot, lambda: _question_text(kiosk) == "Please choose answer number 3.")
+        assert _progress(kiosk) == "Practice 2 of 2"
+        await pilot.press("3")
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
     outcomes = [(p.question_id, p.outcome, p.detail) for p in kiosk.store.session(kiosk.session.id).practice]
-    assert outcomes == [("practice_hear", "skipped", "no voice out"), ("practice_read", "right", "key 1")]
+    assert outcomes == [("practice_hear", "skipped", "no voice out"), ("practice_read", "right", "key 1"),
+                        ("practice_select", "right", "key 3")]
 
 
 async def test_voice_out_on_asks_the_hearing_check_and_losing_it_skips_that_check(ui_kiosk):
@@ -58,11 +62,11 @@ async def test_voice_out_on_asks_the_hearing_check_and_losing_it_skips_that_chec
         await pilot.press("1")
         await settle(pilot, lambda: kiosk.session.snapshot().practice is not None)
         assert _question_text(kiosk) == "Which word did you hear?"
-        assert _progress(kiosk) == "Practice 1 of 2"
+        assert _progress(kiosk) == "Practice 1 of 3"
         deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.LOST, "espeak-ng", "audio device gone"))
         await settle(pilot, lambda: kiosk.session.snapshot().practice.id == "practice_read")
         await settle(pilot, lambda: _question_text(kiosk) == "Please choose the answer that says yes.")
-        assert _progress(kiosk) == "Practice 2 of 2"
+        assert _progress(kiosk) == "Practice 2 of 3"
     stored = kiosk.store.session(kiosk.session.id)
     assert [(p.question_id, p.outcome) for p in stored.practice] == [("practice_hear", "skipped")]
     assert [e.detail for e in stored.log if e.kind == "voice_out"] == ["unavailable"]
@@ -128,10 +132,12 @@ async def test_the_clinician_sees_how_the_practice_went(ui_kiosk):
         await pilot.press("1")
         await settle(pilot, lambda: kiosk.session.snapshot().practice is not None)
         await pilot.press("2")  # "No" where "Yes" was asked for
+        await settle(pilot, lambda: kiosk.session.snapshot().practice.id == "practice_select")
+        await pilot.press("3")
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         await _session_detail(kiosk, pilot)
         line = _text(kiosk.app.screen.query_one("#practice", Label))
-        assert line == "Practice: hearing skipped (no voice out) / reading ✗ (chose No)"
+        assert line == "Practice: hearing skipped (no voice out) / reading ✗ (chose No) / choosing ✓"
 
 
 async def test_the_metrics_plot_keeps_its_key_off_the_data(ui_kiosk):
