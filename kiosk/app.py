@@ -462,8 +462,8 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     closes what it opened. Raises :class:`SetupError` (one sentence) for a user's mistake."""
     from kiosk.adaptation import Adaptation, PolicyError, load_policy
     from kiosk.clock import SystemClock
-    from kiosk.config import ConfigError, load_config
-    from kiosk.questionnaire import QuestionnaireError, load_questionnaire
+    from kiosk.config import ConfigError, configured_questionnaire, load_config
+    from kiosk.questionnaire import QuestionnaireError
     from kiosk.records import MODEL
     from kiosk.storage import PATIENT_ID, StorageError, new_patient_id
     from qos import Engine, load_model
@@ -474,7 +474,7 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
 
     try:
         config = load_config(config_path)
-        questionnaire = load_questionnaire(config.questionnaire)
+        questionnaire = configured_questionnaire(config)
         policy = load_policy(config.adaptation_policy) if config.adaptation else None
         store = Store.open(data_dir or config.data_dir)
     except QuestionnaireError as error:

@@ -13,6 +13,7 @@ Example ``config.yaml`` (every key optional)::
     adaptation: true                  # live adaptation on/off
     adaptation_policy: /etc/kiosk/adaptation.yaml
     questionnaire: /etc/kiosk/barthel.yaml
+    bands: spanish                    # a band set of the questionnaire (default: the file's default)
     familiarisation: true             # practice questions before the questionnaire
     timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
@@ -31,7 +32,7 @@ from typing import Any
 
 import platformdirs
 
-from kiosk.questionnaire import Timing
+from kiosk.questionnaire import Questionnaire, Timing, load_questionnaire
 from kiosk.yamlmarks import Problem, parse
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
@@ -59,6 +60,8 @@ class Config:
     adaptation_policy: Path | None = None
     #: a questionnaire file (None: the bundled Barthel questionnaire)
     questionnaire: Path | None = None
+    #: the questionnaire's band set that interprets totals (None: the file's default, Shah 1989)
+    bands: str | None = None
     #: practice questions before the questionnaire
     familiarisation: bool = True
     #: overrides of the questionnaire's timing (attempt_window_s, between_questions_s, ...)
@@ -160,5 +163,24 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
+        elif key == "bands" and (not isinstance(value, str) or not value):
+            raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
     return values
+
+
+def configured_questionnaire(config: Config) -> Questionnaire:
+    """The questionnaire this kiosk uses, scoring with the configured band set.
+
+    Raises :class:`~kiosk.questionnaire.QuestionnaireError` for a bad questionnaire file and
+    :class:`ConfigError` when ``bands`` names a set the questionnaire does not have.
+    """
+    questionnaire = load_questionnaire(config.questionnaire)
+    if config.bands is None:
+        return questionnaire
+    try:
+        return questionnaire.with_band_set(config.bands)
+    except KeyError:
+        where = f"{config.source}: " if config.source else ""
+        raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
+                          f"(it has {', '.join(questionnaire.band_sets)})") from None

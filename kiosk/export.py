@@ -120,12 +120,15 @@ def fhir_response(q: Questionnaire, stored: StoredSession) -> dict[str, Any]:
     }
 
 
+#: ``band_set`` (total row only) names the band set the band comes from: "severe" is 21-60 in
+#: Shah's set but 20-35 in the Spanish one. The first 13 columns are as they always were.
 CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
-               "attempt", "channel", "answered_by", "t"]
+               "attempt", "channel", "answered_by", "t", "band_set"]
 
 
 def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
-    """One row per item of each session (blank option when not answered) plus a recomputed total row."""
+    """Per session: a row per item (blank option when not answered) and a total row recomputed from
+    the answers, with its band and the band set that gave it."""
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
@@ -136,13 +139,13 @@ def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
         for item in q.items:
             a = answers.get(item.id)
             if a is None:
-                writer.writerow(head + [item.id, "", "not answered", "", "", "", "", ""])
+                writer.writerow(head + [item.id, "", "not answered", "", "", "", "", "", ""])
             else:
                 label = item.option(a.option).label_in(stored.language)
                 writer.writerow(head + [item.id, a.option, label, a.points, a.attempt, a.channel.value,
-                                        a.answered_by.value, f"{a.t:g}"])
+                                        a.answered_by.value, f"{a.t:g}", ""])
         band = score.band.id if score.band else ("incomplete" if not score.complete else "")
-        writer.writerow(head + [TOTAL_LINK, "", band, score.total, "", "", "", ""])
+        writer.writerow(head + [TOTAL_LINK, "", band, score.total, "", "", "", "", score.band_set])
     return out.getvalue()
 
 

@@ -6,6 +6,10 @@ bands with gaps...) is collected with its ``file:line:col`` position and reporte
 nothing is half-loaded. The structural rules live in ``questionnaire.schema.json`` (which editors
 can also use while typing); the rules a JSON Schema cannot express (translations for the declared
 languages, unique ids, band coverage) are checked here.
+
+Interpretation bands come as named band sets (Shah 1989, a Spanish clinical-practice set...), one
+of them the file's default. A kiosk may choose another (``bands:`` in its config,
+:meth:`Questionnaire.with_band_set`); scoring then uses that set everywhere.
 """
 
 from __future__ import annotations
@@ -131,6 +135,24 @@ class Band:
 
 
 @dataclass(frozen=True)
+class BandSet:
+    """A named set of interpretation bands covering every possible total, with its source."""
+
+    id: str
+    #: where the cut-offs come from (a citation, or a warning that the source is unconfirmed)
+    source: str
+    #: in ascending order of totals
+    bands: tuple[Band, ...]
+
+    def band_for(self, total: int) -> Band | None:
+        """The band containing ``total`` (None outside every band)."""
+        for band in self.bands:
+            if band.min <= total <= band.max:
+                return band
+        return None
+
+
+@dataclass(frozen=True)
 class Timing:
     """How long the session waits, in seconds. Defaults come from the questionnaire file."""
 
@@ -178,6 +200,8 @@ class Score:
     missing: tuple[str, ...]
     #: the highest possible total
     max_total: int
+    #: the id of the band set ``band`` comes from
+    band_set: str = ""
 
 
 @dataclass(frozen=True)
@@ -189,8 +213,10 @@ class Questionnaire:
     title: Mapping[str, str]
     languages: tuple[str, ...]
     items: tuple[Item, ...]
-    bands: tuple[Band, ...]
-    band_source: str
+    #: every band set of the file, by id
+    band_sets: Mapping[str, BandSet]
+    #: the band set scoring uses: the file's default unless :meth:`with_band_set` chose another
+    band_set: str
     messages: Mapping[str, Mapping[str, str]]
     familiarisation: tuple[PracticeQuestion, ...]
     timing: Timing
@@ -210,20 +236,40 @@ class Questionnaire:
         """A message (welcome, explanation, paused...) in ``language``; '' if the file has none."""
         return self.messages.get(name, {}).get(language, "")
 
-    def band_for(self, total: int) -> Band | None:
-        """The band containing ``total``."""
-        for band in self.bands:
-            if band.min <= total <= band.max:
-                return band
-        return None
+    @property
+    def bands(self) -> tuple[Band, ...]:
+        """The bands scoring uses (those of :attr:`band_set`)."""
+        return self.band_sets[self.band_set].bands
 
-    def score(self, points: Mapping[str, int]) -> Score:
-        """Score answers given as item id -> points.
+    @property
+    def band_source(self) -> str:
+        """Where the bands scoring uses come from."""
+        return self.band_sets[self.band_set].source
 
-        Raises ValueError for an unknown item or points that are not one of that item's options.
-        Missing items make the score incomplete (and leave it without a band); they never count
-        as 0 silently.
+    def bands_named(self, band_set: str | None = None) -> BandSet:
+        """The band set with this id (None: the one scoring uses); ``KeyError`` naming the sets."""
+        name = self.band_set if band_set is None else band_set
+        if name not in self.band_sets:
+            raise KeyError(f"no band set {name!r} in {self.id} (it has {', '.join(self.band_sets)})")
+        return self.band_sets[name]
+
+    def with_band_set(self, band_set: str) -> Questionnaire:
+        """A copy that scores with another of its band sets; ``KeyError`` if there is none of that id."""
+        return replace(self, band_set=self.bands_named(band_set).id)
+
+    def band_for(self, total: int, band_set: str | None = None) -> Band | None:
+        """The band containing ``total`` in ``band_set`` (None: the set scoring uses)."""
+        return self.bands_named(band_set).band_for(total)
+
+    def score(self, points: Mapping[str, int], band_set: str | None = None) -> Score:
+        """Score answers given as item id -> points, interpreted with ``band_set`` (None: the set
+        scoring uses, normally the file's default).
+
+        Raises ValueError for an unknown item or points that are not one of that item's options,
+        KeyError for an unknown band set. Missing items make the score incomplete (and leave it
+        without a band); they never count as 0 silently.
         """
+        bands = self.bands_named(band_set)
         known = {item.id: item for item in self.items}
         for item_id, value in points.items():
             if item_id not in known:
@@ -239,10 +285,11 @@ class Questionnaire:
         return Score(
             total=total,
             complete=complete,
-            band=self.band_for(total) if complete else None,
+            band=bands.band_for(total) if complete else None,
             answered=answered,
             missing=missing,
             max_total=sum(i.max_points for i in self.items),
+            band_set=bands.id,
         )
 
 
@@ -369,30 +416,70 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                     and expected > len(opts):
                 add(path + ("expected",), f"expected option {expected} but there are only {len(opts)} options")
 
-    bands_block = data.get("bands")
-    bands = dicts(bands_block.get("ranges")) if isinstance(bands_block, dict) else []
-    band_ids: set[str] = set()
-    for i, band in bands:
-        texts(("bands", "ranges", i, "label"), band.get("label"))
-        if band.get("id") in band_ids:
-            add(("bands", "ranges", i, "id"), f"duplicate band id {band['id']!r}")
-        band_ids.add(band.get("id"))
-    if not bands or not all(isinstance(b.get("min"), int) and isinstance(b.get("max"), int) for _, b in bands):
+    _check_bands(data, dicts, texts, add)
+
+
+def _reachable_totals(items: list[tuple[int, dict[str, Any]]]) -> set[int] | None:
+    """Every total a patient can score (one option's points per item), or None when some points
+    are not whole multiples of 5: the schema reports those, and bands judged against totals that
+    the corrected file cannot reach would only bury that one mistake under others."""
+    totals = {0}
+    for _, item in items:
+        options = item.get("options")
+        points = {o.get("points") for o in options if isinstance(o, dict)} if isinstance(options, list) else set()
+        if not all(isinstance(p, int) and not isinstance(p, bool) and p >= 0 and p % 5 == 0 for p in points):
+            return None
+        if points:
+            totals = {t + p for t in totals for p in points}
+    return totals
+
+
+def _check_bands(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
+                 texts: Callable[[tuple[Any, ...], Any], None], add: Callable[..., None]) -> None:
+    """Each band set: labels translated, unique band ids, no two bands sharing a total, every total
+    a patient can reach in a band, and the last band ending at the highest possible total; the
+    default names one of the sets.
+
+    Gaps are judged on reachable totals: with points in steps of 5, "20-35, 40-55" (as published)
+    leaves no total out, so it is not a gap."""
+    block = data.get("bands")
+    if not isinstance(block, dict):
         return
-    for i, band in bands:
-        if band["min"] > band["max"]:
-            add(("bands", "ranges", i), f"band {band.get('id')!r} has min {band['min']} above max {band['max']}")
-    top = sum(max((o.get("points", 0) for _, o in dicts(item.get("options")) if isinstance(o.get("points"), int)),
-                  default=0) for _, item in dicts(data.get("items")))
-    expected_low = 0
-    for i, band in sorted(bands, key=lambda ib: ib[1]["min"]):
-        if band["min"] != expected_low:
-            kind = "a gap" if band["min"] > expected_low else "an overlap"
-            add(("bands", "ranges", i, "min"),
-                f"bands leave {kind} before {band['min']} (expected the next band to start at {expected_low})")
-        expected_low = band["max"] + 1
-    if expected_low != top + 1:
-        add(("bands", "ranges"), f"bands end at {expected_low - 1} but the highest possible total is {top}")
+    sets = block.get("sets") if isinstance(block.get("sets"), dict) else {}
+    default = block.get("default")
+    if isinstance(default, str) and sets and default not in sets:
+        add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")
+    reachable = _reachable_totals(dicts(data.get("items")))
+    for name, band_set in sets.items():
+        path = ("bands", "sets", name, "ranges")
+        bands = dicts(band_set.get("ranges")) if isinstance(band_set, dict) else []
+        band_ids: set[Any] = set()
+        for i, band in bands:
+            texts(path + (i, "label"), band.get("label"))
+            if band.get("id") in band_ids:
+                add(path + (i, "id"), f"band set {name!r}: duplicate band id {band['id']!r}")
+            band_ids.add(band.get("id"))
+        if reachable is None or not bands or not all(isinstance(b.get("min"), int) and isinstance(b.get("max"), int)
+                                                     for _, b in bands):
+            continue
+        for i, band in bands:
+            if band["min"] > band["max"]:
+                add(path + (i,), f"band set {name!r}: band {band.get('id')!r} has min {band['min']} "
+                                 f"above max {band['max']}")
+        ordered = sorted(bands, key=lambda ib: (ib[1]["min"], ib[1]["max"]))
+        below = -1  # the highest total covered so far
+        previous: dict[str, Any] | None = None
+        for i, band in ordered:
+            if previous is not None and band["min"] <= below:
+                add(path + (i, "min"), f"band set {name!r}: bands {previous.get('id')!r} and {band.get('id')!r} "
+                                       f"overlap ({band['min']} to {min(below, band['max'])} are in both)")
+            elif missed := sorted(t for t in reachable if below < t < band["min"]):
+                add(path + (i, "min"), f"band set {name!r}: bands leave a gap before {band['min']} "
+                                       f"(a total of {missed[0]} is in no band)")
+            if band["max"] > below:
+                below, previous = band["max"], band
+        if below != max(reachable):
+            add(path, f"band set {name!r}: bands end at {below} but the highest possible total is {max(reachable)}")
 
 
 def _build(data: dict[str, Any], source: str) -> Questionnaire:
@@ -420,16 +507,20 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
                          options=opts(v["options"]), expected=v["expected"])
         for v in data.get("familiarisation", [])
     )
-    bands = tuple(Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]))
-                  for b in sorted(data["bands"]["ranges"], key=lambda b: b["min"]))
+    band_sets = {
+        name: BandSet(id=name, source=v.get("source", ""),
+                      bands=tuple(Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]))
+                                  for b in sorted(v["ranges"], key=lambda b: b["min"])))
+        for name, v in data["bands"]["sets"].items()
+    }
     return Questionnaire(
         id=data["id"],
         version=str(data.get("version", "")),
         title=dict(data["title"]),
         languages=tuple(data["languages"]),
         items=items,
-        bands=bands,
-        band_source=data["bands"].get("source", ""),
+        band_sets=band_sets,
+        band_set=data["bands"]["default"],
         messages={k: dict(v) for k, v in data.get("messages", {}).items()},
         familiarisation=practice,
         timing=Timing().with_overrides(data.get("timing")),

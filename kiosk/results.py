@@ -1,7 +1,8 @@
 """`kiosk results [SESSION] [--fhir FILE] [--fhir-questionnaire FILE] [--csv FILE]`.
 
 Without SESSION: list stored sessions. With SESSION (an id or a unique prefix): show its answers,
-the total recomputed from them, band and completeness, adaptations and QoS metrics at the end.
+the total recomputed from them, band (from the configured band set) and completeness,
+adaptations and QoS metrics at the end.
 Exports are written readable by their owner only. Exit 2 on an unknown session or unusable store.
 """
 
@@ -10,9 +11,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from kiosk.config import ConfigError, load_config
+from kiosk.config import ConfigError, configured_questionnaire, load_config
 from kiosk.export import ExportError, csv_text, fhir_questionnaire, fhir_response, rescore, write_json, write_private
-from kiosk.questionnaire import QuestionnaireError, load_questionnaire
+from kiosk.questionnaire import QuestionnaireError
 from kiosk.records import open_store
 from kiosk.storage import StorageError, StoredSession
 
@@ -32,7 +33,9 @@ def _show(q, stored: StoredSession) -> None:
             label = item.option(a.option).label_in(stored.language)
             print(f"  {item.number:>2} {item.id:<10} option {a.option} {a.points:>3} points  attempt {a.attempt}  "
                   f"{a.channel.value:<8} {label}")
-    band = score.band.label["en"] if score.band else "no band (incomplete)"
+    source = q.bands_named(score.band_set).source
+    band = (f"{score.band.label['en']} (bands: {score.band_set}, {source})" if score.band
+            else "no band (incomplete)")
     completeness = "complete" if score.complete else f"incomplete, missing {', '.join(score.missing)}"
     print(f"total {score.total}/{score.max_total} ({completeness}); {band}")
     for record in stored.adaptations:
@@ -55,7 +58,7 @@ def main(argv: list[str]) -> int:
         parser.error("--fhir needs a SESSION")
     try:
         config = load_config()
-        q = load_questionnaire(config.questionnaire)
+        q = configured_questionnaire(config)
         with open_store(args.data_dir) as store:
             if args.fhir_questionnaire:
                 write_json(args.fhir_questionnaire, fhir_questionnaire(q))

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from kiosk.clock import SimClock, SystemClock
-from kiosk.config import DEFAULT_PIN, ConfigError, load_config
+from kiosk.config import DEFAULT_PIN, Config, ConfigError, load_config
 
 
 def test_defaults_without_a_file(tmp_path, monkeypatch):
@@ -70,3 +70,23 @@ def test_clocks():
         clock.advance(-1)
     system = SystemClock()
     assert system.now() <= system.now() and system.wall().tzinfo is not None
+
+
+def test_the_band_set_is_chosen_by_config_and_an_unknown_one_is_named(tmp_path):
+    from kiosk.config import configured_questionnaire
+
+    path = tmp_path / "config.yaml"
+    path.write_text("bands: spanish\n")
+    config = load_config(path, environ={})
+    assert config.bands == "spanish"
+    questionnaire = configured_questionnaire(config)
+    assert questionnaire.band_set == "spanish" and questionnaire.band_for(60).id == "mild"
+    assert configured_questionnaire(Config()).band_set == "shah"  # no choice: the file's default
+    path.write_text("bands: castilian\n")
+    with pytest.raises(ConfigError) as caught:
+        configured_questionnaire(load_config(path, environ={}))
+    assert str(caught.value).startswith(f"{path}: bands: 'castilian' is not a band set of ")
+    assert str(caught.value).endswith("(it has shah, spanish)")
+    path.write_text("bands: [spanish]\n")
+    with pytest.raises(ConfigError, match=":1:1: bands must name a band set of the questionnaire"):
+        load_config(path, environ={})

@@ -97,3 +97,28 @@ def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path
 def test_kiosk_results_for_an_unknown_session_is_exit_2(export_store, capsys):
     assert results_main(["zzz", "--data-dir", str(export_store.path.parent)]) == 2
     assert capsys.readouterr().err.strip() == "kiosk results: no session 'zzz'"
+
+
+def test_the_configured_band_set_interprets_the_session_its_export_and_kiosk_results(tmp_path, monkeypatch, capsys):
+    spanish = QUESTIONNAIRE.with_band_set("spanish")
+    store = Store.open(tmp_path / "data")
+    run_script(load_script(ROOT / "recordings/patients/barthel2.yaml"), spanish, store=store)  # 75 points
+    stored = by_patient(store, "TB-0002")
+    db = sqlite3.connect(store.path)
+    assert db.execute("SELECT total, band FROM sessions").fetchall() == [(75, "mild")]  # Shah: moderate
+    store.close()
+    totals = [list(csv.DictReader(io.StringIO(csv_text(q, [stored]))))[-1] for q in (QUESTIONNAIRE, spanish)]
+    assert [(t["item"], t["points"], t["label"], t["band_set"]) for t in totals] == [
+        ("total", "75", "moderate", "shah"), ("total", "75", "mild", "spanish")]
+
+    config = tmp_path / "config.yaml"
+    config.write_text("bands: spanish\n")
+    monkeypatch.setenv("KIOSK_CONFIG", str(config))
+    table = tmp_path / "r.csv"
+    assert results_main([stored.id, "--data-dir", str(tmp_path / "data"), "--csv", str(table)]) == 0
+    assert ("total 75/100 (complete); Mild dependence (bands: spanish, Spanish clinical practice "
+            "(unconfirmed source))") in capsys.readouterr().out
+    assert list(csv.DictReader(table.open()))[-1]["band_set"] == "spanish"
+    config.write_text("bands: castilian\n")
+    assert results_main([stored.id, "--data-dir", str(tmp_path / "data")]) == 2
+    assert "bands: 'castilian' is not a band set" in capsys.readouterr().err

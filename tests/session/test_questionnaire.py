@@ -80,6 +80,37 @@ def test_bands_follow_shah(total, band):
     assert Q.band_for(total).id == band
 
 
+@pytest.mark.parametrize(("total", "band"), [(0, "total"), (15, "total"), (20, "severe"), (35, "severe"),
+                                             (40, "moderate"), (55, "moderate"), (60, "mild"), (95, "mild"),
+                                             (100, "independent")])
+def test_the_spanish_band_set_follows_its_published_cut_offs(total, band):
+    assert Q.band_for(total, "spanish").id == band
+    assert Q.with_band_set("spanish").band_for(total).id == band
+
+
+def test_shah_is_the_default_and_the_spanish_set_says_its_source_is_unconfirmed():
+    assert Q.band_set == "shah" and "Shah" in Q.band_source
+    assert set(Q.band_sets) == {"shah", "spanish"}
+    assert "unconfirmed source" in Q.band_sets["spanish"].source
+    assert "UNCONFIRMED SOURCE" in TEXT
+
+
+def test_scoring_with_another_band_set():
+    points = {i.id: i.max_points for i in Q.items} | {"feeding": 0, "bathing": 0, "grooming": 0, "stairs": 0,
+                                                      "transfers": 5}
+    shah, spanish = Q.score(points), Q.score(points, "spanish")
+    assert shah.total == spanish.total == 60
+    assert (shah.band.id, shah.band_set) == ("severe", "shah")
+    assert (spanish.band.id, spanish.band_set) == ("mild", "spanish")
+    chosen = Q.with_band_set("spanish")
+    assert chosen.score(points) == spanish and chosen.bands == Q.band_sets["spanish"].bands
+    assert Q.score(points) == shah  # choosing a set made a copy
+    with pytest.raises(KeyError, match="no band set 'castilian' in barthel \\(it has shah, spanish\\)"):
+        Q.with_band_set("castilian")
+    with pytest.raises(KeyError):
+        Q.score(points, "castilian")
+
+
 def test_timing_overrides_are_checked():
     assert Q.timing.with_overrides({"attempt_window_s": 30}).attempt_window_s == 30
     with pytest.raises(ValueError, match="unknown timing setting 'window'"):
@@ -147,9 +178,8 @@ def test_option_without_points(tmp_path):
 def test_points_not_a_multiple_of_five(tmp_path):
     path, text = broken(tmp_path, "      - points: 15\n        label: {en: \"Independent\"",
                         "      - points: 12\n        label: {en: \"Independent\"")
-    # the wrong points also make the bands stop short of the highest possible total
+    # one mistake, one message: bands are not judged against totals only the wrong points reach
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{position(text, '- id: total')}: bands end at 100 but the highest possible total is 97",
         f"{path}:{position(text, ' 12') + 1}: items[7].options[3].points: must be a multiple of 5, got 12"]
 
 
@@ -172,9 +202,47 @@ def test_duplicate_keys_are_not_silently_merged(tmp_path):
 
 
 def test_bands_with_a_gap(tmp_path):
-    path, text = broken(tmp_path, "      min: 61", "      min: 65")
+    path, text = broken(tmp_path, "          min: 61", "          min: 70")
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{position(text, ' 65') + 1}: bands leave a gap before 65 (expected the next band to start at 61)"]
+        f"{path}:{position(text, ' 70') + 1}: band set 'shah': bands leave a gap before 70 "
+        "(a total of 65 is in no band)"]
+
+
+def test_a_gap_no_total_can_fall_in_is_not_a_gap(tmp_path):
+    """Totals go in steps of 5: Shah's 61 could be written 65 without leaving any total out."""
+    path, _ = broken(tmp_path, "          min: 61", "          min: 65")
+    assert check_questionnaire_file(path) == []
+
+
+def test_overlapping_bands(tmp_path):
+    path, text = broken(tmp_path, "          min: 40\n", "          min: 30\n")
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, ' 30') + 1}: band set 'spanish': bands 'severe' and 'moderate' overlap "
+        "(30 to 35 are in both)"]
+
+
+def test_bands_that_stop_short_of_the_highest_total(tmp_path):
+    path, text = broken(tmp_path, "          min: 100\n          max: 100\n",
+                        "          min: 96\n          max: 99\n", count=2)
+    where = {name: position(text, "- id: total", nth) for nth, name in enumerate(("shah", "spanish"))}
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{where['shah']}: band set 'shah': bands end at 99 but the highest possible total is 100",
+        f"{path}:{position(text, ' 96') + 1}: band set 'shah': bands 'slight' and 'independent' overlap "
+        "(96 to 99 are in both)",
+        f"{path}:{where['spanish']}: band set 'spanish': bands end at 99 but the highest possible total is 100"]
+
+
+def test_the_default_band_set_must_exist(tmp_path):
+    path, text = broken(tmp_path, "  default: shah", "  default: barthel")
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, 'default: barthel') + 9}: the default band set 'barthel' is not one of the sets "
+        "(shah, spanish)"]
+
+
+def test_bands_in_the_old_single_set_shape_are_refused_by_name(tmp_path):
+    path, text = broken(tmp_path, "  default: shah\n  sets:\n", "  source: mine\n  ranges:\n")
+    messages = [p.message for p in check_questionnaire_file(path)]
+    assert "bands is missing 'sets'" in messages and "unknown key 'ranges' in bands" in messages
 
 
 def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path, capsys):
