@@ -12,11 +12,12 @@ import csv
 import io
 import json
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from kiosk.questionnaire import Questionnaire, Score
-from kiosk.storage import StoredSession
+from kiosk.storage import PracticeRecord, StoredSession
 
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
@@ -93,6 +94,49 @@ def rescore(q: Questionnaire, stored: StoredSession) -> Score:
     return q.score(points)
 
 
+#: what each kind of practice question checks, as a clinician reads it
+PRACTICE_CHECKS = {"hear": "hearing", "read": "reading", "select": "selecting"}
+
+
+@dataclass(frozen=True)
+class PracticeOutcome:
+    """How one practice question went, in a clinician's words: "hearing: wrong (chose Chair)"."""
+
+    #: what it checks: "hearing", "reading" or "selecting"
+    what: str
+    #: "right", "wrong", "not answered" or "skipped"
+    outcome: str
+    #: the option chosen for a wrong answer ("chose Chair"), why it was skipped ("no voice out"), or ""
+    detail: str = ""
+
+    @property
+    def result(self) -> str:
+        """The outcome with its detail: "wrong (chose Chair)", "skipped (no voice out)", "right"."""
+        return f"{self.outcome} ({self.detail})" if self.detail else self.outcome
+
+    def __str__(self) -> str:
+        return f"{self.what}: {self.result}"
+
+
+def practice_outcome(q: Questionnaire, record: PracticeRecord, language: str) -> PracticeOutcome:
+    """A stored practice record in a clinician's words (a wrong answer names the option chosen)."""
+    what = PRACTICE_CHECKS.get(record.checks, record.checks)
+    if record.outcome == "wrong":
+        question = next((p for p in q.familiarisation if p.id == record.question_id), None)
+        chosen = (question.option(record.option).label_in(language)
+                  if question is not None and record.option is not None
+                  and 1 <= record.option <= len(question.options) else f"option {record.option}")
+        return PracticeOutcome(what, "wrong", f"chose {chosen}")
+    if record.outcome == "skipped":
+        return PracticeOutcome(what, "skipped", record.detail)
+    return PracticeOutcome(what, record.outcome.replace("_", " "))
+
+
+def practice_outcomes(q: Questionnaire, stored: StoredSession) -> list[PracticeOutcome]:
+    """The session's practice questions in the order they happened (empty without familiarisation)."""
+    return [practice_outcome(q, record, stored.language) for record in stored.practice]
+
+
 def fhir_response(q: Questionnaire, stored: StoredSession) -> dict[str, Any]:
     """A stored session as a FHIR R4 QuestionnaireResponse (total recomputed)."""
     score = rescore(q, stored)
@@ -121,14 +165,18 @@ def fhir_response(q: Questionnaire, stored: StoredSession) -> dict[str, Any]:
 
 
 #: ``band_set`` (total row only) names the band set the band comes from: "severe" is 21-60 in
-#: Shah's set but 20-35 in the Spanish one. The first 13 columns are as they always were.
+#: Shah's set but 20-35 in the Spanish one. ``kind`` tells the rows apart: "practice" (one per
+#: practice question, first, in the order asked; ``checks`` says what it checks), "item" (one per
+#: questionnaire item, in order) and "total" (last). The first 13 columns are as they always were,
+#: and practice rows carry no points, so a reader that keeps the item and total rows reads as before.
 CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
-               "attempt", "channel", "answered_by", "t", "band_set"]
+               "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks"]
 
 
 def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
-    """Per session: a row per item (blank option when not answered) and a total row recomputed from
-    the answers, with its band and the band set that gave it."""
+    """Per session: a row per practice question (``label`` its outcome: right, wrong (chose ...),
+    not answered, skipped (why); never scored), a row per item (blank option when not answered),
+    and a total row recomputed from the answers, with its band and the band set that gave it."""
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
@@ -136,16 +184,20 @@ def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
         score = rescore(q, stored)
         answers = {a.item_id: a for a in stored.answers}
         head = [stored.id, stored.patient_id, stored.started_at, stored.status, stored.language]
+        for record, outcome in zip(stored.practice, practice_outcomes(q, stored)):
+            channel = record.channel.value if record.channel else ""
+            writer.writerow(head + [record.question_id, record.option or "", outcome.result, "", "", channel,
+                                    stored.answered_by.value, f"{record.t:g}", "", "practice", record.checks])
         for item in q.items:
             a = answers.get(item.id)
             if a is None:
-                writer.writerow(head + [item.id, "", "not answered", "", "", "", "", "", ""])
+                writer.writerow(head + [item.id, "", "not answered", "", "", "", "", "", "", "item", ""])
             else:
                 label = item.option(a.option).label_in(stored.language)
                 writer.writerow(head + [item.id, a.option, label, a.points, a.attempt, a.channel.value,
-                                        a.answered_by.value, f"{a.t:g}", ""])
+                                        a.answered_by.value, f"{a.t:g}", "", "item", ""])
         band = score.band.id if score.band else ("incomplete" if not score.complete else "")
-        writer.writerow(head + [TOTAL_LINK, "", band, score.total, "", "", "", "", score.band_set])
+        writer.writerow(head + [TOTAL_LINK, "", band, score.total, "", "", "", "", score.band_set, "total", ""])
     return out.getvalue()
 
 

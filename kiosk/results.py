@@ -1,8 +1,9 @@
 """`kiosk results [SESSION] [--fhir FILE] [--fhir-questionnaire FILE] [--csv FILE]`.
 
-Without SESSION: list stored sessions. With SESSION (an id or a unique prefix): show its answers,
-the total recomputed from them, band (from the configured band set) and completeness,
-adaptations and QoS metrics at the end.
+Without SESSION: list stored sessions. With SESSION (an id or a unique prefix): show how the
+practice questions went (hearing, reading, selecting: right, wrong, not answered or skipped and
+why), its answers, the total recomputed from them, band (from the configured band set) and
+completeness, adaptations and QoS metrics at the end.
 Exports are written readable by their owner only. Exit 2 on an unknown session or unusable store.
 """
 
@@ -12,7 +13,16 @@ import argparse
 import sys
 
 from kiosk.config import ConfigError, configured_questionnaire, load_config
-from kiosk.export import ExportError, csv_text, fhir_questionnaire, fhir_response, rescore, write_json, write_private
+from kiosk.export import (
+    ExportError,
+    csv_text,
+    fhir_questionnaire,
+    fhir_response,
+    practice_outcomes,
+    rescore,
+    write_json,
+    write_private,
+)
 from kiosk.questionnaire import QuestionnaireError
 from kiosk.records import open_store
 from kiosk.storage import StorageError, StoredSession
@@ -23,6 +33,9 @@ def _show(q, stored: StoredSession) -> None:
     print(f"session {stored.id}  patient {stored.patient_id}  {stored.status}  language {stored.language}  "
           f"answered by {stored.answered_by.value}")
     print(f"started {stored.started_at}" + (f"  finished {stored.finished_at}" if stored.finished_at else ""))
+    outcomes = practice_outcomes(q, stored)
+    print("practice: " + ("; ".join(str(o) for o in outcomes) if outcomes
+                          else "none (no practice questions in this session)"))
     answers = {a.item_id: a for a in stored.answers}
     for item in q.items:
         a = answers.get(item.id)

@@ -10,14 +10,10 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static
 
-from kiosk.export import ExportError, csv_text, fhir_response, rescore, write_json, write_private
+from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.screens.base import ClinicianScreen
 from kiosk.storage import StoredSession
 from kiosk.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png
-
-#: what each kind of practice question checks, as the clinician reads it
-PRACTICE_CHECKS = {"hear": "hearing", "read": "reading", "select": "choosing"}
-
 
 class SessionDetailScreen(ClinicianScreen):
     """The answers table above the metrics plot; export buttons at the bottom."""
@@ -76,22 +72,16 @@ class SessionDetailScreen(ClinicianScreen):
         if not self.stored.practice:
             return "Practice: none (no practice questions in this session)"
         q = self.app.questionnaire  # type: ignore[attr-defined]
-        questions = {p.id: p for p in q.familiarisation}
         parts = []
-        for record in self.stored.practice:
-            what = PRACTICE_CHECKS.get(record.checks, record.checks)
-            if record.outcome == "right":
-                parts.append(f"{what} ✓")
-            elif record.outcome == "wrong":
-                question = questions.get(record.question_id)
-                chosen = (question.option(record.option).label_in(self.stored.language)
-                          if question is not None and record.option is not None
-                          and 1 <= record.option <= len(question.options) else f"option {record.option}")
-                parts.append(f"{what} ✗ (chose {chosen})")
-            elif record.outcome == "not_answered":
-                parts.append(f"{what} ✗ (no answer)")
+        for outcome in practice_outcomes(q, self.stored):
+            if outcome.outcome == "right":
+                parts.append(f"{outcome.what} ✓")
+            elif outcome.outcome == "wrong":
+                parts.append(f"{outcome.what} ✗ ({outcome.detail})")
+            elif outcome.outcome == "not answered":
+                parts.append(f"{outcome.what} ✗ (no answer)")
             else:
-                parts.append(f"{what} skipped ({record.detail})" if record.detail else f"{what} skipped")
+                parts.append(f"{outcome.what} {outcome.result}")
         return "Practice: " + " / ".join(parts)
 
     def _export_path(self, suffix: str) -> Path:

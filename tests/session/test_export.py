@@ -13,9 +13,10 @@ import pytest
 from kiosk.export import ITEM_WEIGHT, ExportError, csv_text, fhir_questionnaire, fhir_response, rescore
 from kiosk.replay import load_script, run_script
 from kiosk.results import main as results_main
+from kiosk.channels import Channel
 from kiosk.storage import Store
 
-from .helpers import QUESTIONNAIRE
+from .helpers import QUESTIONNAIRE, TIMING, make_rig
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -122,3 +123,40 @@ def test_the_configured_band_set_interprets_the_session_its_export_and_kiosk_res
     config.write_text("bands: castilian\n")
     assert results_main([stored.id, "--data-dir", str(tmp_path / "data")]) == 2
     assert "bands: 'castilian' is not a band set" in capsys.readouterr().err
+
+
+def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_path, capsys):
+    store = Store.open(tmp_path / "data")
+    rig = make_rig(familiarisation=True, store=store)
+    rig.session.set_voice_out_available(False)  # the hearing check is skipped
+    rig.at(5)
+    rig.session.start()
+    rig.at(8)
+    rig.answer(2, Channel.REMOTE)  # "No" where "Yes" was asked for
+    rig.run_until(8 + 2 * TIMING["attempt_window_s"])  # the selecting check gets no answer
+    assert rig.session.phase.value == "explanation"
+    session_id = rig.session.id
+    store.close()
+
+    table = tmp_path / "r.csv"
+    assert results_main([session_id, "--data-dir", str(tmp_path / "data"), "--csv", str(table)]) == 0
+    assert ("practice: hearing: skipped (no voice out); reading: wrong (chose No); selecting: not answered"
+            in capsys.readouterr().out.splitlines())
+    rows = list(csv.DictReader(table.open()))
+    practice = [(r["item"], r["checks"], r["option"], r["label"], r["channel"], r["points"])
+                for r in rows if r["kind"] == "practice"]
+    assert practice == [("practice_hear", "hear", "", "skipped (no voice out)", "", ""),
+                        ("practice_read", "read", "2", "wrong (chose No)", "remote", ""),
+                        ("practice_select", "select", "", "not answered", "", "")]
+    assert [r["kind"] for r in rows] == ["practice"] * 3 + ["item"] * 10 + ["total"]
+    assert rows[-1]["points"] == "0" and rows[-1]["label"] == "incomplete"  # practice never scores
+
+    with Store.open(tmp_path / "data") as reopened:
+        response = fhir_response(QUESTIONNAIRE, reopened.session(session_id))
+    assert {i["linkId"] for i in response["item"]} == {i.id for i in QUESTIONNAIRE.items} | {"total"}
+
+
+def test_kiosk_results_says_when_a_session_had_no_practice(export_store, capsys):
+    stored = by_patient(export_store, "TB-0001")
+    assert results_main([stored.id, "--data-dir", str(export_store.path.parent)]) == 0
+    assert "practice: none (no practice questions in this session)" in capsys.readouterr().out

@@ -137,7 +137,7 @@ async def test_the_clinician_sees_how_the_practice_went(ui_kiosk):
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         await _session_detail(kiosk, pilot)
         line = _text(kiosk.app.screen.query_one("#practice", Label))
-        assert line == "Practice: hearing skipped (no voice out) / reading ✗ (chose No) / choosing ✓"
+        assert line == "Practice: hearing skipped (no voice out) / reading ✗ (chose No) / selecting ✓"
 
 
 async def test_the_metrics_plot_keeps_its_key_off_the_data(ui_kiosk):
