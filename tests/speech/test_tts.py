@@ -12,7 +12,7 @@ import pytest
 from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.questionnaire import load_questionnaire
 from kiosk.speech.audio import frame_level_db
-from kiosk.speech.tts import DEFAULT_RATE, MIN_RATE, Delivery, Speaker, Synthesiser, TtsUnavailable, delivery
+from kiosk.speech.tts import DEFAULT_RATE, MIN_RATE, Delivery, Speaker, TtsUnavailable, delivery
 
 QUESTIONNAIRE = load_questionnaire()
 

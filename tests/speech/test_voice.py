@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.clock import SimClock
 from kiosk.questionnaire import load_questionnaire
 from kiosk.session import DoctorCalled, ListeningChanged, Paused, Prompt, Resumed, Session

@@ -7,7 +7,7 @@ from collections.abc import Awaitable, Callable
 
 from textual.pilot import Pilot
 
-from kiosk.channels import ChannelInput, ChannelStatus
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.session import Phase
 
 from .conftest import UiKiosk
@@ -67,3 +67,27 @@ async def answer_every_question(kiosk: UiKiosk, pilot: Pilot,
         await settle(pilot, lambda: item.id in kiosk.session.answers)
     kiosk.to_next_deadline()  # closing
     await settle(pilot, lambda: screen_name(kiosk) == "SummaryScreen")
+
+
+async def late_touch_answer(kiosk: UiKiosk, pilot: Pilot) -> None:
+    """A late touch answer (after the first attempt ran out) drags VoiceInteractionQuality down."""
+    kiosk.to_next_deadline()
+    await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+    kiosk.to_next_deadline()
+    await settle(pilot, lambda: kiosk.session.current_attempt == 2)
+    kiosk.advance(3)
+    item = kiosk.session.current_item
+    await pilot.click("#answer-1")
+    await settle(pilot, lambda: item.id in kiosk.session.answers)
+
+
+async def start_with_voice_off(kiosk: UiKiosk, pilot: Pilot) -> None:
+    """Start a kiosk whose voice in works (so "I am having trouble hearing you" is true) and answer
+    late by touch until the voice_off adaptation switches on."""
+    deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.ON, "voice in", "pocketsphinx"))
+    await start_in_english(kiosk, pilot)
+    for _ in range(8):
+        await late_touch_answer(kiosk, pilot)
+        if "voice_off" in kiosk.session.snapshot().adaptations:
+            return
+    raise AssertionError("voice_off never switched on")

@@ -8,12 +8,11 @@ import time
 from textual.widgets import Input, Label, Static
 
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
-from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.session import AttemptTimedOut, Phase, Prompt, QuestionNotAnswered
 from kiosk.widgets.bars import AdaptationBanner
 
 from .conftest import UI_PIN
-from .helpers import deliver_from_thread, screen_name, settle, start_in_english
+from .helpers import late_touch_answer, screen_name, settle, start_in_english, start_with_voice_off
 
 
 def _text(widget) -> str:
@@ -95,33 +94,10 @@ async def test_an_attempt_times_out_twice_and_the_next_question_comes(ui_kiosk):
         assert kiosk.store.session(kiosk.session.id).not_answered == ("feeding",)
 
 
-async def late_touch_answer(kiosk, pilot) -> None:
-    """A late touch answer (after the first attempt ran out) drags VoiceInteractionQuality down."""
-    kiosk.to_next_deadline()
-    await settle(pilot, lambda: kiosk.session.current_attempt == 1)
-    kiosk.to_next_deadline()
-    await settle(pilot, lambda: kiosk.session.current_attempt == 2)
-    kiosk.advance(3)
-    item = kiosk.session.current_item
-    await pilot.click("#answer-1")
-    await settle(pilot, lambda: item.id in kiosk.session.answers)
-
-
-async def _late_touch_answers_until_voice_off(kiosk, pilot) -> None:
-    for _ in range(8):
-        await late_touch_answer(kiosk, pilot)
-        if "voice_off" in kiosk.session.snapshot().adaptations:
-            return
-    raise AssertionError("voice_off never switched on")
-
-
 async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        # voice in works on this kiosk (so "I am having trouble hearing you" is true)
-        deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.ON, "voice in", "pocketsphinx"))
-        await start_in_english(kiosk, pilot)
-        await _late_touch_answers_until_voice_off(kiosk, pilot)
+        await start_with_voice_off(kiosk, pilot)
         banner = kiosk.app.screen.query_one(AdaptationBanner)
         assert banner.display and "touch your answer or press its number" in _text(banner)
         # it stays on the next question's screen too

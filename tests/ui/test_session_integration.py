@@ -12,8 +12,7 @@ from kiosk.widgets.bars import AdaptationBanner
 from kiosk.widgets.text import ui_text
 
 from .conftest import UI_PIN
-from .helpers import deliver_from_thread, screen_name, settle, start_in_english
-from .test_incidents import _late_touch_answers_until_voice_off
+from .helpers import deliver_from_thread, screen_name, settle, start_in_english, start_with_voice_off
 
 
 def _text(widget) -> str:
@@ -47,9 +46,7 @@ async def test_number_keys_before_the_questions_start_in_that_language_and_ackno
 async def test_voice_in_status_reaches_the_session_and_a_lost_microphone_lifts_voice_off(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.ON, "voice in", "pocketsphinx"))
-        await start_in_english(kiosk, pilot)
-        await _late_touch_answers_until_voice_off(kiosk, pilot)
+        await start_with_voice_off(kiosk, pilot)
         banner = kiosk.app.screen.query_one(AdaptationBanner)
         assert banner.display and "trouble hearing" in _text(banner)
         deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.LOST, "voice in", "microphone unplugged"))
