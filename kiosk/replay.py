@@ -441,7 +441,13 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
         familiarisation=script.practice is not None,
     )
     driver = _Driver(script, session, clock)
-    driver.run()
+    try:
+        driver.run()
+    except ScriptError:
+        if store is not None:
+            # a scripted patient that went wrong must not be offered for resuming at the kiosk
+            store.abandon(session.id)
+        raise
     trace = Trace(MODEL, [TraceEvent(_num(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
                           for e in session.trace])
     return ReplayResult(script, session, trace, replay(trace, model=model), session.now(), driver.events)

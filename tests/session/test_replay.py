@@ -177,3 +177,15 @@ def test_replays_can_be_stored_for_kiosk_results(tmp_path, capsys):
         assert (summary.patient_id, summary.status, summary.answered) == ("TB-0002", "finished", 10)
         assert [(a.item_id, a.option) for a in store.session(summary.id).answers] == [
             (a["item"], a["option"]) for a in printed["answers"]]
+
+
+def test_a_failed_stored_replay_is_abandoned_not_left_for_the_kiosk_to_resume(tmp_path, capsys):
+    from kiosk.storage import Store
+
+    data = tmp_path / "data"
+    path = write(tmp_path, GOOD.replace("option: 3, after: 4}", "option: 3, after: 21}", 1))
+    assert main([str(path), "--data-dir", str(data)]) == 2
+    with Store.open(data) as store:
+        (summary,) = store.sessions()
+        assert summary.status == "abandoned"
+        assert store.unfinished_sessions() == []
