@@ -198,6 +198,8 @@ class _Job:
     path: Path | None = None  # save here instead of playing
     done: threading.Event | None = None
     error: Exception | None = None
+    #: the speaker's generation when queued: a later stop_speaking supersedes the phrase
+    generation: int = 0
 
 
 class Speaker:
@@ -226,6 +228,11 @@ class Speaker:
         self._player: Player | None = None
         self._worker: threading.Thread | None = None
         self._ready = threading.Event()
+        #: bumped by stop_speaking; a phrase queued under an older generation is not played
+        self._generation = 0
+        self._generation_lock = threading.Lock()
+        #: whether the last phrase failed (LOST was reported): the next one played reports ON
+        self._lost = False
         self.available = False
         self.reason = ""
 
@@ -256,10 +263,13 @@ class Speaker:
         if self._ready.is_set() and not self.available:
             log.info("voice out is off (%s); not saying %r", self.reason, text[:40])
             return
-        self._jobs.put(_Job(text, language))
+        self._jobs.put(_Job(text, language, generation=self._generation))
 
     def stop_speaking(self) -> None:
-        """Cut the current phrase short and drop queued ones (the patient already answered)."""
+        """Cut the current phrase short and drop queued ones (the patient already answered),
+        including one being synthesised: it is never played."""
+        with self._generation_lock:
+            self._generation += 1
         with contextlib.suppress(queue.Empty):
             while True:
                 job = self._jobs.get_nowait()
@@ -312,6 +322,7 @@ class Speaker:
             except Exception as exc:  # one bad phrase must not end the kiosk's voice
                 log.warning("voice out failed for %r: %s", job.text[:40], exc)
                 if job.path is None:  # the patient did not hear it: the UI must say so
+                    self._lost = True
                     self.on_status(ChannelStatus(Channel.VOICE, ChannelState.LOST, source=self.source,
                                                  reason=f"voice out failed: {exc}"))
                 job.error = exc if isinstance(exc, TtsUnavailable) else TtsUnavailable(str(exc))
@@ -345,8 +356,15 @@ class Speaker:
                 samples = np.frombuffer(wav.readframes(wav.getnframes()), dtype="<i2")
         finally:
             os.unlink(name)
+        with self._generation_lock:
+            # stop_speaking while it was synthesised: it is off the queue and the player idle
+            if job.generation != self._generation:
+                return
         self.on_speech(True)
         try:
             self._player.play(samples, rate)
         finally:
             self.on_speech(False)
+        if self._lost:  # a phrase failed before; this one was heard, so voice out works again
+            self._lost = False
+            self.on_status(ChannelStatus(Channel.VOICE, ChannelState.ON, source=self.source))

@@ -12,7 +12,7 @@ import pytest
 from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.questionnaire import load_questionnaire
 from kiosk.speech.audio import frame_level_db
-from kiosk.speech.tts import DEFAULT_RATE, MIN_RATE, Delivery, Speaker, TtsUnavailable, delivery
+from kiosk.speech.tts import DEFAULT_RATE, MIN_RATE, Delivery, Speaker, Synthesiser, TtsUnavailable, delivery
 
 QUESTIONNAIRE = load_questionnaire()
 
@@ -207,9 +207,40 @@ def test_a_failing_loudspeaker_is_reported_and_the_next_phrase_still_plays():
     speaker.say("Second", "en")
     assert ended.acquire(timeout=10) and ended.acquire(timeout=10)
     speaker.close()
-    assert [s.state for s in statuses] == [ChannelState.ON, ChannelState.LOST]
+    # the second phrase was heard: voice out is on again, not lost for good
+    assert [s.state for s in statuses] == [ChannelState.ON, ChannelState.LOST, ChannelState.ON]
     assert statuses[1].reason == "voice out failed: PortAudio: device unavailable"
     assert len(player.played) == 2 and player.played[1] is not None
+
+
+def test_stop_speaking_drops_the_phrase_being_synthesised(monkeypatch):
+    """The patient answers while a phrase is still being synthesised (already off the queue,
+    the player idle): it is never played, and the next phrase is."""
+    synthesising, stopped = threading.Event(), threading.Event()
+    real = Synthesiser.synthesise
+
+    def held_synthesise(self, *args, **kwargs):
+        synthesising.set()
+        assert stopped.wait(10)  # hold the first phrase in synthesis until stop_speaking ran
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Synthesiser, "synthesise", held_synthesise)
+    player = _RecordingPlayer()
+    events: list[bool] = []
+    ended = threading.Event()
+    speaker = Speaker(player_factory=lambda: player,
+                      on_speech=lambda s: (events.append(s), None if s else ended.set()))
+    speaker.start()
+    speaker.say("How do you manage eating your meals?", "en")
+    assert synthesising.wait(10)
+    speaker.stop_speaking()
+    stopped.set()
+    speaker.say("Two", "en")
+    assert ended.wait(10)
+    speaker.close()
+    assert events == [True, False]  # no start/end events for the dropped phrase
+    (played,) = player.played
+    assert len(played[0]) / played[1] < 1.5  # "Two", not the question
 
 
 def test_without_espeak_ng_voice_out_is_off_and_says_why(monkeypatch, tmp_path):
