@@ -11,13 +11,13 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from kiosk.questionnaire import Questionnaire, Score
 from kiosk.storage import PracticeRecord, StoredSession
+from qos.files import write_private  # the one owner-only writer; exports use it from here too
 
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
@@ -199,13 +199,6 @@ def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
         band = score.band.id if score.band else ("incomplete" if not score.complete else "")
         writer.writerow(head + [TOTAL_LINK, "", band, score.total, "", "", "", "", score.band_set, "total", ""])
     return out.getvalue()
-
-
-def write_private(path: str | Path, text: str) -> None:
-    """Write an export readable by its owner only (it holds patient data)."""
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(fd, "w", encoding="utf-8") as handle:
-        handle.write(text)
 
 
 def write_json(path: str | Path, resource: dict[str, Any]) -> None:

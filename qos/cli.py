@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from qos.errors import QosError
+from qos.files import open_private
 from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
 
 
@@ -73,7 +74,8 @@ def plot(samples: ReplaySamples, path: Path, title: str) -> None:
     axes.legend(loc="best")
     figure.tight_layout()
     try:
-        figure.savefig(path, format="png")
+        with open_private(path, binary=True) as handle:
+            figure.savefig(handle, format="png")
     finally:
         pyplot.close(figure)
 

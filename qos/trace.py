@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import statistics
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -26,6 +25,7 @@ import yaml
 
 from qos.engine import Engine, UpdateResult, check_batch
 from qos.errors import ContextError, TraceError
+from qos.files import write_private
 from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")
@@ -133,9 +133,7 @@ def dump_trace(trace: Trace, path: str | Path, header: str | None = None) -> Non
     """Write a trace to a file (JSON when the name ends in .json, else YAML), readable by its owner only."""
     path = Path(path)
     text = trace.to_json() + "\n" if path.suffix == ".json" else trace.to_yaml(header)
-    descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(descriptor, "w", encoding="utf-8") as handle:
-        handle.write(text)
+    write_private(path, text)
 
 
 def _parse_event(raw: object, where: str) -> TraceEvent:

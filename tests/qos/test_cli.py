@@ -47,6 +47,15 @@ def test_plot_writes_a_png(tmp_path, capsys):
     assert "cannot write the plot" in capsys.readouterr().err
 
 
+def test_plot_replaces_a_world_readable_png_with_an_owner_only_one(tmp_path):
+    # the plot's title is the trace description, which names the patient
+    target = tmp_path / "old.png"
+    target.write_bytes(b"old")
+    target.chmod(0o644)
+    assert main(["replay", str(TABLE4), "--plot", str(target)]) == 0
+    assert target.stat().st_mode & 0o777 == 0o600 and target.read_bytes()[:4] == b"\x89PNG"
+
+
 @pytest.mark.parametrize(("trace", "model", "message"), [
     ("model: clarc\nevents:\n  - {t: 1, set: {Mood: happy}}\n", None,
      "python -m qos replay: {dir}/t.yaml: events[0]: context 'Mood' is not in model CLARC"),

@@ -117,6 +117,8 @@ def test_statistics_sample_every_period_up_to_the_last_event():
 
 def test_trace_writes_back_as_it_reads(tmp_path):
     original = load_trace("recordings/testbench/barthel5.yaml")
+    (tmp_path / "copy.json").write_text("{}")
+    (tmp_path / "copy.json").chmod(0o644)  # an old world-readable file is replaced owner-only
     for name in ("copy.yaml", "copy.json"):
         dump_trace(original, tmp_path / name, header="copied")
         assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o600

@@ -88,6 +88,8 @@ def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path
     assert len(listing) == 2 and all("finished" in line for line in listing)
     session_id = by_patient(export_store, "TB-0004").id
     fhir, table = tmp_path / "r.json", tmp_path / "r.csv"
+    table.write_text("old export\n")
+    table.chmod(0o644)  # an export written over an old world-readable file becomes owner-only
     assert results_main([session_id[:6], "--data-dir", data, "--fhir", str(fhir), "--csv", str(table)]) == 0
     shown = capsys.readouterr().out
     assert "total 65/100 (incomplete, missing grooming, bladder)" in shown
