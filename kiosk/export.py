@@ -17,7 +17,7 @@ from typing import Any
 
 from kiosk.questionnaire import Questionnaire, Score
 from kiosk.storage import PracticeRecord, StoredSession
-from qos.files import write_private  # the one owner-only writer; exports use it from here too
+from qos.files import write_error, write_private  # the one owner-only writer; exports use it from here too
 
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
@@ -26,7 +26,8 @@ TOTAL_LINK = "total"
 
 
 class ExportError(ValueError):
-    """A stored session does not fit the questionnaire (unknown item, option or points)."""
+    """A stored session does not fit the questionnaire (unknown item, option or points), or an
+    export cannot be written."""
 
 
 def questionnaire_url(q: Questionnaire) -> str:
@@ -201,6 +202,14 @@ def csv_text(q: Questionnaire, sessions: list[StoredSession]) -> str:
     return out.getvalue()
 
 
+def write_export(path: str | Path, text: str) -> None:
+    """Write an export owner-only; ExportError ``cannot write PATH: reason`` when the path is unusable."""
+    try:
+        write_private(path, text)
+    except OSError as exc:
+        raise ExportError(write_error(path, exc)) from None
+
+
 def write_json(path: str | Path, resource: dict[str, Any]) -> None:
-    """Write a FHIR resource as JSON, owner-only."""
-    write_private(path, json.dumps(resource, indent=2, ensure_ascii=False) + "\n")
+    """Write a FHIR resource as JSON, owner-only (ExportError when the path is unusable)."""
+    write_export(path, json.dumps(resource, indent=2, ensure_ascii=False) + "\n")

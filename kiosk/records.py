@@ -55,9 +55,13 @@ def trace_main(argv: list[str]) -> int:
     trace = session_trace(stored)
     text = trace.to_json() + "\n" if args.json else trace.to_yaml()
     if args.output:
-        from kiosk.export import write_private
+        from kiosk.export import ExportError, write_export
 
-        write_private(args.output, text)
+        try:
+            write_export(args.output, text)
+        except ExportError as exc:
+            print(f"kiosk qos trace: {exc}", file=sys.stderr)
+            return 2
     else:
         sys.stdout.write(text)
     return 0

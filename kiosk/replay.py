@@ -510,8 +510,13 @@ def main(argv: list[str]) -> int:
             store.close()
     if args.trace:
         from qos import dump_trace
+        from qos.files import write_error
 
-        dump_trace(results[0].trace, args.trace, header=f"context trace of {results[0].script.source}")
+        try:
+            dump_trace(results[0].trace, args.trace, header=f"context trace of {results[0].script.source}")
+        except OSError as exc:
+            print(f"kiosk replay: {write_error(args.trace, exc)}", file=sys.stderr)
+            return 2
     for result in results:
         if args.json:
             print(json.dumps(result.to_dict(), ensure_ascii=False))

@@ -20,8 +20,8 @@ from kiosk.export import (
     fhir_response,
     practice_outcomes,
     rescore,
+    write_export,
     write_json,
-    write_private,
 )
 from kiosk.questionnaire import QuestionnaireError
 from kiosk.records import open_store
@@ -78,7 +78,7 @@ def main(argv: list[str]) -> int:
             if args.session is None:
                 summaries = store.sessions()
                 if args.csv:
-                    write_private(args.csv, csv_text(q, [store.session(s.id) for s in summaries]))
+                    write_export(args.csv, csv_text(q, [store.session(s.id) for s in summaries]))
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
                 for s in summaries:
@@ -89,7 +89,7 @@ def main(argv: list[str]) -> int:
             if args.fhir:
                 write_json(args.fhir, fhir_response(q, stored))
             if args.csv:
-                write_private(args.csv, csv_text(q, [stored]))
+                write_export(args.csv, csv_text(q, [stored]))
             _show(q, stored)
     except (ConfigError, StorageError, QuestionnaireError, ExportError) as exc:
         print(f"kiosk results: {exc}", file=sys.stderr)

@@ -34,3 +34,8 @@ def write_private(path: str | Path, data: str | bytes) -> None:
     """Write text (UTF-8) or bytes to ``path``, created or replaced with mode 0600. Raises ``OSError``."""
     with open_private(path, binary=isinstance(data, bytes)) as handle:
         handle.write(data)
+
+
+def write_error(path: str | Path, exc: OSError) -> str:
+    """The one-line message for a file that cannot be written: ``cannot write PATH: reason``."""
+    return f"cannot write {path}: {exc.strerror or exc}"

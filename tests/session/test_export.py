@@ -162,3 +162,16 @@ def test_kiosk_results_says_when_a_session_had_no_practice(export_store, capsys)
     stored = by_patient(export_store, "TB-0001")
     assert results_main([stored.id, "--data-dir", str(export_store.path.parent)]) == 0
     assert "practice: none (no practice questions in this session)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("option", ["--csv", "--fhir", "--fhir-questionnaire"])
+def test_kiosk_results_to_an_unwritable_path_is_one_line_and_exit_2(export_store, tmp_path, capsys, option):
+    target = tmp_path / "no" / "such" / "out"
+    session_id = by_patient(export_store, "TB-0004").id
+    assert results_main([session_id, "--data-dir", str(export_store.path.parent), option, str(target)]) == 2
+    assert capsys.readouterr().err == f"kiosk results: cannot write {target}: No such file or directory\n"
+
+
+def test_kiosk_results_csv_of_all_sessions_to_a_directory_is_one_line_and_exit_2(export_store, tmp_path, capsys):
+    assert results_main(["--data-dir", str(export_store.path.parent), "--csv", str(tmp_path)]) == 2
+    assert capsys.readouterr().err == f"kiosk results: cannot write {tmp_path}: Is a directory\n"

@@ -189,3 +189,22 @@ def test_a_failed_stored_replay_is_abandoned_not_left_for_the_kiosk_to_resume(tm
         (summary,) = store.sessions()
         assert summary.status == "abandoned"
         assert store.unfinished_sessions() == []
+
+
+def test_replay_trace_to_an_unwritable_file_is_one_line_and_exit_2(tmp_path, capsys):
+    target = tmp_path / "missing" / "trace.yaml"
+    assert main([str(write(tmp_path, GOOD)), "--trace", str(target)]) == 2
+    assert capsys.readouterr().err == f"kiosk replay: cannot write {target}: No such file or directory\n"
+
+
+@pytest.mark.parametrize("data_dir", [False, True])
+def test_a_scripted_patient_named_by_name_is_rejected_where_it_is_written(tmp_path, capsys, data_dir):
+    from kiosk.storage import PATIENT_ID
+
+    path = write(tmp_path, GOOD.replace("patient: P-T1", 'patient: "Ann Smith"'))
+    extra = ["--data-dir", str(tmp_path / "data")] if data_dir else []
+    assert main([str(path), *extra]) == 2
+    assert capsys.readouterr().err.startswith(f"{path}:1:10: patient: 'Ann Smith' does not match")
+    # the script schema and the store accept the same ids
+    schema = json.loads((ROOT / "kiosk/patient.schema.json").read_text())
+    assert schema["properties"]["patient"]["pattern"] == PATIENT_ID.pattern

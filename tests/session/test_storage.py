@@ -221,3 +221,11 @@ def test_the_store_keeps_the_session_log_and_not_answered_questions(tmp_path):
         ("start", "answered by caregiver"), ("language", "fr"), ("pause", ""), ("resume", "")]
     assert stored.timing["attempt_window_s"] == 30
     assert [s.id for s in store.sessions()] == [rig.session.id]
+
+
+def test_kiosk_qos_trace_to_an_unwritable_file_is_one_line_and_exit_2(tmp_path, capsys):
+    with Store.open(tmp_path / "data") as store:
+        result = run_script(load_script(ROOT / "recordings/patients/barthel5.yaml"), store=store)
+    target = tmp_path / "missing" / "trace.yaml"
+    assert trace_main([result.session.id, "--data-dir", str(tmp_path / "data"), "-o", str(target)]) == 2
+    assert capsys.readouterr().err == f"kiosk qos trace: cannot write {target}: No such file or directory\n"
