@@ -55,7 +55,7 @@ from kiosk.session import (
 )
 from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
-from kiosk.widgets.bars import ControlBar
+from kiosk.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.widgets.channel_board import VOICE_IN, VOICE_OUT, ChannelBoard
 from kiosk.widgets.text import ui_text
 
@@ -242,6 +242,10 @@ class KioskApp(App[int]):
         """A touched Pause/Continue/Repeat/Call-doctor is a touch command."""
         self.forward(ChannelInput(Channel.TOUCH, command=message.command, detail="screen"))
 
+    def on_voice_again_button_requested(self, message: VoiceAgainButton.Requested) -> None:
+        """The patient asked to answer by voice again; the session decides."""
+        self._drive(self.session.request_voice)
+
     def on_welcome_screen_language_chosen(self, message: WelcomeScreen.LanguageChosen) -> None:
         """Start in the language the patient touched."""
         self._start(message.language)
@@ -335,8 +339,12 @@ class KioskApp(App[int]):
         if self.resumable is not None and snap.phase is Phase.WELCOME:
             offer = ui_text(snap.language, "resume_offer", answered=len(self.resumable.answers),
                             total=len(self.questionnaire.items))
+        # the session lifts voice_off when voice in goes; checked here too so the button never
+        # promises listening that cannot happen (and not over Continue while paused)
+        voice_again = ("voice_off" in snap.adaptations and not (snap.paused or snap.halted)
+                       and self.board.state(VOICE_IN)[0] is ChannelState.ON)
         return PatientView(snap, self.questionnaire, self.board.lines(snap.language),
-                           " ".join(notices) or None, offer)
+                           " ".join(notices) or None, voice_again=voice_again, resume_offer=offer)
 
     @staticmethod
     def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:

@@ -790,11 +790,15 @@ class Session:
             self._reprompt_after_freeze(t)
 
     def request_voice(self) -> None:
-        """The patient asks to answer by voice again (lifts a voice-off adaptation)."""
+        """The patient asks to answer by voice again (lifts a voice-off adaptation; logged)."""
         with _Op(self) as t:
-            if self.adaptation is not None:
-                for change in self.adaptation.patient_requests_voice():
-                    self._apply_adaptation(t, change)
+            if self.adaptation is None:
+                return
+            changes = self.adaptation.patient_requests_voice()
+            if changes:
+                self._log(t, "voice_requested", "the patient asked to answer by voice again")
+            for change in changes:
+                self._apply_adaptation(t, change)
 
     def set_voice_available(self, available: bool) -> None:
         """Whether voice in works on this kiosk (the UI knows it from the voice-in channel's status).

@@ -13,7 +13,7 @@ from textual.widgets import Label
 
 from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
-from kiosk.widgets.bars import AdaptationBanner, ChannelBar, ChannelLine
+from kiosk.widgets.bars import AdaptationBanner, ChannelBar, ChannelLine, VoiceAgainButton
 from kiosk.widgets.text import ui_text
 
 
@@ -27,6 +27,8 @@ class PatientView:
     channels: tuple[ChannelLine, ...]
     #: a notice to show above the answers (an adaptation, "we cannot see you"), or None
     banner: str | None = None
+    #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
+    voice_again: bool = False
     #: on the welcome screen: how far an interrupted session got, when it can be continued
     resume_offer: str | None = None
 
@@ -58,12 +60,13 @@ class PatientScreen(Screen):
         return self.view.snapshot.language
 
     def compose_bars(self) -> ComposeResult:
-        """Progress and attempt, channel states and the adaptation banner, at the top."""
+        """Progress and attempt, channel states, the adaptation banner and its voice-again button."""
         with Horizontal(id="topbar"):
             yield Label("", id="progress")
             yield Label("", id="attempt")
         yield ChannelBar(id="channels")
         yield AdaptationBanner(id="banner")
+        yield VoiceAgainButton(self.language)
 
     def on_mount(self) -> None:
         """Fill the bars once they exist."""
@@ -82,6 +85,8 @@ class PatientScreen(Screen):
             bar.show(view.channels)
         for banner in self.query(AdaptationBanner):
             banner.show(view.banner)
+        for button in self.query(VoiceAgainButton):
+            button.show(view.voice_again)
 
     def progress_text(self, view: PatientView) -> str:
         """The left of the top bar: the questionnaire's title unless a screen says more."""

@@ -59,6 +59,28 @@ class AdaptationBanner(Static):
         self.display = bool(message)
 
 
+class VoiceAgainButton(Button):
+    """"Answer by voice again": shown with the voice-off notice, so the patient can undo it (the
+    session decides; touch answers alone never give the voice evidence that would lift it)."""
+
+    class Requested(Message):
+        """The patient asked to answer by voice again."""
+
+    def __init__(self, language: str) -> None:
+        """Label the button in ``language``; hidden until :meth:`show` says otherwise."""
+        super().__init__(ui_text(language, "voice_again"), id="voice-again")
+        self.display = False
+
+    def show(self, shown: bool) -> None:
+        """Show or hide the button."""
+        self.display = shown
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        """A touch on the button is a request to the session, forwarded by the app."""
+        event.stop()
+        self.post_message(self.Requested())
+
+
 class ControlBar(Horizontal):
     """Pause, Repeat and Call-doctor, always visible at the bottom of the patient's screens."""
 

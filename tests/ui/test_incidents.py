@@ -9,7 +9,7 @@ from textual.widgets import Input, Label, Static
 
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.session import AttemptTimedOut, Phase, Prompt, QuestionNotAnswered
-from kiosk.widgets.bars import AdaptationBanner
+from kiosk.widgets.bars import AdaptationBanner, VoiceAgainButton
 
 from .conftest import UI_PIN
 from .helpers import late_touch_answer, screen_name, settle, start_in_english, start_with_voice_off
@@ -107,6 +107,28 @@ async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
         assert kiosk.session.phase is Phase.QUESTIONS
 
 
+async def test_the_patient_touches_answer_by_voice_again_and_the_kiosk_listens_again(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_with_voice_off(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        assert not kiosk.session.listening
+        button = kiosk.app.screen.query_one(VoiceAgainButton)
+        assert button.display and str(button.label) == "Answer by voice again"
+        await pilot.click("#voice-again")
+        await settle(pilot, lambda: kiosk.session.listening)
+        assert "voice_off" not in kiosk.session.snapshot().adaptations
+        assert not kiosk.app.screen.query_one(AdaptationBanner).display
+        assert not kiosk.app.screen.query_one(VoiceAgainButton).display
+        assert [e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")] == [
+            "voice_off", "voice_on"]
+        stored = kiosk.store.session(kiosk.session.id)
+        assert [(a.name, a.active, a.reason) for a in stored.adaptations][-1] == (
+            "voice_off", False, "the patient asked to answer by voice")
+        assert [e.kind for e in stored.log][-1:] == ["voice_requested"]
+
+
 async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)  # voice in is off: no microphone
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
@@ -115,6 +137,7 @@ async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
             await late_touch_answer(kiosk, pilot)
         assert "voice_off" not in kiosk.session.snapshot().adaptations  # the session knows voice in is off
         assert "trouble hearing" not in _text(kiosk.app.screen.query_one(AdaptationBanner))
+        assert not kiosk.app.screen.query_one(VoiceAgainButton).display
         assert not [e for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
         assert "voice_off" not in {a.name for a in kiosk.store.session(kiosk.session.id).adaptations}
 
