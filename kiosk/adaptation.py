@@ -15,6 +15,10 @@ from pathlib import Path
 from typing import Any
 
 from kiosk.yamlmarks import Problem, parse
+from qos import Model, load_model
+
+#: the QoS model the kiosk runs (sessions, replays, stored traces); the rules watch its properties
+MODEL = "clarc"
 
 #: adaptations the session knows how to carry out
 KNOWN = ("voice_off", "slow_speech")
@@ -57,8 +61,12 @@ class AdaptationChange:
     reason: str
 
 
-def load_policy(path: str | Path | None = None) -> Policy:
-    """Load an adaptation policy (default: the bundled ``kiosk/adaptation.yaml``)."""
+def load_policy(path: str | Path | None = None, model: Model | None = None) -> Policy:
+    """Load an adaptation policy (default: the bundled ``kiosk/adaptation.yaml``).
+
+    Each rule's metric must be a property of ``model`` (default: the bundled CLARC model the
+    session runs), so a misspelt metric is an error instead of a rule that never fires.
+    """
     if path is None:
         text, name = resources.files("kiosk").joinpath("adaptation.yaml").read_text(encoding="utf-8"), "adaptation.yaml"
     else:
@@ -77,7 +85,8 @@ def load_policy(path: str | Path | None = None) -> Policy:
 
     if not isinstance(data, dict) or set(data) != {"rules"} or not isinstance(data["rules"], list):
         raise fail((), "an adaptation policy is a mapping with one key, 'rules', holding a list")
-    rules = []
+    properties = sorted((model or load_model(MODEL)).properties)
+    rules: list[Rule] = []
     for i, raw in enumerate(data["rules"]):
         p = ("rules", i)
         if not isinstance(raw, dict):
@@ -90,12 +99,17 @@ def load_policy(path: str | Path | None = None) -> Policy:
             raise fail(p, f"rule is missing {sorted(missing)[0]!r}")
         if raw["name"] not in KNOWN:
             raise fail(p + ("name",), f"unknown adaptation {raw['name']!r} (known: {', '.join(KNOWN)})")
+        if any(rule.name == raw["name"] for rule in rules):
+            raise fail(p + ("name",), f"a second rule for {raw['name']!r} (one rule per adaptation)")
+        if raw["metric"] not in properties:
+            raise fail(p + ("metric",), f"unknown metric {raw['metric']!r} (the model's properties: "
+                                        f"{', '.join(properties)})")
         if raw["count_on"] not in ("answers", "updates"):
             raise fail(p + ("count_on",), "count_on is 'answers' or 'updates'")
-        for key in ("below", "recover_above", "speech_rate"):
+        for key, top in (("below", 1), ("recover_above", 1), ("speech_rate", 2)):
             value = raw.get(key, 1.0)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= 2:
-                raise fail(p + (key,), f"{key} must be a number between 0 and 1 (speech_rate up to 2)")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= top:
+                raise fail(p + (key,), f"{key} must be a number between 0 and {top}")
         if not isinstance(raw["count"], int) or isinstance(raw["count"], bool) or raw["count"] < 1:
             raise fail(p + ("count",), "count must be a whole number of at least 1")
         if raw["recover_above"] < raw["below"]:

@@ -11,10 +11,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from kiosk.adaptation import MODEL
 from kiosk.config import ConfigError, load_config
 from kiosk.storage import StorageError, Store, StoredSession
 
-MODEL = "clarc"
+__all__ = ["MODEL", "open_store", "session_trace", "trace_main"]
 
 
 def open_store(data_dir: str | None) -> Store:

@@ -38,10 +38,8 @@ from kiosk.session import (
     Session,
     SessionEvent,
 )
+from kiosk.adaptation import MODEL
 from kiosk.yamlmarks import Problem, describe, parse, schema_problems
-
-#: the QoS model scripted sessions are watched by
-MODEL = "clarc"
 
 #: incidents that are commands a patient gives through a channel
 _COMMANDS = {"pause": Command.PAUSE, "resume": Command.RESUME, "call_doctor": Command.CALL_DOCTOR,

@@ -79,6 +79,13 @@ def test_disabled_adaptation_does_nothing_and_turning_it_off_lifts_everything():
      "0.4}", "recover_above must not be below 'below'"),
     ("rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 0, count_on: answers, recover_above: 0.4}\n",
      "0, count_on", "count must be a whole number of at least 1"),
+    ("rules:\n  - {name: voice_off, metric: VoiceInteractionQualty, below: 0.2, count: 3, count_on: answers,"
+     " recover_above: 0.4}\n", "VoiceInteractionQualty", "unknown metric 'VoiceInteractionQualty' (the model's "
+     "properties: Interaction, Performance, VoiceInteractionQuality)"),
+    ("rules:\n  - {name: voice_off, metric: Interaction, below: 1.5, count: 3, count_on: answers, recover_above: 1.8}\n",
+     "1.5", "below must be a number between 0 and 1"),
+    ("rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 3, count_on: answers, recover_above: 1.5}\n",
+     "1.5", "recover_above must be a number between 0 and 1"),
     ("rules: [\n", None, ":2:1: YAML syntax"),
     ("policy: []\n", None, ":1:1: an adaptation policy is a mapping with one key, 'rules'"),
 ])
@@ -142,3 +149,24 @@ def test_low_interaction_slows_speech_and_repeats_the_question():
     after = rig.events[rig.events.index(slow[0]):]
     later = [p for p in after if isinstance(p, Prompt) and p.kind == "question"]
     assert later and all(p.speech_rate == 0.85 for p in later)
+
+
+def test_a_second_rule_for_the_same_adaptation_is_an_error(tmp_path):
+    rule = "  - {name: slow_speech, metric: Interaction, below: 0.2, count: 3, count_on: answers, recover_above: 0.4}\n"
+    path = tmp_path / "policy.yaml"
+    path.write_text("rules:\n" + rule + rule)
+    with pytest.raises(PolicyError) as caught:
+        load_policy(path)
+    assert str(caught.value) == f"{path}:3:12: a second rule for 'slow_speech' (one rule per adaptation)"
+
+
+def test_the_metric_is_checked_against_the_model_given(tmp_path):
+    from qos import parse_model
+
+    path = tmp_path / "policy.yaml"
+    path.write_text("rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 3, count_on: answers,"
+                    " recover_above: 0.4}\n")
+    assert load_policy(path).rules[0].metric == "Interaction"
+    other = parse_model("roqme Other\nproperty Calm reference 0.5\n", "other.roqme")
+    with pytest.raises(PolicyError, match=r":2:31: unknown metric 'Interaction' \(the model's properties: Calm\)"):
+        load_policy(path, model=other)
