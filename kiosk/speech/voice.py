@@ -8,8 +8,11 @@ closes the microphone gate, and while the session is paused only commands are li
 :class:`kiosk.speech.tts.Speaker`'s ``on_speech``). Audio arrives on the microphone's thread;
 answers and status changes go to the sink from that thread, as the channel contract says.
 
-Without a microphone or a recogniser for the language, voice in reports
-``ChannelStatus(VOICE, OFF, reason=...)`` and the session goes on with the other channels.
+Speech models load on the channel's own loader thread (seconds for vosk), never on the thread
+that changes the language; meanwhile voice in is CONNECTING and does not listen. Every status
+carries the source ``"voice"``, the latest one being the truth. Without a microphone or a
+recogniser for the language, voice in reports ``ChannelStatus(VOICE, OFF, "voice", reason=...)``
+and the session goes on with the other channels.
 """
 
 from __future__ import annotations
@@ -26,6 +29,9 @@ from kiosk.speech.audio import AudioUnavailable, MicrophoneStream, PcmConsumer, 
 from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords
 
 log = logging.getLogger(__name__)
+
+#: how long attach()/wait_loaded() wait for a speech model (a large vosk model takes seconds)
+LOAD_TIMEOUT_S = 60.0
 
 
 def option_words(options: Sequence[Any]) -> list[OptionWords]:
@@ -65,54 +71,75 @@ class VoiceChannel:
         self._matcher: Matcher | None = None
         self._options: list[OptionWords] = []
         self._listening = self._speaking = self._paused = False
+        #: notified when the loader thread ends (see wait_loaded)
+        self._loaded = threading.Condition(self._lock)
+        #: whether audio can arrive (microphone open, or attached): language changes load models
+        self._running = False
+        #: stop() was called: a start() still opening the microphone closes it again
+        self._stopped = False
+        #: the language the loader thread is to load next, and that thread while it runs
+        self._wanted: str | None = None
+        self._loader: threading.Thread | None = None
 
     # -- InputSource -------------------------------------------------------------------------
 
     def start(self, sink: Sink) -> None:
-        """Open the microphone and load the recogniser; reports ON, or OFF with the reason.
+        """Open the microphone, then load the recogniser on the channel's loader thread: reports
+        CONNECTING while it loads, then ON, or OFF with the reason. Does not wait for the model.
 
         The microphone stays open when only the recogniser is missing: choosing a language
         that has one turns voice answers on.
         """
-        self._sink = sink
-        self._microphone = self._microphone_factory(self)
-        try:
-            self._microphone.start()
-        except AudioUnavailable as exc:
-            self._microphone = None
-            self._status(ChannelState.OFF, "microphone", str(exc))
-            return
-        if self._open_recogniser(self.language):
-            self._status(ChannelState.ON, self._recogniser.name)
-            with self._lock:
-                self._apply_grammar()
-
-    def attach(self, sink: Sink) -> bool:
-        """Like :meth:`start` without a microphone: audio comes from :meth:`feed` (WAV files,
-        tests, the benchmark). Returns whether a recogniser is available."""
-        self._sink = sink
-        if not self._open_recogniser(self.language):
-            return False
         with self._lock:
-            self._apply_grammar()
-        return True
+            if self._stopped:
+                return
+            self._sink = sink
+        microphone = self._microphone_factory(self)
+        try:
+            microphone.start()
+        except AudioUnavailable as exc:
+            self._status(ChannelState.OFF, str(exc))
+            return
+        with self._lock:
+            if not self._stopped:
+                self._microphone = microphone
+                self._running = True
+                self._load(self.language)
+                return
+        # stop() came while the microphone was opening: nobody else will close it
+        microphone.stop()
+
+    def attach(self, sink: Sink, timeout: float = LOAD_TIMEOUT_S) -> bool:
+        """Like :meth:`start` without a microphone: audio comes from :meth:`feed` (WAV files,
+        tests, the benchmark). Waits for the recogniser; returns whether one is available."""
+        with self._lock:
+            self._sink = sink
+            self._running = True
+            self._load(self.language)
+        return self.wait_loaded(timeout)
+
+    def wait_loaded(self, timeout: float = LOAD_TIMEOUT_S) -> bool:
+        """Wait until no recogniser is being loaded; returns whether voice in has one now."""
+        with self._loaded:
+            self._loaded.wait_for(lambda: self._loader is None, timeout)
+            return self._recogniser is not None
 
     def stop(self) -> None:
-        """Close the microphone; safe to call twice."""
-        if self._microphone is not None:
-            self._microphone.stop()
-            self._microphone = None
+        """Close the microphone, also one a concurrent :meth:`start` is still opening; safe to
+        call twice. A model still loading is dropped when it arrives."""
+        with self._lock:
+            self._stopped = True
+            self._running = False
+            self._wanted = None
+            microphone, self._microphone = self._microphone, None
+        if microphone is not None:  # outside the lock: its thread may be in feed()
+            microphone.stop()
 
     def feed(self, pcm: bytes) -> None:
         """16 kHz mono int16 audio into the pipeline (what the microphone thread does)."""
         with self._lock:
             if self._pipeline is not None:
                 self._pipeline.feed(pcm)
-
-    @property
-    def pipeline(self) -> UtterancePipeline | None:
-        """The audio pipeline, for :func:`kiosk.speech.audio.feed_wav`; None when voice in is off."""
-        return self._pipeline
 
     # -- what the session and the voice out tell it (UI / TTS threads) ------------------------
 
@@ -139,9 +166,9 @@ class VoiceChannel:
             self._options = list(options)
             if language != self.language:
                 self.language = language
-                # before start() the language is only noted; a failure is reported once, not per question
-                if self._sink is not None and self._open_recogniser(language) and self._microphone is not None:
-                    self._status(ChannelState.ON, self._recogniser.name)
+                # before start() the language is only noted; the model loads off the UI thread
+                if self._running:
+                    self._load(language)
             self._apply_grammar()
 
     def listen(self, listening: bool) -> None:
@@ -165,22 +192,56 @@ class VoiceChannel:
                 self._apply_grammar()
                 self._gate()
 
-    def _open_recogniser(self, language: str) -> bool:
-        try:
-            recogniser = self._recogniser_factory(language)
-        except AsrUnavailable as exc:
-            self._recogniser = self._pipeline = None
-            self._status(ChannelState.OFF, "speech recognition", str(exc))
-            return False
-        with self._lock:
-            self._recogniser = recogniser
-            if self._pipeline is None:
-                self._pipeline = UtterancePipeline(recogniser, self._on_utterance)
-            else:
-                self._pipeline.muted = True  # drop an utterance the old recogniser was hearing
-                self._pipeline.recogniser = recogniser
-            self._gate()
-        return True
+    def _load(self, language: str) -> None:
+        """(Lock held.) Have the loader thread load ``language``'s recogniser; until it is
+        installed voice in does not listen, and its status says so."""
+        self._recogniser = self._matcher = None
+        self._gate()
+        self._wanted = language
+        self._status(ChannelState.CONNECTING, f"loading the speech model for {language!r}")
+        if self._loader is None:
+            self._loader = threading.Thread(target=self._run_loader, name="kiosk-voice-model", daemon=True)
+            self._loader.start()
+
+    def _run_loader(self) -> None:
+        """The loader thread: loads the wanted language's recogniser (seconds for vosk) and
+        installs it only if that is still the language; ends when nothing more is wanted."""
+        while True:
+            with self._lock:
+                language, self._wanted = self._wanted, None
+                if language is None or self._stopped:
+                    self._loader = None
+                    self._loaded.notify_all()
+                    return
+            recogniser, failure = None, ""
+            try:
+                recogniser = self._recogniser_factory(language)
+            except AsrUnavailable as exc:
+                failure = str(exc)
+            except Exception as exc:  # a broken model must not leave voice in loading for ever
+                log.exception("voice: loading the speech model for %r failed", language)
+                failure = f"the speech model for {language!r} cannot be loaded ({exc})"
+            with self._lock:
+                if self._stopped or language != self.language:
+                    continue  # superseded while it loaded: the newer language is wanted next
+                if self._wanted == language:
+                    self._wanted = None  # changed away and back while loading: this one is current
+                if recogniser is None:
+                    self._status(ChannelState.OFF, failure)
+                else:
+                    self._install(recogniser)
+
+    def _install(self, recogniser: Recogniser) -> None:
+        """(Lock held.) Make ``recogniser`` the one the audio reaches, with the current grammar."""
+        self._recogniser = recogniser
+        if self._pipeline is None:
+            self._pipeline = UtterancePipeline(recogniser, self._on_utterance)
+        else:
+            self._pipeline.muted = True  # drop an utterance the old recogniser was hearing
+            self._pipeline.recogniser = recogniser
+        self._apply_grammar()
+        self._gate()
+        self._status(ChannelState.ON, f"voice answers on: {recogniser.name}")
 
     def _apply_grammar(self) -> None:
         if self._recogniser is None or not (self._options or self._paused):
@@ -192,7 +253,8 @@ class VoiceChannel:
 
     def _gate(self) -> None:
         if self._pipeline is not None:
-            wanted = (self._listening or self._paused) and self._matcher is not None
+            wanted = (self._listening or self._paused) and self._matcher is not None \
+                and self._recogniser is not None
             self._pipeline.muted = self._speaking or not wanted
 
     def _on_utterance(self, utterance: Utterance) -> None:
@@ -206,7 +268,10 @@ class VoiceChannel:
             self._sink(ChannelInput(Channel.VOICE, option=match.option, command=match.command,
                                     detail=result.text, confidence=round(result.confidence, 3)))
 
-    def _status(self, state: ChannelState, source: str, reason: str = "") -> None:
+    def _status(self, state: ChannelState, reason: str) -> None:
+        """Every status under the one source name, so the latest always wins on the channel
+        board; what it is about (microphone, model, recogniser) is in the reason."""
         if self._sink is not None:
-            self._sink(ChannelStatus(Channel.VOICE, state, source=source,
-                                     reason=reason and f"voice answers off: {reason}"))
+            if state is ChannelState.OFF:
+                reason = f"voice answers off: {reason}"
+            self._sink(ChannelStatus(Channel.VOICE, state, source=self.name, reason=reason))

@@ -23,6 +23,7 @@ from kiosk.speech.audio import feed_wav, list_input_devices, resample
 from kiosk.speech.models import find_model
 from kiosk.speech.tts import VOICES, Speaker
 from kiosk.speech.voice import VoiceChannel
+from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
 
 QUESTIONNAIRE = load_questionnaire()
 DEVELOPER_MODELS = Path(__file__).resolve().parents[2].parent / "shared" / "models"
@@ -204,8 +205,8 @@ def test_no_recogniser_for_the_language_turns_voice_off_and_the_session_goes_on(
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     kiosk = _Kiosk(open_recogniser, language="es")
     assert not kiosk.available
-    (status,) = kiosk.statuses
-    assert (status.channel, status.state) == (Channel.VOICE, ChannelState.OFF)
+    loading, status = kiosk.statuses
+    assert (loading.state, status.channel, status.state) == (ChannelState.CONNECTING, Channel.VOICE, ChannelState.OFF)
     assert "no speech model for language 'es'" in status.reason
     kiosk.to_question("bathing")  # answered feeding by touch on the way
     assert kiosk.session.answers["feeding"].channel is Channel.TOUCH
@@ -218,7 +219,7 @@ def test_no_microphone_turns_voice_off_with_a_reason():
     voice = VoiceChannel("en")
     voice.start(statuses.append)
     voice.stop()
-    assert statuses == [ChannelStatus(Channel.VOICE, ChannelState.OFF, source="microphone",
+    assert statuses == [ChannelStatus(Channel.VOICE, ChannelState.OFF, source="voice",
                                       reason="voice answers off: no microphone found")]
 
 
@@ -234,6 +235,7 @@ def test_language_change_follows_the_prompts(spoken):
     kiosk = _Kiosk(factory)
     kiosk.to_question("feeding")
     kiosk.session.choose_language("fr")
+    assert not kiosk.voice.wait_loaded()
     assert opened == ["en", "fr"]
     assert kiosk.statuses[-1].state is ChannelState.OFF
 
@@ -298,14 +300,95 @@ def test_started_channel_hears_its_microphone_thread_and_follows_language_change
     microphones: list[_WavMicrophone] = []
     kiosk = _Kiosk(open_recogniser, language="es",
                    microphone=lambda consumer: microphones.append(_WavMicrophone(consumer)) or microphones[-1])
-    (off,) = kiosk.statuses  # the microphone works; Spanish has no recogniser here
+    assert not kiosk.voice.wait_loaded()
+    (loading, off) = kiosk.statuses  # the microphone works; Spanish has no recogniser here
     assert off.state is ChannelState.OFF and "no speech model for language 'es'" in off.reason
     kiosk.to_question("bathing")
     kiosk.session.choose_language("en")  # the prompt comes again, in English
-    assert [(s.state, s.source) for s in kiosk.statuses[1:]] == [(ChannelState.ON, "pocketsphinx")]
+    assert kiosk.voice.wait_loaded()
+    assert [(s.state, s.source, s.reason) for s in kiosk.statuses[2:]] == [
+        (ChannelState.CONNECTING, "voice", "loading the speech model for 'en'"),
+        (ChannelState.ON, "voice", "voice answers on: pocketsphinx")]
     (microphone,) = microphones
     microphone.files.append(spoken("independent"))
     microphone.thread.start()
     microphone.thread.join(timeout=30)
     assert kiosk.session.answers["bathing"].option == 2
     assert kiosk.session.answers["bathing"].channel is Channel.VOICE
+
+
+def _no_models(monkeypatch, tmp_path) -> None:
+    """A kiosk with no vosk model: English has pocketsphinx, Spanish nothing."""
+    monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
+
+
+def test_a_language_without_a_model_turns_voice_in_off_on_the_channel_board(spoken, monkeypatch, tmp_path):
+    _no_models(monkeypatch, tmp_path)
+    kiosk = _Kiosk(open_recogniser, microphone=_WavMicrophone)
+    assert kiosk.voice.wait_loaded()
+    kiosk.to_question("feeding")
+    kiosk.session.choose_language("es")
+    assert not kiosk.voice.wait_loaded()
+    board = ChannelBoard(Speaker.source)
+    for status in kiosk.statuses:
+        board.update(status)
+    # one source: the latest status replaces the English ON instead of standing beside it
+    assert {s.source for s in kiosk.statuses} == {"voice"}
+    state, reason = board.state(VOICE_IN)
+    assert state is ChannelState.OFF and "no speech model for language 'es'" in reason
+    kiosk.say(spoken("independent"))  # nobody is listening any more
+    assert kiosk.session.answers == {} and kiosk.unmatched == []
+
+
+def test_models_load_off_the_thread_that_changes_language_and_a_late_one_is_not_installed(
+        spoken, monkeypatch, tmp_path):
+    _no_models(monkeypatch, tmp_path)
+    english_loading, english_loaded = threading.Event(), threading.Event()
+    loads: list[tuple[str, threading.Thread]] = []
+
+    def slow_english(language):
+        loads.append((language, threading.current_thread()))
+        if language == "en":  # a model that takes a while, still loading when the language changes
+            english_loading.set()
+            assert english_loaded.wait(10)
+        return open_recogniser(language)
+
+    kiosk = _Kiosk(slow_english, microphone=_WavMicrophone)  # start() does not wait for the model
+    kiosk.to_question("feeding")
+    assert english_loading.wait(10)
+    kiosk.session.choose_language("es")  # returns at once, though English is still loading
+    english_loaded.set()
+    assert not kiosk.voice.wait_loaded()
+    assert [language for language, _ in loads] == ["en", "es"]
+    assert threading.current_thread() not in {thread for _, thread in loads}
+    # the English recogniser arrived after Spanish was chosen: never installed, never ON
+    assert [s.state for s in kiosk.statuses] == [ChannelState.CONNECTING, ChannelState.CONNECTING,
+                                                 ChannelState.OFF]
+    kiosk.say(spoken("independent"))
+    assert kiosk.session.answers == {}
+
+
+def test_stop_while_the_microphone_opens_leaves_it_closed():
+    class OpeningMicrophone:
+        """A device that takes a while to open: the app stops the channel meanwhile."""
+
+        def __init__(self, consumer) -> None:
+            self.open = False
+
+        def start(self) -> None:
+            voice.stop()  # the kiosk quits while the device is opening
+            self.open = True
+
+        def stop(self) -> None:
+            self.open = False
+
+    microphones: list[OpeningMicrophone] = []
+    voice = VoiceChannel("en", recogniser_factory=PocketSphinxRecogniser,
+                         microphone_factory=lambda consumer: microphones.append(OpeningMicrophone(consumer))
+                         or microphones[-1])
+    statuses: list[ChannelStatus] = []
+    voice.start(statuses.append)
+    (microphone,) = microphones
+    assert not microphone.open
+    assert statuses == []  # a stopped channel loads nothing and reports nothing
