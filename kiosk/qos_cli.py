@@ -7,7 +7,6 @@ only when asked for.
 
 from __future__ import annotations
 
-import importlib
 import sys
 from collections.abc import Sequence
 
@@ -16,21 +15,11 @@ from qos.cli import main as qos_main
 PROG = "kiosk qos"
 
 
-def _trace(argv: list[str]) -> int:
-    try:
-        records = importlib.import_module("kiosk.records")
-    except ModuleNotFoundError as exc:
-        if exc.name != "kiosk.records":
-            raise
-        print(f"{PROG} trace: session records are not available in this build (kiosk.records is missing)",
-              file=sys.stderr)
-        return 2
-    return int(records.trace_main(argv) or 0)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Dispatch ``trace`` to the session records and everything else to the QoS replay tool."""
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] == "trace":
-        return _trace(args[1:])
+        from kiosk.records import trace_main  # the session store, only when asked for
+
+        return trace_main(args[1:])
     return qos_main(args, prog=PROG, epilog="`kiosk qos trace SESSION` prints a stored session's context trace.")

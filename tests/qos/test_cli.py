@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from kiosk import qos_cli
-from qos import replay
+from qos import load_trace, replay
 from qos.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -79,23 +79,22 @@ def test_bad_arguments_exit_2(capsys):
     assert "must be a positive number of seconds" in capsys.readouterr().err
 
 
-def test_kiosk_qos_trace_without_the_session_records_is_one_clear_error(monkeypatch, capsys):
-    monkeypatch.setitem(sys.modules, "kiosk.records", None)  # as if kiosk.records did not exist
-    assert qos_cli.main(["trace", "S1"]) == 2
-    assert capsys.readouterr().err == ("kiosk qos trace: session records are not available in this build "
-                                       "(kiosk.records is missing)\n")
+def test_kiosk_qos_trace_prints_a_stored_sessions_trace_that_replays_to_its_metrics(tmp_path, capsys):
+    from kiosk.replay import load_script, run_script
+    from kiosk.storage import Store
 
-
-def test_kiosk_qos_trace_hands_its_arguments_to_the_session_records(monkeypatch):
-    import types
-
-    # kiosk.records is written by the session-core work; a stand-in checks the hand-over only
-    records = types.ModuleType("kiosk.records")
-    calls = []
-    records.trace_main = lambda argv: calls.append(argv) or 0
-    monkeypatch.setitem(sys.modules, "kiosk.records", records)
-    assert qos_cli.main(["trace", "S1", "--json"]) == 0
-    assert calls == [["S1", "--json"]]
+    data = tmp_path / "data"
+    with Store.open(data) as store:
+        result = run_script(load_script(ROOT / "recordings/patients/barthel3.yaml"), store=store)
+        stored = store.session(result.session.id)
+    assert qos_cli.main(["trace", result.session.id, "--data-dir", str(data)]) == 0
+    printed = tmp_path / "printed.yaml"
+    printed.write_text(capsys.readouterr().out)
+    assert main(["replay", str(printed), "--json"]) == 0
+    replayed = json.loads(capsys.readouterr().out)
+    assert stored.metrics and len(load_trace(printed).events) == len(stored.trace)
+    for name, value in stored.metrics[-1].metrics.items():
+        assert replayed["metrics"][name]["last"] == pytest.approx(value, abs=1e-12)
 
 
 @pytest.mark.parametrize("command", [["-m", "qos"], ["-m", "kiosk", "qos"]])
