@@ -142,8 +142,6 @@ class PocketSphinxRecogniser:
         #: whether a whole utterance has been decoded (see :meth:`accept`)
         self._settled = False
         self._pcm = bytearray()
-        #: the parts of the last confidence (coverage, cost), for the benchmark's report
-        self.last_scores: dict[str, float] = {}
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
         """Compile the phrases the dictionary knows to JSGF and make it the active search.
@@ -225,7 +223,6 @@ class PocketSphinxRecogniser:
         acoustic = _sigmoid((PS_COST_MIDPOINT - cost) / PS_COST_SPREAD)
         # a phrase the model cannot tell from another answer's is never taken as either
         distinct = 0.0 if hyp.hypstr in self._confusable else 1.0
-        self.last_scores = {"coverage": coverage, "cost": cost, "distinct": distinct}
         return Recognition(hyp.hypstr, min(coverage, acoustic, distinct))
 
 
