@@ -431,13 +431,11 @@ class KioskApp(App[int]):
         return self._new_session is not None
 
     def start_new_session(self) -> None:
-        """The clinician starts over for the next patient. A started, unfinished session is marked
-        abandoned (its answers stay stored) so a restart does not offer it again."""
+        """The clinician starts over for the next patient; the session decides whether the one it
+        replaces counts as abandoned (:meth:`Session.abandon`)."""
         if self._new_session is None:
             return
-        old = self.session
-        if self.store is not None and old.phase is not Phase.WELCOME and not old.finished:
-            self.store.abandon(old.id)
+        self.session.abandon()
         self._replace_session(self._new_session())
         self.close_clinician()
 

@@ -789,6 +789,19 @@ class Session:
             self._emit(PersonBack(t, self._deadline_t()))
             self._reprompt_after_freeze(t)
 
+    def abandon(self) -> bool:
+        """The clinician starts over for the next patient: a started, unfinished session is logged
+        and marked abandoned in the store (its answers stay) so a restart does not offer to resume
+        it. True if it was abandoned; a session still on the welcome screen or finished is left as it is.
+        """
+        with _Op(self) as t:
+            if self.phase is Phase.WELCOME or self.finished:
+                return False
+            self._log(t, "abandoned", "a new session was started")
+            if self.store is not None:
+                self.store.abandon(self.id)
+            return True
+
     def request_voice(self) -> None:
         """The patient asks to answer by voice again (lifts a voice-off adaptation; logged)."""
         with _Op(self) as t:

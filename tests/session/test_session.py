@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from kiosk.channels import Channel, ChannelInput, Command
+from kiosk.storage import Store
 from kiosk.session import (
     AnswerRecorded,
     AttemptOpened,
@@ -338,3 +339,33 @@ def test_two_operations_at_one_instant_are_recorded_as_the_engine_saw_them():
     engine = Engine(MODEL)
     replayed = [(t, engine.update(t, set=v, emit=em)) for t, v, em in trace.batches()]
     assert [(t, r.metrics, tuple(r.fired)) for t, r in replayed] == live
+
+
+def test_abandon_marks_a_started_unfinished_session_and_logs_why(tmp_path):
+    store = Store.open(tmp_path)
+    rig = started(store=store)
+    rig.at(30)
+    rig.answer(1)
+    assert rig.session.abandon()
+    stored = store.session(rig.session.id)
+    assert stored.status == "abandoned" and len(stored.answers) == 1  # the answer stays
+    assert [(e.kind, e.detail) for e in stored.log][-1] == ("abandoned", "a new session was started")
+    assert store.unfinished_sessions() == []
+    store.close()
+
+
+def test_abandon_leaves_a_session_on_the_welcome_screen_or_finished_as_it_is(tmp_path):
+    store = Store.open(tmp_path)
+    waiting = make_rig(store=store)
+    assert not waiting.session.abandon()
+    assert store.sessions() == []  # never started, so never stored
+    rig = started(store=store)
+    for _ in QUESTIONNAIRE.items:
+        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # noqa: SLF001 - open the next item
+        rig.answer(1)
+    rig.run_until(rig.session.now() + 20)
+    assert rig.session.finished
+    assert not rig.session.abandon()
+    stored = store.session(rig.session.id)
+    assert stored.status == "finished" and "abandoned" not in [e.kind for e in stored.log]
+    store.close()
