@@ -74,11 +74,6 @@ class Config:
     source: Path | None = None
 
     @property
-    def database(self) -> Path:
-        """The SQLite file inside the data directory."""
-        return self.data_dir / "kiosk.sqlite3"
-
-    @property
     def default_pin(self) -> bool:
         """The PIN is still the public default."""
         return self.clinician_pin == DEFAULT_PIN

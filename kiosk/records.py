@@ -25,14 +25,10 @@ def open_store(data_dir: str | None) -> Store:
 
 def session_trace(stored: StoredSession):  # -> qos.Trace
     """A stored session's context trace as a ``qos.Trace``."""
-    from qos import Trace, TraceEvent
+    from qos import Trace
 
-    def num(t: float) -> float | int:
-        return int(t) if float(t).is_integer() else t
-
-    return Trace(MODEL, [TraceEvent(num(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
-                         for e in stored.trace],
-                 description=f"session {stored.id} (patient {stored.patient_id}, started {stored.started_at})")
+    return Trace.from_events(MODEL, stored.trace, description=f"session {stored.id} (patient {stored.patient_id}, "
+                                                             f"started {stored.started_at})")
 
 
 def trace_main(argv: list[str]) -> int:

@@ -40,6 +40,7 @@ from kiosk.session import (
 )
 from kiosk.adaptation import MODEL
 from kiosk.yamlmarks import Problem, describe, parse, schema_problems
+from qos.trace import seconds
 
 #: incidents that are commands a patient gives through a channel
 _COMMANDS = {"pause": Command.PAUSE, "resume": Command.RESUME, "call_doctor": Command.CALL_DOCTOR,
@@ -277,7 +278,7 @@ class ReplayResult:
 
 
 def _num(value: float) -> float | int:
-    return int(value) if float(value).is_integer() else round(value, 6)
+    return round(seconds(value), 6)
 
 
 class _Driver:
@@ -427,7 +428,7 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
                model: Any = None) -> ReplayResult:
     """Run a script through a real Session and QoS engine on a simulated clock."""
     from kiosk.adaptation import Adaptation, load_policy
-    from qos import Engine, Trace, TraceEvent, load_model, replay
+    from qos import Engine, Trace, load_model, replay
 
     questionnaire = questionnaire or load_questionnaire()
     model = model or load_model(MODEL)
@@ -446,8 +447,7 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
             # a scripted patient that went wrong must not be offered for resuming at the kiosk
             store.abandon(session.id)
         raise
-    trace = Trace(MODEL, [TraceEvent(_num(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
-                          for e in session.trace])
+    trace = Trace.from_events(MODEL, session.trace)
     return ReplayResult(script, session, trace, replay(trace, model=model), session.now(), driver.events)
 
 

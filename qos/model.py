@@ -6,7 +6,6 @@ own run-time state, so one model can serve many engines.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Union
 
@@ -212,11 +211,6 @@ class Observation:
         """The evidence's likelihood ratio: the intensity's LR, or 1/LR when undermining."""
         lr = INTENSITY_LR[self.intensity]
         return lr if self.reinforces else 1.0 / lr
-
-    @property
-    def log_factor(self) -> float:
-        """log(p/q) of a fresh firing, p = 1/(1+LR), q = LR/(1+LR): that is, -log(LR)."""
-        return -math.log(self.likelihood_ratio)
 
 
 @dataclass(frozen=True)

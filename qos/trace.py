@@ -17,9 +17,10 @@ from __future__ import annotations
 import json
 import math
 import statistics
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -30,6 +31,11 @@ from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")
 _TRACE_KEYS = ("model", "events", "description")
+
+
+def seconds(t: float) -> float | int:
+    """A time as written in traces and reports: an int when whole (``10``, not ``10.0``)."""
+    return int(t) if float(t).is_integer() else t
 
 
 @dataclass
@@ -65,6 +71,13 @@ class Trace:
     def name(self) -> str:
         """How messages name this trace."""
         return str(self.source) if self.source is not None else "<trace>"
+
+    @classmethod
+    def from_events(cls, model: str, events: Iterable[Mapping[str, Any]], description: str | None = None) -> Trace:
+        """A trace from recorded events (mappings with ``t`` and optional ``set``/``emit``, as a
+        session records them), times whole where they are whole."""
+        return cls(model, [TraceEvent(seconds(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
+                           for e in events], description=description)
 
     def load_model(self) -> Model:
         """Load the trace's model (a bundled name, or a path relative to the trace's folder)."""
@@ -225,8 +238,7 @@ class TraceRecorder:
         self._unsubscribe = engine.subscribe(self._record)
 
     def _record(self, result: UpdateResult) -> None:
-        t = int(result.t) if float(result.t).is_integer() else result.t
-        self.events.append(TraceEvent(t, dict(result.set), list(result.emit)))
+        self.events.append(TraceEvent(seconds(result.t), dict(result.set), list(result.emit)))
 
     @property
     def trace(self) -> Trace:

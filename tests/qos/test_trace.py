@@ -145,3 +145,15 @@ def test_a_recorded_session_replays_to_the_same_results(tmp_path):
     assert len(recorded.events) == len(source.batches())
     assert replay(recorded) == replay(source)
     assert [entry["observations"] for entry in replay(recorded)["fired"]] == [fired for fired in live[:-1] if fired]
+
+
+def test_a_trace_from_recorded_events_keeps_whole_times_whole():
+    from qos.trace import seconds
+
+    assert (seconds(10.0), type(seconds(10.0)), seconds(2.5)) == (10, int, 2.5)
+    trace = Trace.from_events("clarc", [{"t": 10.0, "set": {"PersonDetected": True}}, {"t": 12.25, "emit": ["CallingDoctor"]}],
+                              description="session S")
+    assert (trace.model, trace.description) == ("clarc", "session S")
+    assert [e.to_dict() for e in trace.events] == [{"t": 10, "set": {"PersonDetected": True}},
+                                                   {"t": 12.25, "emit": ["CallingDoctor"]}]
+    assert type(trace.events[0].t) is int

@@ -15,7 +15,6 @@ def test_defaults_without_a_file(tmp_path, monkeypatch):
     config = load_config(environ={})
     assert config.source is None and config.language == "en" and config.adaptation and config.familiarisation
     assert config.clinician_pin == DEFAULT_PIN and config.default_pin
-    assert config.database.name == "kiosk.sqlite3"
 
 
 def test_file_and_environment(tmp_path):
