@@ -271,6 +271,10 @@ class ReplaySamples:
     fired: list[dict[str, object]]
 
 
+#: samples one replay may take (each holds every property): bounds time and memory for a tiny period
+MAX_SAMPLES = 10_000_000
+
+
 def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
                  model: Model | None = None) -> ReplaySamples:
     """Replay a trace through a fresh engine, sampling every property.
@@ -278,7 +282,8 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     Samples are taken at t = 0, period, 2·period, … up to and including the last event's time, each
     after the events at times ≤ t; when the last event falls between two of those, one more sample
     is taken at its time. Raises :class:`TraceError` (or ModelError) before replaying
-    anything when the trace or its model is bad.
+    anything when the trace or its model is bad, or when the period would take more than
+    :data:`MAX_SAMPLES` samples.
     """
     if isinstance(sample_period, bool) or not isinstance(sample_period, (int, float)) \
             or not math.isfinite(sample_period) or sample_period <= 0:
@@ -290,6 +295,9 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
+    if count > MAX_SAMPLES:
+        raise TraceError(f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
+                         f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period")
     samples = ReplaySamples([], {name: [] for name in model.properties}, [])
     upcoming = 0
     for k in range(count):

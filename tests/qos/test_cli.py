@@ -72,6 +72,14 @@ def test_bad_trace_or_model_exits_2_with_one_line(tmp_path, trace, model, messag
     assert done.stderr == message.format(dir=tmp_path) + "\n"
 
 
+def test_a_sample_period_too_small_for_the_trace_is_one_line_not_an_endless_replay(capsys):
+    # TABLE4 lasts 1000 s: 1e-7 s would be 10 billion samples (before the cap: an endless replay)
+    assert main(["replay", str(TABLE4), "--sample-period", "1e-7"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"python -m qos replay: {TABLE4}: a sample period of 1e-07 s over the trace's ") and \
+        "(at most 10,000,000); use a longer sample period\n" in err and err.count("\n") == 1
+
+
 def test_bad_arguments_exit_2(capsys):
     with pytest.raises(SystemExit) as exited:
         main(["replay", str(TABLE4), "--sample-period", "0"])
