@@ -24,9 +24,9 @@ matcher). Prints one JSON document:
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -37,7 +37,7 @@ from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser, VoskRecogni
 from kiosk.speech.audio import EndpointerSettings, UtterancePipeline, feed_wav
 from kiosk.speech.matching import COMMAND_PHRASES, NUMBER_FORMS, ORDINALS, CARDINALS, Matcher
 from kiosk.speech.models import find_model
-from kiosk.speech.tts import VOICES
+from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import option_words
 
 #: things people say at a kiosk that are not answers (per language)
@@ -78,11 +78,14 @@ class _Timed:
             self.seconds += time.perf_counter() - began
 
 
+#: the kiosk's own espeak-ng synthesiser, made once (it lists espeak-ng's voices)
+_synthesiser = functools.cache(Synthesiser)
+
+
 def _say(folder: Path, text: str, language: str) -> Path:
     path = folder / f"{language}-{abs(hash(text))}.wav"
     if not path.exists():
-        subprocess.run(["espeak-ng", "-v", VOICES[language], "-s", "160", "-w", str(path), text],
-                       check=True, capture_output=True)
+        _synthesiser().synthesise(text, language, path)
     return path
 
 

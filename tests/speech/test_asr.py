@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import logging
-import subprocess
 
 import pytest
 
@@ -65,15 +64,13 @@ def test_pocketsphinx_needs_a_grammar_first():
         PocketSphinxRecogniser("en").accept(b"\0\0" * 160)
 
 
-def test_pocketsphinx_decodes_speech_and_scores_it(tmp_path):
+def test_pocketsphinx_decodes_speech_and_scores_it(spoken):
     recogniser = PocketSphinxRecogniser("en")
     recogniser.set_grammar(["unable", "needs help", "independent", "one", "two", "three", "repeat"])
     heard = []
     pipeline = UtterancePipeline(recogniser, heard.append)
     for text in ("independent", "the weather is nice today"):
-        path = tmp_path / f"{len(text)}.wav"
-        subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", "160", "-w", str(path), text], check=True)
-        feed_wav(path, pipeline)
+        feed_wav(spoken(text), pipeline)
     answer, sentence = (u.result for u in heard)
     assert answer.text == "independent" and answer.confidence > 0.9
     # a sentence is forced onto the grammar too, but mostly into silence: low confidence
@@ -112,11 +109,10 @@ def test_confusable_phrases_only_where_the_partner_means_something_else():
     assert confusable_phrases(["first", "third"], lambda p: p, first_third) == {"first", "third"}
 
 
-def test_pocketsphinx_never_turns_first_into_third(tmp_path):
+def test_pocketsphinx_never_turns_first_into_third(spoken):
     """espeak-ng's "the first one" sounds like "the third one" to the wheel's model: with a third
     option it is not an answer (asked again), with two options it is understood."""
-    path = tmp_path / "first.wav"
-    subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", "160", "-w", str(path), "the first one"], check=True)
+    path = spoken("the first one")
     recogniser = PocketSphinxRecogniser("en")
     heard = []
     pipeline = UtterancePipeline(recogniser, heard.append)
@@ -138,10 +134,9 @@ def test_final_phrases_are_those_nothing_of_another_meaning_continues():
                                                "repeat", "repeat that"}
 
 
-def test_pocketsphinx_says_when_a_whole_answer_was_heard(tmp_path):
+def test_pocketsphinx_says_when_a_whole_answer_was_heard(spoken):
     """A whole answer ends after the short hangover, once the decoder has settled on a voice."""
-    path = tmp_path / "independent.wav"
-    subprocess.run(["espeak-ng", "-v", "gmw/en-us", "-s", "160", "-w", str(path), "independent"], check=True)
+    path = spoken("independent")
     recogniser = PocketSphinxRecogniser("en")
     matcher = Matcher([OptionWords(w) for w in ("unable", "needs help", "independent")], "en")
     recogniser.set_grammar(matcher.phrases(), matcher.meaning)

@@ -8,7 +8,6 @@ present (``KIOSK_VOSK_MODEL``, or ``../shared/models`` beside the repository).
 from __future__ import annotations
 
 import os
-import subprocess
 import threading
 from pathlib import Path
 
@@ -21,7 +20,7 @@ from kiosk.session import DoctorCalled, ListeningChanged, Paused, Prompt, Resume
 from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser, VoskRecogniser, open_recogniser
 from kiosk.speech.audio import feed_wav, list_input_devices, resample
 from kiosk.speech.models import find_model
-from kiosk.speech.tts import VOICES, Speaker
+from kiosk.speech.tts import Speaker
 from kiosk.speech.voice import VoiceChannel
 from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
 
@@ -51,20 +50,6 @@ def _backends(language: str):
                                  "KIOSK_VOSK_MODEL or put one in ../shared/models (none can be downloaded here)"),
     ))
     return params
-
-
-@pytest.fixture(scope="module")
-def spoken(tmp_path_factory):
-    """say(text, language) → a WAV of espeak-ng saying it (cached per module)."""
-    folder = tmp_path_factory.mktemp("answers")
-
-    def say(text: str, language: str = "en") -> Path:
-        path = folder / f"{language}-{text.replace(' ', '_')}.wav"
-        if not path.exists():
-            subprocess.run(["espeak-ng", "-v", VOICES[language], "-s", "160", "-w", str(path), text], check=True)
-        return path
-
-    return say
 
 
 class _Kiosk:

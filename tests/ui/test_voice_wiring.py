@@ -1,4 +1,4 @@
-"""The app wired to the real voice channel: espeak-ng speaks an answer into a WAV file, a thread
+"""The app wired to the real voice channel: the kiosk's espeak-ng synthesiser speaks an answer into a WAV file, a thread
 plays it into the channel the way the microphone's thread delivers audio (no sound card here),
 pocketsphinx recognises it with the grammar the app set from the question's prompt, and the answer
 reaches the session through the app's sink -- recorded with channel voice."""
@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import asyncio
 import shutil
-import subprocess
 import threading
 import time
 from pathlib import Path
@@ -17,7 +16,7 @@ import pytest
 from kiosk.app import KIOSK_SIZE
 from kiosk.channels import Channel, ChannelState
 from kiosk.speech.audio import feed_wav
-from kiosk.speech.tts import VOICES
+from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel
 from kiosk.widgets.channel_board import VOICE_IN
 
@@ -59,8 +58,7 @@ async def _until(condition) -> None:
 
 
 async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp_path):
-    wav = tmp_path / "independent.wav"
-    subprocess.run(["espeak-ng", "-v", VOICES["en"], "-s", "160", "-w", str(wav), "independent"], check=True)
+    wav = Synthesiser().synthesise("independent", "en", tmp_path / "independent.wav")
     microphones: list[WavMicrophone] = []
     voice = VoiceChannel(
         "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
