@@ -32,6 +32,7 @@ from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
 from kiosk.questionnaire import Questionnaire
+from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
 from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView
 from kiosk.screens.clinician_home import ClinicianHomeScreen
 from kiosk.screens.doctor_called import DoctorCalledScreen
@@ -63,11 +64,6 @@ from kiosk.widgets.text import ui_text
 KIOSK_SIZE = (100, 32)
 #: the clinician screens open with this chord, then ask for the PIN
 CLINICIAN_CHORD = "ctrl+k"
-#: the kiosk's own keys (channel KEYBOARD): answers 1-4 and the remote's command buttons
-KIOSK_KEYS: dict[str, int | Command] = {
-    "1": 1, "2": 2, "3": 3, "4": 4,
-    "p": Command.PAUSE, "d": Command.CALL_DOCTOR, "r": Command.REPEAT,
-}
 #: how often the session is polled for time-outs (seconds); it fires them at their own due time
 POLL_INTERVAL = 0.1
 #: the source name the voice-out statuses carry when no speaker is wired
@@ -224,8 +220,8 @@ class KioskApp(App[int]):
     def patient_key(self, key: str) -> bool:
         """A key pressed on a patient screen; True if it meant something to the kiosk."""
         item = self.keyboard.translate(key) if self.keyboard is not None else None
-        if item is None and key in KIOSK_KEYS:
-            meaning = KIOSK_KEYS[key]
+        if item is None and key in KIOSK_KEY_BUTTONS:
+            meaning = KIOSK_KEY_BUTTONS[key]
             detail = f"key {key}"
             item = (ChannelInput(Channel.KEYBOARD, command=meaning, detail=detail) if isinstance(meaning, Command)
                     else ChannelInput(Channel.KEYBOARD, option=meaning, detail=detail))

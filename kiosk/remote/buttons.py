@@ -49,6 +49,13 @@ def to_input(button: Button, detail: str) -> ChannelInput:
     return ChannelInput(channel=Channel.REMOTE, option=button, detail=detail)
 
 
-#: keys the kiosk itself binds (answers 1-4, pause, doctor, repeat); a keyboard-emulating remote
-#: must not claim them, or one key press would count twice (compared case-insensitively)
-KIOSK_KEYS = frozenset({"1", "2", "3", "4", "p", "d", "r"})
+#: the kiosk's own keys (channel KEYBOARD) and the button each stands for: answers 1-4, pause,
+#: call doctor, repeat
+KIOSK_KEY_BUTTONS: dict[str, Button] = {
+    "1": 1, "2": 2, "3": 3, "4": 4,
+    "p": Command.PAUSE, "d": Command.CALL_DOCTOR, "r": Command.REPEAT,
+}
+
+#: keys the kiosk itself binds; a keyboard-emulating remote must not claim them, or one key press
+#: would count twice (compared case-insensitively)
+KIOSK_KEYS = frozenset(KIOSK_KEY_BUTTONS)
