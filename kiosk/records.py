@@ -19,8 +19,9 @@ __all__ = ["MODEL", "open_store", "session_trace", "trace_main"]
 
 
 def open_store(data_dir: str | None) -> Store:
-    """The store in ``data_dir``, or in the configured data directory (ConfigError/StorageError)."""
-    return Store.open(Path(data_dir) if data_dir else load_config().data_dir)
+    """The existing store in ``data_dir``, or in the configured data directory; never creates one
+    (ConfigError/StorageError)."""
+    return Store.open(Path(data_dir) if data_dir else load_config().data_dir, create=False)
 
 
 def session_trace(stored: StoredSession):  # -> qos.Trace

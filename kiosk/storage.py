@@ -237,10 +237,17 @@ class Store:
         self.path = path
 
     @classmethod
-    def open(cls, data_dir: str | Path) -> Store:
-        """Open (creating if needed) the database in ``data_dir``."""
+    def open(cls, data_dir: str | Path, create: bool = True) -> Store:
+        """Open the database in ``data_dir``, creating both if needed; with ``create=False`` (the
+        tools that only read, where a mistyped directory must not become an empty database) a
+        missing directory or database is a StorageError."""
         directory = Path(data_dir).expanduser()
         path = directory / DB_NAME
+        if not create:
+            if not directory.is_dir():
+                raise StorageError(f"no data directory {directory}")
+            if not path.is_file():
+                raise StorageError(f"no session database in {directory} (expected {DB_NAME}; nothing stored there)")
         try:
             _secure_dir(directory)
             _secure_file(path)

@@ -19,7 +19,7 @@ from kiosk.clock import SimClock
 from kiosk.records import trace_main
 from kiosk.replay import load_script, run_script
 from kiosk.session import AttemptOpened, Session
-from kiosk.storage import Store, new_patient_id
+from kiosk.storage import StorageError, Store, new_patient_id
 from qos import Engine, load_trace
 
 from .helpers import MODEL, QUESTIONNAIRE, TIMING, Rig
@@ -229,3 +229,22 @@ def test_kiosk_qos_trace_to_an_unwritable_file_is_one_line_and_exit_2(tmp_path, 
     target = tmp_path / "missing" / "trace.yaml"
     assert trace_main([result.session.id, "--data-dir", str(tmp_path / "data"), "-o", str(target)]) == 2
     assert capsys.readouterr().err == f"kiosk qos trace: cannot write {target}: No such file or directory\n"
+
+
+def test_reading_tools_refuse_a_missing_data_directory_or_database_and_create_nothing(tmp_path, capsys):
+    from kiosk.results import main as results_main
+
+    typo = tmp_path / "typo"
+    assert results_main(["--data-dir", str(typo)]) == 2
+    assert capsys.readouterr().err == f"kiosk results: no data directory {typo}\n"
+    assert trace_main(["abc", "--data-dir", str(typo)]) == 2
+    assert capsys.readouterr().err == f"kiosk qos trace: no data directory {typo}\n"
+    assert not typo.exists()
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert results_main(["--data-dir", str(empty)]) == 2
+    assert capsys.readouterr().err == (f"kiosk results: no session database in {empty} "
+                                       "(expected kiosk.sqlite3; nothing stored there)\n")
+    assert list(empty.iterdir()) == []
+    with pytest.raises(StorageError, match="no data directory"):
+        Store.open(typo, create=False)
