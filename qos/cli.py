@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from qos.errors import QosError
-from qos.files import open_private
+from qos.files import open_private, write_error
 from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
 
 
@@ -94,7 +94,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "python -m qos", epilog:
         try:
             plot(samples, args.plot, trace.description or args.trace.name)
         except OSError as exc:
-            print(f"{prog} replay: cannot write the plot {args.plot}: {exc.strerror or exc}", file=sys.stderr)
+            print(f"{prog} replay: {write_error(args.plot, exc)}", file=sys.stderr)
             return 2
     if args.json:
         print(json.dumps(result))

@@ -43,8 +43,9 @@ def test_plot_writes_a_png(tmp_path, capsys):
     target = tmp_path / "b4.png"
     assert main(["replay", str(TABLE4), "--plot", str(target)]) == 0
     assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and target.stat().st_size > 10_000
-    assert main(["replay", str(TABLE4), "--plot", str(tmp_path / "no" / "such" / "dir.png")]) == 2
-    assert "cannot write the plot" in capsys.readouterr().err
+    missing = tmp_path / "no" / "such" / "dir.png"
+    assert main(["replay", str(TABLE4), "--plot", str(missing)]) == 2
+    assert capsys.readouterr().err == f"python -m qos replay: cannot write {missing}: No such file or directory\n"
 
 
 def test_plot_replaces_a_world_readable_png_with_an_owner_only_one(tmp_path):
