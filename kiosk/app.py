@@ -444,7 +444,8 @@ class KioskApp(App[int]):
 # `kiosk run`
 
 
-def _parser() -> argparse.ArgumentParser:
+def run_parser() -> argparse.ArgumentParser:
+    """The options of `kiosk run` (`kiosk serve` checks what it passes on with it)."""
     parser = argparse.ArgumentParser(prog="kiosk run", description="Start the kiosk (a patient session).")
     parser.add_argument("--data-dir", type=Path, help="where sessions are stored (default: from the configuration)")
     parser.add_argument("--config", type=Path, help="configuration file (default: $KIOSK_CONFIG or the user's)")
@@ -544,7 +545,7 @@ def _voice_in(config: Any, wanted: bool, statuses: list[ChannelStatus]) -> Any:
 
 def main(argv: list[str]) -> int:
     """`kiosk run`: build the session and channels from the configuration and run the app."""
-    args = _parser().parse_args(argv)
+    args = run_parser().parse_args(argv)
     try:
         app, close = build_app(config_path=args.config, data_dir=args.data_dir, patient_id=args.patient,
                                voice=not args.no_voice, remote=not args.no_remote)

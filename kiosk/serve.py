@@ -23,6 +23,22 @@ def build_command(run_args: list[str]) -> str:
     return shlex.join([sys.executable, "-m", "kiosk", "run", *run_args])
 
 
+def run_args_problem(run_args: list[str]) -> str | None:
+    """What is wrong with the options passed on to `kiosk run`, or None: checked before serving,
+    because every browser connection would otherwise only show `kiosk run`'s usage error."""
+    from kiosk.app import run_parser
+
+    parser = run_parser()
+    parser.exit_on_error = False  # report the problem as one line here, not argparse's usage text
+    try:
+        _, unknown = parser.parse_known_args(run_args)
+    except argparse.ArgumentError as error:
+        return str(error)
+    if unknown:
+        return f"unrecognised arguments: {' '.join(unknown)} (neither `kiosk serve` nor `kiosk run` takes them)"
+    return None
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="kiosk serve",
@@ -40,6 +56,9 @@ def main(argv: list[str]) -> int:
     args, run_args = _parser().parse_known_args(argv)
     if not 0 < args.port < 65536:
         print(f"kiosk serve: --port must be between 1 and 65535, got {args.port}", file=sys.stderr)
+        return 2
+    if (problem := run_args_problem(run_args)) is not None:
+        print(f"kiosk serve: {problem}", file=sys.stderr)
         return 2
     if args.host not in (LOCALHOST, "localhost", "::1"):
         print(f"kiosk serve: warning: listening on {args.host}, so other machines can reach the "

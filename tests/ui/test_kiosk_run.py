@@ -5,10 +5,11 @@ which channels are off and why. Plus the command lines' answers to a user's mist
 from __future__ import annotations
 
 import asyncio
+import threading
 import time
 
 from kiosk import app as kiosk_app
-from kiosk import serve
+from kiosk import cli, serve
 from kiosk.app import KIOSK_SIZE, build_app
 from kiosk.channels import ChannelState
 from kiosk.session import Phase
@@ -65,3 +66,22 @@ def test_kiosk_serve_listens_on_localhost_by_default_and_refuses_a_bad_port(caps
     assert serve.build_command(rest).endswith("-m kiosk run --data-dir /somewhere")
     assert serve.main(["--port", "70000"]) == 2
     assert "between 1 and 65535" in capsys.readouterr().err
+
+
+def test_kiosk_serve_refuses_a_mistyped_run_option_before_starting_a_server(capsys):
+    results: list[int] = []
+    # a server would block this thread serving; a refusal returns at once
+    thread = threading.Thread(target=lambda: results.append(cli.main(["serve", "--prot", "8001"])), daemon=True)
+    thread.start()
+    thread.join(timeout=PATIENCE_S)
+    assert not thread.is_alive(), "kiosk serve started a server"
+    assert results == [2]
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["kiosk serve: unrecognised arguments: --prot 8001 "
+                   "(neither `kiosk serve` nor `kiosk run` takes them)"]
+
+
+def test_kiosk_serve_refuses_a_run_option_without_its_value(capsys):
+    assert serve.main(["--data-dir"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["kiosk serve: argument --data-dir: expected one argument"]
