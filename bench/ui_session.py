@@ -9,7 +9,9 @@
   ``pause`` (P: question -> paused screen), ``resume`` (P: paused -> question screen),
   ``next_question`` (an answer key, then the app's poll once the gap is over -> the next question
   screen), and ``answer_marked`` (an answer key -> the chosen answer highlighted on the same screen).
-  Goal: median under 50 ms.
+  Each kind's median is reported with its own ``met`` flag (under 50 ms); ``key_goal_met`` judges
+  the kinds that change the screen (pause, resume, next_question), each on its own median: a
+  pooled median would let the quick ``answer_marked`` hide a slow screen change.
 
 Prints JSON. Run: uv run python bench/ui_session.py [--rounds N]
 """
@@ -39,6 +41,8 @@ from qos import Engine, load_model
 
 GOAL_SESSION_S = 3.0
 GOAL_MEDIAN_MS = 50.0
+#: the key latencies the goal is about: a key that brings another screen
+SCREEN_CHANGES = ("pause", "resume", "next_question")
 
 
 def build(data_dir: Path) -> tuple[KioskApp, SimClock, Store]:
@@ -140,12 +144,13 @@ async def one_session(data_dir: Path, latencies: dict[str, list[float]]) -> floa
     return elapsed
 
 
-def summary(values: list[float]) -> dict[str, float]:
-    """Median, 95th percentile and maximum, rounded."""
+def summary(values: list[float]) -> dict[str, object]:
+    """Median, 95th percentile and maximum, rounded, and whether the median meets the goal."""
     ordered = sorted(values)
-    return {"median": round(statistics.median(ordered), 2),
+    median = statistics.median(ordered)
+    return {"median": round(median, 2),
             "p95": round(ordered[min(len(ordered) - 1, int(0.95 * len(ordered)))], 2),
-            "max": round(ordered[-1], 2), "n": len(ordered)}
+            "max": round(ordered[-1], 2), "n": len(ordered), "met": median < GOAL_MEDIAN_MS}
 
 
 def main(argv: list[str]) -> int:
@@ -158,17 +163,17 @@ def main(argv: list[str]) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for round_ in range(args.rounds):
             times.append(asyncio.run(one_session(Path(tmp) / str(round_), latencies)))
-    all_keys = [v for values in latencies.values() for v in values]
+    kinds = {name: summary(values) for name, values in latencies.items()}
     print(json.dumps({
         "terminal_size": list(KIOSK_SIZE),
         "rounds": args.rounds,
         "session_s": {"best": round(min(times), 3), "median": round(statistics.median(times), 3),
                       "worst": round(max(times), 3), "goal": GOAL_SESSION_S,
                       "met": statistics.median(times) < GOAL_SESSION_S},
-        "key_to_screen_ms": {name: summary(values) for name, values in latencies.items()},
-        "key_to_screen_median_ms": round(statistics.median(all_keys), 2),
+        "key_to_screen_ms": kinds,
         "key_goal_median_ms": GOAL_MEDIAN_MS,
-        "key_goal_met": statistics.median(all_keys) < GOAL_MEDIAN_MS,
+        "key_goal_judged_on": list(SCREEN_CHANGES),
+        "key_goal_met": all(kinds[name]["met"] for name in SCREEN_CHANGES),
     }, indent=2))
     return 0
 
