@@ -9,11 +9,14 @@ import sqlite3
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
+from kiosk.questionnaire import load_questionnaire
 from kiosk.session import Phase
+from kiosk.widgets.text import ui_text
 
 from .helpers import screen_name, settle
 
@@ -24,6 +27,7 @@ CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networki
 FONT_SIZE = 20
 #: what the test waits for at most (server start, first paint, the answer reaching the database)
 PATIENCE_S = 30.0
+QUESTIONNAIRE = load_questionnaire()
 
 pytestmark = [
     pytest.mark.slow,
@@ -60,6 +64,11 @@ def _rows(database: Path, sql: str) -> list[tuple]:
 
 def _answers(database: Path) -> list[tuple]:
     return _rows(database, "SELECT item_id, option, channel FROM answers")
+
+
+def _first_words(text: str) -> str:
+    """The start of a paragraph, short enough to be drawn on its first line."""
+    return " ".join(text.split()[:4])
 
 
 def _count(database: Path, table: str) -> int:
@@ -113,7 +122,14 @@ async def test_a_tap_on_the_served_page_records_the_answer(served_kiosk, ui_kios
         try:
             page = await browser.new_page(viewport={"width": 1200, "height": 780})
             sockets = []
-            page.on("websocket", lambda ws: sockets.append(ws))
+            painted = bytearray()  # what the server sent the page to draw, so far
+
+            def follow(ws) -> None:
+                sockets.append(ws)
+                ws.on("framereceived", lambda data: painted.extend(
+                    data if isinstance(data, bytes) else data.encode()))
+
+            page.on("websocket", follow)
             await page.goto(f"http://127.0.0.1:{port}/?fontsize={FONT_SIZE}")
             screen = page.locator(".xterm-screen")
             await screen.wait_for(timeout=PATIENCE_S * 1000)
@@ -129,19 +145,24 @@ async def test_a_tap_on_the_served_page_records_the_answer(served_kiosk, ui_kios
                 await page.mouse.click(box["x"] + (region.x + region.width / 2) * cell_w,
                                        box["y"] + (region.y + region.height / 2) * cell_h)
 
-            async def wait_until(check) -> None:
+            async def wait_until(check, what: str) -> None:
                 deadline = time.monotonic() + PATIENCE_S
-                while not check() and time.monotonic() < deadline:
-                    await page.wait_for_timeout(100)
+                while not check():
+                    assert time.monotonic() < deadline, f"never saw {what}"
+                    await page.wait_for_timeout(50)  # lets Playwright deliver frames; bounded by PATIENCE_S
 
-            await page.wait_for_timeout(500)  # the app's first screen is painted after the first byte
+            def shows(text: str) -> Callable[[], bool]:
+                """The server has sent the page ``text`` to draw: that screen is up in the app."""
+                return lambda: text.encode() in painted
+
+            await wait_until(shows(ui_text("en", "choose_language")), "the welcome screen")
             await tap(english)
-            await wait_until(lambda: _count(database, "sessions"))  # start() stores the session
-            await page.wait_for_timeout(1000)  # the explanation is painted after start() returns
+            await wait_until(lambda: _count(database, "sessions"), "the session stored")  # start() stores it
+            await wait_until(shows(_first_words(QUESTIONNAIRE.message("explanation", "en"))), "the explanation")
             await tap(start)
-            await page.wait_for_timeout(1500)  # the first question opens 0.5 s after Start
+            await wait_until(shows(QUESTIONNAIRE.items[0].text["en"]), "the first question")
             await tap(answer)
-            await wait_until(lambda: _answers(database))
+            await wait_until(lambda: _answers(database), "the answer stored")
             if os.environ.get("KIOSK_E2E_SCREENSHOT"):
                 await page.screenshot(path=os.environ["KIOSK_E2E_SCREENSHOT"])
         finally:
