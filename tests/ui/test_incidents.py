@@ -129,6 +129,19 @@ async def test_the_patient_touches_answer_by_voice_again_and_the_kiosk_listens_a
         assert [e.kind for e in stored.log][-1:] == ["voice_requested"]
 
 
+async def test_answer_by_voice_again_is_not_offered_over_the_paused_screen(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_with_voice_off(kiosk, pilot)
+        assert kiosk.app.screen.query_one(VoiceAgainButton).display
+        await pilot.press("p")  # while paused the way on is Continue, not a second big button
+        await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
+        assert not kiosk.app.screen.query_one(VoiceAgainButton).display
+        await pilot.press("p")
+        await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+        assert kiosk.app.screen.query_one(VoiceAgainButton).display
+
+
 async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)  # voice in is off: no microphone
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
