@@ -18,6 +18,7 @@ from rich.text import Text
 from textual_plotext import PlotextPlot
 
 from kiosk.storage import StoredSession
+from qos.files import open_private
 
 #: the metrics of the CLARC model, in the order they are drawn, with one colour each
 METRICS = ("Performance", "Interaction", "VoiceInteractionQuality")
@@ -132,15 +133,12 @@ def metrics_figure(data: PlotData, title: str) -> Any:
 
 def save_png(data: PlotData, path: str | Path, title: str) -> Path:
     """Write the plot as a PNG (owner-only, it belongs to a patient's record); returns the path."""
-    import os
-
     from matplotlib import pyplot
 
     figure = metrics_figure(data, title)
     try:
         path = Path(path)
-        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        with os.fdopen(fd, "wb") as handle:
+        with open_private(path, binary=True) as handle:
             figure.savefig(handle, format="png", bbox_inches="tight")
     finally:
         pyplot.close(figure)

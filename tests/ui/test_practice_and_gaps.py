@@ -10,7 +10,7 @@ from textual.widgets import Label, Static
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.channels import Channel, ChannelState, ChannelStatus
 from kiosk.session import Phase
-from kiosk.widgets.metrics_plot import METRICS, MetricsPlot, metrics_figure, plot_data
+from kiosk.widgets.metrics_plot import METRICS, MetricsPlot, metrics_figure, plot_data, save_png
 from kiosk.widgets.question_panel import QuestionPanel
 
 from .conftest import UI_PIN
@@ -140,7 +140,7 @@ async def test_the_clinician_sees_how_the_practice_went(ui_kiosk):
         assert line == "Practice: hearing skipped (no voice out) / reading ✗ (chose No) / selecting ✓"
 
 
-async def test_the_metrics_plot_keeps_its_key_off_the_data(ui_kiosk):
+async def test_the_metrics_plot_keeps_its_key_off_the_data(ui_kiosk, tmp_path):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
@@ -175,3 +175,10 @@ async def test_the_metrics_plot_keeps_its_key_off_the_data(ui_kiosk):
         assert not legend.get_window_extent().overlaps(axes.get_window_extent())
     finally:
         pyplot.close(figure)
+
+    # the exported PNG belongs to a patient's record: owner-only, even over an older 0644 file
+    png = tmp_path / "plot.png"
+    png.write_bytes(b"old")
+    png.chmod(0o644)
+    save_png(plot_data(kiosk.store.session(kiosk.session.id)), png, "test")
+    assert png.read_bytes().startswith(b"\x89PNG") and png.stat().st_mode & 0o777 == 0o600
