@@ -43,3 +43,12 @@ def test_qos_never_imports_textual_or_kiosk():
 def test_session_core_never_imports_textual():
     loaded = _imported_after(PURE_KIOSK_MODULES)
     assert "textual" not in loaded
+
+
+def test_channels_never_import_textual():
+    """Speech and remote readers run on their own threads: they hand inputs to a sink, never to widgets."""
+    import kiosk.remote
+    import kiosk.speech
+
+    loaded = _imported_after(_modules_of(kiosk.speech) + _modules_of(kiosk.remote) + ["kiosk.devices"])
+    assert "textual" not in loaded
