@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import uuid
 from collections.abc import Callable, Mapping
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from datetime import timedelta
 from enum import Enum
@@ -141,6 +142,7 @@ class SessionStore(Protocol):
     def record_event(self, session_id: str, *, t: float, kind: str, detail: str = "") -> None: ...
     def finish_session(self, session_id: str, *, finished_at: str, total: int, complete: bool,
                        band: str | None) -> None: ...
+    def transaction(self) -> AbstractContextManager[None]: ...
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1367,15 +1369,23 @@ def _is_answer(contexts: Mapping[str, Any]) -> bool:
 
 
 class _Op:
-    """One public operation: catch up on time-outs, act, then flush QoS and publish events."""
+    """One public operation: catch up on time-outs, act, then flush QoS and publish events.
+
+    The outermost operation is one store transaction, committed before listeners hear of it: a
+    crash keeps an answer together with its QoS context batch and metrics, or neither.
+    """
 
     def __init__(self, session: Session, inclusive: bool = False) -> None:
         self.s = session
         self.inclusive = inclusive
+        self._transaction: AbstractContextManager[None] | None = None
 
     def __enter__(self) -> float:
         s = self.s
         s._depth += 1
+        if s._depth == 1 and s.store is not None:
+            self._transaction = s.store.transaction()
+            self._transaction.__enter__()
         now = s.clock.now()
         s._advance(now, self.inclusive)
         return s._t(now)
@@ -1383,9 +1393,16 @@ class _Op:
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
         s = self.s
         s._depth -= 1
-        if s._depth or exc_type is not None:
+        if s._depth:
             return
-        s._flush()
+        try:
+            if exc_type is None:
+                s._flush()
+        finally:
+            if self._transaction is not None:
+                self._transaction.__exit__(None, None, None)
+        if exc_type is not None:
+            return
         if s._dispatching:
             return
         s._dispatching = True

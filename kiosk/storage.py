@@ -15,12 +15,13 @@ A stored total is kept for listing only; results always recompute it from the an
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
 import secrets
 import sqlite3
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -270,9 +271,25 @@ class Store:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def _write(self, sql: str, args: tuple[Any, ...]) -> None:
-        with self._db:  # one transaction, committed (and fsynced) on exit
+    @contextlib.contextmanager
+    def transaction(self) -> Iterator[None]:
+        """Group writes into one commit (fsynced): a crash keeps all of them or none.
+
+        The session runs each of its operations in one, so an answer is never stored without the
+        QoS context batch it published. Nested use joins the outer transaction. What was written is
+        committed even if the block raises: recorded answers are never thrown away.
+        """
+        outer = not self._db.in_transaction
+        if outer:
             self._db.execute("BEGIN IMMEDIATE")
+        try:
+            yield
+        finally:
+            if outer:
+                self._db.commit()
+
+    def _write(self, sql: str, args: tuple[Any, ...]) -> None:
+        with self.transaction():
             self._db.execute(sql, args)
 
     def _next_seq(self, table: str, session_id: str) -> int:
@@ -288,8 +305,7 @@ class Store:
         if not PATIENT_ID.match(patient_id):
             raise ValueError(f"patient id {patient_id!r} is not a pseudonymous id "
                              "(2-64 letters, digits, '-' or '_'; never a name)")
-        with self._db:
-            self._db.execute("BEGIN IMMEDIATE")
+        with self.transaction():
             self._db.execute("INSERT OR IGNORE INTO patients (id, created_at) VALUES (?, ?)", (patient_id, started_at))
             self._db.execute(
                 "INSERT INTO sessions (id, patient_id, questionnaire_id, language, answered_by, timing, started_at,"

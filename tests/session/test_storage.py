@@ -248,3 +248,36 @@ def test_reading_tools_refuse_a_missing_data_directory_or_database_and_create_no
     assert list(empty.iterdir()) == []
     with pytest.raises(StorageError, match="no data directory"):
         Store.open(typo, create=False)
+
+
+def test_an_answer_and_its_qos_context_are_committed_together(tmp_path):
+    """A crash between two commits would keep an answer without the evidence it gave the QoS engine;
+    the operation is one transaction, so another reader sees both or neither."""
+    store = Store.open(tmp_path / "data")
+    seen_mid_operation: list[tuple[int, int]] = []
+
+    def committed() -> tuple[int, int]:
+        with sqlite3.connect(store.path) as other:
+            answers = other.execute("SELECT COUNT(*) FROM answers").fetchone()[0]
+            answered = other.execute("SELECT COUNT(*) FROM contexts WHERE sets LIKE '%FirstAttemptAnswered%'"
+                                     ).fetchone()[0]
+        return answers, answered
+
+    class Observed(Engine):
+        """The real engine; it also looks at the database while the answer's batch is applied."""
+
+        def update(self, t, set=None, emit=None):
+            if set and "FirstAttemptAnswered" in set:
+                seen_mid_operation.append(committed())
+            return super().update(t, set=set, emit=emit)
+
+    clock = SimClock()
+    session = Session(QUESTIONNAIRE, clock=clock, engine=Observed(MODEL), store=store, patient_id="P-TEST01",
+                      timing=TIMING, familiarisation=False)
+    rig = Rig(session, clock)
+    session.start()
+    session.acknowledge()
+    rig.run_until(session.now() + 15)
+    rig.answer(2)
+    assert seen_mid_operation == [(0, 0)]  # neither is visible before the operation ends
+    assert committed() == (1, 1)  # both are, once it has
