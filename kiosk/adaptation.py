@@ -8,7 +8,7 @@ changes the kiosk's behaviour, never the contexts sent to the QoS engine.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -189,6 +189,14 @@ class Adaptation:
         self._active.discard("voice_off")
         self._low["voice_off"] = 0
         return [AdaptationChange("voice_off", False, "the patient asked to answer by voice")]
+
+    def restore(self, active: Iterable[str], enabled: bool) -> None:
+        """Continue a stored session's state: these adaptations in force, adaptation on or off.
+
+        Their low-reading counts start afresh; names the policy no longer has are dropped.
+        """
+        self.enabled = enabled
+        self._active = {name for name in active if name in self._low} if enabled else set()
 
     def set_enabled(self, enabled: bool) -> list[AdaptationChange]:
         """The clinician switches adaptation on or off; off lifts everything in force."""

@@ -547,6 +547,14 @@ class Session:
             resume_not_answered=tuple(stored.not_answered), familiarisation=False, **kwargs,
         )
         session.trace = [dict(e) for e in stored.trace]
+        if session.adaptation is not None:
+            # a crash must not undo the clinician's switch or listen again to a patient it stopped hearing
+            active: dict[str, bool] = {}
+            for record in stored.adaptations:
+                active[record.name] = record.active
+            switches = [entry.detail for entry in stored.log if entry.kind == "adaptation_enabled"]
+            enabled = switches[-1] == "on" if switches else session.adaptation.enabled
+            session.adaptation.restore((name for name, on in active.items() if on), enabled)
         return session
 
     # -- listeners --------------------------------------------------------------------------------
@@ -859,6 +867,7 @@ class Session:
         """The clinician turns live adaptation on or off (off lifts every active adaptation)."""
         with _Op(self) as t:
             if self.adaptation is not None:
+                self._log(t, "adaptation_enabled", "on" if enabled else "off")
                 for change in self.adaptation.set_enabled(enabled):
                     self._apply_adaptation(t, change)
 

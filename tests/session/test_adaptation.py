@@ -6,10 +6,12 @@ import pytest
 
 from kiosk.adaptation import Adaptation, PolicyError, load_policy
 from kiosk.channels import Channel
-from kiosk.session import AdaptationChanged, IgnoreReason, InputIgnored, ListeningChanged, Prompt
+from kiosk.clock import SimClock
+from kiosk.session import AdaptationChanged, IgnoreReason, InputIgnored, ListeningChanged, Prompt, Session
 from kiosk.storage import Store
+from qos import Engine
 
-from .helpers import started
+from .helpers import MODEL, QUESTIONNAIRE, TIMING, started
 
 VOICE_OFF = {"VoiceInteractionQuality": 0.1, "Interaction": 0.9}
 
@@ -170,3 +172,29 @@ def test_the_metric_is_checked_against_the_model_given(tmp_path):
     other = parse_model("roqme Other\nproperty Calm reference 0.5\n", "other.roqme")
     with pytest.raises(PolicyError, match=r":2:31: unknown metric 'Interaction' \(the model's properties: Calm\)"):
         load_policy(path, model=other)
+
+
+def _resumed(store: Store, rig) -> Session:
+    """The kiosk restarted after a crash: the stored session continues with a fresh policy state."""
+    stored = store.session(rig.session.id)
+    return Session.from_stored(QUESTIONNAIRE, stored, clock=SimClock(start=900), engine=Engine(MODEL), store=store,
+                               timing=TIMING, adaptation=Adaptation(load_policy()))
+
+
+def test_a_resumed_session_keeps_voice_off_in_force(tmp_path):
+    store = Store.open(tmp_path)
+    rig = started(adaptation=Adaptation(load_policy()), store=store)
+    rig.run_until(25)
+    _touch_answers_until_voice_off(rig)
+    resumed = _resumed(store, rig)
+    assert resumed.snapshot().adaptations == {"voice_off"}  # it does not listen again to a patient it could not hear
+
+
+def test_a_resumed_session_keeps_the_clinicians_adaptation_switch(tmp_path):
+    store = Store.open(tmp_path)
+    rig = started(adaptation=Adaptation(load_policy()), store=store)
+    rig.run_until(25)
+    rig.session.set_adaptation_enabled(False)
+    resumed = _resumed(store, rig)
+    assert resumed.adaptation is not None and not resumed.adaptation.enabled
+    assert [e.detail for e in store.session(rig.session.id).log if e.kind == "adaptation_enabled"] == ["off"]
