@@ -66,6 +66,8 @@ class QuestionScreen(PatientScreen):
             return
         item = view.snapshot.item
         if (item.id if item else None) != self._item_id:
+            if item is not None and self._item_id is not None and self._reword(view):
+                return
             for old in self.query("QuestionPanel, #recap"):
                 old.remove()
             if (panel := self._panel(view)) is not None:
@@ -74,6 +76,19 @@ class QuestionScreen(PatientScreen):
         answer = view.snapshot.answers.get(item.id) if item else None
         for panel in self.query(QuestionPanel):
             panel.mark_chosen(answer.option if answer else None)
+
+    def _reword(self, view: PatientView) -> bool:
+        """Put the view's item into the panel on screen when it has as many answers (no remount);
+        False when it cannot, so the caller builds a new panel."""
+        item = view.snapshot.item
+        assert item is not None
+        answer = view.snapshot.answers.get(item.id)
+        for panel in self.query(QuestionPanel):
+            if panel.show_item(item.text[self.language], [o.label_in(self.language) for o in item.options],
+                               chosen=answer.option if answer else None):
+                self._item_id = item.id
+                return True
+        return False
 
     def progress_text(self, view: PatientView) -> str:
         """"Question 3 of 10"."""

@@ -38,6 +38,11 @@ class AnswerButton(Widget, can_focus=True):
         yield Digits(str(self.option), classes="number")
         yield Label(self.label, classes="label")
 
+    def relabel(self, label: str) -> None:
+        """Show another answer text under the same number (the next question's option)."""
+        self.label = label
+        self.query_one(".label", Label).update(label)
+
     def on_click(self, event: events.Click) -> None:
         """A touch anywhere on the button chooses it."""
         event.stop()

@@ -32,6 +32,20 @@ class QuestionPanel(Vertical):
         """Show the chosen answer, if any, once the buttons exist."""
         self.mark_chosen(self.chosen)
 
+    def show_item(self, question: str, options: Sequence[str], *, chosen: int | None = None) -> bool:
+        """Show another question in place when it has as many options as this one (the usual next
+        question), rewording the existing widgets instead of mounting new ones, which is most of
+        the cost of a question change; returns False, changing nothing, when the count differs."""
+        options = tuple(options)
+        if len(options) != len(self.options):
+            return False
+        self.question, self.options = question, options
+        self.query_one("#question", Static).update(question)
+        for button in self.query(AnswerButton):
+            button.relabel(options[button.option - 1])
+        self.mark_chosen(chosen)
+        return True
+
     def mark_chosen(self, option: int | None) -> None:
         """Highlight the recorded answer (after an answer, until the next question opens)."""
         self.chosen = option
