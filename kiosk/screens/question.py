@@ -8,7 +8,9 @@ from textual.app import ComposeResult
 from textual.widget import Widget
 from textual.widgets import Static
 
+from kiosk.questionnaire import Item
 from kiosk.screens.base import PatientScreen, PatientView
+from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar
 from kiosk.widgets.question_panel import QuestionPanel
 from kiosk.widgets.text import ui_text
@@ -66,7 +68,7 @@ class QuestionScreen(PatientScreen):
             return
         item = view.snapshot.item
         if (item.id if item else None) != self._item_id:
-            if item is not None and self._item_id is not None and self._reword(view):
+            if item is not None and self._item_id is not None and self._reword(view, item):
                 return
             for old in self.query("QuestionPanel, #recap"):
                 old.remove()
@@ -77,16 +79,16 @@ class QuestionScreen(PatientScreen):
         for panel in self.query(QuestionPanel):
             panel.mark_chosen(answer.option if answer else None)
 
-    def _reword(self, view: PatientView) -> bool:
-        """Put the view's item into the panel on screen when it has as many answers (no remount);
-        False when it cannot, so the caller builds a new panel."""
-        item = view.snapshot.item
-        assert item is not None
+    def _reword(self, view: PatientView, item: Item) -> bool:
+        """Put ``item`` into the panel on screen when it has as many answers (no remount); False
+        when it cannot, so the caller builds a new panel."""
         answer = view.snapshot.answers.get(item.id)
         for panel in self.query(QuestionPanel):
             if panel.show_item(item.text[self.language], [o.label_in(self.language) for o in item.options],
                                chosen=answer.option if answer else None):
                 self._item_id = item.id
+                if isinstance(self.focused, AnswerButton):  # it would look chosen on the new item
+                    self.set_focus(None)
                 return True
         return False
 
