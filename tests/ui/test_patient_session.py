@@ -151,3 +151,25 @@ async def test_any_other_remote_button_on_the_welcome_screen_starts_in_the_langu
         deliver_from_thread(kiosk, ChannelInput(Channel.REMOTE, option=4, detail="BTN 4"))
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         assert kiosk.session.language == "fr"
+
+
+async def test_every_question_shows_its_own_text_and_answers_with_none_marked(ui_kiosk):
+    """Consecutive questions with as many answers reuse the answer buttons: none may keep the
+    previous question's label or its marked answer."""
+    from kiosk.widgets.answer_button import AnswerButton
+
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+
+        async def check_then_answer(number: int, option: int) -> None:
+            item = kiosk.session.current_item
+            screen = kiosk.app.screen
+            assert _text(screen.query_one("#question", Static)) == item.text["en"]
+            buttons = list(screen.query(AnswerButton))
+            assert [(b.option, _text(b.query_one(".label", Label))) for b in buttons] == [
+                (o.number, o.label_in("en")) for o in item.options]
+            assert not screen.query(".-chosen")
+            await pilot.press(str(option))
+
+        await answer_every_question(kiosk, pilot, check_then_answer)
