@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import asyncio
 import threading
+import time
 from collections.abc import Awaitable, Callable
 
 from textual.pilot import Pilot
@@ -30,6 +32,20 @@ def deliver_from_thread(kiosk: UiKiosk, item: ChannelInput | ChannelStatus) -> N
     thread = threading.Thread(target=kiosk.app.channel_sink, args=(item,))
     thread.start()
     thread.join(timeout=5)
+
+
+def text_of(widget) -> str:
+    """What a widget shows, as plain text."""
+    return str(widget.render())
+
+
+async def until_thread(condition: Callable[[], bool], what: str, patience_s: float = 30.0) -> None:
+    """Wait, boundedly, for a real worker thread (a reader, espeak-ng, a recogniser) to make
+    ``condition()`` hold; ``what`` names that thread in the failure."""
+    deadline = time.monotonic() + patience_s
+    while not condition():
+        assert time.monotonic() < deadline, f"{what} never got there"
+        await asyncio.sleep(0.01)
 
 
 def screen_name(kiosk: UiKiosk) -> str:

@@ -15,11 +15,7 @@ from kiosk.session import AdaptationChanged
 from kiosk.widgets.metrics_plot import MetricsPlot
 
 from .conftest import UI_PIN
-from .helpers import answer_every_question, screen_name, settle, start_in_english
-
-
-def _text(widget) -> str:
-    return str(widget.render())
+from .helpers import answer_every_question, screen_name, settle, start_in_english, text_of
 
 
 async def _open_clinician(kiosk, pilot) -> None:
@@ -45,7 +41,7 @@ async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk,
         assert table.get_row_at(0) == ["1", "feeding", "1", "Unable", "0", "1", "keyboard"]
         assert table.get_row_at(9)[:5] == ["10", "stairs", "3", "Independent", "10"]
         # feeding and bathing scored 0: 100 - 10 - 5
-        assert _text(screen.query_one("#total", Label)) == "Total 85 of 100 (complete); Moderate dependence"
+        assert text_of(screen.query_one("#total", Label)) == "Total 85 of 100 (complete); Moderate dependence"
         plot = screen.query_one(MetricsPlot)
         assert {name for name, (times, _) in plot.data.series.items() if times} == {
             "Performance", "Interaction", "VoiceInteractionQuality"}
@@ -55,7 +51,7 @@ async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk,
             await pilot.click(button)
             path = exports / f"session-{kiosk.session.id}.{name}"
             await settle(pilot, lambda: path.exists())
-            assert str(path) in _text(screen.query_one("#export-result", Label))
+            assert str(path) in text_of(screen.query_one("#export-result", Label))
             assert stat.S_IMODE(path.stat().st_mode) == 0o600
         response = json.loads((exports / f"session-{kiosk.session.id}.fhir.json").read_text())
         assert response["resourceType"] == "QuestionnaireResponse" and response["status"] == "completed"

@@ -12,11 +12,7 @@ from kiosk.session import AttemptTimedOut, Phase, Prompt, QuestionNotAnswered
 from kiosk.widgets.bars import AdaptationBanner, VoiceAgainButton
 
 from .conftest import UI_PIN
-from .helpers import late_touch_answer, screen_name, settle, start_in_english, start_with_voice_off
-
-
-def _text(widget) -> str:
-    return str(widget.render())
+from .helpers import late_touch_answer, screen_name, settle, start_in_english, start_with_voice_off, text_of
 
 
 async def _first_question(kiosk, pilot) -> None:
@@ -37,7 +33,7 @@ async def test_pause_freezes_the_attempt_and_continue_comes_back_to_the_question
         assert screen_name(kiosk) == "PausedScreen" and kiosk.session.answers == {}
         await pilot.click("#resume")
         await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
-        assert _text(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
+        assert text_of(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
         await pilot.press("2")
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         assert kiosk.session.answers["feeding"].attempt == 1
@@ -60,11 +56,11 @@ async def test_call_doctor_halts_until_a_clinician_continues_behind_the_pin(ui_k
         await pilot.press("9", "9", "9", "9", "enter")
         await settle(pilot)
         assert screen_name(kiosk) == "PinScreen"
-        assert _text(kiosk.app.screen.query_one("#pin-error", Label)) == "Wrong PIN."
+        assert text_of(kiosk.app.screen.query_one("#pin-error", Label)) == "Wrong PIN."
         assert kiosk.app.screen.query_one(Input).value == ""
         await pilot.press(*UI_PIN, "enter")
         await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
-        assert "waiting for a clinician" in _text(kiosk.app.screen.query_one("#current", Static))
+        assert "waiting for a clinician" in text_of(kiosk.app.screen.query_one("#current", Static))
         await pilot.click("#continue")
         await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
         assert not kiosk.session.halted
@@ -79,18 +75,18 @@ async def test_an_attempt_times_out_twice_and_the_next_question_comes(ui_kiosk):
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await _first_question(kiosk, pilot)
         attempt = kiosk.app.screen.query_one("#attempt", Label)
-        assert _text(attempt) == "Attempt 1 of 2"
+        assert text_of(attempt) == "Attempt 1 of 2"
         kiosk.advance(19.9)
         await settle(pilot)
-        assert _text(attempt) == "Attempt 1 of 2"
+        assert text_of(attempt) == "Attempt 1 of 2"
         kiosk.advance(0.2)
-        await settle(pilot, lambda: _text(attempt) == "Attempt 2 of 2")
+        await settle(pilot, lambda: text_of(attempt) == "Attempt 2 of 2")
         kiosk.advance(20.1)
         await settle(pilot, lambda: any(isinstance(e, QuestionNotAnswered) for e in kiosk.app.events))
         assert [e.attempt for e in kiosk.app.events if isinstance(e, AttemptTimedOut)] == [1, 2]
         kiosk.to_next_deadline()
-        await settle(pilot, lambda: _text(kiosk.app.screen.query_one("#progress", Label)) == "Question 2 of 10")
-        assert _text(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
+        await settle(pilot, lambda: text_of(kiosk.app.screen.query_one("#progress", Label)) == "Question 2 of 10")
+        assert text_of(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
         assert kiosk.store.session(kiosk.session.id).not_answered == ("feeding",)
 
 
@@ -99,7 +95,7 @@ async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await start_with_voice_off(kiosk, pilot)
         banner = kiosk.app.screen.query_one(AdaptationBanner)
-        assert banner.display and "touch your answer or press its number" in _text(banner)
+        assert banner.display and "touch your answer or press its number" in text_of(banner)
         # it stays on the next question's screen too
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
@@ -149,7 +145,7 @@ async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
         for _ in range(8):  # with voice in on, voice_off comes within these (the test above)
             await late_touch_answer(kiosk, pilot)
         assert "voice_off" not in kiosk.session.snapshot().adaptations  # the session knows voice in is off
-        assert "trouble hearing" not in _text(kiosk.app.screen.query_one(AdaptationBanner))
+        assert "trouble hearing" not in text_of(kiosk.app.screen.query_one(AdaptationBanner))
         assert not kiosk.app.screen.query_one(VoiceAgainButton).display
         assert not [e for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
         assert "voice_off" not in {a.name for a in kiosk.store.session(kiosk.session.id).adaptations}
@@ -164,4 +160,4 @@ async def test_the_apps_own_timer_polls_the_session(ui_kiosk):
         while kiosk.session.current_attempt != 1:
             assert time.monotonic() < deadline, "the poll timer never fired"
             await pilot.pause(0.01)
-        await settle(pilot, lambda: _text(kiosk.app.screen.query_one("#progress", Label)) == "Question 1 of 10")
+        await settle(pilot, lambda: text_of(kiosk.app.screen.query_one("#progress", Label)) == "Question 1 of 10")

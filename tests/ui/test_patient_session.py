@@ -11,11 +11,7 @@ from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.session import Phase
 from kiosk.widgets.bars import ChannelBar
 
-from .helpers import answer_every_question, deliver_from_thread, screen_name, settle, start_in_english
-
-
-def _text(widget) -> str:
-    return str(widget.render())
+from .helpers import answer_every_question, deliver_from_thread, screen_name, settle, start_in_english, text_of
 
 
 def _stored_channels(kiosk) -> set[str]:
@@ -29,13 +25,13 @@ async def test_a_whole_session_answered_with_the_number_keys(ui_kiosk):
 
         async def by_key(number: int, option: int) -> None:
             progress = kiosk.app.screen.query_one("#progress", Label)
-            assert _text(progress) == f"Question {number} of 10"
+            assert text_of(progress) == f"Question {number} of 10"
             await pilot.press(str(option))
 
         await answer_every_question(kiosk, pilot, by_key)
         stored = kiosk.store.session(kiosk.session.id)
         assert len(stored.answers) == 10 and {a.channel for a in stored.answers} == {Channel.KEYBOARD}
-        assert "Total: 100 of 100" in _text(kiosk.app.screen.query_one("#summary-total", Static))
+        assert "Total: 100 of 100" in text_of(kiosk.app.screen.query_one("#summary-total", Static))
 
 
 async def test_a_whole_session_answered_by_touching_the_buttons(ui_kiosk):
@@ -48,7 +44,7 @@ async def test_a_whole_session_answered_by_touching_the_buttons(ui_kiosk):
         await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
 
         async def by_touch(number: int, option: int) -> None:
-            assert _text(kiosk.app.screen.query_one("#progress", Label)) == f"Pregunta {number} de 10"
+            assert text_of(kiosk.app.screen.query_one("#progress", Label)) == f"Pregunta {number} de 10"
             await pilot.click(f"#answer-{option}")
 
         await answer_every_question(kiosk, pilot, by_touch)
@@ -80,13 +76,13 @@ async def test_a_remote_plugged_in_shows_as_connected_and_unplugged_as_lost(ui_k
     kiosk = ui_kiosk()
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         bar = kiosk.app.screen.query_one(ChannelBar)
-        await settle(pilot, lambda: "Remote: off" in _text(bar))
+        await settle(pilot, lambda: "Remote: off" in text_of(bar))
         deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.ON, "serial", "connected to /dev/ttyUSB0"))
-        await settle(pilot, lambda: "Remote: on" in _text(bar))
+        await settle(pilot, lambda: "Remote: on" in text_of(bar))
         deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.LOST, "serial", "unplugged"))
-        await settle(pilot, lambda: "Remote: lost" in _text(bar))
-        assert "Listening: off" in _text(bar) and "Touch: on" in _text(bar)
-        reasons = _text(kiosk.app.screen.query_one("#channel-reasons", Static))
+        await settle(pilot, lambda: "Remote: lost" in text_of(bar))
+        assert "Listening: off" in text_of(bar) and "Touch: on" in text_of(bar)
+        reasons = text_of(kiosk.app.screen.query_one("#channel-reasons", Static))
         assert "no microphone found" in reasons and "unplugged" in reasons
 
 
@@ -117,7 +113,7 @@ async def test_a_kiosk_restarted_mid_session_offers_to_continue_at_the_first_una
         again.to_next_deadline_of(again.app.session)
         await settle(pilot, lambda: again.app.session.current_attempt == 1)
         assert again.app.session.current_item.id == "dressing"
-        assert _text(again.app.screen.query_one("#progress", Label)) == "Question 4 of 10"
+        assert text_of(again.app.screen.query_one("#progress", Label)) == "Question 4 of 10"
         await pilot.press("2")
         await settle(pilot, lambda: "dressing" in again.app.session.answers)
     stored = again.store.session(first.session.id)
@@ -165,9 +161,9 @@ async def test_every_question_shows_its_own_text_and_answers_with_none_marked(ui
         async def check_then_answer(number: int, option: int) -> None:
             item = kiosk.session.current_item
             screen = kiosk.app.screen
-            assert _text(screen.query_one("#question", Static)) == item.text["en"]
+            assert text_of(screen.query_one("#question", Static)) == item.text["en"]
             buttons = list(screen.query(AnswerButton))
-            assert [(b.option, _text(b.query_one(".label", Label))) for b in buttons] == [
+            assert [(b.option, text_of(b.query_one(".label", Label))) for b in buttons] == [
                 (o.number, o.label_in("en")) for o in item.options]
             assert not screen.query(".-chosen")
             await pilot.press(str(option))

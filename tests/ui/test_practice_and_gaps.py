@@ -14,25 +14,21 @@ from kiosk.widgets.metrics_plot import METRICS, MetricsPlot, metrics_figure, plo
 from kiosk.widgets.question_panel import QuestionPanel
 
 from .conftest import UI_PIN
-from .helpers import deliver_from_thread, screen_name, settle
-
-
-def _text(widget) -> str:
-    return str(widget.render())
+from .helpers import deliver_from_thread, screen_name, settle, text_of
 
 
 def _progress(kiosk) -> str:
-    return _text(kiosk.app.screen.query_one("#progress", Label))
+    return text_of(kiosk.app.screen.query_one("#progress", Label))
 
 
 def _question_text(kiosk) -> str:
-    return _text(kiosk.app.screen.query_one("#question", Static))
+    return text_of(kiosk.app.screen.query_one("#question", Static))
 
 
 def _interlude(kiosk) -> str | None:
     """The between-questions line, or None while it is hidden."""
     line = kiosk.app.screen.query_one("#interlude", Static)
-    return _text(line) if line.display else None
+    return text_of(line) if line.display else None
 
 
 async def test_a_kiosk_without_voice_out_never_asks_which_word_was_heard(ui_kiosk):
@@ -83,7 +79,7 @@ async def test_every_gap_between_questions_shows_a_calm_line_over_the_last_conte
         # between Start and question 1: not an empty screen
         assert _interlude(kiosk) == "Thank you. Here is the first question…"
         assert not kiosk.app.screen.query(QuestionPanel)
-        assert _text(kiosk.app.screen.query_one("#recap", Static)).startswith("I will ask you ten questions")
+        assert text_of(kiosk.app.screen.query_one("#recap", Static)).startswith("I will ask you ten questions")
 
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
@@ -136,7 +132,7 @@ async def test_the_clinician_sees_how_the_practice_went(ui_kiosk):
         await pilot.press("3")
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         await _session_detail(kiosk, pilot)
-        line = _text(kiosk.app.screen.query_one("#practice", Label))
+        line = text_of(kiosk.app.screen.query_one("#practice", Label))
         assert line == "Practice: hearing skipped (no voice out) / reading ✗ (chose No) / selecting ✓"
 
 
@@ -154,7 +150,7 @@ async def test_the_metrics_plot_keeps_its_key_off_the_data(ui_kiosk, tmp_path):
             await pilot.press("1")
             await settle(pilot, lambda: item.id in kiosk.session.answers)
         await _session_detail(kiosk, pilot)
-        key = _text(kiosk.app.screen.query_one("#metrics-key", Static))
+        key = text_of(kiosk.app.screen.query_one("#metrics-key", Static))
         assert all(name in key for name in METRICS)
         plot = kiosk.app.screen.query_one(MetricsPlot)
         canvas = plot.render().plain.splitlines()

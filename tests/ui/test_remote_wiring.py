@@ -4,8 +4,6 @@ sink. Unplugging shows the remote as lost while touch keeps working."""
 
 from __future__ import annotations
 
-import asyncio
-import time
 from dataclasses import replace
 
 from kiosk.app import KIOSK_SIZE
@@ -17,14 +15,7 @@ from kiosk.widgets.bars import ChannelBar
 from kiosk.widgets.channel_board import REMOTE
 from tests.remote.boxes import PATIENCE, ButtonBox
 
-from .helpers import settle, start_in_english
-
-
-async def _until(condition) -> None:
-    deadline = time.monotonic() + PATIENCE
-    while not condition():
-        assert time.monotonic() < deadline, "the remote's reader thread never got there"
-        await asyncio.sleep(0.01)  # a real reader thread is working
+from .helpers import settle, start_in_english, until_thread
 
 
 async def test_a_serial_remote_answers_and_its_unplugging_shows(ui_kiosk, tmp_path):
@@ -32,18 +23,18 @@ async def test_a_serial_remote_answers_and_its_unplugging_shows(ui_kiosk, tmp_pa
     box = ButtonBox(tmp_path / "ttyUSB-ui0")
     kiosk = ui_kiosk(familiarisation=False, sources=[SerialRemote(profile, backoff=Backoff(0.01, 2, 0.05))])
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await _until(lambda: kiosk.app.board.state(REMOTE)[0] is ChannelState.ON)
+        await until_thread(lambda: kiosk.app.board.state(REMOTE)[0] is ChannelState.ON, "the remote's reader thread", PATIENCE)
         await start_in_english(kiosk, pilot)
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         assert "Remote: on" in str(kiosk.app.screen.query_one(ChannelBar).render())
         box.write(b"BTN 2\n")
-        await _until(lambda: "feeding" in kiosk.session.answers)
+        await until_thread(lambda: "feeding" in kiosk.session.answers, "the remote's reader thread", PATIENCE)
         answer = kiosk.session.answers["feeding"]
         assert (answer.option, answer.channel) == (2, Channel.REMOTE)
 
         box.unplug()
-        await _until(lambda: kiosk.app.board.state(REMOTE)[0] is not ChannelState.ON)
+        await until_thread(lambda: kiosk.app.board.state(REMOTE)[0] is not ChannelState.ON, "the remote's reader thread", PATIENCE)
         await settle(pilot)
         assert "Remote: lost" in str(kiosk.app.screen.query_one(ChannelBar).render())
         kiosk.to_next_deadline()

@@ -12,11 +12,7 @@ from kiosk.widgets.bars import AdaptationBanner
 from kiosk.widgets.text import ui_text
 
 from .conftest import UI_PIN
-from .helpers import deliver_from_thread, screen_name, settle, start_in_english, start_with_voice_off
-
-
-def _text(widget) -> str:
-    return str(widget.render())
+from .helpers import deliver_from_thread, screen_name, settle, start_in_english, start_with_voice_off, text_of
 
 
 async def test_the_attempt_indicator_counts_up_to_the_sessions_attempts(ui_kiosk):
@@ -27,7 +23,7 @@ async def test_the_attempt_indicator_counts_up_to_the_sessions_attempts(ui_kiosk
             kiosk.to_next_deadline()  # the gap before the question, then each attempt's window
             await settle(pilot, lambda: kiosk.session.current_attempt == attempt)
             label = kiosk.app.screen.query_one("#attempt", Label)
-            await settle(pilot, lambda: _text(label) == f"Attempt {attempt} of {ATTEMPTS}")
+            await settle(pilot, lambda: text_of(label) == f"Attempt {attempt} of {ATTEMPTS}")
 
 
 async def test_number_keys_before_the_questions_start_in_that_language_and_acknowledge(ui_kiosk):
@@ -48,7 +44,7 @@ async def test_voice_in_status_reaches_the_session_and_a_lost_microphone_lifts_v
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await start_with_voice_off(kiosk, pilot)
         banner = kiosk.app.screen.query_one(AdaptationBanner)
-        assert banner.display and "trouble hearing" in _text(banner)
+        assert banner.display and "trouble hearing" in text_of(banner)
         deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.LOST, "voice in", "microphone unplugged"))
         await settle(pilot, lambda: "voice_off" not in kiosk.session.snapshot().adaptations)
         await settle(pilot, lambda: not kiosk.app.screen.query_one(AdaptationBanner).display)
@@ -82,12 +78,12 @@ async def test_the_clinician_marks_the_patient_left_and_back_and_the_attempt_clo
 
         await _clinician_presses(kiosk, pilot, "#person-lost")
         notice = ui_text("en", "person_lost")
-        await settle(pilot, lambda: notice in _text(kiosk.app.screen.query_one(AdaptationBanner)))
+        await settle(pilot, lambda: notice in text_of(kiosk.app.screen.query_one(AdaptationBanner)))
         kiosk.advance(10 * timing.attempt_window_s)  # far past the deadline: the clock is frozen
         await settle(pilot)
         assert not [e for e in kiosk.app.events if isinstance(e, AttemptTimedOut)]
         assert kiosk.session.current_attempt == 1 and kiosk.session.remaining() == left_with
-        assert notice in _text(kiosk.app.screen.query_one(AdaptationBanner))
+        assert notice in text_of(kiosk.app.screen.query_one(AdaptationBanner))
 
         await _clinician_presses(kiosk, pilot, "#person-back")
         await settle(pilot, lambda: not kiosk.app.screen.query_one(AdaptationBanner).display)

@@ -5,10 +5,8 @@ never said while voice in is off."""
 
 from __future__ import annotations
 
-import asyncio
 import shutil
 import threading
-import time
 
 import pytest
 
@@ -18,10 +16,8 @@ from kiosk.session import Prompt
 from kiosk.speech.tts import Speaker
 from kiosk.widgets.channel_board import VOICE_OUT
 
-from .helpers import settle, start_in_english
-from .test_incidents import late_touch_answer
+from .helpers import late_touch_answer, settle, start_in_english, until_thread
 
-PATIENCE_S = 30.0
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")]
@@ -43,26 +39,19 @@ class RecordingPlayer:
         """Nothing is playing."""
 
 
-async def _until(condition) -> None:
-    deadline = time.monotonic() + PATIENCE_S
-    while not condition():
-        assert time.monotonic() < deadline, "the speaker's worker never got there"
-        await asyncio.sleep(0.02)  # espeak-ng is synthesising on the worker thread
-
-
 async def test_prompts_are_spoken_and_a_spoken_repeat_is_reported_to_the_session(ui_kiosk):
     player = RecordingPlayer()
     kiosk = ui_kiosk(familiarisation=False, speaker=Speaker(player_factory=lambda: player))
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await _until(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON)
+        await until_thread(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON, "the speaker's worker")
         await start_in_english(kiosk, pilot)
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         spoken = sum(1 for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken)
-        await _until(lambda: player.played >= spoken)  # welcome, explanation, the first question
+        await until_thread(lambda: player.played >= spoken, "the speaker's worker")  # welcome, explanation, the first question
         states = lambda: [e["set"]["TestState"] for e in kiosk.session.trace if "TestState" in e.get("set", {})]
         await pilot.press("r")  # repeat: TestState REPEATING until the repeat has been said
-        await _until(lambda: states()[-2:] == ["REPEATING", "STARTED"])
+        await until_thread(lambda: states()[-2:] == ["REPEATING", "STARTED"], "the speaker's worker")
         assert player.played >= spoken + 1
 
 
@@ -70,12 +59,12 @@ async def test_trouble_hearing_is_never_said_while_voice_in_is_off(ui_kiosk):
     player = RecordingPlayer()
     kiosk = ui_kiosk(familiarisation=False, speaker=Speaker(player_factory=lambda: player))
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await _until(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON)
+        await until_thread(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON, "the speaker's worker")
         await start_in_english(kiosk, pilot)
         for _ in range(8):  # with voice in on, these late answers switch voice_off on
             await late_touch_answer(kiosk, pilot)
         prompts = [e for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken]
         assert not [p for p in prompts if p.key in ("voice_off", "voice_on")]  # the session never asked...
-        await _until(lambda: player.played >= len(prompts))
+        await until_thread(lambda: player.played >= len(prompts), "the speaker's worker")
         await settle(pilot)
         assert player.played == len(prompts)  # ...and the app said every prompt it was given

@@ -5,10 +5,8 @@ reaches the session through the app's sink -- recorded with channel voice."""
 
 from __future__ import annotations
 
-import asyncio
 import shutil
 import threading
-import time
 from pathlib import Path
 
 import pytest
@@ -20,7 +18,7 @@ from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel
 from kiosk.widgets.channel_board import VOICE_IN
 
-from .helpers import settle, start_in_english
+from .helpers import settle, start_in_english, until_thread
 
 PATIENCE_S = 30.0
 
@@ -50,13 +48,6 @@ class WavMicrophone:
         thread.start()
 
 
-async def _until(condition) -> None:
-    deadline = time.monotonic() + PATIENCE_S
-    while not condition():
-        assert time.monotonic() < deadline, "timed out waiting for the voice channel"
-        await asyncio.sleep(0.02)  # real threads (recogniser, audio) are working
-
-
 async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp_path):
     wav = Synthesiser().synthesise("independent", "en", tmp_path / "independent.wav")
     microphones: list[WavMicrophone] = []
@@ -64,14 +55,14 @@ async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp
         "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
     kiosk = ui_kiosk(familiarisation=False, voice=voice)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await _until(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON)
+        await until_thread(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON, "the voice channel")
         await start_in_english(kiosk, pilot)
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_item is not None and kiosk.session.listening)
         assert kiosk.session.current_item.id == "feeding"
         assert "Listening: listening" in str(kiosk.app.screen.query_one("#channels").render())
         microphones[0].play(wav)
-        await _until(lambda: "feeding" in kiosk.session.answers)
+        await until_thread(lambda: "feeding" in kiosk.session.answers, "the voice channel")
         await settle(pilot)
     answer = kiosk.store.session(kiosk.session.id).answers[0]
     assert (answer.item_id, answer.option, answer.channel) == ("feeding", 3, Channel.VOICE)
