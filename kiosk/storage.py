@@ -236,6 +236,8 @@ class Store:
     def __init__(self, connection: sqlite3.Connection, path: Path) -> None:
         self._db = connection
         self.path = path
+        #: depth of nested transaction() blocks; writes inside them commit when the outermost ends
+        self._grouping = 0
 
     @classmethod
     def open(cls, data_dir: str | Path, create: bool = True) -> Store:
@@ -278,18 +280,22 @@ class Store:
         The session runs each of its operations in one, so an answer is never stored without the
         QoS context batch it published. Nested use joins the outer transaction. What was written is
         committed even if the block raises: recorded answers are never thrown away.
+
+        The transaction begins with its first write, so an operation that writes nothing (most
+        polls of the attempt clock) takes no write lock and syncs nothing.
         """
-        outer = not self._db.in_transaction
-        if outer:
-            self._db.execute("BEGIN IMMEDIATE")
+        self._grouping += 1
         try:
             yield
         finally:
-            if outer:
+            self._grouping -= 1
+            if not self._grouping and self._db.in_transaction:
                 self._db.commit()
 
     def _write(self, sql: str, args: tuple[Any, ...]) -> None:
         with self.transaction():
+            if not self._db.in_transaction:
+                self._db.execute("BEGIN IMMEDIATE")
             self._db.execute(sql, args)
 
     def _next_seq(self, table: str, session_id: str) -> int:
@@ -306,8 +312,8 @@ class Store:
             raise ValueError(f"patient id {patient_id!r} is not a pseudonymous id "
                              "(2-64 letters, digits, '-' or '_'; never a name)")
         with self.transaction():
-            self._db.execute("INSERT OR IGNORE INTO patients (id, created_at) VALUES (?, ?)", (patient_id, started_at))
-            self._db.execute(
+            self._write("INSERT OR IGNORE INTO patients (id, created_at) VALUES (?, ?)", (patient_id, started_at))
+            self._write(
                 "INSERT INTO sessions (id, patient_id, questionnaire_id, language, answered_by, timing, started_at,"
                 " status) VALUES (?, ?, ?, ?, ?, ?, ?, 'running')",
                 (session_id, patient_id, questionnaire_id, language, answered_by, json.dumps(dict(timing)), started_at),

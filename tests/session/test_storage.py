@@ -281,3 +281,15 @@ def test_an_answer_and_its_qos_context_are_committed_together(tmp_path):
     rig.answer(2)
     assert seen_mid_operation == [(0, 0)]  # neither is visible before the operation ends
     assert committed() == (1, 1)  # both are, once it has
+
+
+def test_an_operation_that_writes_nothing_takes_no_write_lock(tmp_path):
+    """The UI polls the attempt clock ten times a second; a poll with nothing due must not lock
+    the database against another writer (say `kiosk replay --data-dir` on the same kiosk)."""
+    store = Store.open(tmp_path / "data")
+    rig = stored_rig(store)
+    rig.session.start()
+    with store.transaction():
+        rig.session.poll()  # nothing is due
+        with sqlite3.connect(store.path, timeout=0) as other:
+            other.execute("INSERT INTO patients (id, created_at) VALUES ('P-OTHER1', 'now')")  # not locked out
