@@ -35,6 +35,9 @@ class Command(str, Enum):
     REPEAT = "repeat"
     VOLUME_UP = "volume_up"
     VOLUME_DOWN = "volume_down"
+    #: "No, that's wrong" / the Change button: take back the last answer while it can still be
+    #: changed (the session decides how long that is)
+    UNDO = "undo"
 
 
 @dataclass(frozen=True)
@@ -53,6 +56,9 @@ class ChannelInput:
     detail: str = ""
     #: for voice: the recogniser's confidence in [0, 1]; None for channels without one
     confidence: float | None = None
+    #: the channel is not sure enough to store this answer as heard: the session asks the patient
+    #: to confirm it ("I heard: Independent. Is that right?") before recording it
+    needs_confirmation: bool = False
 
     def __post_init__(self) -> None:
         if (self.option is None) == (self.command is None):
