@@ -33,7 +33,7 @@ from typing import Any
 import platformdirs
 
 from kiosk.questionnaire import Questionnaire, Timing, load_questionnaire
-from kiosk.yamlmarks import Problem, parse
+from kiosk.yamlmarks import Problem, parse_file
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
 DEFAULT_PIN = "1234"
@@ -112,12 +112,9 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
 
 def _read(path: Path) -> dict[str, Any]:
     name = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ConfigError(f"{name}: cannot read the configuration: {reason}") from None
-    data, positions, problems = parse(text, name)
+    data, positions, problems = parse_file(path)
+    if problems and problems[0].message == "the file is empty":
+        return {}  # a config file with every setting commented out means the defaults
     if problems:
         raise ConfigError(str(problems[0]))
     if data is None:

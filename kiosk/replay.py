@@ -39,7 +39,7 @@ from kiosk.session import (
     SessionEvent,
 )
 from kiosk.adaptation import MODEL
-from kiosk.yamlmarks import Problem, describe, parse, schema_problems
+from kiosk.yamlmarks import Problem, describe, parse_file, schema_problems
 from qos.trace import seconds
 
 #: incidents that are commands a patient gives through a channel
@@ -115,12 +115,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
     """Read and check a scripted patient; :class:`ScriptError` lists every problem with its position."""
     questionnaire = questionnaire or load_questionnaire()
     name = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ScriptError(f"{name}:1:1: cannot read the script: {reason}") from None
-    data, positions, problems = parse(text, name)
+    data, positions, problems = parse_file(path)
     if positions is None or not isinstance(data, dict):
         problems = problems or [Problem(name, 1, 1, "a script is a mapping (patient:, questions:, ...)")]
         raise _script_error(problems)
