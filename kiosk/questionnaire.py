@@ -28,6 +28,9 @@ from kiosk.yamlmarks import Positions, Problem, describe, parse, parse_file, sch
 _PACKAGE_DIR = "kiosk.questionnaires"
 DEFAULT_FILE = "barthel.yaml"
 SCHEMA_FILE = "questionnaire.schema.json"
+#: the languages the kiosk's own screens are written in (kiosk/widgets/ui_text.yaml): a
+#: questionnaire in another language would start a session its screens cannot show
+SCREEN_LANGUAGES = ("en", "es", "fr")
 
 
 # --------------------------------------------------------------------------------------------
@@ -360,6 +363,10 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
         data.get("languages"), list) else []
     if len(set(languages)) != len(languages):
         add(("languages",), "a language is listed twice in 'languages'")
+    for i, lang in enumerate(languages):
+        if lang not in SCREEN_LANGUAGES:
+            add(("languages", i), f"language {lang!r}: the kiosk's screens have text in "
+                                  f"{', '.join(SCREEN_LANGUAGES)} only")
 
     def texts(path: tuple[Any, ...], value: Any) -> None:
         if not isinstance(value, dict):
@@ -441,7 +448,9 @@ def _check_bands(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, di
     default = block.get("default")
     if isinstance(default, str) and sets and default not in sets:
         add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")
-    reachable = _reachable_totals(dicts(data.get("items")))
+    items = dicts(data.get("items"))
+    # no items: the schema says so, and every band would only repeat it as "ends above 0"
+    reachable = _reachable_totals(items) if items else None
     for name, band_set in sets.items():
         path = ("bands", "sets", name, "ranges")
         bands = dicts(band_set.get("ranges")) if isinstance(band_set, dict) else []

@@ -103,6 +103,8 @@ def schema_problems(data: Any, schema: dict[str, Any], positions: Positions,
         elif error.validator == "required":
             missing = error.message.split("'")[1] if "'" in error.message else error.message
             add(path, f"{where} is missing {missing!r}")
+        elif error.validator == "minItems" and error.validator_value == 1 and error.instance == []:
+            add(path, f"{where} is empty: list at least one")
         elif error.validator == "multipleOf":
             add(path, f"{where}: must be a multiple of {error.validator_value}, got {error.instance!r}")
         else:

@@ -256,8 +256,10 @@ class ReplaySamples:
     fired: list[dict[str, object]]
 
 
-#: samples one replay may take (each holds every property): bounds time and memory for a tiny period
-MAX_SAMPLES = 10_000_000
+#: samples one replay may take (each holds every property): bounds time and memory, so that a tiny
+#: trace whose last event is at t = 10⁷ s is refused at once instead of replayed for minutes; a
+#: day of events at the default 1 s period fits
+MAX_SAMPLES = 100_000
 
 
 def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
