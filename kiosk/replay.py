@@ -504,7 +504,7 @@ def main(argv: list[str]) -> int:
         from kiosk.storage import StorageError, Store
 
         try:
-            store = Store.open(args.data_dir)
+            store = Store.open(args.data_dir, simulated=True)  # scripted patients: never offered to anyone
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
