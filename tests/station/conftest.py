@@ -11,6 +11,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 import uuid
 from collections.abc import Iterator
@@ -47,14 +48,15 @@ def _as_postgres(argv: list[str]) -> list[str]:
 
 
 @pytest.fixture(scope="session")
-def postgres(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+def postgres() -> Iterator[str]:
     """A PostgreSQL server for this test session; yields its URL (superuser, trust on 127.0.0.1)."""
     bin_dir = _pg_bin()
     if bin_dir is None:
         if os.environ.get("CI"):
             pytest.fail("PostgreSQL is not installed (.ci/run installs the Debian package 'postgresql')")
         pytest.skip("PostgreSQL is not installed (apt-get install postgresql)")
-    base = tmp_path_factory.mktemp("pg")
+    # not under pytest's tmp_path: that is private to root, and the server runs as 'postgres'
+    base = Path(tempfile.mkdtemp(prefix="station-pg-"))
     data, sockets = base / "data", base / "sock"
     data.mkdir(mode=0o700)
     sockets.mkdir()
@@ -65,15 +67,16 @@ def postgres(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         base.chmod(0o755)
     port = free_port()
     subprocess.run(_as_postgres([str(bin_dir / "initdb"), "-D", str(data), "-U", "postgres", "--auth=trust",
-                                 "--no-sync", "-E", "UTF8"]), check=True, capture_output=True)
+                                 "--no-sync", "-E", "UTF8"]), check=True, capture_output=True, cwd=base)
     subprocess.run(_as_postgres([str(bin_dir / "pg_ctl"), "-D", str(data), "-l", str(base / "log"), "-w", "-t", "60",
                                  "-o", f"-p {port} -k {sockets} -c listen_addresses=127.0.0.1 -c fsync=off "
-                                       "-c max_connections=300", "start"]), check=True, capture_output=True)
+                                       "-c max_connections=300", "start"]), check=True, capture_output=True, cwd=base)
     try:
         yield f"postgresql://postgres@127.0.0.1:{port}/postgres"
     finally:
         subprocess.run(_as_postgres([str(bin_dir / "pg_ctl"), "-D", str(data), "-m", "immediate", "stop"]),
-                       capture_output=True)
+                       capture_output=True, cwd=base)
+        shutil.rmtree(base, ignore_errors=True)
 
 
 @pytest.fixture
