@@ -108,8 +108,8 @@ def names_in(node: object) -> Iterator[str]:
     elif dataclasses.is_dataclass(node) and not isinstance(node, type):
         for item in dataclasses.fields(node):
             yield from names_in(getattr(node, item.name))
-    elif isinstance(node, (tuple, list)):
-        for item in node:
+    elif isinstance(node, (tuple, list, dict)):
+        for item in (node.values() if isinstance(node, dict) else node):
             yield from names_in(item)
 
 

@@ -69,7 +69,7 @@ def load_model_file(path: str | Path) -> Model:
 
 def _description(token: Token) -> str:
     lines = str(token)[3:-2].strip("\n").splitlines()
-    lines = [re.sub(r"^\s*\*?\s?", "", line).rstrip() for line in lines]
+    lines = [re.sub(r"^\s*\*?\s*", "", line).rstrip() for line in lines]
     return "\n".join(lines).strip()
 
 
@@ -98,6 +98,8 @@ class _Checker(TermChecker):
             raise source.error(problem.line, problem.column, problem.message) from None
 
     def model(self, source: _Source) -> Model:
+        if source.folder is not None and source.filename != "<string>":
+            self.reading.append((source.folder / source.filename).resolve())
         tree, descriptions = self._tree(source)
         name, description = self._declarations(tree, descriptions)
         if name is None:
