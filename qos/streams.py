@@ -20,8 +20,10 @@ Aggregate ``X'f(w)`` / ``f(X, w, where)`` over the updates of X (after which ``w
     if nothing else happens); a batch without updates produces nothing and the next batch starts at the
     next update.
     ``avg min max sum`` need numbers, ``count`` counts updates of any context (eventtype
-    occurrences too); ``increasing`` / ``decreasing`` / ``stable`` are true when every update in the
-    window is greater / smaller / equal to the one before (undefined with fewer than two).
+    occurrences too). ``increasing`` / ``decreasing`` / ``stable`` look at *steps*, pairs of
+    consecutive updates (the generator's ``every a=X -> b=X`` window): true when every step in the
+    window goes up / down / stays; ``increasing(X, 2)`` covers the last 2 steps, i.e. 3 updates; a
+    time batch holds the steps that end in it. Undefined before the first step.
 ``period(X)``
     at an update of X whose value differs from the previous update's (every occurrence of an
     eventtype), the seconds since that previous update.
@@ -40,14 +42,19 @@ from qos.model import EVENTTYPE, Aggregate, Context, Model, Period, Stream, Vari
 from qos.patterns import Batch, PatternRunner
 
 
+TRENDS = ("increasing", "decreasing", "stable")
+
+
 class _Accumulator:
     """Running values of one aggregate window, in constant memory."""
 
-    __slots__ = ("count", "total", "low", "high", "last", "rising", "falling", "flat")
+    __slots__ = ("count", "total", "low", "high", "last", "steps", "rising", "falling", "flat")
 
-    def __init__(self):
-        self.count, self.total = 0, 0.0
-        self.low = self.high = self.last = None
+    def __init__(self, last: object = None):
+        self.count, self.total, self.steps = 0, 0.0, 0
+        self.low = self.high = None
+        #: the update before this window's first (its first step starts there)
+        self.last = last
         self.rising = self.falling = self.flat = True
 
     def add(self, value: object) -> None:
@@ -58,6 +65,7 @@ class _Accumulator:
         self.low = value if self.low is None else min(self.low, value)
         self.high = value if self.high is None else max(self.high, value)
         if self.last is not None:
+            self.steps += 1
             self.rising &= value > self.last
             self.falling &= value < self.last
             self.flat &= value == self.last
@@ -68,8 +76,8 @@ class _Accumulator:
             return float(self.count)
         if self.count == 0:
             return None
-        if function in ("increasing", "decreasing", "stable"):
-            if self.count < 2:
+        if function in TRENDS:
+            if self.steps == 0:
                 return None
             return {"increasing": self.rising, "decreasing": self.falling, "stable": self.flat}[function]
         result = {"avg": self.total / self.count, "sum": self.total, "min": self.low, "max": self.high}[function]
@@ -136,7 +144,8 @@ class _Aggregate(StreamRunner):
         self.eventtype = eventtype
         self.running = _Accumulator()
         #: length window: the last n samples
-        self.recent: deque = deque(maxlen=self.window if isinstance(self.window, int) else None)
+        trend = self.function in TRENDS
+        self.recent: deque = deque(maxlen=self.window + trend if isinstance(self.window, int) else None)
         #: time window: end of the current batch (None: waiting for an update to start one)
         self.end: float | None = None
 
@@ -150,7 +159,7 @@ class _Aggregate(StreamRunner):
                 self.end += self.window
             else:
                 self.end = None
-            self.running = _Accumulator()
+            self.running = _Accumulator(self.running.last)
         if self.source not in updated or (self.where is not None and self.where(values) is not True):
             return
         sample = True if self.eventtype else values.get(self.source)
