@@ -14,6 +14,7 @@ from pathlib import Path
 from lark import Token, Tree
 
 from qos.errors import ModelError
+from qos.files import BadFile, read_text
 from qos.grammar import SyntaxProblem, parse_text
 from qos.model import (
     BOOLEAN, EVENTTYPE, INTENSITY_LR, NUMBER, ArrayType, ClearEvidence, Context, EnumType, Evidence, Literal, Model,
@@ -45,11 +46,9 @@ class _Source:
 
 def _read(path: Path) -> str:
     try:
-        return path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ModelError(f"{path}: cannot read the model ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise ModelError(f"{path}: the model is not UTF-8 text (byte {exc.start})") from None
+        return read_text(path)  # the project's bounded reader
+    except BadFile as exc:
+        raise ModelError(str(exc)) from None
 
 
 def parse_model(text: str, filename: str = "<string>", folder: str | Path | None = None) -> Model:
