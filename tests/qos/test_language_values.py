@@ -84,9 +84,11 @@ def test_types_with_bounds_units_and_arrays_check_what_the_kiosk_sets():
 def test_arithmetic_functions_and_the_conditional():
     body = ("observation O : eventWhen(pow(N, 2) = 9 & sqrt(N * 3) = 3 & abs(-N) = 3 & exp(0) = 1) reinforces P\n"
             "observation Q : eventWhen((N > 2 ? N : 0) + 1 = 4) reinforces P\n"
-            "observation R : eventWhen(sqrt(N) > 0) reinforces P\n")
+            "observation R : eventWhen(sqrt(N) > 0) reinforces P\n"
+            "observation U : eventWhen(N > 2 meters & N < 1 minutes) reinforces P\n")
     fired = run(body, [(0, {"N": 1}), (1, {"N": 3}), (2, {"N": -4})])
     assert times(fired, "O") == [1] and times(fired, "Q") == [1]
+    assert times(fired, "U") == [1]  # a unit-measured value is its number; a time is in seconds
     assert times(fired, "R") == [0]  # sqrt(-4) is undefined: never true, never "changes"
 
 
