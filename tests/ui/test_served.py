@@ -79,7 +79,7 @@ def _count(database: Path, table: str) -> int:
 def served_kiosk(tmp_path):
     """`kiosk serve` on a free localhost port with its own configuration and data directory."""
     config = tmp_path / "config.yaml"
-    config.write_text("familiarisation: false\nclinician_pin: \"2468\"\n"
+    config.write_text("familiarisation: false\nclinician_pin: \"246813\"\n"
                       "timing: {attempt_window_s: 300, between_questions_s: 0.5}\n")
     port = _free_port()
     env = dict(os.environ, KIOSK_CONFIG=str(config))
