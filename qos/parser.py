@@ -377,6 +377,10 @@ class _Checker(TermChecker):
 
     def _belief_target(self, name: Token, verb: Token, target: Token) -> str:
         if str(target) not in self.beliefs:
+            what = self.declared.get(str(target))
+            if what:
+                raise self.error(target, f"observation {name} {verb} {target}, a {what}: only a property or a "
+                                         "beliefvar holds evidence")
             raise self.error(target, f"observation {name} {verb} unknown property {target}")
         return str(target)
 

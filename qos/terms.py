@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from lark import Token, Tree
 
+from qos.expressions import variables_of
 from qos.grammar import TIME_UNITS
 from qos.model import (
     BOOLEAN, EVENTTYPE, NUMBER, Aggregate, AllOf, AndNot, AnyOf, ArrayType, Binary, Call, Changed, Conditional,
@@ -121,6 +122,13 @@ class TermChecker:
         expr = self.expr(argument, role=f"the argument of {keyword}")
         if when_true and expr.type != BOOLEAN:
             raise self.error(argument, f"eventWhen needs a boolean expression, not {type_name(expr.type)}")
+        return self._changed(argument, expr, when_true)
+
+    def _changed(self, node, expr: Expr, when_true: bool) -> Changed:
+        """A change of a value, which only an update of a context (or of a stream) can bring."""
+        if not any(name in self.contexts or name.startswith("#") for name in variables_of(expr)):
+            raise self.error(node, "this value reads no context, so it never changes by an update: use it as a "
+                                   "condition (X while(…)) or read a context")
         return Changed(expr, when_true=when_true)
 
     def _count(self, token: Token, message: str) -> int:
@@ -142,7 +150,7 @@ class TermChecker:
         if expr.type != BOOLEAN:
             raise self.error(node, f"a {type_name(expr.type)} value cannot stand as a pattern: use update(…) or "
                                    "compare it")
-        return Changed(expr, when_true=True)
+        return self._changed(node, expr, True)
 
     def _enum_occurrence(self, node: Tree) -> Pattern:
         """``ctx::LIT`` as a pattern: every update of ctx to LIT (RoQME's enum filter)."""
@@ -221,6 +229,8 @@ class TermChecker:
             return Var(text, NUMBER)
         if text in self.timers:
             raise self.error(name, f"{text} is a timer and has no value: use it as a pattern")
+        if self.declared.get(text) in ("context", "variable"):
+            raise self.error(name, f"{text} is used in its own definition")
         what = self.declared.get(text)
         detail = f" ({text} is a {what})" if what else ""
         raise self.error(name, f"unknown context {text}{detail}")
