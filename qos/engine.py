@@ -59,6 +59,10 @@ def observation_sort_key(name: str) -> tuple:
 
 Subscriber = Callable[[UpdateResult], object]
 
+#: timer batches one update or advance may run: a jump that needs more (a 1-second timer and a month of
+#: silence) is refused rather than left to run for minutes
+MAX_TIMED_BATCHES = 1_000_000
+
 
 class Engine:
     """Runs one model: feed it batches of context updates with ``update``, read ``metrics``.
@@ -155,12 +159,17 @@ class Engine:
         return t
 
     def _start_timers(self, t: float) -> None:
+        """Start the timers at the engine's start, and refuse a jump that would fire them too often."""
         if not self._started:
             start = self._start if self._start is not None else t
             for clock in self._timers.values():
                 if not clock.timer.paused:
                     clock.start(start)
             self._started = True
+        firings = sum(clock.firings_until(t) for clock in self._timers.values())
+        if firings > MAX_TIMED_BATCHES:
+            raise ContextError(f"time {t:g} s is too far ahead: the timers would fire about {firings:,.0f} times "
+                               f"before it (at most {MAX_TIMED_BATCHES:,}); advance the engine in smaller steps")
 
     def _timers_due(self, t: float) -> list[str]:
         fired = [name for name, clock in self._timers.items() if clock.due is not None and clock.due <= t]
