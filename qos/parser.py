@@ -66,6 +66,22 @@ def load_model_file(path: str | Path) -> Model:
     return parse_model(_read(path), path.name, path.parent)
 
 
+#: how deeply terms may nest (parentheses, chains of operators): checking and running a term recurse
+#: once per level, and no model a person writes comes near this
+MAX_NESTING = 200
+
+
+def _check_nesting(source: _Source, tree: Tree) -> None:
+    """Refuse a term nested deeper than MAX_NESTING, naming its declaration (checked without recursion)."""
+    stack = [(declaration, 1, declaration) for declaration in tree.children]
+    while stack:
+        node, depth, declaration = stack.pop()
+        if depth > MAX_NESTING:
+            raise source.at(declaration, f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
+                                         "deep: split it with derived contexts")
+        stack.extend((child, depth + 1, declaration) for child in node.children if isinstance(child, Tree))
+
+
 def _description(token: Token) -> str:
     lines = str(token)[3:-2].strip("\n").splitlines()
     lines = [re.sub(r"^\s*\*?\s*", "", line).rstrip() for line in lines]
@@ -92,9 +108,11 @@ class _Checker(TermChecker):
 
     def _tree(self, source: _Source) -> tuple[Tree, list[Token]]:
         try:
-            return parse_text(source.text)
+            tree, descriptions = parse_text(source.text)
         except SyntaxProblem as problem:
             raise source.error(problem.line, problem.column, problem.message) from None
+        _check_nesting(source, tree)
+        return tree, descriptions
 
     def model(self, source: _Source) -> Model:
         if source.folder is not None and source.filename != "<string>":

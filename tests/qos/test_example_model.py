@@ -62,3 +62,8 @@ def test_the_models_descriptions_are_there_for_engineers():
     assert "longer than SlowAnswer" in model.contexts["SlowStreak"].description
     assert model.variables["SlowAnswer"].initial == 15
     assert load_trace(SLOW_PATIENT).model == "kiosk_pace"
+
+
+def test_timers_fire_at_their_own_times_whatever_the_sample_period():
+    fired = [replay(SLOW_PATIENT, sample_period=period)["fired"] for period in (1, 7, 0.5, 100)]
+    assert fired[0] == fired[1] == fired[2] == fired[3]

@@ -119,3 +119,11 @@ def test_comments_units_and_reference_bounds_are_read():
     assert [model.properties[name].survival for name in "ABCD"] == [30.0, 7200.0, 0.5, None]
     assert model.properties["A"].prior == 0.99 and model.properties["B"].prior == 0.01
     assert model.properties["D"].reference == 0.5
+
+
+def test_a_term_nested_without_end_is_one_line_not_a_crash():
+    text = HEAD + "observation O : eventWhen(" + "N + " * 5000 + "1 > 2) reinforces P"
+    with pytest.raises(ModelError, match=r"^m\.roqme:7:1: O nests operators more than 200 levels deep"):
+        parse_model(text, "m.roqme")
+    # parentheses alone add no level
+    parse_model(HEAD + "observation O : " + "(" * 5000 + "B" + ")" * 5000 + " reinforces P", "m.roqme")
