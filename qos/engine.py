@@ -86,7 +86,7 @@ class Engine:
             variable = model.variables.get(name)
             if variable is None or not variable.parameter:
                 raise ContextError(f"{name!r} is not a parameter of model {model.name}")
-            self._values[name] = check_value(variable, name, variable.type, value)  # type: ignore[arg-type]
+            self._values[name] = check_value(variable, name, variable.type, value)
         self._streams = build_streams(model, self._values)
         self._timers = {name: TimerClock(timer, origin) for name, timer in model.timers.items()}
         self._start = None if start is None else check_time(start)

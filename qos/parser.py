@@ -278,16 +278,20 @@ class _Checker(TermChecker):
         _, name, type_node, _define, definition = tree.children
         self._declare(name, "variable")
         spec = self._type_spec(str(name), type_node, "variable")
-        value = self.expr(definition, f"the definition of {name}")
-        if value.type != spec.type:
-            raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
-                                         f"{type_name(spec.type)}")
-        if isinstance(value, Literal):
-            variable = Variable(str(name), spec.type, spec, self._value_of(definition, spec, str(name), "the value"),
-                                None, False, self.description)
-        else:
-            variable = Variable(str(name), spec.type, spec, None, value, False, self.description)
-            self.streams.append((str(name), variable))
+        self.defining = (str(name), spec.type)  # its own enum literals: var W : enum {C, D} := W::D
+        try:
+            value = self.expr(definition, f"the definition of {name}")
+            if value.type != spec.type:
+                raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
+                                             f"{type_name(spec.type)}")
+            if isinstance(value, Literal):
+                variable = Variable(str(name), spec.type, spec, self._value_of(definition, spec, str(name), "the value"),
+                                    None, False, self.description)
+            else:
+                variable = Variable(str(name), spec.type, spec, None, value, False, self.description)
+                self.streams.append((str(name), variable))
+        finally:
+            self.defining = None
         self.variables[str(name)] = variable
 
     def param_decl(self, tree: Tree) -> None:
@@ -296,7 +300,11 @@ class _Checker(TermChecker):
         spec = self._type_spec(str(name), type_node, "parameter")
         if spec.type == EVENTTYPE:
             raise self.error(type_node, f"parameter {name} holds a value; an eventtype has none")
-        initial = None if default is None else self._value_of(default, spec, str(name), "the default")
+        self.defining = (str(name), spec.type)  # its own enum literals: default L::A
+        try:
+            initial = None if default is None else self._value_of(default, spec, str(name), "the default")
+        finally:
+            self.defining = None
         self.variables[str(name)] = Variable(str(name), spec.type, spec, initial, None, True, self.description)
 
     def timer_decl(self, tree: Tree) -> None:

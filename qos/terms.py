@@ -247,6 +247,8 @@ class TermChecker:
             enum = self.variables[qualifier].type
         elif self.defining is not None and self.defining[0] == qualifier:
             enum = self.defining[1]
+        if isinstance(enum, ArrayType):  # an array of enum literals: its elements' type
+            enum = enum.element
         if not isinstance(enum, EnumType):
             raise self.error(type_token, f"{type_token} is not an enum type")
         if str(literal) not in enum.literals:
