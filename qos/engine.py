@@ -195,9 +195,8 @@ class Engine:
         self._act(t, fired)
         metrics = self._metrics_at(t)
         outputs = {name: self._output(name, metrics[name]) for name in self._outputs}
-        beliefs = {name: self._beliefs[name].metric(t) for name in self.model.beliefvars}
         result = UpdateResult(t, metrics, sorted(fired, key=observation_sort_key), values, emitted, timers,
-                              outputs, beliefs)
+                              outputs, self.beliefs(t))
         for callback in list(self._subscribers):
             callback(result)
         return result
@@ -231,6 +230,13 @@ class Engine:
         if self._t is not None and t < self._t:
             raise ContextError(f"time {t:g} s is before the last update at {self._t:g} s")
         return self._metrics_at(t)
+
+    def beliefs(self, t: float | None = None) -> dict[str, float]:
+        """Every ``beliefvar``'s probability at time t (default: the last update), with decay applied."""
+        t = self._t if t is None and self._t is not None else (0.0 if t is None else check_time(t))
+        if self._t is not None and t < self._t:
+            raise ContextError(f"time {t:g} s is before the last update at {self._t:g} s")
+        return {name: self._beliefs[name].metric(t) for name in self.model.beliefvars}
 
     def _metrics_at(self, t: float) -> dict[str, float]:
         return {name: self._beliefs[name].metric(t) for name in self.model.properties}

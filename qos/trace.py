@@ -257,6 +257,8 @@ class ReplaySamples:
     series: dict[str, list[float]]
     #: one entry per batch that fired something: {"t": time as in the trace, "observations": [...]}
     fired: list[dict[str, object]]
+    #: beliefvar name -> its probability at each of ``times`` (models with ``beliefvar`` only)
+    beliefs: dict[str, list[float]] = field(default_factory=dict)
 
 
 #: samples one replay may take (each holds every property): bounds time and memory, so that a tiny
@@ -293,7 +295,7 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if firings > MAX_TIMED_BATCHES:
         raise TraceError(f"{trace.name}: the model's timers would fire about {firings:,.0f} times over the trace's "
                          f"{last_t:g} s (at most {MAX_TIMED_BATCHES:,}); is a timer's interval too short?")
-    samples = ReplaySamples([], {name: [] for name in model.properties}, [])
+    samples = ReplaySamples([], {name: [] for name in model.properties}, [], {name: [] for name in model.beliefvars})
     # every batch that fires, timer batches included, in the order the engine runs them
     engine.subscribe(lambda result: samples.fired.append({"t": seconds(result.t), "observations": result.fired})
                      if result.fired else None)
@@ -301,8 +303,11 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     def sample(now: float) -> None:
         engine.advance(max(now, engine.t or 0.0))
         samples.times.append(now)
-        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
+        at = max(now, engine.t or 0.0)
+        for name, value in engine.metrics(at).items():
             samples.series[name].append(value)
+        for name, value in engine.beliefs(at).items():
+            samples.beliefs[name].append(value)
 
     try:
         _run(engine, batches, count, sample_period, last_t, sample)
@@ -340,6 +345,10 @@ def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model |
 
 
 def summarise(samples: ReplaySamples) -> dict:
-    """The replay result of trace-format.md from a replay's samples."""
-    return {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
-            "fired": samples.fired}
+    """The replay result of trace-format.md from a replay's samples (and, for a model with belief
+    variables, their statistics under ``beliefs``)."""
+    result: dict = {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
+                    "fired": samples.fired}
+    if samples.beliefs:
+        result["beliefs"] = {name: _statistics(values) for name, values in samples.beliefs.items()}
+    return result
