@@ -3,7 +3,7 @@
 Where the file is: ``$KIOSK_CONFIG`` if set (it must exist), else
 ``<user config dir>/kiosk/config.yaml`` if present (``platformdirs.user_config_dir("kiosk")``),
 else built-in defaults. Environment variables override the file: ``KIOSK_DATA_DIR``,
-``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``.
+``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``, ``KIOSK_STATION_URL``, ``KIOSK_STATION_TOKEN``.
 
 Example ``config.yaml`` (every key optional)::
 
@@ -18,6 +18,11 @@ Example ``config.yaml`` (every key optional)::
     timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
     remote_profiles: /etc/kiosk/remotes.yaml
+    interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
+    station:                          # report to a ward station (docs/station-protocol.md)
+      url: https://ward.example:8443  # without a url the kiosk talks to no station at all
+      token: "…"                      # from `kiosk station add-kiosk NAME`
+      kiosk_id: ward3-bed2            # default: this machine's host name
 
 A bad file is one :class:`ConfigError` naming the file, line and column and what is wrong.
 """
@@ -25,6 +30,8 @@ A bad file is one :class:`ConfigError` naming the file, line and column and what
 from __future__ import annotations
 
 import os
+import re
+import socket
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -41,6 +48,22 @@ DEFAULT_PIN = "1234"
 
 class ConfigError(ValueError):
     """The configuration file (or an environment override) is unusable."""
+
+
+#: a kiosk's name at the station: letters, digits, '.', '-' and '_'
+KIOSK_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+
+
+@dataclass(frozen=True)
+class Station:
+    """Where this kiosk reports (``station:`` in the configuration)."""
+
+    #: the station's base URL, http:// or https://
+    url: str
+    #: this kiosk's bearer token, issued by the station
+    token: str
+    #: this kiosk's name at the station
+    kiosk_id: str = field(default_factory=socket.gethostname)
 
 
 @dataclass(frozen=True)
@@ -69,6 +92,10 @@ class Config:
     vosk_model: Path | None = None
     #: user overrides of the remote-control profiles
     remote_profiles: Path | None = None
+    #: a running test older than this is marked interrupted (staff may continue it; no patient is offered it)
+    interrupt_after_minutes: float = 120.0
+    #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
+    station: Station | None = None
     #: the file this was read from (None: defaults only)
     source: Path | None = None
 
@@ -104,6 +131,11 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     for var, key in overrides.items():
         if env.get(var):
             values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
+    station = values.get("station") or {}
+    for var, key in (("KIOSK_STATION_URL", "url"), ("KIOSK_STATION_TOKEN", "token")):
+        if env.get(var):
+            station = {**station, key: env[var]}
+    values["station"] = _station(station, f"{path}: station" if path is not None else "KIOSK_STATION_URL")
     if values.get("language", "en") not in SCREEN_LANGUAGES:
         raise ConfigError(f"language {values['language']!r} is not one of {', '.join(SCREEN_LANGUAGES)}")
     return Config(**values, source=Path(path) if path is not None else None)
@@ -154,10 +186,38 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
+        elif key == "station":
+            if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \
+                    or not all(isinstance(v, str) for v in value.values()):
+                raise fail((key,), "station must be a mapping {url: ..., token: ..., kiosk_id: ...} of strings")
+            try:
+                _station(value, "station")
+            except ConfigError as exc:
+                raise fail((key,), str(exc)) from None
+        elif key == "interrupt_after_minutes":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
+                raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
     return values
+
+
+def _station(values: Mapping[str, str], where: str) -> Station | None:
+    """The station settings, checked; None without a url (a token alone is harmless)."""
+    url = values.get("url", "")
+    if not url:
+        return None
+    if not re.match(r"^https?://[^\s/?#]+(/[^\s?#]*)?$", url):
+        raise ConfigError(f"{where}: url {url!r} must be an http:// or https:// address such as "
+                          "https://ward.example:8443")
+    if not values.get("token"):
+        raise ConfigError(f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
+                          "the station issues it with `kiosk station add-kiosk NAME`)")
+    kiosk_id = values.get("kiosk_id") or socket.gethostname()
+    if not KIOSK_ID.match(kiosk_id):
+        raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'")
+    return Station(url.rstrip("/"), values["token"], kiosk_id)
 
 
 def configured_questionnaire(config: Config) -> Questionnaire:

@@ -25,7 +25,7 @@ from typing import Any
 import yaml
 
 from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
-from qos.errors import ContextError, TraceError
+from qos.errors import ContextError, ModelError, TraceError
 from qos.files import BadFile, load_data, write_private
 from qos.model import Model
 
@@ -84,9 +84,15 @@ class Trace:
         from qos import load_model  # the package function, which knows the bundled models
 
         model = self.model
-        if self.source is not None and (model.endswith(".roqme") or "/" in model):
+        is_path = model.endswith(".roqme") or "/" in model
+        if self.source is not None and is_path:
             model = str(self.source.parent / model)
-        return load_model(model)
+        try:
+            return load_model(model)
+        except ModelError as exc:
+            if is_path:
+                raise  # it names the model file, and where in it
+            raise ModelError(f"{self.name}: {exc}") from None  # an unknown name: say which trace uses it
 
     def check(self, model: Model | None = None) -> Model:
         """Validate every event against the model; raise :class:`TraceError` on the first problem."""
