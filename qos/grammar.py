@@ -107,7 +107,7 @@ evidence_option: NAME           -> strength
      | UPDATE "(" term ")"                   -> update
      | EVENTWHEN "(" term ")"                -> event_when
      | NAME "(" [term ("," term)*] ")"       -> call
-     | (NAME | BELIEF) "'" NAME [arguments]  -> postfix_call
+     | (NAME | BELIEF) "'" (NAME | UPDATE | EVENTWHEN) [arguments]  -> postfix_call
      | "(" term ")"
 arguments: "(" [term ("," term)*] ")"
 

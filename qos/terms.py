@@ -74,6 +74,12 @@ class TermChecker:
 
     def pattern(self, node) -> Pattern:
         """A pattern; a value standing as a pattern becomes an occurrence."""
+        if isinstance(node, Tree) and node.data == "postfix_call" and node.children[1].type in ("UPDATE", "EVENTWHEN"):
+            subject, keyword, arguments = node.children  # X'update is update(X), X'eventWhen is eventWhen(X)
+            if arguments is not None and any(child is not None for child in arguments.children):
+                raise self.error(node, f"{subject}'{keyword} takes no arguments")
+            kind = "update" if keyword.type == "UPDATE" else "event_when"
+            node = Tree(kind, [keyword, Tree("var", [subject], node.meta)], node.meta)
         if not is_pattern(node):
             return self._occurrence(node)
         kind = node.data
@@ -310,6 +316,9 @@ class TermChecker:
             function, *rest = node.children
             args = [child for child in rest if child is not None]
         name = str(function)
+        if name in ("update", "eventWhen"):
+            raise self.error(node, f"the pattern operator '{name}' cannot be used in a value; only values and & | ! "
+                                   "comparisons and arithmetic can")
         if name in AGGREGATES:
             return self._aggregate(node, name, args)
         if name == "period":

@@ -144,3 +144,12 @@ def test_a_jump_that_would_fire_a_timer_too_often_is_refused_before_anything_run
     (tmp_path / "t.yaml").write_text("model: m.roqme\nevents:\n  - {t: 5000, set: {}}\n", encoding="utf-8")
     with pytest.raises(TraceError, match="the model's timers would fire about 5,000,000 times over the trace's 5000 s"):
         replay(tmp_path / "t.yaml")
+
+
+def test_postfix_forms_of_update_event_when_and_period():
+    body = ("observation O : N'update reinforces P\nobservation Q : B'eventWhen reinforces P\n"
+            "observation R : N'period > 1 reinforces P\n")
+    fired = run(body, [(0, {"N": 1}), (1, {"B": True}), (5, {"N": 2}), (6, {"N": 2})])
+    assert (times(fired, "O"), times(fired, "Q"), times(fired, "R")) == ([0, 5, 6], [1], [5])
+    with pytest.raises(ModelError, match=r"m\.roqme:8:17: the pattern operator 'update' cannot be used in a value"):
+        parse_model(HEAD + "observation O : N'update > 1 reinforces P\n", "m.roqme")
