@@ -310,7 +310,8 @@ class Store:
             raise KeyError(f"session {session_id} has no answer to {item_id!r} to withdraw")
         withdrawn = dict(zip(("option", "points", "attempt", "channel", "answered_by", "t", "at", "detail"), row))
         with self.transaction():
-            self._write("DELETE FROM answers WHERE session_id = ? AND item_id = ?", (session_id, item_id))
+            self._record("withdraw_answer", session_id, {"item_id": item_id, "t": t, "at": at, "reason": reason},
+                         "DELETE FROM answers WHERE session_id = ? AND item_id = ?", (session_id, item_id))
             self.record_event(session_id, t=t, kind="answer_withdrawn", detail=json.dumps(
                 {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False))
 
