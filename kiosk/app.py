@@ -489,12 +489,11 @@ class KioskApp(App[int], inherit_bindings=False):
         self.store.renew()
         self.store.interrupt_stale()
         session = self.session
-        if session.phase is Phase.WELCOME or session.finished or self.store.holds(session.id):
+        if session.phase is Phase.WELCOME or session.finished:
             return
-        stored = {s.id: s for s in self.store.sessions()}.get(session.id)
-        if stored is not None:
-            why = f" ({stored.interrupted_reason})" if stored.interrupted_reason else ""
-            self._session_lost(f"session {session.id} is {stored.status}{why}")
+        why = self.store.why_not_held(session.id)
+        if why is not None:
+            self._session_lost(why)
 
     def _session_lost(self, reason: str) -> None:
         """This kiosk may no longer record in its session: say so plainly and start over."""

@@ -86,7 +86,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         return line
 
     def _channels_text(self) -> str:
-        lines = self.app.board.lines("en")  # type: ignore[attr-defined]
+        lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
         return "Channels: " + "; ".join(
             f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
             for line in lines)
