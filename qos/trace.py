@@ -24,7 +24,7 @@ from typing import Any
 
 import yaml
 
-from qos.engine import Engine, UpdateResult, check_batch
+from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
 from qos.errors import ContextError, ModelError, TraceError
 from qos.files import BadFile, load_data, write_private
 from qos.model import Model
@@ -263,6 +263,8 @@ class ReplaySamples:
     series: dict[str, list[float]]
     #: one entry per batch that fired something: {"t": time as in the trace, "observations": [...]}
     fired: list[dict[str, object]]
+    #: beliefvar name -> its probability at each of ``times`` (models with ``beliefvar`` only)
+    beliefs: dict[str, list[float]] = field(default_factory=dict)
 
 
 #: samples one replay may take (each holds every property): bounds time and memory, so that a tiny
@@ -295,18 +297,34 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if count > MAX_SAMPLES:
         raise TraceError(f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
                          f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period")
-    samples = ReplaySamples([], {name: [] for name in model.properties}, [])
+    firings = sum(last_t / (timer.interval or 1.0) for timer in model.timers.values())
+    if firings > MAX_TIMED_BATCHES:
+        raise TraceError(f"{trace.name}: the model's timers would fire about {firings:,.0f} times over the trace's "
+                         f"{last_t:g} s (at most {MAX_TIMED_BATCHES:,}); is a timer's interval too short?")
+    samples = ReplaySamples([], {name: [] for name in model.properties}, [], {name: [] for name in model.beliefvars})
     # every batch that fires, timer batches included, in the order the engine runs them
     engine.subscribe(lambda result: samples.fired.append({"t": seconds(result.t), "observations": result.fired})
                      if result.fired else None)
-    upcoming = 0
 
     def sample(now: float) -> None:
         engine.advance(max(now, engine.t or 0.0))
         samples.times.append(now)
-        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
+        at = max(now, engine.t or 0.0)
+        for name, value in engine.metrics(at).items():
             samples.series[name].append(value)
+        for name, value in engine.beliefs(at).items():
+            samples.beliefs[name].append(value)
 
+    try:
+        _run(engine, batches, count, sample_period, last_t, sample)
+    except ContextError as exc:  # the model's timers cannot follow the trace (a jump too far ahead)
+        raise TraceError(f"{trace.name}: {exc}") from None
+    return samples
+
+
+def _run(engine: Engine, batches: list, count: int, sample_period: float, last_t: float, sample) -> None:
+    """Apply the batches in time order, sampling at every period (see :func:`sample_trace`)."""
+    upcoming = 0
     for k in range(count):
         now = k * sample_period
         # a small tolerance so that samples at k·0.1 s still see the events written at that time
@@ -321,7 +339,6 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
         for t, values, emitted in batches[upcoming:]:
             engine.update(float(t), set=values, emit=emitted)
         sample(last_t)
-    return samples
 
 
 def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> dict:
@@ -334,6 +351,10 @@ def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model |
 
 
 def summarise(samples: ReplaySamples) -> dict:
-    """The replay result of trace-format.md from a replay's samples."""
-    return {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
-            "fired": samples.fired}
+    """The replay result of trace-format.md from a replay's samples (and, for a model with belief
+    variables, their statistics under ``beliefs``)."""
+    result: dict = {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
+                    "fired": samples.fired}
+    if samples.beliefs:
+        result["beliefs"] = {name: _statistics(values) for name, values in samples.beliefs.items()}
+    return result
