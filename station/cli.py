@@ -60,7 +60,15 @@ def _admin_parser(command: str) -> argparse.ArgumentParser:
 
 
 def _url(option: str | None) -> str:
-    return option or db.sqlite_url(db.default_data_dir())
+    """The database URL; a SQLite file, default or given, is created owner-only."""
+    try:
+        if option is None:
+            return db.sqlite_url(db.default_data_dir())
+        if option.startswith("sqlite:///") and option != "sqlite:///:memory:":
+            return db.private_sqlite(Path(option.removeprefix("sqlite:///")))
+    except OSError as exc:
+        raise UsageError(f"cannot create the station database {exc.filename}: {exc.strerror}") from None
+    return option
 
 
 def _password(path: Path | None) -> str:
