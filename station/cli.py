@@ -36,8 +36,14 @@ def _db_option(parser: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="kiosk station", description="The ward station: kiosks report to it, "
-                                     "staff watch the ward, answer doctor calls and validate results.")
+    parser = argparse.ArgumentParser(
+        prog="kiosk station", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="The ward station: kiosks report to it, staff watch the ward, answer doctor calls and "
+                    "validate results.",
+        epilog="administration (each takes --db too):\n"
+               "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
+               "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
+               "  kiosk station revoke-kiosk NAME")
     _db_option(parser)
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
     parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
