@@ -141,7 +141,10 @@ def _serve(argv: list[str]) -> int:
     logging.basicConfig(level=logging.WARNING)
     uvicorn.run(app, host=args.host, port=args.port, log_level="warning", access_log=False,
                 ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
-                ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2)
+                ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2,
+                # kiosks keep their connection between batches; closing it after 5 s idle made
+                # them retry on a half-closed socket
+                timeout_keep_alive=75)
     return 0
 
 
