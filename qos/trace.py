@@ -289,8 +289,7 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if not isinstance(trace, Trace):
         trace = load_trace(trace)
     model = trace.check(model)
-    # the trace's clock starts with the session: timers start at t = 0
-    engine = Engine(model, start=0.0)
+    engine = Engine(model)
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
