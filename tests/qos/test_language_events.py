@@ -172,3 +172,14 @@ def test_timers_start_with_the_session_so_a_recorded_trace_replays_them_exactly(
     assert [event.t for event in recorder.trace.events] == [3.5, 27]  # timer batches are not recorded
     dump_trace(recorder.trace, tmp_path / "t.yaml")
     assert replay(tmp_path / "t.yaml")["fired"] == live_fired
+
+
+def test_a_traces_origin_places_scheduled_timers_on_the_calendar(tmp_path):
+    (tmp_path / "m.roqme").write_text(HEAD + 'timer Nine := schedule("0, 9, *, *, *")\nobservation O : Nine reinforces P\n',
+                                      encoding="utf-8")
+    trace = "model: m.roqme\norigin: {origin}\nevents:\n  - {{t: 7200, set: {{B: true}}}}\n"
+    (tmp_path / "t.yaml").write_text(trace.format(origin="2026-11-23T08:00:00Z"), encoding="utf-8")
+    assert replay(tmp_path / "t.yaml")["fired"] == [{"t": 3600, "observations": ["O"]}]  # 09:00
+    (tmp_path / "t.yaml").write_text(trace.format(origin="tomorrow"), encoding="utf-8")
+    with pytest.raises(TraceError, match="'origin' must be a date and time such as 2026-11-23T09:00:00Z"):
+        replay(tmp_path / "t.yaml")
