@@ -375,19 +375,25 @@ class Store:
 
     def _check_held(self, session_id: str) -> None:
         """Inside a write transaction: this kiosk holds the session, else SessionTaken."""
+        why = self.why_not_held(session_id)
+        if why is not None:
+            raise SessionTaken(why)
+        self._held.add(session_id)
+
+    def why_not_held(self, session_id: str) -> str | None:
+        """Why this kiosk may not record in the session (a sentence for staff), or None if it holds it."""
         holder = self._holder(session_id)
         if holder is not None and holder[0].token == self.owner.token:
-            self._held.add(session_id)
-            return
+            return None
         if holder is not None:
-            raise SessionTaken(f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
-                               "one kiosk at a time records a test")
+            return (f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
+                    "one kiosk at a time records a test")
         row = self._db.execute("SELECT status, interrupted_reason FROM sessions WHERE id = ?",
                                (session_id,)).fetchone()
         if row is None:
-            raise SessionTaken(f"session {session_id} is not stored")
+            return f"session {session_id} is not stored"
         why = f" ({row[1]})" if row[0] == "interrupted" and row[1] else ""
-        raise SessionTaken(f"session {session_id} is no longer held by this kiosk: it is {row[0]}{why}")
+        return f"session {session_id} is no longer held by this kiosk: it is {row[0]}{why}"
 
     def _take(self, session_id: str) -> None:
         """Inside a write transaction: take the session's lease unless a live kiosk holds it."""
@@ -406,8 +412,7 @@ class Store:
 
     def holds(self, session_id: str) -> bool:
         """Whether this kiosk holds the session now."""
-        holder = self._holder(session_id)
-        return holder is not None and holder[0].token == self.owner.token
+        return self.why_not_held(session_id) is None
 
     def renew(self) -> None:
         """Renew this kiosk's leases (the running kiosk calls this every third of the lease time)."""
