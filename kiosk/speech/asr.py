@@ -134,6 +134,7 @@ PS_CONFUSABLE_WORDS: tuple[frozenset[str], ...] = (frozenset({"first", "third"})
 PS_EXTRA_WORDS = {
     "español": "EH S P AA N Y OW L", "espanol": "EH S P AA N Y OW L",
     "français": "F R AA N S EY", "francais": "F R AA N S EY",
+    "français(2)": "F R AA N S EH", "français(3)": "F R AO S EH", "français(4)": "F AA S EH",
     "empezar": "EH M P EY S AA R", "commencer": "K AO M AA N S EY",
 }
 
