@@ -21,6 +21,8 @@ Example ``config.yaml`` (every key optional)::
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
     remote_profiles: /etc/kiosk/remotes.yaml
     interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
+    next_patient_after_s: 90          # the end screen stays this long, then the welcome for the next patient
+    show_score_to_patient: false      # the end screen shows the patient their total and band
     station:                          # report to a ward station (docs/station-protocol.md)
       url: https://ward.example:8443  # without a url the kiosk talks to no station at all
       token: "…"                      # from `kiosk station add-kiosk NAME`
@@ -107,6 +109,11 @@ class Config:
     remote_profiles: Path | None = None
     #: a running test older than this is marked interrupted (staff may continue it; no patient is offered it)
     interrupt_after_minutes: float = 120.0
+    #: seconds the end screen ("Thank you, you are done. Please call the nurse.") stays before the
+    #: kiosk goes back to the welcome for the next patient; the result stays stored for staff
+    next_patient_after_s: float = 90.0
+    #: the end screen shows the patient their total and band (default: only staff see them)
+    show_score_to_patient: bool = False
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)
@@ -124,7 +131,7 @@ class Config:
 
 
 _PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
-_BOOLS = {"adaptation", "familiarisation"}
+_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient"}
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}
 
@@ -231,6 +238,9 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "interrupt_after_minutes":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
+        elif key == "next_patient_after_s":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
+                raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
