@@ -181,8 +181,8 @@ class _BoundedComposer(Composer):
         return node
 
     def _check_number(self, node: yaml.ScalarNode) -> None:
-        if node.tag == "tag:yaml.org,2002:int":
-            if sum(c.isdigit() for c in node.value) > MAX_DIGITS:
+        if node.tag == "tag:yaml.org,2002:int":  # decimal, 0x hex, 0o octal or 1:30 sexagesimal
+            if len(node.value) > 2 * MAX_DIGITS or abs(self.construct_yaml_int(node)) >= 10**MAX_DIGITS:
                 raise self.fail(node.start_mark, f"the number {node.value[:20]}… is too large "
                                                  f"(more than {MAX_DIGITS} digits)")
         elif node.tag == "tag:yaml.org,2002:float":
