@@ -11,6 +11,7 @@ import json
 import math
 import os
 import re
+import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -106,13 +107,15 @@ def _position(data: bytes | str, offset: int) -> tuple[int, int]:
 
 def read_text(path: str | Path, limit: int = MAX_BYTES) -> str:
     """A UTF-8 text file's contents (a leading byte-order mark dropped); :class:`BadFile` when it
-    cannot be read, is larger than ``limit`` bytes, holds a NUL byte or is not UTF-8.
-
-    Reads at most ``limit + 1`` bytes, so a device or a FIFO named by mistake cannot exhaust memory.
-    """
+    cannot be read, is not a regular file (a device, a FIFO), is larger than ``limit`` bytes, holds
+    a NUL byte or is not UTF-8. Reads at most ``limit + 1`` bytes."""
     name = str(path)
     try:
-        with open(path, "rb") as handle:
+        # O_NONBLOCK: a FIFO named by mistake must not wait for a writer; it is refused just below
+        descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        with os.fdopen(descriptor, "rb") as handle:
+            if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+                raise BadFile(Problem(name, 1, 1, "not a regular file"))
             data = handle.read(limit + 1)
     except OSError as exc:
         raise BadFile(Problem(name, 1, 1, f"cannot read the file: {exc.strerror or exc}")) from None
