@@ -65,7 +65,7 @@ def write_error(path: str | Path, exc: OSError) -> str:
 # UTF-8, binary, nested without end, an alias bomb, or full of NaN and thousand-digit numbers is
 # one `file:line:col: problem` before any loader sees it, in bounded time and memory.
 
-#: the largest file read (bytes): the biggest real one (a recorded trace) is a few hundred KB
+#: the largest file read (bytes): a JSON trace of a long session stays far below it
 MAX_BYTES = 4 * 1024 * 1024
 #: the largest YAML file: PyYAML composes a few hundred KB a second, and a bad file must be
 #: refused within one (the biggest real one, the questionnaire, is 22 KB)
