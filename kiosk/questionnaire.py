@@ -31,6 +31,8 @@ SCHEMA_FILE = "questionnaire.schema.json"
 #: the languages the kiosk's own screens are written in (kiosk/widgets/ui_text.yaml): a
 #: questionnaire in another language would start a session its screens cannot show
 SCREEN_LANGUAGES = ("en", "es", "fr")
+#: the longest a timing setting may be: a day (a longer wait is a typo, and no session lasts it)
+MAX_TIMING_S = 86400.0
 
 
 # --------------------------------------------------------------------------------------------
@@ -182,8 +184,9 @@ class Timing:
         for name, value in overrides.items():
             if name not in known:
                 raise ValueError(f"unknown timing setting {name!r} (known: {', '.join(sorted(known))})")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
-                raise ValueError(f"timing setting {name!r} must be a number of seconds >= 0, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_TIMING_S:
+                raise ValueError(f"timing setting {name!r} must be a number of seconds from 0 to "
+                                 f"{MAX_TIMING_S:g} (a day), got {value!r}")
             changes[name] = float(value)
         for name in ("attempt_window_s", "confirm_window_s"):
             if changes.get(name, getattr(self, name)) <= 0:
