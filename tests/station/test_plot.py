@@ -32,7 +32,7 @@ def test_incidents_are_marked_with_what_happened():
     stored = _session("barthel5.yaml")
     svg = qos_svg(stored)
     marks = re.findall(r'class="incident incident-([a-z_]+)"><title>([^<]+)</title>', svg)
-    logged = [e.kind for e in stored.log if e.kind in ("pause", "call_doctor", "person_lost", "attempt_timed_out")]
+    logged = [e.kind for e in stored.log if e.kind in ("pause", "doctor_called", "person_lost", "attempt_timed_out")]
     assert logged and [kind for kind, _ in marks if kind in logged] == logged
     assert all(" s" in title for _, title in marks)
 
