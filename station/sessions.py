@@ -56,11 +56,11 @@ def status_of(rows: Iterable[Row]) -> dict[str, Any]:
         elif row.kind == "finish_session":
             state.update(status="finished", finished_at=row.payload.get("finished_at"))
         elif row.kind == "abandon" and state["status"] in ("running", "pending", "interrupted"):
-            state["status"] = "abandoned"
+            state["status"] = "abandoned"  # staff may end an interrupted test too
         elif row.kind == "mark_interrupted" and state["status"] in ("running", "pending"):
             state["status"] = "interrupted"
-        elif row.kind == "continue_session" and state["status"] == "interrupted":  # staff resumed it
-            state["status"] = "running"
+        elif row.kind == "continue_session" and state["status"] == "interrupted":
+            state["status"] = "running"  # staff continued it on a kiosk
     return state
 
 
