@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import pytest
 import sqlalchemy as sa
+from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
-from alembic.config import Config
 
 from kiosk.questionnaire import load_questionnaire
 from kiosk.review import ReviewState
