@@ -7,6 +7,7 @@ publish what changed, redirect back (post/redirect/get, so a reload never repeat
 from __future__ import annotations
 
 from typing import Any
+from urllib.parse import quote
 
 import sqlalchemy as sa
 from starlette.applications import Starlette
@@ -54,14 +55,12 @@ async def ward_page(request: Request) -> Response:
     views = await run_in_threadpool(ward.kiosk_views, engine)
     pending = await run_in_threadpool(ward.open_alerts, engine)
     recent = await run_in_threadpool(_session_rows, engine)
-    reviews = {row.id: await run_in_threadpool(validation.review, engine, row.id) for row in recent}
+    reviews = await run_in_threadpool(validation.reviews, engine, [row.id for row in recent])
     return render(request, "ward.html", kiosks=views, alerts=pending, sessions=recent, reviews=reviews,
                   now=db.now(), message=request.query_params.get("message"))
 
 
 def _back(request: Request, message: str | None = None, to: str = "/") -> Response:
-    from urllib.parse import quote
-
     return RedirectResponse(f"{to}?message={quote(message)}" if message else to, status_code=303)
 
 
@@ -87,16 +86,16 @@ async def command(request: Request) -> Response:
         return _back(request, str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "command", "kiosk": kiosk},
                             {"type": "ack", "kiosk": kiosk})
-    return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.", to=form.get("back", "/") if
-                 form.get("back", "/").startswith("/s") else "/")
+    return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.")
 
 
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:
     """One row per questionnaire item: what the kiosk recorded, what it is now, how it was answered."""
     answers = {a.item_id: a for a in stored.answers}
     options = review.options({a.item_id: a.option for a in stored.answers})
+    # a question's attempts timing out are logged as "ITEM attempt N"
     outcomes = sorted([(a.t, a.item_id) for a in stored.answers] + [
-        (e.t, e.detail) for e in stored.log if e.kind == "attempt_timed_out"])
+        (e.t, e.detail.split(" ")[0]) for e in stored.log if e.kind == "attempt_timed_out"])
     start = next((e.t for e in stored.log if e.kind == "start"), 0.0)
     rows, previous_t = [], start
     for number, item in enumerate(q.items, 1):
