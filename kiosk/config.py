@@ -18,6 +18,13 @@ Example ``config.yaml`` (every key optional)::
     timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
     remote_profiles: /etc/kiosk/remotes.yaml
+    site: hosp-north                  # short code of the site (default "local"); part of export ids
+    kiosk_id: ward3-bed2              # this kiosk (default: the host name); exports and the station
+    fhir:                             # FHIR identity of this site's exports (defaults: urn:barthel-kiosk:...)
+      patient_system: https://hosp-north.example/sid/kiosk-patient
+      questionnaire_url: https://hosp-north.example/fhir/Questionnaire/barthel
+      identifier_system: https://hosp-north.example/sid/kiosk-result
+      device_system: https://hosp-north.example/sid/kiosk
 
 A bad file is one :class:`ConfigError` naming the file, line and column and what is wrong.
 """
@@ -25,6 +32,8 @@ A bad file is one :class:`ConfigError` naming the file, line and column and what
 from __future__ import annotations
 
 import os
+import re
+import socket
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -38,6 +47,17 @@ from kiosk.yamlmarks import Problem, parse
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
 DEFAULT_PIN = "1234"
 LANGUAGES = ("en", "es", "fr")
+#: a site code or kiosk id: it goes into identifiers, so no spaces, '/' or '|'
+SITE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+#: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
+FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
+_URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\s|]+$")
+
+
+def default_kiosk_id() -> str:
+    """The host name made fit for an identifier (set ``kiosk_id`` so it never changes)."""
+    name = re.sub(r"[^A-Za-z0-9._-]", "-", socket.gethostname()).strip("-._")[:64]
+    return name or "kiosk"
 
 
 class ConfigError(ValueError):
@@ -70,6 +90,13 @@ class Config:
     vosk_model: Path | None = None
     #: user overrides of the remote-control profiles
     remote_profiles: Path | None = None
+    #: short code of the site: part of each exported result's identifier (site + kiosk + session)
+    site: str = "local"
+    #: this kiosk's id: in exported identifiers, the FHIR Device and the station protocol; set it
+    #: once (a changed id makes re-exports look like new results)
+    kiosk_id: str = field(default_factory=default_kiosk_id)
+    #: FHIR identity of the site's exports: any of FHIR_KEYS (defaults in kiosk.export.ExportSite)
+    fhir: Mapping[str, str] = field(default_factory=dict)
     #: the file this was read from (None: defaults only)
     source: Path | None = None
 
@@ -158,6 +185,18 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
+        elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not SITE_ID.match(value)):
+            raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
+        elif key == "fhir":
+            if not isinstance(value, dict):
+                raise fail((key,), "fhir must be a mapping such as {patient_system: https://example.org/sid/patient}")
+            for name, uri in value.items():
+                if name not in FHIR_KEYS:
+                    raise fail((key, name), f"unknown fhir setting {name!r} (known: {', '.join(FHIR_KEYS)})")
+                if not isinstance(uri, str) or not _URI.match(uri):
+                    raise fail((key, name), f"fhir {name} must be an absolute URI without spaces or '|', "
+                                            "such as https://example.org/sid/patient")
+            value = dict(value)
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
