@@ -14,7 +14,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from kiosk.yamlmarks import Problem, parse
+from kiosk.yamlmarks import Problem, parse_file
 from qos import Model, load_model
 
 #: the QoS model the kiosk runs (sessions, replays, stored traces); the rules watch its properties
@@ -68,14 +68,12 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
     session runs), so a misspelt metric is an error instead of a rule that never fires.
     """
     if path is None:
-        text, name = resources.files("kiosk").joinpath("adaptation.yaml").read_text(encoding="utf-8"), "adaptation.yaml"
+        data, positions, problems = parse_file(str(resources.files("kiosk").joinpath("adaptation.yaml")),
+                                               "adaptation.yaml")
+        name = "adaptation.yaml"
     else:
         name = str(path)
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except OSError as exc:
-            raise PolicyError(f"{name}:1:1: cannot read the policy: {exc.strerror or exc}") from None
-    data, positions, problems = parse(text, name)
+        data, positions, problems = parse_file(path)
     if problems or positions is None:
         raise PolicyError("\n".join(map(str, problems)))
 

@@ -21,6 +21,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "devices": ("kiosk.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
     "models": ("kiosk.speech.models", "install and list speech-recognition models"),
     "qos": ("kiosk.qos_cli", "QoS tools: replay a context trace, print a session's trace"),
+    "station": ("station.cli", "the ward station web app (kiosks report to it; staff watch and validate)"),
 }
 
 

@@ -41,12 +41,11 @@ from typing import Any
 
 import platformdirs
 
-from kiosk.questionnaire import Questionnaire, Timing, load_questionnaire
-from kiosk.yamlmarks import Problem, parse
+from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
+from kiosk.yamlmarks import Problem, parse_file
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
 DEFAULT_PIN = "1234"
-LANGUAGES = ("en", "es", "fr")
 #: a site code or kiosk id: it goes into identifiers, so no spaces, '/' or '|'
 SITE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
@@ -132,19 +131,16 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     for var, key in overrides.items():
         if env.get(var):
             values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
-    if values.get("language", "en") not in LANGUAGES:
-        raise ConfigError(f"language {values['language']!r} is not one of {', '.join(LANGUAGES)}")
+    if values.get("language", "en") not in SCREEN_LANGUAGES:
+        raise ConfigError(f"language {values['language']!r} is not one of {', '.join(SCREEN_LANGUAGES)}")
     return Config(**values, source=Path(path) if path is not None else None)
 
 
 def _read(path: Path) -> dict[str, Any]:
     name = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ConfigError(f"{name}: cannot read the configuration: {reason}") from None
-    data, positions, problems = parse(text, name)
+    data, positions, problems = parse_file(path)
+    if problems and problems[0].message == "the file is empty":
+        return {}  # a config file with every setting commented out means the defaults
     if problems:
         raise ConfigError(str(problems[0]))
     if data is None:
@@ -210,11 +206,14 @@ def configured_questionnaire(config: Config) -> Questionnaire:
     :class:`ConfigError` when ``bands`` names a set the questionnaire does not have.
     """
     questionnaire = load_questionnaire(config.questionnaire)
+    where = f"{config.source}: " if config.source else ""
+    if config.language not in questionnaire.languages:
+        raise ConfigError(f"{where}language: {config.language!r} is not a language of {questionnaire.source} "
+                          f"(it has {', '.join(questionnaire.languages)}); set language: to one of them")
     if config.bands is None:
         return questionnaire
     try:
         return questionnaire.with_band_set(config.bands)
     except KeyError:
-        where = f"{config.source}: " if config.source else ""
         raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
                           f"(it has {', '.join(questionnaire.band_sets)})") from None

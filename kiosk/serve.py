@@ -13,9 +13,12 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
+from pathlib import Path
 
 #: the address a kiosk's own browser uses; anything else exposes the kiosk to the network
 LOCALHOST = "127.0.0.1"
+#: the folder of the page the browser loads (``app_index.html``)
+PAGE_DIR = Path(__file__).parent / "web"
 
 
 def build_command(run_args: list[str]) -> str:
@@ -66,8 +69,9 @@ def main(argv: list[str]) -> int:
 
     from textual_serve.server import Server
 
-    server = Server(build_command(run_args), host=args.host, port=args.port,
-                    title="Barthel kiosk")
+    # the kiosk's own page (offline font, large text that fits the display), textual-serve's statics
+    server = Server(build_command(run_args), host=args.host, port=args.port, title="Barthel kiosk",
+                    templates_path=PAGE_DIR)
     try:
         server.serve()
     except OSError as error:  # port in use, address not on this machine

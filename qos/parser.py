@@ -16,6 +16,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from qos.errors import ModelError
+from qos.files import BadFile, read_text
 from qos.model import (
     BOOLEAN, EVENTTYPE, INTENSITY_LR, NUMBER, AllOf, AnyOf, Binary, Changed, Context, EnumType, Expr,
     FollowedBy, Literal, Model, Observation, Once, Pattern, Property, Repeat, Unary, Updated, ValueType,
@@ -224,11 +225,9 @@ def load_model_file(path: str | Path) -> Model:
     """Read and parse a ``.roqme`` file; errors name the file by its base name."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ModelError(f"{path}: cannot read the model ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise ModelError(f"{path}: the model is not UTF-8 text (byte {exc.start})") from None
+        text = read_text(path)
+    except BadFile as exc:
+        raise ModelError(str(exc)) from None
     return parse_model(text, path.name)
 
 

@@ -26,7 +26,7 @@ import yaml
 
 from qos.engine import Engine, UpdateResult, check_batch
 from qos.errors import ContextError, TraceError
-from qos.files import write_private
+from qos.files import BadFile, load_data, write_private
 from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")
@@ -202,24 +202,9 @@ def load_trace(path: str | Path) -> Trace:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise TraceError(f"{path}: cannot read the trace ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise TraceError(f"{path}: the trace is not UTF-8 text (byte {exc.start})") from None
-    if path.suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise TraceError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
-    else:
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
-            problem = getattr(exc, "problem", None) or "malformed"
-            raise TraceError(f"{where}: invalid YAML: {problem}") from None
+        data = load_data(path)
+    except BadFile as exc:
+        raise TraceError(str(exc)) from None
     trace = trace_from_data(data, path)
     trace.check()
     return trace
@@ -271,8 +256,10 @@ class ReplaySamples:
     fired: list[dict[str, object]]
 
 
-#: samples one replay may take (each holds every property): bounds time and memory for a tiny period
-MAX_SAMPLES = 10_000_000
+#: samples one replay may take (each holds every property): bounds time and memory, so that a tiny
+#: trace whose last event is at t = 10⁷ s is refused at once instead of replayed for minutes; a
+#: day of events at the default 1 s period fits
+MAX_SAMPLES = 100_000
 
 
 def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,

@@ -78,7 +78,7 @@ def test_a_sample_period_too_small_for_the_trace_is_one_line_not_an_endless_repl
     assert main(["replay", str(TABLE4), "--sample-period", "1e-7"]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"python -m qos replay: {TABLE4}: a sample period of 1e-07 s over the trace's ") and \
-        "(at most 10,000,000); use a longer sample period\n" in err and err.count("\n") == 1
+        "(at most 100,000); use a longer sample period\n" in err and err.count("\n") == 1
 
 
 def test_bad_arguments_exit_2(capsys):

@@ -89,7 +89,7 @@ def test_errors_in_a_model_file_name_the_file(tmp_path):
 
 
 def test_missing_model_file_and_unknown_bundled_name(tmp_path):
-    with pytest.raises(ModelError, match=r"missing\.roqme: cannot read the model"):
+    with pytest.raises(ModelError, match=r"missing\.roqme:1:1: cannot read the file"):
         load_model(tmp_path / "missing.roqme")
     with pytest.raises(ModelError, match=r"no bundled model named 'nope' \(bundled: clarc\)"):
         load_model("nope")
