@@ -3,8 +3,8 @@
 Without SESSION: list stored sessions; exports then cover every stored session. With SESSION (an
 id, a unique prefix, or the CSV's tagged ``S:id``), exports cover those sessions: ``--fhir`` one
 FHIR R4 transaction Bundle (Questionnaires, kiosk Device, responses, totals; see
-:mod:`kiosk.fhir`), ``--csv`` the long CSV and ``--csv-wide`` one row per session (see
-:mod:`kiosk.export`), with the site and kiosk of the configuration. For each SESSION it shows how the
+:mod:`kiosk.export.fhir`), ``--csv`` the long CSV and ``--csv-wide`` one row per session (see
+:mod:`kiosk.export.tables`), with the site and kiosk of the configuration. For each SESSION it shows how the
 practice questions went (hearing, reading, selecting: right, wrong, not answered or skipped and
 why), its answers, the total recomputed from them, band (from the configured band set) and
 completeness, adaptations and QoS metrics at the end.
@@ -21,14 +21,16 @@ from kiosk.export import (
     ID_TAGS,
     ExportError,
     csv_text,
+    fhir_questionnaire,
     practice_outcomes,
+    questionnaire_bundle,
     rescore,
     site_from_config,
+    transaction_bundle,
     wide_csv_text,
     write_export,
     write_json,
 )
-from kiosk.fhir import fhir_questionnaire, questionnaire_bundle, transaction_bundle
 from kiosk.questionnaire import QuestionnaireError
 from kiosk.records import open_store
 from kiosk.storage import StorageError, StoredSession
@@ -91,11 +93,11 @@ def main(argv: list[str]) -> int:
             chosen = ([store.session(ref) for ref in refs] if refs
                       else [store.session(s.id) for s in store.sessions()] if exporting else [])
             if args.fhir:
-                write_json(args.fhir, transaction_bundle(q, chosen, site))
+                write_json(args.fhir, transaction_bundle(q, chosen, site=site))
             if args.csv:
-                write_export(args.csv, csv_text(q, chosen, site, bom=args.bom))
+                write_export(args.csv, csv_text(q, chosen, site=site, bom=args.bom))
             if args.csv_wide:
-                write_export(args.csv_wide, wide_csv_text(q, chosen, site, bom=args.bom))
+                write_export(args.csv_wide, wide_csv_text(q, chosen, site=site, bom=args.bom))
             if not refs:
                 summaries = store.sessions()
                 if not summaries:

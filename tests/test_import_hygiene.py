@@ -12,7 +12,7 @@ import qos
 #: the pure-Python parts of the kiosk (imported by module name; missing ones are an error)
 PURE_KIOSK_MODULES = [
     "kiosk.channels", "kiosk.cli", "kiosk.clock", "kiosk.questionnaire", "kiosk.session", "kiosk.adaptation",
-    "kiosk.storage", "kiosk.replay", "kiosk.config", "kiosk.records", "kiosk.export", "kiosk.fhir", "kiosk.results",
+    "kiosk.storage", "kiosk.replay", "kiosk.config", "kiosk.records", "kiosk.export", "kiosk.results",
     "kiosk.validate", "kiosk.yamlmarks",
 ]
 

@@ -10,8 +10,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static
 
-from kiosk.export import ExportError, csv_text, practice_outcomes, rescore, write_json, write_private
-from kiosk.fhir import fhir_response
+from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.screens.base import ClinicianScreen
 from kiosk.storage import StoredSession
 from kiosk.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import pandas as pd
 
-from kiosk.export import ExportSite, csv_text, questionnaire_version, result, wide_csv_text
+from kiosk.export import ExportSite, csv_text, questionnaire_version, wide_csv_text
 from kiosk.results import main as results_main
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
@@ -24,8 +24,8 @@ def tricky_sessions(replayed):
 
 def test_ids_stay_text_in_pandas_in_both_layouts(replayed, tmp_path):
     sessions = tricky_sessions(replayed)
-    for name, text in (("long", csv_text(QUESTIONNAIRE, sessions, SITE)),
-                       ("wide", wide_csv_text(QUESTIONNAIRE, sessions, SITE))):
+    for name, text in (("long", csv_text(QUESTIONNAIRE, sessions, site=SITE)),
+                       ("wide", wide_csv_text(QUESTIONNAIRE, sessions, site=SITE))):
         path = tmp_path / f"{name}.csv"
         path.write_text(text, encoding="utf-8")
         frame = pd.read_csv(path)
@@ -40,7 +40,7 @@ def test_ids_stay_text_in_pandas_in_both_layouts(replayed, tmp_path):
 def test_the_wide_csv_has_one_row_per_session_and_no_total_when_incomplete(replayed, tmp_path):
     sessions = [replayed["TB-0001"], replayed["TB-0004"], replayed["P-FR-0003"]]
     path = tmp_path / "wide.csv"
-    path.write_text(wide_csv_text(QUESTIONNAIRE, sessions, SITE), encoding="utf-8")
+    path.write_text(wide_csv_text(QUESTIONNAIRE, sessions, site=SITE), encoding="utf-8")
     frame = pd.read_csv(path, keep_default_na=False)
     assert len(frame) == 3
     complete, partial, french = (frame.iloc[i] for i in range(3))
@@ -59,7 +59,7 @@ def test_the_long_csv_shows_the_review_and_what_the_kiosk_recorded(replayed):
                                           Correction("feeding", 2, 3, "patient overstated", "dr.lopez", "2026-11-23T15:01:00Z"),
                                           Correction("bladder", 3, None, "chart", "dr.lopez", "2026-11-23T15:01:00Z")),
                     "dr.lopez", "2026-11-23T15:02:00Z")
-    frame = pd.read_csv(io.StringIO(csv_text(QUESTIONNAIRE, [result(QUESTIONNAIRE, stored, review)], SITE)),
+    frame = pd.read_csv(io.StringIO(csv_text(QUESTIONNAIRE, [stored], [review], SITE)),
                         keep_default_na=False)
     items = frame[frame["kind"] == "item"].set_index("item")
     assert (items.loc["feeding", "option"], items.loc["feeding", "recorded_option"]) == ("2", "3")

@@ -12,7 +12,7 @@ import pytest
 from pydantic import ValidationError
 
 from kiosk.export import ExportSite, questionnaire_version
-from kiosk.fhir import (
+from kiosk.export import (
     ORDINAL_VALUE,
     SIGNATURE,
     fhir_questionnaire,
@@ -51,7 +51,7 @@ def total_answer(response):
 
 
 def test_every_replayed_session_exports_as_valid_r4_in_one_transaction_bundle(replayed):
-    bundle = transaction_bundle(QUESTIONNAIRE, list(replayed.values()), SITE)
+    bundle = transaction_bundle(QUESTIONNAIRE, list(replayed.values()), site=SITE)
     check_fhir(bundle)
     assert bundle["type"] == "transaction"
     assert len(entries(bundle, "QuestionnaireResponse")) == len(replayed) == 9
@@ -70,7 +70,7 @@ def test_an_incomplete_session_has_no_total_anywhere_and_is_not_completed(replay
     assert total_answer(response) is None
     assert sum("answer" in i for i in response["item"]) == 8
     assert fhir_total(QUESTIONNAIRE, stored, site=SITE) is None
-    bundle = transaction_bundle(QUESTIONNAIRE, [stored], SITE)
+    bundle = transaction_bundle(QUESTIONNAIRE, [stored], site=SITE)
     assert not entries(bundle, "Observation")
     assert not any(key in json.dumps(bundle) for key in ("valueInteger", "valueQuantity"))  # no total at all
 
@@ -90,7 +90,7 @@ def test_an_abandoned_session_is_stopped(tmp_path):
 
 def test_a_complete_unreviewed_session_is_completed_with_a_preliminary_total(replayed):
     stored = replayed["TB-0001"]
-    bundle = transaction_bundle(QUESTIONNAIRE, [stored], SITE)
+    bundle = transaction_bundle(QUESTIONNAIRE, [stored], site=SITE)
     response = entries(bundle, "QuestionnaireResponse")[0]
     observation = entries(bundle, "Observation")[0]
     assert response["resource"]["status"] == "completed" and total_answer(response["resource"]) == [{"valueInteger": 100}]
@@ -118,16 +118,10 @@ def test_a_signed_off_result_is_final_and_carries_who_signed_and_when(replayed):
     total = fhir_total(QUESTIONNAIRE, stored, signed(), SITE)
     check_fhir(total)
     assert total["status"] == "final" and total["performer"][0]["display"] == "dr.lopez"
-    bundle = transaction_bundle(QUESTIONNAIRE, [replace_review(stored, signed())], SITE)
+    bundle = transaction_bundle(QUESTIONNAIRE, [stored], [signed()], SITE)
     check_fhir(bundle)
     request = entries(bundle, "QuestionnaireResponse")[0]["request"]
     assert request["method"] == "PUT" and request["url"].startswith("QuestionnaireResponse?identifier=")
-
-
-def replace_review(stored, review):
-    from kiosk.export import result
-
-    return result(QUESTIONNAIRE, stored, review)
 
 
 def test_a_clinician_completing_an_incomplete_session_makes_it_amended_with_a_total(replayed):
@@ -154,7 +148,7 @@ def test_a_sign_off_of_an_incomplete_result_stays_without_a_total(replayed):
 
 
 def test_responses_match_their_questionnaire_word_for_word_in_every_language(replayed):
-    bundle = transaction_bundle(QUESTIONNAIRE, list(replayed.values()), SITE)
+    bundle = transaction_bundle(QUESTIONNAIRE, list(replayed.values()), site=SITE)
     questionnaires = {f"{e['resource']['url']}|{e['resource']['version']}": e["resource"]
                       for e in entries(bundle, "Questionnaire")}
     for entry in entries(bundle, "QuestionnaireResponse"):
@@ -189,7 +183,7 @@ def test_answers_carry_loinc_answer_codes_and_points_on_the_option_not_the_code(
 
 def test_identity_is_stable_and_site_configured(replayed):
     sessions = list(replayed.values())
-    first, again = (transaction_bundle(QUESTIONNAIRE, sessions, SITE) for _ in range(2))
+    first, again = (transaction_bundle(QUESTIONNAIRE, sessions, site=SITE) for _ in range(2))
     assert first == again  # re-export: same identifiers and fullUrls, so a server sees the same results
     stored = replayed["P-ES-0001"]
     response = entries(first, "QuestionnaireResponse")[[s.id for s in sessions].index(stored.id)]
@@ -203,7 +197,7 @@ def test_identity_is_stable_and_site_configured(replayed):
     device = entries(first, "Device")[0]
     assert device["resource"]["identifier"] == [{"system": "urn:barthel-kiosk:hosp-north:kiosk", "value": "ward3-bed2"}]
     assert response["resource"]["author"]["reference"] == device["fullUrl"]
-    other_kiosk = transaction_bundle(QUESTIONNAIRE, [stored], replace(SITE, kiosk_id="ward4-bed1"))
+    other_kiosk = transaction_bundle(QUESTIONNAIRE, [stored], site=replace(SITE, kiosk_id="ward4-bed1"))
     assert entries(other_kiosk, "QuestionnaireResponse")[0]["resource"]["identifier"]["value"] != \
         response["resource"]["identifier"]["value"]
 

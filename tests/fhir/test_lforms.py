@@ -13,7 +13,7 @@ import pytest
 from playwright.sync_api import sync_playwright
 
 from kiosk.export import ExportSite, result
-from kiosk.fhir import fhir_questionnaire, fhir_response
+from kiosk.export import fhir_questionnaire, fhir_response
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from kiosk.export import ExportError, csv_text, rescore
-from kiosk.fhir import ITEM_WEIGHT, fhir_questionnaire, fhir_response
+from kiosk.export import ITEM_WEIGHT, fhir_questionnaire, fhir_response
 from kiosk.replay import load_script, run_script
 from kiosk.results import main as results_main
 from kiosk.channels import Channel

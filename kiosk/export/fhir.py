@@ -7,7 +7,7 @@ Choices, each from the R4 specification:
   also carrying the other languages in the ``translation`` extension on every text and option
   display. A response points at the Questionnaire of its own language, so its item texts and
   answer displays are the Questionnaire's, word for word, in every language.
-- **Version** from the content (:func:`kiosk.export.questionnaire_version`): editing the file
+- **Version** from the content (:func:`kiosk.export.result.questionnaire_version`): editing the file
   gives a new version, and responses name the exact one (``questionnaire``: ``URL-es|version``).
 - **Answers**: LOINC answer codes where the YAML has them (else a local code per option); each
   option's points ride on the option with ``itemWeight`` and R4's ``ordinalValue`` (older
@@ -36,12 +36,20 @@ Choices, each from the R4 specification:
 from __future__ import annotations
 
 import uuid
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping, Sequence
 from datetime import datetime, timezone
 from typing import Any
 from urllib.parse import quote
 
-from kiosk.export import TOTAL_LINK, ExportError, ExportSite, Result, questionnaire_version, result
+from kiosk.export.result import (
+    TOTAL_LINK,
+    ExportError,
+    ExportSite,
+    Result,
+    questionnaire_version,
+    result,
+    results,
+)
 from kiosk.questionnaire import Code, Questionnaire
 from kiosk.review import Review, ReviewState
 from kiosk.storage import StoredSession
@@ -274,24 +282,24 @@ def _entry(resource: dict[str, Any], full_url: str, condition: str, update: bool
     return {"fullUrl": full_url, "resource": {k: v for k, v in resource.items() if k != "id"}, "request": request}
 
 
-def transaction_bundle(q: Questionnaire, sessions: Iterable[StoredSession | Result],
+def transaction_bundle(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
                        site: ExportSite | None = None) -> dict[str, Any]:
-    """Results (stored sessions, unreviewed, or :class:`Result` with their review) as one R4
-    transaction Bundle with the Questionnaires they answer and the kiosk Device (see the module
-    docstring for the conditional requests)."""
+    """Sessions with their reviews (same order; None: unreviewed) as one R4 transaction Bundle with
+    the Questionnaires they answer and the kiosk Device (see the module docstring for the
+    conditional requests)."""
     site = site or ExportSite()
-    results = [s if isinstance(s, Result) else result(q, s) for s in sessions]
+    reviewed = results(q, sessions, reviews)
     version = questionnaire_version(q)
     entries = []
-    for language in dict.fromkeys(r.stored.language for r in results):
+    for language in dict.fromkeys(r.stored.language for r in reviewed):
         url = questionnaire_canonical(q, site, language)
         entries.append(_entry(fhir_questionnaire(q, language, site), _full_url(url, version),
                               _query(url=url, version=version), update=False))
     device_url = _full_url(site.device_system, site.kiosk_id)
-    if results:
+    if reviewed:
         entries.append(_entry(fhir_device(site), device_url,
                               _query(identifier=f"{site.device_system}|{site.kiosk_id}"), update=False))
-    for r in results:
+    for r in reviewed:
         response = _response(q, r, site)
         response["author"] = response["author"] | ({"reference": device_url} if response["author"]["type"] == "Device"
                                                    else {})
