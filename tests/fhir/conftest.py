@@ -57,12 +57,18 @@ def check_fhir(resource: dict[str, Any]) -> None:
 
 
 @pytest.fixture(scope="session")
-def replayed(tmp_path_factory) -> dict[str, StoredSession]:
-    """Every scripted patient of recordings/patients/ replayed into one real SQLite store, by patient id."""
-    store = Store.open(tmp_path_factory.mktemp("fhir") / "data")
-    try:
+def replay_dir(tmp_path_factory) -> Path:
+    """A data directory whose real SQLite store holds every scripted patient of
+    recordings/patients/ replayed through the real session (English, Spanish, French)."""
+    data = tmp_path_factory.mktemp("fhir") / "data"
+    with Store.open(data) as store:
         for path in PATIENTS:
             run_script(load_script(path), store=store)
+    return data
+
+
+@pytest.fixture(scope="session")
+def replayed(replay_dir) -> dict[str, StoredSession]:
+    """The replayed sessions, by patient id."""
+    with Store.open(replay_dir, create=False) as store:
         return {s.patient_id: store.session(s.id) for s in store.sessions()}
-    finally:
-        store.close()
