@@ -27,6 +27,9 @@ Choices, each from the R4 specification:
 - **Total Observation** (LOINC 96761-2, ``derivedFrom`` the response, ``device`` the kiosk, the
   band and its band set as ``interpretation``) only for a complete result: ``preliminary`` until
   signed off, then ``final`` (``amended`` with corrections, each correction as a ``note``).
+- **Test data**: a session stored by ``kiosk replay`` (a scripted patient) is labelled ``HTEST``
+  (``meta.security``, "test health data") on its response and total, so no EHR takes it for a
+  patient's result.
 - **Bundle** (transaction): the Questionnaires used and the kiosk Device are conditional creates
   (``ifNoneExist`` on url+version / identifier). Results not yet signed off are conditional creates
   on their identifier, so re-sending never duplicates and never overwrites; signed-off results are
@@ -62,6 +65,9 @@ CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-c
 #: ASTM E1762-95 "Verification Signature": the signer checked the content is complete and correct
 VERIFICATION = {"system": "urn:iso-astm:E1762-95:2013", "code": "1.2.840.10065.1.12.1.5",
                 "display": "Verification Signature"}
+#: the security label of test data: a scripted patient's session (``kiosk replay``) is no patient's result
+TEST_DATA = {"system": "http://terminology.hl7.org/CodeSystem/v3-ActReason", "code": "HTEST",
+             "display": "test health data"}
 SURVEY = {"system": "http://terminology.hl7.org/CodeSystem/observation-category", "code": "survey",
           "display": "Survey"}
 TOTAL_TEXT = {"en": "Total score", "es": "Puntuación total", "fr": "Score total"}
@@ -211,6 +217,12 @@ def _response(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
     }
     if r.final:
         resource["extension"] = [_signature(r.review)]
+    return _labelled(resource, stored)
+
+
+def _labelled(resource: dict[str, Any], stored: StoredSession) -> dict[str, Any]:
+    if stored.simulated:
+        resource["meta"] = {"security": [TEST_DATA]}
     return resource
 
 
@@ -264,7 +276,7 @@ def _total(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, An
              for c in r.review.corrections]
     if notes:
         observation["note"] = notes
-    return observation
+    return _labelled(observation, stored)
 
 
 def _full_url(system: str, value: str) -> str:

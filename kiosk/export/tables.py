@@ -4,7 +4,8 @@
 Ids are written with a kind tag (``S:`` session, ``P:`` patient, ``K:`` kiosk) so that no reader
 (pandas, spreadsheets) takes ``00123``, ``8e1234567890``, ``NA`` or ``True`` for a number, a
 missing value or a boolean; strip the first two characters to get the id (``kiosk results``
-accepts the tagged session id too). ``complete`` is ``true``/``false``. ``bom=True`` starts the
+accepts the tagged session id too). ``complete`` and ``simulated`` (a scripted patient's session,
+from ``kiosk replay``) are ``true``/``false``. ``bom=True`` starts the
 text with a UTF-8 byte-order mark for spreadsheets that need it.
 """
 
@@ -40,7 +41,8 @@ ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
 #: session's columns (ids tagged, see the module docstring).
 CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
                "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks", "finished_at",
-               "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by"]
+               "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by",
+               "simulated"]
 
 
 def tag(kind: str, value: str) -> str:
@@ -59,7 +61,7 @@ def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str,
             "finished_at": stored.finished_at or "", "status": stored.status, "language": stored.language,
             "answered_by": stored.answered_by.value, "questionnaire": q.id,
             "questionnaire_version": questionnaire_version(q), "complete": "true" if r.complete else "false",
-            "review_state": r.review_state}
+            "review_state": r.review_state, "simulated": "true" if stored.simulated else "false"}
 
 
 def _writer(out: io.StringIO, columns: list[str]) -> csv.DictWriter:
@@ -109,7 +111,7 @@ def csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Seque
 def wide_columns(q: Questionnaire) -> list[str]:
     """The wide CSV's columns: the session's, then each item's option number and points."""
     return ["session", "patient", "kiosk_id", "started_at", "finished_at", "status", "language", "answered_by",
-            "questionnaire", "questionnaire_version", "complete", "review_state", "signed_by", "signed_at",
+            "questionnaire", "questionnaire_version", "complete", "review_state", "signed_by", "signed_at", "simulated",
             "total", "answered_points", "missing", "band", "band_set"] + [
         f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
 

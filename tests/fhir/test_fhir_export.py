@@ -95,6 +95,7 @@ def test_a_complete_unreviewed_session_is_completed_with_a_preliminary_total(rep
     observation = entries(bundle, "Observation")[0]
     assert response["resource"]["status"] == "completed" and total_answer(response["resource"]) == [{"valueInteger": 100}]
     assert "extension" not in response["resource"]  # no signature: nobody signed it off
+    assert "meta" not in response["resource"]  # a patient's session, not test data
     total = observation["resource"]
     assert total["status"] == "preliminary"
     assert total["code"]["coding"] == [{"system": "http://loinc.org", "code": "96761-2"}]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pandas as pd
+
 from kiosk.export import questionnaire_version
 from kiosk.results import main as results_main
 from tests.session.helpers import QUESTIONNAIRE
@@ -66,3 +68,24 @@ def test_a_bad_site_setting_is_one_line_and_exit_2(replay_dir, tmp_path, monkeyp
     err = capsys.readouterr().err
     assert err.startswith(f"kiosk results: {config}:1:1: kiosk_id must be") and err.count("\n") == 1
     assert not (tmp_path / "x.json").exists()
+
+
+def test_sessions_from_kiosk_replay_are_labelled_test_data(tmp_path, monkeypatch, capsys):
+    from kiosk.replay import main as replay_main
+
+    from .conftest import ROOT
+
+    _configure(tmp_path, monkeypatch)
+    data = tmp_path / "data"
+    assert replay_main([str(ROOT / "recordings/patients/barthel1.yaml"), "--data-dir", str(data)]) == 0
+    out, table = tmp_path / "replayed.json", tmp_path / "replayed.csv"
+    assert results_main(["--data-dir", str(data), "--fhir", str(out), "--csv-wide", str(table)]) == 0
+    bundle = json.loads(out.read_text(encoding="utf-8"))
+    check_fhir(bundle)
+    labelled = {e["resource"]["resourceType"]: e["resource"].get("meta", {}).get("security") for e in bundle["entry"]}
+    test_data = [{"system": "http://terminology.hl7.org/CodeSystem/v3-ActReason", "code": "HTEST",
+                  "display": "test health data"}]
+    assert labelled["QuestionnaireResponse"] == labelled["Observation"] == test_data
+    assert labelled["Questionnaire"] is None and labelled["Device"] is None
+    frame = pd.read_csv(table)
+    assert frame["simulated"].tolist() == [True]
