@@ -157,7 +157,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
 def response_status(r: Result) -> str:
     """The QuestionnaireResponse status of a result (see the module docstring)."""
     if r.complete:
-        return "amended" if r.review.state == ReviewState.AMENDED else "completed"
+        return "amended" if r.amended else "completed"
     return "stopped" if r.stored.status == "abandoned" or r.final else "in-progress"
 
 
@@ -209,7 +209,7 @@ def _response(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
         "questionnaire": f"{questionnaire_canonical(q, site, language)}|{questionnaire_version(q)}",
         "status": response_status(r), "subject": _patient(site, stored), "authored": _authored(r),
-        "author": _clinician(r.review.signed_by) if r.review.state == ReviewState.AMENDED and r.review.signed_by
+        "author": _clinician(r.review.signed_by) if r.amended and r.review.signed_by
         else device_reference(site),
         "source": _patient(site, stored) if stored.answered_by.value == "patient"
         else {"type": "RelatedPerson", "display": stored.answered_by.value},
@@ -235,7 +235,7 @@ def _signature(review: Review) -> dict[str, Any]:
 
 def observation_status(r: Result) -> str:
     """``preliminary`` until a clinician signs off; then ``final``, or ``amended`` with corrections."""
-    return {ReviewState.SIGNED_OFF: "final", ReviewState.AMENDED: "amended"}.get(r.review.state, "preliminary")
+    return ("amended" if r.amended else "final") if r.final else "preliminary"
 
 
 def fhir_total(q: Questionnaire, stored: StoredSession, review: Review | None = None,

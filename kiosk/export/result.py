@@ -108,9 +108,16 @@ class Result:
         return self.review.final
 
     @property
+    def amended(self) -> bool:
+        """Signed off with answers other than the kiosk recorded (state ``amended``, or a sign-off
+        that still carries corrections: a changed answer is never reported as the kiosk's)."""
+        changed = any(self.recorded(c.item_id) != c.option for c in self.review.corrections)
+        return self.final and (self.review.state == ReviewState.AMENDED or changed)
+
+    @property
     def review_state(self) -> str:
-        """``unreviewed``, ``signed_off`` or ``amended``."""
-        return ReviewState(self.review.state).value
+        """``unreviewed``, ``signed_off`` or ``amended`` (see :attr:`amended`)."""
+        return ReviewState.AMENDED.value if self.amended else ReviewState(self.review.state).value
 
     def recorded(self, item_id: str) -> int | None:
         """The option the kiosk stored for an item (None: not answered at the kiosk)."""

@@ -258,3 +258,13 @@ def test_the_checkers_reject_what_r4_forbids(replayed, path, bad, models_reject)
     if models_reject:
         with pytest.raises(ValidationError):
             parse_r4(response)
+
+
+def test_a_sign_off_that_still_changes_an_answer_is_reported_amended(replayed):
+    stored = replayed["TB-0001"]  # feeding: option 3 at the kiosk
+    review = signed(ReviewState.SIGNED_OFF, fill("feeding", 2, 3))
+    response = fhir_response(QUESTIONNAIRE, stored, review, SITE)
+    assert response["status"] == "amended" and total_answer(response) == [{"valueInteger": 95}]
+    assert fhir_total(QUESTIONNAIRE, stored, review, SITE)["status"] == "amended"
+    same = signed(ReviewState.SIGNED_OFF, fill("feeding", 3, 3))  # a "correction" to what was recorded
+    assert fhir_response(QUESTIONNAIRE, stored, same, SITE)["status"] == "completed"
