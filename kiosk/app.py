@@ -54,6 +54,7 @@ from kiosk.session import (
     SessionEvent,
     VolumeChanged,
 )
+from kiosk.lease import LEASE_TTL_S, SessionTaken
 from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar, VoiceAgainButton
@@ -92,10 +93,14 @@ class KioskApp(App[int]):
     also follows the session's events) or None; ``sources`` the remotes' input sources
     (all started with :meth:`channel_sink` on mount and stopped on exit). ``statuses`` are channel
     states known before start-up, such as "voice in off: no microphone found". ``keyboard`` is a
-    ``kiosk.remote.KeyboardRemote`` for remotes that type keys. ``resumable`` is an interrupted
-    stored session the welcome screen offers to continue, through ``resume`` (which builds the
-    session continuing it, ``Session.from_stored``). ``new_session`` builds a fresh session for
-    the next patient (the clinician's "New session").
+    ``kiosk.remote.KeyboardRemote`` for remotes that type keys. ``resume`` builds the session
+    continuing an interrupted stored one (``Session.from_stored``): staff choose it on the clinician
+    screen ("Continue this test"); a patient is never offered someone else's test. ``new_session``
+    builds a fresh session for the next patient (the clinician's "New session").
+
+    With a store, the app renews this kiosk's hold on its session every ``lease_interval`` seconds
+    and marks interrupted the tests whose kiosk is gone (:meth:`Store.interrupt_stale`); a session
+    this kiosk no longer holds (taken over, or too old) is dropped with a plain notice.
     """
 
     CSS_PATH = "kiosk.tcss"
@@ -115,7 +120,6 @@ class KioskApp(App[int]):
         statuses: Iterable[ChannelStatus] = (),
         export_dir: Path | None = None,
         poll_interval: float = POLL_INTERVAL,
-        resumable: StoredSession | None = None,
         resume: Callable[[StoredSession], Session] | None = None,
         new_session: Callable[[], Session] | None = None,
     ) -> None:
@@ -132,7 +136,6 @@ class KioskApp(App[int]):
         self.keyboard = keyboard
         self.export_dir = export_dir
         self.poll_interval = poll_interval
-        self.resumable = resumable if resume is not None else None
         self._resume = resume
         self._new_session = new_session
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
@@ -163,6 +166,8 @@ class KioskApp(App[int]):
             self.run_worker(partial(source.start, self.channel_sink), thread=True,
                             name=f"start {source.name}", group="channels")
         self.set_interval(self.poll_interval, self.poll_session)
+        if self.store is not None:
+            self.set_interval(LEASE_TTL_S / 3, self.keep_session)
         self._render()
 
     def on_unmount(self) -> None:
@@ -246,17 +251,11 @@ class KioskApp(App[int]):
         """Start in the language the patient touched."""
         self._start(message.language)
 
-    def on_welcome_screen_resume_chosen(self, message: WelcomeScreen.ResumeChosen) -> None:
-        """Continue the interrupted session instead of the fresh one (which was never started)."""
-        if self.resumable is None or self._resume is None or self.session.phase is not Phase.WELCOME:
-            return
-        self._replace_session(self._resume(self.resumable))
-        self._drive(self.session.start)
-
     def _replace_session(self, session: Session) -> None:
+        old, self.session = self.session, session
         self._unsubscribe()
-        self.session = session
-        self.resumable = None
+        if self.store is not None and old.id != session.id:
+            self.store.release(old.id)  # a finished one is let go; one still running is interrupted
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -282,8 +281,13 @@ class KioskApp(App[int]):
     # -- the session's events ----------------------------------------------------------------------
 
     def _drive(self, operation: Callable[..., object], *args: object) -> None:
-        """Run a session operation, then redraw if it published anything."""
-        operation(*args)
+        """Run a session operation, then redraw if it published anything. A session another kiosk
+        took over (or that was interrupted) stores nothing more here: the kiosk lets it go."""
+        try:
+            operation(*args)
+        except SessionTaken as taken:
+            self._session_lost(str(taken))
+            return
         if self._dirty:
             self._dirty = False
             self._render()
@@ -331,16 +335,12 @@ class KioskApp(App[int]):
         for name in sorted(snap.adaptations):
             notices.append(self.questionnaire.message(name, snap.language)
                            or ui_text(snap.language, name, default=name.replace("_", " ")))
-        offer = None
-        if self.resumable is not None and snap.phase is Phase.WELCOME:
-            offer = ui_text(snap.language, "resume_offer", answered=len(self.resumable.answers),
-                            total=len(self.questionnaire.items))
         # the session lifts voice_off when voice in goes; checked here too so the button never
         # promises listening that cannot happen (and not over Continue while paused)
         voice_again = ("voice_off" in snap.adaptations and not (snap.paused or snap.halted)
                        and self.board.state(VOICE_IN)[0] is ChannelState.ON)
         return PatientView(snap, self.questionnaire, self.board.lines(snap.language),
-                           " ".join(notices) or None, voice_again=voice_again, resume_offer=offer)
+                           " ".join(notices) or None, voice_again=voice_again)
 
     @staticmethod
     def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:
@@ -431,9 +431,57 @@ class KioskApp(App[int]):
         replaces counts as abandoned (:meth:`Session.abandon`)."""
         if self._new_session is None:
             return
-        self.session.abandon()
+        try:
+            self.session.abandon()
+        except SessionTaken:
+            pass  # another kiosk holds it now: nothing of it is this kiosk's to end
         self._replace_session(self._new_session())
         self.close_clinician()
+
+    # -- interrupted tests and this kiosk's hold on its session ------------------------------------
+
+    def interrupted_tests(self) -> list[StoredSession]:
+        """The tests staff may continue here (their kiosk stopped, or they grew too old), newest first."""
+        return self.store.unfinished_sessions() if self.store is not None else []
+
+    def continue_test(self, session_id: str) -> str | None:
+        """Staff continue an interrupted test on this kiosk (clinician screen, behind the PIN).
+        Returns why not, as a sentence for staff, or None once it continues."""
+        if self.store is None or self._resume is None:
+            return "this kiosk stores no sessions"
+        if self.session.phase is not Phase.WELCOME and not self.session.finished:
+            return "a test is in progress on this kiosk: finish it, or start a new patient, first"
+        try:
+            stored = self.store.continue_session(session_id)
+        except (SessionTaken, ValueError, KeyError) as refused:
+            return str(refused.args[0] if isinstance(refused, KeyError) else refused)
+        self._replace_session(self._resume(stored))
+        self.close_clinician()
+        self._drive(self.session.start)
+        return None
+
+    def keep_session(self) -> None:
+        """Renew this kiosk's hold on its session and interrupt the tests whose kiosk is gone (a
+        timer calls this); a running session this kiosk no longer holds is let go."""
+        assert self.store is not None
+        self.store.renew()
+        self.store.interrupt_stale()
+        session = self.session
+        if session.phase is Phase.WELCOME or session.finished or self.store.holds(session.id):
+            return
+        stored = {s.id: s for s in self.store.sessions()}.get(session.id)
+        if stored is not None:
+            why = f" ({stored.interrupted_reason})" if stored.interrupted_reason else ""
+            self._session_lost(f"session {session.id} is {stored.status}{why}")
+
+    def _session_lost(self, reason: str) -> None:
+        """This kiosk may no longer record in its session: say so plainly and start over."""
+        self.notify(f"This kiosk stopped the test of {self.session.patient_id}: {reason}. Staff can see it "
+                    "on the clinician screen.", title="Test stopped", severity="warning", timeout=60)
+        if self._new_session is not None:
+            self._replace_session(self._new_session())
+        self._screen_key = None
+        self._render()
 
     def set_adaptation(self, enabled: bool) -> None:
         """A clinician switches live adaptation on or off for this session."""
@@ -479,7 +527,10 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
         config = load_config(config_path)
         questionnaire = configured_questionnaire(config)
         policy = load_policy(config.adaptation_policy) if config.adaptation else None
-        store = Store.open(data_dir or config.data_dir)
+        store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
+                           outbox=config.station is not None)
+        # what a kiosk that stopped left running is interrupted now: for staff, never a patient
+        store.interrupt_stale()
     except QuestionnaireError as error:
         problems = getattr(error, "problems", None)
         raise SetupError("\n".join(str(p) for p in problems) if problems else str(error)) from None
@@ -502,12 +553,10 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
                                    store=store, timing=config.timing,
                                    adaptation=Adaptation(policy) if policy else None)
 
-    # a kiosk restarted after a crash offers the interrupted session (not when told whom to test)
-    unfinished = store.unfinished_sessions() if patient_id is None else []
     app = KioskApp(fresh(patient_id), clinician_pin=config.clinician_pin, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports",
-                   resumable=unfinished[0] if unfinished else None, resume=resume, new_session=fresh)
+                   resume=resume, new_session=fresh)
     return app, store.close
 
 

@@ -3,7 +3,7 @@
 Where the file is: ``$KIOSK_CONFIG`` if set (it must exist), else
 ``<user config dir>/kiosk/config.yaml`` if present (``platformdirs.user_config_dir("kiosk")``),
 else built-in defaults. Environment variables override the file: ``KIOSK_DATA_DIR``,
-``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``.
+``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``, ``KIOSK_STATION_URL``, ``KIOSK_STATION_TOKEN``.
 
 Example ``config.yaml`` (every key optional)::
 
@@ -19,12 +19,17 @@ Example ``config.yaml`` (every key optional)::
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
     remote_profiles: /etc/kiosk/remotes.yaml
     site: hosp-north                  # short code of the site (default "local"); part of export ids
-    kiosk_id: ward3-bed2              # this kiosk (default: the host name); exports and the station
+    kiosk_id: ward3-bed2              # this kiosk (default: the host name): exports and the station
     fhir:                             # FHIR identity of this site's exports (defaults: urn:barthel-kiosk:...)
       patient_system: https://hosp-north.example/sid/kiosk-patient
       questionnaire_url: https://hosp-north.example/fhir/Questionnaire/barthel
       identifier_system: https://hosp-north.example/sid/kiosk-result
       device_system: https://hosp-north.example/sid/kiosk
+    interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
+    station:                          # report to a ward station (docs/station-protocol.md)
+      url: https://ward.example:8443  # without a url the kiosk talks to no station at all
+      token: "…"                      # from `kiosk station add-kiosk NAME`
+      kiosk_id: ward3-bed2            # the same as kiosk_id (older place; give one of the two)
 
 A bad file is one :class:`ConfigError` naming the file, line and column and what is wrong.
 """
@@ -46,11 +51,18 @@ from kiosk.yamlmarks import Problem, parse_file
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
 DEFAULT_PIN = "1234"
-#: a site code or kiosk id: it goes into identifiers, so no spaces, '/' or '|'
-SITE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
 _URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\s|]+$")
+
+
+class ConfigError(ValueError):
+    """The configuration file (or an environment override) is unusable."""
+
+
+#: a kiosk's name at the station, and a site's code: letters, digits, '.', '-' and '_' (both go
+#: into exported identifiers, so no spaces, '/' or '|')
+KIOSK_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
 
 
 def default_kiosk_id() -> str:
@@ -59,8 +71,16 @@ def default_kiosk_id() -> str:
     return name or "kiosk"
 
 
-class ConfigError(ValueError):
-    """The configuration file (or an environment override) is unusable."""
+@dataclass(frozen=True)
+class Station:
+    """Where this kiosk reports (``station:`` in the configuration)."""
+
+    #: the station's base URL, http:// or https://
+    url: str
+    #: this kiosk's bearer token, issued by the station
+    token: str
+    #: this kiosk's name at the station
+    kiosk_id: str = field(default_factory=default_kiosk_id)
 
 
 @dataclass(frozen=True)
@@ -96,6 +116,10 @@ class Config:
     kiosk_id: str = field(default_factory=default_kiosk_id)
     #: FHIR identity of the site's exports: any of FHIR_KEYS (defaults in kiosk.export.ExportSite)
     fhir: Mapping[str, str] = field(default_factory=dict)
+    #: a running test older than this is marked interrupted (staff may continue it; no patient is offered it)
+    interrupt_after_minutes: float = 120.0
+    #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
+    station: Station | None = None
     #: the file this was read from (None: defaults only)
     source: Path | None = None
 
@@ -131,6 +155,17 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     for var, key in overrides.items():
         if env.get(var):
             values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
+    station = values.get("station") or {}
+    # one kiosk id for exports and the station: kiosk_id, or station.kiosk_id, never two different ones
+    if station.get("kiosk_id") and values.get("kiosk_id", station["kiosk_id"]) != station["kiosk_id"]:
+        raise ConfigError(f"{path}: kiosk_id {values['kiosk_id']!r} and station.kiosk_id {station['kiosk_id']!r} "
+                          "differ: one kiosk has one id (set kiosk_id only)")
+    values["kiosk_id"] = values.get("kiosk_id") or station.get("kiosk_id") or default_kiosk_id()
+    station = {**station, "kiosk_id": values["kiosk_id"]} if station else station
+    for var, key in (("KIOSK_STATION_URL", "url"), ("KIOSK_STATION_TOKEN", "token")):
+        if env.get(var):
+            station = {**station, key: env[var]}
+    values["station"] = _station(station, f"{path}: station" if path is not None else "KIOSK_STATION_URL")
     if values.get("language", "en") not in SCREEN_LANGUAGES:
         raise ConfigError(f"language {values['language']!r} is not one of {', '.join(SCREEN_LANGUAGES)}")
     return Config(**values, source=Path(path) if path is not None else None)
@@ -181,7 +216,7 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
-        elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not SITE_ID.match(value)):
+        elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.match(value)):
             raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
         elif key == "fhir":
             if not isinstance(value, dict):
@@ -193,10 +228,38 @@ def _read(path: Path) -> dict[str, Any]:
                     raise fail((key, name), f"fhir {name} must be an absolute URI without spaces or '|', "
                                             "such as https://example.org/sid/patient")
             value = dict(value)
+        elif key == "station":
+            if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \
+                    or not all(isinstance(v, str) for v in value.values()):
+                raise fail((key,), "station must be a mapping {url: ..., token: ..., kiosk_id: ...} of strings")
+            try:
+                _station(value, "station")
+            except ConfigError as exc:
+                raise fail((key,), str(exc)) from None
+        elif key == "interrupt_after_minutes":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
+                raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
     return values
+
+
+def _station(values: Mapping[str, str], where: str) -> Station | None:
+    """The station settings, checked; None without a url (a token alone is harmless)."""
+    url = values.get("url", "")
+    if not url:
+        return None
+    if not re.match(r"^https?://[^\s/?#]+(/[^\s?#]*)?$", url):
+        raise ConfigError(f"{where}: url {url!r} must be an http:// or https:// address such as "
+                          "https://ward.example:8443")
+    if not values.get("token"):
+        raise ConfigError(f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
+                          "the station issues it with `kiosk station add-kiosk NAME`)")
+    kiosk_id = values.get("kiosk_id") or default_kiosk_id()
+    if not KIOSK_ID.match(kiosk_id):
+        raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'")
+    return Station(url.rstrip("/"), values["token"], kiosk_id)
 
 
 def configured_questionnaire(config: Config) -> Questionnaire:

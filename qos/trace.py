@@ -25,7 +25,7 @@ from typing import Any
 import yaml
 
 from qos.engine import Engine, UpdateResult, check_batch
-from qos.errors import ContextError, TraceError
+from qos.errors import ContextError, ModelError, TraceError
 from qos.files import BadFile, load_data, write_private
 from qos.model import Model
 
@@ -84,9 +84,15 @@ class Trace:
         from qos import load_model  # the package function, which knows the bundled models
 
         model = self.model
-        if self.source is not None and (model.endswith(".roqme") or "/" in model):
+        is_path = model.endswith(".roqme") or "/" in model
+        if self.source is not None and is_path:
             model = str(self.source.parent / model)
-        return load_model(model)
+        try:
+            return load_model(model)
+        except ModelError as exc:
+            if is_path:
+                raise  # it names the model file, and where in it
+            raise ModelError(f"{self.name}: {exc}") from None  # an unknown name: say which trace uses it
 
     def check(self, model: Model | None = None) -> Model:
         """Validate every event against the model; raise :class:`TraceError` on the first problem."""
@@ -223,7 +229,10 @@ class TraceRecorder:
         self._unsubscribe = engine.subscribe(self._record)
 
     def _record(self, result: UpdateResult) -> None:
-        self.events.append(TraceEvent(seconds(result.t), dict(result.set), list(result.emit)))
+        if result.timed:
+            return  # timers and time windows: a replay runs them again from the model
+        values = {name: list(value) if isinstance(value, tuple) else value for name, value in result.set.items()}
+        self.events.append(TraceEvent(seconds(result.t), values, list(result.emit)))
 
     @property
     def trace(self) -> Trace:
@@ -278,7 +287,8 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if not isinstance(trace, Trace):
         trace = load_trace(trace)
     model = trace.check(model)
-    engine = Engine(model)
+    # the trace's clock starts with the session: timers start at t = 0
+    engine = Engine(model, start=0.0)
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
@@ -286,29 +296,31 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
         raise TraceError(f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
                          f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period")
     samples = ReplaySamples([], {name: [] for name in model.properties}, [])
+    # every batch that fires, timer batches included, in the order the engine runs them
+    engine.subscribe(lambda result: samples.fired.append({"t": seconds(result.t), "observations": result.fired})
+                     if result.fired else None)
     upcoming = 0
+
+    def sample(now: float) -> None:
+        engine.advance(max(now, engine.t or 0.0))
+        samples.times.append(now)
+        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
+            samples.series[name].append(value)
+
     for k in range(count):
         now = k * sample_period
         # a small tolerance so that samples at k·0.1 s still see the events written at that time
         while upcoming < len(batches) and float(batches[upcoming][0]) <= now + 1e-9:
             t, values, emitted = batches[upcoming]
-            result = engine.update(float(t), set=values, emit=emitted)
-            if result.fired:
-                samples.fired.append({"t": t, "observations": result.fired})
+            engine.update(float(t), set=values, emit=emitted)
             upcoming += 1
-        samples.times.append(now)
-        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
-            samples.series[name].append(value)
+        sample(now)
     if upcoming < len(batches):
         # the last event falls between two samples: apply the rest and sample at that time too,
         # so that every batch is counted and `last` is the value after the last event
         for t, values, emitted in batches[upcoming:]:
-            result = engine.update(float(t), set=values, emit=emitted)
-            if result.fired:
-                samples.fired.append({"t": t, "observations": result.fired})
-        samples.times.append(last_t)
-        for name, value in engine.metrics(last_t).items():
-            samples.series[name].append(value)
+            engine.update(float(t), set=values, emit=emitted)
+        sample(last_t)
     return samples
 
 

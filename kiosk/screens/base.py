@@ -29,8 +29,6 @@ class PatientView:
     banner: str | None = None
     #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
     voice_again: bool = False
-    #: on the welcome screen: how far an interrupted session got, when it can be continued
-    resume_offer: str | None = None
 
 
 class PatientScreen(Screen):

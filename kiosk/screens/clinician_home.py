@@ -1,5 +1,6 @@
 """The clinician's first screen: the running session (continue it, adaptation on/off, patient left or
-back), the channel states with their reasons, and the list of stored sessions."""
+back), the channel states with their reasons, the interrupted tests staff may continue, and the
+list of stored sessions."""
 
 from __future__ import annotations
 
@@ -46,16 +47,31 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Button("Patient left", id="person-lost", disabled=not (running and present))
                 yield Button("Patient back", id="person-back", disabled=not (running and not present))
             yield Static(self._channels_text(), id="channel-reasons")
+            # continuing a test is the staff's decision: only with the same patient at the kiosk
+            yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")
+            yield DataTable(id="interrupted", cursor_type="row", zebra_stripes=True)
+            with Horizontal(id="interrupted-actions"):
+                yield Button("Continue this test", id="continue-test", variant="warning", disabled=True)
+                yield Static("", id="continue-result")
             yield Label("Stored sessions (Enter or click to open):")
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
 
     def on_mount(self) -> None:
         """Fill the session list from the store."""
+        interrupted = self.query_one("#interrupted", DataTable)
+        interrupted.add_columns("patient", "started", "progress", "why it stopped", "session")
+        count = len(self.app.questionnaire.items)  # type: ignore[attr-defined]
+        for test in self.app.interrupted_tests():  # type: ignore[attr-defined]
+            progress = f"{len(test.answers)} of {count} answered" + (
+                f", {len(test.not_answered)} not answered" if test.not_answered else "")
+            interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,
+                                test.interrupted_reason or "", test.id, key=test.id)
+        self.query_one("#continue-test", Button).disabled = not interrupted.row_count
         table = self.query_one("#sessions", DataTable)
         table.add_columns("session", "patient", "started", "status", "language", "answered", "not answered")
         store = self.app.store  # type: ignore[attr-defined]
         for s in store.sessions() if store is not None else []:
-            table.add_row(s.id, s.patient_id, s.started_at[:19], s.status, s.language, str(s.answered),
+            table.add_row(s.id, s.patient_id, s.started_at[:19], s.label, s.language, str(s.answered),
                           str(s.not_answered), key=s.id)
 
     def _session_line(self) -> str:
@@ -90,6 +106,16 @@ class ClinicianHomeScreen(ClinicianScreen):
     def _person_back(self) -> None:
         self.app.person_back()  # type: ignore[attr-defined]
         self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#continue-test")
+    def _continue_test(self) -> None:
+        table = self.query_one("#interrupted", DataTable)
+        if not table.row_count:
+            return
+        row_key, _ = table.coordinate_to_cell_key(table.cursor_coordinate)
+        refused = self.app.continue_test(str(row_key.value))  # type: ignore[attr-defined]
+        if refused:
+            self.query_one("#continue-result", Static).update(f"Not continued: {refused}")
 
     @on(Button.Pressed, "#new-session")
     def _new_session(self) -> None:

@@ -29,22 +29,16 @@ class WelcomeScreen(PatientScreen):
             """One of the questionnaire's languages."""
             super().__init__()
 
-    class ResumeChosen(Message):
-        """The patient chose to continue the interrupted session."""
-
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
-        """Rebuilt when the language changes (the welcome sentence changes with it) or the offer to
-        continue an interrupted session comes or goes."""
-        return (view.snapshot.language, view.resume_offer)
+        """Rebuilt when the language changes (the welcome sentence changes with it)."""
+        return view.snapshot.language
 
     def compose(self) -> ComposeResult:
         """Bars, the welcome message, the language buttons (numbered like the remote)."""
         yield from self.compose_bars()
         q = self.view.questionnaire
         yield Static(q.message("welcome", self.language), classes="heading", id="welcome")
-        if self.view.resume_offer:
-            yield Button(self.view.resume_offer, id="resume-session", classes="big-action")
         yield Static(ui_text(self.language, "choose_language"), classes="notice")
         with Vertical(id="languages"):
             for number, language in enumerate(q.languages, start=1):
@@ -56,11 +50,6 @@ class WelcomeScreen(PatientScreen):
         super().show(view)
         for reasons in self.query("#channel-reasons").results(Static):
             reasons.update(channel_reasons(view.channels))
-
-    @on(Button.Pressed, "#resume-session")
-    def _resume(self, event: Button.Pressed) -> None:
-        event.stop()
-        self.post_message(self.ResumeChosen())
 
     @on(Button.Pressed, "#languages Button")
     def _language(self, event: Button.Pressed) -> None:

@@ -172,7 +172,9 @@ class Operation:
     """One public operation: catch up on time-outs, act, then flush QoS and publish events.
 
     The outermost operation is one store transaction, committed before listeners hear of it: a
-    crash keeps an answer together with its QoS context batch and metrics, or neither.
+    crash keeps an answer together with its QoS context batch and metrics, or neither. An
+    operation that raises (an error, Ctrl-C, the store refusing a session another kiosk holds)
+    rolls the transaction back, and its events are dropped: nobody hears of what was not stored.
     """
 
     def __init__(self, session: Session, inclusive: bool = False) -> None:
@@ -186,23 +188,37 @@ class Operation:
         if s._depth == 1 and s.store is not None:
             self._transaction = s.store.transaction()
             self._transaction.__enter__()
-        now = s.clock.now()
-        for kind, due in s._timers.due(now, self.inclusive):
-            s._fire(kind, due)
-        return s._timers.t(now)
+        try:
+            now = s.clock.now()
+            for kind, due in s._timers.due(now, self.inclusive):
+                s._fire(kind, due)
+            return s._timers.t(now)
+        except BaseException as error:  # `with` does not call __exit__ when __enter__ raises
+            self.__exit__(type(error), error, error.__traceback__)
+            raise
 
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
         s = self.s
         s._depth -= 1
         if s._depth:
             return
+        failure = exc if exc_type is not None else None
         try:
-            if exc_type is None:
+            if failure is None:
                 s._flush()
+        except BaseException as error:
+            failure = error
+            raise
         finally:
+            if failure is not None:
+                s._queue.clear()
+                s._batch = None
             if self._transaction is not None:
-                self._transaction.__exit__(None, None, None)
-        if exc_type is not None:
+                if failure is None:
+                    self._transaction.__exit__(None, None, None)
+                else:  # the store rolls back, then lets the failure go on
+                    self._transaction.__exit__(type(failure), failure, failure.__traceback__)
+        if failure is not None:
             return
         if s._dispatching:
             return

@@ -50,3 +50,14 @@ def test_new_pseudonyms_have_60_random_bits_and_old_ones_stay_valid():
     assert len(ids) == 2000
     assert all(re.fullmatch(r"P-([A-HJ-NP-Z2-9]{4}-){2}[A-HJ-NP-Z2-9]{4}", i) and PATIENT_ID.match(i) for i in ids)
     assert PATIENT_ID.match("P-7K3QX9")  # the older six-character form
+
+
+def test_one_kiosk_id_serves_exports_and_the_station(tmp_path):
+    station = "station: {url: 'https://ward.example:8443', token: t0k3n"
+    both = config(tmp_path, f"kiosk_id: ward3-bed2\n{station}}}\n")
+    assert both.kiosk_id == both.station.kiosk_id == "ward3-bed2"
+    older = config(tmp_path, f"{station}, kiosk_id: ward4-bed1}}\n")  # the station's own key still works
+    assert older.kiosk_id == older.station.kiosk_id == "ward4-bed1"
+    assert site_from_config(older).kiosk_id == "ward4-bed1"
+    with pytest.raises(ConfigError, match="kiosk_id 'ward3-bed2' and station.kiosk_id 'ward4-bed1' differ"):
+        config(tmp_path, f"kiosk_id: ward3-bed2\n{station}, kiosk_id: ward4-bed1}}\n")

@@ -89,3 +89,37 @@ def test_the_band_set_is_chosen_by_config_and_an_unknown_one_is_named(tmp_path):
     path.write_text("bands: [spanish]\n")
     with pytest.raises(ConfigError, match=":1:1: bands must name a band set of the questionnaire"):
         load_config(path, environ={})
+
+
+def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypatch):
+    monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
+    assert load_config(environ={}).station is None  # no station: the kiosk works alone
+    path = tmp_path / "config.yaml"
+    path.write_text("station: {url: 'https://ward.example:8443/', token: abc, kiosk_id: ward3-bed2}\n"
+                    "interrupt_after_minutes: 45\n")
+    config = load_config(path, environ={})
+    assert config.station is not None
+    assert (config.station.url, config.station.token, config.station.kiosk_id) == (
+        "https://ward.example:8443", "abc", "ward3-bed2")
+    assert config.interrupt_after_minutes == 45
+    env = {"KIOSK_STATION_URL": "http://127.0.0.1:9000", "KIOSK_STATION_TOKEN": "xyz"}
+    config = load_config(path, environ=env)
+    assert (config.station.url, config.station.token, config.station.kiosk_id) == (
+        "http://127.0.0.1:9000", "xyz", "ward3-bed2")
+    only_env = load_config(environ=env).station
+    assert only_env is not None and only_env.kiosk_id  # the host name by default
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("station: {url: 'ftp://x', token: a}\n", ":1:1: station: url 'ftp://x' must be an http:// or https://"),
+    ("station: {url: 'http://x:1'}\n", ":1:1: station: a token is needed with the url"),
+    ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:1: station: kiosk_id 'bed 2' must be"),
+    ("station: {url: 'http://x:1', tokn: a}\n", ":1:1: station must be a mapping"),
+    ("interrupt_after_minutes: 0\n", ":1:1: interrupt_after_minutes must be a number of minutes"),
+])
+def test_bad_station_settings_say_where(tmp_path, text, message):
+    path = tmp_path / "config.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as caught:
+        load_config(path, environ={})
+    assert str(caught.value).startswith(f"{path}{message}")
