@@ -38,6 +38,7 @@ Choices, each from the R4 specification:
 
 from __future__ import annotations
 
+import re
 import uuid
 from collections.abc import Mapping, Sequence
 from datetime import datetime, timezone
@@ -113,6 +114,12 @@ def _total_expression(q: Questionnaire) -> str:
             f"{answered}.answer.value.weight().sum(), {{}})")
 
 
+def _computable_name(title: str) -> str:
+    """A title as R4 wants a computable name (invariant que-0): letters and digits, a capital first."""
+    name = "".join(word[:1].upper() + word[1:] for word in re.findall(r"[A-Za-z0-9]+", title)).lstrip("0123456789")
+    return name or "Questionnaire"
+
+
 def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite | None = None) -> dict[str, Any]:
     """The questionnaire in ``language`` as an R4 Questionnaire (other languages as translations)."""
     if language not in q.languages:
@@ -145,7 +152,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
     resource: dict[str, Any] = {
         "resourceType": "Questionnaire", "id": f"{q.id}-{language}", "language": language,
         "url": questionnaire_canonical(q, site, language), "version": questionnaire_version(q),
-        "name": "".join(w.capitalize() for w in q.title["en"].split()) + language.upper(),
+        "name": _computable_name(q.title["en"]) + language.upper(),
         "title": q.title[language], "_title": _translated(q.title, language),
         "status": "active", "subjectType": ["Patient"], "item": items,
     }
@@ -325,7 +332,8 @@ def transaction_bundle(q: Questionnaire, sessions: Sequence[StoredSession], revi
             total["device"] |= {"reference": device_url}
             entries.append(_entry(total, _full_url(site.identifier_system, value + "/total"),
                                   _query(identifier=f"{site.identifier_system}|{value}/total"), update=r.final))
-    return {"resourceType": "Bundle", "type": "transaction", "entry": entries}
+    # FHIR JSON has no empty arrays: a Bundle of nothing has no entry at all
+    return {"resourceType": "Bundle", "type": "transaction"} | ({"entry": entries} if entries else {})
 
 
 def questionnaire_bundle(q: Questionnaire, site: ExportSite | None = None) -> dict[str, Any]:

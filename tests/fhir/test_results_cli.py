@@ -89,3 +89,16 @@ def test_sessions_from_kiosk_replay_are_labelled_test_data(tmp_path, monkeypatch
     assert labelled["Questionnaire"] is None and labelled["Device"] is None
     frame = pd.read_csv(table)
     assert frame["simulated"].tolist() == [True]
+
+
+def test_an_empty_store_exports_an_empty_but_valid_bundle(tmp_path, monkeypatch, capsys):
+    from kiosk.storage import Store
+
+    _configure(tmp_path, monkeypatch)
+    Store.open(tmp_path / "data").close()
+    out = tmp_path / "none.json"
+    assert results_main(["--data-dir", str(tmp_path / "data"), "--fhir", str(out)]) == 0
+    assert capsys.readouterr().err == "no sessions stored\n"
+    bundle = json.loads(out.read_text(encoding="utf-8"))
+    check_fhir(bundle)
+    assert bundle == {"resourceType": "Bundle", "type": "transaction"}
