@@ -87,7 +87,7 @@ def instant(value: str) -> str:
 
 def questionnaire_canonical(q: Questionnaire, site: ExportSite, language: str) -> str:
     """The canonical URL of the questionnaire in one language (without the version)."""
-    return f"{site.questionnaire_url}-{language}"
+    return f"{site.questionnaire_url or f'urn:barthel-kiosk:{site.site}:questionnaire:{q.id}'}-{language}"
 
 
 def _translated(texts: Mapping[str, str], language: str) -> dict[str, Any]:

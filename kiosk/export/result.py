@@ -39,6 +39,7 @@ class ExportSite:
     #: the system of the patients' pseudonymous ids
     patient_system: str = ""
     #: the canonical URL of the questionnaire; one Questionnaire per language is ``URL-LANG``
+    #: (empty: ``urn:barthel-kiosk:SITE:questionnaire:ID``, ID the questionnaire file's id)
     questionnaire_url: str = ""
     #: the system of result identifiers: ``SITE/KIOSK/SESSION`` (+ ``/total`` for the Observation)
     identifier_system: str = ""
@@ -47,7 +48,6 @@ class ExportSite:
 
     def __post_init__(self) -> None:
         defaults = {"patient_system": f"urn:barthel-kiosk:{self.site}:patient",
-                    "questionnaire_url": f"urn:barthel-kiosk:{self.site}:questionnaire:barthel",
                     "identifier_system": "urn:barthel-kiosk:result",
                     "device_system": f"urn:barthel-kiosk:{self.site}:kiosk"}
         for name, value in defaults.items():

@@ -22,7 +22,6 @@ def test_a_site_sets_its_identity_and_the_rest_keeps_documented_defaults(tmp_pat
                                              "fhir: {patient_system: 'https://hosp-north.example/sid/kiosk-patient'}\n"))
     assert site == ExportSite(site="hosp-north", kiosk_id="ward3-bed2",
                               patient_system="https://hosp-north.example/sid/kiosk-patient",
-                              questionnaire_url="urn:barthel-kiosk:hosp-north:questionnaire:barthel",
                               identifier_system="urn:barthel-kiosk:result",
                               device_system="urn:barthel-kiosk:hosp-north:kiosk")
     assert site.result_id("0a1b2c3d4e5f") == "hosp-north/ward3-bed2/0a1b2c3d4e5f"
@@ -61,3 +60,17 @@ def test_one_kiosk_id_serves_exports_and_the_station(tmp_path):
     assert site_from_config(older).kiosk_id == "ward4-bed1"
     with pytest.raises(ConfigError, match="kiosk_id 'ward3-bed2' and station.kiosk_id 'ward4-bed1' differ"):
         config(tmp_path, f"kiosk_id: ward3-bed2\n{station}, kiosk_id: ward4-bed1}}\n")
+
+
+def test_the_default_canonical_url_names_the_site_and_the_questionnaire_file_id():
+    from dataclasses import replace
+
+    from kiosk.export import questionnaire_canonical
+    from tests.session.helpers import QUESTIONNAIRE
+
+    site = ExportSite(site="hosp-north", kiosk_id="k1")
+    assert questionnaire_canonical(QUESTIONNAIRE, site, "es") == "urn:barthel-kiosk:hosp-north:questionnaire:barthel-es"
+    other = replace(QUESTIONNAIRE, id="barthel_short")
+    assert questionnaire_canonical(other, site, "fr") == "urn:barthel-kiosk:hosp-north:questionnaire:barthel_short-fr"
+    configured = replace(site, questionnaire_url="https://hosp-north.example/fhir/Questionnaire/barthel")
+    assert questionnaire_canonical(other, configured, "en") == "https://hosp-north.example/fhir/Questionnaire/barthel-en"
