@@ -80,6 +80,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--bom", action="store_true", help="start CSV files with a UTF-8 byte-order mark")
     parser.add_argument("--data-dir", help="data directory (default: from the kiosk configuration)")
     args = parser.parse_args(argv)
+    if args.language and not args.fhir_questionnaire:
+        parser.error("--language says which language --fhir-questionnaire writes; give --fhir-questionnaire FILE")
     try:
         config = load_config()
         q = configured_questionnaire(config)

@@ -74,3 +74,17 @@ def test_the_default_canonical_url_names_the_site_and_the_questionnaire_file_id(
     assert questionnaire_canonical(other, site, "fr") == "urn:barthel-kiosk:hosp-north:questionnaire:barthel_short-fr"
     configured = replace(site, questionnaire_url="https://hosp-north.example/fhir/Questionnaire/barthel")
     assert questionnaire_canonical(other, configured, "en") == "https://hosp-north.example/fhir/Questionnaire/barthel-en"
+
+
+def test_the_kiosk_app_exports_with_the_configured_site(tmp_path):
+    from kiosk.app import build_app
+
+    path = tmp_path / "config.yaml"
+    path.write_text("data_dir: data\nsite: hosp-north\nkiosk_id: ward3-bed2\n", encoding="utf-8")
+    app, close = build_app(config_path=path)
+    try:
+        # the clinician screen's FHIR/CSV exports name the same site and kiosk as `kiosk results`
+        assert app.export_site == site_from_config(load_config(path, environ={}))
+        assert app.export_site.result_id("abc") == "hosp-north/ward3-bed2/abc"
+    finally:
+        close()
