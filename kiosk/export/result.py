@@ -132,6 +132,9 @@ class Result:
 def result(q: Questionnaire, stored: StoredSession, review: Review | None = None) -> Result:
     """A stored session with its review applied (ExportError if either does not fit ``q``)."""
     review = review or Review.unreviewed()
+    if stored.questionnaire_id != q.id:
+        raise ExportError(f"session {stored.id} was answered on questionnaire {stored.questionnaire_id!r}, "
+                          f"not on {q.id!r} ({q.source}): export it with that questionnaire")
     rescore(q, stored)  # the stored answers must fit the questionnaire before anything is said about them
     options = review.options({a.item_id: a.option for a in stored.answers})
     points = {}

@@ -268,3 +268,11 @@ def test_a_sign_off_that_still_changes_an_answer_is_reported_amended(replayed):
     assert fhir_total(QUESTIONNAIRE, stored, review, SITE)["status"] == "amended"
     same = signed(ReviewState.SIGNED_OFF, fill("feeding", 3, 3))  # a "correction" to what was recorded
     assert fhir_response(QUESTIONNAIRE, stored, same, SITE)["status"] == "completed"
+
+
+def test_a_session_of_another_questionnaire_is_never_exported_as_this_one(replayed):
+    from kiosk.export import ExportError
+
+    other = replace(replayed["TB-0001"], questionnaire_id="katz")
+    with pytest.raises(ExportError, match="was answered on questionnaire 'katz', not on 'barthel'"):
+        transaction_bundle(QUESTIONNAIRE, [replayed["TB-0002"], other], site=SITE)
