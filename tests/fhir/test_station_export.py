@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.station.conftest import new_kiosk, shared_station  # noqa: F401 - the station fixture
+from tests.station.conftest import new_kiosk, shared_station  # noqa: F401,F811 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 
 from .conftest import check_fhir
@@ -14,7 +14,7 @@ from .conftest import check_fhir
 pytestmark = pytest.mark.slow
 
 
-def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_final(shared_station):
+def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_final(shared_station):  # noqa: F811
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)
     rows = record_patient(PATIENTS / "barthel4.yaml")  # grooming and bladder unanswered: 65 from 8 items
