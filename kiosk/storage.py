@@ -305,6 +305,20 @@ class Store:
             "INSERT INTO answers VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             (session_id, item_id, option, points, attempt, channel, answered_by, t, at, detail))
 
+    def withdraw_answer(self, session_id: str, *, item_id: str, t: float, at: str, reason: str) -> None:
+        """Take back a committed answer (the patient's "Change my answer"): its row is deleted and
+        the session log keeps what it was (an ``answer_withdrawn`` event, detail JSON), in one commit."""
+        row = self._db.execute("SELECT option, points, attempt, channel, answered_by, t, at, detail FROM answers"
+                               " WHERE session_id = ? AND item_id = ?", (session_id, item_id)).fetchone()
+        if row is None:
+            raise KeyError(f"session {session_id} has no answer to {item_id!r} to withdraw")
+        withdrawn = dict(zip(("option", "points", "attempt", "channel", "answered_by", "t", "at", "detail"), row))
+        with self.transaction():
+            self._record("withdraw_answer", session_id, {"item_id": item_id, "t": t, "at": at, "reason": reason},
+                         "DELETE FROM answers WHERE session_id = ? AND item_id = ?", (session_id, item_id))
+            self.record_event(session_id, t=t, kind="answer_withdrawn", detail=json.dumps(
+                {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False))
+
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None:
         """Store that both attempts of a question timed out."""
         self._record("record_not_answered", session_id, {"item_id": item_id, "t": t, "at": at},
@@ -379,19 +393,25 @@ class Store:
 
     def _check_held(self, session_id: str) -> None:
         """Inside a write transaction: this kiosk holds the session, else SessionTaken."""
+        why = self.why_not_held(session_id)
+        if why is not None:
+            raise SessionTaken(why)
+        self._held.add(session_id)
+
+    def why_not_held(self, session_id: str) -> str | None:
+        """Why this kiosk may not record in the session (a sentence for staff), or None if it holds it."""
         holder = self._holder(session_id)
         if holder is not None and holder[0].token == self.owner.token:
-            self._held.add(session_id)
-            return
+            return None
         if holder is not None:
-            raise SessionTaken(f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
-                               "one kiosk at a time records a test")
+            return (f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
+                    "one kiosk at a time records a test")
         row = self._db.execute("SELECT status, interrupted_reason FROM sessions WHERE id = ?",
                                (session_id,)).fetchone()
         if row is None:
-            raise SessionTaken(f"session {session_id} is not stored")
+            return f"session {session_id} is not stored"
         why = f" ({row[1]})" if row[0] == "interrupted" and row[1] else ""
-        raise SessionTaken(f"session {session_id} is no longer held by this kiosk: it is {row[0]}{why}")
+        return f"session {session_id} is no longer held by this kiosk: it is {row[0]}{why}"
 
     def _take(self, session_id: str) -> None:
         """Inside a write transaction: take the session's lease unless a live kiosk holds it."""
@@ -410,8 +430,7 @@ class Store:
 
     def holds(self, session_id: str) -> bool:
         """Whether this kiosk holds the session now."""
-        holder = self._holder(session_id)
-        return holder is not None and holder[0].token == self.owner.token
+        return self.why_not_held(session_id) is None
 
     def renew(self) -> None:
         """Renew this kiosk's leases (the running kiosk calls this every third of the lease time)."""

@@ -9,7 +9,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 
 from qos.errors import ContextError
-from qos.model import BOOLEAN, EVENTTYPE, NUMBER, ArrayType, Context, Model, ValueType
+from qos.model import BOOLEAN, EVENTTYPE, NUMBER, ArrayType, Context, Model, ValueType, Variable
 
 
 def _describe(value: object) -> str:
@@ -43,14 +43,7 @@ def check_batch(model: Model, set: Mapping[str, object] | None,
             raise ContextError(f"context {name} is derived: the engine computes it from its definition")
         if context.kind == EVENTTYPE:
             raise ContextError(f"context {name} is an eventtype: emit it, do not set it")
-        if isinstance(context.type, ArrayType):
-            size = context.type.size
-            if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence) or len(value) > size:
-                raise ContextError(f"context {name} is an array of at most {size} values, got {_describe(value)}")
-            values[name] = tuple(check_value(context, f"{name}[{index + 1}]", context.type.element, item)
-                                 for index, item in enumerate(value))
-        else:
-            values[name] = check_value(context, name, context.type, value)
+        values[name] = check_value(context, name, context.type, value)
     if emit is None:
         emit = []
     if isinstance(emit, (str, bytes)) or not isinstance(emit, Iterable):
@@ -67,27 +60,35 @@ def check_batch(model: Model, set: Mapping[str, object] | None,
     return values, emitted
 
 
-def check_value(context: Context, name: str, value_type: ValueType, value: object) -> object:
-    """One value for a context (or an element of an array context), as the engine keeps it."""
+def check_value(context: Context | Variable, name: str, value_type: ValueType, value: object) -> object:
+    """One value for a context or a parameter (``context`` gives its name and bounds), as the engine
+    keeps it: booleans, floats, enum literal names, tuples for arrays."""
+    what = "parameter" if isinstance(context, Variable) else "context"
+    if isinstance(value_type, ArrayType):
+        size = value_type.size
+        if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence) or len(value) > size:
+            raise ContextError(f"{what} {name} is an array of at most {size} values, got {_describe(value)}")
+        return tuple(check_value(context, f"{name}[{index + 1}]", value_type.element, item)
+                     for index, item in enumerate(value))
     if value_type == BOOLEAN:
         if not isinstance(value, bool):
-            raise ContextError(f"context {name} is boolean, got {_describe(value)}")
+            raise ContextError(f"{what} {name} is boolean, got {_describe(value)}")
         return value
     if value_type == NUMBER:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ContextError(f"context {name} is a number, got {_describe(value)}")
+            raise ContextError(f"{what} {name} is a number, got {_describe(value)}")
         problem = context.spec.out_of_bounds(value) if context.spec is not None else None
         if problem:
-            raise ContextError(f"context {name}: {problem}")
+            raise ContextError(f"{what} {name}: {problem}")
         return float(value)
     literal = value
     if isinstance(value, str) and "::" in value:
         type_name, _, literal = value.partition("::")
         if type_name not in (value_type.name, context.name):
-            raise ContextError(f"context {name} is of type {value_type.name}, got {value!r}")
+            raise ContextError(f"{what} {name} is of type {value_type.name}, got {value!r}")
     if not isinstance(literal, str):
-        raise ContextError(f"context {name} is an enum of {', '.join(value_type.literals)}; got {_describe(value)}")
+        raise ContextError(f"{what} {name} is an enum of {', '.join(value_type.literals)}; got {_describe(value)}")
     if literal not in value_type.literals:
-        raise ContextError(f"context {name} has no literal {literal!r} (expected one of "
+        raise ContextError(f"{what} {name} has no literal {literal!r} (expected one of "
                            f"{', '.join(value_type.literals)})")
     return literal

@@ -59,18 +59,23 @@ def observation_sort_key(name: str) -> tuple:
 
 Subscriber = Callable[[UpdateResult], object]
 
+#: timer batches one update or advance may run: a jump that needs more (a 1-second timer and a month of
+#: silence) is refused rather than left to run for minutes
+MAX_TIMED_BATCHES = 1_000_000
+
 
 class Engine:
     """Runs one model: feed it batches of context updates with ``update``, read ``metrics``.
 
     Each ``update`` call is one batch (see :mod:`qos.patterns` for what that means for patterns).
-    Times are seconds on any clock the caller likes, but must never go backwards. ``start`` is when
-    timers start (default: the first time the engine is given); ``origin`` is the calendar time of
-    engine time 0 in seconds since 1970 UTC, for ``schedule`` timers; ``params`` overrides parameters'
-    defaults.
+    Times are seconds since the session started and must never go backwards. ``start`` is when
+    timers start: 0 by default, as in a trace, so that replaying a session's recorded trace fires its
+    timers exactly when the live engine did; None starts them at the first time the engine is given
+    (for a caller on another clock). ``origin`` is the calendar time of engine time 0 in seconds since
+    1970 UTC, for ``schedule`` timers; ``params`` overrides parameters' defaults.
     """
 
-    def __init__(self, model: Model, start: float | None = None, origin: float = 0.0,
+    def __init__(self, model: Model, start: float | None = 0.0, origin: float = 0.0,
                  params: Mapping[str, object] | None = None):
         self.model = model
         beliefs = {**model.properties, **model.beliefvars}
@@ -82,7 +87,7 @@ class Engine:
             variable = model.variables.get(name)
             if variable is None or not variable.parameter:
                 raise ContextError(f"{name!r} is not a parameter of model {model.name}")
-            self._values[name] = check_value(variable, name, variable.type, value)  # type: ignore[arg-type]
+            self._values[name] = check_value(variable, name, variable.type, value)
         self._streams = build_streams(model, self._values)
         self._timers = {name: TimerClock(timer, origin) for name, timer in model.timers.items()}
         self._start = None if start is None else check_time(start)
@@ -155,12 +160,17 @@ class Engine:
         return t
 
     def _start_timers(self, t: float) -> None:
+        """Start the timers at the engine's start, and refuse a jump that would fire them too often."""
         if not self._started:
             start = self._start if self._start is not None else t
             for clock in self._timers.values():
                 if not clock.timer.paused:
                     clock.start(start)
             self._started = True
+        firings = sum(clock.firings_until(t) for clock in self._timers.values())
+        if firings > MAX_TIMED_BATCHES:
+            raise ContextError(f"time {t:g} s is too far ahead: the timers would fire about {firings:,.0f} times "
+                               f"before it (at most {MAX_TIMED_BATCHES:,}); advance the engine in smaller steps")
 
     def _timers_due(self, t: float) -> list[str]:
         fired = [name for name, clock in self._timers.items() if clock.due is not None and clock.due <= t]
@@ -186,9 +196,8 @@ class Engine:
         self._act(t, fired)
         metrics = self._metrics_at(t)
         outputs = {name: self._output(name, metrics[name]) for name in self._outputs}
-        beliefs = {name: self._beliefs[name].metric(t) for name in self.model.beliefvars}
         result = UpdateResult(t, metrics, sorted(fired, key=observation_sort_key), values, emitted, timers,
-                              outputs, beliefs)
+                              outputs, self.beliefs(t))
         for callback in list(self._subscribers):
             callback(result)
         return result
@@ -222,6 +231,13 @@ class Engine:
         if self._t is not None and t < self._t:
             raise ContextError(f"time {t:g} s is before the last update at {self._t:g} s")
         return self._metrics_at(t)
+
+    def beliefs(self, t: float | None = None) -> dict[str, float]:
+        """Every ``beliefvar``'s probability at time t (default: the last update), with decay applied."""
+        t = self._t if t is None and self._t is not None else (0.0 if t is None else check_time(t))
+        if self._t is not None and t < self._t:
+            raise ContextError(f"time {t:g} s is before the last update at {self._t:g} s")
+        return {name: self._beliefs[name].metric(t) for name in self.model.beliefvars}
 
     def _metrics_at(self, t: float) -> dict[str, float]:
         return {name: self._beliefs[name].metric(t) for name in self.model.properties}

@@ -1,7 +1,8 @@
 """The RoQME grammar (lark, LALR) and the one-line messages for syntax errors.
 
 It follows RoQME's own Xtext grammar (``RoQME.xtext`` of roqme/robmosys-roqme-itp), written anew:
-declarations in any order after an optional ``roqme NAME`` header and ``import``s; terms with RoQME's
+declarations and ``import``s in any order after an optional ``roqme NAME`` header (RoQME wants the
+imports first); terms with RoQME's
 precedence, loosest first: ``once``, postfix ``while(…)``/``repeat(n)``/``range(a, b)``, ``->``, ``or``,
 ``and``/``not``, ``? :``, ``|``, ``&``/``!``, comparisons, ``+ -``, ``* /``. Two tolerances keep older
 models working where RoQME would reject them: an operator may follow a postfix (``X while(c) or Y``
@@ -20,7 +21,7 @@ from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 GRAMMAR = r"""
-start: header? import_* decl*
+start: header? (import_ | decl)*
 header: MODEL ename
 import_: IMPORT (ename | MODEL_FILE)
 ?ename: NAME | STRING
@@ -106,7 +107,7 @@ evidence_option: NAME           -> strength
      | UPDATE "(" term ")"                   -> update
      | EVENTWHEN "(" term ")"                -> event_when
      | NAME "(" [term ("," term)*] ")"       -> call
-     | (NAME | BELIEF) "'" NAME [arguments]  -> postfix_call
+     | (NAME | BELIEF) "'" (NAME | UPDATE | EVENTWHEN) [arguments]  -> postfix_call
      | "(" term ")"
 arguments: "(" [term ("," term)*] ")"
 

@@ -66,6 +66,22 @@ def load_model_file(path: str | Path) -> Model:
     return parse_model(_read(path), path.name, path.parent)
 
 
+#: how deeply terms may nest (parentheses, chains of operators): checking and running a term recurse
+#: once per level, and no model a person writes comes near this
+MAX_NESTING = 200
+
+
+def _check_nesting(source: _Source, tree: Tree) -> None:
+    """Refuse a term nested deeper than MAX_NESTING, naming its declaration (checked without recursion)."""
+    stack = [(declaration, 1, declaration) for declaration in tree.children]
+    while stack:
+        node, depth, declaration = stack.pop()
+        if depth > MAX_NESTING:
+            raise source.at(declaration, f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
+                                         "deep: split it with derived contexts")
+        stack.extend((child, depth + 1, declaration) for child in node.children if isinstance(child, Tree))
+
+
 def _description(token: Token) -> str:
     lines = str(token)[3:-2].strip("\n").splitlines()
     lines = [re.sub(r"^\s*\*?\s*", "", line).rstrip() for line in lines]
@@ -92,9 +108,11 @@ class _Checker(TermChecker):
 
     def _tree(self, source: _Source) -> tuple[Tree, list[Token]]:
         try:
-            return parse_text(source.text)
+            tree, descriptions = parse_text(source.text)
         except SyntaxProblem as problem:
             raise source.error(problem.line, problem.column, problem.message) from None
+        _check_nesting(source, tree)
+        return tree, descriptions
 
     def model(self, source: _Source) -> Model:
         if source.folder is not None and source.filename != "<string>":
@@ -260,16 +278,20 @@ class _Checker(TermChecker):
         _, name, type_node, _define, definition = tree.children
         self._declare(name, "variable")
         spec = self._type_spec(str(name), type_node, "variable")
-        value = self.expr(definition, f"the definition of {name}")
-        if value.type != spec.type:
-            raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
-                                         f"{type_name(spec.type)}")
-        if isinstance(value, Literal):
-            variable = Variable(str(name), spec.type, spec, self._value_of(definition, spec, str(name), "the value"),
-                                None, False, self.description)
-        else:
-            variable = Variable(str(name), spec.type, spec, None, value, False, self.description)
-            self.streams.append((str(name), variable))
+        self.defining = (str(name), spec.type)  # its own enum literals: var W : enum {C, D} := W::D
+        try:
+            value = self.expr(definition, f"the definition of {name}")
+            if value.type != spec.type:
+                raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
+                                             f"{type_name(spec.type)}")
+            if isinstance(value, Literal):
+                variable = Variable(str(name), spec.type, spec, self._value_of(definition, spec, str(name), "the value"),
+                                    None, False, self.description)
+            else:
+                variable = Variable(str(name), spec.type, spec, None, value, False, self.description)
+                self.streams.append((str(name), variable))
+        finally:
+            self.defining = None
         self.variables[str(name)] = variable
 
     def param_decl(self, tree: Tree) -> None:
@@ -278,7 +300,11 @@ class _Checker(TermChecker):
         spec = self._type_spec(str(name), type_node, "parameter")
         if spec.type == EVENTTYPE:
             raise self.error(type_node, f"parameter {name} holds a value; an eventtype has none")
-        initial = None if default is None else self._value_of(default, spec, str(name), "the default")
+        self.defining = (str(name), spec.type)  # its own enum literals: default L::A
+        try:
+            initial = None if default is None else self._value_of(default, spec, str(name), "the default")
+        finally:
+            self.defining = None
         self.variables[str(name)] = Variable(str(name), spec.type, spec, initial, None, True, self.description)
 
     def timer_decl(self, tree: Tree) -> None:
@@ -377,6 +403,10 @@ class _Checker(TermChecker):
 
     def _belief_target(self, name: Token, verb: Token, target: Token) -> str:
         if str(target) not in self.beliefs:
+            what = self.declared.get(str(target))
+            if what:
+                raise self.error(target, f"observation {name} {verb} {target}, a {what}: only a property or a "
+                                         "beliefvar holds evidence")
             raise self.error(target, f"observation {name} {verb} unknown property {target}")
         return str(target)
 

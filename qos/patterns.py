@@ -27,10 +27,14 @@ a bare context ``X``
     ``eventWhen(X)`` for a boolean context, ``update(X)`` for any other type (eventtype: X is emitted).
 a bare boolean expression ``e`` (``TestState = TestState::PAUSED``, ``!PersonDetected``)
     ``eventWhen(e)``.
+an enum literal ``X::LIT``
+    every update of the context X to LIT (RoQME's enum filter), even when X already was LIT.
 
 Pattern operators. Every observation's pattern re-arms after it fires (it is implicitly "every"):
 all partial progress (``and``, ``->``, ``repeat``) is cleared and matching starts again from the
-next batch. Precedence, loosest first: ``->``, ``or``, ``and``, ``once``, postfix ``while``/``repeat``.
+next batch. Precedence is RoQME's (see :mod:`qos.grammar`), loosest first: ``once``, postfix
+``while``/``repeat``/``range`` (applied to everything before them: ``a -> b while(c)`` is
+``(a -> b) while(c)``), ``->``, ``or``, ``and``.
 
 ``a or b``
     occurs in a batch in which ``a`` or ``b`` occurs (both keep being evaluated).

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from lark import Token, Tree
 
+from qos.expressions import variables_of
 from qos.grammar import TIME_UNITS
 from qos.model import (
     BOOLEAN, EVENTTYPE, NUMBER, Aggregate, AllOf, AndNot, AnyOf, ArrayType, Binary, Call, Changed, Conditional,
@@ -73,6 +74,12 @@ class TermChecker:
 
     def pattern(self, node) -> Pattern:
         """A pattern; a value standing as a pattern becomes an occurrence."""
+        if isinstance(node, Tree) and node.data == "postfix_call" and node.children[1].type in ("UPDATE", "EVENTWHEN"):
+            subject, keyword, arguments = node.children  # X'update is update(X), X'eventWhen is eventWhen(X)
+            if arguments is not None and any(child is not None for child in arguments.children):
+                raise self.error(node, f"{subject}'{keyword} takes no arguments")
+            kind = "update" if keyword.type == "UPDATE" else "event_when"
+            node = Tree(kind, [keyword, Tree("var", [subject], node.meta)], node.meta)
         if not is_pattern(node):
             return self._occurrence(node)
         kind = node.data
@@ -121,6 +128,13 @@ class TermChecker:
         expr = self.expr(argument, role=f"the argument of {keyword}")
         if when_true and expr.type != BOOLEAN:
             raise self.error(argument, f"eventWhen needs a boolean expression, not {type_name(expr.type)}")
+        return self._changed(argument, expr, when_true)
+
+    def _changed(self, node, expr: Expr, when_true: bool) -> Changed:
+        """A change of a value, which only an update of a context (or of a stream) can bring."""
+        if not any(name in self.contexts or name.startswith("#") for name in variables_of(expr)):
+            raise self.error(node, "this value reads no context, so it never changes by an update: use it as a "
+                                   "condition (X while(…)) or read a context")
         return Changed(expr, when_true=when_true)
 
     def _count(self, token: Token, message: str) -> int:
@@ -142,7 +156,7 @@ class TermChecker:
         if expr.type != BOOLEAN:
             raise self.error(node, f"a {type_name(expr.type)} value cannot stand as a pattern: use update(…) or "
                                    "compare it")
-        return Changed(expr, when_true=True)
+        return self._changed(node, expr, True)
 
     def _enum_occurrence(self, node: Tree) -> Pattern:
         """``ctx::LIT`` as a pattern: every update of ctx to LIT (RoQME's enum filter)."""
@@ -221,6 +235,8 @@ class TermChecker:
             return Var(text, NUMBER)
         if text in self.timers:
             raise self.error(name, f"{text} is a timer and has no value: use it as a pattern")
+        if self.declared.get(text) in ("context", "variable"):
+            raise self.error(name, f"{text} is used in its own definition")
         what = self.declared.get(text)
         detail = f" ({text} is a {what})" if what else ""
         raise self.error(name, f"unknown context {text}{detail}")
@@ -237,6 +253,8 @@ class TermChecker:
             enum = self.variables[qualifier].type
         elif self.defining is not None and self.defining[0] == qualifier:
             enum = self.defining[1]
+        if isinstance(enum, ArrayType):  # an array of enum literals: its elements' type
+            enum = enum.element
         if not isinstance(enum, EnumType):
             raise self.error(type_token, f"{type_token} is not an enum type")
         if str(literal) not in enum.literals:
@@ -298,6 +316,9 @@ class TermChecker:
             function, *rest = node.children
             args = [child for child in rest if child is not None]
         name = str(function)
+        if name in ("update", "eventWhen"):
+            raise self.error(node, f"the pattern operator '{name}' cannot be used in a value; only values and & | ! "
+                                   "comparisons and arithmetic can")
         if name in AGGREGATES:
             return self._aggregate(node, name, args)
         if name == "period":

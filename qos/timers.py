@@ -85,7 +85,15 @@ def parse_schedule(text: str) -> Schedule:
 
 
 def next_match(schedule: Schedule, after: float, origin: float) -> float | None:
-    """Engine time of the first instant strictly after ``after`` the schedule matches (None: never)."""
+    """Engine time of the first instant strictly after ``after`` the schedule matches (None: never, or
+    beyond the calendar's year 9999)."""
+    try:
+        return _next_match(schedule, after, origin)
+    except (OverflowError, ValueError, OSError):
+        return None
+
+
+def _next_match(schedule: Schedule, after: float, origin: float) -> float | None:
     moment = datetime.fromtimestamp(origin + after, timezone.utc).replace(microsecond=0) + timedelta(seconds=1)
     day = moment.replace(hour=0, minute=0, second=0)
     for _ in range(_HORIZON_DAYS):
@@ -136,6 +144,15 @@ class TimerClock:
             self.due, self.remaining = t + self.remaining, None
         else:
             self.start(t)
+
+    def firings_until(self, t: float) -> float:
+        """How many times the timer would fire up to t at most (to refuse a jump that would take ages)."""
+        if self.due is None or self.due > t:
+            return 0
+        if self.timer.onetime:
+            return 1
+        spacing = self.timer.interval or (1.0 if len(self.timer.schedule.seconds) > 1 else 60.0)
+        return (t - self.due) / spacing + 1
 
     def fired(self) -> None:
         """The timer fired at its due time: plan the next firing."""

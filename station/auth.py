@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import sqlalchemy as sa
 from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
-from sqlalchemy.engine import Engine
+from sqlalchemy.engine import Connection, Engine
 
 from station import db
 from station.db import kiosks, login_failures, settings, users
@@ -148,6 +148,17 @@ def kiosk_for(engine: Engine, token: str) -> str | None:
     with engine.connect() as connection:
         return connection.execute(sa.select(kiosks.c.name).where(
             kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None))).scalar()
+
+
+def touch_kiosk(connection: Connection, token: str, status: str | None = None) -> str | None:
+    """Authenticate a kiosk's request and note it was seen (and its new status), in one
+    statement: the kiosk's name, or None for an unknown or revoked token."""
+    values: dict[str, object] = {"last_seen": db.now()}
+    if status is not None:
+        values["status"] = status
+    return connection.execute(kiosks.update().where(
+        kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None)).values(**values).returning(
+        kiosks.c.name)).scalar()
 
 
 def secret_key(engine: Engine) -> str:

@@ -9,7 +9,6 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
-from kiosk.config import DEFAULT_PIN
 from kiosk.screens.base import ClinicianScreen
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
@@ -27,9 +26,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         session = app.session  # type: ignore[attr-defined]
         with Vertical(classes="clinician"):
             yield Static("Clinician", classes="heading")
-            if app.clinician_pin == DEFAULT_PIN:  # type: ignore[attr-defined]
-                yield Static("The clinician PIN is still the public default: set clinician_pin in the "
-                            "configuration.", id="pin-warning")
+            if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
+                yield Static(warning, id="pin-warning")
             yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
                 yield Button("Continue the session", id="continue", variant="primary",
@@ -46,6 +44,8 @@ class ClinicianHomeScreen(ClinicianScreen):
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost", disabled=not (running and present))
                 yield Button("Patient back", id="person-back", disabled=not (running and not present))
+                # the only way out of the locked-down kiosk, on the shorter row so it always shows
+                yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             yield Static(self._channels_text(), id="channel-reasons")
             # continuing a test is the staff's decision: only with the same patient at the kiosk
             yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")
@@ -87,7 +87,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         return line
 
     def _channels_text(self) -> str:
-        lines = self.app.board.lines("en")  # type: ignore[attr-defined]
+        lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
         return "Channels: " + "; ".join(
             f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
             for line in lines)
@@ -124,6 +124,10 @@ class ClinicianHomeScreen(ClinicianScreen):
     @on(Button.Pressed, "#back")
     def _back(self) -> None:
         self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#quit-kiosk")
+    def _quit(self) -> None:
+        self.app.quit_kiosk()  # type: ignore[attr-defined]
 
     @on(Switch.Changed, "#adaptation")
     def _adaptation(self, event: Switch.Changed) -> None:

@@ -46,7 +46,7 @@ def _trace(path: Path) -> None:
 #: loader name -> (a real file of its kind, the file name it is written under, the loader)
 LOADERS: dict[str, tuple[bytes, str, Callable[[Path], object]]] = {
     "questionnaire": (bundled_path().read_bytes(), "q.yaml", _questionnaire),
-    "config": (b'language: es\nclinician_pin: "4821"\ntiming: {attempt_window_s: 30}\nadaptation: true\n',
+    "config": (b'language: es\nclinician_pin: "482193"\ntiming: {attempt_window_s: 30}\nadaptation: true\n',
                "config.yaml", lambda p: load_config(p, environ={})),
     "policy": ((ROOT / "kiosk/adaptation.yaml").read_bytes(), "policy.yaml", load_policy),
     "profiles": ((ROOT / "kiosk/remote/devices.yaml").read_bytes(), "site.yaml", load_profiles),

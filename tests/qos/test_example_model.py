@@ -32,6 +32,15 @@ def test_the_slow_patient_shows_slow_answers_silence_and_a_fresh_start(capsys):
     assert fired[10] == ["O2", "O8"] and "O6" in fired[245]
 
 
+def test_the_replay_reports_belief_variables_apart_from_the_published_properties(capsys):
+    result = replay(SLOW_PATIENT)
+    assert list(result["metrics"]) == ["Performance", "Interaction", "VoiceInteractionQuality"]
+    fatigue = result["beliefs"]["Fatigue"]
+    assert fatigue["min"] == 0.2 and fatigue["max"] > 0.5 and fatigue["last"] == 0.2  # cleared by the restart
+    assert qos_cli.main(["replay", str(SLOW_PATIENT)]) == 0
+    assert "belief variables (not published):\nFatigue" in capsys.readouterr().out
+
+
 def test_the_example_replays_identically_from_python_and_from_the_shell():
     done = subprocess.run([sys.executable, "-m", "qos", "replay", str(SLOW_PATIENT), "--json"],
                           capture_output=True, text=True, cwd=ROOT)
@@ -42,7 +51,7 @@ def test_the_example_replays_identically_from_python_and_from_the_shell():
 
 def test_silence_and_slow_answers_lower_the_metrics_they_should():
     model = load_model("kiosk_pace")
-    engine = Engine(model, start=0.0)
+    engine = Engine(model)
     engine.update(0, set={"PersonDetected": True})
     engine.update(5, emit=["QuestionAsked"])
     before = engine.metrics(5)["Interaction"]
@@ -62,3 +71,8 @@ def test_the_models_descriptions_are_there_for_engineers():
     assert "longer than SlowAnswer" in model.contexts["SlowStreak"].description
     assert model.variables["SlowAnswer"].initial == 15
     assert load_trace(SLOW_PATIENT).model == "kiosk_pace"
+
+
+def test_timers_fire_at_their_own_times_whatever_the_sample_period():
+    fired = [replay(SLOW_PATIENT, sample_period=period)["fired"] for period in (1, 7, 0.5, 100)]
+    assert fired[0] == fired[1] == fired[2] == fired[3]

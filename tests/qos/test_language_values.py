@@ -176,3 +176,15 @@ def test_a_belief_is_read_as_a_number_and_belief_is_a_propertys_own_in_its_outpu
     assert result.outputs["Shown"] == pytest.approx(100 * result.metrics["Shown"])
     with pytest.raises(ModelError, match="'belief' is the property's own belief"):
         parse_model(HEAD + "observation O : eventWhen(belief > 1) reinforces P\n", "m.roqme")
+
+
+def test_array_and_enum_parameters_and_variables():
+    body = ("param Pair : number[2] lower 0 default [1, 2]\nparam Mode : enum {CALM, BRISK} default Mode::CALM\n"
+            "var Level : enum {LOW, HIGH} := Level::LOW\n"
+            "observation O : update(N) while(Pair'includes(N) & Mode = Mode::BRISK) { sets Level := Level::HIGH }\n")
+    engine = engine_for(body, params={"Pair": [3], "Mode": "BRISK"})
+    assert engine.variables == {"Pair": (3.0,), "Mode": "BRISK", "Level": "LOW"}
+    engine.update(0, set={"N": 3})
+    assert engine.variables["Level"] == "HIGH"
+    with pytest.raises(ContextError, match=r"parameter Pair\[1\]: -3 is below the lower bound 0"):
+        engine_for(body, params={"Pair": [-3]})

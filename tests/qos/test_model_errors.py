@@ -74,6 +74,19 @@ CASES = [
      "m.roqme:8:13: O is already declared as an observation"),
     (HEAD + "observation O : B reinforces P /* unterminated", "m.roqme:7:32: unterminated comment: '/*' without '*/'"),
     (HEAD + "observation P : B reinforces P", "m.roqme:7:13: P is already declared as a property"),
+    (HEAD + "context C : number := C + 1", "m.roqme:7:23: C is used in its own definition"),
+    (HEAD + "observation O : B clears N", "m.roqme:7:26: observation O clears N, a context: only a property or a "
+     "beliefvar holds evidence"),
+    (HEAD + "beliefvar F\nobservation O : update(F < 0.5) reinforces P",
+     "m.roqme:8:24: this value reads no context, so it never changes by an update: use it as a condition "
+     "(X while(…)) or read a context"),
+    (HEAD + "observation O : B { undermines P; sets v := 1 }",
+     "m.roqme:7:40: observation O sets v, which is undeclared: only a var can be set"),
+    (HEAD + 'timer T := schedule("0, 9, *, *")',
+     'm.roqme:7:21: bad schedule: expected 5 or 6 comma-separated fields (minutes, hours, days, months, '
+     'weekdays[, seconds]), found 4'),
+    (HEAD + "observation O : N'avg(3, B, B) > 1 reinforces P",
+     "m.roqme:7:17: avg takes a context, then optionally a window (a count or a time) and a condition"),
 ]
 
 
@@ -106,3 +119,11 @@ def test_comments_units_and_reference_bounds_are_read():
     assert [model.properties[name].survival for name in "ABCD"] == [30.0, 7200.0, 0.5, None]
     assert model.properties["A"].prior == 0.99 and model.properties["B"].prior == 0.01
     assert model.properties["D"].reference == 0.5
+
+
+def test_a_term_nested_without_end_is_one_line_not_a_crash():
+    text = HEAD + "observation O : eventWhen(" + "N + " * 5000 + "1 > 2) reinforces P"
+    with pytest.raises(ModelError, match=r"^m\.roqme:7:1: O nests operators more than 200 levels deep"):
+        parse_model(text, "m.roqme")
+    # parentheses alone add no level
+    parse_model(HEAD + "observation O : " + "(" * 5000 + "B" + ")" * 5000 + " reinforces P", "m.roqme")

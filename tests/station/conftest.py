@@ -4,14 +4,10 @@ one headless Chromium for the page tests."""
 
 from __future__ import annotations
 
-import glob
 import os
-import shutil
 import signal
-import socket
 import subprocess
 import sys
-import tempfile
 import time
 import uuid
 from collections.abc import Iterator
@@ -21,6 +17,7 @@ from pathlib import Path
 import httpx
 import pytest
 
+from bench._postgres import create_database, free_port, pg_bin, start_postgres
 from station import auth, db
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -29,65 +26,25 @@ PATIENCE_S = 60.0
 PASSWORDS = {"nurse": "nurse-password-1", "doctor": "doctor-password-1"}
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _pg_bin() -> Path | None:
-    found = sorted(glob.glob("/usr/lib/postgresql/*/bin/initdb"))
-    return Path(found[-1]).parent if found else None
-
-
-def _as_postgres(argv: list[str]) -> list[str]:
-    """initdb refuses to run as root: as root, run the server as the Debian 'postgres' user."""
-    if os.geteuid() != 0:
-        return argv
-    return ["runuser", "-u", "postgres", "--", *argv]
-
-
 @pytest.fixture(scope="session")
 def postgres() -> Iterator[str]:
     """A PostgreSQL server for this test session; yields its URL (superuser, trust on 127.0.0.1)."""
-    bin_dir = _pg_bin()
+    bin_dir = pg_bin()
     if bin_dir is None:
         if os.environ.get("CI"):
             pytest.fail("PostgreSQL is not installed (.ci/run installs the Debian package 'postgresql')")
         pytest.skip("PostgreSQL is not installed (apt-get install postgresql)")
-    # not under pytest's tmp_path: that is private to root, and the server runs as 'postgres'
-    base = Path(tempfile.mkdtemp(prefix="station-pg-"))
-    data, sockets = base / "data", base / "sock"
-    data.mkdir(mode=0o700)
-    sockets.mkdir()
-    if os.geteuid() == 0:
-        shutil.chown(base, "postgres")
-        shutil.chown(data, "postgres")
-        shutil.chown(sockets, "postgres")
-        base.chmod(0o755)
-    port = free_port()
-    subprocess.run(_as_postgres([str(bin_dir / "initdb"), "-D", str(data), "-U", "postgres", "--auth=trust",
-                                 "--no-sync", "-E", "UTF8"]), check=True, capture_output=True, cwd=base)
-    subprocess.run(_as_postgres([str(bin_dir / "pg_ctl"), "-D", str(data), "-l", str(base / "log"), "-w", "-t", "60",
-                                 "-o", f"-p {port} -k {sockets} -c listen_addresses=127.0.0.1 -c fsync=off "
-                                       "-c max_connections=300", "start"]), check=True, capture_output=True, cwd=base)
+    url, stop = start_postgres(bin_dir)
     try:
-        yield f"postgresql://postgres@127.0.0.1:{port}/postgres"
+        yield url
     finally:
-        subprocess.run(_as_postgres([str(bin_dir / "pg_ctl"), "-D", str(data), "-m", "immediate", "stop"]),
-                       capture_output=True, cwd=base)
-        shutil.rmtree(base, ignore_errors=True)
+        stop()
 
 
 @pytest.fixture
 def pg_url(postgres: str) -> str:
     """A fresh, empty database on the shared server for one test."""
-    name = "t_" + uuid.uuid4().hex[:12]
-    import psycopg
-
-    with psycopg.connect(postgres.replace("postgresql://", "postgresql://", 1), autocommit=True) as connection:
-        connection.execute(f"CREATE DATABASE {name}")
-    return postgres.rsplit("/", 1)[0] + "/" + name
+    return create_database(postgres, "t_" + uuid.uuid4().hex[:12])
 
 
 @pytest.fixture
@@ -195,9 +152,13 @@ def new_kiosk(db_url: str) -> tuple[str, str]:
         engine.dispose()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def browser() -> Iterator:
-    """One headless Chromium (Debian's) for every page test."""
+    """One headless Chromium (Debian's) for every page test of this package.
+
+    Package scope, not session: Playwright's sync API keeps an event loop running in the main
+    thread while it is open, and every async (Textual Pilot) test after the station's would fail
+    with "Runner.run() cannot be called from a running event loop"."""
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:

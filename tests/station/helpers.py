@@ -3,18 +3,13 @@
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
 import httpx
 
+from bench._station_client import PATIENTS, KioskClient, Row, record_patient
 from tests.station.conftest import PASSWORDS
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from bench._station_client import KioskClient, Row, record_patient  # noqa: E402
-
 __all__ = ["KioskClient", "Row", "record_patient", "Staff", "PATIENTS"]
-PATIENTS = Path(__file__).resolve().parents[2] / "recordings" / "patients"
 _CSRF = re.compile(r'name="csrf" content="([^"]+)"')
 
 

@@ -27,7 +27,8 @@ def engine(request, tmp_path):
 
 def _ingest(engine, script: str, kiosk: str = "bed1"):
     rows = record_patient(PATIENTS / script)
-    stored, _ = sync.intake(engine, kiosk, sync.parse({"events": [r.event() for r in rows]}))
+    with engine.begin() as connection:
+        stored, _ = sync.intake(connection, kiosk, sync.parse({"events": [r.event() for r in rows]}))
     assert stored == [r.seq for r in rows]
     return rows
 
@@ -88,7 +89,8 @@ def test_an_unanswered_item_is_filled_and_a_running_session_cannot_be_validated(
         assert validation.review(engine, session_id).corrections[0].previous_option is None
     running = record_patient(PATIENTS / "barthel1.yaml", first_seq=1000)
     cut = [r for r in running if r.kind != "finish_session"]
-    sync.intake(engine, "bed1", sync.parse({"events": [r.event() for r in cut]}))
+    with engine.begin() as connection:
+        sync.intake(connection, "bed1", sync.parse({"events": [r.event() for r in cut]}))
     with pytest.raises(validation.ValidationError, match="running"):
         validation.sign_off(engine, running[0].session_id, doctor)
 
