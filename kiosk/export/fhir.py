@@ -15,12 +15,13 @@ Choices, each from the R4 specification:
 - **Status** says what happened: ``completed`` only when every item has an answer;
   ``in-progress`` for a session still running or finished with items unanswered (a clinician is
   expected to complete it), ``stopped`` for one abandoned or signed off incomplete; ``amended``
-  when a clinician signed off with corrections. The ``total`` item (LOINC 96761-2) has an answer
+  once a clinician's corrections changed the kiosk's answers (signed off or still in review: the
+  signature and the Observation's status tell which). The ``total`` item (LOINC 96761-2) has an answer
   only when the result is complete, and its calculatedExpression gives none otherwise.
 - **Review**: a sign-off is the R4 ``questionnaireresponse-signature`` extension (a Verification
-  Signature: who and when). ``author`` is the kiosk (a Device) that recorded the answers, or the
-  signing clinician once corrected answers are theirs (``amended``); ``authored`` is when the
-  answers last changed (the latest correction, else the end of the session).
+  Signature: who and when). ``author`` ("who recorded the answers") is the kiosk (a Device), or
+  the clinician who last changed an answer; ``authored`` is when the answers last changed (the
+  latest correction, else the end of the session).
 - **Identity**: ``identifier`` ``SITE/KIOSK/SESSION`` in the site's system (stable, so re-exports
   never duplicate); the patient's pseudonym in the site's patient system (a logical reference:
   no Patient resource is made); the kiosk as a Device identified by its kiosk id.
@@ -164,7 +165,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
 def response_status(r: Result) -> str:
     """The QuestionnaireResponse status of a result (see the module docstring)."""
     if r.complete:
-        return "amended" if r.amended else "completed"
+        return "amended" if r.amended or r.changers else "completed"
     return "stopped" if r.stored.status == "abandoned" or r.final else "in-progress"
 
 
@@ -216,8 +217,7 @@ def _response(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
         "questionnaire": f"{questionnaire_canonical(q, site, language)}|{questionnaire_version(q)}",
         "status": response_status(r), "subject": _patient(site, stored), "authored": _authored(r),
-        "author": _clinician(r.review.signed_by) if r.amended and r.review.signed_by
-        else device_reference(site),
+        "author": _clinician(r.changers[-1]) if r.changers else device_reference(site),
         "source": _patient(site, stored) if stored.answered_by.value == "patient"
         else {"type": "RelatedPerson", "display": stored.answered_by.value},
         "item": items,

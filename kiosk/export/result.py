@@ -108,11 +108,15 @@ class Result:
         return self.review.final
 
     @property
+    def changers(self) -> tuple[str, ...]:
+        """Who changed an answer the kiosk recorded (or filled one it had not), oldest first."""
+        return tuple(dict.fromkeys(c.author for c in self.review.corrections if self.recorded(c.item_id) != c.option))
+
+    @property
     def amended(self) -> bool:
         """Signed off with answers other than the kiosk recorded (state ``amended``, or a sign-off
         that still carries corrections: a changed answer is never reported as the kiosk's)."""
-        changed = any(self.recorded(c.item_id) != c.option for c in self.review.corrections)
-        return self.final and (self.review.state == ReviewState.AMENDED or changed)
+        return self.final and (self.review.state == ReviewState.AMENDED or bool(self.changers))
 
     @property
     def review_state(self) -> str:

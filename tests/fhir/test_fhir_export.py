@@ -276,3 +276,15 @@ def test_a_session_of_another_questionnaire_is_never_exported_as_this_one(replay
     other = replace(replayed["TB-0001"], questionnaire_id="katz")
     with pytest.raises(ExportError, match="was answered on questionnaire 'katz', not on 'barthel'"):
         transaction_bundle(QUESTIONNAIRE, [replayed["TB-0002"], other], site=SITE)
+
+
+def test_corrections_still_in_review_are_the_nurses_answers_not_the_kiosks(replayed):
+    stored = replayed["TB-0001"]
+    nurse = Correction("stairs", 2, 3, "saw the patient on the stairs", "nurse.kim", "2026-11-23T14:00:00Z")
+    review = Review(ReviewState.UNREVIEWED, (nurse,))
+    response = fhir_response(QUESTIONNAIRE, stored, review, SITE)
+    check_fhir(response)
+    assert response["status"] == "amended" and "extension" not in response  # changed, not signed off
+    assert response["author"] == {"type": "Practitioner", "display": "nurse.kim"}
+    assert response["authored"] == "2026-11-23T14:00:00+00:00"
+    assert fhir_total(QUESTIONNAIRE, stored, review, SITE)["status"] == "preliminary"
