@@ -26,7 +26,8 @@ from kiosk.review import Correction, Review, ReviewState
 from kiosk.storage import Store
 from tests.session.helpers import QUESTIONNAIRE, TIMING, make_rig
 
-from .conftest import ROOT, check_fhir, parse_r4, schema_errors
+from .conftest import ROOT
+from .standard import check_fhir, parse_r4, schema_errors
 
 SITE = ExportSite(site="hosp-north", kiosk_id="ward3-bed2",
                   patient_system="https://hosp-north.example/sid/kiosk-patient",

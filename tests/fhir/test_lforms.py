@@ -17,7 +17,7 @@ from kiosk.export import fhir_questionnaire, fhir_response
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
 
-from .conftest import JS
+from .standard import JS
 
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

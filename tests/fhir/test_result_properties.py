@@ -11,7 +11,7 @@ from kiosk.export import ExportSite, fhir_response, fhir_total
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
 
-from .conftest import check_fhir
+from .standard import check_fhir
 
 SITE = ExportSite(site="hosp-north", kiosk_id="ward3-bed2")
 PATIENTS = ["TB-0001", "TB-0004", "TB-0005", "TB-0006", "P-ES-0001", "P-FR-0003"]

@@ -10,7 +10,7 @@ from kiosk.export import questionnaire_version
 from kiosk.results import main as results_main
 from tests.session.helpers import QUESTIONNAIRE
 
-from .conftest import check_fhir
+from .standard import check_fhir
 
 
 def _configure(tmp_path, monkeypatch) -> None:

@@ -9,7 +9,7 @@ import pytest
 from tests.station.conftest import new_kiosk, shared_station  # noqa: F401,F811 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 
-from .conftest import check_fhir
+from .standard import check_fhir
 
 pytestmark = pytest.mark.slow
 

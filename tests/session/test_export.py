@@ -17,6 +17,8 @@ from kiosk.results import main as results_main
 from kiosk.channels import Channel
 from kiosk.storage import Store
 
+from tests.fhir.standard import check_fhir
+
 from .helpers import QUESTIONNAIRE, TIMING, make_rig
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,16 +47,18 @@ def test_the_fhir_questionnaire_puts_each_items_points_on_its_options():
                for o in items[i.id]["answerOption"])
     assert items["feeding"]["code"][0]["code"] == "83184-2"
     assert items["total"]["readOnly"] and "calculatedExpression" in items["total"]["extension"][0]["url"]
-    json.dumps(resource)  # serialisable as is
+    check_fhir(resource)  # valid R4 for the official schema and fhir.resources
 
 
 def test_the_fhir_response_recomputes_the_total(export_store):
     complete = fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0001"))
+    check_fhir(complete)
     assert complete["status"] == "completed"
     assert complete["subject"]["identifier"]["value"] == "TB-0001"
     total = [i for i in complete["item"] if i["linkId"] == "total"][0]["answer"][0]["valueInteger"]
     assert total == 100
     partial = fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0004"))
+    check_fhir(partial)
     answered = [i for i in partial["item"] if "answer" in i and i["linkId"] != "total"]
     assert len(answered) == 8
     assert "answer" not in [i for i in partial["item"] if i["linkId"] == "total"][0]  # no partial total
@@ -95,6 +99,7 @@ def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path
     shown = capsys.readouterr().out
     assert "total 65/100 (incomplete, missing grooming, bladder)" in shown
     bundle = json.loads(fhir.read_text())
+    check_fhir(bundle)
     assert [e["resource"]["resourceType"] for e in bundle["entry"]] == ["Questionnaire", "Device", "QuestionnaireResponse"]
     assert fhir.stat().st_mode & 0o777 == 0o600 and table.stat().st_mode & 0o777 == 0o600
 
@@ -158,6 +163,7 @@ def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_
 
     with Store.open(tmp_path / "data") as reopened:
         response = fhir_response(QUESTIONNAIRE, reopened.session(session_id))
+    check_fhir(response)
     assert {i["linkId"] for i in response["item"]} == {i.id for i in QUESTIONNAIRE.items} | {"total"}
 
 
