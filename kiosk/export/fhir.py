@@ -91,11 +91,13 @@ def questionnaire_canonical(q: Questionnaire, site: ExportSite, language: str) -
     return f"{site.questionnaire_url or f'urn:barthel-kiosk:{site.site}:questionnaire:{q.id}'}-{language}"
 
 
-def _translated(texts: Mapping[str, str], language: str) -> dict[str, Any]:
-    """The ``_element`` carrying the other languages of a text (FHIR translation extension)."""
-    return {"extension": [
-        {"url": TRANSLATION, "extension": [{"url": "lang", "valueCode": lang}, {"url": "content", "valueString": text}]}
-        for lang, text in texts.items() if lang != language]}
+def _text(key: str, texts: Mapping[str, str], language: str) -> dict[str, Any]:
+    """``{key: text in language, _key: the other languages}`` (FHIR translation extension; no
+    ``_key`` for a text in one language only, as FHIR JSON has no empty arrays)."""
+    others = [{"url": TRANSLATION, "extension": [{"url": "lang", "valueCode": lang},
+                                                 {"url": "content", "valueString": text}]}
+              for lang, text in texts.items() if lang != language]
+    return {key: texts[language]} | ({f"_{key}": {"extension": others}} if others else {})
 
 
 def _coding(code: Code, display: str | None = None) -> dict[str, str]:
@@ -128,23 +130,23 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
     site = site or ExportSite()
     items = []
     for item in q.items:
-        entry: dict[str, Any] = {"linkId": item.id, "text": item.text[language],
-                                 "_text": _translated(item.text, language), "type": "choice", "required": True}
+        entry: dict[str, Any] = {"linkId": item.id, **_text("text", item.text, language), "type": "choice",
+                                 "required": True}
         if item.code:
             entry["code"] = [_coding(item.code)]
         entry["answerOption"] = [
             {"extension": [{"url": ITEM_WEIGHT, "valueDecimal": option.points},
                            {"url": ORDINAL_VALUE, "valueDecimal": option.points}],
              "valueCoding": _option_coding(q, item.id, option.number, language)
-             | {"_display": _translated(option.label, language)}}
+             | _text("display", option.label, language)}
             for option in item.options
         ]
         items.append(entry)
     total: dict[str, Any] = {
         "extension": [{"url": CALCULATED, "valueExpression": {"language": "text/fhirpath",
                                                                "expression": _total_expression(q)}}],
-        "linkId": TOTAL_LINK, "text": TOTAL_TEXT.get(language, TOTAL_TEXT["en"]),
-        "_text": _translated({lang: TOTAL_TEXT[lang] for lang in q.languages if lang in TOTAL_TEXT}, language),
+        "linkId": TOTAL_LINK,
+        **_text("text", {lang: TOTAL_TEXT.get(lang, TOTAL_TEXT["en"]) for lang in q.languages}, language),
         "type": "integer", "readOnly": True,
     }
     if q.total_code:
@@ -154,7 +156,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
         "resourceType": "Questionnaire", "id": f"{q.id}-{language}", "language": language,
         "url": questionnaire_canonical(q, site, language), "version": questionnaire_version(q),
         "name": _computable_name(q.title["en"]) + language.upper(),
-        "title": q.title[language], "_title": _translated(q.title, language),
+        **_text("title", q.title, language),
         "status": "active", "subjectType": ["Patient"], "item": items,
     }
     if q.code:

@@ -289,3 +289,13 @@ def test_corrections_still_in_review_are_the_nurses_answers_not_the_kiosks(repla
     assert response["author"] == {"type": "Practitioner", "display": "nurse.kim"}
     assert response["authored"] == "2026-11-23T14:00:00+00:00"
     assert fhir_total(QUESTIONNAIRE, stored, review, SITE)["status"] == "preliminary"
+
+
+def test_a_questionnaire_in_one_language_has_no_empty_translations():
+    english = replace(QUESTIONNAIRE, languages=("en",), title={"en": QUESTIONNAIRE.title["en"]}, items=tuple(
+        replace(item, text={"en": item.text["en"]},
+                options=tuple(replace(o, label={"en": o.label["en"]}) for o in item.options))
+        for item in QUESTIONNAIRE.items))
+    resource = fhir_questionnaire(english, "en", SITE)
+    check_fhir(resource)
+    assert "_text" not in json.dumps(resource) and "_display" not in json.dumps(resource)
