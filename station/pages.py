@@ -16,7 +16,7 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export import csv_text, fhir_response, practice_outcomes
+from kiosk.export import ExportSite, csv_text, fhir_response, practice_outcomes
 from kiosk.questionnaire import Questionnaire
 from kiosk.storage import StoredSession
 from station import db, validation, ward
@@ -176,17 +176,18 @@ async def export(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id, fmt = request.path_params["session_id"], request.path_params["fmt"]
     try:
-        _, stored = await run_in_threadpool(_load, engine, session_id)
+        kiosk, stored = await run_in_threadpool(_load, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
     current = await run_in_threadpool(validation.review, engine, session_id)
+    site = ExportSite(kiosk_id=kiosk)  # the session's kiosk: the result's identifier is the one the kiosk exports
     if fmt == "json":
         import json
 
-        body = json.dumps(fhir_response(q, stored, current), indent=2, ensure_ascii=False)
+        body = json.dumps(fhir_response(q, stored, current, site), indent=2, ensure_ascii=False)
         media = "application/fhir+json"
     else:
-        body, media = csv_text(q, [stored], [current]), "text/csv"
+        body, media = csv_text(q, [stored], [current], site), "text/csv"
     return Response(body, media_type=media, headers={
         "content-disposition": f'attachment; filename="{session_id}.{"fhir.json" if fmt == "json" else "csv"}"'})
 
