@@ -32,6 +32,7 @@ from textual.binding import Binding
 from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
+from kiosk.export import ExportSite, site_from_config
 from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
@@ -130,6 +131,7 @@ class KioskApp(App[int], inherit_bindings=False):
         keyboard: Any = None,
         statuses: Iterable[ChannelStatus] = (),
         export_dir: Path | None = None,
+        export_site: ExportSite | None = None,
         poll_interval: float = POLL_INTERVAL,
         resume: Callable[[StoredSession], Session] | None = None,
         new_session: Callable[[], Session] | None = None,
@@ -149,6 +151,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self.sources = list(sources)
         self.keyboard = keyboard
         self.export_dir = export_dir
+        #: the site and kiosk the clinician's exports name (the same identifiers as `kiosk results`)
+        self.export_site = export_site or ExportSite()
         self.poll_interval = poll_interval
         self._resume = resume
         self._new_session = new_session
@@ -617,7 +621,7 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     guard = PinGuard(config.pin_secret, data_dir or config.data_dir)
     app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
-                   export_dir=(data_dir or config.data_dir) / "exports",
+                   export_dir=(data_dir or config.data_dir) / "exports", export_site=site_from_config(config),
                    resume=resume, new_session=fresh, show_score=config.show_score_to_patient)
     return app, store.close
 
