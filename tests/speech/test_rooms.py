@@ -94,14 +94,16 @@ def test_steady_noise_does_not_run_to_the_cut_off(voice_of, snr_db):
     and nothing is taken for an answer the patient did not give."""
     ear = Ear().question("feeding")
     rng = np.random.default_rng(snr_db)
+    ear.hear(_in_noise(np.zeros(0), rooms.white_noise(2, rng), snr_db))  # the fan was on before the question
     for voice, rate in PATIENTS:
         for text, option in (("independent", 3), ("two", 2)):
             speech = voice_of(text, voice, rate)
             ear.utterances.clear()
             got = ear.hear(_in_noise(speech, rooms.white_noise(len(speech) / SAMPLE_RATE + 3.5, rng), snr_db))
-            (utterance,) = ear.utterances
-            assert not utterance.cut_off
-            assert utterance.speech_end - utterance.speech_start < len(speech) / SAMPLE_RATE + 0.6
+            assert ear.utterances
+            for utterance in ear.utterances:
+                assert not utterance.cut_off
+                assert utterance.speech_end - utterance.speech_start < len(speech) / SAMPLE_RATE + 0.6
             assert got is None or got.option == option or got.needs_confirmation
 
 
