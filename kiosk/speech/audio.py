@@ -236,9 +236,13 @@ class Endpointer:
 
     def _learn(self, level_db: float) -> None:
         self._levels.append(max(level_db, -90.0))
-        if len(self._levels) < self._levels.maxlen:
+        if len(self._levels) < self.start_frames * 3:
+            # too little heard to know the room: a quiet one, so an answer spoken as the
+            # microphone opens is heard from its first sound
+            self.noise_db = -90.0
+        elif len(self._levels) < self._levels.maxlen:
             # until a whole window is heard, the quietest frame so far: a fan running as the
-            # microphone opens is learned at once, and an answer spoken then still stands out
+            # microphone opens is learned within a third of a second
             self.noise_db = min(self._levels)
         else:
             self.noise_db = float(np.percentile(self._levels, self.settings.floor_percentile))
