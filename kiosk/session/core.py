@@ -107,6 +107,12 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         #: the latest metrics from the QoS engine
         self.metrics: dict[str, float] = {}
         self._batch: Batch | None = None
+        #: batches the engine ran since the session last looked (see Publisher._take_qos_results)
+        self._qos_results: list[Any] = []
+        #: time of the latest batch the engine ran on its own (timers, time windows)
+        self._timed_t = -1.0
+        if engine is not None:
+            engine.subscribe(self._qos_results.append)
         self._listeners: list[Listener] = []
         self._queue: list[SessionEvent] = []
         self._depth = 0
@@ -207,9 +213,11 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
     def next_deadline(self) -> float | None:
         """Clock time (``clock.now()`` scale) of the next time-out, or None if none is running.
 
-        A driver calls :meth:`poll` once the clock has reached it.
+        A driver calls :meth:`poll` once the clock has reached it. The QoS model's timers and
+        time windows count too: time passes for the engine on every operation and poll.
         """
-        return self._timers.next_deadline()
+        deadlines = [d for d in (self._timers.next_deadline(), self._qos_deadline()) if d is not None]
+        return min(deadlines, default=None)
 
     def score(self) -> Score:
         """The score of the answers recorded so far, recomputed from them."""
