@@ -30,16 +30,17 @@ KIOSK_BATCHES: tuple[tuple[dict[str, object], list[str]], ...] = (
 
 
 def resolve_model(value: str, folder: Path | None = None) -> str:
-    """What ``qos_model:`` names: a bundled model's name (``clarc``, ``kiosk_pace``, also written
-    ``kiosk_pace.roqme`` when no such file is there), else a .roqme file's absolute path, relative
-    paths counted from ``folder`` (the configuration file's)."""
+    """What ``qos_model:`` names: a bundled model's name (``clarc``, ``kiosk_pace``; also written
+    ``kiosk_pace.roqme`` when there is no such file), else a .roqme file's absolute path, relative
+    paths counted from ``folder`` (the configuration file's). A bare name is returned as it is:
+    the caller says when no bundled model has it."""
+    if "/" not in value and not value.endswith(".roqme"):
+        return value
     path = Path(value).expanduser()
     if not path.is_absolute() and folder is not None:
         path = folder / path
-    if value in bundled_models():
-        return value
-    if not path.exists() and "/" not in value and value.endswith(".roqme") and value[:-6] in bundled_models():
-        return value[:-6]
+    if "/" not in value and not path.exists() and value[: -len(".roqme")] in bundled_models():
+        return value[: -len(".roqme")]
     return str(path)
 
 
