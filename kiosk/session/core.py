@@ -133,11 +133,16 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         for event in stored.trace:
             if engine is not None:
                 engine.update(event["t"], set=event.get("set") or {}, emit=list(event.get("emit") or []))
+        last = max((e["t"] for e in stored.trace), default=0.0)
+        # the model's timers that fired after the last context (stored as metrics) are not run twice
+        last_timed = max((m.t for m in stored.metrics), default=last)
+        if engine is not None and last_timed > last:
+            engine.advance(last_timed)
         session = cls(
             questionnaire, clock=clock, engine=engine, store=store, patient_id=stored.patient_id,
             language=stored.language, answered_by=stored.answered_by, session_id=stored.id,
             # the crash took some time: resumed batches come a second after the stored ones
-            t_offset=max((e["t"] for e in stored.trace), default=0.0) + 1.0,
+            t_offset=max(last, last_timed) + 1.0,
             resume_answers={a.item_id: a for a in stored.answers},
             resume_not_answered=tuple(stored.not_answered), familiarisation=False, **kwargs,
         )

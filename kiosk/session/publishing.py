@@ -138,16 +138,20 @@ class Publisher:
         """Advance the engine to session time ``t``: its timers and time windows due by then run.
 
         Only once the engine has had the session's first batch (its timers start then, at time 0,
-        as in a replay of the trace), so nothing happens before the patient starts.
+        as in a replay of the trace), so nothing happens before the patient starts, and only until
+        the test is over: what a model says about the time after it is about no one.
         """
-        if self.engine is not None and self.engine.t is not None and t >= self.engine.t:
+        if self._qos_running() and t >= self.engine.t:
             self.engine.advance(t)
             self._take_qos_results(None, None)
 
     def _qos_deadline(self: Session) -> float | None:
         """Clock time at which the engine next needs time to pass (a timer, a time window), or None."""
-        due = self.engine.next_due() if self.engine is not None and self.engine.t is not None else None
+        due = self.engine.next_due() if self._qos_running() else None
         return None if due is None else self._timers.origin + due
+
+    def _qos_running(self: Session) -> bool:
+        return self.engine is not None and self.engine.t is not None and not self.finished
 
     def _take_qos_results(self: Session, own: Any, batch: Batch | None) -> None:
         """Publish every batch the engine ran since the last call, in order: the ones it ran on its

@@ -116,3 +116,48 @@ def test_clarc_sessions_wait_for_their_own_time_outs_only():
     assert rig.session.next_deadline() is None
     assert not any(m.timers for m in rig.of(MetricsUpdated))
     assert all("QuestionAsked" not in e.get("emit", ()) for e in rig.session.trace)
+
+
+def test_a_continued_session_does_not_run_the_models_timers_again(tmp_path):
+    """The kiosk stops after the timer fired, with no context since: the continued session's engine
+    is brought to the stored metrics' time, so Silent is stored once and the trace still replays."""
+    store = Store.open(tmp_path / "data")
+    rig = pace_rig(store=store)
+    asked = asked_first_question(rig)
+    rig.at(asked + 5)
+    rig.session.person_lost()
+    rig.clock.set(rig.session.next_deadline())
+    rig.session.poll()
+    stored = store.session(rig.session.id)
+    assert stored.metrics[-1].fired == ("Silent",) and stored.trace[-1]["t"] < stored.metrics[-1].t
+
+    again = Session.from_stored(QUESTIONNAIRE, stored, clock=SimClock(), engine=Engine(PACE), store=store,
+                                timing=TIMING)
+    again.clock.advance(2 * SILENCE_S)  # the continued session waits on the welcome screen a while
+    again.poll()
+    again.start()
+    again.acknowledge()
+    again.clock.advance(TIMING["between_questions_s"])
+    again.poll()
+    assert again.current_item.id == QUESTIONNAIRE.items[0].id
+    metrics = store.session(again.id).metrics
+    assert [m.fired for m in metrics].count(("Silent",)) == 1
+    assert replayed(again.trace) == [(m.t, dict(m.metrics), m.fired) for m in metrics]
+    store.close()
+
+
+def test_time_stops_passing_for_the_model_once_the_test_is_over():
+    rig = pace_rig()
+    asked_first_question(rig)
+    for _ in QUESTIONNAIRE.items:
+        while rig.session.current_attempt is None:
+            rig.clock.set(rig.session.next_deadline())
+            rig.session.poll()
+        rig.answer(1)
+    rig.run_until(rig.session.now() + 60)
+    assert rig.session.finished
+    assert rig.session.next_deadline() is None  # nothing wakes a finished kiosk for the model's sake
+    count = len(rig.of(MetricsUpdated))
+    rig.clock.advance(24 * 3600)
+    rig.session.poll()
+    assert len(rig.of(MetricsUpdated)) == count
