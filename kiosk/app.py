@@ -579,9 +579,9 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     from kiosk.clock import SystemClock
     from kiosk.config import ConfigError, configured_questionnaire, load_config
     from kiosk.questionnaire import QuestionnaireError
-    from kiosk.records import MODEL
+    from kiosk.qos_model import load_kiosk_model
     from kiosk.storage import PATIENT_ID, StorageError, new_patient_id
-    from qos import Engine, load_model
+    from qos import Engine, ModelError
 
     if patient_id is not None and not PATIENT_ID.match(patient_id):
         raise SetupError(f"--patient {patient_id!r} is not a pseudonymous id: use letters, digits, '-' "
@@ -590,7 +590,8 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     try:
         config = load_config(config_path)
         questionnaire = configured_questionnaire(config)
-        policy = load_policy(config.adaptation_policy) if config.adaptation else None
+        model = load_kiosk_model(config.qos_model)
+        policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
         store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
                            outbox=config.station is not None)
         # what a kiosk that stopped left running is interrupted now: for staff, never a patient
@@ -598,7 +599,7 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     except QuestionnaireError as error:
         problems = getattr(error, "problems", None)
         raise SetupError("\n".join(str(p) for p in problems) if problems else str(error)) from None
-    except (ConfigError, PolicyError, StorageError) as error:
+    except (ConfigError, PolicyError, ModelError, StorageError) as error:
         raise SetupError(str(error)) from None
     statuses: list[ChannelStatus] = []
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
@@ -607,13 +608,13 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     clock = SystemClock()
 
     def fresh(patient: str | None = None) -> Session:
-        return Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)),
+        return Session(questionnaire, clock=clock, engine=Engine(model),
                        patient_id=patient or new_patient_id(), store=store, language=config.language,
                        timing=config.timing, adaptation=Adaptation(policy) if policy else None,
                        familiarisation=config.familiarisation, next_patient_after_s=config.next_patient_after_s)
 
     def resume(stored: StoredSession) -> Session:
-        return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(load_model(MODEL)),
+        return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(model),
                                    store=store, timing=config.timing,
                                    adaptation=Adaptation(policy) if policy else None,
                                    next_patient_after_s=config.next_patient_after_s)
