@@ -1,6 +1,6 @@
 """Live adaptation inside a session: the policy (:class:`kiosk.adaptation.Adaptation`) decides from
 the QoS metrics; the session records each change and acts on it (stops or resumes listening,
-speaks more slowly)."""
+speaks more slowly, gives a slow patient longer attempts from the next one opened)."""
 
 from __future__ import annotations
 
@@ -59,6 +59,11 @@ class LiveAdaptation:
     def _speech_rate(self: Session) -> float:
         return self.adaptation.speech_rate if self.adaptation is not None else 1.0
 
+    def _attempt_window(self: Session) -> float:
+        """How long an attempt opened now waits: longer while ``longer_attempts`` is on."""
+        factor = self.adaptation.attempt_factor if self.adaptation is not None else 1.0
+        return self.timing.attempt_window_s * factor
+
     def _apply_adaptation(self: Session, t: float, change: Any) -> None:
         """Publish and store one adaptation change and act on it (voice on/off, slower speech)."""
         if self.store is not None:
@@ -70,3 +75,8 @@ class LiveAdaptation:
             self._update_listening(t)
         elif change.name == "slow_speech" and change.active and self.current_attempt is not None:
             self._prompt_question(t, repeat=True)
+        elif change.name == "longer_attempts" and change.active and self.current_attempt is not None:
+            # the attempt open now gets the extra time too (it opened with the normal window)
+            extra = self._attempt_window() - self.timing.attempt_window_s
+            if (remaining := self._timers.attempt_remaining()) is not None:
+                self._timers.at_least(remaining + extra)

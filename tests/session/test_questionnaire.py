@@ -33,7 +33,7 @@ def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
         assert item.code is not None and item.code.system == "http://loinc.org"
     assert Q.item("transfers").points == {0, 5, 10, 15}
     assert [b.id for b in Q.bands] == ["total", "severe", "moderate", "slight", "independent"]
-    assert Q.timing == Timing(20, 2, 10, 5, 5)
+    assert Q.timing == Timing(20, 5, 10, 5, 5, 10)
     assert [p.checks for p in Q.familiarisation] == ["hear", "read", "select"]
 
 
@@ -115,7 +115,7 @@ def test_timing_overrides_are_checked():
     assert Q.timing.with_overrides({"attempt_window_s": 30}).attempt_window_s == 30
     with pytest.raises(ValueError, match="unknown timing setting 'window'"):
         Q.timing.with_overrides({"window": 3})
-    with pytest.raises(ValueError, match="must be a number of seconds >= 0"):
+    with pytest.raises(ValueError, match="must be a number of seconds from 0 to 86400"):
         Q.timing.with_overrides({"closing_s": -1})
 
 

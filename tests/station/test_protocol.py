@@ -62,7 +62,7 @@ def test_a_replayed_session_arrives_whole_and_a_retry_stores_nothing_twice(ward_
 def test_an_alert_sent_first_is_raised_at_once_and_the_session_reads_in_order_when_the_rest_arrives(ward_station):
     ward, station, client = ward_station
     rows = record_patient(PATIENTS / "barthel5.yaml")
-    call = next(r for r in rows if r.alert and r.payload["kind"] in ("call_doctor", "doctor_called"))
+    call = next(r for r in rows if r.alert and r.payload["kind"] == "doctor_called")
     assert client.sync([call]).json()["stored"] == [call.seq]
     staff = Staff(station.url)
     page = staff.http.get("/").text
@@ -168,3 +168,17 @@ def test_page_posts_need_the_csrf_token_and_logins_are_rate_limited(ward_station
     right = anonymous.post("/login", data={"csrf": token, "name": "dr.target", "password": "the-right-password"})
     assert right.status_code == 429
     assert anonymous.get("/", follow_redirects=False).status_code == 303
+
+
+def test_a_kiosk_silent_for_more_than_30_s_shows_offline_with_when_it_was_last_seen(ward_station):
+    ward, station, client = ward_station
+    client.status(session_id="abc124", patient_id="P-7K3QX8", phase="questions", question=5, of=10)
+    engine = db.make_engine(ward.db_url)
+    with engine.begin() as connection:  # as if its last heartbeat came two minutes ago
+        connection.execute(db.kiosks.update().where(db.kiosks.c.name == ward.kiosk_id).values(
+            last_seen=db.now() - 120))
+    engine.dispose()
+    page = Staff(station.url).http.get("/").text
+    tile = page[page.index(f'id="kiosk-{ward.kiosk_id}"'):]
+    tile = tile[:tile.index("</article>")]
+    assert "offline" in tile and "last seen" in tile and "12" in tile  # "120 s ago" (or a little more)
