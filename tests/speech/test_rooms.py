@@ -15,6 +15,7 @@ import pytest
 
 from kiosk.channels import ChannelInput, Command
 from kiosk.questionnaire import load_questionnaire
+from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
 from kiosk.speech import rooms
 from kiosk.speech.asr import PocketSphinxRecogniser
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav
@@ -193,7 +194,9 @@ def test_taking_back_an_answer_by_voice_is_undo(voice_of, text):
 def test_the_welcome_hears_start_and_the_language_names(voice_of, text, voice, option):
     """The welcome listens with options naming the languages; each is heard from a speaker of it."""
     ear = Ear()
-    ear.channel.set_question([OptionWords("Start in English"), OptionWords("Empezar en español"),
-                              OptionWords("Commencer en français")], "en")
+    # the options of the session's English welcome prompt (kiosk.session.core._welcome_prompt)
+    ear.channel.set_question([OptionWords(OWN_NAME[lang], (*LANGUAGE_NAMES["en"][lang],
+                                                           *(START_WORDS["en"] if lang == "en" else ())))
+                              for lang in ("en", "es", "fr")], "en")
     got = ear.hear(_in_noise(voice_of(text, voice, 150), None))
     assert got is not None and got.option == option and not got.needs_confirmation

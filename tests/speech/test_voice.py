@@ -104,6 +104,14 @@ class _Kiosk:
     def say(self, wav: Path) -> None:
         feed_wav(wav, self.voice)
 
+    def answer(self, wav: Path, spoken) -> None:
+        """Say an answer, and "yes" when the kiosk asks back "I heard ... Is that right?"."""
+        self.say(wav)
+        prompts = [e for e in self.events if isinstance(e, Prompt)]
+        if prompts and prompts[-1].kind == "confirm":
+            language = prompts[-1].language
+            self.say(spoken({"en": "yes", "es": "sí", "fr": "oui"}[language], language))
+
 
 ANSWERS_EN = [
     ("feeding", "independent", 3),
@@ -121,11 +129,11 @@ ANSWERS_EN = [
 def test_spoken_answer_is_recorded_as_a_voice_answer(backend, spoken, item_id, utterance, option):
     kiosk = _Kiosk(backend)
     kiosk.to_question(item_id)
-    kiosk.say(spoken(utterance))
+    kiosk.answer(spoken(utterance), spoken)
     answer = kiosk.session.answers[item_id]
     assert (answer.option, answer.channel) == (option, Channel.VOICE)
     recorded = [e for e in kiosk.events if type(e).__name__ == "AnswerRecorded" and e.item_id == item_id]
-    assert recorded[0].detail == utterance
+    assert recorded[0].detail == f"{utterance} (confirmed)"
 
 
 ANSWERS_OTHER = [
@@ -142,7 +150,7 @@ ANSWERS_OTHER = [
 def test_spoken_answer_in_spanish_and_french(spoken, language, item_id, utterance, option, backend):
     kiosk = _Kiosk(backend, language=language)
     kiosk.to_question(item_id)
-    kiosk.say(spoken(utterance, language))
+    kiosk.answer(spoken(utterance, language), spoken)
     answer = kiosk.session.answers[item_id]
     assert (answer.option, answer.channel) == (option, Channel.VOICE)
 
@@ -204,7 +212,7 @@ def test_the_kiosks_own_voice_and_closed_attempts_are_not_heard(backend, spoken)
     kiosk.say(spoken("independent"))
     assert kiosk.session.answers == {}
     kiosk.voice.set_muted(False)
-    kiosk.say(spoken("independent"))
+    kiosk.answer(spoken("independent"), spoken)
     assert kiosk.session.answers["feeding"].option == 3
 
 
@@ -288,7 +296,7 @@ def test_the_kiosk_reading_options_aloud_into_its_own_microphone_records_nothing
     assert done.wait(10)
     speaker.close()
     assert kiosk.session.answers == {}
-    kiosk.say(spoken("independent"))  # the patient, after the kiosk stopped talking
+    kiosk.answer(spoken("independent"), spoken)  # the patient, after the kiosk stopped talking
     assert kiosk.session.answers["feeding"].option == 3
 
 
@@ -296,7 +304,7 @@ def test_the_apps_calls_drive_the_channel(spoken):
     """The app forwards only Prompt (expect) and ListeningChanged (listen); that is enough."""
     kiosk = _Kiosk(lambda lang: PocketSphinxRecogniser(lang), app_style=True)
     kiosk.to_question("feeding")
-    kiosk.say(spoken("two"))
+    kiosk.answer(spoken("two"), spoken)
     assert kiosk.session.answers["feeding"].option == 2
 
 
@@ -336,7 +344,7 @@ def test_started_channel_hears_its_microphone_thread_and_follows_language_change
         (ChannelState.CONNECTING, "voice", "loading the speech model for 'en'"),
         (ChannelState.ON, "voice", "voice answers on: pocketsphinx")]
     (microphone,) = microphones
-    microphone.files.append(spoken("independent"))
+    microphone.files += [spoken("independent"), spoken("yes")]  # the answer, and yes to "Is that right?"
     microphone.thread.start()
     microphone.thread.join(timeout=30)
     assert kiosk.session.answers["bathing"].option == 2
