@@ -122,6 +122,7 @@ class KioskApp(App[int]):
         poll_interval: float = POLL_INTERVAL,
         resume: Callable[[StoredSession], Session] | None = None,
         new_session: Callable[[], Session] | None = None,
+        sync: Any = None,
     ) -> None:
         super().__init__()
         # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
@@ -138,6 +139,8 @@ class KioskApp(App[int]):
         self.poll_interval = poll_interval
         self._resume = resume
         self._new_session = new_session
+        #: the ward station's client (``kiosk.sync.SyncClient``), or None: no station, no threads
+        self.sync = sync
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is not None:  # its worker thread reports through these (it starts on mount)
             speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
@@ -168,10 +171,14 @@ class KioskApp(App[int]):
         self.set_interval(self.poll_interval, self.poll_session)
         if self.store is not None:
             self.set_interval(LEASE_TTL_S / 3, self.keep_session)
+        if self.sync is not None:
+            self.sync.start()
         self._render()
 
     def on_unmount(self) -> None:
-        """Stop every channel (each stop is safe to call twice)."""
+        """Stop every channel (each stop is safe to call twice) and the station's client."""
+        if self.sync is not None:
+            self.sync.stop()
         for source in self._input_sources():
             source.stop()
         if self.speaker is not None:
@@ -291,6 +298,7 @@ class KioskApp(App[int]):
         if self._dirty:
             self._dirty = False
             self._render()
+        self._report_status()
 
     def _on_session_event(self, event: SessionEvent) -> None:
         """Carry out what an event asks of the channels; the redraw follows the operation."""
@@ -438,6 +446,62 @@ class KioskApp(App[int]):
         self._replace_session(self._new_session())
         self.close_clinician()
 
+    # -- the ward station (kiosk.sync) ----------------------------------------------------------
+
+    def _report_status(self) -> None:
+        """Give the station's client what the ward view shows of this kiosk (sent when it changes)."""
+        if self.sync is None:
+            return
+        session, snap = self.session, self.session.snapshot()
+        started = session.phase is not Phase.WELCOME
+        self.sync.set_status({
+            "session_id": session.id if started else None, "patient_id": session.patient_id if started else None,
+            "phase": snap.phase.value, "question": snap.number, "of": snap.count, "paused": snap.paused,
+            "person_away": not snap.person_present, "doctor_called": snap.halted, "simulated": False})
+
+    def station_command(self, command: Any) -> tuple[str, str | None]:
+        """A command from the ward station (called on the client's thread): applied on the UI thread."""
+        return self.call_from_thread(self.apply_station_command, dict(command))
+
+    def apply_station_command(self, command: dict[str, Any]) -> tuple[str, str | None]:
+        """Carry out a station command through the operations the clinician screen uses; returns
+        ("done", None) or ("refused", why)."""
+        kind, session = command.get("kind"), self.session
+        if session.phase is Phase.WELCOME or command.get("session_id") != session.id:
+            return "refused", f"session {command.get('session_id')} is not the one running on this kiosk"
+        if session.finished:
+            return "refused", f"session {session.id} is finished"
+        snap = session.snapshot()
+        if kind == "continue":
+            if not (snap.halted or snap.paused):
+                return "refused", "the session is not waiting for a doctor"
+            self.clinician_continue()
+        elif kind == "person_away":
+            if not snap.person_present:
+                return "refused", "the patient is already marked away"
+            self.person_lost()
+        elif kind == "person_back":
+            if snap.person_present:
+                return "refused", "the patient is not marked away"
+            self.person_back()
+        elif kind == "end":
+            self.end_session(f"ended from the ward station by {command.get('by') or 'staff'}")
+        else:
+            return "refused", f"unknown command {kind!r}"
+        return "done", None
+
+    def end_session(self, reason: str) -> None:
+        """Staff end the running test (stored as abandoned, with why); the kiosk welcomes the next patient."""
+        try:
+            self.session.abandon(reason)
+        except SessionTaken:
+            pass  # another kiosk holds it now: nothing of it is this kiosk's to end
+        if self._new_session is not None:
+            self._replace_session(self._new_session())
+        self._screen_key = None
+        self._render()
+        self._report_status()
+
     # -- interrupted tests and this kiosk's hold on its session ------------------------------------
 
     def interrupted_tests(self) -> list[StoredSession]:
@@ -528,6 +592,7 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
         policy = load_policy(config.adaptation_policy) if config.adaptation else None
         store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
                            outbox=config.station is not None)
+        sync = _station_client(config.station, store, lambda command: app.station_command(command))
         # what a kiosk that stopped left running is interrupted now: for staff, never a patient
         store.interrupt_stale()
     except QuestionnaireError as error:
@@ -555,8 +620,20 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     app = KioskApp(fresh(patient_id), clinician_pin=config.clinician_pin, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports",
-                   resume=resume, new_session=fresh)
+                   resume=resume, new_session=fresh, sync=sync)
     return app, store.close
+
+
+def _station_client(station: Any, store: Store, on_command: Callable[[Any], Any]) -> Any:
+    """The ward station's client (started with the app), or None when no station is configured."""
+    if station is None:
+        return None
+    from kiosk.sync import SyncClient
+
+    client = SyncClient(store.path, url=station.url, token=station.token, kiosk_id=station.kiosk_id,
+                        on_command=on_command)
+    store.on_outbox = client.wake
+    return client
 
 
 def _remotes(profiles: Path | None, wanted: bool, statuses: list[ChannelStatus],

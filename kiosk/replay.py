@@ -504,7 +504,8 @@ def main(argv: list[str]) -> int:
         from kiosk.storage import StorageError, Store
 
         try:
-            store = Store.open(args.data_dir, simulated=True)  # scripted patients: never offered to anyone
+            # scripted patients: never offered to anyone; queued for the station when there is one
+            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None)
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
@@ -518,6 +519,12 @@ def main(argv: list[str]) -> int:
     finally:
         if store is not None:
             store.close()
+    if store is not None and config.station is not None:
+        from kiosk.sync import deliver_pending
+
+        unsent = deliver_pending(store.path, config.station)
+        if unsent:
+            print(f"kiosk replay: {unsent}", file=sys.stderr)
     if args.trace:
         from qos import dump_trace
         from qos.files import write_error
