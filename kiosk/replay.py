@@ -483,6 +483,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--config", metavar="FILE",
                         help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
                              "band set and adaptation policy are the ones replayed, as at the kiosk")
+    parser.add_argument("--station-wait", metavar="S", type=float, default=30.0,
+                        help="with a station configured, how long to try delivering the stored sessions to it "
+                             "before exiting (default 30; what is left goes with the next kiosk run)")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
@@ -522,7 +525,7 @@ def main(argv: list[str]) -> int:
     if store is not None and config.station is not None:
         from kiosk.sync import deliver_pending
 
-        unsent = deliver_pending(store.path, config.station)
+        unsent = deliver_pending(store.path, config.station, max(0.0, args.station_wait))
         if unsent:
             print(f"kiosk replay: {unsent}", file=sys.stderr)
     if args.trace:
