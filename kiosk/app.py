@@ -26,11 +26,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from textual import events
 from textual.app import App
 from textual.binding import Binding
 from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
+from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
 from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView
@@ -85,8 +87,13 @@ class SpeechActivity(Message):
     speaking: bool
 
 
-class KioskApp(App[int]):
-    """The patient's kiosk, with the clinician screens behind a key chord and a PIN.
+class KioskApp(App[int], inherit_bindings=False):
+    """The patient's kiosk, with the clinician screens behind a PIN pad.
+
+    Locked down: nothing a patient can press leaves or reconfigures it. Textual's own keys are
+    not inherited (ctrl+q quit, ctrl+c) and there is no command palette (ctrl+p: quit, theme,
+    screenshot). Staff open the PIN pad with five taps on the top-left corner (or ``ctrl+k``);
+    quitting is a button behind the PIN.
 
     ``session`` is a fresh (not yet started) session. ``speaker`` is a ``kiosk.speech.tts.Speaker``
     or None (voice out off); ``voice`` a ``kiosk.speech.voice.VoiceChannel`` (an input source that
@@ -106,12 +113,13 @@ class KioskApp(App[int]):
     CSS_PATH = "kiosk.tcss"
     TITLE = "Barthel kiosk"
     BINDINGS = [Binding(CLINICIAN_CHORD, "clinician", "Clinician", show=False, priority=True)]
+    ENABLE_COMMAND_PALETTE = False
 
     def __init__(
         self,
         session: Session,
         *,
-        clinician_pin: str,
+        clinician_pin: str | PinGuard,
         store: Store | None = None,
         speaker: Any = None,
         voice: Any = None,
@@ -130,7 +138,9 @@ class KioskApp(App[int]):
         self.session = session
         self.questionnaire: Questionnaire = session.questionnaire
         self.store = store
-        self.clinician_pin = clinician_pin
+        #: checks the clinician PIN (a plain string: an in-memory guard, for tests and benches)
+        self.pin_guard = clinician_pin if isinstance(clinician_pin, PinGuard) else PinGuard(clinician_pin)
+        self._corner = CornerTaps()
         self.speaker = speaker
         self.voice = voice
         self.sources = list(sources)
@@ -408,7 +418,19 @@ class KioskApp(App[int]):
             if ok:
                 self.push_screen(ClinicianHomeScreen())
 
-        self.push_screen(PinScreen(self.clinician_pin), unlocked)
+        self.push_screen(PinScreen(self.pin_guard), unlocked)
+
+    async def on_event(self, event: events.Event) -> None:
+        """Watch every press for the staff corner before the screens see it (a button under the
+        corner must not hide the taps)."""
+        if isinstance(event, events.MouseDown) and not self.clinician_open \
+                and self._corner.tap(event.screen_x, event.screen_y):
+            self.action_clinician()
+        await super().on_event(event)
+
+    def quit_kiosk(self) -> None:
+        """Staff end the kiosk (a button behind the PIN): it exits as after a normal close."""
+        self.exit(0)
 
     def close_clinician(self) -> None:
         """Leave the clinician screens and show the patient's screen as the session now is."""
@@ -617,7 +639,8 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
                                    store=store, timing=config.timing,
                                    adaptation=Adaptation(policy) if policy else None)
 
-    app = KioskApp(fresh(patient_id), clinician_pin=config.clinician_pin, store=store, speaker=speaker,
+    guard = PinGuard(config.pin_secret, data_dir or config.data_dir)
+    app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports",
                    resume=resume, new_session=fresh, sync=sync)
@@ -677,6 +700,8 @@ def main(argv: list[str]) -> int:
     except SetupError as error:
         print(f"kiosk run: {error}", file=sys.stderr)
         return 2
+    if (warning := app.pin_guard.warning) is not None:
+        print(f"kiosk run: warning: {warning}", file=sys.stderr)
     try:
         app.run()
     finally:

@@ -9,7 +9,9 @@ Example ``config.yaml`` (every key optional)::
 
     data_dir: /var/lib/kiosk          # default: platformdirs.user_data_dir("kiosk")
     language: es                      # default language on the welcome screen
-    clinician_pin: "4821"             # CHANGE IT: the default "1234" is public
+    clinician_pin_hash: "scrypt$…"    # written by `kiosk pin set` (6 to 12 digits); default PIN 1234
+    serve_token_sha256: "…"           # written by `kiosk serve --new-token`: the served page's device key
+    serve_max_sessions: 2             # browser connections `kiosk serve` runs at once
     adaptation: true                  # live adaptation on/off
     adaptation_policy: /etc/kiosk/adaptation.yaml
     questionnaire: /etc/kiosk/barthel.yaml
@@ -24,7 +26,9 @@ Example ``config.yaml`` (every key optional)::
       token: "…"                      # from `kiosk station add-kiosk NAME`
       kiosk_id: ward3-bed2            # default: this machine's host name
 
-A bad file is one :class:`ConfigError` naming the file, line and column and what is wrong.
+A legacy plain ``clinician_pin: "482193"`` still works (6 to 12 digits, or the default), with a
+warning to run `kiosk pin set`. A bad file is one :class:`ConfigError` naming the file, line and
+column and what is wrong.
 """
 
 from __future__ import annotations
@@ -40,10 +44,13 @@ from typing import Any
 import platformdirs
 
 from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
+from kiosk.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.yamlmarks import Problem, parse_file
+from qos.files import BadFile, open_private, read_text
 
-#: the PIN a fresh install uses; the clinician screens warn while it is unchanged
-DEFAULT_PIN = "1234"
+#: browser connections `kiosk serve` runs at once unless configured: each is a kiosk process
+#: of about 55 MB, and a ward kiosk has one screen
+SERVE_MAX_SESSIONS = 2
 
 
 class ConfigError(ValueError):
@@ -74,8 +81,14 @@ class Config:
     data_dir: Path = field(default_factory=lambda: Path(platformdirs.user_data_dir("kiosk")))
     #: default language on the welcome screen
     language: str = "en"
-    #: the clinician screens' PIN; the default must be changed on a real kiosk
+    #: a legacy plain clinician PIN (use clinician_pin_hash); the default must be changed
     clinician_pin: str = DEFAULT_PIN
+    #: the clinician PIN's scrypt hash, written by `kiosk pin set` (wins over clinician_pin)
+    clinician_pin_hash: str | None = None
+    #: SHA-256 (hex) of the served page's device key, written by `kiosk serve --new-token`
+    serve_token_sha256: str | None = None
+    #: browser connections (kiosk processes) `kiosk serve` runs at once
+    serve_max_sessions: int = SERVE_MAX_SESSIONS
     #: live adaptation (the clinician can still switch it off per session)
     adaptation: bool = True
     #: an adaptation policy file (None: the bundled kiosk/adaptation.yaml)
@@ -102,11 +115,17 @@ class Config:
     @property
     def default_pin(self) -> bool:
         """The PIN is still the public default."""
-        return self.clinician_pin == DEFAULT_PIN
+        return self.clinician_pin_hash is None and self.clinician_pin == DEFAULT_PIN
+
+    @property
+    def pin_secret(self) -> str:
+        """What the PIN pad checks against: the hash, else the legacy plain PIN."""
+        return self.clinician_pin_hash or self.clinician_pin
 
 
 _PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
 _BOOLS = {"adaptation", "familiarisation"}
+_SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}
 
 
@@ -181,9 +200,24 @@ def _read(path: Path) -> dict[str, Any]:
             value = dict(value)
         elif key == "clinician_pin":
             if isinstance(value, int) and not isinstance(value, bool):
-                raise fail((key,), 'write the PIN in quotes ("0123"), or leading zeros are lost')
-            if not isinstance(value, str) or not value.isdigit() or not 4 <= len(value) <= 12:
-                raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
+                raise fail((key,), 'write the PIN in quotes ("012345"), or leading zeros are lost')
+            if not isinstance(value, str) or not value.isascii() or not value.isdigit() or len(value) > 12 \
+                    or (len(value) < MIN_DIGITS and value != DEFAULT_PIN):
+                raise fail((key,), f"clinician_pin must be {MIN_DIGITS} to 12 digits, in quotes "
+                                   "(better: run `kiosk pin set`, which stores it hashed)")
+            if "clinician_pin_hash" in data:
+                raise fail((key,), "clinician_pin and clinician_pin_hash are both set: remove clinician_pin")
+        elif key == "clinician_pin_hash":
+            problem = hash_problem(value) if isinstance(value, str) else "clinician_pin_hash must be text"
+            if problem is not None:
+                raise fail((key,), problem)
+        elif key == "serve_token_sha256":
+            if not isinstance(value, str) or not _SHA256.fullmatch(value):
+                raise fail((key,), "serve_token_sha256 is not a key written by `kiosk serve --new-token`; "
+                                   "run it again")
+        elif key == "serve_max_sessions":
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 16:
+                raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
         elif key == "station":
@@ -238,3 +272,34 @@ def configured_questionnaire(config: Config) -> Questionnaire:
     except KeyError:
         raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
                           f"(it has {', '.join(questionnaire.band_sets)})") from None
+
+
+def write_settings(path: Path, changes: Mapping[str, str | None]) -> None:
+    """Set (or, with None, remove) top-level settings of a configuration file, keeping its other
+    lines and comments; the file is created if missing, and always left owner-only (0600).
+
+    The new file is checked with :func:`load_config` before it replaces the old one, so a mistake
+    leaves the old file as it was. Raises :class:`ConfigError`.
+    """
+    try:
+        lines = read_text(path).splitlines() if path.exists() else []
+    except BadFile as exc:
+        raise ConfigError(str(exc)) from None
+    for key, value in changes.items():
+        lines = [line for line in lines if not re.match(rf"{re.escape(key)}\s*:", line)]
+        if value is not None:
+            lines.append(f'{key}: "{value}"')  # the values written here never hold quotes or backslashes
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_name(f".{path.name}.new")
+    try:
+        with open_private(temporary) as handle:
+            handle.write("\n".join(lines) + "\n")
+        load_config(temporary, environ={})
+        os.replace(temporary, path)
+    except ConfigError as exc:  # name the file staff know, not the one checked in its place
+        raise ConfigError(str(exc).replace(str(temporary), str(path))) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot write {path}: {exc.strerror or exc}") from None
+    finally:
+        temporary.unlink(missing_ok=True)
+    os.chmod(path, 0o600)

@@ -326,7 +326,14 @@ def load_questionnaire(path: str | Path | None = None) -> Questionnaire:
 def check_questionnaire_file(path: str | Path) -> list[Problem]:
     """Every problem in a questionnaire file (empty if it is valid): the checks :func:`load_questionnaire`
     makes, so a file this accepts is one the kiosk runs. Unreadable: one problem."""
-    return _check(parse_file(path), str(path))[1]
+    return check_questionnaire(path)[1]
+
+
+def check_questionnaire(path: str | Path) -> tuple[bool, list[Problem]]:
+    """(readable, every problem) of a questionnaire file; ``readable`` is False when the file could
+    not be read as YAML at all (then its one problem says why)."""
+    parsed = parse_file(path)
+    return parsed[1] is not None, _check(parsed, str(path))[1]
 
 
 def check_questionnaire_text(text: str, filename: str) -> tuple[Any, list[Problem]]:

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import IO, Any
 
 import yaml
+import yaml.reader
 from yaml.composer import Composer
 
 from qos.errors import QosError
@@ -230,15 +231,22 @@ def compose_yaml(text: str, name: str) -> yaml.Node | None:
 
 
 def _compose(kind: type[_BoundedComposer], text: str, name: str) -> yaml.Node | None:
-    composer = kind(text, name)
+    try:
+        composer = kind(text, name)  # PyYAML's reader refuses control characters here
+    except yaml.reader.ReaderError as exc:
+        raise _SyntaxProblem(Problem(name, *_position(text, exc.position),
+                                     f"character #x{exc.character:04x} is not allowed in YAML")) from None
     try:
         return composer.get_single_node()
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise _SyntaxProblem(Problem(name, line, column, f"YAML syntax: {exc.problem or exc.context}")) from None
+    except yaml.reader.ReaderError as exc:  # met while reading on
+        raise _SyntaxProblem(Problem(name, *_position(text, exc.position),
+                                     f"character #x{exc.character:04x} is not allowed in YAML")) from None
     except yaml.YAMLError as exc:
-        raise _SyntaxProblem(Problem(name, 1, 1, f"YAML syntax: {exc}")) from None
+        raise _SyntaxProblem(Problem(name, 1, 1, f"YAML syntax: {str(exc).splitlines()[0]}")) from None
     finally:
         composer.dispose()
 

@@ -24,8 +24,8 @@ from typing import Any
 
 import yaml
 
-from qos.engine import Engine, UpdateResult, check_batch
-from qos.errors import ContextError, TraceError
+from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
+from qos.errors import ContextError, ModelError, TraceError
 from qos.files import BadFile, load_data, write_private
 from qos.model import Model
 
@@ -84,9 +84,15 @@ class Trace:
         from qos import load_model  # the package function, which knows the bundled models
 
         model = self.model
-        if self.source is not None and (model.endswith(".roqme") or "/" in model):
+        is_path = model.endswith(".roqme") or "/" in model
+        if self.source is not None and is_path:
             model = str(self.source.parent / model)
-        return load_model(model)
+        try:
+            return load_model(model)
+        except ModelError as exc:
+            if is_path:
+                raise  # it names the model file, and where in it
+            raise ModelError(f"{self.name}: {exc}") from None  # an unknown name: say which trace uses it
 
     def check(self, model: Model | None = None) -> Model:
         """Validate every event against the model; raise :class:`TraceError` on the first problem."""
@@ -223,7 +229,10 @@ class TraceRecorder:
         self._unsubscribe = engine.subscribe(self._record)
 
     def _record(self, result: UpdateResult) -> None:
-        self.events.append(TraceEvent(seconds(result.t), dict(result.set), list(result.emit)))
+        if result.timed:
+            return  # timers and time windows: a replay runs them again from the model
+        values = {name: list(value) if isinstance(value, tuple) else value for name, value in result.set.items()}
+        self.events.append(TraceEvent(seconds(result.t), values, list(result.emit)))
 
     @property
     def trace(self) -> Trace:
@@ -254,6 +263,8 @@ class ReplaySamples:
     series: dict[str, list[float]]
     #: one entry per batch that fired something: {"t": time as in the trace, "observations": [...]}
     fired: list[dict[str, object]]
+    #: beliefvar name -> its probability at each of ``times`` (models with ``beliefvar`` only)
+    beliefs: dict[str, list[float]] = field(default_factory=dict)
 
 
 #: samples one replay may take (each holds every property): bounds time and memory, so that a tiny
@@ -278,38 +289,56 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if not isinstance(trace, Trace):
         trace = load_trace(trace)
     model = trace.check(model)
-    engine = Engine(model)
+    # the trace's clock starts with the session: timers start at t = 0
+    engine = Engine(model, start=0.0)
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
     if count > MAX_SAMPLES:
         raise TraceError(f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
                          f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period")
-    samples = ReplaySamples([], {name: [] for name in model.properties}, [])
+    firings = sum(last_t / (timer.interval or 1.0) for timer in model.timers.values())
+    if firings > MAX_TIMED_BATCHES:
+        raise TraceError(f"{trace.name}: the model's timers would fire about {firings:,.0f} times over the trace's "
+                         f"{last_t:g} s (at most {MAX_TIMED_BATCHES:,}); is a timer's interval too short?")
+    samples = ReplaySamples([], {name: [] for name in model.properties}, [], {name: [] for name in model.beliefvars})
+    # every batch that fires, timer batches included, in the order the engine runs them
+    engine.subscribe(lambda result: samples.fired.append({"t": seconds(result.t), "observations": result.fired})
+                     if result.fired else None)
+
+    def sample(now: float) -> None:
+        engine.advance(max(now, engine.t or 0.0))
+        samples.times.append(now)
+        at = max(now, engine.t or 0.0)
+        for name, value in engine.metrics(at).items():
+            samples.series[name].append(value)
+        for name, value in engine.beliefs(at).items():
+            samples.beliefs[name].append(value)
+
+    try:
+        _run(engine, batches, count, sample_period, last_t, sample)
+    except ContextError as exc:  # the model's timers cannot follow the trace (a jump too far ahead)
+        raise TraceError(f"{trace.name}: {exc}") from None
+    return samples
+
+
+def _run(engine: Engine, batches: list, count: int, sample_period: float, last_t: float, sample) -> None:
+    """Apply the batches in time order, sampling at every period (see :func:`sample_trace`)."""
     upcoming = 0
     for k in range(count):
         now = k * sample_period
         # a small tolerance so that samples at k·0.1 s still see the events written at that time
         while upcoming < len(batches) and float(batches[upcoming][0]) <= now + 1e-9:
             t, values, emitted = batches[upcoming]
-            result = engine.update(float(t), set=values, emit=emitted)
-            if result.fired:
-                samples.fired.append({"t": t, "observations": result.fired})
+            engine.update(float(t), set=values, emit=emitted)
             upcoming += 1
-        samples.times.append(now)
-        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
-            samples.series[name].append(value)
+        sample(now)
     if upcoming < len(batches):
         # the last event falls between two samples: apply the rest and sample at that time too,
         # so that every batch is counted and `last` is the value after the last event
         for t, values, emitted in batches[upcoming:]:
-            result = engine.update(float(t), set=values, emit=emitted)
-            if result.fired:
-                samples.fired.append({"t": t, "observations": result.fired})
-        samples.times.append(last_t)
-        for name, value in engine.metrics(last_t).items():
-            samples.series[name].append(value)
-    return samples
+            engine.update(float(t), set=values, emit=emitted)
+        sample(last_t)
 
 
 def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> dict:
@@ -322,6 +351,10 @@ def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model |
 
 
 def summarise(samples: ReplaySamples) -> dict:
-    """The replay result of trace-format.md from a replay's samples."""
-    return {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
-            "fired": samples.fired}
+    """The replay result of trace-format.md from a replay's samples (and, for a model with belief
+    variables, their statistics under ``beliefs``)."""
+    result: dict = {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
+                    "fired": samples.fired}
+    if samples.beliefs:
+        result["beliefs"] = {name: _statistics(values) for name, values in samples.beliefs.items()}
+    return result

@@ -9,31 +9,63 @@ from __future__ import annotations
 
 import asyncio
 import json
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
+from sqlalchemy.engine import Connection
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
 from station import auth, sync, ward
-from station.bus import Bus
 
 #: the longest long poll the station holds open (seconds)
 MAX_WAIT_S = 30.0
 MAX_BODY = 4 * 1024 * 1024
+#: worker threads for alert batches only (the protocol sends alerts in a request of their own)
+ALERT_LANE = ThreadPoolExecutor(max_workers=4, thread_name_prefix="station-alerts")
 
 
 def _error(status: int, message: str) -> JSONResponse:
     return JSONResponse({"error": message}, status_code=status)
 
 
+def _token(request: Request) -> str | None:
+    scheme, _, token = request.headers.get("authorization", "").partition(" ")
+    return token.strip() if scheme.lower() == "bearer" and token.strip() else None
+
+
 async def _kiosk(request: Request) -> str | None:
-    header = request.headers.get("authorization", "")
-    scheme, _, token = header.partition(" ")
-    if scheme.lower() != "bearer" or not token.strip():
-        return None
-    return await run_in_threadpool(auth.kiosk_for, request.app.state.engine, token.strip())
+    token = _token(request)
+    return await run_in_threadpool(auth.kiosk_for, request.app.state.engine, token) if token else None
+
+
+class _Unauthorised(Exception):
+    pass
+
+
+def _in_worker(request: Request, work: Any, urgent: bool = False, status: str | None = None) -> Any:
+    """Authenticate, do the work and publish what changed in one worker-thread hop: under load the
+    hops, not the queries, are what a request waits for. Urgent work (a batch of alerts) runs on
+    threads of its own, so a doctor call never queues behind the kiosks' routine rows."""
+    token = _token(request)
+    engine, bus = request.app.state.engine, request.app.state.bus
+
+    def run() -> Any:
+        if token is None:
+            raise _Unauthorised
+        with bus.transaction() as (connection, messages):
+            kiosk = auth.touch_kiosk(connection, token, status)
+            if kiosk is None:
+                raise _Unauthorised
+            result, more = work(connection, kiosk)
+            messages += more
+        return result
+
+    if urgent:
+        return asyncio.get_running_loop().run_in_executor(ALERT_LANE, run)
+    return run_in_threadpool(run)
 
 
 async def _json(request: Request) -> Any:
@@ -48,36 +80,52 @@ def _unauthorised() -> JSONResponse:
                         headers={"WWW-Authenticate": "Bearer"})
 
 
+class _WrongKiosk(ValueError):
+    status = 403
+
+
+def _check_kiosk_id(body: Any, kiosk: str) -> None:
+    if isinstance(body, dict) and body.get("kiosk_id") not in (None, kiosk):
+        raise _WrongKiosk(f"this token belongs to kiosk {kiosk!r}, not {body.get('kiosk_id')!r}")
+
+
 async def post_sync(request: Request) -> Response:
-    kiosk = await _kiosk(request)
-    if kiosk is None:
-        return _unauthorised()
     try:
         body = await _json(request)
-        if isinstance(body, dict) and body.get("kiosk_id") not in (None, kiosk):
-            return _error(403, f"this token belongs to kiosk {kiosk!r}, not {body.get('kiosk_id')!r}")
         events = sync.parse(body)
-        stored, messages = await run_in_threadpool(sync.intake, request.app.state.engine, kiosk, events)
     except ValueError as exc:  # json errors are ValueErrors too
         return _error(getattr(exc, "status", 400), str(exc))
-    bus: Bus = request.app.state.bus
-    await run_in_threadpool(bus.publish, *messages)
+
+    def work(connection: Connection, kiosk: str) -> tuple[list[int], list[dict[str, Any]]]:
+        _check_kiosk_id(body, kiosk)
+        return sync.intake(connection, kiosk, events)
+
+    try:
+        stored = await _in_worker(request, work, urgent=all(sync.is_alert(e) for e in events))
+    except _Unauthorised:
+        return _unauthorised()
+    except ValueError as exc:
+        return _error(getattr(exc, "status", 400), str(exc))
     return JSONResponse({"stored": stored})
 
 
 async def post_status(request: Request) -> Response:
-    kiosk = await _kiosk(request)
-    if kiosk is None:
-        return _unauthorised()
     try:
         body = await _json(request)
-        if isinstance(body, dict) and body.get("kiosk_id") not in (None, kiosk):
-            return _error(403, f"this token belongs to kiosk {kiosk!r}, not {body.get('kiosk_id')!r}")
         status = ward.parse_status(body)
     except ValueError as exc:
         return _error(400, str(exc))
-    await run_in_threadpool(ward.report_status, request.app.state.engine, kiosk, status)
-    await run_in_threadpool(request.app.state.bus.publish, {"type": "kiosk", "kiosk": kiosk})
+
+    def work(connection: Connection, kiosk: str) -> tuple[None, list[dict[str, Any]]]:
+        _check_kiosk_id(body, kiosk)  # raising rolls the status back
+        return None, [{"type": "kiosk", "kiosk": kiosk}]
+
+    try:
+        await _in_worker(request, work, status=json.dumps(status))
+    except _Unauthorised:
+        return _unauthorised()
+    except ValueError as exc:
+        return _error(getattr(exc, "status", 400), str(exc))
     return JSONResponse({"ok": True})
 
 

@@ -9,6 +9,7 @@ every station process behind one PostgreSQL shares the limit.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import hmac
 import re
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 import sqlalchemy as sa
 from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
-from sqlalchemy.engine import Engine
+from sqlalchemy.engine import Connection, Engine
 
 from station import db
 from station.db import kiosks, login_failures, settings, users
@@ -26,13 +27,20 @@ from station.db import kiosks, login_failures, settings, users
 ROLES = ("nurse", "doctor")
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
 MIN_PASSWORD = 10
-#: failed logins allowed per user name and per address within the window
+#: failed logins allowed per user name within the window (guessing one person's password), and
+#: per address (guessing across names; higher, as a ward's devices may share one address)
 MAX_FAILURES = 5
+MAX_FAILURES_PER_ADDRESS = 20
 WINDOW_S = 15 * 60
 
 _hasher = PasswordHasher()
-#: verified against when the user does not exist, so a wrong name costs as long as a wrong password
-_DUMMY_HASH = _hasher.hash("not a password of anyone")
+
+
+@functools.cache
+def _dummy_hash() -> str:
+    """Verified against when the user does not exist, so a wrong name costs as long as a wrong
+    password (made on first use: hashing is deliberately slow)."""
+    return _hasher.hash("not a password of anyone")
 
 
 class AuthError(ValueError):
@@ -74,10 +82,11 @@ def throttled(engine: Engine, name: str, address: str) -> bool:
     """Whether logins for this name or from this address are paused after too many failures."""
     since = db.now() - WINDOW_S
     with engine.connect() as connection:
-        for column, value in ((login_failures.c.name, name), (login_failures.c.address, address)):
+        for column, value, limit in ((login_failures.c.name, name, MAX_FAILURES),
+                                     (login_failures.c.address, address, MAX_FAILURES_PER_ADDRESS)):
             count = connection.execute(sa.select(sa.func.count()).select_from(login_failures).where(
                 column == value, login_failures.c.at > since)).scalar_one()
-            if count >= MAX_FAILURES:
+            if count >= limit:
                 return True
     return False
 
@@ -87,7 +96,7 @@ def login(engine: Engine, name: str, password: str, address: str) -> User | None
     with engine.connect() as connection:
         row = connection.execute(sa.select(users.c.role, users.c.password_hash).where(users.c.name == name)).first()
     try:
-        _hasher.verify(row.password_hash if row else _DUMMY_HASH, password)
+        _hasher.verify(row.password_hash if row else _dummy_hash(), password)
         if row is not None:
             return User(name, row.role)
     except (VerificationError, InvalidHashError):
@@ -139,6 +148,17 @@ def kiosk_for(engine: Engine, token: str) -> str | None:
     with engine.connect() as connection:
         return connection.execute(sa.select(kiosks.c.name).where(
             kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None))).scalar()
+
+
+def touch_kiosk(connection: Connection, token: str, status: str | None = None) -> str | None:
+    """Authenticate a kiosk's request and note it was seen (and its new status), in one
+    statement: the kiosk's name, or None for an unknown or revoked token."""
+    values: dict[str, object] = {"last_seen": db.now()}
+    if status is not None:
+        values["status"] = status
+    return connection.execute(kiosks.update().where(
+        kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None)).values(**values).returning(
+        kiosks.c.name)).scalar()
 
 
 def secret_key(engine: Engine) -> str:

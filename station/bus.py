@@ -11,13 +11,15 @@ all, so a page served by another process sees the same alert as quickly. Message
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import logging
 import threading
+from collections.abc import Iterator
 from typing import Any
 
 import sqlalchemy as sa
-from sqlalchemy.engine import Engine
+from sqlalchemy.engine import Connection, Engine
 
 from station.db import is_postgres
 
@@ -52,6 +54,22 @@ class Bus:
             self._thread.join(timeout=3)
 
     # -- publishing ------------------------------------------------------------------------------
+
+    @contextlib.contextmanager
+    def transaction(self) -> Iterator[tuple[Connection, list[dict[str, Any]]]]:
+        """A write transaction and the list of messages to publish if it commits: on PostgreSQL
+        they are NOTIFYed in the transaction itself (sent by the commit, never without it), on
+        SQLite delivered right after the commit."""
+        messages: list[dict[str, Any]] = []
+        with self._engine.begin() as connection:
+            yield connection, messages
+            if is_postgres(self._engine):
+                for message in messages:
+                    connection.execute(sa.text("SELECT pg_notify(:channel, :payload)"),
+                                       {"channel": CHANNEL, "payload": json.dumps(message)})
+        if not is_postgres(self._engine):
+            for message in messages:
+                self._deliver(message)
 
     def publish(self, *messages: dict[str, Any]) -> None:
         """Tell every station process what changed (call after the change committed)."""

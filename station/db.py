@@ -183,7 +183,8 @@ def make_engine(url: str) -> Engine:
             cursor.close()
 
         return engine
-    return sa.create_engine(url, pool_size=10, max_overflow=20, pool_pre_ping=True)
+    # more connections than the web's 40 worker threads, so a worker never waits for one
+    return sa.create_engine(url, pool_size=20, max_overflow=30, pool_pre_ping=True)
 
 
 def is_postgres(engine: Engine) -> bool:

@@ -13,9 +13,8 @@ import asyncio
 import json
 import logging
 from collections.abc import AsyncIterator, Callable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
-
-from starlette.concurrency import run_in_threadpool
 
 from station.bus import Bus
 
@@ -38,6 +37,8 @@ class Live:
         self._render_alerts = render_alerts
         self._pages: set[asyncio.Queue[str]] = set()
         self._task: asyncio.Task[None] | None = None
+        #: a thread of its own: rendering an alert never queues behind the kiosks' requests
+        self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-live")
 
     def start(self) -> None:
         self._task = asyncio.get_running_loop().create_task(self._run())
@@ -45,6 +46,10 @@ class Live:
     async def stop(self) -> None:
         if self._task is not None:
             self._task.cancel()
+        self._executor.shutdown(wait=False)
+
+    async def _render(self, render: Callable[..., dict[str, Any]], *args: Any) -> dict[str, Any]:
+        return await asyncio.get_running_loop().run_in_executor(self._executor, render, *args)
 
     async def _run(self) -> None:
         queue = self._bus.subscribe()
@@ -76,9 +81,9 @@ class Live:
             return [sse("resync", {})]
         events = []
         if alerts:  # alerts first: they are what a nurse must see soonest
-            events.append(sse("alerts", await run_in_threadpool(self._render_alerts)))
+            events.append(sse("alerts", await self._render(self._render_alerts)))
         for name in sorted(kiosks):
-            events.append(sse("kiosk", await run_in_threadpool(self._render_kiosk, name)))
+            events.append(sse("kiosk", await self._render(self._render_kiosk, name)))
         return events
 
     async def stream(self) -> AsyncIterator[str]:
@@ -87,7 +92,7 @@ class Live:
         self._pages.add(page)
         try:
             yield "retry: 1000\n\n"
-            yield sse("alerts", await run_in_threadpool(self._render_alerts))
+            yield sse("alerts", await self._render(self._render_alerts))
             while True:
                 try:
                     yield await asyncio.wait_for(page.get(), timeout=KEEPALIVE_S)

@@ -39,7 +39,8 @@ def alerts_event(app: Starlette) -> dict[str, Any]:
     pending = ward.open_alerts(app.state.engine)
     html = templates.get_template("_alerts.html").render(alerts=pending, csrf="__CSRF__")
     return {"ids": [a.id for a in pending], "html": html,
-            "texts": {str(a.id): f"{a.text} — {a.kiosk_id}" for a in pending}}
+            "alerts": [{"id": a.id, "kiosk": a.kiosk_id, "kind": a.kind, "raised_at": a.raised_at,
+                        "text": f"{a.text} — {a.kiosk_id}"} for a in pending]}
 
 
 def _session_rows(engine: Any, limit: int = RECENT) -> list[Any]:

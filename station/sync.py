@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import sqlalchemy as sa
-from sqlalchemy.engine import Connection, Engine
+from sqlalchemy.engine import Connection
 
 from kiosk.storage import PATIENT_ID
 from station import db
@@ -41,6 +41,11 @@ REQUIRED: dict[str, tuple[str, ...]] = {
 #: doctor_called/doctor_continued; today's session log says call_doctor/clinician_continue.
 RAISES = {"doctor_called": "doctor_called", "call_doctor": "doctor_called", "person_lost": "person_lost"}
 ENDS = {"doctor_continued": "doctor_called", "clinician_continue": "doctor_called", "person_back": "person_lost"}
+
+
+def is_alert(event: Event) -> bool:
+    """A row the protocol sends first: a doctor call, a patient leaving, and their ends."""
+    return event.kind == "record_event" and event.payload.get("kind") in RAISES.keys() | ENDS.keys()
 
 
 class SyncError(ValueError):
@@ -103,34 +108,31 @@ def _same(stored: Any, event: Event) -> bool:
     return (stored.kind, stored.session_id, json.loads(stored.payload)) == (event.kind, event.session_id, event.payload)
 
 
-def intake(engine: Engine, kiosk_id: str, events: Sequence[Event]) -> tuple[list[int], list[dict[str, Any]]]:
-    """Store a batch from ``kiosk_id``; returns the seqs now stored (new and already known) and
-    the bus messages to publish once committed."""
+def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tuple[list[int], list[dict[str, Any]]]:
+    """Store a batch from ``kiosk_id`` in the caller's transaction; returns the seqs now stored
+    (new and already known) and the bus messages to publish once committed."""
     messages: list[dict[str, Any]] = []
     seqs = [e.seq for e in events]
     if len(set(seqs)) != len(seqs):
         raise SyncError("a seq appears twice in one batch")
     received = db.now()
-    with engine.begin() as connection:
-        known = {row.seq: row for row in connection.execute(
-            sa.select(inbox.c.seq, inbox.c.kind, inbox.c.session_id, inbox.c.payload).where(
-                inbox.c.kiosk_id == kiosk_id, inbox.c.seq.in_(seqs)))}
-        for event in events:
-            if event.seq in known and not _same(known[event.seq], event):
-                raise Conflict(f"seq {event.seq}: already stored with different content (was this kiosk's "
-                               "database replaced? its rows are kept apart until someone checks)")
-        new = [e for e in events if e.seq not in known]
-        _claim_sessions(connection, kiosk_id, new, received)
-        db.insert_ignore(connection, inbox, [{"kiosk_id": kiosk_id, "seq": e.seq, "kind": e.kind, "session_id": e.session_id,
-                                     "payload": json.dumps(e.payload), "at": e.at, "received_at": received}
-                                    for e in new], ["kiosk_id", "seq"])
-        for session_id in {e.session_id for e in new if e.kind in LIFECYCLE}:
-            connection.execute(sessions.update().where(sessions.c.id == session_id).values(
-                updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE))))
-        if new:
-            messages += _alerts(connection, kiosk_id, new, received)
-            messages += [{"type": "session", "session": s} for s in sorted({e.session_id for e in new})]
-        connection.execute(db.kiosks.update().where(db.kiosks.c.name == kiosk_id).values(last_seen=received))
+    known = {row.seq: row for row in connection.execute(
+        sa.select(inbox.c.seq, inbox.c.kind, inbox.c.session_id, inbox.c.payload).where(
+            inbox.c.kiosk_id == kiosk_id, inbox.c.seq.in_(seqs)))}
+    for event in events:
+        if event.seq in known and not _same(known[event.seq], event):
+            raise Conflict(f"seq {event.seq}: already stored with different content (was this kiosk's "
+                           "database replaced? its rows are kept apart until someone checks)")
+    new = [e for e in events if e.seq not in known]
+    _claim_sessions(connection, kiosk_id, new, received)
+    db.insert_ignore(connection, inbox, [{"kiosk_id": kiosk_id, "seq": e.seq, "kind": e.kind,
+                                          "session_id": e.session_id, "payload": json.dumps(e.payload), "at": e.at,
+                                          "received_at": received} for e in new], ["kiosk_id", "seq"])
+    for session_id in {e.session_id for e in new if e.kind in LIFECYCLE}:
+        connection.execute(sessions.update().where(sessions.c.id == session_id).values(
+            updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE))))
+    if new:
+        messages += _alerts(connection, kiosk_id, new, received)
     return seqs, messages
 
 

@@ -75,12 +75,6 @@ def parse_status(body: Any) -> dict[str, Any]:
     return status
 
 
-def report_status(engine: Engine, kiosk_id: str, status: dict[str, Any]) -> None:
-    with engine.begin() as connection:
-        connection.execute(kiosks.update().where(kiosks.c.name == kiosk_id).values(
-            status=json.dumps(status), last_seen=db.now()))
-
-
 def seen(engine: Engine, kiosk_id: str) -> None:
     with engine.begin() as connection:
         connection.execute(kiosks.update().where(kiosks.c.name == kiosk_id).values(last_seen=db.now()))

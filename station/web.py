@@ -14,6 +14,7 @@ from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Any
 
+import anyio.to_thread
 from sqlalchemy.engine import Engine
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
@@ -31,6 +32,7 @@ from station.bus import Bus
 from station.live import Live
 
 HERE = Path(__file__).parent
+ROUTINE_WORKERS = 12
 SECURITY_HEADERS = {
     # no inline script or style, nothing from elsewhere: the pages work with the network cut
     "content-security-policy": "default-src 'self'; img-src 'self' data:; frame-ancestors 'none'; form-action 'self'",
@@ -142,6 +144,9 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
 
     @asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
+        # fewer routine workers than the default 40: past a few, more threads only share the GIL
+        # thinner, and the alert lane's threads would get less of it
+        anyio.to_thread.current_default_thread_limiter().total_tokens = ROUTINE_WORKERS
         bus.start(asyncio.get_running_loop())
         app.state.live.start()
         yield

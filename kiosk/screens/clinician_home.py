@@ -9,7 +9,6 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
-from kiosk.config import DEFAULT_PIN
 from kiosk.screens.base import ClinicianScreen
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
@@ -27,9 +26,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         session = app.session  # type: ignore[attr-defined]
         with Vertical(classes="clinician"):
             yield Static("Clinician", classes="heading")
-            if app.clinician_pin == DEFAULT_PIN:  # type: ignore[attr-defined]
-                yield Static("The clinician PIN is still the public default: set clinician_pin in the "
-                            "configuration.", id="pin-warning")
+            if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
+                yield Static(warning, id="pin-warning")
             yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
                 yield Button("Continue the session", id="continue", variant="primary",
@@ -40,6 +38,7 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
                 yield Button("Back to the patient", id="back")
+                yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
             present = session.snapshot().person_present
@@ -87,7 +86,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         return line
 
     def _channels_text(self) -> str:
-        lines = self.app.board.lines("en")  # type: ignore[attr-defined]
+        lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
         return "Channels: " + "; ".join(
             f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
             for line in lines)
@@ -124,6 +123,10 @@ class ClinicianHomeScreen(ClinicianScreen):
     @on(Button.Pressed, "#back")
     def _back(self) -> None:
         self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#quit-kiosk")
+    def _quit(self) -> None:
+        self.app.quit_kiosk()  # type: ignore[attr-defined]
 
     @on(Switch.Changed, "#adaptation")
     def _adaptation(self, event: Switch.Changed) -> None:

@@ -52,8 +52,8 @@
   function showAlerts(data) {
     alertsList.innerHTML = withCsrf(data.html);
     document.getElementById("no-alerts").hidden = data.ids.length > 0;
-    for (const id of data.ids) {
-      if (!station.seen.has(id)) { station.seen.add(id); notify(id, data.texts[String(id)]); }
+    for (const alert of data.alerts) {
+      if (!station.seen.has(alert.id)) { station.seen.add(alert.id); notify(alert.id, alert.text); }
     }
     setSounding(data.ids.length > 0);
   }

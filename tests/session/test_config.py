@@ -19,11 +19,11 @@ def test_defaults_without_a_file(tmp_path, monkeypatch):
 
 def test_file_and_environment(tmp_path):
     path = tmp_path / "config.yaml"
-    path.write_text('data_dir: data\nlanguage: es\nclinician_pin: "0420"\nadaptation: false\n'
+    path.write_text('data_dir: data\nlanguage: es\nclinician_pin: "042042"\nadaptation: false\n'
                     "timing: {attempt_window_s: 45}\nvosk_model: /opt/vosk\n")
     config = load_config(environ={"KIOSK_CONFIG": str(path)})
     assert config.data_dir == tmp_path / "data"  # relative to the config file
-    assert (config.language, config.clinician_pin, config.adaptation) == ("es", "0420", False)
+    assert (config.language, config.clinician_pin, config.adaptation) == ("es", "042042", False)
     assert config.timing == {"attempt_window_s": 45} and config.vosk_model == Path("/opt/vosk")
     assert not config.default_pin
     env = {"KIOSK_CONFIG": str(path), "KIOSK_DATA_DIR": str(tmp_path / "elsewhere"), "KIOSK_VOSK_MODEL": "/m",
@@ -34,8 +34,8 @@ def test_file_and_environment(tmp_path):
 
 @pytest.mark.parametrize(("text", "message"), [
     ("colour: red\n", ":1:1: unknown setting 'colour'"),
-    ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("0123")'),
-    ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 4 to 12 digits"),
+    ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("012345")'),
+    ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 6 to 12 digits"),
     ("adaptation: maybe\n", ":1:1: adaptation must be true or false"),
     ("timing: {attempt_window_s: -3}\n", ":1:1: timing setting 'attempt_window_s' must be a number"),
     ("timing: {window: 3}\n", ":1:1: unknown timing setting 'window'"),
