@@ -19,7 +19,7 @@ from kiosk.storage import AdaptationRecord, LogEntry, MetricSample, PracticeReco
 from station.db import inbox, sessions
 
 #: the outbox kinds that change a session's status (they refresh the session list)
-LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted")
+LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted", "continue_session")
 
 
 @dataclass(frozen=True)
@@ -55,10 +55,12 @@ def status_of(rows: Iterable[Row]) -> dict[str, Any]:
                 state["status"] = "running"
         elif row.kind == "finish_session":
             state.update(status="finished", finished_at=row.payload.get("finished_at"))
-        elif row.kind == "abandon" and state["status"] in ("running", "pending"):
-            state["status"] = "abandoned"
+        elif row.kind == "abandon" and state["status"] in ("running", "pending", "interrupted"):
+            state["status"] = "abandoned"  # staff may end an interrupted test too
         elif row.kind == "mark_interrupted" and state["status"] in ("running", "pending"):
             state["status"] = "interrupted"
+        elif row.kind == "continue_session" and state["status"] == "interrupted":
+            state["status"] = "running"  # staff continued it on a kiosk
     return state
 
 
