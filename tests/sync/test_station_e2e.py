@@ -89,3 +89,39 @@ def test_replays_reach_the_real_station_even_after_it_was_down(tmp_path):
     assert len(seqs) == len(set(seqs)) and len(seqs) > kept  # both replays' rows, each once
     assert at_station == set(sessions)
     assert all(statuses[s] == "finished" for s in sessions)
+
+
+@pytest.mark.slow
+async def test_a_doctor_call_reaches_the_real_station_and_its_continue_reaches_the_kiosk(tmp_path):
+    """The kiosk as `kiosk run` builds it, reporting to a `kiosk station` process: the patient's
+    doctor call becomes the station's alert; staff's continue (queued in the station's database)
+    is long-polled, applied to the running session and acknowledged."""
+    from kiosk.app import KIOSK_SIZE, build_app
+    from station import auth, db, ward
+    from tests.ui.helpers import until_thread
+
+    db_url = db.sqlite_url(tmp_path / "station")
+    engine = db.open_database(db_url)
+    token = auth.add_kiosk(engine, "ward3-bed2")
+    port = free_port()
+    config = tmp_path / "config.yaml"
+    config.write_text(f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
+                      f"station: {{url: 'http://127.0.0.1:{port}', token: '{token}', kiosk_id: ward3-bed2}}\n")
+    station = start_station(db_url, port, tmp_path / "station.log")
+    app, close = build_app(config_path=config, voice=False, remote=False)
+    try:
+        async with app.run_test(size=KIOSK_SIZE) as pilot:
+            await pilot.press("1", "1")
+            await until_thread(lambda: app.session.current_attempt == 1, "the first question", PATIENCE_S)
+            session = app.session
+            await pilot.press("d")
+            await until_thread(lambda: any(a.session_id == session.id for a in ward.open_alerts(engine, "ward3-bed2")),
+                               "the doctor call at the station", PATIENCE_S)
+            command = ward.queue_command(engine, "ward3-bed2", session.id, "continue", "dr.lopez")
+            await until_thread(lambda: not session.halted, "the kiosk continuing", PATIENCE_S)
+            await until_thread(lambda: ward.recent_commands(engine, session.id)[0].get("result") == "done",
+                               f"the ack of command {command}", PATIENCE_S)
+    finally:
+        close()
+        station.terminate()
+        station.wait(timeout=PATIENCE_S)
