@@ -472,45 +472,16 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def _report_status(self) -> None:
         """Give the station's client what the ward view shows of this kiosk (sent when it changes)."""
-        if self.sync is None:
-            return
-        session, snap = self.session, self.session.snapshot()
-        started = session.phase is not Phase.WELCOME
-        self.sync.set_status({
-            "session_id": session.id if started else None, "patient_id": session.patient_id if started else None,
-            "phase": snap.phase.value, "question": snap.number, "of": snap.count, "paused": snap.paused,
-            "person_away": not snap.person_present, "doctor_called": snap.halted, "simulated": False})
+        if self.sync is not None:
+            from kiosk.sync.commands import live_status
+
+            self.sync.set_status(live_status(self.session))
 
     def station_command(self, command: Any) -> tuple[str, str | None]:
         """A command from the ward station (called on the client's thread): applied on the UI thread."""
-        return self.call_from_thread(self.apply_station_command, dict(command))
+        from kiosk.sync.commands import apply_command
 
-    def apply_station_command(self, command: dict[str, Any]) -> tuple[str, str | None]:
-        """Carry out a station command through the operations the clinician screen uses; returns
-        ("done", None) or ("refused", why)."""
-        kind, session = command.get("kind"), self.session
-        if session.phase is Phase.WELCOME or command.get("session_id") != session.id:
-            return "refused", f"session {command.get('session_id')} is not the one running on this kiosk"
-        if session.finished:
-            return "refused", f"session {session.id} is finished"
-        snap = session.snapshot()
-        if kind == "continue":
-            if not (snap.halted or snap.paused):
-                return "refused", "the session is not waiting for a doctor"
-            self.clinician_continue()
-        elif kind == "person_away":
-            if not snap.person_present:
-                return "refused", "the patient is already marked away"
-            self.person_lost()
-        elif kind == "person_back":
-            if snap.person_present:
-                return "refused", "the patient is not marked away"
-            self.person_back()
-        elif kind == "end":
-            self.end_session(f"ended from the ward station by {command.get('by') or 'staff'}")
-        else:
-            return "refused", f"unknown command {kind!r}"
-        return "done", None
+        return self.call_from_thread(apply_command, self, dict(command))
 
     def end_session(self, reason: str) -> None:
         """Staff end the running test (stored as abandoned, with why); the kiosk welcomes the next patient."""
