@@ -19,6 +19,8 @@ microphone, no espeak-ng, no remote) is shown as off with its reason and the ses
 from __future__ import annotations
 
 import argparse
+import contextlib
+import sqlite3
 import sys
 from functools import partial
 from collections.abc import Callable, Iterable
@@ -272,7 +274,8 @@ class KioskApp(App[int], inherit_bindings=False):
         old, self.session = self.session, session
         self._unsubscribe()
         if self.store is not None and old.id != session.id:
-            self.store.release(old.id)  # a finished one is let go; one still running is interrupted
+            with contextlib.suppress(sqlite3.Error):  # else keep_session lets it go later
+                self.store.release(old.id)  # a finished one is let go; one still running is interrupted
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -304,6 +307,9 @@ class KioskApp(App[int], inherit_bindings=False):
             operation(*args)
         except SessionTaken as taken:
             self._session_lost(str(taken))
+            return
+        except sqlite3.Error as failed:  # the step was rolled back: the session in memory is ahead of it
+            self._session_lost(f"the kiosk could not store its last step ({failed})")
             return
         if self._dirty:
             self._dirty = False
@@ -521,12 +527,14 @@ class KioskApp(App[int], inherit_bindings=False):
         """Renew this kiosk's hold on its session and interrupt the tests whose kiosk is gone (a
         timer calls this); a running session this kiosk no longer holds is let go."""
         assert self.store is not None
-        self.store.renew()
-        self.store.interrupt_stale()
         session = self.session
-        if session.phase is Phase.WELCOME or session.finished:
-            return
-        why = self.store.why_not_held(session.id)
+        try:
+            self.store.renew()
+            self.store.release_others(session.id)  # one this kiosk dropped when it could not write
+            self.store.interrupt_stale()
+            why = None if session.phase is Phase.WELCOME or session.finished else self.store.why_not_held(session.id)
+        except sqlite3.Error:
+            return  # the database is busy or failing: the next round tries again
         if why is not None:
             self._session_lost(why)
 

@@ -96,6 +96,12 @@ class Custody:
                 self._interrupt(session_id, reason)
             self._write("DELETE FROM leases WHERE session_id = ?", (session_id,))
 
+    def release_others(self, keep: str) -> None:
+        """Release every session this kiosk holds but ``keep`` (its running one)."""
+        for session_id in self._my_sessions():
+            if session_id != keep:
+                self.release(session_id)
+
     def _interrupt(self, session_id: str, reason: str) -> None:
         self._write("UPDATE sessions SET status = 'interrupted', interrupted_at = ?, interrupted_reason = ?"
                     " WHERE id = ? AND status = 'running'", (self._iso_now(), reason, session_id))
