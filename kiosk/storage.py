@@ -383,6 +383,12 @@ class Store(Custody):
             " ORDER BY started_at DESC, rowid DESC")]
         return [self.session(i) for i in ids]
 
+    def outbox_waiting(self) -> tuple[int, int]:
+        """Outbox rows waiting for the station, and rows it refused (parked, kept for an engineer)."""
+        waiting, parked = self._db.execute(
+            "SELECT COUNT(*) - COUNT(parked), COUNT(parked) FROM outbox").fetchone()
+        return int(waiting), int(parked)
+
     def resolve(self, ref: str) -> str:
         """A session id from a full id or a unique prefix; KeyError naming the problem otherwise."""
         rows = [r[0] for r in self._db.execute("SELECT id FROM sessions WHERE substr(id, 1, ?) = ?",

@@ -18,7 +18,8 @@ KIOSK = "ward3-bed2"
 
 def config_for(tmp_path, server: Server | None):
     config = tmp_path / "config.yaml"
-    text = f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
+    text = (f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
+            'clinician_pin: "246813"\n')
     if server is not None:
         text += f"station: {{url: '{server.url}', token: {TOKEN}, kiosk_id: {KIOSK}}}\n"
     config.write_text(text)
@@ -69,6 +70,11 @@ async def test_station_commands_continue_mark_away_and_back_and_end_the_running_
             assert session.snapshot().person_present
             refused = await command(5, "continue", session_id="someoneelse")
             assert refused["result"] == "refused" and "not the one running" in refused["reason"]
+            await pilot.press("ctrl+k", *"246813", "enter")  # staff see the station's state too
+            await until_thread(lambda: type(app.screen).__name__ == "ClinicianHomeScreen", "the clinician screen")
+            line = str(app.screen.query_one("#station").render())
+            assert line.startswith(f"Ward station {server.url}: reachable;") and "waiting to be sent" in line
+            app.close_clinician()
             assert await command(6, "end") == {"result": "done"}
             await until_thread(lambda: app.session is not session, "the kiosk starting over")
             await pilot.pause()
