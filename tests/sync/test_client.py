@@ -9,12 +9,9 @@ import threading
 
 import pytest
 
-from kiosk.clock import SimClock
-from kiosk.session import Session
 from kiosk.storage import Store
 from kiosk.sync import SyncClient
-from qos import Engine
-from tests.session.helpers import MODEL, QUESTIONNAIRE, TIMING, Rig
+from tests.session.helpers import Rig, at_first_question
 
 from .ward import TOKEN, Server
 
@@ -28,13 +25,8 @@ def outbox_rows(store: Store) -> list[tuple[int, str, str]]:
 
 def session_with_incidents(store: Store) -> Rig:
     """A session that answers, calls the doctor, is continued, and answers again."""
-    clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=Engine(MODEL), store=store, patient_id="P-SYNC01",
-                      timing=TIMING, familiarisation=False)
-    rig = Rig(session, clock)
-    session.start()
-    session.acknowledge()
-    rig.run_until(session.now() + 15)
+    rig = at_first_question(store, patient_id="P-SYNC01")
+    session = rig.session
     rig.answer(2)
     rig.at(session.now() + 3)
     session.call_doctor()
