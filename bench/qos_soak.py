@@ -87,12 +87,12 @@ def soak(model: Model, day) -> dict:
         elif t > DAY - HOUR:
             last_hour.append(spent)
 
-    sessions, events = simulate_day(Engine(model, start=0.0), day(), timed)
+    sessions, events = simulate_day(Engine(model), day(), timed)
     # memory pass: what the engine holds after the first hour and at the end of the day
     events_of_day = day()
     first = next(events_of_day)  # loads the session data before tracing starts
     tracemalloc.start()
-    engine = Engine(model, start=0.0)
+    engine = Engine(model)
     engine.update(first[1], set=first[2], emit=first[3])
     after_first_hour: list[int] = []
 

@@ -6,6 +6,9 @@ Load a model, feed an :class:`Engine` batches of context updates, read the prope
     engine = Engine(load_model("clarc"))
     result = engine.update(10, set={"PersonDetected": True})
     result.metrics, result.fired
+    engine.advance(75)  # nothing happened since: let the model's timers and time windows run
+
+Times are seconds since the session started; the engine never reads the wall clock.
 
 Context traces (recorded sessions, hand-written scenarios) are loaded with :func:`load_trace` and
 replayed with :func:`replay`, or from the shell with ``python -m qos replay TRACE``.

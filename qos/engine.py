@@ -68,13 +68,14 @@ class Engine:
     """Runs one model: feed it batches of context updates with ``update``, read ``metrics``.
 
     Each ``update`` call is one batch (see :mod:`qos.patterns` for what that means for patterns).
-    Times are seconds on any clock the caller likes, but must never go backwards. ``start`` is when
-    timers start (default: the first time the engine is given); ``origin`` is the calendar time of
-    engine time 0 in seconds since 1970 UTC, for ``schedule`` timers; ``params`` overrides parameters'
-    defaults.
+    Times are seconds since the session started and must never go backwards. ``start`` is when
+    timers start: 0 by default, as in a trace, so that replaying a session's recorded trace fires its
+    timers exactly when the live engine did; None starts them at the first time the engine is given
+    (for a caller on another clock). ``origin`` is the calendar time of engine time 0 in seconds since
+    1970 UTC, for ``schedule`` timers; ``params`` overrides parameters' defaults.
     """
 
-    def __init__(self, model: Model, start: float | None = None, origin: float = 0.0,
+    def __init__(self, model: Model, start: float | None = 0.0, origin: float = 0.0,
                  params: Mapping[str, object] | None = None):
         self.model = model
         beliefs = {**model.properties, **model.beliefvars}

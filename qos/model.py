@@ -1,4 +1,5 @@
-"""The in-memory form of a RoQME model: types, properties, contexts and observations.
+"""The in-memory form of a RoQME model: types, properties and belief variables, contexts (primitive and
+derived), variables, parameters, timers, observations with their actions, and the terms in them.
 
 A :class:`Model` is immutable once loaded; every :class:`~qos.engine.Engine` built from it keeps its
 own run-time state, so one model can serve many engines.

@@ -19,6 +19,7 @@ import math
 import statistics
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +31,7 @@ from qos.files import BadFile, load_data, write_private
 from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")
-_TRACE_KEYS = ("model", "events", "description")
+_TRACE_KEYS = ("model", "events", "description", "origin")
 
 
 def seconds(t: float) -> float | int:
@@ -66,6 +67,13 @@ class Trace:
     description: str | None = None
     #: the file it was loaded from, for messages and relative model paths
     source: Path | None = None
+    #: the calendar time of t = 0 (ISO 8601, UTC unless it says otherwise), for ``schedule`` timers
+    origin: str | None = None
+
+    @property
+    def origin_seconds(self) -> float:
+        """The origin in seconds since 1970 UTC (0 when the trace has none)."""
+        return _calendar(self.origin, self.name) if self.origin is not None else 0.0
 
     @property
     def name(self) -> str:
@@ -125,6 +133,8 @@ class Trace:
         data: dict[str, object] = {"model": self.model}
         if self.description:
             data["description"] = self.description
+        if self.origin:
+            data["origin"] = self.origin
         data["events"] = [event.to_dict() for event in self.events]
         return data
 
@@ -134,6 +144,8 @@ class Trace:
         lines.append(f"model: {_flow(self.model)}")
         if self.description:
             lines.append(f"description: {_flow(self.description)}")
+        if self.origin:
+            lines.append(f"origin: {_flow(self.origin)}")
         lines.append("events:" if self.events else "events: []")
         lines += [f"  - {_flow(event.to_dict())}" for event in self.events]
         return "\n".join(lines) + "\n"
@@ -186,7 +198,7 @@ def trace_from_data(data: object, source: Path | None = None) -> Trace:
         raise TraceError(f"{name}: a trace must be a mapping with 'model' and 'events'")
     unknown = [key for key in data if key not in _TRACE_KEYS]
     if unknown:
-        raise TraceError(f"{name}: unknown key {unknown[0]!r} (a trace has model, events and description)")
+        raise TraceError(f"{name}: unknown key {unknown[0]!r} (a trace has model, events, description and origin)")
     model = data.get("model")
     if not isinstance(model, str) or not model:
         raise TraceError(f"{name}: 'model' must name a bundled model or a .roqme file, not {model!r}")
@@ -196,8 +208,25 @@ def trace_from_data(data: object, source: Path | None = None) -> Trace:
     description = data.get("description")
     if description is not None and not isinstance(description, str):
         raise TraceError(f"{name}: 'description' must be text")
+    origin = data.get("origin")
+    if isinstance(origin, datetime):  # YAML reads an unquoted timestamp as one
+        origin = origin.isoformat()
+    if origin is not None:
+        if not isinstance(origin, str):
+            raise TraceError(f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {origin!r}")
+        _calendar(origin, name)
     parsed = [_parse_event(raw, f"{name}: events[{index}]") for index, raw in enumerate(events)]
-    return Trace(model, parsed, description, source)
+    return Trace(model, parsed, description, source, origin)
+
+
+def _calendar(text: str, name: str) -> float:
+    """An ISO 8601 date and time in seconds since 1970 UTC (UTC when it names no zone)."""
+    try:
+        moment = datetime.fromisoformat(text.replace("Z", "+00:00"))
+    except ValueError:
+        raise TraceError(f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {text!r}") \
+            from None
+    return (moment if moment.tzinfo else moment.replace(tzinfo=timezone.utc)).timestamp()
 
 
 def load_trace(path: str | Path) -> Trace:
@@ -289,8 +318,7 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if not isinstance(trace, Trace):
         trace = load_trace(trace)
     model = trace.check(model)
-    # the trace's clock starts with the session: timers start at t = 0
-    engine = Engine(model, start=0.0)
+    engine = Engine(model, origin=trace.origin_seconds)
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1

@@ -9,8 +9,7 @@ HEAD = ("roqme M\nproperty P\ncontext B : boolean\ncontext C : boolean\ncontext 
 
 
 def engine_for(body: str, head: str = HEAD, **options) -> Engine:
-    """An engine (timers starting at t = 0) for the model ``head + body``."""
-    options.setdefault("start", 0.0)
+    """An engine for the model ``head + body``."""
     return Engine(parse_model(head + body, "m.roqme"), **options)
 
 

@@ -51,7 +51,7 @@ def test_the_example_replays_identically_from_python_and_from_the_shell():
 
 def test_silence_and_slow_answers_lower_the_metrics_they_should():
     model = load_model("kiosk_pace")
-    engine = Engine(model, start=0.0)
+    engine = Engine(model)
     engine.update(0, set={"PersonDetected": True})
     engine.update(5, emit=["QuestionAsked"])
     before = engine.metrics(5)["Interaction"]

@@ -153,3 +153,33 @@ def test_postfix_forms_of_update_event_when_and_period():
     assert (times(fired, "O"), times(fired, "Q"), times(fired, "R")) == ([0, 5, 6], [1], [5])
     with pytest.raises(ModelError, match=r"m\.roqme:8:17: the pattern operator 'update' cannot be used in a value"):
         parse_model(HEAD + "observation O : N'update > 1 reinforces P\n", "m.roqme")
+
+
+def test_timers_start_with_the_session_so_a_recorded_trace_replays_them_exactly(tmp_path):
+    from qos import Engine, TraceRecorder, dump_trace
+
+    model_path = tmp_path / "m.roqme"
+    model_path.write_text(HEAD + "timer T := 10 seconds\nobservation O : T reinforces P\nobservation Q : B reinforces P\n",
+                          encoding="utf-8")
+    live = Engine(load_model(model_path))
+    recorder = TraceRecorder(live, "m.roqme")
+    live_fired = []
+    live.subscribe(lambda result: live_fired.append({"t": result.t, "observations": result.fired})
+                   if result.fired else None)
+    live.update(3.5, set={"B": True})  # the patient starts a few seconds into the session
+    live.update(27, set={"B": True})
+    assert [entry["t"] for entry in live_fired] == [3.5, 10, 20, 27]
+    assert [event.t for event in recorder.trace.events] == [3.5, 27]  # timer batches are not recorded
+    dump_trace(recorder.trace, tmp_path / "t.yaml")
+    assert replay(tmp_path / "t.yaml")["fired"] == live_fired
+
+
+def test_a_traces_origin_places_scheduled_timers_on_the_calendar(tmp_path):
+    (tmp_path / "m.roqme").write_text(HEAD + 'timer Nine := schedule("0, 9, *, *, *")\nobservation O : Nine reinforces P\n',
+                                      encoding="utf-8")
+    trace = "model: m.roqme\norigin: {origin}\nevents:\n  - {{t: 7200, set: {{B: true}}}}\n"
+    (tmp_path / "t.yaml").write_text(trace.format(origin="2026-11-23T08:00:00Z"), encoding="utf-8")
+    assert replay(tmp_path / "t.yaml")["fired"] == [{"t": 3600, "observations": ["O"]}]  # 09:00
+    (tmp_path / "t.yaml").write_text(trace.format(origin="tomorrow"), encoding="utf-8")
+    with pytest.raises(TraceError, match="'origin' must be a date and time such as 2026-11-23T09:00:00Z"):
+        replay(tmp_path / "t.yaml")

@@ -14,7 +14,7 @@ MALFORMED = [
     ("- just a list\n", "t.yaml: a trace must be a mapping with 'model' and 'events'"),
     ("model: clarc\nevents: {}\n", "t.yaml: 'events' must be a list, not {}"),
     ("model: 3\nevents: []\n", "t.yaml: 'model' must name a bundled model or a .roqme file, not 3"),
-    ("model: clarc\nevents: []\nsession: 4\n", "t.yaml: unknown key 'session' (a trace has model, events and description)"),
+    ("model: clarc\nevents: []\nsession: 4\n", "t.yaml: unknown key 'session' (a trace has model, events, description and origin)"),
     ("model: clarc\nevents:\n  - 10\n", "t.yaml: events[0]: an event must be a mapping with t and set and/or emit, not 10"),
     ("model: clarc\nevents:\n  - {set: {PersonDetected: true}}\n", "t.yaml: events[0]: missing time 't'"),
     ("model: clarc\nevents:\n  - {t: 1, set: {PersonDetected: true}}\n  - {t: -5, set: {PersonDetected: true}}\n",
