@@ -111,12 +111,14 @@ class Custody:
         """Running sessions whose kiosk is gone, or older than the limit: (id, why)."""
         now = self._wall()
         stale = []
-        for session_id, started_at, host, pid, token, renewed_at in self._db.execute(
-                "SELECT s.id, s.started_at, l.host, l.pid, l.token, l.renewed_at FROM sessions s"
+        for session_id, started_at, simulated, host, pid, token, renewed_at in self._db.execute(
+                "SELECT s.id, s.started_at, s.simulated, l.host, l.pid, l.token, l.renewed_at FROM sessions s"
                 " LEFT JOIN leases l ON l.session_id = s.id WHERE s.status = 'running'").fetchall():
             why = "no kiosk held it" if host is None else lapsed(Owner(host, int(pid), token), float(renewed_at),
                                                                  now, self.lease_ttl_s, self.owner)
-            if why is None and self.interrupt_after_s is not None and _age_s(started_at, now) > self.interrupt_after_s:
+            # a simulated session's start is on the replay's simulated clock: its age means nothing
+            if why is None and not simulated and self.interrupt_after_s is not None \
+                    and _age_s(started_at, now) > self.interrupt_after_s:
                 why = f"not finished within {self.interrupt_after_s / 60:g} minutes"
             if why is not None:
                 stale.append((session_id, why))

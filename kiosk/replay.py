@@ -39,6 +39,7 @@ from kiosk.session import (
     SessionEvent,
 )
 from kiosk.adaptation import MODEL
+from kiosk.lease import SessionTaken
 from kiosk.yamlmarks import Problem, describe, parse_file, schema_problems
 from qos.errors import QosError
 from qos.trace import seconds
@@ -518,6 +519,9 @@ def main(argv: list[str]) -> int:
             results.append(run_script(load_script(file, questionnaire), questionnaire, store=store, policy=policy))
     except ScriptError as exc:
         print(exc, file=sys.stderr)
+        return 2
+    except SessionTaken as exc:  # another kiosk on this data directory took the session over
+        print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     finally:
         if store is not None:
