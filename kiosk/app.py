@@ -483,7 +483,7 @@ class KioskApp(App[int], inherit_bindings=False):
 
             self.sync.set_status(live_status(self.session))
 
-    def station_command(self, command: Any) -> tuple[str, str | None]:
+    def station_command(self, command: Any) -> tuple[str, str | None] | None:
         """A command from the ward station (called on the client's thread): applied on the UI thread."""
         from kiosk.sync.commands import apply_command
 

@@ -76,6 +76,13 @@ class Custody:
     def _my_sessions(self) -> list[str]:
         return [r[0] for r in self._db.execute("SELECT session_id FROM leases WHERE token = ?", (self.owner.token,))]
 
+    def held_elsewhere(self, session_id: str) -> bool:
+        """Whether another running kiosk process holds the session (say another browser tab of
+        `kiosk serve` on this data directory)."""
+        holder = self._holder(session_id)
+        return holder is not None and holder[0].token != self.owner.token \
+            and lapsed(holder[0], holder[1], self._wall(), self.lease_ttl_s, self.owner) is None
+
     def holds(self, session_id: str) -> bool:
         """Whether this kiosk holds the session now."""
         return self.why_not_held(session_id) is None

@@ -65,12 +65,13 @@ class SyncClient:
     """Delivers the outbox of the database at ``db_path`` to the station at ``url`` as ``kiosk_id``.
 
     ``on_command(command) -> (result, reason)`` applies a station command (called on the commands
-    thread; it must hand the work to the UI thread itself); without it no commands are fetched.
+    thread; it must hand the work to the UI thread itself; None: not this process's to answer,
+    no ack, so the station re-delivers it); without it no commands are fetched.
     ``backoff`` is (first, most) in seconds.
     """
 
     def __init__(self, db_path: Path, *, url: str, token: str, kiosk_id: str,
-                 on_command: Callable[[Mapping[str, Any]], Outcome] | None = None,
+                 on_command: Callable[[Mapping[str, Any]], Outcome | None] | None = None,
                  backoff: tuple[float, float] = (0.5, 60.0), heartbeat_s: float = HEARTBEAT_S,
                  poll_wait_s: float = POLL_WAIT_S) -> None:
         self.station = Station(url, token)
@@ -221,9 +222,12 @@ class SyncClient:
                 if self._stopping.is_set() or not isinstance(command, dict):
                     break
                 try:
-                    result, reason = self._on_command(command)
+                    outcome = self._on_command(command)
                 except Exception:  # noqa: BLE001 - the kiosk is closing: not acked, so re-delivered
                     continue
+                if outcome is None:
+                    continue
+                result, reason = outcome
                 ack: dict[str, Any] = {"result": result}
                 if reason:
                     ack["reason"] = reason

@@ -18,6 +18,7 @@ class Kiosk(Protocol):
     """What a command needs of the kiosk app."""
 
     session: Session
+    store: Any
 
     def clinician_continue(self) -> None: ...
     def person_lost(self) -> None: ...
@@ -34,9 +35,13 @@ def live_status(session: Session) -> dict[str, Any]:
             "person_away": not snap.person_present, "doctor_called": snap.halted, "simulated": False}
 
 
-def apply_command(kiosk: Kiosk, command: Mapping[str, Any]) -> Outcome:
-    """Carry out a station command on the running session: ("done", None) or ("refused", why)."""
+def apply_command(kiosk: Kiosk, command: Mapping[str, Any]) -> Outcome | None:
+    """Carry out a station command on the running session: ("done", None) or ("refused", why);
+    None when another kiosk process on this data directory runs that session (it answers)."""
     kind, session = command.get("kind"), kiosk.session
+    if command.get("session_id") != session.id and kiosk.store is not None \
+            and kiosk.store.held_elsewhere(str(command.get("session_id"))):
+        return None
     if session.phase is Phase.WELCOME or command.get("session_id") != session.id:
         return "refused", f"session {command.get('session_id')} is not the one running on this kiosk"
     if session.finished:

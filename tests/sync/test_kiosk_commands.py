@@ -5,15 +5,31 @@ nothing of the sync client runs."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
+from contextlib import contextmanager
 
 from kiosk.app import KIOSK_SIZE, build_app
+from kiosk.lease import Owner
 from kiosk.session import Phase
+from kiosk.storage import Store
 from tests.ui.helpers import until_thread
 
 from .ward import TOKEN, Server
 
 KIOSK = "ward3-bed2"
+
+
+@contextmanager
+def other_kiosk():
+    """A real process standing in for another kiosk process on the same data directory."""
+    child = subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"], stdin=subprocess.PIPE)
+    try:
+        yield child.pid
+    finally:
+        child.kill()
+        child.wait(timeout=30)
 
 
 def config_for(tmp_path, server: Server | None):
@@ -75,7 +91,16 @@ async def test_station_commands_continue_mark_away_and_back_and_end_the_running_
             line = str(app.screen.query_one("#station").render())
             assert line.startswith(f"Ward station {server.url}: reachable;") and "waiting to be sent" in line
             app.close_clinician()
-            assert await command(6, "end") == {"result": "done"}
+            # a session another kiosk process on this data directory runs (another tab of kiosk
+            # serve): its command is left for that process, never refused from here
+            with other_kiosk() as pid:
+                elsewhere = Store.open(tmp_path / "data", owner=Owner(pid=pid))
+                elsewhere.create_session(session_id="other1", patient_id="P-OTHER1", questionnaire_id="barthel",
+                                         language="en", answered_by="patient", started_at="2026-11-23T15:00:00+00:00",
+                                         timing={})
+                ward.queue({"id": 7, "kind": "continue", "session_id": "other1", "by": "dr.lopez", "at": "x"})
+                assert await command(6, "end") == {"result": "done"}
+                assert 7 not in ward.acks
             await until_thread(lambda: app.session is not session, "the kiosk starting over")
             await pilot.pause()
             assert app.session.phase is Phase.WELCOME and type(app.screen).__name__ == "WelcomeScreen"
