@@ -15,6 +15,7 @@ from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
 from kiosk.widgets.bars import AdaptationBanner, ChannelBar, ChannelLine, VoiceAgainButton
 from kiosk.widgets.text import ui_text
+from kiosk.widgets.waiting_sign import WaitingSign
 
 
 @dataclass(frozen=True)
@@ -29,6 +30,16 @@ class PatientView:
     banner: str | None = None
     #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
     voice_again: bool = False
+    #: session time now (the waiting sign's slow dot follows it)
+    now: float = 0.0
+    #: the end screen shows the total and band (a site's choice; default: staff only)
+    show_score: bool = False
+
+    @property
+    def waiting(self) -> bool:
+        """An answer is awaited now (an attempt is open and nothing stops the clock)."""
+        snap = self.snapshot
+        return snap.attempt is not None and not (snap.paused or snap.halted) and snap.person_present
 
 
 class PatientScreen(Screen):
@@ -85,6 +96,8 @@ class PatientScreen(Screen):
             banner.show(view.banner)
         for button in self.query(VoiceAgainButton):
             button.show(view.voice_again)
+        for sign in self.query(WaitingSign):
+            sign.show(view.waiting, view.now)
 
     def progress_text(self, view: PatientView) -> str:
         """The left of the top bar: the questionnaire's title unless a screen says more."""
