@@ -259,8 +259,8 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "serve_max_sessions":
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 16:
                 raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
-        elif key == "language" and not isinstance(value, str):
-            raise fail((key,), "language must be en, es or fr")
+        elif key == "language" and (not isinstance(value, str) or value not in SCREEN_LANGUAGES):
+            raise fail((key,), f"language must be one of {', '.join(SCREEN_LANGUAGES)}")
         elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.match(value)):
             raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
         elif key == "fhir":

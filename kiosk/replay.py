@@ -38,6 +38,7 @@ from kiosk.session import (
     Session,
     SessionEvent,
 )
+from kiosk.lease import SessionTaken
 from kiosk.qos_model import DEFAULT_MODEL
 from kiosk.yamlmarks import Problem, describe, parse_file, schema_problems
 from qos.errors import QosError
@@ -582,6 +583,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--config", metavar="FILE",
                         help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
                              "band set, adaptation policy and QoS model are the ones replayed, as at the kiosk")
+    parser.add_argument("--station-wait", metavar="S", type=float, default=30.0,
+                        help="with a station configured, how long to try delivering the stored sessions to it "
+                             "before exiting (default 30; what is left goes with the next kiosk run)")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
@@ -604,7 +608,8 @@ def main(argv: list[str]) -> int:
         from kiosk.storage import StorageError, Store
 
         try:
-            store = Store.open(args.data_dir, simulated=True)  # scripted patients: never offered to anyone
+            # scripted patients: never offered to anyone; queued for the station when there is one
+            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None)
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
@@ -616,9 +621,18 @@ def main(argv: list[str]) -> int:
     except ScriptError as exc:
         print(exc, file=sys.stderr)
         return 2
+    except SessionTaken as exc:  # another kiosk on this data directory took the session over
+        print(f"kiosk replay: {exc}", file=sys.stderr)
+        return 2
     finally:
         if store is not None:
             store.close()
+    if store is not None and config.station is not None:
+        from kiosk.sync import deliver_pending
+
+        unsent = deliver_pending(store.path, config.station, max(0.0, args.station_wait))
+        if unsent:
+            print(f"kiosk replay: {unsent}", file=sys.stderr)
     if args.trace:
         from qos import dump_trace
         from qos.files import write_error

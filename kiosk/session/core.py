@@ -323,15 +323,16 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
                 self._repeating = False
                 self._context(t, {"TestState": "STARTED"})
 
-    def abandon(self) -> bool:
-        """The clinician starts over for the next patient: a started, unfinished session is logged
-        and marked abandoned in the store (its answers stay) so a restart does not offer to resume
-        it. True if it was abandoned; a session still on the welcome screen or finished is left as it is.
+    def abandon(self, reason: str = "a new session was started") -> bool:
+        """The clinician starts over for the next patient (or staff end the test from the ward
+        station; ``reason`` says which): a started, unfinished session is logged and marked
+        abandoned in the store (its answers stay) so a restart does not offer to resume it. True
+        if it was abandoned; a session still on the welcome screen or finished is left as it is.
         """
         with Operation(self) as t:
             if self.phase is Phase.WELCOME or self.finished:
                 return False
-            self._log(t, "abandoned", "a new session was started")
+            self._log(t, "abandoned", reason)
             if self.store is not None:
                 self.store.abandon(self.id)
             return True
