@@ -38,7 +38,8 @@ from kiosk.session import (
     Session,
     SessionEvent,
 )
-from kiosk.adaptation import MODEL
+from kiosk.lease import SessionTaken
+from kiosk.qos_model import DEFAULT_MODEL
 from kiosk.yamlmarks import Problem, describe, parse_file, schema_problems
 from qos.errors import QosError
 from qos.trace import seconds
@@ -515,25 +516,30 @@ class _Driver:
 
 
 def run_script(script: Script, questionnaire: Questionnaire | None = None, *, store: Any = None,
-               model: Any = None, policy: Any = None) -> ReplayResult:
+               model: str = DEFAULT_MODEL, policy: Any = None) -> ReplayResult:
     """Run a script through a real Session and QoS engine on a simulated clock, adapting by
-    ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on."""
+    ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on.
+
+    ``model`` is the QoS model (a bundled name or a .roqme path, as ``qos_model:`` in the
+    configuration); its timers fire on the simulated clock while nothing happens, as at the kiosk.
+    """
     from kiosk.adaptation import Adaptation, load_policy
-    from qos import Engine, Trace, load_model, replay
+    from kiosk.qos_model import load_kiosk_model
+    from qos import Engine, Trace, replay
 
     questionnaire = questionnaire or load_questionnaire()
-    model = model or load_model(MODEL)
+    reference, model = model, load_kiosk_model(model)
     clock = SimClock()
     session = Session(
         questionnaire, clock=clock, engine=Engine(model), store=store, patient_id=script.patient,
         language=script.language, answered_by=script.answered_by, timing=script.timing,
-        adaptation=Adaptation(policy or load_policy()) if script.adaptation else None,
+        adaptation=Adaptation(policy or load_policy(model=model)) if script.adaptation else None,
         familiarisation=script.practice is not None,
     )
     driver = _Driver(script, session, clock)
     try:
         driver.run()
-        trace = Trace.from_events(MODEL, session.trace)
+        trace = Trace.from_events(reference, session.trace)
         summary = replay(trace, model=model)
     except (ScriptError, QosError) as exc:
         if store is not None:
@@ -576,21 +582,25 @@ def main(argv: list[str]) -> int:
                         help="also store the replayed sessions in this data directory (see `kiosk results`)")
     parser.add_argument("--config", metavar="FILE",
                         help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
-                             "band set and adaptation policy are the ones replayed, as at the kiosk")
+                             "band set, adaptation policy and QoS model are the ones replayed, as at the kiosk")
+    parser.add_argument("--station-wait", metavar="S", type=float, default=30.0,
+                        help="with a station configured, how long to try delivering the stored sessions to it "
+                             "before exiting (default 30; what is left goes with the next kiosk run)")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
     from kiosk.adaptation import PolicyError, load_policy
     from kiosk.config import ConfigError, configured_questionnaire, load_config
+    from kiosk.qos_model import load_kiosk_model
 
     try:
         config = load_config(args.config)
         questionnaire = configured_questionnaire(config)
-        policy = load_policy(config.adaptation_policy)
+        policy = load_policy(config.adaptation_policy, model=load_kiosk_model(config.qos_model))
     except QuestionnaireError as exc:
         print(f"kiosk replay: the questionnaire is invalid: {exc}", file=sys.stderr)
         return 2
-    except (ConfigError, PolicyError) as exc:
+    except (ConfigError, PolicyError, QosError) as exc:
         print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     store = None
@@ -598,20 +608,31 @@ def main(argv: list[str]) -> int:
         from kiosk.storage import StorageError, Store
 
         try:
-            store = Store.open(args.data_dir, simulated=True)  # scripted patients: never offered to anyone
+            # scripted patients: never offered to anyone; queued for the station when there is one
+            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None)
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
     results = []
     try:
         for file in args.files:
-            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store, policy=policy))
+            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store,
+                                      model=config.qos_model, policy=policy))
     except ScriptError as exc:
         print(exc, file=sys.stderr)
+        return 2
+    except SessionTaken as exc:  # another kiosk on this data directory took the session over
+        print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     finally:
         if store is not None:
             store.close()
+    if store is not None and config.station is not None:
+        from kiosk.sync import deliver_pending
+
+        unsent = deliver_pending(store.path, config.station, max(0.0, args.station_wait))
+        if unsent:
+            print(f"kiosk replay: {unsent}", file=sys.stderr)
     if args.trace:
         from qos import dump_trace
         from qos.files import write_error
