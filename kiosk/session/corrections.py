@@ -104,7 +104,7 @@ class Corrections:
         item = self.questionnaire.items[open_.index]
         self._log(t, "answer_confirmed", f"{item.id} option {pending.option} by {event.channel.value} "
                                          f"{event.detail!r}")
-        self._record_answer(t, pending.option, pending.channel, pending.detail)
+        self._record_answer(t, pending.option, pending.channel, f"{pending.detail} (confirmed)")
 
     def _not_confirmed(self: Session, t: float, why: str) -> None:
         """The answer waiting for confirmation is dropped: asked again, or (timed out) the attempt ends."""
