@@ -32,7 +32,13 @@ class FamiliarisationScreen(PatientScreen):
         else:
             yield QuestionPanel(practice.text[self.language],
                                 [o.label_in(self.language) for o in practice.options])
-        yield ControlBar(self.language)
+        yield ControlBar(self.language, repeat=self.view.ways.voice_out)
+
+    def show(self, view: PatientView) -> None:
+        """Offer Repeat only while the kiosk can speak."""
+        super().show(view)
+        for bar in self.query(ControlBar):
+            bar.show_repeat(view.ways.voice_out)
 
     def progress_text(self, view: PatientView) -> str:
         """"Practice 1 of 3" (of those asked on this kiosk, as the session counts them)."""

@@ -92,11 +92,13 @@ class ControlBar(Horizontal):
             """What the patient asked for."""
             super().__init__()
 
-    def __init__(self, language: str, *, paused: bool = False) -> None:
-        """Label the buttons in ``language``; while ``paused`` the pause button resumes."""
+    def __init__(self, language: str, *, paused: bool = False, repeat: bool = True) -> None:
+        """Label the buttons in ``language``; while ``paused`` the pause button resumes. Repeat is
+        shown only while ``repeat`` (the kiosk can speak: without a voice it would do nothing)."""
         super().__init__(id="controls")
         self.language = language
         self.paused = paused
+        self.repeat = repeat
 
     def compose(self) -> ComposeResult:
         """Pause (or Continue), Repeat and Call doctor, each with its key letter."""
@@ -106,6 +108,16 @@ class ControlBar(Horizontal):
             yield Button(ui_text(self.language, "pause"), id="pause", classes="control")
             yield Button(ui_text(self.language, "repeat"), id="repeat", classes="control")
         yield Button(ui_text(self.language, "call_doctor"), id="call-doctor", classes="control")
+
+    def on_mount(self) -> None:
+        """Hide Repeat if the kiosk cannot speak."""
+        self.show_repeat(self.repeat)
+
+    def show_repeat(self, shown: bool) -> None:
+        """Offer Repeat or not (voice out came or went)."""
+        self.repeat = shown
+        for button in self.query("#repeat").results(Button):
+            button.display = shown
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         """Turn a touched control into the command it stands for."""

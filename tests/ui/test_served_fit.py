@@ -1,0 +1,140 @@
+"""The served kiosk in real Chromium fits the display: at 1024x600 with ?fontsize=28, 1280x800
+and 1920x1080 (no ?fontsize: the page's large default), every question in every language is
+tapped through on the real page; each answer lies wholly inside the viewport and the text is at
+least 24 px. Where the answers lie comes from the same app laid out by Textual at the terminal
+size the page reports (as in test_served.py)."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from kiosk.session import Phase
+
+from .fit import problems
+from .helpers import screen_name, settle
+from .test_served import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, _answers, served_kiosk  # noqa: F401
+
+#: the smallest text the page may draw (px): what an 85-year-old can still read on the panel
+MIN_TEXT_PX = 24
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(not __import__("pathlib").Path(CHROMIUM).exists(), reason="no Debian chromium"),
+]
+
+
+async def _layout(ui_kiosk, size: tuple[int, int], language: str) -> list:
+    """For the language button, Start and each question in turn: the regions to tap, and each
+    question's answer regions, with the same app laid out headless at ``size``."""
+    kiosk = ui_kiosk(familiarisation=False)
+    number = kiosk.questionnaire.languages.index(language) + 1
+    async with kiosk.app.run_test(size=size) as pilot:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        steps = [("language", kiosk.app.screen.query_one(f"#language-{language}").region, [])]
+        await pilot.press(str(number))
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        steps.append(("start", kiosk.app.screen.query_one("#understood").region, []))
+        await pilot.press("1")
+        for item in kiosk.questionnaire.items:
+            kiosk.to_next_deadline()
+            await settle(pilot, lambda: kiosk.session.current_item == item and kiosk.session.current_attempt == 1)
+            await settle(pilot)
+            assert not problems(kiosk.app.screen), (item.id, problems(kiosk.app.screen))
+            regions = [b.region for b in kiosk.app.screen.query("AnswerButton")]
+            steps.append((item.id, regions[-1], regions))
+            await pilot.press(str(len(item.options)))
+            await settle(pilot, lambda: item.id in kiosk.session.answers)
+        assert kiosk.session.phase in (Phase.QUESTIONS, Phase.SUMMARY)
+    return steps
+
+
+@pytest.mark.parametrize("viewport,fontsize", [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
+                         ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"])
+@pytest.mark.parametrize("language", ["en", "es", "fr"])
+async def test_every_question_fits_the_served_page(served_kiosk, ui_kiosk, viewport, fontsize, language):  # noqa: F811
+    from playwright.async_api import async_playwright
+
+    port, database = served_kiosk
+    width, height = viewport
+    async with async_playwright() as pw:
+        browser = await pw.chromium.launch(executable_path=CHROMIUM, headless=True,
+                                           args=[*CHROMIUM_ARGS, "--disable-quic"])
+        try:
+            page = await browser.new_page(viewport={"width": width, "height": height})
+            outside = []
+            page.on("request", lambda r: outside.append(r.url) if not r.url.startswith(
+                ("http://127.0.0.1", "ws://127.0.0.1", "data:")) else None)
+            sockets = []
+            painted = bytearray()  # what the server sent the page to draw, so far
+
+            def follow(ws) -> None:
+                sockets.append(ws)
+                ws.on("framereceived", lambda data: painted.extend(
+                    data if isinstance(data, bytes) else data.encode()))
+
+            def shown_since(text: str, offset: int):
+                """The server sent the page ``text`` to draw after ``offset`` bytes."""
+                return lambda: text.encode() in painted[offset:]
+
+            tapped_at = 0
+            page.on("websocket", follow)
+            await page.goto(f"http://127.0.0.1:{port}/" + (f"?fontsize={fontsize}" if fontsize else ""))
+            screen = page.locator(".xterm-screen")
+            await screen.wait_for(timeout=PATIENCE_S * 1000)
+            await page.wait_for_function("document.body.classList.contains('-first-byte')",
+                                         timeout=PATIENCE_S * 1000)
+            font_px = float(await page.evaluate(
+                "getComputedStyle(document.querySelector('.xterm-char-measure-element')).fontSize"
+                ".replace('px', '')"))
+            assert font_px >= MIN_TEXT_PX
+            if fontsize is None:
+                assert font_px >= 28, "without ?fontsize the page should still draw large text"
+            query = dict(part.split("=") for part in sockets[0].url.split("?", 1)[1].split("&"))
+            size = (int(query["width"]), int(query["height"]))
+            box = await screen.bounding_box()
+            assert box["x"] >= 0 and box["y"] >= 0
+            assert box["x"] + box["width"] <= width and box["y"] + box["height"] <= height
+            cell_w, cell_h = box["width"] / size[0], box["height"] / size[1]
+            steps = await _layout(ui_kiosk, size, language)
+
+            def pixels(region) -> tuple[float, float, float, float]:
+                return (box["x"] + region.x * cell_w, box["y"] + region.y * cell_h,
+                        box["x"] + region.right * cell_w, box["y"] + region.bottom * cell_h)
+
+            async def wait_until(check, what: str) -> None:
+                deadline = time.monotonic() + PATIENCE_S
+                while not check():
+                    assert time.monotonic() < deadline, f"never saw {what}"
+                    await page.wait_for_timeout(50)  # lets Playwright deliver frames; bounded by PATIENCE_S
+
+            from kiosk.questionnaire import load_questionnaire
+            from kiosk.widgets.text import language_name, ui_text
+
+            questionnaire = load_questionnaire()
+            explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
+            answered = 0
+            for name, target, regions in steps:
+                for region in regions:
+                    left, top, right, bottom = pixels(region)
+                    assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
+                        f"{name}: an answer at {left:.0f},{top:.0f}-{right:.0f},{bottom:.0f} px is not "
+                        f"inside the {width}x{height} viewport")
+                if name == "language":  # the welcome is on the page
+                    await wait_until(shown_since(language_name(language), 0), "the welcome")
+                elif name == "start":  # the explanation is on the page
+                    await wait_until(shown_since(explanation, tapped_at), "the explanation")
+                elif regions:  # this question is open on the page: its number is in the top bar
+                    progress = ui_text(language, "question_of", number=answered + 1, total=len(questionnaire.items))
+                    await wait_until(shown_since(progress, tapped_at), f"{name} on the page")
+                tapped_at = len(painted)
+                left, top, right, bottom = pixels(target)
+                await page.mouse.click((left + right) / 2, (top + bottom) / 2)
+                if regions:
+                    answered += 1
+                    await wait_until(lambda: len(_answers(database)) == answered, f"{name} stored")
+            assert [a[0] for a in _answers(database)] == [s[0] for s in steps[2:]]
+            assert outside == [], f"the page fetched from outside this machine: {outside}"
+        finally:
+            await browser.close()
