@@ -12,6 +12,7 @@ import pytest
 
 from kiosk.session import Phase
 
+from .conftest import UiKiosk
 from .fit import problems
 from .helpers import screen_name, settle
 from .test_served import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, _answers, served_kiosk  # noqa: F401
@@ -25,10 +26,11 @@ pytestmark = [
 ]
 
 
-async def _layout(ui_kiosk, size: tuple[int, int], language: str) -> list:
+async def _layout(folder, size: tuple[int, int], language: str) -> list:
     """For the language button, Start and each question in turn: the regions to tap, and each
-    question's answer regions, with the same app laid out headless at ``size``."""
-    kiosk = ui_kiosk(familiarisation=False)
+    question's answer regions, with the same app laid out headless at ``size`` (its own store in
+    ``folder``: the served kiosk's database must hold only the taps)."""
+    kiosk = UiKiosk(folder, familiarisation=False)
     number = kiosk.questionnaire.languages.index(language) + 1
     async with kiosk.app.run_test(size=size) as pilot:
         await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
@@ -47,13 +49,26 @@ async def _layout(ui_kiosk, size: tuple[int, int], language: str) -> list:
             await pilot.press(str(len(item.options)))
             await settle(pilot, lambda: item.id in kiosk.session.answers)
         assert kiosk.session.phase in (Phase.QUESTIONS, Phase.SUMMARY)
+    kiosk.store.close()
     return steps
+
+
+def _opening(text: str, most: int = 40) -> str:
+    """The question's first words, short enough to be drawn on one line, long enough to tell it
+    from the question before ("Do you have accidents with your urine?" after "...stools?")."""
+    words = text.split()
+    kept = [words[0]]
+    for word in words[1:]:
+        if len(" ".join([*kept, word])) > most:
+            break
+        kept.append(word)
+    return " ".join(kept)
 
 
 @pytest.mark.parametrize("viewport,fontsize", [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
                          ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"])
 @pytest.mark.parametrize("language", ["en", "es", "fr"])
-async def test_every_question_fits_the_served_page(served_kiosk, ui_kiosk, viewport, fontsize, language):  # noqa: F811
+async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factory, viewport, fontsize, language):  # noqa: F811
     from playwright.async_api import async_playwright
 
     port, database = served_kiosk
@@ -85,9 +100,8 @@ async def test_every_question_fits_the_served_page(served_kiosk, ui_kiosk, viewp
             await screen.wait_for(timeout=PATIENCE_S * 1000)
             await page.wait_for_function("document.body.classList.contains('-first-byte')",
                                          timeout=PATIENCE_S * 1000)
-            font_px = float(await page.evaluate(
-                "getComputedStyle(document.querySelector('.xterm-char-measure-element')).fontSize"
-                ".replace('px', '')"))
+            # the size the page gave xterm.js (it may shrink the asked size, never below the floor)
+            font_px = float(await page.evaluate("document.getElementById('terminal').dataset.fontSize"))
             assert font_px >= MIN_TEXT_PX
             if fontsize is None:
                 assert font_px >= 28, "without ?fontsize the page should still draw large text"
@@ -97,7 +111,8 @@ async def test_every_question_fits_the_served_page(served_kiosk, ui_kiosk, viewp
             assert box["x"] >= 0 and box["y"] >= 0
             assert box["x"] + box["width"] <= width and box["y"] + box["height"] <= height
             cell_w, cell_h = box["width"] / size[0], box["height"] / size[1]
-            steps = await _layout(ui_kiosk, size, language)
+            assert cell_h >= MIN_TEXT_PX, f"rows of {cell_h:.1f} px cannot hold {MIN_TEXT_PX} px text"
+            steps = await _layout(tmp_path_factory.mktemp("layout"), size, language)
 
             def pixels(region) -> tuple[float, float, float, float]:
                 return (box["x"] + region.x * cell_w, box["y"] + region.y * cell_h,
@@ -125,9 +140,9 @@ async def test_every_question_fits_the_served_page(served_kiosk, ui_kiosk, viewp
                     await wait_until(shown_since(language_name(language), 0), "the welcome")
                 elif name == "start":  # the explanation is on the page
                     await wait_until(shown_since(explanation, tapped_at), "the explanation")
-                elif regions:  # this question is open on the page: its number is in the top bar
-                    progress = ui_text(language, "question_of", number=answered + 1, total=len(questionnaire.items))
-                    await wait_until(shown_since(progress, tapped_at), f"{name} on the page")
+                elif regions:  # this question is open on the page: its text replaced the last one's
+                    text = _opening(questionnaire.item(name).patient_text_in(language))
+                    await wait_until(shown_since(text, tapped_at), f"{name} on the page")
                 tapped_at = len(painted)
                 left, top, right, bottom = pixels(target)
                 await page.mouse.click((left + right) / 2, (top + bottom) / 2)
