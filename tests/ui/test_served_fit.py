@@ -6,6 +6,7 @@ size the page reports (as in test_served.py)."""
 
 from __future__ import annotations
 
+import io
 import time
 
 import pytest
@@ -51,6 +52,25 @@ async def _layout(folder, size: tuple[int, int], language: str) -> list:
         assert kiosk.session.phase in (Phase.QUESTIONS, Phase.SUMMARY)
     kiosk.store.close()
     return steps
+
+
+#: an answer button's background on the page (kiosk.tcss), as RGB
+ANSWER_RGB = (0xdc, 0xe6, 0xf5)
+
+
+async def answer_drawn(page, left: float, top: float, right: float, bottom: float, cell_h: float) -> bool:
+    """The page shows an unchosen answer button exactly over this box: its colour just inside the
+    top and bottom rows, not in the row above (a button drawn a row off would fail one of them)."""
+    from PIL import Image
+
+    shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
+    x = int(right) - 4  # the label's right padding: never a letter there
+
+    def colour(y: float) -> tuple[int, int, int]:
+        return shot.getpixel((x, min(max(int(y), 0), shot.height - 1)))
+
+    return (colour(top + 2) == ANSWER_RGB and colour(bottom - 2) == ANSWER_RGB
+            and (top < cell_h or colour(top - cell_h / 2) != ANSWER_RGB))
 
 
 def _opening(text: str, most: int = 40) -> str:
@@ -129,6 +149,12 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
 
             questionnaire = load_questionnaire()
             explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
+            async def wait_until_async(check, what: str) -> None:
+                deadline = time.monotonic() + PATIENCE_S
+                while not await check():
+                    assert time.monotonic() < deadline, f"never saw {what}"
+                    await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S
+
             answered = 0
             for name, target, regions in steps:
                 for region in regions:
@@ -143,8 +169,11 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                 elif regions:  # this question is open on the page: its text replaced the last one's
                     text = _opening(questionnaire.item(name).patient_text_in(language))
                     await wait_until(shown_since(text, tapped_at), f"{name} on the page")
-                tapped_at = len(painted)
                 left, top, right, bottom = pixels(target)
+                if regions:  # and its answers laid out where the headless app put them
+                    await wait_until_async(lambda: answer_drawn(page, left, top, right, bottom, cell_h),
+                                           f"{name}'s answers drawn in place")
+                tapped_at = len(painted)
                 await page.mouse.click((left + right) / 2, (top + bottom) / 2)
                 if regions:
                     answered += 1
