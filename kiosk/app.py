@@ -26,11 +26,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from textual import events
 from textual.app import App
 from textual.binding import Binding
 from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
+from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
 from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView, Ways
@@ -56,6 +58,7 @@ from kiosk.session import (
     SessionEvent,
     VolumeChanged,
 )
+from kiosk.lease import LEASE_TTL_S, SessionTaken
 from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar, VoiceAgainButton
@@ -86,29 +89,39 @@ class SpeechActivity(Message):
     speaking: bool
 
 
-class KioskApp(App[int]):
-    """The patient's kiosk, with the clinician screens behind a key chord and a PIN.
+class KioskApp(App[int], inherit_bindings=False):
+    """The patient's kiosk, with the clinician screens behind a PIN pad.
+
+    Locked down: nothing a patient can press leaves or reconfigures it. Textual's own keys are
+    not inherited (ctrl+q quit, ctrl+c) and there is no command palette (ctrl+p: quit, theme,
+    screenshot). Staff open the PIN pad with five taps on the top-left corner (or ``ctrl+k``);
+    quitting is a button behind the PIN.
 
     ``session`` is a fresh (not yet started) session. ``speaker`` is a ``kiosk.speech.tts.Speaker``
     or None (voice out off); ``voice`` a ``kiosk.speech.voice.VoiceChannel`` (an input source that
     also follows the session's events) or None; ``sources`` the remotes' input sources
     (all started with :meth:`channel_sink` on mount and stopped on exit). ``statuses`` are channel
     states known before start-up, such as "voice in off: no microphone found". ``keyboard`` is a
-    ``kiosk.remote.KeyboardRemote`` for remotes that type keys. ``resumable`` is an interrupted
-    stored session the welcome screen offers to continue, through ``resume`` (which builds the
-    session continuing it, ``Session.from_stored``). ``new_session`` builds a fresh session for
-    the next patient (the clinician's "New session").
+    ``kiosk.remote.KeyboardRemote`` for remotes that type keys. ``resume`` builds the session
+    continuing an interrupted stored one (``Session.from_stored``): staff choose it on the clinician
+    screen ("Continue this test"); a patient is never offered someone else's test. ``new_session``
+    builds a fresh session for the next patient (the clinician's "New session").
+
+    With a store, the app renews this kiosk's hold on its session every ``lease_interval`` seconds
+    and marks interrupted the tests whose kiosk is gone (:meth:`Store.interrupt_stale`); a session
+    this kiosk no longer holds (taken over, or too old) is dropped with a plain notice.
     """
 
     CSS_PATH = "kiosk.tcss"
     TITLE = "Barthel kiosk"
     BINDINGS = [Binding(CLINICIAN_CHORD, "clinician", "Clinician", show=False, priority=True)]
+    ENABLE_COMMAND_PALETTE = False
 
     def __init__(
         self,
         session: Session,
         *,
-        clinician_pin: str,
+        clinician_pin: str | PinGuard,
         store: Store | None = None,
         speaker: Any = None,
         voice: Any = None,
@@ -117,7 +130,6 @@ class KioskApp(App[int]):
         statuses: Iterable[ChannelStatus] = (),
         export_dir: Path | None = None,
         poll_interval: float = POLL_INTERVAL,
-        resumable: StoredSession | None = None,
         resume: Callable[[StoredSession], Session] | None = None,
         new_session: Callable[[], Session] | None = None,
     ) -> None:
@@ -127,14 +139,15 @@ class KioskApp(App[int]):
         self.session = session
         self.questionnaire: Questionnaire = session.questionnaire
         self.store = store
-        self.clinician_pin = clinician_pin
+        #: checks the clinician PIN (a plain string: an in-memory guard, for tests and benches)
+        self.pin_guard = clinician_pin if isinstance(clinician_pin, PinGuard) else PinGuard(clinician_pin)
+        self._corner = CornerTaps()
         self.speaker = speaker
         self.voice = voice
         self.sources = list(sources)
         self.keyboard = keyboard
         self.export_dir = export_dir
         self.poll_interval = poll_interval
-        self.resumable = resumable if resume is not None else None
         self._resume = resume
         self._new_session = new_session
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
@@ -169,6 +182,8 @@ class KioskApp(App[int]):
             self.run_worker(partial(source.start, self.channel_sink), thread=True,
                             name=f"start {source.name}", group="channels")
         self.set_interval(self.poll_interval, self.poll_session)
+        if self.store is not None:
+            self.set_interval(LEASE_TTL_S / 3, self.keep_session)
         self._render()
 
     def on_unmount(self) -> None:
@@ -252,17 +267,11 @@ class KioskApp(App[int]):
         """Start in the language the patient touched."""
         self._start(message.language)
 
-    def on_welcome_screen_resume_chosen(self, message: WelcomeScreen.ResumeChosen) -> None:
-        """Continue the interrupted session instead of the fresh one (which was never started)."""
-        if self.resumable is None or self._resume is None or self.session.phase is not Phase.WELCOME:
-            return
-        self._replace_session(self._resume(self.resumable))
-        self._drive(self.session.start)
-
     def _replace_session(self, session: Session) -> None:
+        old, self.session = self.session, session
         self._unsubscribe()
-        self.session = session
-        self.resumable = None
+        if self.store is not None and old.id != session.id:
+            self.store.release(old.id)  # a finished one is let go; one still running is interrupted
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -288,8 +297,13 @@ class KioskApp(App[int]):
     # -- the session's events ----------------------------------------------------------------------
 
     def _drive(self, operation: Callable[..., object], *args: object) -> None:
-        """Run a session operation, then redraw if it published anything."""
-        operation(*args)
+        """Run a session operation, then redraw if it published anything. A session another kiosk
+        took over (or that was interrupted) stores nothing more here: the kiosk lets it go."""
+        try:
+            operation(*args)
+        except SessionTaken as taken:
+            self._session_lost(str(taken))
+            return
         if self._dirty:
             self._dirty = False
             self._render()
@@ -335,10 +349,6 @@ class KioskApp(App[int]):
 
     def _view(self) -> PatientView:
         snap = self.session.snapshot()
-        offer = None
-        if self.resumable is not None and snap.phase is Phase.WELCOME:
-            offer = ui_text(snap.language, "resume_offer", answered=len(self.resumable.answers),
-                            total=len(self.questionnaire.items))
         voice_in = self.board.state(VOICE_IN)[0] is ChannelState.ON
         # the session lifts voice_off when voice in goes; checked here too so the button never
         # promises listening that cannot happen (and not over Continue while paused)
@@ -349,7 +359,7 @@ class KioskApp(App[int]):
                     voice_out=self.board.state(VOICE_OUT)[0] is ChannelState.ON)
         question = snap.item or snap.practice
         hint = len(question.options) if self._no_such_option and question is not None else None
-        return PatientView(snap, self.questionnaire, ways, voice_again=voice_again, resume_offer=offer,
+        return PatientView(snap, self.questionnaire, ways, voice_again=voice_again,
                            hint_options=hint)
 
     @staticmethod
@@ -412,8 +422,20 @@ class KioskApp(App[int]):
             else:
                 self._release_session()
 
-        self.push_screen(PinScreen(self.clinician_pin), unlocked)
+        self.push_screen(PinScreen(self.pin_guard), unlocked)
         self._hold_session()
+
+    async def on_event(self, event: events.Event) -> None:
+        """Watch every press for the staff corner before the screens see it (a button under the
+        corner must not hide the taps)."""
+        if isinstance(event, events.MouseDown) and not self.clinician_open \
+                and self._corner.tap(event.screen_x, event.screen_y):
+            self.action_clinician()
+        await super().on_event(event)
+
+    def quit_kiosk(self) -> None:
+        """Staff end the kiosk (a button behind the PIN): it exits as after a normal close."""
+        self.exit(0)
 
     def close_clinician(self) -> None:
         """Leave the clinician screens and show the patient's screen as the session now is."""
@@ -465,9 +487,56 @@ class KioskApp(App[int]):
         replaces counts as abandoned (:meth:`Session.abandon`)."""
         if self._new_session is None:
             return
-        self.session.abandon()
+        try:
+            self.session.abandon()
+        except SessionTaken:
+            pass  # another kiosk holds it now: nothing of it is this kiosk's to end
         self._replace_session(self._new_session())
         self.close_clinician()
+
+    # -- interrupted tests and this kiosk's hold on its session ------------------------------------
+
+    def interrupted_tests(self) -> list[StoredSession]:
+        """The tests staff may continue here (their kiosk stopped, or they grew too old), newest first."""
+        return self.store.unfinished_sessions() if self.store is not None else []
+
+    def continue_test(self, session_id: str) -> str | None:
+        """Staff continue an interrupted test on this kiosk (clinician screen, behind the PIN).
+        Returns why not, as a sentence for staff, or None once it continues."""
+        if self.store is None or self._resume is None:
+            return "this kiosk stores no sessions"
+        if self.session.phase is not Phase.WELCOME and not self.session.finished:
+            return "a test is in progress on this kiosk: finish it, or start a new patient, first"
+        try:
+            stored = self.store.continue_session(session_id)
+        except (SessionTaken, ValueError, KeyError) as refused:
+            return str(refused.args[0] if isinstance(refused, KeyError) else refused)
+        self._replace_session(self._resume(stored))
+        self.close_clinician()
+        self._drive(self.session.start)
+        return None
+
+    def keep_session(self) -> None:
+        """Renew this kiosk's hold on its session and interrupt the tests whose kiosk is gone (a
+        timer calls this); a running session this kiosk no longer holds is let go."""
+        assert self.store is not None
+        self.store.renew()
+        self.store.interrupt_stale()
+        session = self.session
+        if session.phase is Phase.WELCOME or session.finished:
+            return
+        why = self.store.why_not_held(session.id)
+        if why is not None:
+            self._session_lost(why)
+
+    def _session_lost(self, reason: str) -> None:
+        """This kiosk may no longer record in its session: say so plainly and start over."""
+        self.notify(f"This kiosk stopped the test of {self.session.patient_id}: {reason}. Staff can see it "
+                    "on the clinician screen.", title="Test stopped", severity="warning", timeout=60)
+        if self._new_session is not None:
+            self._replace_session(self._new_session())
+        self._screen_key = None
+        self._render()
 
     def set_adaptation(self, enabled: bool) -> None:
         """A clinician switches live adaptation on or off for this session."""
@@ -513,7 +582,10 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
         config = load_config(config_path)
         questionnaire = configured_questionnaire(config)
         policy = load_policy(config.adaptation_policy) if config.adaptation else None
-        store = Store.open(data_dir or config.data_dir)
+        store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
+                           outbox=config.station is not None)
+        # what a kiosk that stopped left running is interrupted now: for staff, never a patient
+        store.interrupt_stale()
     except QuestionnaireError as error:
         problems = getattr(error, "problems", None)
         raise SetupError("\n".join(str(p) for p in problems) if problems else str(error)) from None
@@ -536,12 +608,11 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
                                    store=store, timing=config.timing,
                                    adaptation=Adaptation(policy) if policy else None)
 
-    # a kiosk restarted after a crash offers the interrupted session (not when told whom to test)
-    unfinished = store.unfinished_sessions() if patient_id is None else []
-    app = KioskApp(fresh(patient_id), clinician_pin=config.clinician_pin, store=store, speaker=speaker,
+    guard = PinGuard(config.pin_secret, data_dir or config.data_dir)
+    app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports",
-                   resumable=unfinished[0] if unfinished else None, resume=resume, new_session=fresh)
+                   resume=resume, new_session=fresh)
     return app, store.close
 
 
@@ -586,6 +657,8 @@ def main(argv: list[str]) -> int:
     except SetupError as error:
         print(f"kiosk run: {error}", file=sys.stderr)
         return 2
+    if (warning := app.pin_guard.warning) is not None:
+        print(f"kiosk run: warning: {warning}", file=sys.stderr)
     try:
         app.run()
     finally:

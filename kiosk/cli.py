@@ -19,8 +19,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "validate": ("kiosk.validate", "check a questionnaire YAML file and list every problem"),
     "results": ("kiosk.results", "list stored sessions, show one, or export it (FHIR JSON, CSV)"),
     "devices": ("kiosk.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
+    "pin": ("kiosk.pin_cli", "set the clinician PIN (`kiosk pin set`; stored hashed in the configuration)"),
     "models": ("kiosk.speech.models", "install and list speech-recognition models"),
     "qos": ("kiosk.qos_cli", "QoS tools: replay a context trace, print a session's trace"),
+    "station": ("station.cli", "the ward station web app (kiosks report to it; staff watch and validate)"),
 }
 
 

@@ -3,13 +3,15 @@
 Where the file is: ``$KIOSK_CONFIG`` if set (it must exist), else
 ``<user config dir>/kiosk/config.yaml`` if present (``platformdirs.user_config_dir("kiosk")``),
 else built-in defaults. Environment variables override the file: ``KIOSK_DATA_DIR``,
-``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``.
+``KIOSK_LANGUAGE``, ``KIOSK_VOSK_MODEL``, ``KIOSK_STATION_URL``, ``KIOSK_STATION_TOKEN``.
 
 Example ``config.yaml`` (every key optional)::
 
     data_dir: /var/lib/kiosk          # default: platformdirs.user_data_dir("kiosk")
     language: es                      # default language on the welcome screen
-    clinician_pin: "4821"             # CHANGE IT: the default "1234" is public
+    clinician_pin_hash: "scrypt$…"    # written by `kiosk pin set` (6 to 12 digits); default PIN 1234
+    serve_token_sha256: "…"           # written by `kiosk serve --new-token`: the served page's device key
+    serve_max_sessions: 2             # browser connections `kiosk serve` runs at once
     adaptation: true                  # live adaptation on/off
     adaptation_policy: /etc/kiosk/adaptation.yaml
     questionnaire: /etc/kiosk/barthel.yaml
@@ -18,13 +20,22 @@ Example ``config.yaml`` (every key optional)::
     timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
     remote_profiles: /etc/kiosk/remotes.yaml
+    interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
+    station:                          # report to a ward station (docs/station-protocol.md)
+      url: https://ward.example:8443  # without a url the kiosk talks to no station at all
+      token: "…"                      # from `kiosk station add-kiosk NAME`
+      kiosk_id: ward3-bed2            # default: this machine's host name
 
-A bad file is one :class:`ConfigError` naming the file, line and column and what is wrong.
+A legacy plain ``clinician_pin: "482193"`` still works (6 to 12 digits, or the default), with a
+warning to run `kiosk pin set`. A bad file is one :class:`ConfigError` naming the file, line and
+column and what is wrong.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import socket
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -32,16 +43,34 @@ from typing import Any
 
 import platformdirs
 
-from kiosk.questionnaire import Questionnaire, Timing, load_questionnaire
-from kiosk.yamlmarks import Problem, parse
+from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
+from kiosk.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
+from kiosk.yamlmarks import Problem, parse_file
+from qos.files import BadFile, open_private, read_text
 
-#: the PIN a fresh install uses; the clinician screens warn while it is unchanged
-DEFAULT_PIN = "1234"
-LANGUAGES = ("en", "es", "fr")
+#: browser connections `kiosk serve` runs at once unless configured: each is a kiosk process
+#: of about 55 MB, and a ward kiosk has one screen
+SERVE_MAX_SESSIONS = 2
 
 
 class ConfigError(ValueError):
     """The configuration file (or an environment override) is unusable."""
+
+
+#: a kiosk's name at the station: letters, digits, '.', '-' and '_'
+KIOSK_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+
+
+@dataclass(frozen=True)
+class Station:
+    """Where this kiosk reports (``station:`` in the configuration)."""
+
+    #: the station's base URL, http:// or https://
+    url: str
+    #: this kiosk's bearer token, issued by the station
+    token: str
+    #: this kiosk's name at the station
+    kiosk_id: str = field(default_factory=socket.gethostname)
 
 
 @dataclass(frozen=True)
@@ -52,8 +81,14 @@ class Config:
     data_dir: Path = field(default_factory=lambda: Path(platformdirs.user_data_dir("kiosk")))
     #: default language on the welcome screen
     language: str = "en"
-    #: the clinician screens' PIN; the default must be changed on a real kiosk
+    #: a legacy plain clinician PIN (use clinician_pin_hash); the default must be changed
     clinician_pin: str = DEFAULT_PIN
+    #: the clinician PIN's scrypt hash, written by `kiosk pin set` (wins over clinician_pin)
+    clinician_pin_hash: str | None = None
+    #: SHA-256 (hex) of the served page's device key, written by `kiosk serve --new-token`
+    serve_token_sha256: str | None = None
+    #: browser connections (kiosk processes) `kiosk serve` runs at once
+    serve_max_sessions: int = SERVE_MAX_SESSIONS
     #: live adaptation (the clinician can still switch it off per session)
     adaptation: bool = True
     #: an adaptation policy file (None: the bundled kiosk/adaptation.yaml)
@@ -70,17 +105,27 @@ class Config:
     vosk_model: Path | None = None
     #: user overrides of the remote-control profiles
     remote_profiles: Path | None = None
+    #: a running test older than this is marked interrupted (staff may continue it; no patient is offered it)
+    interrupt_after_minutes: float = 120.0
+    #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
+    station: Station | None = None
     #: the file this was read from (None: defaults only)
     source: Path | None = None
 
     @property
     def default_pin(self) -> bool:
         """The PIN is still the public default."""
-        return self.clinician_pin == DEFAULT_PIN
+        return self.clinician_pin_hash is None and self.clinician_pin == DEFAULT_PIN
+
+    @property
+    def pin_secret(self) -> str:
+        """What the PIN pad checks against: the hash, else the legacy plain PIN."""
+        return self.clinician_pin_hash or self.clinician_pin
 
 
 _PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
 _BOOLS = {"adaptation", "familiarisation"}
+_SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}
 
 
@@ -105,19 +150,21 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     for var, key in overrides.items():
         if env.get(var):
             values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
-    if values.get("language", "en") not in LANGUAGES:
-        raise ConfigError(f"language {values['language']!r} is not one of {', '.join(LANGUAGES)}")
+    station = values.get("station") or {}
+    for var, key in (("KIOSK_STATION_URL", "url"), ("KIOSK_STATION_TOKEN", "token")):
+        if env.get(var):
+            station = {**station, key: env[var]}
+    values["station"] = _station(station, f"{path}: station" if path is not None else "KIOSK_STATION_URL")
+    if values.get("language", "en") not in SCREEN_LANGUAGES:
+        raise ConfigError(f"language {values['language']!r} is not one of {', '.join(SCREEN_LANGUAGES)}")
     return Config(**values, source=Path(path) if path is not None else None)
 
 
 def _read(path: Path) -> dict[str, Any]:
     name = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ConfigError(f"{name}: cannot read the configuration: {reason}") from None
-    data, positions, problems = parse(text, name)
+    data, positions, problems = parse_file(path)
+    if problems and problems[0].message == "the file is empty":
+        return {}  # a config file with every setting commented out means the defaults
     if problems:
         raise ConfigError(str(problems[0]))
     if data is None:
@@ -153,15 +200,58 @@ def _read(path: Path) -> dict[str, Any]:
             value = dict(value)
         elif key == "clinician_pin":
             if isinstance(value, int) and not isinstance(value, bool):
-                raise fail((key,), 'write the PIN in quotes ("0123"), or leading zeros are lost')
-            if not isinstance(value, str) or not value.isdigit() or not 4 <= len(value) <= 12:
-                raise fail((key,), "clinician_pin must be 4 to 12 digits, in quotes")
+                raise fail((key,), 'write the PIN in quotes ("012345"), or leading zeros are lost')
+            if not isinstance(value, str) or not value.isascii() or not value.isdigit() or len(value) > 12 \
+                    or (len(value) < MIN_DIGITS and value != DEFAULT_PIN):
+                raise fail((key,), f"clinician_pin must be {MIN_DIGITS} to 12 digits, in quotes "
+                                   "(better: run `kiosk pin set`, which stores it hashed)")
+            if "clinician_pin_hash" in data:
+                raise fail((key,), "clinician_pin and clinician_pin_hash are both set: remove clinician_pin")
+        elif key == "clinician_pin_hash":
+            problem = hash_problem(value) if isinstance(value, str) else "clinician_pin_hash must be text"
+            if problem is not None:
+                raise fail((key,), problem)
+        elif key == "serve_token_sha256":
+            if not isinstance(value, str) or not _SHA256.fullmatch(value):
+                raise fail((key,), "serve_token_sha256 is not a key written by `kiosk serve --new-token`; "
+                                   "run it again")
+        elif key == "serve_max_sessions":
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 16:
+                raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
+        elif key == "station":
+            if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \
+                    or not all(isinstance(v, str) for v in value.values()):
+                raise fail((key,), "station must be a mapping {url: ..., token: ..., kiosk_id: ...} of strings")
+            try:
+                _station(value, "station")
+            except ConfigError as exc:
+                raise fail((key,), str(exc)) from None
+        elif key == "interrupt_after_minutes":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
+                raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
     return values
+
+
+def _station(values: Mapping[str, str], where: str) -> Station | None:
+    """The station settings, checked; None without a url (a token alone is harmless)."""
+    url = values.get("url", "")
+    if not url:
+        return None
+    if not re.match(r"^https?://[^\s/?#]+(/[^\s?#]*)?$", url):
+        raise ConfigError(f"{where}: url {url!r} must be an http:// or https:// address such as "
+                          "https://ward.example:8443")
+    if not values.get("token"):
+        raise ConfigError(f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
+                          "the station issues it with `kiosk station add-kiosk NAME`)")
+    kiosk_id = values.get("kiosk_id") or socket.gethostname()
+    if not KIOSK_ID.match(kiosk_id):
+        raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'")
+    return Station(url.rstrip("/"), values["token"], kiosk_id)
 
 
 def configured_questionnaire(config: Config) -> Questionnaire:
@@ -171,11 +261,45 @@ def configured_questionnaire(config: Config) -> Questionnaire:
     :class:`ConfigError` when ``bands`` names a set the questionnaire does not have.
     """
     questionnaire = load_questionnaire(config.questionnaire)
+    where = f"{config.source}: " if config.source else ""
+    if config.language not in questionnaire.languages:
+        raise ConfigError(f"{where}language: {config.language!r} is not a language of {questionnaire.source} "
+                          f"(it has {', '.join(questionnaire.languages)}); set language: to one of them")
     if config.bands is None:
         return questionnaire
     try:
         return questionnaire.with_band_set(config.bands)
     except KeyError:
-        where = f"{config.source}: " if config.source else ""
         raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
                           f"(it has {', '.join(questionnaire.band_sets)})") from None
+
+
+def write_settings(path: Path, changes: Mapping[str, str | None]) -> None:
+    """Set (or, with None, remove) top-level settings of a configuration file, keeping its other
+    lines and comments; the file is created if missing, and always left owner-only (0600).
+
+    The new file is checked with :func:`load_config` before it replaces the old one, so a mistake
+    leaves the old file as it was. Raises :class:`ConfigError`.
+    """
+    try:
+        lines = read_text(path).splitlines() if path.exists() else []
+    except BadFile as exc:
+        raise ConfigError(str(exc)) from None
+    for key, value in changes.items():
+        lines = [line for line in lines if not re.match(rf"{re.escape(key)}\s*:", line)]
+        if value is not None:
+            lines.append(f'{key}: "{value}"')  # the values written here never hold quotes or backslashes
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_name(f".{path.name}.new")
+    try:
+        with open_private(temporary) as handle:
+            handle.write("\n".join(lines) + "\n")
+        load_config(temporary, environ={})
+        os.replace(temporary, path)
+    except ConfigError as exc:  # name the file staff know, not the one checked in its place
+        raise ConfigError(str(exc).replace(str(temporary), str(path))) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot write {path}: {exc.strerror or exc}") from None
+    finally:
+        temporary.unlink(missing_ok=True)
+    os.chmod(path, 0o600)

@@ -22,12 +22,15 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from kiosk.yamlmarks import Problem, describe, parse, schema_problems
+from kiosk.yamlmarks import Positions, Problem, describe, parse, parse_file, schema_problems
 
 #: where the bundled questionnaire and its schema live
 _PACKAGE_DIR = "kiosk.questionnaires"
 DEFAULT_FILE = "barthel.yaml"
 SCHEMA_FILE = "questionnaire.schema.json"
+#: the languages the kiosk's own screens are written in (kiosk/widgets/ui_text.yaml): a
+#: questionnaire in another language would start a session its screens cannot show
+SCREEN_LANGUAGES = ("en", "es", "fr")
 
 
 # --------------------------------------------------------------------------------------------
@@ -182,6 +185,9 @@ class Timing:
     person_back_grace_s: float = 5.0
     #: after the last question, before FINISHED and the summary
     closing_s: float = 5.0
+    #: how long "I heard: ... Is that right?" waits for Yes or No; no reply stores nothing and
+    #: ends the attempt as if it had timed out
+    confirm_window_s: float = 10.0
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Timing:
         """A copy with some values replaced; unknown names or negative values raise ValueError."""
@@ -195,8 +201,9 @@ class Timing:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
                 raise ValueError(f"timing setting {name!r} must be a number of seconds >= 0, got {value!r}")
             changes[name] = float(value)
-        if changes.get("attempt_window_s", self.attempt_window_s) <= 0:
-            raise ValueError("timing setting 'attempt_window_s' must be more than 0 seconds")
+        for name in ("attempt_window_s", "confirm_window_s"):
+            if changes.get(name, getattr(self, name)) <= 0:
+                raise ValueError(f"timing setting {name!r} must be more than 0 seconds")
         return replace(self, **changes)
 
 
@@ -330,33 +337,32 @@ def load_questionnaire(path: str | Path | None = None) -> Questionnaire:
     """
     file = Path(path) if path is not None else bundled_path()
     name = str(path if path is not None else file)
-    try:
-        text = file.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise QuestionnaireError([_unreadable(name, exc)]) from None
-    data, problems = check_questionnaire_text(text, name)
+    data, problems = _check(parse_file(file, name), name)
     if problems:
         raise QuestionnaireError(problems)
     return _build(data, str(file))
 
 
-def _unreadable(name: str, exc: OSError | UnicodeDecodeError) -> Problem:
-    reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-    return Problem(name, 1, 1, f"cannot read the file: {reason}")
-
-
 def check_questionnaire_file(path: str | Path) -> list[Problem]:
-    """Every problem in a questionnaire file (empty if it is valid). Unreadable: one problem."""
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        return [_unreadable(str(path), exc)]
-    return check_questionnaire_text(text, str(path))[1]
+    """Every problem in a questionnaire file (empty if it is valid): the checks :func:`load_questionnaire`
+    makes, so a file this accepts is one the kiosk runs. Unreadable: one problem."""
+    return check_questionnaire(path)[1]
+
+
+def check_questionnaire(path: str | Path) -> tuple[bool, list[Problem]]:
+    """(readable, every problem) of a questionnaire file; ``readable`` is False when the file could
+    not be read as YAML at all (then its one problem says why)."""
+    parsed = parse_file(path)
+    return parsed[1] is not None, _check(parsed, str(path))[1]
 
 
 def check_questionnaire_text(text: str, filename: str) -> tuple[Any, list[Problem]]:
     """Parse and check questionnaire YAML; returns (data, problems). Data is None on a syntax error."""
-    data, positions, problems = parse(text, filename)
+    return _check(parse(text, filename), filename)
+
+
+def _check(parsed: tuple[Any, Positions | None, list[Problem]], filename: str) -> tuple[Any, list[Problem]]:
+    data, positions, problems = parsed
     if positions is None:
         return None, problems
 
@@ -384,6 +390,10 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
         data.get("languages"), list) else []
     if len(set(languages)) != len(languages):
         add(("languages",), "a language is listed twice in 'languages'")
+    for i, lang in enumerate(languages):
+        if lang not in SCREEN_LANGUAGES:
+            add(("languages", i), f"language {lang!r}: the kiosk's screens have text in "
+                                  f"{', '.join(SCREEN_LANGUAGES)} only")
 
     def texts(path: tuple[Any, ...], value: Any) -> None:
         if not isinstance(value, dict):
@@ -467,7 +477,9 @@ def _check_bands(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, di
     default = block.get("default")
     if isinstance(default, str) and sets and default not in sets:
         add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")
-    reachable = _reachable_totals(dicts(data.get("items")))
+    items = dicts(data.get("items"))
+    # no items: the schema says so, and every band would only repeat it as "ends above 0"
+    reachable = _reachable_totals(items) if items else None
     for name, band_set in sets.items():
         path = ("bands", "sets", name, "ranges")
         bands = dicts(band_set.get("ranges")) if isinstance(band_set, dict) else []

@@ -39,7 +39,8 @@ from kiosk.session import (
     SessionEvent,
 )
 from kiosk.adaptation import MODEL
-from kiosk.yamlmarks import Problem, describe, parse, schema_problems
+from kiosk.yamlmarks import Problem, describe, parse_file, schema_problems
+from qos.errors import QosError
 from qos.trace import seconds
 
 #: incidents that are commands a patient gives through a channel
@@ -115,12 +116,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
     """Read and check a scripted patient; :class:`ScriptError` lists every problem with its position."""
     questionnaire = questionnaire or load_questionnaire()
     name = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ScriptError(f"{name}:1:1: cannot read the script: {reason}") from None
-    data, positions, problems = parse(text, name)
+    data, positions, problems = parse_file(path)
     if positions is None or not isinstance(data, dict):
         problems = problems or [Problem(name, 1, 1, "a script is a mapping (patient:, questions:, ...)")]
         raise _script_error(problems)
@@ -425,8 +421,9 @@ class _Driver:
 
 
 def run_script(script: Script, questionnaire: Questionnaire | None = None, *, store: Any = None,
-               model: Any = None) -> ReplayResult:
-    """Run a script through a real Session and QoS engine on a simulated clock."""
+               model: Any = None, policy: Any = None) -> ReplayResult:
+    """Run a script through a real Session and QoS engine on a simulated clock, adapting by
+    ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on."""
     from kiosk.adaptation import Adaptation, load_policy
     from qos import Engine, Trace, load_model, replay
 
@@ -436,19 +433,23 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
     session = Session(
         questionnaire, clock=clock, engine=Engine(model), store=store, patient_id=script.patient,
         language=script.language, answered_by=script.answered_by, timing=script.timing,
-        adaptation=Adaptation(load_policy()) if script.adaptation else None,
+        adaptation=Adaptation(policy or load_policy()) if script.adaptation else None,
         familiarisation=script.practice is not None,
     )
     driver = _Driver(script, session, clock)
     try:
         driver.run()
-    except ScriptError:
+        trace = Trace.from_events(MODEL, session.trace)
+        summary = replay(trace, model=model)
+    except (ScriptError, QosError) as exc:
         if store is not None:
             # a scripted patient that went wrong must not be offered for resuming at the kiosk
             store.abandon(session.id)
-        raise
-    trace = Trace.from_events(MODEL, session.trace)
-    return ReplayResult(script, session, trace, replay(trace, model=model), session.now(), driver.events)
+        if isinstance(exc, ScriptError):
+            raise
+        # the session ran, but its QoS replay is refused (a session of weeks at 1 s samples)
+        raise ScriptError(f"{script.source}:1:1: the simulated session cannot be replayed: {exc}") from None
+    return ReplayResult(script, session, trace, summary, session.now(), driver.events)
 
 
 def _print_human(result: ReplayResult) -> None:
@@ -479,27 +480,38 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--trace", metavar="OUT", help="write the context trace (one script only)")
     parser.add_argument("--data-dir", metavar="DIR",
                         help="also store the replayed sessions in this data directory (see `kiosk results`)")
+    parser.add_argument("--config", metavar="FILE",
+                        help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
+                             "band set and adaptation policy are the ones replayed, as at the kiosk")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
+    from kiosk.adaptation import PolicyError, load_policy
+    from kiosk.config import ConfigError, configured_questionnaire, load_config
+
     try:
-        questionnaire = load_questionnaire()
+        config = load_config(args.config)
+        questionnaire = configured_questionnaire(config)
+        policy = load_policy(config.adaptation_policy)
     except QuestionnaireError as exc:
         print(f"kiosk replay: the questionnaire is invalid: {exc}", file=sys.stderr)
+        return 2
+    except (ConfigError, PolicyError) as exc:
+        print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     store = None
     if args.data_dir:
         from kiosk.storage import StorageError, Store
 
         try:
-            store = Store.open(args.data_dir)
+            store = Store.open(args.data_dir, simulated=True)  # scripted patients: never offered to anyone
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
     results = []
     try:
         for file in args.files:
-            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store))
+            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store, policy=policy))
     except ScriptError as exc:
         print(exc, file=sys.stderr)
         return 2

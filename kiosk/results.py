@@ -30,7 +30,9 @@ from kiosk.storage import StorageError, StoredSession
 
 def _show(q, stored: StoredSession) -> None:
     score = rescore(q, stored)
-    print(f"session {stored.id}  patient {stored.patient_id}  {stored.status}  language {stored.language}  "
+    status = stored.status + (f" ({stored.interrupted_reason})" if stored.interrupted_reason else "") + (
+        ", simulated (a scripted patient, kiosk replay)" if stored.simulated else "")
+    print(f"session {stored.id}  patient {stored.patient_id}  {status}  language {stored.language}  "
           f"answered by {stored.answered_by.value}")
     print(f"started {stored.started_at}" + (f"  finished {stored.finished_at}" if stored.finished_at else ""))
     outcomes = practice_outcomes(q, stored)
@@ -82,7 +84,7 @@ def main(argv: list[str]) -> int:
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
                 for s in summaries:
-                    print(f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.status:<9} {s.language}  "
+                    print(f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.label:<9} {s.language}  "
                           f"{s.answered} answered, {s.not_answered} not answered")
                 return 0
             stored = store.session(args.session)

@@ -1,10 +1,21 @@
 """Safe storage of sessions in SQLite (stdlib ``sqlite3``).
 
 One database file in the kiosk's data directory (directory 0700, files 0600), in WAL mode with
-``synchronous=FULL``: every call that records something commits before it returns, so a kiosk
-killed mid-session (power cut, SIGKILL) loses no recorded answer. The next start finds the session
-in :meth:`Store.unfinished_sessions` and can continue it at the first question without an outcome
-(:meth:`kiosk.session.Session.from_stored`).
+``synchronous=FULL``. Each session operation is one transaction (:meth:`Store.transaction`):
+an answer is committed together with its QoS context and metrics before anyone learns of it, and
+an operation cut short (an exception, Ctrl-C, a kill) keeps none of its writes. The schema has a
+version and ordered migrations (:mod:`kiosk.schema`); a damaged file is refused with one message.
+
+One running kiosk holds a session at a time (a lease, :mod:`kiosk.lease`): it is taken when the
+session is created or continued, checked in every write transaction, renewed while the kiosk
+runs and released when it stops. A running session whose kiosk is gone, or older than the
+configured limit, is marked *interrupted* (:meth:`Store.interrupt_stale`); only staff continue
+one (:meth:`Store.continue_session`), never a patient. Sessions of scripted patients
+(``kiosk replay``) are stored *simulated* and are never offered.
+
+With ``outbox=True`` (a ward station is configured) every stored change is also written, in the
+same transaction, as a row of the ``outbox`` table that ``kiosk.sync`` delivers
+(``docs/station-protocol.md`` §1). Without it nothing is queued.
 
 Stored per session: the patient's pseudonymous id (never a name), answers (item, option, points,
 attempt, channel, who answered, time), questions not answered, the familiarisation's practice
@@ -21,104 +32,38 @@ import os
 import re
 import secrets
 import sqlite3
-from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+import time
+from collections.abc import Callable, Iterator, Mapping
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
 from kiosk.channels import Channel
+from kiosk.lease import LEASE_TTL_S, Owner, SessionTaken, lapsed
+from kiosk.schema import SchemaError, migrate
 from kiosk.session import Answer, AnsweredBy
+from kiosk.stored import (
+    AdaptationRecord,
+    LogEntry,
+    MetricSample,
+    PracticeRecord,
+    SessionSummary,
+    StoredSession,
+)
+
+__all__ = [
+    "DB_NAME", "PATIENT_ID", "AdaptationRecord", "LogEntry", "MetricSample", "PracticeRecord", "SessionSummary",
+    "SessionTaken", "StorageError", "Store", "StoredSession", "new_patient_id",
+]
 
 DB_NAME = "kiosk.sqlite3"
 #: a pseudonymous patient id: letters, digits, '-' and '_', no spaces (so not "Ann Smith")
 PATIENT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
-
-_SCHEMA = """
-CREATE TABLE IF NOT EXISTS patients (
-    id TEXT PRIMARY KEY,
-    created_at TEXT NOT NULL
-);
-CREATE TABLE IF NOT EXISTS sessions (
-    id TEXT PRIMARY KEY,
-    patient_id TEXT NOT NULL REFERENCES patients(id),
-    questionnaire_id TEXT NOT NULL,
-    language TEXT NOT NULL,
-    answered_by TEXT NOT NULL,
-    timing TEXT NOT NULL,
-    started_at TEXT NOT NULL,
-    status TEXT NOT NULL CHECK (status IN ('running', 'finished', 'abandoned')),
-    finished_at TEXT,
-    total INTEGER,
-    complete INTEGER,
-    band TEXT
-);
-CREATE TABLE IF NOT EXISTS answers (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    item_id TEXT NOT NULL,
-    option INTEGER NOT NULL,
-    points INTEGER NOT NULL,
-    attempt INTEGER NOT NULL,
-    channel TEXT NOT NULL,
-    answered_by TEXT NOT NULL,
-    t REAL NOT NULL,
-    at TEXT NOT NULL,
-    detail TEXT NOT NULL DEFAULT '',
-    PRIMARY KEY (session_id, item_id)
-);
-CREATE TABLE IF NOT EXISTS not_answered (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    item_id TEXT NOT NULL,
-    t REAL NOT NULL,
-    at TEXT NOT NULL,
-    PRIMARY KEY (session_id, item_id)
-);
-CREATE TABLE IF NOT EXISTS practice (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    seq INTEGER NOT NULL,
-    question_id TEXT NOT NULL,
-    checks TEXT NOT NULL,
-    outcome TEXT NOT NULL CHECK (outcome IN ('right', 'wrong', 'not_answered', 'skipped')),
-    option INTEGER,
-    channel TEXT,
-    t REAL NOT NULL,
-    at TEXT NOT NULL,
-    detail TEXT NOT NULL DEFAULT '',
-    PRIMARY KEY (session_id, seq)
-);
-CREATE TABLE IF NOT EXISTS contexts (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    seq INTEGER NOT NULL,
-    t REAL NOT NULL,
-    sets TEXT NOT NULL,
-    emits TEXT NOT NULL,
-    PRIMARY KEY (session_id, seq)
-);
-CREATE TABLE IF NOT EXISTS metric_samples (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    seq INTEGER NOT NULL,
-    t REAL NOT NULL,
-    metrics TEXT NOT NULL,
-    fired TEXT NOT NULL,
-    PRIMARY KEY (session_id, seq)
-);
-CREATE TABLE IF NOT EXISTS adaptations (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    seq INTEGER NOT NULL,
-    t REAL NOT NULL,
-    name TEXT NOT NULL,
-    active INTEGER NOT NULL,
-    reason TEXT NOT NULL,
-    PRIMARY KEY (session_id, seq)
-);
-CREATE TABLE IF NOT EXISTS events (
-    session_id TEXT NOT NULL REFERENCES sessions(id),
-    seq INTEGER NOT NULL,
-    t REAL NOT NULL,
-    kind TEXT NOT NULL,
-    detail TEXT NOT NULL,
-    PRIMARY KEY (session_id, seq)
-);
-"""
+#: how long a write waits for another kiosk's transaction on the same file before giving up
+BUSY_TIMEOUT_S = 10.0
+#: session-log kinds that are alerts for the ward, with the name the station protocol gives them
+ALERT_EVENTS = {"call_doctor": "doctor_called", "clinician_continue": "doctor_continued",
+                "person_lost": "person_lost", "person_back": "person_back"}
 
 
 class StorageError(RuntimeError):
@@ -129,89 +74,6 @@ def new_patient_id() -> str:
     """A fresh random pseudonymous patient id, e.g. ``P-7K3QX9``."""
     alphabet = "ABCDEFGHJKLMNPQRSTUVWXYZ23456789"  # no 0/O, 1/I: read aloud and typed by staff
     return "P-" + "".join(secrets.choice(alphabet) for _ in range(6))
-
-
-@dataclass(frozen=True)
-class SessionSummary:
-    """One line of the session list. ``total`` is as stored; results recompute it."""
-
-    id: str
-    patient_id: str
-    started_at: str
-    finished_at: str | None
-    status: str
-    language: str
-    answered: int
-    not_answered: int
-
-
-@dataclass(frozen=True)
-class MetricSample:
-    """The QoS metrics after one update, and what fired."""
-
-    t: float
-    metrics: Mapping[str, float]
-    fired: tuple[str, ...]
-
-
-@dataclass(frozen=True)
-class AdaptationRecord:
-    """An adaptation switched on or off during a session."""
-
-    t: float
-    name: str
-    active: bool
-    reason: str
-
-
-@dataclass(frozen=True)
-class PracticeRecord:
-    """How one familiarisation question went: it checks whether the patient can hear, read or choose."""
-
-    question_id: str
-    #: "hear", "read" or "select"
-    checks: str
-    #: "right", "wrong", "not_answered" or "skipped"
-    outcome: str
-    #: the option chosen (None when not answered or skipped)
-    option: int | None
-    channel: Channel | None
-    t: float
-    #: the input's detail for an answer; why it was skipped ("no voice out")
-    detail: str = ""
-
-
-@dataclass(frozen=True)
-class LogEntry:
-    """A line of the session log (start, pause, ignored input, ...)."""
-
-    t: float
-    kind: str
-    detail: str
-
-
-@dataclass(frozen=True)
-class StoredSession:
-    """Everything stored about one session."""
-
-    id: str
-    patient_id: str
-    questionnaire_id: str
-    language: str
-    answered_by: AnsweredBy
-    timing: Mapping[str, float]
-    started_at: str
-    status: str
-    finished_at: str | None
-    answers: tuple[Answer, ...]
-    not_answered: tuple[str, ...]
-    #: the context trace: [{"t":..., "set": {...}, "emit": [...]}] in recording order
-    trace: tuple[dict[str, Any], ...]
-    metrics: tuple[MetricSample, ...]
-    adaptations: tuple[AdaptationRecord, ...]
-    log: tuple[LogEntry, ...]
-    #: the familiarisation's outcomes, in the order they happened (empty without practice)
-    practice: tuple[PracticeRecord, ...] = ()
 
 
 def _secure_dir(path: Path) -> None:
@@ -230,20 +92,56 @@ def _secure_file(path: Path) -> None:
         os.chmod(path, 0o600)
 
 
-class Store:
-    """The session database. Not shared between threads: use it from the session's thread."""
 
-    def __init__(self, connection: sqlite3.Connection, path: Path) -> None:
+def _damaged(path: Path, exc: BaseException | str) -> StorageError:
+    """The one message for a database that is not one, or is corrupt: which file, what to do."""
+    return StorageError(
+        f"{path} is damaged ({exc}); nothing was changed. Stop the kiosk, keep a copy of {path.name} "
+        f"(and {path.name}-wal, -shm if present) for the engineers, then move them out of {path.parent} "
+        "and restore a backup, or start with an empty database")
+
+
+def _is_damage(exc: sqlite3.DatabaseError) -> bool:
+    message = str(exc).lower()
+    return type(exc) is sqlite3.DatabaseError or "malformed" in message or "not a database" in message
+
+
+class Store:
+    """The session database. Not shared between threads: use it from the session's thread.
+
+    ``owner`` is this kiosk process (leases name it); ``simulated`` marks every session it creates
+    as a scripted patient's; ``outbox`` queues every change for the ward station;
+    ``interrupt_after_s`` is the age after which a running session counts as interrupted (None: no
+    limit); ``wall`` gives the epoch seconds leases are dated with.
+    """
+
+    def __init__(self, connection: sqlite3.Connection, path: Path, *, owner: Owner | None = None,
+                 simulated: bool = False, outbox: bool = False, interrupt_after_s: float | None = None,
+                 lease_ttl_s: float = LEASE_TTL_S, wall: Callable[[], float] = time.time) -> None:
         self._db = connection
         self.path = path
+        self.owner = owner or Owner()
+        self.simulated = simulated
+        self.outbox = outbox
+        self.interrupt_after_s = interrupt_after_s
+        self.lease_ttl_s = lease_ttl_s
+        self._wall = wall
         #: depth of nested transaction() blocks; writes inside them commit when the outermost ends
         self._grouping = 0
+        #: sessions whose lease this transaction has checked (a check per transaction is enough: it
+        #: holds the write lock, so no other kiosk can take the lease before it ends)
+        self._held: set[str] = set()
+        #: outbox rows written in this transaction: (any, any alert)
+        self._queued = (False, False)
+        #: called after a commit that queued outbox rows (True: one is an alert): the sync client's wake-up
+        self.on_outbox: Callable[[bool], None] | None = None
 
     @classmethod
-    def open(cls, data_dir: str | Path, create: bool = True) -> Store:
-        """Open the database in ``data_dir``, creating both if needed; with ``create=False`` (the
-        tools that only read, where a mistyped directory must not become an empty database) a
-        missing directory or database is a StorageError."""
+    def open(cls, data_dir: str | Path, create: bool = True, **options: Any) -> Store:
+        """Open the database in ``data_dir``, creating both if needed, and bring its schema up to
+        date; with ``create=False`` (the tools that only read, where a mistyped directory must not
+        become an empty database) a missing directory or database is a StorageError. ``options``
+        are the constructor's keywords."""
         directory = Path(data_dir).expanduser()
         path = directory / DB_NAME
         if not create:
@@ -251,21 +149,43 @@ class Store:
                 raise StorageError(f"no data directory {directory}")
             if not path.is_file():
                 raise StorageError(f"no session database in {directory} (expected {DB_NAME}; nothing stored there)")
+        db = None
         try:
             _secure_dir(directory)
             _secure_file(path)
-            db = sqlite3.connect(path, isolation_level=None)
+            db = sqlite3.connect(path, isolation_level=None, timeout=BUSY_TIMEOUT_S)
             db.execute("PRAGMA journal_mode=WAL")
             db.execute("PRAGMA synchronous=FULL")
             db.execute("PRAGMA foreign_keys=ON")
-            db.executescript(_SCHEMA)
-        except (OSError, sqlite3.Error) as exc:
+            check = db.execute("PRAGMA quick_check").fetchall()
+            if check != [("ok",)]:
+                raise _damaged(path, "; ".join(str(row[0]) for row in check[:3]))
+            migrate(db, str(path))
+        except SchemaError as exc:
+            db.close() if db else None
+            raise StorageError(str(exc)) from None
+        except sqlite3.DatabaseError as exc:
+            db.close() if db else None
+            if _is_damage(exc):
+                raise _damaged(path, exc) from None
             raise StorageError(f"cannot use the data directory {directory}: {exc}") from None
-        return cls(db, path)
+        except OSError as exc:
+            raise StorageError(f"cannot use the data directory {directory}: {exc}") from None
+        except StorageError:
+            db.close() if db else None
+            raise
+        return cls(db, path, **options)
 
     def close(self) -> None:
-        """Close the database (everything is already committed)."""
-        self._db.close()
+        """Release this kiosk's leases (a session still running is marked interrupted: its kiosk
+        was closed) and close the database."""
+        try:
+            for session_id in self._my_sessions():
+                self.release(session_id, "its kiosk was closed")
+        except sqlite3.Error:
+            pass  # closing must not fail: whatever is left lapses with this process
+        finally:
+            self._db.close()
 
     def __enter__(self) -> Store:
         return self
@@ -278,36 +198,83 @@ class Store:
         """Group writes into one commit (fsynced): a crash keeps all of them or none.
 
         The session runs each of its operations in one, so an answer is never stored without the
-        QoS context batch it published. Nested use joins the outer transaction. What was written is
-        committed even if the block raises: recorded answers are never thrown away.
+        QoS context batch it published. Nested use joins the outer transaction. If the outermost
+        block raises (an error, Ctrl-C) everything it wrote is rolled back: half an operation is
+        never stored.
 
         The transaction begins with its first write, so an operation that writes nothing (most
         polls of the attempt clock) takes no write lock and syncs nothing.
         """
         self._grouping += 1
+        completed = False
         try:
             yield
+            completed = True
         finally:
             self._grouping -= 1
             if not self._grouping and self._db.in_transaction:
-                self._db.commit()
+                if completed:
+                    self._commit()
+                else:
+                    self._rollback()
 
-    def _write(self, sql: str, args: tuple[Any, ...]) -> None:
+    def _commit(self) -> None:
+        try:
+            self._db.commit()
+        except BaseException:
+            self._rollback()
+            raise
+        queued, alert = self._queued
+        self._held.clear()
+        self._queued = (False, False)
+        if queued and self.on_outbox is not None:
+            self.on_outbox(alert)
+
+    def _rollback(self) -> None:
+        self._held.clear()
+        self._queued = (False, False)
+        if self._db.in_transaction:
+            self._db.rollback()
+
+    def _write(self, sql: str, args: tuple[Any, ...], session: str | None = None) -> None:
+        """One statement in the current transaction; with ``session``, only while this kiosk holds it."""
         with self.transaction():
             if not self._db.in_transaction:
                 self._db.execute("BEGIN IMMEDIATE")
+            if session is not None and session not in self._held:
+                self._check_held(session)
             self._db.execute(sql, args)
+
+    def _record(self, kind: str, session_id: str, payload: dict[str, Any], sql: str, args: tuple[Any, ...]) -> None:
+        """A change to a held session, and its outbox row, in one transaction."""
+        with self.transaction():
+            self._write(sql, args, session=session_id)
+            self._queue(kind, session_id, payload)
+
+    def _queue(self, kind: str, session_id: str | None, payload: dict[str, Any]) -> None:
+        """The change's outbox row (protocol §1), when a station is configured."""
+        if not self.outbox:
+            return
+        alert = kind == "record_event" and payload.get("kind") in ALERT_EVENTS
+        if alert:
+            payload = {**payload, "kind": ALERT_EVENTS[payload["kind"]]}
+        self._db.execute("INSERT INTO outbox (kind, session_id, payload, at, alert) VALUES (?, ?, ?, ?, ?)",
+                         (kind, session_id, json.dumps(payload, ensure_ascii=False), self._iso_now(), int(alert)))
+        self._queued = (True, self._queued[1] or alert)
 
     def _next_seq(self, table: str, session_id: str) -> int:
         row = self._db.execute(f"SELECT COALESCE(MAX(seq), -1) + 1 FROM {table} WHERE session_id = ?",
                                (session_id,)).fetchone()
         return int(row[0])
 
+    def _iso_now(self) -> str:
+        return datetime.fromtimestamp(self._wall(), timezone.utc).isoformat().replace("+00:00", "Z")
+
     # -- writing (kiosk.session.SessionStore) ----------------------------------------------------
 
     def create_session(self, *, session_id: str, patient_id: str, questionnaire_id: str, language: str,
                        answered_by: str, started_at: str, timing: Mapping[str, float]) -> None:
-        """Record a new running session (and its patient, the first time)."""
+        """Record a new running session (and its patient, the first time), held by this kiosk."""
         if not PATIENT_ID.match(patient_id):
             raise ValueError(f"patient id {patient_id!r} is not a pseudonymous id "
                              "(2-64 letters, digits, '-' or '_'; never a name)")
@@ -315,57 +282,222 @@ class Store:
             self._write("INSERT OR IGNORE INTO patients (id, created_at) VALUES (?, ?)", (patient_id, started_at))
             self._write(
                 "INSERT INTO sessions (id, patient_id, questionnaire_id, language, answered_by, timing, started_at,"
-                " status) VALUES (?, ?, ?, ?, ?, ?, ?, 'running')",
-                (session_id, patient_id, questionnaire_id, language, answered_by, json.dumps(dict(timing)), started_at),
+                " status, simulated) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?)",
+                (session_id, patient_id, questionnaire_id, language, answered_by, json.dumps(dict(timing)), started_at,
+                 int(self.simulated)),
             )
+            self._take(session_id)
+            self._queue("create_session", session_id, {
+                "session_id": session_id, "patient_id": patient_id, "questionnaire_id": questionnaire_id,
+                "language": language, "answered_by": answered_by, "started_at": started_at, "timing": dict(timing),
+                "simulated": self.simulated})
 
     def record_answer(self, session_id: str, *, item_id: str, option: int, points: int, attempt: int,
                       channel: str, answered_by: str, t: float, at: str, detail: str = "") -> None:
-        """Commit one answer."""
-        self._write("INSERT INTO answers VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    (session_id, item_id, option, points, attempt, channel, answered_by, t, at, detail))
+        """Store one answer."""
+        self._record("record_answer", session_id, {
+            "item_id": item_id, "option": option, "points": points, "attempt": attempt, "channel": channel,
+            "answered_by": answered_by, "t": t, "at": at, "detail": detail},
+            "INSERT INTO answers VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (session_id, item_id, option, points, attempt, channel, answered_by, t, at, detail))
+
+    def withdraw_answer(self, session_id: str, *, item_id: str, t: float, at: str, reason: str) -> None:
+        """Take back a committed answer (the patient's "Change my answer"): its row is deleted and
+        the session log keeps what it was (an ``answer_withdrawn`` event, detail JSON), in one commit."""
+        row = self._db.execute("SELECT option, points, attempt, channel, answered_by, t, at, detail FROM answers"
+                               " WHERE session_id = ? AND item_id = ?", (session_id, item_id)).fetchone()
+        if row is None:
+            raise KeyError(f"session {session_id} has no answer to {item_id!r} to withdraw")
+        withdrawn = dict(zip(("option", "points", "attempt", "channel", "answered_by", "t", "at", "detail"), row))
+        with self.transaction():
+            self._record("withdraw_answer", session_id, {"item_id": item_id, "t": t, "at": at, "reason": reason},
+                         "DELETE FROM answers WHERE session_id = ? AND item_id = ?", (session_id, item_id))
+            self.record_event(session_id, t=t, kind="answer_withdrawn", detail=json.dumps(
+                {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False))
 
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None:
-        """Commit that both attempts of a question timed out."""
-        self._write("INSERT INTO not_answered VALUES (?, ?, ?, ?)", (session_id, item_id, t, at))
+        """Store that both attempts of a question timed out."""
+        self._record("record_not_answered", session_id, {"item_id": item_id, "t": t, "at": at},
+                     "INSERT INTO not_answered VALUES (?, ?, ?, ?)", (session_id, item_id, t, at))
 
     def record_practice(self, session_id: str, *, question_id: str, checks: str, outcome: str, option: int | None,
                         channel: str | None, t: float, at: str, detail: str = "") -> None:
-        """Commit a practice question's outcome ("right", "wrong", "not_answered" or "skipped")."""
-        self._write("INSERT INTO practice VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    (session_id, self._next_seq("practice", session_id), question_id, checks, outcome, option,
-                     channel, t, at, detail))
+        """Store a practice question's outcome ("right", "wrong", "not_answered" or "skipped")."""
+        self._record("record_practice", session_id, {
+            "question_id": question_id, "checks": checks, "outcome": outcome, "option": option, "channel": channel,
+            "t": t, "at": at, "detail": detail},
+            "INSERT INTO practice VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (session_id, self._next_seq("practice", session_id), question_id, checks, outcome, option, channel, t,
+             at, detail))
 
     def record_context(self, session_id: str, *, t: float, set: Mapping[str, Any], emit: list[str]) -> None:
-        """Commit one batch of the session's QoS context trace."""
-        self._write("INSERT INTO contexts VALUES (?, ?, ?, ?, ?)",
-                    (session_id, self._next_seq("contexts", session_id), t, json.dumps(dict(set)), json.dumps(list(emit))))
+        """Store one batch of the session's QoS context trace."""
+        self._record("record_context", session_id, {"t": t, "set": dict(set), "emit": list(emit)},
+                     "INSERT INTO contexts VALUES (?, ?, ?, ?, ?)",
+                     (session_id, self._next_seq("contexts", session_id), t, json.dumps(dict(set)),
+                      json.dumps(list(emit))))
 
     def record_metrics(self, session_id: str, *, t: float, metrics: Mapping[str, float], fired: list[str]) -> None:
-        """Commit the QoS metrics after one update."""
-        self._write("INSERT INTO metric_samples VALUES (?, ?, ?, ?, ?)",
-                    (session_id, self._next_seq("metric_samples", session_id), t, json.dumps(dict(metrics)),
-                     json.dumps(list(fired))))
+        """Store the QoS metrics after one update."""
+        self._record("record_metrics", session_id, {"t": t, "metrics": dict(metrics), "fired": list(fired)},
+                     "INSERT INTO metric_samples VALUES (?, ?, ?, ?, ?)",
+                     (session_id, self._next_seq("metric_samples", session_id), t, json.dumps(dict(metrics)),
+                      json.dumps(list(fired))))
 
     def record_adaptation(self, session_id: str, *, t: float, name: str, active: bool, reason: str) -> None:
-        """Commit an adaptation switched on or off."""
-        self._write("INSERT INTO adaptations VALUES (?, ?, ?, ?, ?, ?)",
-                    (session_id, self._next_seq("adaptations", session_id), t, name, int(active), reason))
+        """Store an adaptation switched on or off."""
+        self._record("record_adaptation", session_id, {"t": t, "name": name, "active": active, "reason": reason},
+                     "INSERT INTO adaptations VALUES (?, ?, ?, ?, ?, ?)",
+                     (session_id, self._next_seq("adaptations", session_id), t, name, int(active), reason))
 
     def record_event(self, session_id: str, *, t: float, kind: str, detail: str = "") -> None:
-        """Commit a line of the session log."""
-        self._write("INSERT INTO events VALUES (?, ?, ?, ?, ?)",
-                    (session_id, self._next_seq("events", session_id), t, kind, detail))
+        """Store a line of the session log (a call for the doctor, a patient leaving: alerts first)."""
+        self._record("record_event", session_id, {"t": t, "kind": kind, "detail": detail},
+                     "INSERT INTO events VALUES (?, ?, ?, ?, ?)",
+                     (session_id, self._next_seq("events", session_id), t, kind, detail))
 
     def finish_session(self, session_id: str, *, finished_at: str, total: int, complete: bool,
                        band: str | None) -> None:
         """Mark a session finished (the total is kept for listing; results recompute it)."""
-        self._write("UPDATE sessions SET status = 'finished', finished_at = ?, total = ?, complete = ?, band = ?"
-                    " WHERE id = ?", (finished_at, total, int(complete), band, session_id))
+        self._record("finish_session", session_id,
+                     {"finished_at": finished_at, "total": total, "complete": complete, "band": band},
+                     "UPDATE sessions SET status = 'finished', finished_at = ?, total = ?, complete = ?, band = ?"
+                     " WHERE id = ?", (finished_at, total, int(complete), band, session_id))
 
     def abandon(self, session_id: str) -> None:
-        """Mark an unfinished session as not to be resumed (its answers stay)."""
-        self._write("UPDATE sessions SET status = 'abandoned' WHERE id = ? AND status = 'running'", (session_id,))
+        """Mark an unfinished session as not to be continued (its answers stay): this kiosk's
+        running session, or an interrupted one that staff end."""
+        with self.transaction():
+            status = self._status(session_id)
+            if status not in ("running", "interrupted"):
+                return
+            self._write("UPDATE sessions SET status = 'abandoned' WHERE id = ?", (session_id,),
+                        session=session_id if status == "running" else None)
+            self._db.execute("DELETE FROM leases WHERE session_id = ?", (session_id,))
+            self._queue("abandon", session_id, {})
+
+    # -- who holds a session (kiosk.lease) ---------------------------------------------------------
+
+    def _status(self, session_id: str) -> str | None:
+        row = self._db.execute("SELECT status FROM sessions WHERE id = ?", (session_id,)).fetchone()
+        return row[0] if row else None
+
+    def _holder(self, session_id: str) -> tuple[Owner, float] | None:
+        row = self._db.execute("SELECT host, pid, token, renewed_at FROM leases WHERE session_id = ?",
+                               (session_id,)).fetchone()
+        return (Owner(row[0], int(row[1]), row[2]), float(row[3])) if row else None
+
+    def _check_held(self, session_id: str) -> None:
+        """Inside a write transaction: this kiosk holds the session, else SessionTaken."""
+        why = self.why_not_held(session_id)
+        if why is not None:
+            raise SessionTaken(why)
+        self._held.add(session_id)
+
+    def why_not_held(self, session_id: str) -> str | None:
+        """Why this kiosk may not record in the session (a sentence for staff), or None if it holds it."""
+        holder = self._holder(session_id)
+        if holder is not None and holder[0].token == self.owner.token:
+            return None
+        if holder is not None:
+            return (f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
+                    "one kiosk at a time records a test")
+        row = self._db.execute("SELECT status, interrupted_reason FROM sessions WHERE id = ?",
+                               (session_id,)).fetchone()
+        if row is None:
+            return f"session {session_id} is not stored"
+        why = f" ({row[1]})" if row[0] == "interrupted" and row[1] else ""
+        return f"session {session_id} is no longer held by this kiosk: it is {row[0]}{why}"
+
+    def _take(self, session_id: str) -> None:
+        """Inside a write transaction: take the session's lease unless a live kiosk holds it."""
+        holder = self._holder(session_id)
+        now = self._wall()
+        if holder is not None and holder[0].token != self.owner.token \
+                and lapsed(holder[0], holder[1], now, self.lease_ttl_s, self.owner) is None:
+            raise SessionTaken(f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
+                               "one kiosk at a time records a test")
+        self._db.execute("INSERT OR REPLACE INTO leases VALUES (?, ?, ?, ?, ?, ?)",
+                         (session_id, self.owner.host, self.owner.pid, self.owner.token, now, now))
+        self._held.add(session_id)
+
+    def _my_sessions(self) -> list[str]:
+        return [r[0] for r in self._db.execute("SELECT session_id FROM leases WHERE token = ?", (self.owner.token,))]
+
+    def holds(self, session_id: str) -> bool:
+        """Whether this kiosk holds the session now."""
+        return self.why_not_held(session_id) is None
+
+    def renew(self) -> None:
+        """Renew this kiosk's leases (the running kiosk calls this every third of the lease time)."""
+        if not self._my_sessions():
+            return
+        with self.transaction():
+            self._write("UPDATE leases SET renewed_at = ? WHERE token = ?", (self._wall(), self.owner.token))
+
+    def release(self, session_id: str, reason: str = "its kiosk moved on to another test") -> None:
+        """Give up the session: this kiosk no longer records in it. Still running, it is interrupted."""
+        with self.transaction():
+            if not self.holds(session_id):
+                return
+            if self._status(session_id) == "running":
+                self._interrupt(session_id, reason)
+            self._write("DELETE FROM leases WHERE session_id = ?", (session_id,))
+
+    def _interrupt(self, session_id: str, reason: str) -> None:
+        self._write("UPDATE sessions SET status = 'interrupted', interrupted_at = ?, interrupted_reason = ?"
+                    " WHERE id = ? AND status = 'running'", (self._iso_now(), reason, session_id))
+        self._queue("mark_interrupted", session_id, {"reason": reason})
+
+    def _stale(self) -> list[tuple[str, str]]:
+        """Running sessions whose kiosk is gone, or older than the limit: (id, why)."""
+        now = self._wall()
+        stale = []
+        for session_id, started_at, host, pid, token, renewed_at in self._db.execute(
+                "SELECT s.id, s.started_at, l.host, l.pid, l.token, l.renewed_at FROM sessions s"
+                " LEFT JOIN leases l ON l.session_id = s.id WHERE s.status = 'running'").fetchall():
+            why = "no kiosk held it" if host is None else lapsed(Owner(host, int(pid), token), float(renewed_at),
+                                                                 now, self.lease_ttl_s, self.owner)
+            if why is None and self.interrupt_after_s is not None and _age_s(started_at, now) > self.interrupt_after_s:
+                why = f"not finished within {self.interrupt_after_s / 60:g} minutes"
+            if why is not None:
+                stale.append((session_id, why))
+        return stale
+
+    def interrupt_stale(self) -> list[str]:
+        """Mark interrupted every running session whose kiosk is gone (process ended on this host,
+        lease not renewed) or that is older than ``interrupt_after_s``; returns their ids. A patient
+        is never offered one; staff may continue it (:meth:`continue_session`)."""
+        if not self._stale():
+            return []  # the usual case: a read, no write lock
+        with self.transaction():
+            self._db.execute("BEGIN IMMEDIATE")
+            stale = self._stale()  # again under the lock: another kiosk may have acted meanwhile
+            for session_id, why in stale:
+                self._interrupt(session_id, why)
+                self._db.execute("DELETE FROM leases WHERE session_id = ?", (session_id,))
+        return [session_id for session_id, _ in stale]
+
+    def continue_session(self, ref: str) -> StoredSession:
+        """Staff continue an interrupted session on this kiosk: it is taken (atomically; SessionTaken
+        if a running kiosk holds it) and running again. ValueError if it cannot be continued."""
+        session_id = self.resolve(ref)
+        self.interrupt_stale()
+        with self.transaction():
+            self._db.execute("BEGIN IMMEDIATE")
+            status, simulated = self._db.execute("SELECT status, simulated FROM sessions WHERE id = ?",
+                                                 (session_id,)).fetchone()
+            if simulated:
+                raise ValueError(f"session {session_id} is a simulated (replayed) session: it cannot be continued")
+            if status == "running":
+                self._take(session_id)  # SessionTaken unless it is this kiosk's already
+            elif status != "interrupted":
+                raise ValueError(f"session {session_id} is {status}: only an interrupted test can be continued")
+            self._take(session_id)
+            self._db.execute("UPDATE sessions SET status = 'running', interrupted_at = NULL, interrupted_reason = NULL"
+                             " WHERE id = ?", (session_id,))
+            self._queue("continue_session", session_id, {})
+        return self.session(session_id)
 
     # -- reading ------------------------------------------------------------------------------------
 
@@ -374,14 +506,17 @@ class Store:
         rows = self._db.execute(
             "SELECT s.id, s.patient_id, s.started_at, s.finished_at, s.status, s.language,"
             " (SELECT COUNT(*) FROM answers a WHERE a.session_id = s.id),"
-            " (SELECT COUNT(*) FROM not_answered n WHERE n.session_id = s.id)"
+            " (SELECT COUNT(*) FROM not_answered n WHERE n.session_id = s.id), s.simulated, s.interrupted_reason"
             " FROM sessions s ORDER BY s.started_at DESC, s.rowid DESC").fetchall()
-        return [SessionSummary(*row) for row in rows]
+        return [SessionSummary(*row[:8], simulated=bool(row[8]), interrupted_reason=row[9]) for row in rows]
 
     def unfinished_sessions(self) -> list[StoredSession]:
-        """Sessions that were running when the kiosk stopped (crash, power cut), newest first."""
+        """The tests staff may continue, newest first: interrupted (their kiosk stopped, or they grew
+        too old: see :meth:`interrupt_stale`, run first), never simulated ones."""
+        self.interrupt_stale()
         ids = [r[0] for r in self._db.execute(
-            "SELECT id FROM sessions WHERE status = 'running' ORDER BY started_at DESC, rowid DESC")]
+            "SELECT id FROM sessions WHERE status = 'interrupted' AND simulated = 0"
+            " ORDER BY started_at DESC, rowid DESC")]
         return [self.session(i) for i in ids]
 
     def resolve(self, ref: str) -> str:
@@ -398,8 +533,8 @@ class Store:
         """Everything stored about one session (full id or unique prefix)."""
         session_id = self.resolve(ref)
         row = self._db.execute(
-            "SELECT id, patient_id, questionnaire_id, language, answered_by, timing, started_at, status, finished_at"
-            " FROM sessions WHERE id = ?", (session_id,)).fetchone()
+            "SELECT id, patient_id, questionnaire_id, language, answered_by, timing, started_at, status, finished_at,"
+            " simulated, interrupted_reason, interrupted_at FROM sessions WHERE id = ?", (session_id,)).fetchone()
         answers = tuple(
             Answer(item_id, option, points, attempt, Channel(channel), AnsweredBy(by), t, detail)
             for item_id, option, points, attempt, channel, by, t, detail in self._db.execute(
@@ -432,5 +567,16 @@ class Store:
             id=row[0], patient_id=row[1], questionnaire_id=row[2], language=row[3], answered_by=AnsweredBy(row[4]),
             timing=json.loads(row[5]), started_at=row[6], status=row[7], finished_at=row[8], answers=answers,
             not_answered=not_answered, trace=tuple(trace), metrics=metrics, adaptations=adaptations, log=log,
-            practice=practice,
+            practice=practice, simulated=bool(row[9]), interrupted_reason=row[10], interrupted_at=row[11],
         )
+
+
+def _age_s(started_at: str, now: float) -> float:
+    """Seconds since an ISO 8601 start time (naive times are UTC)."""
+    try:
+        started = datetime.fromisoformat(started_at.replace("Z", "+00:00"))
+    except ValueError:
+        return 0.0
+    if started.tzinfo is None:
+        started = started.replace(tzinfo=timezone.utc)
+    return now - started.timestamp()

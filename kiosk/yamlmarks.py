@@ -2,30 +2,22 @@
 
 Hand-edited files (questionnaires, scripted patients, the config) must report problems as
 ``file:line:col``. PyYAML's ``compose`` keeps the marks that ``safe_load`` throws away; this module
-keeps both the constructed data and a map from each path (keys and list indexes) to its mark, and
-notices duplicate keys, which ``safe_load`` silently lets the last one win.
+keeps both the constructed data and a map from each path (keys and list indexes) to its mark. The
+file itself is read by ``qos.files`` (size, encoding, nesting, aliases, duplicate keys, numbers),
+the one bounded reader every loader of the project shares.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import yaml
 
+from qos.files import MAX_YAML_BYTES, BadFile, Problem, compose_yaml, construct_yaml, read_text
 
-@dataclass(frozen=True)
-class Problem:
-    """One thing wrong with a file, at a 1-based line and column."""
-
-    file: str
-    line: int
-    column: int
-    message: str
-
-    def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.column}: {self.message}"
+__all__ = ["Positions", "Problem", "describe", "parse", "parse_file", "schema_problems"]
 
 
 class Positions:
@@ -34,8 +26,6 @@ class Positions:
     def __init__(self, root: yaml.Node) -> None:
         self._marks: dict[tuple[Any, ...], tuple[int, int]] = {}
         self._key_marks: dict[tuple[Any, ...], tuple[int, int]] = {}
-        #: (path of the mapping, key, position of the second occurrence)
-        self.duplicate_keys: list[tuple[tuple[Any, ...], str, tuple[int, int]]] = []
         self._walk(root, ())
 
     @staticmethod
@@ -45,12 +35,8 @@ class Positions:
     def _walk(self, node: yaml.Node, path: tuple[Any, ...]) -> None:
         self._marks[path] = self._mark(node)
         if isinstance(node, yaml.MappingNode):
-            seen: set[str] = set()
             for key_node, value_node in node.value:
                 key = key_node.value
-                if key in seen:
-                    self.duplicate_keys.append((path, key, self._mark(key_node)))
-                seen.add(key)
                 self._key_marks[path + (key,)] = self._mark(key_node)
                 self._walk(value_node, path + (key,))
         elif isinstance(node, yaml.SequenceNode):
@@ -72,31 +58,31 @@ def describe(path: tuple[Any, ...]) -> str:
 
 
 def parse(text: str, filename: str) -> tuple[Any, Positions | None, list[Problem]]:
-    """Parse one YAML document: (data, positions, problems).
+    """Parse one YAML document under the shared reader's limits (``qos.files``): (data, positions,
+    problems).
 
-    A syntax error or an empty document gives (None, None, [that problem]); duplicate keys are
-    returned as problems alongside the data.
+    A document that cannot be read (syntax, duplicate keys, nesting, alias bombs, huge or
+    non-finite numbers) or is empty gives (None, None, [that problem]).
     """
-    loader = yaml.SafeLoader(text)
     try:
-        node = loader.get_single_node()
+        node = compose_yaml(text, filename)
         if node is None:
             return None, None, [Problem(filename, 1, 1, "the file is empty")]
-        data = loader.construct_document(node)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-        return None, None, [Problem(filename, line, col, f"YAML syntax: {exc.problem or exc.context}")]
-    except yaml.YAMLError as exc:
-        return None, None, [Problem(filename, 1, 1, f"YAML syntax: {exc}")]
-    finally:
-        loader.dispose()
-    positions = Positions(node)
-    problems = [
-        Problem(filename, line, col, f"duplicate key {key!r}" + (f" in {describe(path)}" if path else ""))
-        for path, key, (line, col) in positions.duplicate_keys
-    ]
-    return data, positions, problems
+        data = construct_yaml(node, filename)
+    except BadFile as exc:
+        return None, None, [exc.problem]
+    return data, Positions(node), []
+
+
+def parse_file(path: str | Path, name: str | None = None) -> tuple[Any, Positions | None, list[Problem]]:
+    """Read a YAML file through the shared bounded reader and :func:`parse` it; an unreadable file
+    (missing, too big, not UTF-8, binary) is one problem. ``name`` is how messages call the file."""
+    name = str(path) if name is None else name
+    try:
+        text = read_text(path, MAX_YAML_BYTES)
+    except BadFile as exc:
+        return None, None, [Problem(name, exc.problem.line, exc.problem.column, exc.problem.message)]
+    return parse(text, name)
 
 
 def schema_problems(data: Any, schema: dict[str, Any], positions: Positions,
@@ -117,6 +103,8 @@ def schema_problems(data: Any, schema: dict[str, Any], positions: Positions,
         elif error.validator == "required":
             missing = error.message.split("'")[1] if "'" in error.message else error.message
             add(path, f"{where} is missing {missing!r}")
+        elif error.validator == "minItems" and error.validator_value == 1 and error.instance == []:
+            add(path, f"{where} is empty: list at least one")
         elif error.validator == "multipleOf":
             add(path, f"{where}: must be a multiple of {error.validator_value}, got {error.instance!r}")
         else:

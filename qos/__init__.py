@@ -6,6 +6,9 @@ Load a model, feed an :class:`Engine` batches of context updates, read the prope
     engine = Engine(load_model("clarc"))
     result = engine.update(10, set={"PersonDetected": True})
     result.metrics, result.fired
+    engine.advance(75)  # nothing happened since: let the model's timers and time windows run
+
+Times are seconds since the session started; the engine never reads the wall clock.
 
 Context traces (recorded sessions, hand-written scenarios) are loaded with :func:`load_trace` and
 replayed with :func:`replay`, or from the shell with ``python -m qos replay TRACE``.
@@ -18,7 +21,7 @@ from pathlib import Path
 
 from qos.engine import Engine, UpdateResult
 from qos.errors import ContextError, ModelError, QosError, TraceError
-from qos.model import Context, EnumType, Model, Observation, Property
+from qos.model import Context, EnumType, Model, Observation, Property, Timer, Variable
 from qos.parser import load_model_file, parse_model
 from qos.trace import (
     ReplaySamples, Trace, TraceEvent, TraceRecorder, dump_trace, load_trace, replay, sample_trace,
@@ -26,7 +29,8 @@ from qos.trace import (
 
 __all__ = [
     "Context", "ContextError", "Engine", "EnumType", "Model", "ModelError", "Observation", "Property",
-    "QosError", "ReplaySamples", "Trace", "TraceError", "TraceEvent", "TraceRecorder", "UpdateResult", "bundled_models",
+    "QosError", "ReplaySamples", "Timer", "Trace", "TraceError", "TraceEvent", "TraceRecorder", "UpdateResult",
+    "Variable", "bundled_models",
     "dump_trace", "load_model", "load_trace", "parse_model", "replay", "sample_trace",
 ]
 
@@ -48,5 +52,6 @@ def load_model(name_or_path: str | Path) -> Model:
     if text not in bundled_models():
         raise ModelError(f"no bundled model named {text!r} (bundled: {', '.join(bundled_models())}); "
                          "give a path to a .roqme file instead")
-    resource = resources.files("qos") / "models" / f"{text}.roqme"
-    return parse_model(resource.read_text(encoding="utf-8"), f"{text}.roqme")
+    folder = resources.files("qos") / "models"
+    # bundled models may import each other (the package is installed as files, not zipped)
+    return parse_model((folder / f"{text}.roqme").read_text(encoding="utf-8"), f"{text}.roqme", Path(str(folder)))

@@ -44,10 +44,14 @@ def build_parser(prog: str, epilog: str | None = None) -> argparse.ArgumentParse
 def format_table(result: dict) -> str:
     """The replay result for people: a statistics table, then the observations over time."""
     metrics = result["metrics"]
-    width = max(len("property"), *(len(name) for name in metrics))
+    beliefs = result.get("beliefs", {})
+    width = max(len("property"), *(len(name) for name in [*metrics, *beliefs]))
     lines = [f"{'property':<{width}}  " + "  ".join(f"{column:>6}" for column in ("min", "max", "avg", "sd", "last"))]
-    for name, stats in metrics.items():
-        lines.append(f"{name:<{width}}  " + "  ".join(f"{stats[key]:6.4f}" for key in ("min", "max", "avg", "sd", "last")))
+    for heading, table in (("", metrics), ("belief variables (not published):", beliefs)):
+        if table and heading:
+            lines.append(heading)
+        for name, stats in table.items():
+            lines.append(f"{name:<{width}}  " + "  ".join(f"{stats[key]:6.4f}" for key in ("min", "max", "avg", "sd", "last")))
     lines += ["", "fired observations:" if result["fired"] else "no observation fired"]
     for entry in result["fired"]:
         lines.append(f"  t={entry['t']:>8g} s  {' '.join(entry['observations'])}")

@@ -1,4 +1,5 @@
-"""The in-memory form of a RoQME model: types, properties, contexts and observations.
+"""The in-memory form of a RoQME model: types, properties and belief variables, contexts (primitive and
+derived), variables, parameters, timers, observations with their actions, and the terms in them.
 
 A :class:`Model` is immutable once loaded; every :class:`~qos.engine.Engine` built from it keeps its
 own run-time state, so one model can serve many engines.
@@ -14,6 +15,7 @@ INTENSITY_LR: dict[str, float] = {
     "veryhigh": 0.1,
     "high": 0.3,
     "default": 0.5,
+    "medium": 0.5,
     "low": 0.7,
     "verylow": 0.9,
 }
@@ -33,8 +35,19 @@ class EnumType:
         return f"enum {self.name} {{{', '.join(self.literals)}}}"
 
 
-#: the type of a context or expression: "boolean", "number", "eventtype" or an enumeration
-ValueType = Union[str, EnumType]
+@dataclass(frozen=True)
+class ArrayType:
+    """An array of at most ``size`` values of one scalar type (``number[3]``, ``enum[2] {…}``)."""
+
+    element: "ValueType"
+    size: int
+
+    def __str__(self) -> str:
+        return f"{type_name(self.element)}[{self.size}]"
+
+
+#: the type of a context or expression: "boolean", "number", "eventtype", an enumeration or an array
+ValueType = Union[str, EnumType, ArrayType]
 
 BOOLEAN = "boolean"
 NUMBER = "number"
@@ -42,8 +55,30 @@ EVENTTYPE = "eventtype"
 
 
 def type_name(value_type: ValueType) -> str:
-    """How a type is named in messages: ``boolean``, ``number``, ``eventtype`` or ``enum T``."""
+    """How a type is named in messages: ``boolean``, ``number``, ``eventtype``, ``enum T`` or ``number[3]``."""
+    if isinstance(value_type, ArrayType):
+        return str(value_type)
     return f"enum {value_type.name}" if isinstance(value_type, EnumType) else value_type
+
+
+@dataclass(frozen=True)
+class TypeSpec:
+    """A declared data type with its constraints: what ``type T : …`` names and a context or
+    variable declares. Bounds and units apply to numbers (and to the elements of number arrays)."""
+
+    type: ValueType
+    lower: float | None = None
+    upper: float | None = None
+    #: the unit a number is measured in (documentation; ``time`` is a number of seconds)
+    unit: str | None = None
+
+    def out_of_bounds(self, value: float) -> str | None:
+        """Why a number breaks the bounds, or None when it keeps them."""
+        if self.lower is not None and value < self.lower:
+            return f"{value:g} is below the lower bound {self.lower:g}"
+        if self.upper is not None and value > self.upper:
+            return f"{value:g} is above the upper bound {self.upper:g}"
+        return None
 
 
 @dataclass(frozen=True)
@@ -52,11 +87,24 @@ class Context:
 
     name: str
     type: ValueType
+    #: bounds and unit (numbers); None for an unconstrained context
+    spec: TypeSpec | None = None
+    #: a derived context's definition (``context X : T := …``): an expression or, for an eventtype,
+    #: a pattern; None for a primitive context, which the kiosk sets
+    definition: Union["Expr", "Pattern", None] = None
+    description: str | None = None
 
     @property
     def kind(self) -> str:
-        """``boolean``, ``number``, ``eventtype`` or ``enum``."""
+        """``boolean``, ``number``, ``eventtype``, ``enum`` or ``array``."""
+        if isinstance(self.type, ArrayType):
+            return "array"
         return "enum" if isinstance(self.type, EnumType) else self.type
+
+    @property
+    def derived(self) -> bool:
+        """True for a derived context: the engine computes it, nobody may set it."""
+        return self.definition is not None
 
     @property
     def literals(self) -> tuple[str, ...]:
@@ -72,6 +120,9 @@ class Property:
     reference: float = 0.5
     #: seconds; ``None`` means the evidence never fades
     survival: float | None = None
+    #: ``property P : T := …``: the value published beside the metric, computed from ``belief``
+    transformation: "Expr | None" = None
+    description: str | None = None
 
     @property
     def prior(self) -> float:
@@ -122,7 +173,54 @@ class Binary:
     type: ValueType
 
 
-Expr = Union[Var, Literal, Unary, Binary]
+@dataclass(frozen=True)
+class Conditional:
+    """``condition ? then : otherwise``; undefined when the condition is."""
+
+    condition: "Expr"
+    then: "Expr"
+    otherwise: "Expr"
+    type: ValueType
+
+
+@dataclass(frozen=True)
+class Call:
+    """A function of values: ``pow sqrt exp abs`` (numbers) or ``size isEmpty first last at includes``
+    (arrays); ``X'f(a)`` is ``f(X, a)``."""
+
+    function: str
+    args: tuple["Expr", ...]
+    type: ValueType
+
+
+@dataclass(frozen=True)
+class Aggregate:
+    """``avg min max count sum increasing decreasing stable`` over the updates of one context.
+
+    ``window`` is None (every update so far), an int (the last n updates, Esper ``length(n)``) or a
+    float number of seconds (consecutive batches of that length, Esper ``time_batch``); ``where`` keeps
+    only the updates after which it is true. Checked models hold it as a stream (see ``Model.streams``).
+    """
+
+    function: str
+    source: str
+    window: int | float | None
+    where: "Expr | None"
+    type: ValueType
+
+
+@dataclass(frozen=True)
+class Period:
+    """``period(X)``: at an update that changes X, the seconds since X's previous update;
+    ``period(a -> b)``: at each ``b`` after an ``a``, the seconds since the latest ``a``."""
+
+    source: str | None
+    first: "Pattern | None" = None
+    then: "Pattern | None" = None
+    type: ValueType = NUMBER
+
+
+Expr = Union[Var, Literal, Unary, Binary, Conditional, Call]
 
 
 @dataclass(frozen=True)
@@ -191,20 +289,38 @@ class Repeat:
     times: int
 
 
-Pattern = Union[Updated, Changed, AnyOf, AllOf, FollowedBy, Once, While, Repeat]
+@dataclass(frozen=True)
+class AndNot:
+    """``a and not b``: ``a`` occurs before ``b`` has occurred since the pattern was (re-)armed; an
+    occurrence of ``b`` ends the attempt and the pattern starts again (Esper ``every (a and not b)``)."""
+
+    pattern: "Pattern"
+    excluded: "Pattern"
 
 
 @dataclass(frozen=True)
-class Observation:
-    """``observation NAME : PATTERN (reinforces | undermines) PROPERTY [INTENSITY]``."""
+class Range:
+    """``p range(a, b)``: occurs on the a-th to the b-th occurrence of ``p`` in the engine's life."""
 
-    name: str
-    pattern: Pattern
-    property: str
+    pattern: "Pattern"
+    low: int
+    high: int
+
+
+Pattern = Union[Updated, Changed, AnyOf, AllOf, AndNot, FollowedBy, Once, While, Repeat, Range]
+
+
+# ---- actions, variables, timers ------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Evidence:
+    """``reinforces | undermines BELIEF [strength] [survival T]``."""
+
+    target: str
     reinforces: bool
     intensity: str = "default"
-    #: line of the declaration in the model file (for messages)
-    line: int = 0
+    #: seconds this evidence takes to fade; None: the target's own survival
+    survival: float | None = None
 
     @property
     def likelihood_ratio(self) -> float:
@@ -214,14 +330,121 @@ class Observation:
 
 
 @dataclass(frozen=True)
+class SetVariable:
+    """``sets v := expr``: the variable takes the expression's value after the batch."""
+
+    variable: str
+    expr: Expr
+
+
+@dataclass(frozen=True)
+class ClearEvidence:
+    """``clears BELIEF``: forget every piece of evidence; the belief is its reference again."""
+
+    target: str
+
+
+@dataclass(frozen=True)
+class TimerAction:
+    """``starts | stops | resumes TIMER``."""
+
+    verb: str
+    timer: str
+
+
+Action = Union[Evidence, SetVariable, ClearEvidence, TimerAction]
+
+
+@dataclass(frozen=True)
+class Variable:
+    """``var v : T := expr`` (recomputed every batch unless constant, set by ``sets``) or
+    ``param p : T default value`` (a constant a caller may override)."""
+
+    name: str
+    type: ValueType
+    spec: TypeSpec | None = None
+    #: the value before any batch (None: undefined)
+    initial: object = None
+    #: recomputed after every batch's contexts when not constant
+    definition: Expr | None = None
+    parameter: bool = False
+    description: str | None = None
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """``schedule("minutes, hours, days, months, weekdays[, seconds]")`` (Esper ``timer:at``), read by
+    :func:`qos.timers.parse_schedule`: each field holds the values at which the timer fires."""
+
+    text: str
+    minutes: frozenset[int]
+    hours: frozenset[int]
+    days: frozenset[int]
+    months: frozenset[int]
+    weekdays: frozenset[int]
+    seconds: frozenset[int]
+
+
+@dataclass(frozen=True)
+class Timer:
+    """``timer T := interval | schedule(…) [offset d] [onetime] [paused]``; it occurs as a pattern."""
+
+    name: str
+    #: seconds between firings (``timer:interval``); None for a schedule
+    interval: float | None = None
+    schedule: Schedule | None = None
+    offset: float = 0.0
+    onetime: bool = False
+    paused: bool = False
+    description: str | None = None
+
+
+@dataclass(frozen=True)
+class Observation:
+    """``observation NAME : PATTERN ACTION`` or ``… { ACTION… }``."""
+
+    name: str
+    pattern: Pattern
+    actions: tuple[Action, ...]
+    #: line of the declaration in the model file (for messages)
+    line: int = 0
+    description: str | None = None
+
+    @property
+    def evidence(self) -> list[Evidence]:
+        """The ``reinforces``/``undermines`` actions, in order."""
+        return [action for action in self.actions if isinstance(action, Evidence)]
+
+    @property
+    def likelihood_ratio(self) -> float:
+        """The likelihood ratio of the first piece of evidence (CLARC's observations have one)."""
+        return self.evidence[0].likelihood_ratio
+
+
+#: a computed value the engine keeps up to date each batch, in ``Model.streams`` order: a derived
+#: context (by name), a variable with a definition (by name), or an Aggregate/Period (hidden name ``#n``)
+Stream = Union[Context, Variable, Aggregate, Period]
+
+
+@dataclass(frozen=True)
 class Model:
     """A loaded, checked RoQME model."""
 
     name: str
     #: where it was loaded from (a path, or ``<string>``)
     source: str
+    #: published properties (the metrics), in declaration order
     properties: dict[str, Property] = field(default_factory=dict)
-    types: dict[str, EnumType] = field(default_factory=dict)
+    types: dict[str, TypeSpec] = field(default_factory=dict)
     contexts: dict[str, Context] = field(default_factory=dict)
     #: in declaration order
     observations: dict[str, Observation] = field(default_factory=dict)
+    #: ``beliefvar`` declarations: beliefs like properties, not published
+    beliefvars: dict[str, Property] = field(default_factory=dict)
+    variables: dict[str, Variable] = field(default_factory=dict)
+    timers: dict[str, Timer] = field(default_factory=dict)
+    #: (name, definition) of every computed value, dependencies first
+    streams: tuple[tuple[str, Stream], ...] = ()
+    #: models brought in with ``import`` (their declarations are merged into this one)
+    imports: tuple[str, ...] = ()
+    description: str | None = None

@@ -1,10 +1,9 @@
 """Parse RoQME model text into a checked :class:`~qos.model.Model`.
 
-The grammar is a lark LALR grammar. Patterns and value expressions share one precedence ladder
-(lowest first): ``->``, ``or``, ``and``, ``once``, postfix ``while(…)``/``repeat(n)``, ``|``, ``&``,
-comparisons, ``+ -``, ``* /``, unary ``! -``. A checking pass then tells patterns from values, so
-``update(!X)`` is fine but ``!update(X)`` is an error. Every error message starts with
-``FILE:LINE:COLUMN:`` and says what was expected or what is not supported.
+:mod:`qos.grammar` parses; this module checks declarations (names, types, bounds, actions) and
+:mod:`qos.terms` checks patterns and values. Names are declared before they are used, so a model
+has no cycles. Every error message starts with ``FILE:LINE:COLUMN:`` and nothing is half-loaded: a
+model is returned whole or not at all.
 """
 
 from __future__ import annotations
@@ -12,170 +11,29 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from lark import Lark, Token, Tree
-from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
+from lark import Token, Tree
 
 from qos.errors import ModelError
+from qos.files import BadFile, read_text
+from qos.grammar import SyntaxProblem, parse_text
 from qos.model import (
-    BOOLEAN, EVENTTYPE, INTENSITY_LR, NUMBER, AllOf, AnyOf, Binary, Changed, Context, EnumType, Expr,
-    FollowedBy, Literal, Model, Observation, Once, Pattern, Property, Repeat, Unary, Updated, ValueType,
-    Var, While, type_name,
+    BOOLEAN, EVENTTYPE, INTENSITY_LR, NUMBER, ArrayType, ClearEvidence, Context, EnumType, Evidence, Literal, Model,
+    Observation, Property, SetVariable, Timer, TimerAction, TypeSpec, Variable, type_name,
 )
+from qos.terms import TermChecker, is_pattern, seconds_of
+from qos.timers import ScheduleError, parse_schedule
 
-GRAMMAR = r"""
-start: MODEL NAME decl*
-
-?decl: type_decl | property_decl | context_decl | observation_decl
-
-type_decl: TYPE NAME ":" enum_type
-enum_type: ENUM "{" NAME ("," NAME)* "}"
-
-property_decl: PROPERTY NAME prop_option*
-prop_option: REFERENCE NUMBER   -> reference
-           | SURVIVAL TIME      -> survival
-
-context_decl: CONTEXT NAME ":" context_type
-context_type: BOOLEAN_KW | NUMBER_KW | EVENTTYPE_KW | enum_type | NAME
-
-observation_decl: OBSERVATION NAME ":" pattern (REINFORCES | UNDERMINES) NAME [NAME]
-
-?pattern: alternative
-        | pattern "->" alternative           -> followed_by
-?alternative: conjunction
-            | alternative OR conjunction     -> p_or
-?conjunction: once
-            | conjunction AND once           -> p_and
-?once: postfix
-     | ONCE once                             -> once
-?postfix: disjunction
-        | postfix WHILE "(" pattern ")"      -> while_
-        | postfix REPEAT "(" NUMBER ")"      -> repeat
-?disjunction: conjunct
-            | disjunction BAR conjunct       -> binary
-?conjunct: comparison
-         | conjunct AMP comparison           -> binary
-?comparison: sum
-           | sum COMPARE sum                 -> binary
-?sum: product
-    | sum ADD product                        -> binary
-?product: unary
-        | product MUL unary                  -> binary
-?unary: atom
-      | "!" unary                            -> not_
-      | ADD unary                            -> negate
-?atom: NAME                                  -> var
-     | NAME "::" NAME                        -> enum_literal
-     | NUMBER                                -> number
-     | TRUE                                  -> true
-     | FALSE                                 -> false
-     | UPDATE "(" pattern ")"                -> update
-     | EVENTWHEN "(" pattern ")"             -> event_when
-     | NAME "(" [argument ("," argument)*] ")" -> call
-     | "(" pattern ")"
-?argument: pattern | TIME
-
-MODEL: "roqme"
-TYPE: "type"
-ENUM: "enum"
-PROPERTY: "property"
-REFERENCE: "reference"
-SURVIVAL: "survival"
-CONTEXT: "context"
-OBSERVATION: "observation"
-BOOLEAN_KW: "boolean"
-NUMBER_KW: "number"
-EVENTTYPE_KW: "eventtype"
-REINFORCES: "reinforces"
-UNDERMINES: "undermines"
-OR: "or"
-AND: "and"
-ONCE: "once"
-WHILE: "while"
-REPEAT: "repeat"
-UPDATE: "update"
-EVENTWHEN: "eventWhen"
-TRUE: "true"
-FALSE: "false"
-COMPARE: "!=" | "<=" | ">=" | "=" | "<" | ">"
-ADD: "+" | "-"
-MUL: "*" | "/"
-BAR: "|"
-AMP: "&"
-TIME.2: /[0-9]+(\.[0-9]+)?[ \t]*(ms|sec|s|min|h)(?![A-Za-z0-9_])/
-NAME: /[A-Za-z_][A-Za-z0-9_]*/
-NUMBER: /[0-9]+(\.[0-9]+)?/
-
-COMMENT: /\/\/[^\n]*/ | /\/\*(.|\n)*?\*\//
-%import common.WS
-%ignore WS
-%ignore COMMENT
-"""
-
-# The basic lexer keeps keywords reserved everywhere, so a misplaced 'reinforces' is reported as such
-# instead of being read as a context name.
-_PARSER = Lark(GRAMMAR, parser="lalr", lexer="basic", propagate_positions=True)
-
-#: seconds per time unit
-TIME_UNITS = {"ms": 0.001, "s": 1.0, "sec": 1.0, "min": 60.0, "h": 3600.0}
-
-#: words of the full RoQME language this engine does not implement, with what they are
-UNSUPPORTED_WORDS = {
-    "timer": "timer declarations are not supported",
-    "import": "imports are not supported",
-    "var": "variable declarations are not supported",
-    "param": "parameters are not supported",
-    "every": "the 'every' pattern operator is not supported (observations re-arm after every match anyway)",
-    "not": "the 'not' pattern operator is not supported",
-    "within": "time-window guards ('within') are not supported",
-    "where": "'where' guards are not supported",
-}
-AGGREGATES = {"avg", "mean", "sum", "count", "min", "max", "stdev", "median", "first", "last", "timer"}
-
-#: how an expected terminal is described in a message
-_TERMINAL_TEXT = {
-    "NAME": "a name", "NUMBER": "a number", "TIME": "a time such as 100min, 30 sec or 2h",
-    "COLON": "':'", "LBRACE": "'{'", "RBRACE": "'}'", "COMMA": "','", "LPAR": "'('", "RPAR": "')'",
-    "REINFORCES": "'reinforces'", "UNDERMINES": "'undermines'", "COMPARE": "a comparison", "ADD": "'+' or '-'",
-    "MUL": "'*' or '/'", "BAR": "'|'", "AMP": "'&'", "ENUM": "'enum'", "MODEL": "'roqme'",
-}
-#: what a NAME means right after a keyword
-_NAME_AFTER = {
-    "roqme": "a model name", "property": "a property name", "context": "a context name",
-    "type": "a type name", "observation": "an observation name", "reinforces": "a property name",
-    "undermines": "a property name", "::": "an enum literal", "{": "an enum literal",
-}
-_DECLARATION_START = {"TYPE", "PROPERTY", "CONTEXT", "OBSERVATION"}
-
-
-def _describe_expected(expected: set[str], previous: str | None) -> str:
-    if expected and expected <= _DECLARATION_START | {"$END"}:
-        return "a declaration (type, property, context or observation)"
-    if "NAME" in expected and previous in _NAME_AFTER:
-        return _NAME_AFTER[previous]
-    if "REINFORCES" in expected:
-        return "an operator, or 'reinforces' or 'undermines' and a property"
-    if {"NAME", "NUMBER", "LPAR"} <= expected:
-        return "a pattern or a value"
-    if expected == {"TIME"}:
-        return _TERMINAL_TEXT["TIME"]
-    texts = []
-    for name in sorted(expected):
-        if name == "$END":
-            continue
-        text = _TERMINAL_TEXT.get(name)
-        if text is None:
-            pattern = _PARSER.get_terminal(name).pattern
-            text = repr(pattern.value) if pattern.type == "str" else name.lower()
-        texts.append(text)
-    return " or ".join(texts[:6]) or "the end of the file"
+_STRENGTHS = "verylow, low, medium, high, veryhigh"
 
 
 class _Source:
     """The text of a model and the name used for it in messages."""
 
-    def __init__(self, text: str, filename: str):
+    def __init__(self, text: str, filename: str, folder: Path | None):
         self.text = text
         self.filename = filename
+        #: where its imports are looked for
+        self.folder = folder
 
     def error(self, line: int, column: int, message: str) -> ModelError:
         return ModelError(f"{self.filename}:{line}:{column}: {message}")
@@ -185,76 +43,135 @@ class _Source:
             return self.error(node.line, node.column, message)
         return self.error(node.meta.line, node.meta.column, message)
 
-    def syntax_error(self, exc: UnexpectedInput, previous: Token | None) -> ModelError:
-        if isinstance(exc, UnexpectedCharacters):
-            char = self.text[exc.pos_in_stream]
-            return self.error(exc.line, exc.column, f"unexpected character {char!r}")
-        assert isinstance(exc, UnexpectedToken)
-        token = exc.token
-        if token.type != "$END" and self.text.startswith("/*", token.start_pos):
-            return self.at(token, "unterminated comment: '/*' without '*/'")
-        for word_token in (token, previous):
-            if word_token is not None and word_token.type == "NAME" and str(word_token) in UNSUPPORTED_WORDS:
-                return self.at(word_token, UNSUPPORTED_WORDS[str(word_token)])
-        after = f" after {str(previous)!r}" if previous is not None else ""
-        expected = _describe_expected(set(exc.expected), str(previous) if previous is not None else None)
-        if token.type == "$END":
-            lines = self.text.splitlines() or [""]
-            return self.error(len(lines), len(lines[-1]) + 1, f"expected {expected}{after}, found the end of the file")
-        return self.at(token, f"expected {expected}{after}, found {str(token)!r}")
 
-
-def parse_model(text: str, filename: str = "<string>") -> Model:
-    """Parse and check a model; raise :class:`ModelError` naming file, line and column."""
-    source = _Source(text, filename)
-    parser = _PARSER.parse_interactive(text)
-    # fed token by token so that an error can say what it came after
-    previous = current = None
+def _read(path: Path) -> str:
     try:
-        for token in parser.iter_parse():
-            previous, current = current, token
-        previous = current
-        tree = parser.feed_eof(current)
-    except UnexpectedInput as exc:
-        raise source.syntax_error(exc, previous) from None
-    return _Checker(source).model(tree)
+        return read_text(path)  # the project's bounded reader
+    except BadFile as exc:
+        raise ModelError(str(exc)) from None
+
+
+def parse_model(text: str, filename: str = "<string>", folder: str | Path | None = None) -> Model:
+    """Parse and check a model; raise :class:`ModelError` naming file, line and column.
+
+    ``folder`` is where ``import`` looks for other models (default: the current directory).
+    """
+    source = _Source(text, filename, Path(folder) if folder is not None else Path("."))
+    return _Checker(source).model(source)
 
 
 def load_model_file(path: str | Path) -> Model:
     """Read and parse a ``.roqme`` file; errors name the file by its base name."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ModelError(f"{path}: cannot read the model ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise ModelError(f"{path}: the model is not UTF-8 text (byte {exc.start})") from None
-    return parse_model(text, path.name)
+    return parse_model(_read(path), path.name, path.parent)
 
 
-class _Checker:
-    """Turns the parse tree into a model, checking names and types on the way."""
+#: how deeply terms may nest (parentheses, chains of operators): checking and running a term recurse
+#: once per level, and no model a person writes comes near this
+MAX_NESTING = 200
+
+
+def _check_nesting(source: _Source, tree: Tree) -> None:
+    """Refuse a term nested deeper than MAX_NESTING, naming its declaration (checked without recursion)."""
+    stack = [(declaration, 1, declaration) for declaration in tree.children]
+    while stack:
+        node, depth, declaration = stack.pop()
+        if depth > MAX_NESTING:
+            raise source.at(declaration, f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
+                                         "deep: split it with derived contexts")
+        stack.extend((child, depth + 1, declaration) for child in node.children if isinstance(child, Tree))
+
+
+def _description(token: Token) -> str:
+    lines = str(token)[3:-2].strip("\n").splitlines()
+    lines = [re.sub(r"^\s*\*?\s*", "", line).rstrip() for line in lines]
+    return "\n".join(lines).strip()
+
+
+class _Checker(TermChecker):
+    """Turns parse trees into a model, checking names and types on the way."""
 
     def __init__(self, source: _Source):
+        super().__init__()
         self.source = source
-        self.types: dict[str, EnumType] = {}
         self.properties: dict[str, Property] = {}
-        self.contexts: dict[str, Context] = {}
+        self.beliefvars: dict[str, Property] = {}
         self.observations: dict[str, Observation] = {}
-        #: every declared name -> what it is (names share one namespace)
-        self.declared: dict[str, str] = {}
+        self.imported: list[str] = []
+        #: the description (``/** … */``) of the declaration being checked
+        self.description: str | None = None
+        #: files being read, outermost first (an import cycle is an error)
+        self.reading: list[Path] = []
 
     def error(self, node, message: str) -> ModelError:
         return self.source.at(node, message)
 
-    def model(self, tree: Tree) -> Model:
-        _, name, *declarations = tree.children
-        for declaration in declarations:
-            getattr(self, declaration.data)(declaration)
+    def _tree(self, source: _Source) -> tuple[Tree, list[Token]]:
+        try:
+            tree, descriptions = parse_text(source.text)
+        except SyntaxProblem as problem:
+            raise source.error(problem.line, problem.column, problem.message) from None
+        _check_nesting(source, tree)
+        return tree, descriptions
+
+    def model(self, source: _Source) -> Model:
+        if source.folder is not None and source.filename != "<string>":
+            self.reading.append((source.folder / source.filename).resolve())
+        tree, descriptions = self._tree(source)
+        name, description = self._declarations(tree, descriptions)
+        if name is None:
+            name = Path(source.filename).stem if source.filename != "<string>" else "model"
         if not self.properties:
-            raise self.source.error(name.line, name.column, f"model {name} declares no property")
-        return Model(str(name), self.source.filename, self.properties, self.types, self.contexts,
-                     self.observations)
+            header = tree.children[0] if tree.children and tree.children[0].data == "header" else None
+            where = (header.children[1].line, header.children[1].column) if header else (1, 1)
+            raise source.error(*where, f"model {name} declares no property")
+        return Model(name, source.filename, self.properties, self.types, self.contexts, self.observations,
+                     self.beliefvars, self.variables, self.timers, tuple(self.streams), tuple(self.imported),
+                     description)
+
+    def _declarations(self, tree: Tree, descriptions: list[Token]) -> tuple[str | None, str | None]:
+        name = model_description = None
+        previous_end = 0
+        for declaration in tree.children:
+            start = declaration.meta.start_pos
+            mine = [d for d in descriptions if previous_end <= d.start_pos and d.end_pos <= start]
+            described = _description(mine[-1]) if mine else None
+            previous_end = declaration.meta.end_pos
+            if declaration.data == "header":
+                name, model_description = self._name(declaration.children[1]), described
+            elif declaration.data == "import_":
+                self._import(declaration)
+            else:
+                self.description = described
+                getattr(self, declaration.data)(declaration)
+        return name, model_description
+
+    def _name(self, token: Token) -> str:
+        return str(token)[1:-1] if token.type == "STRING" else str(token)  # NAME or MODEL_FILE
+
+    def _import(self, tree: Tree) -> None:
+        """Merge another model's declarations into this one (names share one namespace)."""
+        target = tree.children[1]
+        relative = self._name(target)
+        if not relative.endswith(".roqme"):
+            relative += ".roqme"
+        path = (self.source.folder / relative).resolve()
+        if path in self.reading:
+            raise self.error(target, f"import cycle: {relative} imports this model back")
+        if str(path) in self.imported:
+            return  # already merged (imported twice by different models)
+        if not path.is_file():
+            raise self.error(target, f"cannot import {relative}: no such model file")
+        outer = self.source
+        self.source = _Source(_read(path), path.name, path.parent)
+        self.reading.append(path)
+        try:
+            imported_tree, descriptions = self._tree(self.source)
+            self._declarations(imported_tree, descriptions)
+        finally:
+            self.reading.pop()
+            self.source = outer
+        self.imported.append(str(path))
 
     def _declare(self, name: Token, what: str) -> None:
         if str(name) in self.declared:
@@ -263,194 +180,273 @@ class _Checker:
             raise self.error(name, f"{name} is already declared as {article} {what}")
         self.declared[str(name)] = what
 
-    def _enum(self, name: Token, tree: Tree) -> EnumType:
-        literals: list[str] = []
-        for literal in tree.children[1:]:
-            if str(literal) in literals:
-                raise self.error(literal, f"enum literal {literal} appears twice in {name}")
-            literals.append(str(literal))
-        return EnumType(str(name), tuple(literals))
+    # ---- data types -----------------------------------------------------------------------------
+
+    def _type_spec(self, owner: str, node, what: str) -> TypeSpec:
+        """The type of a declaration: a referenced type name or a data type written in place."""
+        if isinstance(node, Token):
+            if str(node) not in self.types:
+                raise self.error(node, f"unknown type {node} (declare it with 'type {node} : enum {{…}}' before "
+                                       f"this {what})")
+            return self.types[str(node)]
+        keyword, cardinality, *rest = node.children
+        kind = node.data
+        lower = upper = unit = None
+        if kind == "enum_type":
+            literals: list[str] = []
+            for literal in rest:
+                if str(literal) in literals:
+                    raise self.error(literal, f"enum literal {literal} appears twice in {owner}")
+                literals.append(str(literal))
+            scalar = EnumType(owner, tuple(literals))
+        elif kind == "number_type":
+            scalar = NUMBER
+            for part in rest:
+                if isinstance(part, Tree):  # a bound
+                    word, signed = part.children
+                    value = float(signed.children[1]) * (-1 if signed.children[0] == "-" else 1)
+                    lower, upper = (value, upper) if word == "lower" else (lower, value)
+                elif part is not None and part.type in ("NAME", "STRING"):
+                    unit = self._name(part)
+            if lower is not None and upper is not None and lower > upper:
+                raise self.error(node, f"the lower bound {lower:g} of {owner} is above its upper bound {upper:g}")
+        elif kind == "time_type":
+            scalar, unit = NUMBER, "s"
+        else:
+            scalar = BOOLEAN if kind == "boolean_type" else EVENTTYPE
+        value_type = scalar
+        if cardinality is not None:
+            size = cardinality.children[0]
+            if "." in size or int(size) < 1:
+                raise self.error(size, f"an array holds a whole number ≥ 1 of values, not {size}")
+            if scalar == EVENTTYPE:
+                raise self.error(keyword, "an eventtype has no values to hold in an array")
+            value_type = ArrayType(scalar, int(size))
+        return TypeSpec(value_type, lower, upper, unit)
 
     def type_decl(self, tree: Tree) -> None:
-        _, name, enum_tree = tree.children
-        self._declare(name, "type")
-        self.types[str(name)] = self._enum(name, enum_tree)
+        _, name_token, data_type = tree.children
+        self._declare(name_token, "type")
+        name = self._name(name_token)
+        self.types[name] = self._type_spec(name, data_type, "type")
+
+    def _value_of(self, node, spec: TypeSpec, owner: str, role: str):
+        """A constant of the declared type (a default, a constant definition), checked against bounds."""
+        value = self.expr(node, role)
+        if not isinstance(value, Literal):
+            raise self.error(node, f"{role} must be a constant")
+        if value.type != spec.type and not (isinstance(spec.type, ArrayType) and isinstance(value.type, ArrayType)
+                                             and value.type.element == spec.type.element):
+            raise self.error(node, f"{role} is {type_name(value.type)}, but {owner} is {type_name(spec.type)}")
+        if isinstance(spec.type, ArrayType) and len(value.value) > spec.type.size:
+            raise self.error(node, f"{role} has {len(value.value)} values; {owner} holds at most {spec.type.size}")
+        for number in (value.value if isinstance(value.value, tuple) else (value.value,)):
+            problem = spec.out_of_bounds(number) if isinstance(number, float) else None
+            if problem:
+                raise self.error(node, f"{role}: {problem} of {owner}")
+        return value.value
+
+    # ---- contexts, variables, timers --------------------------------------------------------------
+
+    def context_decl(self, tree: Tree) -> None:
+        _, name, type_node, _define, definition = tree.children
+        self._declare(name, "context")
+        spec = self._type_spec(str(name), type_node, "context")
+        if definition is None:
+            self.contexts[str(name)] = Context(str(name), spec.type, spec, None, self.description)
+            return
+        self.defining = (str(name), spec.type)
+        try:
+            if spec.type == EVENTTYPE:
+                value = self.pattern(definition)
+            else:
+                if is_pattern(definition):
+                    raise self.error(definition, f"a pattern defines an eventtype context; {name} is "
+                                                 f"{type_name(spec.type)}: declare it eventtype, or define it by a "
+                                                 "value")
+                value = self.expr(definition, f"the definition of {name}")
+                if value.type != spec.type:
+                    raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
+                                                 f"{type_name(spec.type)}")
+        finally:
+            self.defining = None
+        context = Context(str(name), spec.type, spec, value, self.description)
+        self.contexts[str(name)] = context
+        self.streams.append((str(name), context))
+
+    def var_decl(self, tree: Tree) -> None:
+        _, name, type_node, _define, definition = tree.children
+        self._declare(name, "variable")
+        spec = self._type_spec(str(name), type_node, "variable")
+        self.defining = (str(name), spec.type)  # its own enum literals: var W : enum {C, D} := W::D
+        try:
+            value = self.expr(definition, f"the definition of {name}")
+            if value.type != spec.type:
+                raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
+                                             f"{type_name(spec.type)}")
+            if isinstance(value, Literal):
+                variable = Variable(str(name), spec.type, spec, self._value_of(definition, spec, str(name), "the value"),
+                                    None, False, self.description)
+            else:
+                variable = Variable(str(name), spec.type, spec, None, value, False, self.description)
+                self.streams.append((str(name), variable))
+        finally:
+            self.defining = None
+        self.variables[str(name)] = variable
+
+    def param_decl(self, tree: Tree) -> None:
+        _, name, type_node, _default, default = tree.children
+        self._declare(name, "parameter")
+        spec = self._type_spec(str(name), type_node, "parameter")
+        if spec.type == EVENTTYPE:
+            raise self.error(type_node, f"parameter {name} holds a value; an eventtype has none")
+        self.defining = (str(name), spec.type)  # its own enum literals: default L::A
+        try:
+            initial = None if default is None else self._value_of(default, spec, str(name), "the default")
+        finally:
+            self.defining = None
+        self.variables[str(name)] = Variable(str(name), spec.type, spec, initial, None, True, self.description)
+
+    def timer_decl(self, tree: Tree) -> None:
+        _, name, *parts = tree.children
+        self._declare(name, "timer")
+        seen: set[str] = set()
+        interval = schedule = None
+        offset, onetime, paused = 0.0, False, False
+        for part in parts:
+            keyword = part.children[0]
+            if part.data in seen:
+                raise self.error(keyword, f"{keyword} is given twice for timer {name}")
+            seen.add(part.data)
+            if part.data == "offset":
+                offset = seconds_of(part.children[1])
+            elif part.data == "onetime":
+                onetime = True
+            elif part.data == "paused":
+                paused = True
+            else:
+                interval, schedule = self._timer_definition(name, part.children[1])
+        if "definition" not in seen:
+            raise self.error(name, f"timer {name} needs a definition: timer {name} := 1 minutes, or := "
+                                   "schedule(\"0, 9, *, *, *\")")
+        self.timers[str(name)] = Timer(str(name), interval, schedule, offset, onetime, paused, self.description)
+
+    def _timer_definition(self, name: Token, node):
+        if isinstance(node, Tree) and node.data == "time":
+            interval = seconds_of(node.children[0])
+            if interval <= 0:
+                raise self.error(node, f"the interval of timer {name} must be longer than 0")
+            return interval, None
+        if isinstance(node, Tree) and node.data == "call" and str(node.children[0]) == "schedule":
+            args = [child for child in node.children[1:] if child is not None]
+            if len(args) != 1 or not (isinstance(args[0], Tree) and args[0].data == "string"):
+                raise self.error(node, "schedule takes one string: schedule(\"minutes, hours, days, months, "
+                                       "weekdays\")")
+            try:
+                return None, parse_schedule(str(args[0].children[0])[1:-1])
+            except ScheduleError as exc:
+                raise self.error(args[0], f"bad schedule: {exc}") from None
+        raise self.error(node, f"timer {name} is defined by a time (1 minutes) or schedule(\"…\")")
+
+    # ---- properties and belief variables ---------------------------------------------------------
 
     def property_decl(self, tree: Tree) -> None:
-        _, name, *options = tree.children
+        _, name, type_node, _define, transformation, *options = tree.children
         self._declare(name, "property")
+        output = None
+        if transformation is not None:
+            spec = self._type_spec(str(name), type_node, "property")
+            self.self_belief_allowed, self.defining = True, (str(name), spec.type)
+            try:
+                output = self.expr(transformation, f"the output of {name}")
+            finally:
+                self.self_belief_allowed, self.defining = False, None
+            if output.type != spec.type:
+                raise self.error(transformation, f"the output of {name} is {type_name(output.type)}, not "
+                                                 f"{type_name(spec.type)}")
+        self.properties[str(name)] = self._belief(name, "property", options, output)
+        self.beliefs[str(name)] = self.properties[str(name)]
+
+    def beliefvar_decl(self, tree: Tree) -> None:
+        _, name, *options = tree.children
+        self._declare(name, "belief variable")
+        self.beliefvars[str(name)] = self.beliefs[str(name)] = self._belief(name, "belief variable", options, None)
+
+    def _belief(self, name: Token, what: str, options: list, output) -> Property:
         reference, survival, seen = 0.5, None, set()
         for option in options:
             keyword = option.children[0]
             if option.data in seen:
-                raise self.error(keyword, f"{keyword} is given twice for property {name}")
+                raise self.error(keyword, f"{keyword} is given twice for {what} {name}")
             seen.add(option.data)
             if option.data == "reference":
                 reference = float(option.children[1])
                 if not 0.0 <= reference <= 1.0:
-                    raise self.error(option.children[1], f"reference {option.children[1]} of property {name} "
+                    raise self.error(option.children[1], f"reference {option.children[1]} of {what} {name} "
                                                          "is outside [0, 1]")
             else:
-                survival = self._seconds(option.children[1])
+                survival = seconds_of(option.children[1])
                 if survival <= 0:
-                    raise self.error(option.children[1], f"survival of property {name} must be positive")
-        self.properties[str(name)] = Property(str(name), reference, survival)
+                    raise self.error(option.children[1], f"survival of {what} {name} must be positive")
+        return Property(str(name), reference, survival, output, self.description)
 
-    def _seconds(self, time: Token) -> float:
-        number, unit = re.fullmatch(r"([0-9.]+)\s*([a-z]+)", str(time)).groups()
-        return float(number) * TIME_UNITS[unit]
-
-    def context_decl(self, tree: Tree) -> None:
-        _, name, type_tree = tree.children
-        self._declare(name, "context")
-        (spec,) = type_tree.children
-        if isinstance(spec, Tree):
-            value_type: ValueType = self._enum(name, spec)
-        elif spec.type == "NAME":
-            if str(spec) not in self.types:
-                raise self.error(spec, f"unknown type {spec} (declare it with 'type {spec} : enum {{…}}' "
-                                       "before this context)")
-            value_type = self.types[str(spec)]
-        else:
-            value_type = str(spec)
-        self.contexts[str(name)] = Context(str(name), value_type)
+    # ---- observations ----------------------------------------------------------------------------
 
     def observation_decl(self, tree: Tree) -> None:
-        _, name, pattern_tree, effect, property_name, intensity = tree.children
+        _, name, pattern_tree, *action_trees = tree.children
         self._declare(name, "observation")
+        description = self.description
         pattern = self.pattern(pattern_tree)
-        if str(property_name) not in self.properties:
-            raise self.error(property_name, f"observation {name} {effect} unknown property {property_name}")
-        level = "default"
-        if intensity is not None:
-            level = str(intensity).lower().replace("_", "")
-            if level not in INTENSITY_LR or level == "default":
-                raise self.error(intensity, f"expected an intensity (verylow, low, high, veryhigh) after "
-                                            f"{str(property_name)!r}, found {str(intensity)!r}")
-        self.observations[str(name)] = Observation(str(name), pattern, str(property_name),
-                                                   str(effect) == "reinforces", level, name.line)
+        actions = tuple(getattr(self, f"_{action.data}")(name, action)
+                        for action in action_trees if action is not None)
+        self.observations[str(name)] = Observation(str(name), pattern, actions, name.line, description)
 
-    # ---- patterns -------------------------------------------------------------------------------
+    def _belief_target(self, name: Token, verb: Token, target: Token) -> str:
+        if str(target) not in self.beliefs:
+            what = self.declared.get(str(target))
+            if what:
+                raise self.error(target, f"observation {name} {verb} {target}, a {what}: only a property or a "
+                                         "beliefvar holds evidence")
+            raise self.error(target, f"observation {name} {verb} unknown property {target}")
+        return str(target)
 
-    _PATTERN_NODES = {"followed_by", "p_or", "p_and", "once", "while_", "repeat", "update", "event_when"}
+    def _evidence(self, name: Token, tree: Tree) -> Evidence:
+        verb, target, *options = tree.children
+        level, survival, seen = "default", None, set()
+        for option in options:
+            if option.data in seen:
+                raise self.error(option, f"observation {name} gives {option.data.replace('evidence_', '')} twice "
+                                         f"for {target}")
+            seen.add(option.data)
+            if option.data == "strength":
+                word = option.children[0]
+                level = str(word).lower().replace("_", "")
+                if level not in INTENSITY_LR or level == "default":
+                    raise self.error(word, f"expected a strength ({_STRENGTHS}) after {str(target)!r}, found "
+                                           f"{str(word)!r}")
+            else:
+                survival = seconds_of(option.children[1])
+                if survival <= 0:
+                    raise self.error(option.children[1], "the survival of evidence must be positive")
+        return Evidence(self._belief_target(name, verb, target), str(verb) == "reinforces", level, survival)
 
-    def _is_pattern(self, node) -> bool:
-        return isinstance(node, Tree) and node.data in self._PATTERN_NODES
+    def _sets(self, name: Token, tree: Tree) -> SetVariable:
+        _, target, _define, value_node = tree.children
+        variable = self.variables.get(str(target))
+        if variable is None or variable.parameter:
+            what = "a parameter, a constant" if variable is not None else self.declared.get(str(target), "undeclared")
+            raise self.error(target, f"observation {name} sets {target}, which is {what}: only a var can be set")
+        value = self.expr(value_node, f"the value set to {target}")
+        if value.type != variable.type:
+            raise self.error(value_node, f"{target} is {type_name(variable.type)}, not {type_name(value.type)}")
+        return SetVariable(str(target), value)
 
-    def pattern(self, node) -> Pattern:
-        """A pattern; a value expression standing as a pattern becomes an occurrence."""
-        if not self._is_pattern(node):
-            if isinstance(node, Tree) and node.data == "var":
-                context = self._context(node.children[0])
-                return Updated(context.name, when_true=context.type == BOOLEAN)
-            expr = self.expr(node)
-            if expr.type != BOOLEAN:
-                raise self.error(node, f"a {type_name(expr.type)} value cannot stand as a pattern: use "
-                                       "update(…) or compare it")
-            return Changed(expr, when_true=True)
-        kind = node.data
-        if kind == "followed_by":
-            return FollowedBy(self.pattern(node.children[0]), self.pattern(node.children[1]))
-        if kind == "p_or":
-            return AnyOf(self.pattern(node.children[0]), self.pattern(node.children[2]))
-        if kind == "p_and":
-            return AllOf(self.pattern(node.children[0]), self.pattern(node.children[2]))
-        if kind == "once":
-            return Once(self.pattern(node.children[1]))
-        if kind == "while_":
-            condition = self.expr(node.children[2], role="the while condition")
-            if condition.type != BOOLEAN:
-                raise self.error(node.children[2], f"the while condition must be boolean, not "
-                                                   f"{type_name(condition.type)}")
-            return While(self.pattern(node.children[0]), condition)
-        if kind == "repeat":
-            count = node.children[2]
-            if "." in count or int(count) < 1:
-                raise self.error(count, f"repeat needs a whole number of times ≥ 1, not {count}")
-            return Repeat(self.pattern(node.children[0]), int(count))
-        # update(…) / eventWhen(…)
-        keyword, argument = node.children
-        when_true = kind == "event_when"
-        if isinstance(argument, Tree) and argument.data == "var":
-            context = self._context(argument.children[0])
-            if when_true and context.type != BOOLEAN:
-                raise self.error(argument, f"eventWhen needs a boolean, but {context.name} is "
-                                           f"{type_name(context.type)}")
-            return Updated(context.name, when_true=when_true)
-        expr = self.expr(argument, role=f"the argument of {keyword}")
-        if when_true and expr.type != BOOLEAN:
-            raise self.error(argument, f"eventWhen needs a boolean expression, not {type_name(expr.type)}")
-        return Changed(expr, when_true=when_true)
+    def _clears(self, name: Token, tree: Tree) -> ClearEvidence:
+        verb, target = tree.children
+        return ClearEvidence(self._belief_target(name, verb, target))
 
-    def _context(self, name: Token) -> Context:
-        if str(name) not in self.contexts:
-            what = self.declared.get(str(name))
-            detail = f" ({name} is a {what})" if what else ""
-            raise self.error(name, f"unknown context {name}{detail}")
-        return self.contexts[str(name)]
-
-    # ---- value expressions ----------------------------------------------------------------------
-
-    def expr(self, node, role: str = "a value") -> Expr:
-        if self._is_pattern(node):
-            operator = {"followed_by": "->", "p_or": "or", "p_and": "and", "once": "once",
-                        "while_": "while", "repeat": "repeat", "update": "update", "event_when": "eventWhen"}
-            raise self.error(node, f"the pattern operator '{operator[node.data]}' cannot be used in {role}; "
-                                   "only values and & | ! comparisons and arithmetic can")
-        kind = node.data
-        if kind == "var":
-            context = self._context(node.children[0])
-            if context.type == EVENTTYPE:
-                raise self.error(node, f"{context.name} is an eventtype and has no value: use it as a "
-                                       "pattern or in update()")
-            return Var(context.name, context.type)
-        if kind == "number":
-            return Literal(float(node.children[0]), NUMBER)
-        if kind in ("true", "false"):
-            return Literal(kind == "true", BOOLEAN)
-        if kind == "enum_literal":
-            type_token, literal = node.children
-            enum = self.types.get(str(type_token))
-            if enum is None and str(type_token) in self.contexts:
-                enum = self.contexts[str(type_token)].type
-            if not isinstance(enum, EnumType):
-                raise self.error(type_token, f"{type_token} is not an enum type")
-            if str(literal) not in enum.literals:
-                raise self.error(literal, f"{type_token} has no literal {literal} (expected one of "
-                                          f"{', '.join(enum.literals)})")
-            return Literal(str(literal), enum)
-        if kind == "call":
-            function = str(node.children[0])
-            if function in AGGREGATES:
-                raise self.error(node, f"the aggregate function {function}(…) is not supported")
-            raise self.error(node, f"the function {function}(…) is not supported (patterns may use "
-                                   "update(…) and eventWhen(…))")
-        if kind == "not_":
-            operand = self.expr(node.children[0], role)
-            self._expect(node.children[0], operand, BOOLEAN, "'!'")
-            return Unary("!", operand, BOOLEAN)
-        if kind == "negate":
-            operand = self.expr(node.children[1], role)
-            self._expect(node.children[1], operand, NUMBER, f"'{node.children[0]}'")
-            return Unary("-", operand, NUMBER) if str(node.children[0]) == "-" else operand
-        if kind == "binary":
-            left_node, op_token, right_node = node.children
-            op = str(op_token)
-            left, right = self.expr(left_node, role), self.expr(right_node, role)
-            if op in ("&", "|"):
-                self._expect(left_node, left, BOOLEAN, f"'{op}'")
-                self._expect(right_node, right, BOOLEAN, f"'{op}'")
-                return Binary(op, left, right, BOOLEAN)
-            if op in ("=", "!="):
-                if left.type != right.type:
-                    raise self.error(node, f"'{op}' compares {type_name(left.type)} with {type_name(right.type)}")
-                return Binary(op, left, right, BOOLEAN)
-            self._expect(left_node, left, NUMBER, f"'{op}'")
-            self._expect(right_node, right, NUMBER, f"'{op}'")
-            return Binary(op, left, right, BOOLEAN if op in ("<", "<=", ">", ">=") else NUMBER)
-        raise self.error(node, f"unexpected {kind}")  # pragma: no cover - the grammar has no other node
-
-    def _expect(self, node, expr: Expr, wanted: str, operator: str) -> None:
-        if expr.type != wanted:
-            raise self.error(node, f"{operator} needs a {wanted} operand, not {type_name(expr.type)}")
-
+    def _timer_action(self, name: Token, tree: Tree) -> TimerAction:
+        verb, target = tree.children
+        if str(target) not in self.timers:
+            raise self.error(target, f"observation {name} {verb} {target}, which is not a timer")
+        return TimerAction(str(verb), str(target))

@@ -27,10 +27,14 @@ a bare context ``X``
     ``eventWhen(X)`` for a boolean context, ``update(X)`` for any other type (eventtype: X is emitted).
 a bare boolean expression ``e`` (``TestState = TestState::PAUSED``, ``!PersonDetected``)
     ``eventWhen(e)``.
+an enum literal ``X::LIT``
+    every update of the context X to LIT (RoQME's enum filter), even when X already was LIT.
 
 Pattern operators. Every observation's pattern re-arms after it fires (it is implicitly "every"):
 all partial progress (``and``, ``->``, ``repeat``) is cleared and matching starts again from the
-next batch. Precedence, loosest first: ``->``, ``or``, ``and``, ``once``, postfix ``while``/``repeat``.
+next batch. Precedence is RoQME's (see :mod:`qos.grammar`), loosest first: ``once``, postfix
+``while``/``repeat``/``range`` (applied to everything before them: ``a -> b while(c)`` is
+``(a -> b) while(c)``), ``->``, ``or``, ``and``.
 
 ``a or b``
     occurs in a batch in which ``a`` or ``b`` occurs (both keep being evaluated).
@@ -49,90 +53,44 @@ next batch. Precedence, loosest first: ``->``, ``or``, ``and``, ``once``, postfi
 ``once p``
     occurs the first time ``p`` occurs and never again for the life of the engine (re-arming of an
     enclosing pattern does not revive it).
+``a and not b``
+    occurs when ``a`` occurs while ``b`` has not occurred since the pattern was (re-)armed (``b`` in the
+    same batch as ``a`` prevents it). An occurrence of ``b`` makes the attempt fail: as Esper's
+    ``every`` does, the whole observation's pattern then starts again (so in ``x -> (a and not b)`` a
+    ``b`` after ``x`` means waiting for a new ``x``). ``not b`` alone never occurs and is refused.
+``p range(a, b)``
+    occurs on the a-th, (a+1)-th … b-th occurrence of ``p`` counted over the engine's life (the count
+    is not cleared by re-arming, as the generator's unbounded ``count(*)`` is not): a way to say "the
+    second and third time".
+a timer ``T``
+    occurs in the batch in which it fires (see :mod:`qos.timers`).
 """
 
 from __future__ import annotations
 
-import math
-import operator
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 
+from qos.expressions import Evaluator, compile_expr, variables_of
 from qos.model import (
-    AllOf, AnyOf, Binary, Changed, Expr, FollowedBy, Literal, Observation, Once, Pattern, Repeat, Unary,
-    Updated, Var, While,
+    AllOf, AndNot, AnyOf, Changed, FollowedBy, Observation, Once, Pattern, Range, Repeat, Updated, While,
 )
-
-#: a compiled expression: context values -> value, or None when undefined
-Evaluator = Callable[[Mapping[str, object]], object]
 
 
 @dataclass(frozen=True)
 class Batch:
-    """What the matcher sees of one batch: values after it, and which contexts it set or emitted."""
+    """What the matcher sees of one batch: values after it, and which names it updated (contexts set
+    or emitted, derived contexts and aggregates recomputed, timers fired)."""
 
     values: Mapping[str, object]
-    updated: frozenset[str]
-
-
-def _divide(left: float, right: float) -> float | None:
-    return None if right == 0 else left / right
-
-
-_BINARY: dict[str, Callable[[object, object], object]] = {
-    "=": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le, ">": operator.gt,
-    ">=": operator.ge, "+": operator.add, "-": operator.sub, "*": operator.mul, "/": _divide,
-}
-
-
-def compile_expr(expr: Expr) -> Evaluator:
-    """Turn a checked expression into a function of the context values."""
-    if isinstance(expr, Var):
-        name = expr.name
-        return lambda values: values.get(name)
-    if isinstance(expr, Literal):
-        value = expr.value
-        return lambda values: value
-    if isinstance(expr, Unary):
-        inner = compile_expr(expr.operand)
-        if expr.op == "!":
-            return lambda values: None if (x := inner(values)) is None else not x
-        return lambda values: None if (x := inner(values)) is None else -x
-    assert isinstance(expr, Binary)
-    left, right = compile_expr(expr.left), compile_expr(expr.right)
-    if expr.op in ("&", "|"):
-        want = expr.op == "|"  # the value that decides the result on its own
-
-        def logic(values):
-            a, b = left(values), right(values)
-            if a is want or b is want:
-                return want
-            return None if a is None or b is None else not want
-        return logic
-    function = _BINARY[expr.op]
-
-    def binary(values):
-        a, b = left(values), right(values)
-        if a is None or b is None:
-            return None
-        result = function(a, b)
-        return None if isinstance(result, float) and not math.isfinite(result) else result
-    return binary
-
-
-def variables_of(expr: Expr) -> frozenset[str]:
-    """The contexts an expression reads."""
-    if isinstance(expr, Var):
-        return frozenset({expr.name})
-    if isinstance(expr, Literal):
-        return frozenset()
-    if isinstance(expr, Unary):
-        return variables_of(expr.operand)
-    return variables_of(expr.left) | variables_of(expr.right)
+    updated: frozenset[str] | set[str]
 
 
 class _Matcher:
     """One node of a pattern at run time."""
+
+    #: set by ``step`` when the node can no longer occur until it is reset (an ``and not`` failed)
+    failed = False
 
     def step(self, batch: Batch) -> bool:
         """Advance by one batch; True when the node occurs in it."""
@@ -181,9 +139,11 @@ class _AnyOfMatcher(_Matcher):
         if left or right:
             self.reset()
             return True
+        self.failed = self.left.failed and self.right.failed
         return False
 
     def reset(self) -> None:
+        self.failed = False
         self.left.reset()
         self.right.reset()
 
@@ -196,12 +156,17 @@ class _AllOfMatcher(_Matcher):
     def step(self, batch: Batch) -> bool:
         self.seen_left = self.seen_left or self.left.step(batch)
         self.seen_right = self.seen_right or self.right.step(batch)
+        if self.left.failed or self.right.failed:
+            self.reset()
+            self.failed = True
+            return False
         if self.seen_left and self.seen_right:
             self.reset()
             return True
         return False
 
     def reset(self) -> None:
+        self.failed = False
         self.seen_left = self.seen_right = False
         self.left.reset()
         self.right.reset()
@@ -215,13 +180,18 @@ class _FollowedByMatcher(_Matcher):
     def step(self, batch: Batch) -> bool:
         if not self.armed:
             self.armed = self.first.step(batch)
+            self.failed = self.first.failed
             return False
         if self.then.step(batch):
             self.reset()
             return True
+        if self.then.failed:
+            self.reset()
+            self.failed = True
         return False
 
     def reset(self) -> None:
+        self.failed = False
         self.armed = False
         self.first.reset()
         self.then.reset()
@@ -236,6 +206,8 @@ class _OnceMatcher(_Matcher):
         if self.done:
             return False
         self.done = self.inner.step(batch)
+        if self.inner.failed:
+            self.inner.reset()
         return self.done
 
     def reset(self) -> None:
@@ -249,8 +221,11 @@ class _WhileMatcher(_Matcher):
     def step(self, batch: Batch) -> bool:
         if self.condition(batch.values) is not True:
             self.inner.reset()
+            self.failed = False
             return False
-        return self.inner.step(batch)
+        occurred = self.inner.step(batch)
+        self.failed = self.inner.failed
+        return occurred
 
     def reset(self) -> None:
         self.inner.reset()
@@ -267,19 +242,63 @@ class _RepeatMatcher(_Matcher):
             if self.count == self.times:
                 self.reset()
                 return True
+        if self.inner.failed:
+            self.reset()
+            self.failed = True
         return False
 
     def reset(self) -> None:
+        self.failed = False
         self.count = 0
         self.inner.reset()
 
 
-class ObservationMatcher:
-    """The run-time state of every observation of a model (one per engine)."""
+class _AndNotMatcher(_Matcher):
+    def __init__(self, wanted: _Matcher, excluded: _Matcher):
+        self.wanted, self.excluded = wanted, excluded
 
-    def __init__(self, observations: Mapping[str, Observation]):
+    def step(self, batch: Batch) -> bool:
+        wanted, excluded = self.wanted.step(batch), self.excluded.step(batch)
+        if excluded:
+            self.reset()
+            self.failed = True
+            return False
+        if wanted:
+            self.reset()
+            return True
+        self.failed = self.wanted.failed
+        return False
+
+    def reset(self) -> None:
+        self.failed = False
+        self.wanted.reset()
+        self.excluded.reset()
+
+
+class _RangeMatcher(_Matcher):
+    def __init__(self, inner: _Matcher, low: int, high: int):
+        self.inner, self.low, self.high = inner, low, high
+        #: occurrences over the engine's life: re-arming does not clear it
+        self.count = 0
+
+    def step(self, batch: Batch) -> bool:
+        if self.inner.step(batch):
+            self.count += 1
+            return self.low <= self.count <= self.high
+        if self.inner.failed:
+            self.inner.reset()
+        return False
+
+    def reset(self) -> None:
+        self.inner.reset()
+
+
+class PatternRunner:
+    """One pattern at run time: steps it batch by batch and re-arms it after it occurs or fails."""
+
+    def __init__(self, pattern: Pattern):
         self._changed: list[_ChangedMatcher] = []
-        self._roots = [(name, self._build(observation.pattern)) for name, observation in observations.items()]
+        self._root = self._build(pattern)
 
     def _build(self, node: Pattern) -> _Matcher:
         if isinstance(node, Updated):
@@ -292,17 +311,35 @@ class ObservationMatcher:
             return _AnyOfMatcher(self._build(node.left), self._build(node.right))
         if isinstance(node, AllOf):
             return _AllOfMatcher(self._build(node.left), self._build(node.right))
+        if isinstance(node, AndNot):
+            return _AndNotMatcher(self._build(node.pattern), self._build(node.excluded))
         if isinstance(node, FollowedBy):
             return _FollowedByMatcher(self._build(node.first), self._build(node.then))
         if isinstance(node, Once):
             return _OnceMatcher(self._build(node.pattern))
         if isinstance(node, While):
             return _WhileMatcher(self._build(node.pattern), compile_expr(node.condition))
+        if isinstance(node, Range):
+            return _RangeMatcher(self._build(node.pattern), node.low, node.high)
         assert isinstance(node, Repeat)
         return _RepeatMatcher(self._build(node.pattern), node.times)
 
-    def step(self, batch: Batch) -> list[str]:
-        """Evaluate every observation on one batch; return the names that fired, in model order."""
+    def step(self, batch: Batch) -> bool:
+        """True when the pattern occurs in this batch."""
         for changed in self._changed:  # value tracking must see every batch
             changed.observe(batch)
-        return [name for name, root in self._roots if root.step(batch)]
+        occurred = self._root.step(batch)
+        if self._root.failed:
+            self._root.reset()  # Esper's `every` starts a failed attempt again
+        return occurred
+
+
+class ObservationMatcher:
+    """The run-time state of every observation of a model (one per engine)."""
+
+    def __init__(self, observations: Mapping[str, Observation]):
+        self._runners = [(name, PatternRunner(observation.pattern)) for name, observation in observations.items()]
+
+    def step(self, batch: Batch) -> list[str]:
+        """Evaluate every observation on one batch; return the names that fired, in model order."""
+        return [name for name, runner in self._runners if runner.step(batch)]

@@ -39,14 +39,12 @@ def _logistic(log_odds: float) -> float:
     return odds / (1.0 + odds)
 
 
-class PropertyBelief:
-    """The evidence gathered for one property, and its metric at any later time."""
+class _Evidence:
+    """The firings that fade at one rate (a property's survival, or an action's own)."""
 
-    def __init__(self, prop: Property):
-        self.property = prop
-        self._prior = math.log(prop.prior / (1.0 - prop.prior))
+    def __init__(self, rate: float):
         #: twice the decay rate: d = exp(-rate·τ)
-        self._rate = 2.0 * prop.decay_rate
+        self._rate = rate
         #: log-odds of evidence that never fades (no survival)
         self._lasting = 0.0
         #: lone firings: (time, u)
@@ -57,11 +55,6 @@ class PropertyBelief:
         self._series_live = False
 
     def add(self, t: float, likelihood_ratio: float) -> None:
-        """Record a firing at time t; times of successive calls must not decrease.
-
-        Lone firings that have faded to ``|u·d| ≤ FOLD_AT`` by t are folded into the series here,
-        so that reading a metric stays a pure function of time.
-        """
         if self._rate == 0.0:
             self._lasting -= math.log(likelihood_ratio)
             return
@@ -75,19 +68,14 @@ class PropertyBelief:
         keep.append((t, (1.0 - likelihood_ratio) / (1.0 + likelihood_ratio)))
         self._recent = keep
 
-    def log_odds(self, t: float) -> float:
-        """The log-odds at time t (≥ the last firing)."""
-        total = self._prior + self._lasting
+    def accumulate(self, total: float, t: float) -> float:
+        """``total`` plus this evidence's log-odds at time t (added in a fixed order, for exact replays)."""
+        total += self._lasting
         if self._rate == 0.0:
             return total
         for fired_at, u in self._recent:
             total += 2.0 * math.atanh(u * math.exp(-self._rate * (t - fired_at)))
         return total + self._series_value(t)
-
-    def metric(self, t: float) -> float:
-        """The property's probability at time t."""
-        return _logistic(self.log_odds(t))
-
     def _rebase(self, t: float) -> None:
         """Move the series' reference time to t, decaying its coefficients."""
         if t == self._series_t:
@@ -130,5 +118,48 @@ class PropertyBelief:
 
     @property
     def live_firings(self) -> int:
-        """How many firings are kept on their own (the rest are folded or pruned)."""
         return len(self._recent)
+
+
+class PropertyBelief:
+    """The evidence gathered for one property (or beliefvar), and its metric at any later time."""
+
+    def __init__(self, prop: Property):
+        self.property = prop
+        self._prior = math.log(prop.prior / (1.0 - prop.prior))
+        self._rate = 2.0 * prop.decay_rate
+        #: evidence by fading rate; the property's own rate first
+        self._pools: dict[float, _Evidence] = {self._rate: _Evidence(self._rate)}
+
+    def add(self, t: float, likelihood_ratio: float, survival: float | None = None) -> None:
+        """Record a firing at time t that fades with ``survival`` seconds (default: the property's);
+        times of successive calls must not decrease.
+
+        Lone firings that have faded to ``|u·d| ≤ FOLD_AT`` by t are folded into the series here,
+        so that reading a metric stays a pure function of time.
+        """
+        rate = self._rate if survival is None else 2.0 / survival
+        pool = self._pools.get(rate)
+        if pool is None:
+            pool = self._pools[rate] = _Evidence(rate)
+        pool.add(t, likelihood_ratio)
+
+    def clear(self) -> None:
+        """Forget all evidence (``clears``): the metric is the reference again."""
+        self._pools = {self._rate: _Evidence(self._rate)}
+
+    def log_odds(self, t: float) -> float:
+        """The log-odds at time t (≥ the last firing)."""
+        total = self._prior
+        for pool in self._pools.values():
+            total = pool.accumulate(total, t)
+        return total
+
+    def metric(self, t: float) -> float:
+        """The property's probability at time t."""
+        return _logistic(self.log_odds(t))
+
+    @property
+    def live_firings(self) -> int:
+        """How many firings are kept on their own (the rest are folded or pruned)."""
+        return sum(pool.live_firings for pool in self._pools.values())

@@ -19,18 +19,19 @@ import math
 import statistics
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from qos.engine import Engine, UpdateResult, check_batch
-from qos.errors import ContextError, TraceError
-from qos.files import write_private
+from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
+from qos.errors import ContextError, ModelError, TraceError
+from qos.files import BadFile, load_data, write_private
 from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")
-_TRACE_KEYS = ("model", "events", "description")
+_TRACE_KEYS = ("model", "events", "description", "origin")
 
 
 def seconds(t: float) -> float | int:
@@ -66,6 +67,13 @@ class Trace:
     description: str | None = None
     #: the file it was loaded from, for messages and relative model paths
     source: Path | None = None
+    #: the calendar time of t = 0 (ISO 8601, UTC unless it says otherwise), for ``schedule`` timers
+    origin: str | None = None
+
+    @property
+    def origin_seconds(self) -> float:
+        """The origin in seconds since 1970 UTC (0 when the trace has none)."""
+        return _calendar(self.origin, self.name) if self.origin is not None else 0.0
 
     @property
     def name(self) -> str:
@@ -84,9 +92,15 @@ class Trace:
         from qos import load_model  # the package function, which knows the bundled models
 
         model = self.model
-        if self.source is not None and (model.endswith(".roqme") or "/" in model):
+        is_path = model.endswith(".roqme") or "/" in model
+        if self.source is not None and is_path:
             model = str(self.source.parent / model)
-        return load_model(model)
+        try:
+            return load_model(model)
+        except ModelError as exc:
+            if is_path:
+                raise  # it names the model file, and where in it
+            raise ModelError(f"{self.name}: {exc}") from None  # an unknown name: say which trace uses it
 
     def check(self, model: Model | None = None) -> Model:
         """Validate every event against the model; raise :class:`TraceError` on the first problem."""
@@ -119,6 +133,8 @@ class Trace:
         data: dict[str, object] = {"model": self.model}
         if self.description:
             data["description"] = self.description
+        if self.origin:
+            data["origin"] = self.origin
         data["events"] = [event.to_dict() for event in self.events]
         return data
 
@@ -128,6 +144,8 @@ class Trace:
         lines.append(f"model: {_flow(self.model)}")
         if self.description:
             lines.append(f"description: {_flow(self.description)}")
+        if self.origin:
+            lines.append(f"origin: {_flow(self.origin)}")
         lines.append("events:" if self.events else "events: []")
         lines += [f"  - {_flow(event.to_dict())}" for event in self.events]
         return "\n".join(lines) + "\n"
@@ -180,7 +198,7 @@ def trace_from_data(data: object, source: Path | None = None) -> Trace:
         raise TraceError(f"{name}: a trace must be a mapping with 'model' and 'events'")
     unknown = [key for key in data if key not in _TRACE_KEYS]
     if unknown:
-        raise TraceError(f"{name}: unknown key {unknown[0]!r} (a trace has model, events and description)")
+        raise TraceError(f"{name}: unknown key {unknown[0]!r} (a trace has model, events, description and origin)")
     model = data.get("model")
     if not isinstance(model, str) or not model:
         raise TraceError(f"{name}: 'model' must name a bundled model or a .roqme file, not {model!r}")
@@ -190,8 +208,25 @@ def trace_from_data(data: object, source: Path | None = None) -> Trace:
     description = data.get("description")
     if description is not None and not isinstance(description, str):
         raise TraceError(f"{name}: 'description' must be text")
+    origin = data.get("origin")
+    if isinstance(origin, datetime):  # YAML reads an unquoted timestamp as one
+        origin = origin.isoformat()
+    if origin is not None:
+        if not isinstance(origin, str):
+            raise TraceError(f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {origin!r}")
+        _calendar(origin, name)
     parsed = [_parse_event(raw, f"{name}: events[{index}]") for index, raw in enumerate(events)]
-    return Trace(model, parsed, description, source)
+    return Trace(model, parsed, description, source, origin)
+
+
+def _calendar(text: str, name: str) -> float:
+    """An ISO 8601 date and time in seconds since 1970 UTC (UTC when it names no zone)."""
+    try:
+        moment = datetime.fromisoformat(text.replace("Z", "+00:00"))
+    except ValueError:
+        raise TraceError(f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {text!r}") \
+            from None
+    return (moment if moment.tzinfo else moment.replace(tzinfo=timezone.utc)).timestamp()
 
 
 def load_trace(path: str | Path) -> Trace:
@@ -202,24 +237,9 @@ def load_trace(path: str | Path) -> Trace:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise TraceError(f"{path}: cannot read the trace ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise TraceError(f"{path}: the trace is not UTF-8 text (byte {exc.start})") from None
-    if path.suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise TraceError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
-    else:
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
-            problem = getattr(exc, "problem", None) or "malformed"
-            raise TraceError(f"{where}: invalid YAML: {problem}") from None
+        data = load_data(path)
+    except BadFile as exc:
+        raise TraceError(str(exc)) from None
     trace = trace_from_data(data, path)
     trace.check()
     return trace
@@ -238,7 +258,10 @@ class TraceRecorder:
         self._unsubscribe = engine.subscribe(self._record)
 
     def _record(self, result: UpdateResult) -> None:
-        self.events.append(TraceEvent(seconds(result.t), dict(result.set), list(result.emit)))
+        if result.timed:
+            return  # timers and time windows: a replay runs them again from the model
+        values = {name: list(value) if isinstance(value, tuple) else value for name, value in result.set.items()}
+        self.events.append(TraceEvent(seconds(result.t), values, list(result.emit)))
 
     @property
     def trace(self) -> Trace:
@@ -269,10 +292,14 @@ class ReplaySamples:
     series: dict[str, list[float]]
     #: one entry per batch that fired something: {"t": time as in the trace, "observations": [...]}
     fired: list[dict[str, object]]
+    #: beliefvar name -> its probability at each of ``times`` (models with ``beliefvar`` only)
+    beliefs: dict[str, list[float]] = field(default_factory=dict)
 
 
-#: samples one replay may take (each holds every property): bounds time and memory for a tiny period
-MAX_SAMPLES = 10_000_000
+#: samples one replay may take (each holds every property): bounds time and memory, so that a tiny
+#: trace whose last event is at t = 10⁷ s is refused at once instead of replayed for minutes; a
+#: day of events at the default 1 s period fits
+MAX_SAMPLES = 100_000
 
 
 def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
@@ -291,38 +318,55 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     if not isinstance(trace, Trace):
         trace = load_trace(trace)
     model = trace.check(model)
-    engine = Engine(model)
+    engine = Engine(model, origin=trace.origin_seconds)
     batches = trace.batches()
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
     if count > MAX_SAMPLES:
         raise TraceError(f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
                          f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period")
-    samples = ReplaySamples([], {name: [] for name in model.properties}, [])
+    firings = sum(last_t / (timer.interval or 1.0) for timer in model.timers.values())
+    if firings > MAX_TIMED_BATCHES:
+        raise TraceError(f"{trace.name}: the model's timers would fire about {firings:,.0f} times over the trace's "
+                         f"{last_t:g} s (at most {MAX_TIMED_BATCHES:,}); is a timer's interval too short?")
+    samples = ReplaySamples([], {name: [] for name in model.properties}, [], {name: [] for name in model.beliefvars})
+    # every batch that fires, timer batches included, in the order the engine runs them
+    engine.subscribe(lambda result: samples.fired.append({"t": seconds(result.t), "observations": result.fired})
+                     if result.fired else None)
+
+    def sample(now: float) -> None:
+        engine.advance(max(now, engine.t or 0.0))
+        samples.times.append(now)
+        at = max(now, engine.t or 0.0)
+        for name, value in engine.metrics(at).items():
+            samples.series[name].append(value)
+        for name, value in engine.beliefs(at).items():
+            samples.beliefs[name].append(value)
+
+    try:
+        _run(engine, batches, count, sample_period, last_t, sample)
+    except ContextError as exc:  # the model's timers cannot follow the trace (a jump too far ahead)
+        raise TraceError(f"{trace.name}: {exc}") from None
+    return samples
+
+
+def _run(engine: Engine, batches: list, count: int, sample_period: float, last_t: float, sample) -> None:
+    """Apply the batches in time order, sampling at every period (see :func:`sample_trace`)."""
     upcoming = 0
     for k in range(count):
         now = k * sample_period
         # a small tolerance so that samples at k·0.1 s still see the events written at that time
         while upcoming < len(batches) and float(batches[upcoming][0]) <= now + 1e-9:
             t, values, emitted = batches[upcoming]
-            result = engine.update(float(t), set=values, emit=emitted)
-            if result.fired:
-                samples.fired.append({"t": t, "observations": result.fired})
+            engine.update(float(t), set=values, emit=emitted)
             upcoming += 1
-        samples.times.append(now)
-        for name, value in engine.metrics(max(now, engine.t or 0.0)).items():
-            samples.series[name].append(value)
+        sample(now)
     if upcoming < len(batches):
         # the last event falls between two samples: apply the rest and sample at that time too,
         # so that every batch is counted and `last` is the value after the last event
         for t, values, emitted in batches[upcoming:]:
-            result = engine.update(float(t), set=values, emit=emitted)
-            if result.fired:
-                samples.fired.append({"t": t, "observations": result.fired})
-        samples.times.append(last_t)
-        for name, value in engine.metrics(last_t).items():
-            samples.series[name].append(value)
-    return samples
+            engine.update(float(t), set=values, emit=emitted)
+        sample(last_t)
 
 
 def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> dict:
@@ -335,6 +379,10 @@ def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model |
 
 
 def summarise(samples: ReplaySamples) -> dict:
-    """The replay result of trace-format.md from a replay's samples."""
-    return {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
-            "fired": samples.fired}
+    """The replay result of trace-format.md from a replay's samples (and, for a model with belief
+    variables, their statistics under ``beliefs``)."""
+    result: dict = {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
+                    "fired": samples.fired}
+    if samples.beliefs:
+        result["beliefs"] = {name: _statistics(values) for name, values in samples.beliefs.items()}
+    return result

@@ -17,7 +17,7 @@ from typing import Any
 
 from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
 from kiosk.remote.decoders import ReportMatch
-from kiosk.yamlmarks import Positions, Problem, parse
+from kiosk.yamlmarks import Positions, Problem, parse_file
 
 #: the profiles shipped with the kiosk
 BUILTIN_PROFILES = Path(__file__).with_name("devices.yaml")
@@ -139,13 +139,7 @@ class _Where:
 
 
 def _read_file(path: Path) -> list[_Fields]:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ProfileError(f"{path}: device profile file not found") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise ProfileError(f"{path}: cannot read device profiles: {error}") from None
-    document, positions, problems = parse(text, str(path))
+    document, positions, problems = parse_file(path)
     if problems:
         raise ProfileError(str(problems[0]))
     assert positions is not None

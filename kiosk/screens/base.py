@@ -56,8 +56,6 @@ class PatientView:
     banner: str | None = None
     #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
     voice_again: bool = False
-    #: on the welcome screen: how far an interrupted session got, when it can be continued
-    resume_offer: str | None = None
     #: the number of answers of the question on screen, when the patient pressed a number it
     #: does not have (a gentle "Please choose 1, 2 or 3" follows)
     hint_options: int | None = None

@@ -1,5 +1,6 @@
 """The clinician's first screen: the running session (continue it, adaptation on/off, patient left or
-back), the channel states with their reasons, and the list of stored sessions."""
+back), the channel states with their reasons, the interrupted tests staff may continue, and the
+list of stored sessions."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
-from kiosk.config import DEFAULT_PIN
 from kiosk.screens.base import ClinicianScreen
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
@@ -29,9 +29,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         session = app.session  # type: ignore[attr-defined]
         with Vertical(classes="clinician"):
             yield Static("Clinician", classes="heading")
-            if app.clinician_pin == DEFAULT_PIN:  # type: ignore[attr-defined]
-                yield Static("The clinician PIN is still the public default: set clinician_pin in the "
-                            "configuration.", id="pin-warning")
+            if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
+                yield Static(warning, id="pin-warning")
             yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
                 yield Button("Continue", id="continue", variant="primary")
@@ -45,12 +44,29 @@ class ClinicianHomeScreen(ClinicianScreen):
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost")
                 yield Button("Patient back", id="person-back")
+                # the only way out of the locked-down kiosk, on the shorter row so it always shows
+                yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             yield Static(self._channels_text(), id="channel-reasons")
+            # continuing a test is the staff's decision: only with the same patient at the kiosk
+            yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")
+            yield DataTable(id="interrupted", cursor_type="row", zebra_stripes=True)
+            with Horizontal(id="interrupted-actions"):
+                yield Button("Continue this test", id="continue-test", variant="warning", disabled=True)
+                yield Static("", id="continue-result")
             yield Label("Stored sessions (Enter or click to open):")
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
 
     def on_mount(self) -> None:
-        """Fill the session list, and keep the running session's line current while it runs."""
+        """Fill the tables, and keep the running session's line current while it runs."""
+        interrupted = self.query_one("#interrupted", DataTable)
+        interrupted.add_columns("patient", "started", "progress", "why it stopped", "session")
+        count = len(self.app.questionnaire.items)  # type: ignore[attr-defined]
+        for test in self.app.interrupted_tests():  # type: ignore[attr-defined]
+            progress = f"{len(test.answers)} of {count} answered" + (
+                f", {len(test.not_answered)} not answered" if test.not_answered else "")
+            interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,
+                                test.interrupted_reason or "", test.id, key=test.id)
+        self.query_one("#continue-test", Button).disabled = not interrupted.row_count
         table = self.query_one("#sessions", DataTable)
         table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
         self._fill_sessions()
@@ -61,7 +77,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         table = self.query_one("#sessions", DataTable)
         store = self.app.store  # type: ignore[attr-defined]
         for s in store.sessions() if store is not None else []:
-            row = (s.id, s.patient_id, s.started_at[:19], s.status, s.language, str(s.answered), str(s.not_answered))
+            row = (s.id, s.patient_id, s.started_at[:19], s.label, s.language, str(s.answered), str(s.not_answered))
             if s.id in table.rows:
                 for column, value in zip(table.columns, row):
                     table.update_cell(s.id, column, value)
@@ -99,7 +115,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         return line
 
     def _channels_text(self) -> str:
-        lines = self.app.board.lines("en")  # type: ignore[attr-defined]
+        lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
         return "Channels: " + "; ".join(
             f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
             for line in lines)
@@ -119,6 +135,16 @@ class ClinicianHomeScreen(ClinicianScreen):
         self.app.person_back()  # type: ignore[attr-defined]
         self.app.close_clinician()  # type: ignore[attr-defined]
 
+    @on(Button.Pressed, "#continue-test")
+    def _continue_test(self) -> None:
+        table = self.query_one("#interrupted", DataTable)
+        if not table.row_count:
+            return
+        row_key, _ = table.coordinate_to_cell_key(table.cursor_coordinate)
+        refused = self.app.continue_test(str(row_key.value))  # type: ignore[attr-defined]
+        if refused:
+            self.query_one("#continue-result", Static).update(f"Not continued: {refused}")
+
     @on(Button.Pressed, "#new-session")
     def _new_session(self) -> None:
         self.app.start_new_session()  # type: ignore[attr-defined]
@@ -126,6 +152,10 @@ class ClinicianHomeScreen(ClinicianScreen):
     @on(Button.Pressed, "#back")
     def _back(self) -> None:
         self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#quit-kiosk")
+    def _quit(self) -> None:
+        self.app.quit_kiosk()  # type: ignore[attr-defined]
 
     @on(Switch.Changed, "#adaptation")
     def _adaptation(self, event: Switch.Changed) -> None:

@@ -40,14 +40,10 @@ class WelcomeScreen(PatientScreen):
             """One of the questionnaire's languages."""
             super().__init__()
 
-    class ResumeChosen(Message):
-        """The patient chose to continue the interrupted session."""
-
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
-        """Rebuilt when the language changes or the offer to continue an interrupted session comes
-        or goes."""
-        return (view.snapshot.language, view.resume_offer)
+        """Rebuilt when the language changes."""
+        return view.snapshot.language
 
     def compose(self) -> ComposeResult:
         """Bars, the welcome lines, the language buttons."""
@@ -57,8 +53,6 @@ class WelcomeScreen(PatientScreen):
             for language in q.languages:
                 yield Static(welcome_line(self.view, language), classes="welcome-line",
                              id=f"welcome-{language}")
-        if self.view.resume_offer:
-            yield Button(self.view.resume_offer, id="resume-session", classes="big-action")
         with Vertical(id="languages"):
             for number, language in enumerate(q.languages, start=1):
                 yield Button(f"{number}  {language_name(language)}", id=f"language-{language}")
@@ -77,11 +71,6 @@ class WelcomeScreen(PatientScreen):
     def ways_text(self, view: PatientView) -> str:
         """No row of ways here: the welcome lines say them, in every language."""
         return ""
-
-    @on(Button.Pressed, "#resume-session")
-    def _resume(self, event: Button.Pressed) -> None:
-        event.stop()
-        self.post_message(self.ResumeChosen())
 
     @on(Button.Pressed, "#languages Button")
     def _language(self, event: Button.Pressed) -> None:

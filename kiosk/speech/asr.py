@@ -14,12 +14,16 @@ in [0, 1]:
   1. a whole phrase was reached (else 0);
   2. coverage: the recognised words cover the utterance's voiced audio (a sentence forced
      onto the grammar goes mostly into "silence": 5-45 % covered, an answer 80-100 %);
-  3. fit: the acoustic cost per voiced frame is low. PocketSphinx scores every frame against
-     the best-matching sound in that frame, so the path's cost measures how far the grammar
-     had to bend the audio: 3.9-6.5 for answers, 6.6-7.9 for other short words on espeak-ng
-     audio here. :data:`PS_COST_MIDPOINT` and :data:`PS_COST_SPREAD` map it to [0, 1]. The
-     utterance is scored with a fixed quiet tail (:func:`_fixed_tail`), so one the endpointer
-     closed early is scored like one closed late;
+  3. fit: the phrase fits the audio nearly as well as free phone decoding does. The cost per
+     voiced frame of the grammar's best path is compared with that of the best free phone
+     sequence for the same audio (the wheel's phone language model): an answer costs about as
+     much as free phones, a sentence forced onto the grammar much more. An absolute cost (the
+     first design) was tuned on the kiosk's own voice: right answers by other espeak-ng voices
+     cost 6-9.7 per frame against 3.9-6.5 for the kiosk's, so "yes" in a female voice scored 0;
+     the difference to free phones is the same yardstick for every voice and room.
+     :data:`PS_FIT_MIDPOINT` and :data:`PS_FIT_SPREAD` (set on bench/asr.py's dev voices) map
+     it to [0, 1]. The utterance is scored with a fixed quiet tail (:func:`_fixed_tail`), so
+     one the endpointer closed early is scored like one closed late;
   4. no confusable word (:data:`PS_CONFUSABLE_WORDS`): espeak-ng's "the first one" was heard
      as "the third one" on every question with a third option, and decoded against each phrase
      alone "the third one" even fits it better, so no score margin separates them. Such a
@@ -61,6 +65,13 @@ class AsrUnavailable(RuntimeError):
     """Voice in cannot work for this language here; the message is one sentence for the UI."""
 
 
+class NoModelForLanguage(AsrUnavailable):
+    """No speech model for the language (Spanish or French without a Vosk model): the one
+    reason a patient can be told, in their language (screen text ``voice_no_model``)."""
+
+    reason_key = "voice_no_model"
+
+
 @dataclass(frozen=True)
 class Recognition:
     """What a recogniser made of (part of) an utterance."""
@@ -73,6 +84,9 @@ class Recognition:
     #: for a partial result: it already is a whole answer (one of the grammar's
     #: :func:`~kiosk.speech.grammar.final_phrases`), so the endpointer need not wait long
     complete: bool = False
+    #: pocketsphinx: how much worse the phrase fits the audio than free phones do (cost per
+    #: voiced frame); the acoustic part of the confidence, kept for bench/asr.py's calibration
+    fit: float | None = None
 
 
 class Recogniser(Protocol):
@@ -82,8 +96,10 @@ class Recogniser(Protocol):
     name: str
     language: str
 
-    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
-        """Listen only for these phrases from the next utterance on; returns what was kept.
+    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
+        """Listen only for these phrases (each maybe after one lead-in, or one of the fillers)
+        from the next utterance on; returns what was kept.
 
         ``meaning(phrase)`` says what a phrase selects (an option number, a command): phrases
         with the same meaning are not rivals of one another (see :class:`PocketSphinxRecogniser`).
@@ -102,14 +118,25 @@ class Recogniser(Protocol):
 
 # --- PocketSphinx ----------------------------------------------------------------------------
 
-#: acoustic cost per voiced frame where confidence is 0.5, and how fast it falls around it;
-#: with the matcher's 0.6 threshold, a cost above ~6.6 is not an answer (see the docstring)
-PS_COST_MIDPOINT, PS_COST_SPREAD = 6.7, 0.25
+#: the fit (phrase cost minus free-phone cost per voiced frame) where the acoustic confidence
+#: is 0.5, and how fast it falls around it (see the docstring)
+PS_FIT_MIDPOINT, PS_FIT_SPREAD = 2.2, 0.35
+#: the free phone-loop search's name in the decoder
+_PHONES = "phones"
 #: 10 ms frames of quiet after the last voiced one that the final decode scores: the long
 #: hangover's worth (see :func:`_fixed_tail`)
 PS_TRAILING_FRAMES = 50
 #: words the wheel's English model cannot tell apart on espeak-ng speech (see the docstring)
 PS_CONFUSABLE_WORDS: tuple[frozenset[str], ...] = (frozenset({"first", "third"}),)
+
+#: words of the welcome the wheel's English dictionary lacks, as a patient would say them
+#: (CMU phones): the language names and "start" in Spanish and French
+PS_EXTRA_WORDS = {
+    "español": "EH S P AA N Y OW L", "espanol": "EH S P AA N Y OW L",
+    "français": "F R AA N S EY", "francais": "F R AA N S EY",
+    "français(2)": "F R AA N S EH", "français(3)": "F R AO S EH", "français(4)": "F AA S EH",
+    "empezar": "EH M P EY S AA R", "commencer": "K AO M AA N S EY",
+}
 
 #: lattice entries that are not words the patient said
 _FILLERS = {"<s>", "</s>", "<sil>", "(NULL)", "[NOISE]", "[SPEECH]"}
@@ -122,7 +149,7 @@ class PocketSphinxRecogniser:
 
     def __init__(self, language: str = "en") -> None:
         if language != "en":
-            raise AsrUnavailable(f"no speech model for language {language!r}: pocketsphinx only "
+            raise NoModelForLanguage(f"no speech model for language {language!r}: pocketsphinx only "
                                  f"ships English; install one with `kiosk models install {language}`")
         try:
             from pocketsphinx import Decoder
@@ -132,6 +159,13 @@ class PocketSphinxRecogniser:
         # bestpath lattice rescoring picked prefixes like "the" over whole phrases: on the
         # synthesised answer set 76 of 109 right with it, 96 without
         self._decoder = Decoder(lm=None, bestpath=False, loglevel="FATAL")
+        from pocketsphinx import get_model_path
+
+        # free phone decoding of the same audio: the yardstick the answer's fit is measured by
+        self._decoder.add_allphone_file(_PHONES, str(Path(get_model_path()) / "en-us" / "en-us-phone.lm.bin"))
+        for word, phones in PS_EXTRA_WORDS.items():
+            if self._decoder.lookup_word(word) is None:
+                self._decoder.add_word(word, phones, False)
         self._in_utterance = False
         self._grammar: Grammar | None = None
         self._grammars = 0
@@ -143,13 +177,15 @@ class PocketSphinxRecogniser:
         self._settled = False
         self._pcm = bytearray()
 
-    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
+    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
         """Compile the phrases the dictionary knows to JSGF and make it the active search.
 
         ``meaning`` groups phrases that select the same thing: "the first one" is only
         confusable where "the third one" selects something else.
         """
-        grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name)
+        grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name,
+                                lead_ins, fillers, meaning)
         self._end()
         # a fresh search name each time: pocketsphinx keeps searches by name
         self._grammars += 1
@@ -190,7 +226,7 @@ class PocketSphinxRecogniser:
         # utterance closed early scored far better than it should ("banana split" as "number
         # three": cost 6.4 against 6.7 after the long hangover, 7.1 once settled), so the
         # first utterance always gets the long hangover.
-        complete = self._settled and hyp.hypstr in self._final
+        complete = self._settled and self._grammar.core(hyp.hypstr) in self._final
         return Recognition(hyp.hypstr, 0.0, final=False, complete=complete)
 
     def finish(self) -> Recognition:
@@ -213,17 +249,32 @@ class PocketSphinxRecogniser:
         if hyp is None or not hyp.hypstr:
             return Recognition("", 0.0)
         words = [seg for seg in self._decoder.seg() if seg.word not in _FILLERS]
-        if not words or hyp.hypstr not in self._grammar.phrases or not voiced.any():
+        core = self._grammar.core(hyp.hypstr)
+        if not words or core not in self._grammar.phrases or not voiced.any():
             return Recognition(hyp.hypstr, 0.0)  # stopped inside a phrase: not something said
         in_words = np.zeros(len(voiced), dtype=bool)
         for seg in words:
             in_words[seg.start_frame:seg.end_frame + 1] = True
         coverage = float((voiced & in_words).sum() / voiced.sum())
-        cost = _cost(hyp.score, voiced)
-        acoustic = _sigmoid((PS_COST_MIDPOINT - cost) / PS_COST_SPREAD)
+        free = self._free_cost(pcm, voiced)
+        fit = _cost(hyp.score, voiced) - free if math.isfinite(free) else math.inf
+        acoustic = _sigmoid((PS_FIT_MIDPOINT - fit) / PS_FIT_SPREAD)
         # a phrase the model cannot tell from another answer's is never taken as either
-        distinct = 0.0 if hyp.hypstr in self._confusable else 1.0
-        return Recognition(hyp.hypstr, min(coverage, acoustic, distinct))
+        distinct = 0.0 if core in self._confusable else 1.0
+        return Recognition(hyp.hypstr, min(coverage, acoustic, distinct), fit=fit)
+
+    def _free_cost(self, pcm: bytes, voiced: np.ndarray) -> float:
+        """The cost per voiced frame of the best free phone sequence for the same audio."""
+        grammar = self._decoder.current_search()
+        self._decoder.activate_search(_PHONES)
+        try:
+            self._decoder.start_utt()
+            self._decoder.process_raw(pcm, False, True)
+            self._decoder.end_utt()
+            hyp = self._decoder.hyp()
+        finally:
+            self._decoder.activate_search(grammar)
+        return _cost(hyp.score, voiced) if hyp is not None else math.inf
 
 
 def _fixed_tail(pcm: bytes, voiced: np.ndarray) -> tuple[bytes, np.ndarray]:
@@ -292,21 +343,25 @@ class VoskRecogniser:
         self.language = language
         self.model_path = path
         self._recogniser = None
+        self._grammar: Grammar | None = None
         #: Vosk's JSON results for the segments of the current utterance
         self._segments: list[str] = []
         #: phrases that are a whole answer once heard (partial results say so)
         self._final: frozenset[str] = frozenset()
 
-    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None) -> Grammar:
+    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]").
 
         ``meaning`` is not needed: Vosk's own word confidences tell confusable words apart.
         """
-        grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name)
+        grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name,
+                                lead_ins, fillers, meaning)
         if not grammar.phrases:
             raise ValueError("a grammar needs at least one phrase the recogniser knows")
         self._recogniser = self._vosk.KaldiRecognizer(self._model, SAMPLE_RATE, to_vosk(grammar))
         self._recogniser.SetWords(True)
+        self._grammar = grammar
         self._final = final_phrases(grammar.phrases, meaning or (lambda p: p))
         self.reset()
         return grammar
@@ -329,7 +384,8 @@ class VoskRecogniser:
             partial = json.loads(self._recogniser.PartialResult()).get("partial", "")
         text = " ".join([*(json.loads(s).get("text", "") for s in self._segments), partial]).split()
         heard = " ".join(text)
-        return Recognition(heard, 0.0, final=False, complete=heard in self._final) if heard else None
+        complete = self._grammar is not None and self._grammar.core(heard) in self._final
+        return Recognition(heard, 0.0, final=False, complete=complete) if heard else None
 
     def finish(self) -> Recognition:
         """End the utterance and combine its segments (see :func:`vosk_recognition`)."""
@@ -337,7 +393,13 @@ class VoskRecogniser:
             return Recognition("", 0.0)
         segments = [*self._segments, self._recogniser.FinalResult()]
         self._segments = []
-        return vosk_recognition(segments)
+        result = vosk_recognition(segments)
+        if self._grammar is not None and self._grammar.core(result.text) not in self._grammar.phrases:
+            # Vosk's grammar lets phrases follow one another, and a model without "[unk]" (the
+            # Korean one) forces any sentence into a run of them ("셋 셋 혼자", each word 0.65
+            # sure): only one phrase, maybe after a lead-in, is something a patient answered
+            return Recognition(result.text, 0.0)
+        return result
 
 
 def vosk_recognition(results: Sequence[str]) -> Recognition:

@@ -164,10 +164,18 @@ def frame_level_db(frame: np.ndarray) -> float:
 class EndpointerSettings:
     """How the endpointer decides where speech starts and ends."""
 
-    #: a frame this loud (dBFS) or louder may be speech ...
-    min_speech_db: float = -45.0
-    #: ... if it is also this far above the running noise floor
-    margin_db: float = 12.0
+    #: a frame this loud (dBFS) or louder may be speech (a quiet speaker far from the
+    #: microphone is about -45 dBFS; a microphone's own hiss about -70) ...
+    min_speech_db: float = -55.0
+    #: ... if it is also this far above the room's noise floor: to start an utterance ...
+    margin_db: float = 9.0
+    #: ... and to go on with one (hysteresis: the quiet ends of words still count)
+    hold_margin_db: float = 6.0
+    #: the noise floor is this percentile of the frame levels heard over the last
+    #: ``floor_window_s``, in and out of speech: a steady fan is most of every window, an
+    #: answer is not
+    floor_percentile: float = 10.0
+    floor_window_s: float = 3.0
     #: this much continuous speech starts an utterance (short clicks do not)
     start_ms: int = 90
     #: this much quiet ends it while what was heard is not yet a whole answer: older speakers
@@ -185,12 +193,20 @@ class EndpointerSettings:
 
 
 class Endpointer:
-    """Energy-based speech start/end detection with hangover, frame by frame.
+    """Energy-based speech start/end detection against a noise floor that keeps learning.
 
     ``push(frame, complete)`` returns ``"start"``, ``"end"`` or ``None``; ``complete`` says
     whether what was heard so far is already a whole answer, which ends it after the shorter
-    ``complete_hangover_ms``. A running noise floor (tracked while nobody speaks) raises the
-    threshold in a noisy room.
+    ``complete_hangover_ms``.
+
+    The noise floor is a low percentile of the levels of the last few seconds, taken over
+    every frame pushed, speech or not, and kept across utterances and mutes (:meth:`reset`
+    forgets the speech in progress, not the room). An earlier floor that learned only while
+    nobody spoke, and was reset after every prompt, never learned a fan louder than its fixed
+    speech threshold: every frame was "speech" and every utterance ran to the cut-off.
+    Here a fan switched on mid-answer becomes the floor once it fills most of the window, so
+    even then the utterance ends within ``floor_window_s``. Measured against webrtcvad and
+    silero-vad in ``bench/asr.py`` (see its docstring for the figures).
     """
 
     def __init__(self, settings: EndpointerSettings | None = None) -> None:
@@ -201,26 +217,44 @@ class Endpointer:
         self._end_frames = max(1, round(self.settings.hangover_ms / frame_ms))
         self._complete_end_frames = max(1, round(self.settings.complete_hangover_ms / frame_ms))
         self._max_frames = round(self.settings.max_utterance_s * 1000 / frame_ms)
+        self._levels: deque[float] = deque(maxlen=max(1, round(self.settings.floor_window_s * 1000 / frame_ms)))
+        self.noise_db = -90.0
         self.reset()
 
     def reset(self) -> None:
-        """Forget any speech in progress (after a mute, or between questions)."""
+        """Forget any speech in progress (after a mute, or between questions); the room's
+        noise floor is kept."""
         self.in_speech = False
         self._voiced_run = 0
         self._quiet_run = 0
         self._speech_frames = 0
-        self.noise_db = -70.0
 
-    def is_voiced(self, level_db: float) -> bool:
-        """Whether a frame at ``level_db`` counts as speech given the current noise floor."""
-        return level_db >= max(self.settings.min_speech_db, self.noise_db + self.settings.margin_db)
+    def is_voiced(self, level_db: float, margin_db: float | None = None) -> bool:
+        """Whether a frame at ``level_db`` stands out of the current noise floor as speech."""
+        margin = self.settings.margin_db if margin_db is None else margin_db
+        return level_db >= max(self.settings.min_speech_db, self.noise_db + margin)
+
+    def _learn(self, level_db: float) -> None:
+        self._levels.append(max(level_db, -90.0))
+        if len(self._levels) < self._levels.maxlen:
+            # until a whole window is heard, the quietest frame so far: a fan running as the
+            # microphone opens is learned at once, and an answer spoken then still stands out
+            self.noise_db = min(self._levels)
+        else:
+            self.noise_db = float(np.percentile(self._levels, self.settings.floor_percentile))
+
+    def speech_in(self, frame: np.ndarray, level_db: float, starting: bool) -> bool:
+        """Whether ``frame`` (at ``level_db``) is speech: it stands out of the noise floor by
+        the start margin (``starting``) or the hold margin. ``bench/asr.py`` overrides this to
+        measure other voice-activity detectors in the same endpointer."""
+        return self.is_voiced(level_db, None if starting else self.settings.hold_margin_db)
 
     def push(self, frame: np.ndarray, complete: bool = False) -> str | None:
         """Classify one frame of :data:`FRAME_SAMPLES` samples; report a start or an end."""
         level = frame_level_db(frame)
-        voiced = self.is_voiced(level)
+        self._learn(level)
         if not self.in_speech:
-            if voiced:
+            if self.speech_in(frame, level, starting=True):
                 self._voiced_run += 1
                 if self._voiced_run >= self.start_frames:
                     self.in_speech, self._quiet_run = True, 0
@@ -228,12 +262,9 @@ class Endpointer:
                     return "start"
             else:
                 self._voiced_run = 0
-                # the floor follows quiet frames slowly, and drops at once when it gets quieter
-                self.noise_db = min(level, 0.95 * self.noise_db + 0.05 * level)
-                self.noise_db = max(self.noise_db, -90.0)
             return None
         self._speech_frames += 1
-        self._quiet_run = 0 if voiced else self._quiet_run + 1
+        self._quiet_run = 0 if self.speech_in(frame, level, starting=False) else self._quiet_run + 1
         end_frames = self._complete_end_frames if complete else self._end_frames
         if self._quiet_run >= end_frames or self._speech_frames >= self._max_frames:
             self.in_speech, self._voiced_run = False, 0
@@ -244,6 +275,11 @@ class Endpointer:
     def quiet_frames(self) -> int:
         """Quiet frames since the last voiced one while in speech (the hangover so far)."""
         return self._quiet_run
+
+    @property
+    def cut_off(self) -> bool:
+        """Whether the last utterance ended at ``max_utterance_s`` rather than in quiet."""
+        return self._speech_frames >= self._max_frames
 
 
 # --- the pipeline ----------------------------------------------------------------------------
@@ -279,6 +315,8 @@ class Utterance:
     finish_seconds: float
     #: whether the utterance ended after the short hangover, its partial result being a whole answer
     complete: bool = False
+    #: whether it ran to the endpointer's ``max_utterance_s`` instead of ending in quiet
+    cut_off: bool = False
 
 
 class UtterancePipeline:
@@ -295,11 +333,12 @@ class UtterancePipeline:
         on_utterance: Callable[[Utterance], None],
         settings: EndpointerSettings | None = None,
         timer: Callable[[], float] = time.perf_counter,
+        endpointer: Endpointer | None = None,
     ) -> None:
         self.recogniser = recogniser
         self._timer = timer
         self.on_utterance = on_utterance
-        self.endpointer = Endpointer(settings)
+        self.endpointer = endpointer or Endpointer(settings)
         self._preroll: deque[bytes] = deque(
             maxlen=max(1, round(self.endpointer.settings.preroll_ms * SAMPLE_RATE / 1000 / FRAME_SAMPLES))
         )
@@ -381,6 +420,7 @@ class UtterancePipeline:
                 endpoint=endpoint,
                 finish_seconds=finish_seconds,
                 complete=complete,
+                cut_off=self.endpointer.cut_off,
             )
         )
 
@@ -404,12 +444,16 @@ def feed_wav(path: str | Path, pipeline: PcmConsumer, chunk_ms: int = 100) -> fl
     endpointer can close the last utterance.
     """
     samples = read_wav(path)
-    tail = np.zeros(SAMPLE_RATE, dtype=np.int16)
-    pcm = np.concatenate([samples, tail]).tobytes()
+    feed_samples(np.concatenate([samples, np.zeros(SAMPLE_RATE, dtype=np.int16)]), pipeline, chunk_ms)
+    return len(samples) / SAMPLE_RATE
+
+
+def feed_samples(samples: np.ndarray, pipeline: PcmConsumer, chunk_ms: int = 100) -> None:
+    """Feed 16 kHz mono int16 samples into ``pipeline`` in microphone-sized chunks."""
+    pcm = samples.astype("<i2", copy=False).tobytes()
     step = 2 * SAMPLE_RATE * chunk_ms // 1000
     for offset in range(0, len(pcm), step):
         pipeline.feed(pcm[offset:offset + step])
-    return len(samples) / SAMPLE_RATE
 
 
 class MicrophoneStream:

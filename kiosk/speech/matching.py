@@ -25,6 +25,10 @@ LANGUAGES = ("en", "es", "fr")
 
 #: below this recogniser confidence an utterance is not an answer (see asr.py for the scale)
 DEFAULT_MIN_CONFIDENCE = 0.6
+#: a command needs this much: it acts at once, with no confirmation, and on voices other than
+#: the kiosk's own short commands fit non-answers nearly as well as answers do ("uh" as
+#: "stop", "all the time" as "call the doctor"; bench/asr.py)
+COMMAND_MIN_CONFIDENCE = 0.85
 
 #: cardinal words per language, 1..10; the first form of each is the one put in grammars first
 CARDINALS: dict[str, list[tuple[str, ...]]] = {
@@ -72,6 +76,8 @@ COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
         Command.CALL_DOCTOR: ("call the doctor", "doctor", "call the nurse", "nurse"),
         Command.VOLUME_UP: ("louder", "speak up", "volume up"),
         Command.VOLUME_DOWN: ("quieter", "softer", "volume down"),
+        Command.UNDO: ("no that's wrong", "that's wrong", "change my answer", "change the answer",
+                       "that's not what i said"),
     },
     "es": {
         Command.REPEAT: ("repite", "repita", "repetir", "otra vez", "cómo"),
@@ -81,6 +87,8 @@ COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
                               "enfermera"),
         Command.VOLUME_UP: ("más alto", "sube el volumen", "suba el volumen"),
         Command.VOLUME_DOWN: ("más bajo", "baja el volumen", "baje el volumen"),
+        Command.UNDO: ("no eso está mal", "eso está mal", "cambiar mi respuesta", "cambia mi respuesta",
+                       "me he equivocado", "no es eso"),
     },
     "fr": {
         Command.REPEAT: ("répète", "répétez", "répéter", "encore", "pardon", "comment"),
@@ -90,7 +98,59 @@ COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
                               "infirmière"),
         Command.VOLUME_UP: ("plus fort", "montez le son", "monte le son"),
         Command.VOLUME_DOWN: ("moins fort", "plus bas", "baissez le son", "baisse le son"),
+        Command.UNDO: ("non c'est faux", "c'est faux", "changer ma réponse", "je me suis trompé",
+                       "je me suis trompée", "ce n'est pas ça"),
     },
+}
+
+#: commands that only mean something while the session is paused, and are left out of a
+#: question's grammar: "go on" competed with "one" for nothing, as resuming is no answer
+PAUSED_ONLY = frozenset({Command.RESUME})
+
+#: natural ways to say yes / no, added to an option whose label is one of the first words (a
+#: confirmation: "I heard: Independent. Is that right?"); a no option also takes the UNDO phrases
+YES_NO: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "en": (("yes", "yeah", "yes that's right", "that's right", "yes it is", "correct", "yes please"),
+           ("no", "nope", "no it isn't", "it isn't", "wrong", "no no")),
+    "es": (("sí", "si", "sí es correcto", "es correcto", "correcto", "eso es", "sí eso es", "claro"),
+           ("no", "no es correcto", "incorrecto", "no no")),
+    "fr": (("oui", "oui c'est ça", "c'est ça", "c'est juste", "exact", "exactement", "correct"),
+           ("non", "non non", "pas du tout", "ce n'est pas juste")),
+}
+
+#: the kiosk's languages by name, in any of its languages: a welcome option naming a language
+#: ("Empezar en español") also takes these
+LANGUAGE_NAMES: dict[str, tuple[str, ...]] = {
+    "en": ("english", "in english", "inglés", "en inglés", "anglais", "en anglais"),
+    "es": ("español", "spanish", "in spanish", "en español", "castellano", "espagnol", "en espagnol"),
+    "fr": ("français", "french", "in french", "en français", "francés", "en francés"),
+}
+#: ways to say "start": taken by a Start option, and in each language by the option naming it
+START_WORDS: dict[str, tuple[str, ...]] = {
+    "en": ("start", "begin", "let's start", "let's begin", "start please", "i'm ready"),
+    "es": ("empezar", "empiece", "empieza", "comenzar", "comience", "vamos a empezar", "estoy listo",
+           "estoy lista"),
+    "fr": ("commencer", "commencez", "commence", "on commence", "démarrer", "je suis prêt", "je suis prête"),
+}
+
+#: words a patient may put before an answer ("I need a lot of help", "I think two"); the
+#: recogniser's grammar allows one before any phrase, and matching ignores them
+LEAD_INS: dict[str, tuple[str, ...]] = {
+    "en": ("i need", "i", "i can", "i think", "i use a", "i walk", "i eat"),
+    "es": ("necesito", "yo", "creo que", "estoy"),
+    "fr": ("j'ai besoin", "je", "je suis", "je pense"),
+}
+
+#: what patients say that is not an answer: these are in the grammar so that "um", "what?" or
+#: "I don't know" have somewhere to go other than the nearest answer; they match nothing
+FILLERS: dict[str, tuple[str, ...]] = {
+    "en": ("um", "uh", "hmm", "what", "sorry", "what did you say", "i don't know", "hello", "is it",
+           "all the time", "what time is it", "thank you", "i see", "let me think", "where am i",
+           "how long"),
+    "es": ("eh", "em", "qué", "perdón", "no sé", "hola", "vale", "gracias", "a ver", "todo el tiempo",
+           "qué hora es"),
+    "fr": ("euh", "hein", "quoi", "pardon", "je ne sais pas", "bonjour", "d'accord", "merci", "voyons",
+           "tout le temps", "quelle heure est il"),
 }
 
 #: what recognisers emit for sounds outside their grammar
@@ -145,6 +205,31 @@ def _find(needle: tuple[str, ...], haystack: tuple[str, ...]) -> int:
     return next((i for i in range(len(haystack) - n + 1) if haystack[i:i + n] == needle), -1)
 
 
+def _is_word(label: str, which: int, language: str) -> bool:
+    """Whether ``label`` is a yes (``which`` 0) or no (1) word of ``language``."""
+    return normalise(spoken_label(label)) in {normalise(w) for w in YES_NO[language][which][:2]}
+
+
+def _with_known_words(option: OptionWords, language: str) -> OptionWords:
+    """An option the kiosk itself offers, with the natural ways of saying it: Yes or No (a
+    confirmation; No also takes the "that's wrong" phrases), Start, or a language's name (the
+    welcome, where the option in the prompt's own language also takes "start")."""
+    extra: tuple[str, ...] = ()
+    label = normalise(spoken_label(option.label))
+    for which in (0, 1):
+        if _is_word(option.label, which, language):
+            extra = YES_NO[language][which] + (COMMAND_PHRASES[language][Command.UNDO] if which else ())
+    if label in {normalise(w) for w in START_WORDS[language][:2]}:
+        extra = START_WORDS[language]
+    words = set(label.split())
+    for named, names in LANGUAGE_NAMES.items():
+        if words & {normalise(n) for n in names if " " not in n}:
+            extra += names + START_WORDS[named]
+    if not extra:
+        return option
+    return OptionWords(option.label, tuple(dict.fromkeys((*option.synonyms, *extra))))
+
+
 class Matcher:
     """Matches utterances against one question's options in one language.
 
@@ -156,14 +241,19 @@ class Matcher:
         options: Sequence[OptionWords],
         language: str,
         min_confidence: float = DEFAULT_MIN_CONFIDENCE,
+        paused: bool = False,
     ) -> None:
         if language not in LANGUAGES:
             raise ValueError(f"no speech vocabulary for language {language!r} (have {', '.join(LANGUAGES)})")
         if len(options) > len(CARDINALS[language]):
             raise ValueError(f"at most {len(CARDINALS[language])} options can be spoken, got {len(options)}")
-        self.options = tuple(options)
+        self.options = tuple(_with_known_words(o, language) for o in options)
         self.language = language
         self.min_confidence = min_confidence
+        no_option = next((n for n, o in enumerate(self.options, start=1) if _is_word(o.label, 1, language)), None)
+        #: the commands listened for: RESUME only while paused; UNDO on a yes/no question means "no"
+        self.commands = {c: p for c, p in COMMAND_PHRASES[language].items()
+                         if (paused or c not in PAUSED_ONLY) and not (c is Command.UNDO and no_option)}
         #: phrase tokens → what it selects; options first, so a clash is detected, not hidden
         self._targets: dict[tuple[str, ...], set[int | Command]] = {}
         for number, option in enumerate(self.options, start=1):
@@ -172,7 +262,9 @@ class Matcher:
                     self._targets.setdefault(_tokens(phrase), set()).add(number)
         for command, phrases in COMMAND_PHRASES[language].items():
             for phrase in phrases:
-                self._targets.setdefault(_tokens(phrase), set()).add(command)
+                target = no_option if command is Command.UNDO and no_option else command
+                if command in self.commands or target == no_option:
+                    self._targets.setdefault(_tokens(phrase), set()).add(target)
         self._numbers: dict[str, int] = {}
         for table in (CARDINALS, ORDINALS):
             for number, words in enumerate(table[language][: len(self.options)], start=1):
@@ -198,10 +290,20 @@ class Matcher:
             for form in forms:
                 words = CARDINALS[self.language][number] if "{n}" in form else ORDINALS[self.language][number]
                 out += [form.format(n=w, o=w) for w in words]
-        for phrases in COMMAND_PHRASES[self.language].values():
-            out += phrases
+        for command, phrases in COMMAND_PHRASES[self.language].items():
+            if command in self.commands or command is Command.UNDO:
+                out += phrases
         seen: set[str] = set()
         return [p for p in out if p and not (normalise(p) in seen or seen.add(normalise(p)))]
+
+    def lead_ins(self) -> tuple[str, ...]:
+        """Words the grammar allows before any phrase (:data:`LEAD_INS`)."""
+        return LEAD_INS[self.language]
+
+    def fillers(self) -> tuple[str, ...]:
+        """Non-answers the grammar holds so they are not forced onto an answer (:data:`FILLERS`),
+        without any that would mean something here ("no" where no is an answer)."""
+        return tuple(f for f in FILLERS[self.language] if not self.match(f).matched)
 
     def meaning(self, phrase: str) -> int | Command | str:
         """What saying ``phrase`` selects: an option number, a command, or else the phrase itself
@@ -210,6 +312,9 @@ class Matcher:
         return match.option if match.option is not None else (match.command or phrase)
 
     def _number(self, tokens: tuple[str, ...]) -> int | None:
+        leads = sorted(map(_tokens, LEAD_INS[self.language]), key=len, reverse=True)
+        lead = next((lead for lead in leads if tokens[:len(lead)] == lead), ())
+        tokens = tokens[len(lead):] if len(tokens) > len(lead) else tokens
         rest = [t for t in tokens if t not in NUMBER_FILLERS[self.language]]
         if self.language == "en" and len(rest) == 2 and rest[1] == "one" and rest[0] in self._numbers:
             rest = rest[:1]  # "the second one"
@@ -248,4 +353,9 @@ class Matcher:
             names = ", ".join(sorted(f"option {t}" if isinstance(t, int) else t.value for t in found))
             return Match(reason=f"{utterance!r} is ambiguous ({names})")
         (target,) = found
-        return Match(command=target) if isinstance(target, Command) else Match(option=target)
+        if isinstance(target, Command):
+            if confidence is not None and confidence < max(self.min_confidence, COMMAND_MIN_CONFIDENCE):
+                return Match(reason=f"unsure recognition of the command {utterance!r} "
+                                    f"(confidence {confidence:.2f} < {COMMAND_MIN_CONFIDENCE:.2f})")
+            return Match(command=target)
+        return Match(option=target)

@@ -38,6 +38,10 @@ OFFICIAL_MODELS = {
 #: the official index: one entry per model with its name and MD5
 OFFICIAL_INDEX = "https://alphacephei.com/vosk/models/model-list.json"
 DOWNLOAD_TIMEOUT_S = 60
+#: what works without a network, said whenever a download or the index cannot be reached
+OFFLINE_ROUTES = ("; without a network, copy the model zip to this machine and run "
+                  "`kiosk models install {language} --url file:///path/to/model.zip --sha256 HEX`, "
+                  "or unpack it and set KIOSK_VOSK_MODEL=/path/to/the/model/folder")
 
 
 class ModelError(Exception):
@@ -103,7 +107,8 @@ def _download(url: str, into: Path) -> tuple[Path, str, str]:
                 out.write(chunk)
     except (urllib.error.URLError, OSError) as exc:
         os.unlink(name)
-        raise ModelError(f"cannot download {url}: {getattr(exc, 'reason', exc)}") from None
+        raise ModelError(f"cannot download {url}: {getattr(exc, 'reason', exc)}"
+                         + ("" if url.startswith("file:") else OFFLINE_ROUTES)) from None
     return Path(name), sha256.hexdigest(), md5.hexdigest()
 
 
@@ -113,7 +118,8 @@ def _official_md5(url: str, index_url: str) -> str:
         with urllib.request.urlopen(index_url, timeout=DOWNLOAD_TIMEOUT_S) as response:
             index = json.load(response)
     except (urllib.error.URLError, OSError, ValueError) as exc:
-        raise ModelError(f"cannot read the model index {index_url}: {getattr(exc, 'reason', exc)}") from None
+        raise ModelError(f"cannot read the model index {index_url}: {getattr(exc, 'reason', exc)}"
+                         + OFFLINE_ROUTES) from None
     for entry in index if isinstance(index, list) else []:
         if isinstance(entry, dict) and entry.get("name") == name and entry.get("md5"):
             return str(entry["md5"]).lower()
@@ -220,7 +226,7 @@ def main(argv: Sequence[str]) -> int:
     try:
         path = install(args.language, url=args.url, sha256=args.sha256)
     except ModelError as exc:
-        print(f"kiosk models: {exc}", file=sys.stderr)
+        print(f"kiosk models: {str(exc).replace('{language}', args.language)}", file=sys.stderr)
         return 1
     print(f"installed the {args.language} model in {path}")
     return 0

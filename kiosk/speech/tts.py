@@ -142,9 +142,17 @@ class Synthesiser:
             raise TtsUnavailable(f"espeak-ng has no voice for language {language!r}")
         amplitude = str(int(round(volume * 100)))  # espeak-ng's 0-200 % amplitude
         how = delivery(rate, text)
+        return self._run(text, VOICES[language], how.words_per_minute, amplitude, path, how.markup(text))
+
+    def speak_as(self, text: str, voice: str, rate: int, path: str | Path) -> Path:
+        """Say ``text`` with any espeak-ng voice ("en-us+f3", "en+croak", "roa/es+klatt") at
+        exactly ``rate`` words per minute, slow or not, into ``path``: the many patients whose
+        answers the tests and ``bench/asr.py`` feed to voice in, never the kiosk's own voice."""
+        return self._run(text, voice, rate, "100", path, html.escape(text, quote=False))
+
+    def _run(self, text: str, voice: str, rate: int, amplitude: str, path: str | Path, markup: str) -> Path:
         subprocess.run(
-            [self._command, "-v", VOICES[language], "-s", str(how.words_per_minute), "-a", amplitude,
-             "-m", "-w", str(path), "--", how.markup(text)],
+            [self._command, "-v", voice, "-s", str(rate), "-a", amplitude, "-m", "-w", str(path), "--", markup],
             check=True, capture_output=True, timeout=SYNTH_TIMEOUT_S,
         )
         if not _has_audio(path):

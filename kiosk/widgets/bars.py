@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
-from rich.text import Text
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.message import Message
@@ -24,27 +22,6 @@ class ChannelLine:
     live: bool
     #: why it is off, for the clinician standing by ("no microphone found")
     reason: str = ""
-
-
-class ChannelBar(Static):
-    """Which channels are live (speaking, listening, remote connected) and which are off; the
-    reasons would not fit on one line, so the welcome and clinician screens list them."""
-
-    def show(self, lines: Sequence[ChannelLine]) -> None:
-        """Replace the shown channel states."""
-        text = Text()
-        for index, line in enumerate(lines):
-            if index:
-                text.append("   ")
-            text.append(f"{line.name}: ", style="bold")
-            text.append(line.state, style="bold #0b5d1e" if line.live else "bold #8b0000")
-        self.update(text)
-
-
-def channel_reasons(lines: Sequence[ChannelLine]) -> str:
-    """One line per channel that is not live, with why (for whoever sets the kiosk up)."""
-    return "\n".join(f"{line.name}: {line.state} ({line.reason})" for line in lines
-                     if not line.live and line.reason)
 
 
 class AdaptationBanner(Static):

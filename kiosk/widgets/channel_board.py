@@ -40,6 +40,13 @@ class ChannelBoard:
         """Remember the latest status of its source."""
         self._statuses[self.indicator(status)][status.source] = status
 
+    def patient_reason(self, name: str, language: str) -> str:
+        """Why the indicator is off, in ``language`` when its source gave a screen-text key
+        (no speech model for Spanish), else as the source said it."""
+        state, reason = self.state(name)
+        status = next((s for s in self._statuses[name].values() if s.reason == reason and s.reason_key), None)
+        return ui_text(language, status.reason_key, default=reason) if reason and status else reason
+
     def state(self, name: str) -> tuple[ChannelState, str]:
         """The indicator's state and, when it is not on, the reason of its most hopeful source."""
         statuses = list(self._statuses[name].values())
@@ -51,11 +58,13 @@ class ChannelBoard:
                     return state, status.reason
         return ChannelState.OFF, ""
 
-    def lines(self, language: str) -> tuple[ChannelLine, ...]:
-        """The indicators as the bar shows them, in ``language``."""
+    def lines(self, language: str, patient: bool = True) -> tuple[ChannelLine, ...]:
+        """The indicators as the bar shows them, in ``language``; for a ``patient`` the reasons
+        that have screen words are said in the language, for the clinician as the source said."""
         lines = []
         for name in _ORDER:
-            state, reason = self.state(name)
+            state, _ = self.state(name)
+            reason = self.patient_reason(name, language) if patient else self.state(name)[1]
             # the state word agrees with the channel's gender where the language needs it
             word = ui_text(language, f"{state.value}_{name}", default="") or ui_text(language, state.value)
             if state is ChannelState.ON and name == VOICE_OUT and self.speaking:

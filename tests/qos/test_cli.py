@@ -61,7 +61,7 @@ def test_plot_replaces_a_world_readable_png_with_an_owner_only_one(tmp_path):
     ("model: clarc\nevents:\n  - {t: 1, set: {Mood: happy}}\n", None,
      "python -m qos replay: {dir}/t.yaml: events[0]: context 'Mood' is not in model CLARC"),
     ("model: broken.roqme\nevents: []\n", "roqme B\nproperty P survival 10\n",
-     "python -m qos replay: broken.roqme:2:21: expected a time such as 100min, 30 sec or 2h after 'survival', "
+     "python -m qos replay: broken.roqme:2:21: expected a time such as 100min, 30 seconds or 2 hours after 'survival', "
      "found '10'"),
 ])
 def test_bad_trace_or_model_exits_2_with_one_line(tmp_path, trace, model, message):
@@ -78,7 +78,7 @@ def test_a_sample_period_too_small_for_the_trace_is_one_line_not_an_endless_repl
     assert main(["replay", str(TABLE4), "--sample-period", "1e-7"]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"python -m qos replay: {TABLE4}: a sample period of 1e-07 s over the trace's ") and \
-        "(at most 10,000,000); use a longer sample period\n" in err and err.count("\n") == 1
+        "(at most 100,000); use a longer sample period\n" in err and err.count("\n") == 1
 
 
 def test_bad_arguments_exit_2(capsys):

@@ -10,11 +10,11 @@ import pytest
 from qos import Engine, Trace, TraceError, TraceEvent, TraceRecorder, dump_trace, load_model, load_trace, replay
 
 MALFORMED = [
-    ("model: clarc\nevents:\n  - {t: 10, set: {PersonDetected: true}\n", "t.yaml:4:1: invalid YAML: expected ',' or '}', but got '<stream end>'"),
+    ("model: clarc\nevents:\n  - {t: 10, set: {PersonDetected: true}\n", "t.yaml:4:1: YAML syntax: expected ',' or '}', but got '<stream end>'"),
     ("- just a list\n", "t.yaml: a trace must be a mapping with 'model' and 'events'"),
     ("model: clarc\nevents: {}\n", "t.yaml: 'events' must be a list, not {}"),
     ("model: 3\nevents: []\n", "t.yaml: 'model' must name a bundled model or a .roqme file, not 3"),
-    ("model: clarc\nevents: []\nsession: 4\n", "t.yaml: unknown key 'session' (a trace has model, events and description)"),
+    ("model: clarc\nevents: []\nsession: 4\n", "t.yaml: unknown key 'session' (a trace has model, events, description and origin)"),
     ("model: clarc\nevents:\n  - 10\n", "t.yaml: events[0]: an event must be a mapping with t and set and/or emit, not 10"),
     ("model: clarc\nevents:\n  - {set: {PersonDetected: true}}\n", "t.yaml: events[0]: missing time 't'"),
     ("model: clarc\nevents:\n  - {t: 1, set: {PersonDetected: true}}\n  - {t: -5, set: {PersonDetected: true}}\n",
@@ -56,9 +56,9 @@ def test_malformed_trace_is_rejected_with_its_message(tmp_path, monkeypatch, tex
 def test_malformed_json_trace_and_missing_file(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "t.json").write_text('{"model": "clarc", "events": [}', encoding="utf-8")
-    with pytest.raises(TraceError, match=r"^t\.json:1:31: invalid JSON: Expecting value$"):
+    with pytest.raises(TraceError, match=r"^t\.json:1:31: JSON syntax: Expecting value$"):
         load_trace("t.json")
-    with pytest.raises(TraceError, match=r"^gone\.yaml: cannot read the trace \(No such file or directory\)$"):
+    with pytest.raises(TraceError, match=r"^gone\.yaml:1:1: cannot read the file: No such file or directory$"):
         load_trace("gone.yaml")
 
 

@@ -112,7 +112,7 @@ def test_the_message_points_at_the_line_and_column_of_the_field(tmp_path):
 
 
 def test_a_missing_site_file_is_named(tmp_path):
-    with pytest.raises(ProfileError, match="nowhere.yaml: device profile file not found"):
+    with pytest.raises(ProfileError, match="nowhere.yaml:1:1: cannot read the file: No such file or directory"):
         load_profiles(tmp_path / "nowhere.yaml")
 
 

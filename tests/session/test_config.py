@@ -19,11 +19,11 @@ def test_defaults_without_a_file(tmp_path, monkeypatch):
 
 def test_file_and_environment(tmp_path):
     path = tmp_path / "config.yaml"
-    path.write_text('data_dir: data\nlanguage: es\nclinician_pin: "0420"\nadaptation: false\n'
+    path.write_text('data_dir: data\nlanguage: es\nclinician_pin: "042042"\nadaptation: false\n'
                     "timing: {attempt_window_s: 45}\nvosk_model: /opt/vosk\n")
     config = load_config(environ={"KIOSK_CONFIG": str(path)})
     assert config.data_dir == tmp_path / "data"  # relative to the config file
-    assert (config.language, config.clinician_pin, config.adaptation) == ("es", "0420", False)
+    assert (config.language, config.clinician_pin, config.adaptation) == ("es", "042042", False)
     assert config.timing == {"attempt_window_s": 45} and config.vosk_model == Path("/opt/vosk")
     assert not config.default_pin
     env = {"KIOSK_CONFIG": str(path), "KIOSK_DATA_DIR": str(tmp_path / "elsewhere"), "KIOSK_VOSK_MODEL": "/m",
@@ -34,8 +34,8 @@ def test_file_and_environment(tmp_path):
 
 @pytest.mark.parametrize(("text", "message"), [
     ("colour: red\n", ":1:1: unknown setting 'colour'"),
-    ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("0123")'),
-    ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 4 to 12 digits"),
+    ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("012345")'),
+    ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 6 to 12 digits"),
     ("adaptation: maybe\n", ":1:1: adaptation must be true or false"),
     ("timing: {attempt_window_s: -3}\n", ":1:1: timing setting 'attempt_window_s' must be a number"),
     ("timing: {window: 3}\n", ":1:1: unknown timing setting 'window'"),
@@ -89,3 +89,37 @@ def test_the_band_set_is_chosen_by_config_and_an_unknown_one_is_named(tmp_path):
     path.write_text("bands: [spanish]\n")
     with pytest.raises(ConfigError, match=":1:1: bands must name a band set of the questionnaire"):
         load_config(path, environ={})
+
+
+def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypatch):
+    monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
+    assert load_config(environ={}).station is None  # no station: the kiosk works alone
+    path = tmp_path / "config.yaml"
+    path.write_text("station: {url: 'https://ward.example:8443/', token: abc, kiosk_id: ward3-bed2}\n"
+                    "interrupt_after_minutes: 45\n")
+    config = load_config(path, environ={})
+    assert config.station is not None
+    assert (config.station.url, config.station.token, config.station.kiosk_id) == (
+        "https://ward.example:8443", "abc", "ward3-bed2")
+    assert config.interrupt_after_minutes == 45
+    env = {"KIOSK_STATION_URL": "http://127.0.0.1:9000", "KIOSK_STATION_TOKEN": "xyz"}
+    config = load_config(path, environ=env)
+    assert (config.station.url, config.station.token, config.station.kiosk_id) == (
+        "http://127.0.0.1:9000", "xyz", "ward3-bed2")
+    only_env = load_config(environ=env).station
+    assert only_env is not None and only_env.kiosk_id  # the host name by default
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("station: {url: 'ftp://x', token: a}\n", ":1:1: station: url 'ftp://x' must be an http:// or https://"),
+    ("station: {url: 'http://x:1'}\n", ":1:1: station: a token is needed with the url"),
+    ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:1: station: kiosk_id 'bed 2' must be"),
+    ("station: {url: 'http://x:1', tokn: a}\n", ":1:1: station must be a mapping"),
+    ("interrupt_after_minutes: 0\n", ":1:1: interrupt_after_minutes must be a number of minutes"),
+])
+def test_bad_station_settings_say_where(tmp_path, text, message):
+    path = tmp_path / "config.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as caught:
+        load_config(path, environ={})
+    assert str(caught.value).startswith(f"{path}{message}")

@@ -33,7 +33,7 @@ def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
         assert item.code is not None and item.code.system == "http://loinc.org"
     assert Q.item("transfers").points == {0, 5, 10, 15}
     assert [b.id for b in Q.bands] == ["total", "severe", "moderate", "slight", "independent"]
-    assert Q.timing == Timing(20, 2, 10, 5, 5)
+    assert Q.timing == Timing(20, 5, 10, 5, 5, 10)
     assert [p.checks for p in Q.familiarisation] == ["hear", "read", "select"]
 
 
@@ -264,7 +264,7 @@ def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path
 
 def test_validate_accepts_the_bundled_file_and_reports_unreadable_ones(tmp_path, capsys):
     assert validate_main([str(bundled_path())]) == 0
-    assert validate_main([str(tmp_path / "missing.yaml")]) == 1
+    assert validate_main([str(tmp_path / "missing.yaml")]) == 2  # not a questionnaire at all, as opposed to one with problems (1)
     assert "missing.yaml:1:1: cannot read the file" in capsys.readouterr().out
 
 

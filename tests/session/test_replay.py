@@ -156,7 +156,7 @@ def test_a_script_that_never_continues_after_calling_the_doctor_is_an_error(tmp_
 
 def test_a_missing_script_is_a_clear_error(tmp_path, capsys):
     assert main([str(tmp_path / "nope.yaml")]) == 2
-    assert "cannot read the script: No such file or directory" in capsys.readouterr().err
+    assert "nope.yaml:1:1: cannot read the file: No such file or directory" in capsys.readouterr().err
 
 
 def test_the_script_schema_is_a_valid_json_schema():

@@ -143,8 +143,10 @@ def test_sigkill_mid_session_loses_no_answer_and_the_session_resumes_at_the_firs
     assert recorded == ["feeding", "bathing", "grooming", "dressing"]
 
     store = Store.open(data)
-    (unfinished,) = store.unfinished_sessions()
-    assert unfinished.id == session_id
+    (unfinished,) = store.unfinished_sessions()  # its kiosk process is gone: interrupted
+    assert unfinished.id == session_id and unfinished.status == "interrupted"
+    assert "stopped" in (unfinished.interrupted_reason or "")
+    unfinished = store.continue_session(session_id)  # staff continue it on this kiosk
     assert [(a.item_id, a.option) for a in unfinished.answers] == [
         ("feeding", 3), ("bathing", 1), ("grooming", 2), ("dressing", 2)]
     last_t = unfinished.trace[-1]["t"]

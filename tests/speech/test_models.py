@@ -173,3 +173,19 @@ def test_configured_model_is_only_used_for_its_own_language(tmp_path, monkeypatc
     assert models.find_model("es", spanish) == spanish
     assert models.find_model("fr", spanish) is None
     assert isinstance(open_recogniser("en", spanish), PocketSphinxRecogniser)
+
+
+def test_offline_install_names_the_routes_that_work_and_the_file_route_works(models_served, tmp_path, capsys):
+    """No network: the official download fails (here: an index nobody serves), and the message
+    names the two offline routes; the file:// route then installs the same model."""
+    _, base = models_served
+    with pytest.raises(models.ModelError) as failure:
+        models.install("fr", index_url=f"{base}/no-index.json")
+    assert "--url file://" in str(failure.value) and "KIOSK_VOSK_MODEL" in str(failure.value)
+    assert models.main(["install", "fr", "--url", f"{base}/gone.zip", "--sha256", "ab"]) == 1
+    err = capsys.readouterr().err
+    assert "kiosk models install fr --url file:///path/to/model.zip --sha256 HEX" in err
+    assert "KIOSK_VOSK_MODEL" in err
+    digest = _model_zip(tmp_path / "copied.zip", top="vosk-model-small-fr-0.22")
+    assert models.main(["install", "fr", "--url", (tmp_path / "copied.zip").as_uri(), "--sha256", digest]) == 0
+    assert models.find_model("fr") == tmp_path / "models" / "vosk" / "fr"

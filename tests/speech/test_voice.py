@@ -197,6 +197,24 @@ def test_no_recogniser_for_the_language_turns_voice_off_and_the_session_goes_on(
     assert kiosk.session.answers["feeding"].channel is Channel.TOUCH
 
 
+@pytest.mark.parametrize("language,words", [("es", "respuestas habladas en español"),
+                                            ("fr", "réponses parlées en français")])
+def test_no_model_reason_is_shown_in_the_patients_language(monkeypatch, tmp_path, language, words):
+    """The patient's screen says why voice is off in their language; the clinician still sees
+    the technical reason with the command that fixes it."""
+    monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
+    kiosk = _Kiosk(open_recogniser, language=language)
+    board = ChannelBoard("espeak-ng")
+    for status in kiosk.statuses:
+        board.update(status)
+    patient = next(line for line in board.lines(language) if not line.live and words in line.reason)
+    assert "kiosk models" not in patient.reason
+    clinician = [line.reason for line in board.lines("en", patient=False) if "kiosk models install" in line.reason]
+    assert clinician == [f"voice answers off: no speech model for language {language!r}: pocketsphinx only "
+                         f"ships English; install one with `kiosk models install {language}`"]
+
+
 def test_no_microphone_turns_voice_off_with_a_reason():
     if any(d.usable for d in list_input_devices()):
         pytest.skip("this machine has a microphone")

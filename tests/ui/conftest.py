@@ -30,7 +30,7 @@ class UiKiosk:
     """A kiosk app with its clock and store, and helpers to move simulated time."""
 
     def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
-                 language: str = "en", session_id: str = UI_SESSION_ID, offer_resume: bool = False,
+                 language: str = "en", session_id: str = UI_SESSION_ID,
                  voice=None, keyboard=None, sources=(), poll_interval: float = 3600, speaker=None) -> None:
         self.clock = SimClock()
         self.questionnaire = load_questionnaire()
@@ -40,7 +40,6 @@ class UiKiosk:
             store=self.store, language=language, session_id=session_id,
             adaptation=Adaptation(load_policy()) if adaptation else None, familiarisation=familiarisation,
         )
-        unfinished = self.store.unfinished_sessions() if offer_resume else []
         self.app = KioskApp(
             self.session, clinician_pin=UI_PIN, store=self.store, export_dir=tmp_path / "exports", voice=voice,
             keyboard=keyboard, sources=sources, speaker=speaker,
@@ -49,7 +48,7 @@ class UiKiosk:
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
             # of the real timer never finds anything due
             poll_interval=poll_interval,
-            resumable=unfinished[0] if unfinished else None, resume=self._resume, new_session=self._fresh,
+            resume=self._resume, new_session=self._fresh,
         )
 
     def _fresh(self) -> Session:

@@ -4,12 +4,13 @@ messages delivered from another thread, with the answers checked in the SQLite s
 from __future__ import annotations
 
 import pytest
-from textual.widgets import Label, Static
+from textual.widgets import DataTable, Label, Static
 
-from kiosk.app import KIOSK_SIZE
+from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.session import Phase
 
+from .conftest import UI_PIN
 from .helpers import answer_every_question, deliver_from_thread, screen_name, settle, start_in_english, text_of
 
 
@@ -90,7 +91,7 @@ async def test_a_remote_plugged_in_is_offered_to_the_patient_and_device_words_st
         assert lines["Remote"].reason == "unplugged" and lines["Listening"].reason == "no microphone found"
 
 
-async def test_a_kiosk_restarted_mid_session_offers_to_continue_at_the_first_unanswered_question(ui_kiosk):
+async def test_a_kiosk_restarted_mid_session_offers_the_test_to_staff_only_and_continues_it_there(ui_kiosk):
     first = ui_kiosk(familiarisation=False)
     async with first.app.run_test(size=KIOSK_SIZE) as pilot:  # the kiosk dies after three answers
         await settle(pilot, lambda: screen_name(first) == "WelcomeScreen")
@@ -104,12 +105,22 @@ async def test_a_kiosk_restarted_mid_session_offers_to_continue_at_the_first_una
             await pilot.press("1")
             await settle(pilot, lambda: item.id in first.session.answers)
 
-    again = ui_kiosk(familiarisation=False, session_id="5e55a0000002", offer_resume=True)
+    again = ui_kiosk(familiarisation=False, session_id="5e55a0000002")
     async with again.app.run_test(size=KIOSK_SIZE) as pilot:
         await settle(pilot, lambda: screen_name(again) == "WelcomeScreen")
-        offer = again.app.screen.query_one("#resume-session")
-        assert "3 of 10 answered" in str(offer.label)
-        await pilot.click("#resume-session")
+        # the next visitor sees only the fresh start in their language: nobody else's test
+        assert not again.app.screen.query("#resume-session")
+        assert "P-TEST01" not in "".join(text_of(w) for w in again.app.screen.query(Static))
+        assert again.app.screen.query_one("#language-en").display
+        # staff, behind the PIN, see whose test it was, when, and how far it got
+        await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")
+        await settle(pilot, lambda: screen_name(again) == "ClinicianHomeScreen")
+        table = again.app.screen.query_one("#interrupted", DataTable)
+        assert table.row_count == 1
+        patient, started, progress, why, session_id = table.get_row_at(0)
+        assert (patient, progress, session_id) == ("P-TEST01", "3 of 10 answered", first.session.id)
+        assert started.startswith("2026-01-01 00:00") and "stopped" in why
+        await pilot.click("#continue-test")
         await settle(pilot, lambda: again.app.session.id == first.session.id)
         await settle(pilot, lambda: screen_name(again) == "ExplanationScreen")
         await pilot.press("1")

@@ -16,7 +16,8 @@ from kiosk.session import Phase
 from .conftest import UiKiosk
 from .fit import problems
 from .helpers import screen_name, settle
-from .test_served import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, _answers, served_kiosk  # noqa: F401
+from .serving import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until
+from .test_served import _answers
 
 #: the smallest text the page may draw (px): what an 85-year-old can still read on the panel
 MIN_TEXT_PX = 24
@@ -85,37 +86,38 @@ def _opening(text: str, most: int = 40) -> str:
     return " ".join(kept)
 
 
+@pytest.fixture
+def served_kiosk(tmp_path):
+    """`kiosk serve` on a free localhost port with its own configuration and data directory."""
+    with serve(tmp_path) as served:
+        yield served
+
+
 @pytest.mark.parametrize("viewport,fontsize", [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
                          ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"])
 @pytest.mark.parametrize("language", ["en", "es", "fr"])
-async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factory, viewport, fontsize, language):  # noqa: F811
+async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factory, viewport, fontsize, language):
     from playwright.async_api import async_playwright
 
-    port, database = served_kiosk
+    database = served_kiosk.database
     width, height = viewport
     async with async_playwright() as pw:
-        browser = await pw.chromium.launch(executable_path=CHROMIUM, headless=True,
-                                           args=[*CHROMIUM_ARGS, "--disable-quic"])
+        browser = await pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         try:
             page = await browser.new_page(viewport={"width": width, "height": height})
             outside = []
             page.on("request", lambda r: outside.append(r.url) if not r.url.startswith(
                 ("http://127.0.0.1", "ws://127.0.0.1", "data:")) else None)
-            sockets = []
-            painted = bytearray()  # what the server sent the page to draw, so far
-
-            def follow(ws) -> None:
-                sockets.append(ws)
-                ws.on("framereceived", lambda data: painted.extend(
-                    data if isinstance(data, bytes) else data.encode()))
+            painted = Painted(page)
+            sockets = painted.sockets
 
             def shown_since(text: str, offset: int):
                 """The server sent the page ``text`` to draw after ``offset`` bytes."""
-                return lambda: text.encode() in painted[offset:]
+                return lambda: text.encode() in painted.data[offset:]
 
             tapped_at = 0
-            page.on("websocket", follow)
-            await page.goto(f"http://127.0.0.1:{port}/" + (f"?fontsize={fontsize}" if fontsize else ""))
+            # the device key once (as staff set the screen up), then the cookie opens the kiosk
+            await page.goto(served_kiosk.url(f"/?token={TOKEN}" + (f"&fontsize={fontsize}" if fontsize else "")))
             screen = page.locator(".xterm-screen")
             await screen.wait_for(timeout=PATIENCE_S * 1000)
             await page.wait_for_function("document.body.classList.contains('-first-byte')",
@@ -138,17 +140,6 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                 return (box["x"] + region.x * cell_w, box["y"] + region.y * cell_h,
                         box["x"] + region.right * cell_w, box["y"] + region.bottom * cell_h)
 
-            async def wait_until(check, what: str) -> None:
-                deadline = time.monotonic() + PATIENCE_S
-                while not check():
-                    assert time.monotonic() < deadline, f"never saw {what}"
-                    await page.wait_for_timeout(50)  # lets Playwright deliver frames; bounded by PATIENCE_S
-
-            from kiosk.questionnaire import load_questionnaire
-            from kiosk.widgets.text import language_name, ui_text
-
-            questionnaire = load_questionnaire()
-            explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
             async def wait_until_async(check, what: str) -> None:
                 deadline = time.monotonic() + PATIENCE_S
                 while not await check():
@@ -163,21 +154,21 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                         f"{name}: an answer at {left:.0f},{top:.0f}-{right:.0f},{bottom:.0f} px is not "
                         f"inside the {width}x{height} viewport")
                 if name == "language":  # the welcome is on the page
-                    await wait_until(shown_since(language_name(language), 0), "the welcome")
+                    await wait_until(page, shown_since(language_name(language), 0), "the welcome")
                 elif name == "start":  # the explanation is on the page
-                    await wait_until(shown_since(explanation, tapped_at), "the explanation")
+                    await wait_until(page, shown_since(explanation, tapped_at), "the explanation")
                 elif regions:  # this question is open on the page: its text replaced the last one's
                     text = _opening(questionnaire.item(name).patient_text_in(language))
-                    await wait_until(shown_since(text, tapped_at), f"{name} on the page")
+                    await wait_until(page, shown_since(text, tapped_at), f"{name} on the page")
                 left, top, right, bottom = pixels(target)
                 if regions:  # and its answers laid out where the headless app put them
                     await wait_until_async(lambda: answer_drawn(page, left, top, right, bottom, cell_h),
                                            f"{name}'s answers drawn in place")
-                tapped_at = len(painted)
+                tapped_at = len(painted.data)
                 await page.mouse.click((left + right) / 2, (top + bottom) / 2)
                 if regions:
                     answered += 1
-                    await wait_until(lambda: len(_answers(database)) == answered, f"{name} stored")
+                    await wait_until(page, lambda: len(_answers(database)) == answered, f"{name} stored")
             assert [a[0] for a in _answers(database)] == [s[0] for s in steps[2:]]
             assert outside == [], f"the page fetched from outside this machine: {outside}"
         finally:

@@ -1,0 +1,274 @@
+"""Ward-station benchmark: 50 simulated kiosks replay scripted patients at 100x speed against one
+`kiosk station` process on PostgreSQL, while a logged-in page listens to the live feed.
+
+Prints one JSON object:
+- ``alert_to_page_ms`` p50/p99: from the moment a kiosk's session writes a doctor call or a
+  patient leaving (its outbox row) to the moment the page's event stream delivers it (goal p99 < 1000);
+- ``sync_lag_ms`` p50/p99: from a row being written to the station listing it as stored;
+- ``rows_lost`` / ``rows_duplicated``: written by the kiosks vs stored by the station (goal 0);
+- ``station_cpu_percent_per_kiosk``: the station process's CPU time over the run, per kiosk.
+
+The kiosks speak protocol v1 from here (rows recorded from real sessions by
+``bench/_station_client.py``; alerts sent at once in a request of their own, other rows batched
+every 0.2 s, a status on each change): the kiosk's own sync client (``kiosk/sync/``) was not on
+main when this was written.
+
+    uv run python bench/station.py [--kiosks 50] [--speed 100] [--patients 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import statistics
+import sys
+import threading
+import time
+import uuid
+from collections import Counter
+from dataclasses import replace
+from datetime import UTC, datetime
+from pathlib import Path
+
+import httpx
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from bench._postgres import create_database, pg_bin, start_postgres  # noqa: E402
+from bench._station_client import PATIENTS, Row, record_patient  # noqa: E402
+
+SCRIPTS = ["barthel5.yaml", "barthel6.yaml", "relative_french.yaml", "barthel1.yaml", "voice_dropout.yaml",
+           "barthel3.yaml"]
+RAISING = {"call_doctor", "doctor_called", "person_lost"}
+BATCH_EVERY_S = 0.2
+
+
+def percentile(values: list[float], q: float) -> float | None:
+    if not values:
+        return None
+    ordered = sorted(values)
+    return round(ordered[min(len(ordered) - 1, int(q * len(ordered)))], 1)
+
+
+class Kiosk:
+    """One kiosk: its session writes rows on the replay's schedule; a sender posts the routine rows
+    every 0.2 s, and each alert at once in a request of its own (as the protocol says), without
+    waiting for a routine batch in flight."""
+
+    def __init__(self, name: str, token: str, url: str, patients: list[list[Row]], speed: float, marks: dict) -> None:
+        self.http = httpx.AsyncClient(base_url=url, headers={"Authorization": f"Bearer {token}"}, timeout=60)
+        self.name, self.speed, self.marks = name, speed, marks
+        self.rows = self._renumber(patients)
+        self.written: dict[int, float] = {}
+        self.stored: dict[int, float] = {}
+        self.errors = 0
+        self.error_kinds: Counter[str] = Counter()
+        self.pending: list[Row] = []
+
+    def _renumber(self, patients: list[list[Row]]) -> list[tuple[float, Row]]:
+        """The patients one after another, each with a fresh session id and this kiosk's seqs."""
+        schedule, offset, seq = [], 0.0, 1
+        for rows in patients:
+            session_id = uuid.uuid4().hex[:12]
+            for row in rows:
+                payload = dict(row.payload)
+                if row.kind == "create_session":
+                    payload["session_id"] = session_id
+                schedule.append((offset + row.t / self.speed, replace(row, seq=seq, session_id=session_id,
+                                                                      payload=payload)))
+                seq += 1
+            offset += rows[-1].t / self.speed + 0.05
+        return schedule
+
+    async def _send(self, rows: list[Row]) -> None:
+        while rows:
+            try:
+                response = await self.http.post("/api/v1/sync", json={"kiosk_id": self.name,
+                                                                       "events": [r.event() for r in rows]})
+                response.raise_for_status()
+            except httpx.HTTPError as exc:
+                self.errors += 1
+                self.error_kinds[type(exc).__name__ + (f" {exc.response.status_code}" if isinstance(
+                    exc, httpx.HTTPStatusError) else "")] += 1
+                await asyncio.sleep(0.5)
+                continue
+            now = time.monotonic()
+            stored = set(response.json()["stored"])
+            for seq in stored:
+                self.stored.setdefault(seq, now)
+            rows = [r for r in rows if r.seq not in stored]
+
+    async def _status(self, **fields: object) -> None:
+        body = {"kiosk_id": self.name, "phase": "questions", "of": 10, "simulated": True} | fields
+        try:
+            (await self.http.post("/api/v1/status", json=body)).raise_for_status()
+        except httpx.HTTPError:
+            self.errors += 1
+
+    async def _routine(self, done: asyncio.Event) -> None:
+        while not (done.is_set() and not self.pending):
+            await asyncio.sleep(BATCH_EVERY_S)
+            batch, self.pending = self.pending[:500], self.pending[500:]
+            await self._send(batch)
+
+    async def run(self) -> None:
+        start = time.monotonic()
+        done = asyncio.Event()
+        sender = asyncio.create_task(self._routine(done))
+        urgent = []
+        question = 0
+        for due, row in self.rows:
+            await asyncio.sleep(max(0.0, start + due - time.monotonic()))
+            written = time.monotonic()
+            self.written[row.seq] = written
+            if row.alert:
+                if row.payload["kind"] in RAISING:
+                    # the alert's time on the station is its 'at': the wall clock of this write
+                    row = replace(row, at=datetime.now(UTC).isoformat())
+                    self.marks[(self.name, row.at)] = written
+                urgent.append(asyncio.create_task(self._send([row])))
+                urgent.append(asyncio.create_task(self._status(
+                    session_id=row.session_id, question=question,
+                    doctor_called=row.payload["kind"] in ("call_doctor", "doctor_called"),
+                    person_away=row.payload["kind"] == "person_lost")))
+                continue
+            self.pending.append(row)
+            if row.kind in ("record_answer", "record_not_answered", "create_session", "finish_session"):
+                question = question + 1 if row.kind.startswith("record") else 0
+                urgent.append(asyncio.create_task(self._status(session_id=row.session_id, patient_id="P-BENCH1",
+                                                               question=question)))
+        done.set()
+        await sender
+        await asyncio.gather(*urgent)
+        await self.http.aclose()
+
+
+async def run_kiosks(kiosks: list[Kiosk]) -> None:
+    await asyncio.gather(*(kiosk.run() for kiosk in kiosks))
+
+
+def listen(url: str, user: str, password: str, seen: dict, ready: threading.Event, stop: threading.Event) -> None:
+    """A logged-in page's event stream: record when each alert first arrives."""
+    import re
+
+    http = httpx.Client(base_url=url, timeout=None)
+    token = re.search(r'name="csrf" content="([^"]+)"', http.get("/login").text).group(1)
+    http.post("/login", data={"csrf": token, "name": user, "password": password})
+    with http.stream("GET", "/events") as response:
+        ready.set()
+        name = None
+        for line in response.iter_lines():
+            if stop.is_set():
+                return
+            if line.startswith("event: "):
+                name = line[7:]
+            elif line.startswith("data: ") and name == "alerts":
+                now = time.monotonic()
+                for alert in json.loads(line[6:])["alerts"]:
+                    seen.setdefault((alert["kiosk"], alert["raised_at"]), now)
+
+
+def cpu_seconds(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    import os
+
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--kiosks", type=int, default=50)
+    parser.add_argument("--speed", type=float, default=100.0)
+    parser.add_argument("--patients", type=int, default=2, help="patients each kiosk replays, one after another")
+    parser.add_argument("--verbose", action="store_true", help="let the station's errors through to stderr")
+    args = parser.parse_args()
+    bin_dir = pg_bin()
+    if bin_dir is None:
+        print(json.dumps({"error": "PostgreSQL is not installed (apt-get install postgresql)"}))
+        return 2
+    import subprocess
+
+    from station import auth, db
+
+    recorded = [record_patient(PATIENTS / name) for name in SCRIPTS]
+    server, stop_pg = start_postgres(bin_dir)
+    station = None
+    try:
+        url_db = create_database(server, "bench")
+        engine = db.open_database(url_db)
+        auth.add_user(engine, "bench.nurse", "nurse", "bench-password-1")
+        tokens = {f"bed{i:02d}": auth.add_kiosk(engine, f"bed{i:02d}") for i in range(args.kiosks)}
+        from bench._postgres import free_port
+
+        port = free_port()
+        station = subprocess.Popen([sys.executable, "-m", "kiosk", "station", "--db", url_db, "--port", str(port)],
+                                   stdout=subprocess.DEVNULL, stderr=None if args.verbose else subprocess.DEVNULL,
+                                   cwd=ROOT)
+        url = f"http://127.0.0.1:{port}"
+        for _ in range(600):
+            try:
+                if httpx.get(url + "/healthz", timeout=2).status_code == 200:
+                    break
+            except httpx.TransportError:
+                time.sleep(0.1)
+        seen: dict = {}
+        marks: dict = {}
+        ready, stop = threading.Event(), threading.Event()
+        threading.Thread(target=listen, args=(url, "bench.nurse", "bench-password-1", seen, ready, stop),
+                         daemon=True).start()
+        ready.wait(30)
+        kiosks = [Kiosk(name, token, url, [recorded[(i + k) % len(recorded)] for k in range(args.patients)],
+                        args.speed, marks) for i, (name, token) in enumerate(tokens.items())]
+        cpu0, wall0 = cpu_seconds(station.pid), time.monotonic()
+        asyncio.run(run_kiosks(kiosks))
+        cpu1, wall1 = cpu_seconds(station.pid), time.monotonic()
+        deadline = time.monotonic() + 10
+        while len(seen.keys() & marks.keys()) < len(marks) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        stop.set()
+        import sqlalchemy as sa
+
+        with engine.connect() as connection:
+            received = {(k, datetime.fromisoformat(at).timestamp()): r for k, at, r in connection.execute(
+                sa.select(db.alerts.c.kiosk_id, db.alerts.c.raised_at, db.alerts.c.received_at))}
+            stored_rows = connection.execute(sa.select(sa.func.count()).select_from(db.inbox)).scalar_one()
+            distinct = connection.execute(sa.select(sa.func.count()).select_from(
+                sa.select(db.inbox.c.kiosk_id, db.inbox.c.seq).distinct().subquery())).scalar_one()
+        written = sum(len(k.written) for k in kiosks)
+        # where the time goes: kiosk write -> stored at the station (both wall clocks of this machine)
+        to_station_ms = [(received[(k, datetime.fromisoformat(at).timestamp())] - datetime.fromisoformat(at).timestamp())
+                         * 1000 for (k, at) in marks if (k, datetime.fromisoformat(at).timestamp()) in received]
+        alert_ms = [(seen[key] - marks[key]) * 1000 for key in marks if key in seen]
+        lag_ms = [(k.stored[seq] - k.written[seq]) * 1000 for k in kiosks for seq in k.written if seq in k.stored]
+        result = {
+            "kiosks": args.kiosks, "speed": args.speed, "patients_per_kiosk": args.patients,
+            "database": "postgresql", "kiosk_client": "bench/station.py (kiosk/sync not on main yet)",
+            "run_s": round(wall1 - wall0, 1), "rows_written": written, "rows_stored": stored_rows,
+            "rows_lost": written - distinct, "rows_duplicated": stored_rows - distinct,
+            "alerts": len(marks), "alerts_seen_on_page": len(alert_ms),
+            "alert_to_page_ms": {"p50": percentile(alert_ms, 0.5), "p99": percentile(alert_ms, 0.99),
+                                 "max": round(max(alert_ms), 1) if alert_ms else None},
+            "alert_to_station_ms": {"p50": percentile(to_station_ms, 0.5), "p99": percentile(to_station_ms, 0.99)},
+            "alert_goal_p99_ms": 1000,
+            "alert_goal_met": bool(alert_ms) and percentile(alert_ms, 0.99) < 1000 and len(alert_ms) == len(marks),
+            "sync_lag_ms": {"p50": percentile(lag_ms, 0.5), "p99": percentile(lag_ms, 0.99)},
+            "send_errors_retried": sum(k.errors for k in kiosks),
+            "send_errors": dict(sum((k.error_kinds for k in kiosks), Counter())),
+            "station_cpu_s": round(cpu1 - cpu0, 2),
+            "station_cpu_percent_per_kiosk": round(100 * (cpu1 - cpu0) / (wall1 - wall0) / args.kiosks, 2),
+            "mean_alert_ms": round(statistics.mean(alert_ms), 1) if alert_ms else None,
+        }
+        print(json.dumps(result))
+        engine.dispose()
+    finally:
+        if station is not None:
+            station.terminate()
+            station.wait(10)
+        stop_pg()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,289 @@
+"""The RoQME grammar (lark, LALR) and the one-line messages for syntax errors.
+
+It follows RoQME's own Xtext grammar (``RoQME.xtext`` of roqme/robmosys-roqme-itp), written anew:
+declarations and ``import``s in any order after an optional ``roqme NAME`` header (RoQME wants the
+imports first); terms with RoQME's
+precedence, loosest first: ``once``, postfix ``while(…)``/``repeat(n)``/``range(a, b)``, ``->``, ``or``,
+``and``/``not``, ``? :``, ``|``, ``&``/``!``, comparisons, ``+ -``, ``* /``. Two tolerances keep older
+models working where RoQME would reject them: an operator may follow a postfix (``X while(c) or Y``
+is ``(X while(c)) or Y``) and ``->`` takes an ``or`` on its right (``a -> b or c``).
+
+Function names (``avg``, ``count``, ``at``…) and strengths are plain names, so a context may be
+called ``count``; every structural word below is reserved. ``/** … */`` is a description: ignored by
+the grammar, collected by :func:`descriptions_of` and attached to the declaration it precedes.
+"""
+
+from __future__ import annotations
+
+from contextvars import ContextVar
+
+from lark import Lark, Token
+from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
+
+GRAMMAR = r"""
+start: header? (import_ | decl)*
+header: MODEL ename
+import_: IMPORT (ename | MODEL_FILE)
+?ename: NAME | STRING
+
+?decl: type_decl | context_decl | var_decl | param_decl | timer_decl | beliefvar_decl | property_decl
+     | observation_decl
+
+type_decl: TYPE ename ":" data_type
+data_type: BOOLEAN_KW [cardinality]                               -> boolean_type
+         | EVENTTYPE_KW [cardinality]                             -> eventtype_type
+         | ENUM [cardinality] "{" NAME ("," NAME)* "}"            -> enum_type
+         | NUMBER_KW [cardinality] bound* [UNIT ename bound*]     -> number_type
+         | TIME_KW [cardinality]                                  -> time_type
+cardinality: "[" NUMBER "]"
+bound: (LOWER | UPPER) signed
+signed: [ADD] NUMBER
+?declaration: data_type | NAME
+
+context_decl: CONTEXT NAME ":" declaration [DEFINE term]
+var_decl: VAR NAME ":" declaration DEFINE term
+param_decl: PARAM NAME ":" declaration [DEFAULT term]
+timer_decl: TIMER NAME timer_part+
+timer_part: OFFSET TIME       -> offset
+          | ONETIME           -> onetime
+          | PAUSED            -> paused
+          | DEFINE term       -> definition
+beliefvar_decl: BELIEFVAR NAME prop_option*
+property_decl: PROPERTY NAME [":" declaration DEFINE term] prop_option*
+prop_option: REFERENCE NUMBER   -> reference
+           | SURVIVAL TIME      -> survival
+
+observation_decl: OBSERVATION NAME ":" term (action | "{" (action [";"])+ "}")
+action: (REINFORCES | UNDERMINES) NAME evidence_option*    -> evidence
+      | SETS NAME DEFINE term                               -> sets
+      | CLEARS NAME                                         -> clears
+      | (STARTS | STOPS | RESUMES) NAME                     -> timer_action
+evidence_option: NAME           -> strength
+               | SURVIVAL TIME  -> evidence_survival
+
+?term: ONCE body                             -> once
+     | body
+?body: seq | tail
+?tail: post
+     | tail OR and_p                         -> p_or
+     | tail ARROW or_p                       -> followed_by
+?post: body WHILE "(" term ")"               -> while_
+     | body REPEAT "(" NUMBER ")"            -> repeat
+     | body RANGE "(" NUMBER "," NUMBER ")"  -> range
+?seq: or_p
+    | seq ARROW or_p                         -> followed_by
+?or_p: and_p
+     | or_p OR and_p                         -> p_or
+?and_p: not_p
+      | and_p AND not_p                      -> p_and
+?not_p: cond
+      | NOT cond                             -> not_event
+?cond: bor
+     | bor "?" bor ":" cond                  -> conditional
+?bor: band
+    | bor BAR band                           -> binary
+?band: bnot
+     | band AMP bnot                         -> binary
+?bnot: rel
+     | "!" rel                               -> not_
+?rel: sum
+    | sum COMPARE sum                        -> binary
+?sum: product
+    | sum ADD product                        -> binary
+?product: unary
+        | product MUL unary                  -> binary
+?unary: atom
+      | ADD unary                            -> negate
+?atom: NAME                                  -> var
+     | NAME "::" NAME                        -> enum_literal
+     | NUMBER                                -> number
+     | NUMBER NAME                           -> unit_number
+     | TIME                                  -> time
+     | TRUE                                  -> true
+     | FALSE                                 -> false
+     | STRING                                -> string
+     | BELIEF                                -> belief
+     | "[" term ("," term)* "]"              -> array
+     | UPDATE "(" term ")"                   -> update
+     | EVENTWHEN "(" term ")"                -> event_when
+     | NAME "(" [term ("," term)*] ")"       -> call
+     | (NAME | BELIEF) "'" (NAME | UPDATE | EVENTWHEN) [arguments]  -> postfix_call
+     | "(" term ")"
+arguments: "(" [term ("," term)*] ")"
+
+MODEL: "roqme"
+IMPORT: "import"
+TYPE: "type"
+ENUM: "enum"
+BOOLEAN_KW: "boolean"
+NUMBER_KW: "number"
+EVENTTYPE_KW: "eventtype"
+TIME_KW: "time"
+UNIT: "unit"
+LOWER: "lower"
+UPPER: "upper"
+PROPERTY: "property"
+BELIEFVAR: "beliefvar"
+REFERENCE: "reference"
+SURVIVAL: "survival"
+CONTEXT: "context"
+VAR: "var"
+PARAM: "param"
+DEFAULT: "default"
+TIMER: "timer"
+OFFSET: "offset"
+ONETIME: "onetime"
+PAUSED: "paused"
+OBSERVATION: "observation"
+REINFORCES: "reinforces"
+UNDERMINES: "undermines"
+SETS: "sets"
+CLEARS: "clears"
+STARTS: "starts"
+STOPS: "stops"
+RESUMES: "resumes"
+OR: "or"
+AND: "and"
+NOT: "not"
+ONCE: "once"
+WHILE: "while"
+REPEAT: "repeat"
+RANGE: "range"
+UPDATE: "update"
+EVENTWHEN: "eventWhen"
+BELIEF: "belief"
+TRUE: "true"
+FALSE: "false"
+DEFINE: ":="
+ARROW: "->"
+COMPARE: "!=" | "<=" | ">=" | "=" | "<" | ">"
+ADD: "+" | "-"
+MUL: "*" | "/"
+BAR: "|"
+AMP: "&"
+TIME.2: /[0-9]+(\.[0-9]+)?[ \t]*(ms|milliseconds?|sec|seconds?|s|min|minutes?|h|hours?|days?)(?![A-Za-z0-9_])/
+NAME: /[A-Za-z_][A-Za-z0-9_]*/
+NUMBER: /[0-9]+(\.[0-9]+)?/
+STRING: /"(\\.|[^"\\\n])*"/
+MODEL_FILE.2: /[A-Za-z0-9_.\/-]*\.roqme(?![A-Za-z0-9_])/
+
+DESCRIPTION.3: /\/\*\*(?!\/)(.|\n)*?\*\//
+COMMENT: /\/\/[^\n]*/ | /\/\*(.|\n)*?\*\//
+%import common.WS
+%ignore WS
+%ignore COMMENT
+%ignore DESCRIPTION
+"""
+
+#: the descriptions met while lexing the model being parsed (one list per parse, thread-safe)
+_DESCRIPTIONS: ContextVar[list[Token]] = ContextVar("descriptions")
+
+# The basic lexer keeps keywords reserved everywhere, so a misplaced 'reinforces' is reported as such
+# instead of being read as a context name.
+PARSER = Lark(GRAMMAR, parser="lalr", lexer="basic", propagate_positions=True,
+              lexer_callbacks={"DESCRIPTION": lambda token: _DESCRIPTIONS.get().append(token)})
+
+#: seconds per time unit (RoQME's words and the short forms older models use)
+TIME_UNITS = {"ms": 0.001, "millisecond": 0.001, "milliseconds": 0.001, "s": 1.0, "sec": 1.0,
+              "second": 1.0, "seconds": 1.0, "min": 60.0, "minute": 60.0, "minutes": 60.0, "h": 3600.0,
+              "hour": 3600.0, "hours": 3600.0, "day": 86400.0, "days": 86400.0}
+
+#: words of other event languages that RoQME does not have, with what to write instead
+UNSUPPORTED_WORDS = {
+    "every": "the 'every' pattern operator is not supported (observations re-arm after every match anyway)",
+    "within": "time-window guards ('within') are not RoQME: use a timer or an aggregate over a time window",
+    "where": "'where' guards are not RoQME: use while(…), or the third argument of an aggregate",
+}
+
+#: how an expected terminal is described in a message
+_TERMINAL_TEXT = {
+    "NAME": "a name", "NUMBER": "a number", "TIME": "a time such as 100min, 30 seconds or 2 hours",
+    "COLON": "':'", "LBRACE": "'{'", "RBRACE": "'}'", "COMMA": "','", "LPAR": "'('", "RPAR": "')'",
+    "REINFORCES": "'reinforces'", "UNDERMINES": "'undermines'", "COMPARE": "a comparison", "ADD": "'+' or '-'",
+    "MUL": "'*' or '/'", "BAR": "'|'", "AMP": "'&'", "ENUM": "'enum'", "MODEL": "'roqme'", "STRING": "a string",
+    "DEFINE": "':='", "ARROW": "'->'", "LSQB": "'['", "RSQB": "']'", "SEMICOLON": "';'",
+}
+#: what a NAME means right after a keyword
+_NAME_AFTER = {
+    "roqme": "a model name", "property": "a property name", "context": "a context name",
+    "type": "a type name", "observation": "an observation name", "reinforces": "a property name",
+    "undermines": "a property name", "::": "an enum literal", "{": "an enum literal", "var": "a variable name",
+    "param": "a parameter name", "timer": "a timer name", "beliefvar": "a belief variable name",
+    "sets": "a variable name", "clears": "a property name", "starts": "a timer name", "stops": "a timer name",
+    "resumes": "a timer name", "'": "a function name", "import": "a model file name",
+}
+_DECLARATION_START = {"TYPE", "PROPERTY", "CONTEXT", "OBSERVATION", "VAR", "PARAM", "TIMER", "BELIEFVAR"}
+_ACTION_START = {"REINFORCES", "UNDERMINES", "SETS", "CLEARS", "STARTS", "STOPS", "RESUMES"}
+
+
+def describe_expected(expected: set[str], previous: str | None) -> str:
+    """What the parser wanted, in words."""
+    if _DECLARATION_START <= expected:
+        return "a declaration (type, property, context, observation, var, param, timer or beliefvar)"
+    if "NAME" in expected and previous in _NAME_AFTER:
+        return _NAME_AFTER[previous]
+    if "REINFORCES" in expected and "SETS" in expected:
+        if "OR" in expected or "AND" in expected:
+            return "an operator, or an action ('reinforces' or 'undermines' and a property, sets, clears…)"
+        return "an action (reinforces, undermines, sets, clears, starts, stops, resumes)"
+    if {"NAME", "NUMBER", "LPAR"} <= expected:
+        return "a pattern or a value"
+    if expected == {"TIME"}:
+        return _TERMINAL_TEXT["TIME"]
+    texts = []
+    for name in sorted(expected):
+        if name == "$END":
+            continue
+        text = _TERMINAL_TEXT.get(name)
+        if text is None:
+            pattern = PARSER.get_terminal(name).pattern
+            text = repr(pattern.value) if pattern.type == "str" else name.lower()
+        texts.append(text)
+    return " or ".join(texts[:6]) or "the end of the file"
+
+
+def syntax_error(text: str, exc: UnexpectedInput, previous: Token | None) -> tuple[int, int, str]:
+    """Line, column and message of a lark error (the caller adds the file name)."""
+    if isinstance(exc, UnexpectedCharacters):
+        return exc.line, exc.column, f"unexpected character {text[exc.pos_in_stream]!r}"
+    assert isinstance(exc, UnexpectedToken)
+    token = exc.token
+    if token.type != "$END" and text.startswith("/*", token.start_pos):
+        return token.line, token.column, "unterminated comment: '/*' without '*/'"
+    for word in (token, previous):
+        if word is not None and word.type == "NAME" and str(word) in UNSUPPORTED_WORDS:
+            return word.line, word.column, UNSUPPORTED_WORDS[str(word)]
+    after = f" after {str(previous)!r}" if previous is not None else ""
+    expected = describe_expected(set(exc.expected), str(previous) if previous is not None else None)
+    if token.type == "$END":
+        lines = text.splitlines() or [""]
+        return len(lines), len(lines[-1]) + 1, f"expected {expected}{after}, found the end of the file"
+    return token.line, token.column, f"expected {expected}{after}, found {str(token)!r}"
+
+
+def parse_text(text: str):
+    """Parse model text; returns (tree, descriptions) or raises (UnexpectedInput, previous token)."""
+    descriptions: list[Token] = []
+    reset = _DESCRIPTIONS.set(descriptions)
+    try:
+        parser = PARSER.parse_interactive(text)
+        # fed token by token so that an error can say what it came after
+        previous = current = None
+        try:
+            for token in parser.iter_parse():
+                previous, current = current, token
+            previous = current
+            tree = parser.feed_eof(current)
+        except UnexpectedInput as exc:
+            raise SyntaxProblem(*syntax_error(text, exc, previous)) from None
+    finally:
+        _DESCRIPTIONS.reset(reset)
+    return tree, descriptions
+
+
+class SyntaxProblem(Exception):
+    """A syntax error at (line, column) with its message; the parser turns it into a ModelError."""
+
+    def __init__(self, line: int, column: int, message: str):
+        super().__init__(line, column, message)
+        self.line, self.column, self.message = line, column, message

@@ -1,0 +1,180 @@
+"""Who may use the station: staff (argon2-hashed passwords, roles nurse and doctor), kiosks
+(bearer tokens stored as SHA-256 digests, revocable), login rate limiting and CSRF tokens.
+
+Kiosk tokens are 256-bit random strings, so a plain SHA-256 digest is enough to make a stolen
+database useless for impersonating a kiosk and still lets a request find its kiosk by digest;
+passwords are low-entropy, so they get argon2. Failed logins are counted in the database, so
+every station process behind one PostgreSQL shares the limit.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import hmac
+import re
+import secrets
+from dataclasses import dataclass
+
+import sqlalchemy as sa
+from argon2 import PasswordHasher
+from argon2.exceptions import InvalidHashError, VerificationError
+from sqlalchemy.engine import Connection, Engine
+
+from station import db
+from station.db import kiosks, login_failures, settings, users
+
+ROLES = ("nurse", "doctor")
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+MIN_PASSWORD = 10
+#: failed logins allowed per user name within the window (guessing one person's password), and
+#: per address (guessing across names; higher, as a ward's devices may share one address)
+MAX_FAILURES = 5
+MAX_FAILURES_PER_ADDRESS = 20
+WINDOW_S = 15 * 60
+
+_hasher = PasswordHasher()
+
+
+@functools.cache
+def _dummy_hash() -> str:
+    """Verified against when the user does not exist, so a wrong name costs as long as a wrong
+    password (made on first use: hashing is deliberately slow)."""
+    return _hasher.hash("not a password of anyone")
+
+
+class AuthError(ValueError):
+    """An administrative request that cannot be done (message says why)."""
+
+
+@dataclass(frozen=True)
+class User:
+    name: str
+    role: str
+
+    @property
+    def is_doctor(self) -> bool:
+        return self.role == "doctor"
+
+
+def check_name(name: str, what: str) -> str:
+    if not NAME.match(name):
+        raise AuthError(f"{what} {name!r}: use 1-64 letters, digits, '.', '_' or '-'")
+    return name
+
+
+def add_user(engine: Engine, name: str, role: str, password: str) -> None:
+    """Create a user, or set the role and password of an existing one."""
+    check_name(name, "user name")
+    if role not in ROLES:
+        raise AuthError(f"role {role!r}: choose one of {', '.join(ROLES)}")
+    if len(password) < MIN_PASSWORD:
+        raise AuthError(f"the password must have at least {MIN_PASSWORD} characters")
+    values = {"role": role, "password_hash": _hasher.hash(password)}
+    with engine.begin() as connection:
+        if connection.execute(sa.select(users.c.name).where(users.c.name == name)).first():
+            connection.execute(users.update().where(users.c.name == name).values(**values))
+        else:
+            connection.execute(users.insert().values(name=name, created_at=db.now_iso(), **values))
+
+
+def throttled(engine: Engine, name: str, address: str) -> bool:
+    """Whether logins for this name or from this address are paused after too many failures."""
+    since = db.now() - WINDOW_S
+    with engine.connect() as connection:
+        for column, value, limit in ((login_failures.c.name, name, MAX_FAILURES),
+                                     (login_failures.c.address, address, MAX_FAILURES_PER_ADDRESS)):
+            count = connection.execute(sa.select(sa.func.count()).select_from(login_failures).where(
+                column == value, login_failures.c.at > since)).scalar_one()
+            if count >= limit:
+                return True
+    return False
+
+
+def login(engine: Engine, name: str, password: str, address: str) -> User | None:
+    """The user when the password is right; a failure is counted (call :func:`throttled` first)."""
+    with engine.connect() as connection:
+        row = connection.execute(sa.select(users.c.role, users.c.password_hash).where(users.c.name == name)).first()
+    try:
+        _hasher.verify(row.password_hash if row else _dummy_hash(), password)
+        if row is not None:
+            return User(name, row.role)
+    except (VerificationError, InvalidHashError):
+        pass
+    with engine.begin() as connection:
+        connection.execute(login_failures.delete().where(login_failures.c.at < db.now() - WINDOW_S))
+        connection.execute(login_failures.insert().values(name=name[:64], address=address[:64], at=db.now()))
+    return None
+
+
+def user(engine: Engine, name: str) -> User | None:
+    """The user by name (None if deleted since the cookie was issued)."""
+    with engine.connect() as connection:
+        role = connection.execute(sa.select(users.c.role).where(users.c.name == name)).scalar()
+    return User(name, role) if role else None
+
+
+def _digest(token: str) -> str:
+    return hashlib.sha256(token.encode()).hexdigest()
+
+
+def add_kiosk(engine: Engine, name: str) -> str:
+    """Register a kiosk (or give a revoked one a new token); returns the token, shown once."""
+    check_name(name, "kiosk name")
+    token = secrets.token_urlsafe(32)
+    with engine.begin() as connection:
+        existing = connection.execute(sa.select(kiosks.c.revoked_at).where(kiosks.c.name == name)).first()
+        if existing is not None and existing.revoked_at is None:
+            raise AuthError(f"kiosk {name!r} already has a token; revoke it first (kiosk station revoke-kiosk {name})")
+        if existing is None:
+            connection.execute(kiosks.insert().values(name=name, token_hash=_digest(token), created_at=db.now_iso()))
+        else:
+            connection.execute(kiosks.update().where(kiosks.c.name == name).values(
+                token_hash=_digest(token), revoked_at=None))
+    return token
+
+
+def revoke_kiosk(engine: Engine, name: str) -> None:
+    """Refuse the kiosk's token from now on (its data stays)."""
+    with engine.begin() as connection:
+        done = connection.execute(kiosks.update().where(kiosks.c.name == name, kiosks.c.revoked_at.is_(None)).values(
+            revoked_at=db.now_iso())).rowcount
+    if not done:
+        raise AuthError(f"no kiosk {name!r} with a valid token")
+
+
+def kiosk_for(engine: Engine, token: str) -> str | None:
+    """The kiosk a bearer token belongs to, unless revoked."""
+    with engine.connect() as connection:
+        return connection.execute(sa.select(kiosks.c.name).where(
+            kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None))).scalar()
+
+
+def touch_kiosk(connection: Connection, token: str, status: str | None = None) -> str | None:
+    """Authenticate a kiosk's request and note it was seen (and its new status), in one
+    statement: the kiosk's name, or None for an unknown or revoked token."""
+    values: dict[str, object] = {"last_seen": db.now()}
+    if status is not None:
+        values["status"] = status
+    return connection.execute(kiosks.update().where(
+        kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None)).values(**values).returning(
+        kiosks.c.name)).scalar()
+
+
+def secret_key(engine: Engine) -> str:
+    """The key that signs login cookies: made once, shared by every station process."""
+    with engine.begin() as connection:
+        value = connection.execute(sa.select(settings.c.value).where(settings.c.key == "secret_key")).scalar()
+        if value is None:
+            value = secrets.token_urlsafe(48)
+            db.insert_ignore(connection, settings, [{"key": "secret_key", "value": value}], ["key"])
+            value = connection.execute(sa.select(settings.c.value).where(settings.c.key == "secret_key")).scalar_one()
+    return value
+
+
+def new_csrf_token() -> str:
+    return secrets.token_urlsafe(32)
+
+
+def csrf_ok(expected: str | None, given: str | None) -> bool:
+    return bool(expected) and bool(given) and hmac.compare_digest(expected, given)

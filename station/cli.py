@@ -1,0 +1,159 @@
+"""``kiosk station``: start the ward station, or administer it.
+
+    kiosk station [--db URL] [--host H] [--port P] [--tls-cert F --tls-key F] [--insecure-lan]
+    kiosk station add-user NAME --role nurse|doctor [--password-file F] [--db URL]
+    kiosk station add-kiosk NAME [--db URL]        prints the kiosk's token (shown once)
+    kiosk station revoke-kiosk NAME [--db URL]
+
+Without ``--db`` the station keeps one SQLite file in its data directory (``$KIOSK_STATION_DIR``
+or the user's data directory; directory 0700, file 0600). It listens on 127.0.0.1 unless told
+otherwise, and refuses any other address without TLS unless ``--insecure-lan`` says the network
+is trusted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import getpass
+import ipaddress
+import logging
+import sys
+from pathlib import Path
+
+from station import auth, db
+
+ADMIN = ("add-user", "add-kiosk", "revoke-kiosk")
+
+
+class UsageError(Exception):
+    """A mistake on the command line (one sentence, exit 2)."""
+
+
+def _db_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--db", metavar="URL",
+                        help="database URL: postgresql://user@host/dbname, or sqlite:///path "
+                             "(default: station.sqlite3 in $KIOSK_STATION_DIR or the user data directory)")
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="kiosk station", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="The ward station: kiosks report to it, staff watch the ward, answer doctor calls and "
+                    "validate results.",
+        epilog="administration (each takes --db too):\n"
+               "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
+               "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
+               "  kiosk station revoke-kiosk NAME")
+    _db_option(parser)
+    parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
+    parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
+    parser.add_argument("--tls-cert", type=Path, metavar="PEM", help="TLS certificate chain (PEM)")
+    parser.add_argument("--tls-key", type=Path, metavar="PEM", help="TLS private key (PEM)")
+    parser.add_argument("--insecure-lan", action="store_true",
+                        help="allow a non-loopback --host without TLS (only on a network you trust)")
+    return parser
+
+
+def _admin_parser(command: str) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=f"kiosk station {command}")
+    parser.add_argument("name", help="the user's or kiosk's name")
+    _db_option(parser)
+    if command == "add-user":
+        parser.add_argument("--role", required=True, choices=auth.ROLES)
+        parser.add_argument("--password-file", type=Path,
+                            help="read the password from this file's first line (default: ask)")
+    return parser
+
+
+def _url(option: str | None) -> str:
+    """The database URL; a SQLite file, default or given, is created owner-only."""
+    try:
+        if option is None:
+            return db.sqlite_url(db.default_data_dir())
+        if option.startswith("sqlite:///") and option != "sqlite:///:memory:":
+            return db.private_sqlite(Path(option.removeprefix("sqlite:///")))
+    except OSError as exc:
+        raise UsageError(f"cannot create the station database {exc.filename}: {exc.strerror}") from None
+    return option
+
+
+def _password(path: Path | None) -> str:
+    if path is not None:
+        try:
+            return path.read_text(encoding="utf-8").splitlines()[0] if path.stat().st_size else ""
+        except (OSError, UnicodeDecodeError) as exc:
+            raise UsageError(f"cannot read the password file {path}: {exc}") from None
+    if not sys.stdin.isatty():
+        raise UsageError("no terminal to ask for the password: give --password-file FILE")
+    first = getpass.getpass("Password: ")
+    if first != getpass.getpass("Again: "):
+        raise UsageError("the two passwords differ")
+    return first
+
+
+def _admin(command: str, argv: list[str]) -> int:
+    args = _admin_parser(command).parse_args(argv)
+    if command == "add-user":
+        password = _password(args.password_file)  # ask before touching the database
+    engine = db.open_database(_url(args.db))
+    if command == "add-user":
+        auth.add_user(engine, args.name, args.role, password)
+        print(f"user {args.name} ({args.role}) saved")
+    elif command == "add-kiosk":
+        token = auth.add_kiosk(engine, args.name)
+        print(f"kiosk {args.name} added; its token (shown only now; put it in the kiosk's config as station.token):")
+        print(token)
+    else:
+        auth.revoke_kiosk(engine, args.name)
+        print(f"kiosk {args.name}: token revoked")
+    return 0
+
+
+def _check_listen(args: argparse.Namespace) -> None:
+    if bool(args.tls_cert) != bool(args.tls_key):
+        raise UsageError("give both --tls-cert and --tls-key, or neither")
+    for path in (args.tls_cert, args.tls_key):
+        if path is not None and not path.is_file():
+            raise UsageError(f"no such file {path}")
+    if not 0 < args.port < 65536:
+        raise UsageError(f"--port {args.port}: choose 1-65535")
+    try:
+        loopback = ipaddress.ip_address(args.host).is_loopback
+    except ValueError:
+        loopback = args.host == "localhost"
+    if not loopback and not args.tls_cert and not args.insecure_lan:
+        raise UsageError(f"--host {args.host} would let other machines in without encryption: give --tls-cert "
+                         "and --tls-key, or --insecure-lan on a network you trust")
+
+
+def _serve(argv: list[str]) -> int:
+    args = _parser().parse_args(argv)
+    _check_listen(args)
+    import uvicorn
+
+    from station.web import create_app
+
+    engine = db.open_database(_url(args.db))
+    app = create_app(engine, https=bool(args.tls_cert))
+    scheme = "https" if args.tls_cert else "http"
+    print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})",
+          flush=True)
+    logging.basicConfig(level=logging.WARNING)
+    uvicorn.run(app, host=args.host, port=args.port, log_level="warning", access_log=False,
+                ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
+                ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2,
+                # kiosks keep their connection between batches; closing it after 5 s idle made
+                # them retry on a half-closed socket
+                timeout_keep_alive=75)
+    return 0
+
+
+def main(argv: list[str]) -> int:
+    """Entry point of ``kiosk station``; returns the exit status."""
+    try:
+        if argv and argv[0] in ADMIN:
+            return _admin(argv[0], argv[1:])
+        return _serve(argv)
+    except (UsageError, auth.AuthError, db.DatabaseError) as exc:
+        print(f"kiosk station: {exc}", file=sys.stderr)
+        return 2

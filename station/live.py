@@ -1,0 +1,115 @@
+"""Server-sent events for the open station pages.
+
+One :class:`Live` per process subscribes to the bus and renders each change once (the kiosk's
+tile, the open alerts), then hands the same text to every open page; the page swaps the HTML in
+and, for an alert it has not seen, plays a sound and shows a notification. SSE rather than
+websockets: the pages only listen (staff actions are ordinary form posts with CSRF tokens), and
+the browser's EventSource reconnects by itself.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+from collections.abc import AsyncIterator, Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+from station.bus import Bus
+
+KEEPALIVE_S = 15.0
+log = logging.getLogger("station.live")
+
+
+def sse(event: str, data: dict[str, Any]) -> str:
+    """One server-sent event (JSON data on one line)."""
+    return f"event: {event}\ndata: {json.dumps(data)}\n\n"
+
+
+class _Changed:
+    """What the open pages have not been sent yet."""
+
+    def __init__(self) -> None:
+        self.kiosks: set[str] = set()
+        self.alerts = False
+        self.resync = False
+
+    def __bool__(self) -> bool:
+        return bool(self.kiosks) or self.alerts or self.resync
+
+    def take(self, message: dict[str, Any]) -> None:
+        kind = message.get("type")
+        if kind in ("kiosk", "alert") and message.get("kiosk"):
+            self.kiosks.add(message["kiosk"])
+        self.alerts |= kind in ("alert", "ack")
+        self.resync |= kind == "resync"
+
+
+class Live:
+    """Renders bus messages into page events and fans them out to the open pages."""
+
+    def __init__(self, bus: Bus, render_kiosk: Callable[[str], dict[str, Any]],
+                 render_alerts: Callable[[], dict[str, Any]]) -> None:
+        self._bus = bus
+        self._render_kiosk = render_kiosk
+        self._render_alerts = render_alerts
+        self._pages: set[asyncio.Queue[str]] = set()
+        self._task: asyncio.Task[None] | None = None
+        #: a thread of its own: rendering an alert never queues behind the kiosks' requests
+        self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-live")
+
+    def start(self) -> None:
+        self._task = asyncio.get_running_loop().create_task(self._run())
+
+    async def stop(self) -> None:
+        if self._task is not None:
+            self._task.cancel()
+        self._executor.shutdown(wait=False)
+
+    async def _render(self, render: Callable[..., dict[str, Any]], *args: Any) -> dict[str, Any]:
+        return await asyncio.get_running_loop().run_in_executor(self._executor, render, *args)
+
+    async def _run(self) -> None:
+        """Render what changed, one piece at a time, alerts before tiles: after each render the
+        messages that arrived meanwhile are taken in, so a new alert never waits behind a burst
+        of status reports."""
+        queue = self._bus.subscribe()
+        changed = _Changed()
+        while True:
+            if not changed:
+                changed.take(await queue.get())
+            while not queue.empty():
+                changed.take(queue.get_nowait())
+            if not self._pages:
+                changed = _Changed()
+                continue
+            try:
+                if changed.resync:
+                    changed = _Changed()
+                    text = sse("resync", {})
+                elif changed.alerts:
+                    changed.alerts = False
+                    text = sse("alerts", await self._render(self._render_alerts))
+                else:
+                    text = sse("kiosk", await self._render(self._render_kiosk, changed.kiosks.pop()))
+            except Exception:  # a page must keep its feed even if one render fails
+                log.exception("station: could not render a live update")
+                continue
+            for page in list(self._pages):
+                page.put_nowait(text)
+
+    async def stream(self) -> AsyncIterator[str]:
+        """The event stream of one open page (ends when the page goes away)."""
+        page: asyncio.Queue[str] = asyncio.Queue()
+        self._pages.add(page)
+        try:
+            yield "retry: 1000\n\n"
+            yield sse("alerts", await self._render(self._render_alerts))
+            while True:
+                try:
+                    yield await asyncio.wait_for(page.get(), timeout=KEEPALIVE_S)
+                except TimeoutError:
+                    yield ": keepalive\n\n"
+        finally:
+            self._pages.discard(page)

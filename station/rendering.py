@@ -1,0 +1,53 @@
+"""Rendering pages and checking forms: the Jinja2 templates, the login session's user, CSRF.
+
+Shared by the login routes (:mod:`station.web`) and the staff pages (:mod:`station.pages`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+from starlette.requests import Request
+from starlette.responses import Response
+from starlette.templating import Jinja2Templates
+
+from station import auth, ward
+
+templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
+templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
+
+
+class Forbidden(Exception):
+    """A page request without a valid CSRF token or from another origin."""
+
+
+def current_user(request: Request) -> auth.User | None:
+    name = request.session.get("user")
+    return auth.user(request.app.state.engine, name) if name else None
+
+
+def csrf_token(request: Request) -> str:
+    token = request.session.get("csrf")
+    if not token:
+        token = request.session["csrf"] = auth.new_csrf_token()
+    return token
+
+
+async def checked_form(request: Request) -> dict[str, str]:
+    """The POSTed form, after the CSRF and origin checks (Forbidden otherwise)."""
+    origin = request.headers.get("origin")
+    if origin and origin != "null" and urlsplit(origin).netloc != request.headers.get("host"):
+        raise Forbidden("cross-origin form")
+    form = await request.form()
+    values = {k: str(v) for k, v in form.items()}
+    if not auth.csrf_ok(request.session.get("csrf"), values.get("csrf")):
+        raise Forbidden("missing or stale CSRF token (reload the page and try again)")
+    return values
+
+
+def render(request: Request, name: str, status: int = 200, **context: Any) -> Response:
+    context.setdefault("user", getattr(request.state, "user", None))
+    context["csrf"] = csrf_token(request)
+    return templates.TemplateResponse(request, name, context, status_code=status)

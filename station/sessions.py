@@ -1,0 +1,127 @@
+"""A session read back from what its kiosk sent: the inbox rows folded in ``seq`` order into the
+kiosk's own :class:`kiosk.storage.StoredSession`, so scoring, labels and exports are the session
+core's, not a copy. A row that arrived late (alerts go first) simply takes its place in the order.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import sqlalchemy as sa
+from sqlalchemy.engine import Connection
+
+from kiosk.channels import Channel
+from kiosk.session import Answer, AnsweredBy
+from kiosk.storage import AdaptationRecord, LogEntry, MetricSample, PracticeRecord, StoredSession
+from station.db import inbox, sessions
+
+#: the outbox kinds that change a session's status (they refresh the session list)
+LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted")
+
+
+@dataclass(frozen=True)
+class Row:
+    """One outbox row as the kiosk sent it."""
+
+    seq: int
+    kind: str
+    payload: dict[str, Any]
+    at: str
+
+
+class NotFound(KeyError):
+    """No session with that id has reached the station."""
+
+
+def rows_of(connection: Connection, session_id: str, kinds: Iterable[str] | None = None) -> list[Row]:
+    """The session's rows in the kiosk's order."""
+    query = sa.select(inbox.c.seq, inbox.c.kind, inbox.c.payload, inbox.c.at).where(
+        inbox.c.session_id == session_id).order_by(inbox.c.seq)
+    if kinds is not None:
+        query = query.where(inbox.c.kind.in_(list(kinds)))
+    return [Row(seq, kind, json.loads(payload), at) for seq, kind, payload, at in connection.execute(query)]
+
+
+def status_of(rows: Iterable[Row]) -> dict[str, Any]:
+    """The session's patient, start, status and finish from its lifecycle rows (in order)."""
+    state: dict[str, Any] = {"patient_id": None, "started_at": None, "status": "pending", "finished_at": None}
+    for row in rows:
+        if row.kind == "create_session":
+            state.update(patient_id=row.payload.get("patient_id"), started_at=row.payload.get("started_at"))
+            if state["status"] == "pending":
+                state["status"] = "running"
+        elif row.kind == "finish_session":
+            state.update(status="finished", finished_at=row.payload.get("finished_at"))
+        elif row.kind == "abandon" and state["status"] in ("running", "pending"):
+            state["status"] = "abandoned"
+        elif row.kind == "mark_interrupted" and state["status"] in ("running", "pending"):
+            state["status"] = "interrupted"
+    return state
+
+
+def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
+    """The session as the kiosk stored it, from its rows in seq order. Rows of kinds this station
+    does not know are kept in the inbox and listed in the log, never dropped."""
+    head: dict[str, Any] = {}
+    answers: dict[str, Answer] = {}
+    not_answered: list[str] = []
+    trace: list[dict[str, Any]] = []
+    metrics: list[MetricSample] = []
+    adaptations: list[AdaptationRecord] = []
+    log: list[LogEntry] = []
+    practice: list[PracticeRecord] = []
+    status = status_of(rows := list(rows))
+    for row in rows:
+        p = row.payload
+        if row.kind == "create_session":
+            head = p
+        elif row.kind == "record_answer":
+            answers[p["item_id"]] = Answer(p["item_id"], int(p["option"]), int(p["points"]), int(p["attempt"]),
+                                           Channel(p["channel"]), AnsweredBy(p["answered_by"]), float(p["t"]),
+                                           p.get("detail", ""))
+            if p["item_id"] in not_answered:
+                not_answered.remove(p["item_id"])
+        elif row.kind == "withdraw_answer":  # the patient's "Change my answer": the answer is gone
+            answers.pop(p["item_id"], None)
+        elif row.kind == "record_not_answered":
+            if p["item_id"] not in answers and p["item_id"] not in not_answered:
+                not_answered.append(p["item_id"])
+        elif row.kind == "record_practice":
+            practice.append(PracticeRecord(p["question_id"], p["checks"], p["outcome"], p.get("option"),
+                                           Channel(p["channel"]) if p.get("channel") else None, float(p["t"]),
+                                           p.get("detail", "")))
+        elif row.kind == "record_context":
+            event: dict[str, Any] = {"t": float(p["t"])}
+            if p.get("set"):
+                event["set"] = p["set"]
+            if p.get("emit"):
+                event["emit"] = p["emit"]
+            trace.append(event)
+        elif row.kind == "record_metrics":
+            metrics.append(MetricSample(float(p["t"]), p["metrics"], tuple(p.get("fired", ()))))
+        elif row.kind == "record_adaptation":
+            adaptations.append(AdaptationRecord(float(p["t"]), p["name"], bool(p["active"]), p.get("reason", "")))
+        elif row.kind == "record_event":
+            log.append(LogEntry(float(p["t"]), p["kind"], p.get("detail", "")))
+        elif row.kind not in LIFECYCLE:
+            log.append(LogEntry(float(p.get("t", 0.0)), f"unrecognised:{row.kind}", json.dumps(p)[:200]))
+    ordered = sorted(answers.values(), key=lambda a: a.t)
+    return StoredSession(
+        id=session_id, patient_id=status["patient_id"] or "?", questionnaire_id=head.get("questionnaire_id", "barthel"),
+        language=head.get("language", "en"), answered_by=AnsweredBy(head.get("answered_by", "patient")),
+        timing=head.get("timing", {}), started_at=status["started_at"] or "", status=status["status"],
+        finished_at=status["finished_at"], answers=tuple(ordered), not_answered=tuple(not_answered),
+        trace=tuple(trace), metrics=tuple(metrics), adaptations=tuple(adaptations), log=tuple(log),
+        practice=tuple(practice),
+    )
+
+
+def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
+    """The kiosk a session came from, and the session (NotFound if it never arrived)."""
+    kiosk = connection.execute(sa.select(sessions.c.kiosk_id).where(sessions.c.id == session_id)).scalar()
+    if kiosk is None:
+        raise NotFound(session_id)
+    return kiosk, fold(session_id, rows_of(connection, session_id))

@@ -1,0 +1,122 @@
+"""Clinicians validate a session: correct an item (new option and why; the kiosk's answer is
+kept), fill an item the patient did not answer, then a doctor signs off. Every change is a row of
+the append-only audit trail, and the :class:`kiosk.review.Review` exports take is derived from
+those rows, so what an export says can always be traced to who did it and why.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import sqlalchemy as sa
+from sqlalchemy.engine import Connection, Engine
+
+from kiosk.questionnaire import Questionnaire
+from kiosk.review import Correction, Review, ReviewState
+from kiosk.storage import StoredSession
+from station import db
+from station.auth import User
+from station.db import audit
+from station.sessions import load
+
+#: a session that is over (only these can be validated)
+REVIEWABLE = ("finished", "abandoned", "interrupted")
+
+
+class ValidationError(ValueError):
+    """A change the station refuses (message says why)."""
+
+
+@dataclass(frozen=True)
+class AuditEntry:
+    at: str
+    author: str
+    action: str
+    item_id: str | None
+    option: int | None
+    previous_option: int | None
+    reason: str
+
+
+def _entries(connection: Connection, session_id: str) -> list[AuditEntry]:
+    rows = connection.execute(sa.select(audit).where(audit.c.session_id == session_id).order_by(audit.c.id)).all()
+    return [AuditEntry(r.at, r.author, r.action, r.item_id, r.option, r.previous_option, r.reason) for r in rows]
+
+
+def trail(engine: Engine, session_id: str) -> list[AuditEntry]:
+    """The session's audit trail, oldest first."""
+    with engine.connect() as connection:
+        return _entries(connection, session_id)
+
+
+def _locked(connection: Connection, session_id: str) -> tuple[StoredSession, list[AuditEntry]]:
+    """The session and its trail, read under a per-session lock on PostgreSQL, so two clinicians
+    changing one session at once go one after the other (SQLite writers are serialised anyway)."""
+    if connection.dialect.name == "postgresql":
+        connection.execute(sa.text("SELECT pg_advisory_xact_lock(hashtext(:s))"), {"s": session_id})
+    _, stored = load(connection, session_id)
+    return stored, _entries(connection, session_id)
+
+
+def review_of(entries: list[AuditEntry]) -> Review:
+    """The review the audit trail amounts to."""
+    corrections = tuple(Correction(e.item_id or "", e.option or 0, e.previous_option, e.reason, e.author, e.at)
+                        for e in entries if e.action in ("correct", "fill"))
+    sign = next((e for e in entries if e.action == "sign_off"), None)
+    if sign is None:
+        return Review(ReviewState.UNREVIEWED, corrections)
+    state = ReviewState.AMENDED if corrections else ReviewState.SIGNED_OFF
+    return Review(state, corrections, sign.author, sign.at)
+
+
+def review(engine: Engine, session_id: str) -> Review:
+    return review_of(trail(engine, session_id))
+
+
+def change_item(engine: Engine, q: Questionnaire, session_id: str, item_id: str, option: int, reason: str,
+                by: User) -> None:
+    """Correct an answered item or fill an unanswered one (nurse or doctor), before sign-off."""
+    reason = reason.strip()
+    if not reason:
+        raise ValidationError("say why: a correction needs a reason (e.g. 'patient misheard; confirmed by nurse')")
+    try:
+        item = q.item(item_id)
+        item.option(option)
+    except KeyError as exc:
+        raise ValidationError(str(exc.args[0])) from None
+    with engine.begin() as connection:
+        stored, entries = _locked(connection, session_id)
+        current = review_of(entries)
+        _check_open(stored, current)
+        previous = current.options({a.item_id: a.option for a in stored.answers}).get(item_id)
+        if previous == option:
+            raise ValidationError(f"{item_id} already has option {option}")
+        connection.execute(audit.insert().values(
+            session_id=session_id, at=db.now_iso(), author=by.name, action="fill" if previous is None else "correct",
+            item_id=item_id, option=option, previous_option=previous, reason=reason[:1000]))
+
+
+def sign_off(engine: Engine, session_id: str, by: User) -> None:
+    """A doctor makes the result final (as recorded, or with the corrections made)."""
+    if not by.is_doctor:
+        raise ValidationError("only a doctor can sign off a result")
+    with engine.begin() as connection:
+        stored, entries = _locked(connection, session_id)
+        _check_open(stored, review_of(entries))
+        connection.execute(audit.insert().values(session_id=session_id, at=db.now_iso(), author=by.name,
+                                                 action="sign_off", reason=""))
+
+
+def _check_open(stored: StoredSession, current: Review) -> None:
+    if stored.status not in REVIEWABLE:
+        raise ValidationError(f"the session is {stored.status}: it can be validated once it is over")
+    if current.final:
+        raise ValidationError(f"signed off by {current.signed_by} at {current.signed_at}: the result is final")
+
+
+def corrected(stored: StoredSession, q: Questionnaire, current: Review) -> dict[str, Any]:
+    """The items' options after corrections, and the score they give (for the page and exports)."""
+    options = current.options({a.item_id: a.option for a in stored.answers})
+    points = {item_id: q.item(item_id).option(option).points for item_id, option in options.items()}
+    return {"options": options, "score": q.score(points)}

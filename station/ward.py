@@ -1,0 +1,171 @@
+"""The ward now: each kiosk's live status (protocol §2), open alerts and their acknowledgement,
+and the staff commands a kiosk picks up (protocol §3).
+
+Every staff action is also written to the audit trail (who, when, what), in the same transaction.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+import sqlalchemy as sa
+from sqlalchemy.engine import Engine
+
+from station import db
+from station.db import alerts, audit, commands, kiosks
+
+#: a kiosk without a heartbeat for this long shows offline (the kiosk sends one at least every 10 s)
+OFFLINE_AFTER_S = 30.0
+COMMAND_KINDS = ("continue", "person_away", "person_back", "end")
+ALERT_TEXT = {"doctor_called": "Doctor called", "person_lost": "Patient left the kiosk"}
+#: the fields of a status report the ward view shows, with their types
+STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
+    "session_id": (str, type(None)), "patient_id": (str, type(None)), "phase": (str, type(None)),
+    "question": (int, type(None)), "of": (int, type(None)), "paused": bool, "person_away": bool,
+    "doctor_called": bool, "simulated": bool, "at": (str, type(None)),
+}
+
+
+class WardError(ValueError):
+    """A staff action that cannot be done (message says why)."""
+
+
+@dataclass(frozen=True)
+class Alert:
+    id: int
+    kiosk_id: str
+    session_id: str
+    kind: str
+    raised_at: str
+    resolved_at: str | None
+    ack_by: str | None
+    ack_at: str | None
+
+    @property
+    def text(self) -> str:
+        return ALERT_TEXT.get(self.kind, self.kind)
+
+
+@dataclass(frozen=True)
+class KioskView:
+    name: str
+    last_seen: float | None
+    revoked: bool
+    status: dict[str, Any] = field(default_factory=dict)
+    alerts: tuple[Alert, ...] = ()
+
+    def online(self, now: float) -> bool:
+        return self.last_seen is not None and now - self.last_seen <= OFFLINE_AFTER_S and not self.revoked
+
+
+def parse_status(body: Any) -> dict[str, Any]:
+    """A status report's fields (WardError naming a wrong one); unknown fields are ignored."""
+    if not isinstance(body, dict):
+        raise WardError("the body must be a JSON object")
+    status = {}
+    for name, kind in STATUS_FIELDS.items():
+        value = body.get(name)
+        if value is None and kind in (bool,):
+            value = False
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind not in (bool,)):
+            raise WardError(f"status field {name!r}: wrong type {type(value).__name__}")
+        status[name] = value
+    return status
+
+
+def seen(engine: Engine, kiosk_id: str) -> None:
+    with engine.begin() as connection:
+        connection.execute(kiosks.update().where(kiosks.c.name == kiosk_id).values(last_seen=db.now()))
+
+
+def _alert(row: Any) -> Alert:
+    return Alert(row.id, row.kiosk_id, row.session_id, row.kind, row.raised_at, row.resolved_at, row.ack_by, row.ack_at)
+
+
+def open_alerts(engine: Engine, kiosk_id: str | None = None) -> list[Alert]:
+    """Alerts nobody has acknowledged yet, oldest first."""
+    query = sa.select(alerts).where(alerts.c.ack_at.is_(None)).order_by(alerts.c.id)
+    if kiosk_id is not None:
+        query = query.where(alerts.c.kiosk_id == kiosk_id)
+    with engine.connect() as connection:
+        return [_alert(r) for r in connection.execute(query)]
+
+
+def kiosk_views(engine: Engine, name: str | None = None) -> list[KioskView]:
+    """Every kiosk (or one), with its status and open alerts."""
+    query = sa.select(kiosks).order_by(kiosks.c.name)
+    if name is not None:
+        query = query.where(kiosks.c.name == name)
+    with engine.connect() as connection:
+        rows = connection.execute(query).all()
+    pending = open_alerts(engine, name)
+    return [KioskView(r.name, r.last_seen, r.revoked_at is not None, json.loads(r.status) if r.status else {},
+                      tuple(a for a in pending if a.kiosk_id == r.name)) for r in rows]
+
+
+def acknowledge(engine: Engine, alert_id: int, by: str) -> str:
+    """Record who acknowledged an alert and when; returns its kiosk."""
+    at = db.now_iso()
+    with engine.begin() as connection:
+        row = connection.execute(sa.select(alerts).where(alerts.c.id == alert_id)).first()
+        if row is None:
+            raise WardError(f"no alert {alert_id}")
+        if row.ack_at is not None:
+            return row.kiosk_id  # two nurses pressed at once: the first one is recorded
+        connection.execute(alerts.update().where(alerts.c.id == alert_id, alerts.c.ack_at.is_(None)).values(
+            ack_by=by, ack_at=at))
+        connection.execute(audit.insert().values(session_id=row.session_id, at=at, author=by, action="acknowledge",
+                                                 reason=f"{ALERT_TEXT.get(row.kind, row.kind)} on {row.kiosk_id}"))
+    return row.kiosk_id
+
+
+def queue_command(engine: Engine, kiosk_id: str, session_id: str, kind: str, by: str) -> int:
+    """Queue a command for the kiosk (it obeys only if the session is still its running one).
+    A ``continue`` also acknowledges the session's open doctor call."""
+    if kind not in COMMAND_KINDS:
+        raise WardError(f"unknown command {kind!r}")
+    at = db.now_iso()
+    with engine.begin() as connection:
+        if connection.execute(sa.select(kiosks.c.name).where(kiosks.c.name == kiosk_id)).first() is None:
+            raise WardError(f"no kiosk {kiosk_id!r}")
+        command_id = connection.execute(commands.insert().values(
+            kiosk_id=kiosk_id, session_id=session_id, kind=kind, by=by, at=at)).inserted_primary_key[0]
+        connection.execute(audit.insert().values(session_id=session_id, at=at, author=by, action="command",
+                                                 reason=f"{kind} sent to {kiosk_id}"))
+        if kind == "continue":
+            connection.execute(alerts.update().where(
+                alerts.c.session_id == session_id, alerts.c.kind == "doctor_called",
+                alerts.c.ack_at.is_(None)).values(ack_by=by, ack_at=at))
+    return int(command_id)
+
+
+def pending_commands(engine: Engine, kiosk_id: str) -> list[dict[str, Any]]:
+    """Commands the kiosk has not acknowledged (re-delivered until it does)."""
+    with engine.connect() as connection:
+        rows = connection.execute(sa.select(commands).where(
+            commands.c.kiosk_id == kiosk_id, commands.c.acked_at.is_(None)).order_by(commands.c.id)).all()
+    return [{"id": r.id, "kind": r.kind, "session_id": r.session_id, "by": r.by, "at": r.at} for r in rows]
+
+
+def ack_command(engine: Engine, kiosk_id: str, command_id: int, body: Any) -> None:
+    """The kiosk's answer to a command: ``done``, or ``refused`` with a reason."""
+    if not isinstance(body, dict) or body.get("result") not in ("done", "refused"):
+        raise WardError("the body must be {\"result\": \"done\"} or {\"result\": \"refused\", \"reason\": \"...\"}")
+    reason = body.get("reason")
+    with engine.begin() as connection:
+        done = connection.execute(commands.update().where(
+            commands.c.id == command_id, commands.c.kiosk_id == kiosk_id, commands.c.acked_at.is_(None)).values(
+            acked_at=db.now_iso(), result=body["result"], reason=str(reason)[:500] if reason else None)).rowcount
+        if not done and connection.execute(sa.select(commands.c.id).where(
+                commands.c.id == command_id, commands.c.kiosk_id == kiosk_id)).first() is None:
+            raise WardError(f"no command {command_id} for this kiosk")
+
+
+def recent_commands(engine: Engine, session_id: str) -> list[dict[str, Any]]:
+    """The session's commands and what the kiosk answered, newest first."""
+    with engine.connect() as connection:
+        rows = connection.execute(sa.select(commands).where(commands.c.session_id == session_id).order_by(
+            commands.c.id.desc())).all()
+    return [dict(r._mapping) for r in rows]

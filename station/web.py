@@ -1,0 +1,175 @@
+"""The station's web application: pages for staff, the kiosk API, live events.
+
+Routes only check who is asking, read the form and call the module that owns the concept
+(:mod:`station.ward`, :mod:`station.validation`); pages are Jinja2 templates. Every POST from a
+page carries the login session's CSRF token and a same-origin ``Origin`` when the browser sends
+one; the login cookie is HttpOnly, SameSite=Strict, and Secure when served over TLS.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from pathlib import Path
+from typing import Any
+
+import anyio.to_thread
+from sqlalchemy.engine import Engine
+from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
+from starlette.middleware import Middleware
+from starlette.middleware.sessions import SessionMiddleware
+from starlette.requests import Request
+from starlette.responses import PlainTextResponse, RedirectResponse, Response, StreamingResponse
+from starlette.routing import Mount, Route
+from starlette.staticfiles import StaticFiles
+
+from kiosk.questionnaire import Questionnaire, load_questionnaire
+from station import api, auth, pages
+from station.rendering import Forbidden, checked_form, current_user, render
+from station.bus import Bus
+from station.live import Live
+
+HERE = Path(__file__).parent
+ROUTINE_WORKERS = 12
+SECURITY_HEADERS = {
+    # no inline script or style, nothing from elsewhere: the pages work with the network cut
+    "content-security-policy": "default-src 'self'; img-src 'self' data:; frame-ancestors 'none'; form-action 'self'",
+    "x-content-type-options": "nosniff",
+    "referrer-policy": "no-referrer",
+    "x-frame-options": "DENY",
+    "cache-control": "no-store",
+}
+
+
+class SecurityHeaders:
+    """Adds :data:`SECURITY_HEADERS` to every response (plain ASGI, so SSE streams are untouched)."""
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+        async def send_with_headers(message: Any) -> None:
+            if message["type"] == "http.response.start":
+                message.setdefault("headers", [])
+                present = {k.decode().lower() for k, _ in message["headers"]}
+                message["headers"] += [(k.encode(), v.encode()) for k, v in SECURITY_HEADERS.items()
+                                       if k not in present]
+            await send(message)
+
+        await self.app(scope, receive, send_with_headers if scope["type"] == "http" else send)
+
+
+# -- login ---------------------------------------------------------------------------------------
+
+async def login_page(request: Request) -> Response:
+    return render(request, "login.html", next=request.query_params.get("next", "/"))
+
+
+async def login_post(request: Request) -> Response:
+    try:
+        form = await checked_form(request)
+    except Forbidden as exc:
+        return render(request, "login.html", status=403, error=str(exc), next="/")
+    engine = request.app.state.engine
+    name, password = form.get("name", "").strip(), form.get("password", "")
+    address = request.client.host if request.client else "?"
+    target = form.get("next", "/")
+    if not target.startswith("/") or target.startswith("//"):
+        target = "/"
+    if await run_in_threadpool(auth.throttled, engine, name, address):
+        return render(request, "login.html", status=429, next=target,
+                      error=f"Too many failed logins: wait {auth.WINDOW_S // 60} minutes, or ask an administrator.")
+    found = await run_in_threadpool(auth.login, engine, name, password, address)
+    if found is None:
+        return render(request, "login.html", status=401, next=target, error="Wrong user name or password.")
+    request.session.clear()  # a new session on login: no fixation of an earlier cookie
+    request.session.update(user=found.name, csrf=auth.new_csrf_token())
+    return RedirectResponse(target, status_code=303)
+
+
+async def logout(request: Request) -> Response:
+    try:
+        await checked_form(request)
+    except Forbidden as exc:
+        return PlainTextResponse(str(exc), status_code=403)
+    request.session.clear()
+    return RedirectResponse("/login", status_code=303)
+
+
+async def events(request: Request) -> Response:
+    if current_user(request) is None:
+        return PlainTextResponse("log in first", status_code=401)
+    live: Live = request.app.state.live
+    return StreamingResponse(live.stream(), media_type="text/event-stream",
+                             headers={"x-accel-buffering": "no"})
+
+
+class LoginRequired:
+    """Page routes need a logged-in user; the kiosk API, login, events and static files do not
+    (they check their own credentials)."""
+
+    OPEN = ("/login", "/static/", "/api/", "/events", "/healthz")
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+        if scope["type"] != "http" or scope["path"].startswith(self.OPEN):
+            await self.app(scope, receive, send)
+            return
+        request = Request(scope, receive)
+        found = await run_in_threadpool(current_user, request)
+        if found is None:
+            response: Response = RedirectResponse(f"/login?next={scope['path']}", status_code=303)
+            await response(scope, receive, send)
+            return
+        scope.setdefault("state", {})["user"] = found
+        await self.app(scope, receive, send)
+
+
+async def forbidden(request: Request, exc: Exception) -> Response:
+    return PlainTextResponse(str(exc), status_code=403)
+
+
+async def healthz(request: Request) -> Response:
+    return PlainTextResponse("ok")
+
+
+def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https: bool = False) -> Starlette:
+    """The station application on ``engine`` (already migrated)."""
+    bus = Bus(engine)
+    q = questionnaire or load_questionnaire()
+
+    @asynccontextmanager
+    async def lifespan(app: Starlette) -> AsyncIterator[None]:
+        # fewer routine workers than the default 40: past a few, more threads only share the GIL
+        # thinner, and the alert lane's threads would get less of it
+        anyio.to_thread.current_default_thread_limiter().total_tokens = ROUTINE_WORKERS
+        bus.start(asyncio.get_running_loop())
+        app.state.live.start()
+        yield
+        await app.state.live.stop()
+        bus.stop()
+
+    routes = [
+        Route("/login", login_page, methods=["GET"]),
+        Route("/login", login_post, methods=["POST"]),
+        Route("/logout", logout, methods=["POST"]),
+        Route("/events", events),
+        Route("/healthz", healthz),
+        *pages.routes,
+        *api.routes,
+        Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),
+    ]
+    middleware = [
+        Middleware(SecurityHeaders),
+        Middleware(SessionMiddleware, secret_key=auth.secret_key(engine), session_cookie="station_session",
+                   max_age=12 * 3600, same_site="strict", https_only=https),
+        Middleware(LoginRequired),
+    ]
+    app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
+    app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
+    app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app))
+    return app
