@@ -176,10 +176,10 @@ async def test_every_question_shows_its_own_text_and_answers_with_none_marked(ui
         async def check_then_answer(number: int, option: int) -> None:
             item = kiosk.session.current_item
             screen = kiosk.app.screen
-            assert text_of(screen.query_one("#question", Static)) == item.text["en"]
+            assert text_of(screen.query_one("#question", Static)) == item.patient_text_in("en")
             buttons = list(screen.query(AnswerButton))
             assert [(b.option, text_of(b.query_one(".label", Label))) for b in buttons] == [
-                (o.number, o.label_in("en")) for o in item.options]
+                (o.number, o.patient_label_in("en")) for o in item.options]
             assert not screen.query(".-chosen")
             await pilot.press(str(option))
 
