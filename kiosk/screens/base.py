@@ -15,7 +15,7 @@ from textual.widgets import Label
 from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
 from kiosk.widgets.bars import AdaptationBanner, VoiceAgainButton
-from kiosk.widgets.text import ui_text, ways_sentence
+from kiosk.widgets.text import join_or, ui_text, ways_sentence
 
 #: screen heights (rows) from which a patient screen uses its roomy layout: padded text and the
 #: big block digits on the answers; below, it packs everything tighter (a 1024x600 panel at a
@@ -68,8 +68,7 @@ def patient_notices(view: PatientView) -> str | None:
     notices = []
     if view.hint_options:
         options = [str(n) for n in range(1, view.hint_options + 1)]
-        joined = ", ".join(options[:-1]) + f" {ui_text(lang, 'or')} {options[-1]}"
-        notices.append(ui_text(lang, "only_options", options=joined))
+        notices.append(ui_text(lang, "only_options", options=join_or(lang, options)))
     if not snap.person_present:
         notices.append(ui_text(lang, "person_lost"))
     for name in sorted(snap.adaptations):

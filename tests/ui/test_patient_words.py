@@ -104,14 +104,19 @@ def test_patient_wording_is_plain_and_the_clinical_label_stays_for_clinicians():
                 assert not option.patient_label_in("en").startswith(("Needs", "Walks", "Unable")), option
 
 
+async def _first_question(kiosk, pilot, language_key: str) -> None:
+    """Choose the language by its number, start, and wait for question 1's first attempt."""
+    await pilot.press(language_key)
+    await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+    await pilot.press("1")
+    kiosk.to_next_deadline()
+    await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+
+
 async def test_spanish_controls_use_their_own_letters_and_repeat_needs_a_voice(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False, language="es")
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await pilot.press("2")
-        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
-        await pilot.press("1")
-        kiosk.to_next_deadline()
-        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        await _first_question(kiosk, pilot, "2")
         screen = kiosk.app.screen
         assert str(screen.query_one("#call-doctor", Button).label).startswith("M ")
         assert not screen.query_one("#repeat", Button).display  # no voice out: Repeat would do nothing
@@ -124,11 +129,7 @@ async def test_spanish_controls_use_their_own_letters_and_repeat_needs_a_voice(u
 async def test_a_number_with_no_answer_gets_a_gentle_hint_and_tab_does_not_choose(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await pilot.press("1")
-        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
-        await pilot.press("1")
-        kiosk.to_next_deadline()
-        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        await _first_question(kiosk, pilot, "1")
         await pilot.press("4")  # feeding has three answers
         banner = kiosk.app.screen.query_one("#banner", Static)
         await settle(pilot, lambda: banner.display)
@@ -147,11 +148,7 @@ async def test_a_number_with_no_answer_gets_a_gentle_hint_and_tab_does_not_choos
 async def test_the_paused_screen_keeps_the_question_number(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await pilot.press("1")
-        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
-        await pilot.press("1")
-        kiosk.to_next_deadline()
-        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        await _first_question(kiosk, pilot, "1")
         await pilot.press("p")
         await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
         assert text_of(kiosk.app.screen.query_one("#progress")) == "Question 1 of 10"
