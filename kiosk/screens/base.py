@@ -96,6 +96,8 @@ class PatientScreen(Screen):
     #: nothing starts focused: a focused answer would look chosen; keys and touch need no focus
     AUTO_FOCUS = ""
     HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (WIDE_COLUMNS, "-wide")]
+    #: the screen asks the patient for an answer (its top bar shows the ways they can give one)
+    ASKS = False
     VERTICAL_BREAKPOINTS = [(0, "-short"), (ROOMY_ROWS, "-roomy")]
 
     def __init__(self, view: PatientView) -> None:
@@ -144,13 +146,20 @@ class PatientScreen(Screen):
             button.show(view.voice_again)
 
     def ways_text(self, view: PatientView) -> str:
-        """The calm row of the ways the patient can answer: "You can: touch · remote · speak"."""
+        """The calm row of the ways the patient can answer: "You can: touch · remote · speak", on
+        the screens that ask for an answer (:attr:`ASKS`)."""
+        if not self.ASKS:
+            return ""
         words = [ui_text(self.language, f"ways_{way}") for way in view.ways.answering()]
         return f"{ui_text(self.language, 'ways_title')} {' · '.join(words)}"
 
     def progress_text(self, view: PatientView) -> str:
-        """The left of the top bar: the questionnaire's title unless a screen says more."""
-        return view.questionnaire.title.get(self.language, "")
+        """The left of the top bar: "Question 3 of 10" while a question is under way (also on the
+        paused and doctor-called screens over it), else the questionnaire's title."""
+        snap = view.snapshot
+        if snap.number is None:
+            return view.questionnaire.title.get(self.language, "")
+        return ui_text(self.language, "question_of", number=snap.number, total=snap.count)
 
     def on_key(self, event: events.Key) -> None:
         """Hand kiosk keys (1-4, the control letters, a keyboard remote's keys) to the app. The

@@ -21,6 +21,8 @@ def how_to_answer(view: PatientView) -> str:
 class ExplanationScreen(PatientScreen):
     """The explanation text and one big Start button (any answer key or remote button also starts)."""
 
+    ASKS = True
+
     class Understood(Message):
         """The patient touched Start."""
 

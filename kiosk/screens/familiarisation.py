@@ -16,6 +16,8 @@ from kiosk.widgets.text import ui_text
 class FamiliarisationScreen(PatientScreen):
     """A practice question laid out exactly like a real one, so the real ones feel familiar."""
 
+    ASKS = True
+
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
         """A new screen per practice question and language."""

@@ -32,10 +32,3 @@ class PausedScreen(PatientScreen):
         super().show(view)
         for line in self.query("#paused-text").results(Static):
             line.update(how_to_continue(view))
-
-    def progress_text(self, view: PatientView) -> str:
-        """Where the patient stopped: "Question 3 of 10" (the title before the first question)."""
-        snap = view.snapshot
-        if snap.number is None:
-            return super().progress_text(view)
-        return ui_text(self.language, "question_of", number=snap.number, total=snap.count)

@@ -24,6 +24,8 @@ class QuestionScreen(PatientScreen):
     :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile.
     """
 
+    ASKS = True
+
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``'s item."""
         super().__init__(view)
@@ -107,10 +109,3 @@ class QuestionScreen(PatientScreen):
                     self.set_focus(None)
                 return True
         return False
-
-    def progress_text(self, view: PatientView) -> str:
-        """"Question 3 of 10"."""
-        snap = view.snapshot
-        if snap.number is None:
-            return super().progress_text(view)
-        return ui_text(self.language, "question_of", number=snap.number, total=snap.count)

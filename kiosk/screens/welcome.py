@@ -68,10 +68,6 @@ class WelcomeScreen(PatientScreen):
         """The title in every language: the patient has not chosen one yet."""
         return " · ".join(dict.fromkeys(view.questionnaire.title.values()))
 
-    def ways_text(self, view: PatientView) -> str:
-        """No row of ways here: the welcome lines say them, in every language."""
-        return ""
-
     @on(Button.Pressed, "#languages Button")
     def _language(self, event: Button.Pressed) -> None:
         event.stop()
