@@ -1,25 +1,22 @@
 """A kiosk's side of the station protocol, for the station's tests and benchmark.
 
-:class:`RecordingStore` runs under a real :class:`kiosk.session.Session` (a scripted patient
-replayed by :func:`kiosk.replay.run_script`) and turns every store call into the outbox row the
-protocol defines: ``kind`` the ``Store`` method's name, ``payload`` its keyword arguments.
-:class:`KioskClient` speaks protocol v1 over HTTP. The kiosk's own sync client lives in
+:func:`record_patient` gives the outbox rows the kiosk's own store writes while a scripted
+patient runs; :class:`KioskClient` speaks protocol v1 over HTTP. The kiosk's own sync client lives in
 ``kiosk/sync/``; this one exists so the station can be tested and measured on its own.
 """
 
 from __future__ import annotations
 
-import contextlib
-import itertools
-from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
-from datetime import UTC, datetime, timedelta
+import json
+import sqlite3
+import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import httpx
 
-ALERT_KINDS = {"doctor_called", "call_doctor", "doctor_continued", "clinician_continue", "person_lost", "person_back"}
+ALERT_KINDS = {"doctor_called", "doctor_continued", "person_lost", "person_back"}
 PATIENTS = Path(__file__).resolve().parent.parent / "recordings" / "patients"
 
 
@@ -42,58 +39,29 @@ class Row:
         return self.kind == "record_event" and self.payload.get("kind") in ALERT_KINDS
 
 
-@dataclass
-class RecordingStore:
-    """Implements kiosk.session.SessionStore by recording outbox rows (seq from ``first_seq``)."""
-
-    first_seq: int = 1
-    rows: list[Row] = field(default_factory=list)
-
-    def __post_init__(self) -> None:
-        self._seq = itertools.count(self.first_seq)
-        self._t = 0.0
-        self._start = datetime(1970, 1, 1, tzinfo=UTC)
-
-    def _add(self, kind: str, session_id: str, payload: Mapping[str, Any]) -> None:
-        payload = {k: (dict(v) if isinstance(v, Mapping) else list(v) if isinstance(v, tuple) else v)
-                   for k, v in payload.items()}
-        self._t = float(payload.get("t", self._t))
-        if kind == "create_session":
-            self._start = datetime.fromisoformat(payload["started_at"]) - timedelta(seconds=self._t)
-        at = (self._start + timedelta(seconds=self._t)).isoformat()
-        self.rows.append(Row(next(self._seq), kind, session_id, payload, self._t, at))
-
-    @contextlib.contextmanager
-    def transaction(self) -> Iterator[None]:
-        yield
-
-    def create_session(self, **kw: Any) -> None:
-        self._add("create_session", kw["session_id"], kw)
-
-    def finish_session(self, session_id: str, **kw: Any) -> None:
-        self._add("finish_session", session_id, kw)
-
-    def abandon(self, session_id: str) -> None:
-        self._add("abandon", session_id, {})
-
-    def __getattr__(self, name: str) -> Any:
-        if not name.startswith("record_"):
-            raise AttributeError(name)
-        return lambda session_id, **kw: self._add(name, session_id, kw)
-
-
 def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None) -> list[Row]:
-    """The outbox rows a kiosk writes while a scripted patient runs (real session, real QoS)."""
+    """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
+    on the kiosk's real :class:`kiosk.storage.Store` with a station configured, its outbox read
+    back and numbered from ``first_seq``."""
     from dataclasses import replace
 
     from kiosk.replay import load_script, run_script
+    from kiosk.storage import DB_NAME, Store
 
     loaded = load_script(script)
     if patient is not None:
         loaded = replace(loaded, patient=patient)
-    store = RecordingStore(first_seq)
-    run_script(loaded, store=store)
-    return store.rows
+    with tempfile.TemporaryDirectory() as directory:
+        with Store.open(directory, outbox=True) as store:
+            run_script(loaded, store=store)
+        with sqlite3.connect(Path(directory) / DB_NAME) as connection:
+            stored = connection.execute("SELECT kind, session_id, payload, at FROM outbox ORDER BY seq").fetchall()
+    rows, t = [], 0.0
+    for seq, (kind, session_id, payload, at) in enumerate(stored, first_seq):
+        body = json.loads(payload)
+        t = float(body.get("t", t))  # when the session wrote it (rows without a t follow the last one)
+        rows.append(Row(seq, kind, session_id, body, t, at))
+    return rows
 
 
 class KioskClient:

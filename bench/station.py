@@ -41,7 +41,7 @@ from bench._station_client import PATIENTS, Row, record_patient  # noqa: E402
 
 SCRIPTS = ["barthel5.yaml", "barthel6.yaml", "relative_french.yaml", "barthel1.yaml", "voice_dropout.yaml",
            "barthel3.yaml"]
-RAISING = {"call_doctor", "doctor_called", "person_lost"}
+RAISING = {"doctor_called", "person_lost"}
 BATCH_EVERY_S = 0.2
 
 
@@ -131,7 +131,7 @@ class Kiosk:
                 urgent.append(asyncio.create_task(self._send([row])))
                 urgent.append(asyncio.create_task(self._status(
                     session_id=row.session_id, question=question,
-                    doctor_called=row.payload["kind"] in ("call_doctor", "doctor_called"),
+                    doctor_called=row.payload["kind"] == "doctor_called",
                     person_away=row.payload["kind"] == "person_lost")))
                 continue
             self.pending.append(row)

@@ -32,6 +32,7 @@ from textual.binding import Binding
 from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
+from kiosk.export import ExportSite, site_from_config
 from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
@@ -51,6 +52,7 @@ from kiosk.session import (
     IgnoreReason,
     InputIgnored,
     ListeningChanged,
+    NextPatient,
     Paused,
     Phase,
     Prompt,
@@ -62,8 +64,10 @@ from kiosk.lease import LEASE_TTL_S, SessionTaken
 from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar, VoiceAgainButton
+from kiosk.widgets.change_answer import ChangeAnswerButton
 from kiosk.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT, ChannelBoard
 from kiosk.widgets.text import ui_text
+from kiosk.widgets.waiting_sign import WaitingSign
 
 #: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
 KIOSK_SIZE = (100, 32)
@@ -129,9 +133,11 @@ class KioskApp(App[int], inherit_bindings=False):
         keyboard: Any = None,
         statuses: Iterable[ChannelStatus] = (),
         export_dir: Path | None = None,
+        export_site: ExportSite | None = None,
         poll_interval: float = POLL_INTERVAL,
         resume: Callable[[StoredSession], Session] | None = None,
         new_session: Callable[[], Session] | None = None,
+        show_score: bool = False,
     ) -> None:
         super().__init__()
         # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
@@ -147,9 +153,13 @@ class KioskApp(App[int], inherit_bindings=False):
         self.sources = list(sources)
         self.keyboard = keyboard
         self.export_dir = export_dir
+        #: the site and kiosk the clinician's exports name (the same identifiers as `kiosk results`)
+        self.export_site = export_site or ExportSite()
         self.poll_interval = poll_interval
         self._resume = resume
         self._new_session = new_session
+        #: the end screen shows the patient their total and band (config show_score_to_patient)
+        self.show_score = show_score
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is not None:  # its worker thread reports through these (it starts on mount)
             speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
@@ -184,6 +194,7 @@ class KioskApp(App[int], inherit_bindings=False):
         self.set_interval(self.poll_interval, self.poll_session)
         if self.store is not None:
             self.set_interval(LEASE_TTL_S / 3, self.keep_session)
+        self._greet()
         self._render()
 
     def on_unmount(self) -> None:
@@ -275,6 +286,19 @@ class KioskApp(App[int], inherit_bindings=False):
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
+    def _greet(self) -> None:
+        """A fresh session's welcome is said, and listened to: "start", or a language's name."""
+        if self.session.phase is Phase.WELCOME:
+            self._drive(self.session.welcome)
+
+    def on_change_answer_button_requested(self, message: ChangeAnswerButton.Requested) -> None:
+        """"Change my answer" is the undo command, by touch; the session decides if it still can."""
+        self.forward(ChannelInput(Channel.TOUCH, command=Command.UNDO, detail="screen"))
+
+    def on_doctor_called_screen_carry_on(self, message: DoctorCalledScreen.CarryOn) -> None:
+        """The patient touched "I'm fine, carry on" after calling the doctor."""
+        self._drive(self.session.cancel_doctor_call, Channel.TOUCH)
+
     def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
         """The patient touched Start under the explanation."""
         self._drive(self.session.acknowledge)
@@ -291,8 +315,12 @@ class KioskApp(App[int], inherit_bindings=False):
         self._drive(start)
 
     def poll_session(self) -> None:
-        """Let the session's due time-outs happen (the poll timer calls this)."""
+        """Let the session's due time-outs happen (the poll timer calls this), and move the
+        waiting sign's dot on with the session's clock."""
         self._drive(self.session.poll)
+        if isinstance(self.screen, PatientScreen):
+            for sign in self.screen.query(WaitingSign):
+                sign.tick(self.session.now())
 
     # -- the session's events ----------------------------------------------------------------------
 
@@ -327,6 +355,18 @@ class KioskApp(App[int], inherit_bindings=False):
                 self.speaker.stop_speaking()
         elif isinstance(event, VolumeChanged) and self.speaker is not None:
             (self.speaker.volume_up if event.step > 0 else self.speaker.volume_down)()
+        elif isinstance(event, NextPatient):
+            self.call_later(self._next_patient)
+
+    def _next_patient(self) -> None:
+        """The end screen was shown long enough: the welcome, with a fresh session, for the next
+        patient (the finished result stays in the store for staff)."""
+        if self._new_session is None or not self.session.finished:
+            return
+        self._replace_session(self._new_session())
+        self._screen_key = None
+        self._greet()
+        self._render()
 
     def _speak(self, prompt: Prompt) -> None:
         if self.speaker is None or not prompt.spoken:
@@ -359,8 +399,8 @@ class KioskApp(App[int], inherit_bindings=False):
                     voice_out=self.board.state(VOICE_OUT)[0] is ChannelState.ON)
         question = snap.item or snap.practice
         hint = len(question.options) if self._no_such_option and question is not None else None
-        return PatientView(snap, self.questionnaire, ways, voice_again=voice_again,
-                           hint_options=hint)
+        return PatientView(snap, self.questionnaire, ways, voice_again=voice_again, hint_options=hint,
+                           now=self.session.now(), show_score=self.show_score)
 
     @staticmethod
     def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:
@@ -492,6 +532,7 @@ class KioskApp(App[int], inherit_bindings=False):
         except SessionTaken:
             pass  # another kiosk holds it now: nothing of it is this kiosk's to end
         self._replace_session(self._new_session())
+        self._greet()
         self.close_clinician()
 
     # -- interrupted tests and this kiosk's hold on its session ------------------------------------
@@ -535,6 +576,7 @@ class KioskApp(App[int], inherit_bindings=False):
                     "on the clinician screen.", title="Test stopped", severity="warning", timeout=60)
         if self._new_session is not None:
             self._replace_session(self._new_session())
+            self._greet()
         self._screen_key = None
         self._render()
 
@@ -601,18 +643,19 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
         return Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)),
                        patient_id=patient or new_patient_id(), store=store, language=config.language,
                        timing=config.timing, adaptation=Adaptation(policy) if policy else None,
-                       familiarisation=config.familiarisation)
+                       familiarisation=config.familiarisation, next_patient_after_s=config.next_patient_after_s)
 
     def resume(stored: StoredSession) -> Session:
         return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(load_model(MODEL)),
                                    store=store, timing=config.timing,
-                                   adaptation=Adaptation(policy) if policy else None)
+                                   adaptation=Adaptation(policy) if policy else None,
+                                   next_patient_after_s=config.next_patient_after_s)
 
     guard = PinGuard(config.pin_secret, data_dir or config.data_dir)
     app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
-                   export_dir=(data_dir or config.data_dir) / "exports",
-                   resume=resume, new_session=fresh)
+                   export_dir=(data_dir or config.data_dir) / "exports", export_site=site_from_config(config),
+                   resume=resume, new_session=fresh, show_score=config.show_score_to_patient)
     return app, store.close
 
 

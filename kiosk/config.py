@@ -20,11 +20,20 @@ Example ``config.yaml`` (every key optional)::
     timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
     remote_profiles: /etc/kiosk/remotes.yaml
+    site: hosp-north                  # short code of the site (default "local"); part of export ids
+    kiosk_id: ward3-bed2              # this kiosk (default: the host name): exports and the station
+    fhir:                             # FHIR identity of this site's exports (defaults: urn:barthel-kiosk:...)
+      patient_system: https://hosp-north.example/sid/kiosk-patient
+      questionnaire_url: https://hosp-north.example/fhir/Questionnaire/barthel
+      identifier_system: https://hosp-north.example/sid/kiosk-result
+      device_system: https://hosp-north.example/sid/kiosk
     interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
+    next_patient_after_s: 90          # the end screen stays this long, then the welcome for the next patient
+    show_score_to_patient: false      # the end screen shows the patient their total and band
     station:                          # report to a ward station (docs/station-protocol.md)
       url: https://ward.example:8443  # without a url the kiosk talks to no station at all
       token: "…"                      # from `kiosk station add-kiosk NAME`
-      kiosk_id: ward3-bed2            # default: this machine's host name
+      kiosk_id: ward3-bed2            # the same as kiosk_id (older place; give one of the two)
 
 A legacy plain ``clinician_pin: "482193"`` still works (6 to 12 digits, or the default), with a
 warning to run `kiosk pin set`. A bad file is one :class:`ConfigError` naming the file, line and
@@ -48,6 +57,9 @@ from kiosk.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.yamlmarks import Problem, parse_file
 from qos.files import BadFile, open_private, read_text
 
+#: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
+FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
+_URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\s|]+$")
 #: browser connections `kiosk serve` runs at once unless configured: each is a kiosk process
 #: of about 55 MB, and a ward kiosk has one screen
 SERVE_MAX_SESSIONS = 2
@@ -57,8 +69,15 @@ class ConfigError(ValueError):
     """The configuration file (or an environment override) is unusable."""
 
 
-#: a kiosk's name at the station: letters, digits, '.', '-' and '_'
+#: a kiosk's name at the station, and a site's code: letters, digits, '.', '-' and '_' (both go
+#: into exported identifiers, so no spaces, '/' or '|')
 KIOSK_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+
+
+def default_kiosk_id() -> str:
+    """The host name made fit for an identifier (set ``kiosk_id`` so it never changes)."""
+    name = re.sub(r"[^A-Za-z0-9._-]", "-", socket.gethostname()).strip("-._")[:64]
+    return name or "kiosk"
 
 
 @dataclass(frozen=True)
@@ -70,7 +89,7 @@ class Station:
     #: this kiosk's bearer token, issued by the station
     token: str
     #: this kiosk's name at the station
-    kiosk_id: str = field(default_factory=socket.gethostname)
+    kiosk_id: str = field(default_factory=default_kiosk_id)
 
 
 @dataclass(frozen=True)
@@ -105,8 +124,20 @@ class Config:
     vosk_model: Path | None = None
     #: user overrides of the remote-control profiles
     remote_profiles: Path | None = None
+    #: short code of the site: part of each exported result's identifier (site + kiosk + session)
+    site: str = "local"
+    #: this kiosk's id: in exported identifiers, the FHIR Device and the station protocol; set it
+    #: once (a changed id makes re-exports look like new results)
+    kiosk_id: str = field(default_factory=default_kiosk_id)
+    #: FHIR identity of the site's exports: any of FHIR_KEYS (defaults in kiosk.export.ExportSite)
+    fhir: Mapping[str, str] = field(default_factory=dict)
     #: a running test older than this is marked interrupted (staff may continue it; no patient is offered it)
     interrupt_after_minutes: float = 120.0
+    #: seconds the end screen ("Thank you, you are done. Please call the nurse.") stays before the
+    #: kiosk goes back to the welcome for the next patient; the result stays stored for staff
+    next_patient_after_s: float = 90.0
+    #: the end screen shows the patient their total and band (default: only staff see them)
+    show_score_to_patient: bool = False
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)
@@ -124,7 +155,7 @@ class Config:
 
 
 _PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
-_BOOLS = {"adaptation", "familiarisation"}
+_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient"}
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}
 
@@ -151,6 +182,12 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
         if env.get(var):
             values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
     station = values.get("station") or {}
+    # one kiosk id for exports and the station: kiosk_id, or station.kiosk_id, never two different ones
+    if station.get("kiosk_id") and values.get("kiosk_id", station["kiosk_id"]) != station["kiosk_id"]:
+        raise ConfigError(f"{path}: kiosk_id {values['kiosk_id']!r} and station.kiosk_id {station['kiosk_id']!r} "
+                          "differ: one kiosk has one id (set kiosk_id only)")
+    values["kiosk_id"] = values.get("kiosk_id") or station.get("kiosk_id") or default_kiosk_id()
+    station = {**station, "kiosk_id": values["kiosk_id"]} if station else station
     for var, key in (("KIOSK_STATION_URL", "url"), ("KIOSK_STATION_TOKEN", "token")):
         if env.get(var):
             station = {**station, key: env[var]}
@@ -220,6 +257,18 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
         elif key == "language" and not isinstance(value, str):
             raise fail((key,), "language must be en, es or fr")
+        elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.match(value)):
+            raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
+        elif key == "fhir":
+            if not isinstance(value, dict):
+                raise fail((key,), "fhir must be a mapping such as {patient_system: https://example.org/sid/patient}")
+            for name, uri in value.items():
+                if name not in FHIR_KEYS:
+                    raise fail((key, name), f"unknown fhir setting {name!r} (known: {', '.join(FHIR_KEYS)})")
+                if not isinstance(uri, str) or not _URI.match(uri):
+                    raise fail((key, name), f"fhir {name} must be an absolute URI without spaces or '|', "
+                                            "such as https://example.org/sid/patient")
+            value = dict(value)
         elif key == "station":
             if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \
                     or not all(isinstance(v, str) for v in value.values()):
@@ -231,6 +280,9 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "interrupt_after_minutes":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
+        elif key == "next_patient_after_s":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
+                raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
@@ -248,7 +300,7 @@ def _station(values: Mapping[str, str], where: str) -> Station | None:
     if not values.get("token"):
         raise ConfigError(f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
                           "the station issues it with `kiosk station add-kiosk NAME`)")
-    kiosk_id = values.get("kiosk_id") or socket.gethostname()
+    kiosk_id = values.get("kiosk_id") or default_kiosk_id()
     if not KIOSK_ID.match(kiosk_id):
         raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'")
     return Station(url.rstrip("/"), values["token"], kiosk_id)

@@ -14,6 +14,7 @@ of them the file's default. A kiosk may choose another (``bands:`` in its config
 
 from __future__ import annotations
 
+import hashlib
 import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields, replace
@@ -31,6 +32,8 @@ SCHEMA_FILE = "questionnaire.schema.json"
 #: the languages the kiosk's own screens are written in (kiosk/widgets/ui_text.yaml): a
 #: questionnaire in another language would start a session its screens cannot show
 SCREEN_LANGUAGES = ("en", "es", "fr")
+#: the longest a timing setting may be: a day (a longer wait is a typo, and no session lasts it)
+MAX_TIMING_S = 86400.0
 
 
 # --------------------------------------------------------------------------------------------
@@ -70,6 +73,8 @@ class Option:
     points: int | None = None
     #: the patient's wording, when it differs from the clinical ``label`` (empty: the label)
     patient: Mapping[str, str] = field(default_factory=dict)
+    #: a published answer code (LOINC LA...) for export; None: exports use a local code
+    code: Code | None = None
 
     def label_in(self, language: str) -> str:
         """The option's clinical label in ``language`` (clinicians' screens, exports)."""
@@ -198,8 +203,9 @@ class Timing:
         for name, value in overrides.items():
             if name not in known:
                 raise ValueError(f"unknown timing setting {name!r} (known: {', '.join(sorted(known))})")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
-                raise ValueError(f"timing setting {name!r} must be a number of seconds >= 0, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_TIMING_S:
+                raise ValueError(f"timing setting {name!r} must be a number of seconds from 0 to "
+                                 f"{MAX_TIMING_S:g} (a day), got {value!r}")
             changes[name] = float(value)
         for name in ("attempt_window_s", "confirm_window_s"):
             if changes.get(name, getattr(self, name)) <= 0:
@@ -247,6 +253,9 @@ class Questionnaire:
     total_code: Code | None = None
     #: where it was loaded from (for messages and records)
     source: str = field(default="", compare=False)
+    #: SHA-256 of the file's content (as parsed: comments and layout do not count), so exports
+    #: can tell two edits of the same questionnaire apart
+    digest: str = ""
 
     def item(self, item_id: str) -> Item:
         """The item with this id; ``KeyError`` if unknown."""
@@ -413,6 +422,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
 
     def options(path: tuple[Any, ...], value: Any, scored: bool) -> None:
         seen: set[Any] = set()
+        codes: set[tuple[Any, Any]] = set()
         for i, option in dicts(value):
             texts(path + (i, "label"), option.get("label"))
             texts(path + (i, "patient"), option.get("patient"))
@@ -420,6 +430,12 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             for lang in (synonyms if isinstance(synonyms, dict) else ()):
                 if languages and lang not in languages:
                     add(path + (i, "synonyms", lang), f"synonyms in {lang!r}, which is not in 'languages'", key=True)
+            answer_code = option.get("code")
+            if isinstance(answer_code, dict):
+                key = (answer_code.get("system"), answer_code.get("code"))
+                if key in codes:
+                    add(path + (i, "code"), f"two options of {describe(path[:-1])} have the answer code {key[1]!r}")
+                codes.add(key)
             points = option.get("points")
             if scored and isinstance(points, int):
                 if points in seen:
@@ -524,6 +540,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
                 synonyms={lang: tuple(words) for lang, words in v.get("synonyms", {}).items()},
                 points=v.get("points"),
                 patient=dict(v.get("patient", {})),
+                code=code(v.get("code")),
             )
             for i, v in enumerate(values, start=1)
         )
@@ -558,5 +575,6 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         code=code(data.get("code")),
         total_code=code(data.get("total_code")),
         source=source,
+        digest=hashlib.sha256(json.dumps(data, sort_keys=True, ensure_ascii=False).encode()).hexdigest(),
     )
 

@@ -1,6 +1,10 @@
-"""`kiosk results [SESSION] [--fhir FILE] [--fhir-questionnaire FILE] [--csv FILE]`.
+"""`kiosk results [SESSION...] [--fhir FILE] [--fhir-questionnaire FILE] [--csv FILE] [--csv-wide FILE]`.
 
-Without SESSION: list stored sessions. With SESSION (an id or a unique prefix): show how the
+Without SESSION: list stored sessions; exports then cover every stored session. With SESSION (an
+id, a unique prefix, or the CSV's tagged ``S:id``), exports cover those sessions: ``--fhir`` one
+FHIR R4 transaction Bundle (Questionnaires, kiosk Device, responses, totals; see
+:mod:`kiosk.export.fhir`), ``--csv`` the long CSV and ``--csv-wide`` one row per session (see
+:mod:`kiosk.export.tables`), with the site and kiosk of the configuration. For each SESSION it shows how the
 practice questions went (hearing, reading, selecting: right, wrong, not answered or skipped and
 why), its answers, the total recomputed from them, band (from the configured band set) and
 completeness, adaptations and QoS metrics at the end.
@@ -14,12 +18,16 @@ import sys
 
 from kiosk.config import ConfigError, configured_questionnaire, load_config
 from kiosk.export import (
+    ID_TAGS,
     ExportError,
     csv_text,
     fhir_questionnaire,
-    fhir_response,
     practice_outcomes,
+    questionnaire_bundle,
     rescore,
+    site_from_config,
+    transaction_bundle,
+    wide_csv_text,
     write_export,
     write_json,
 )
@@ -62,37 +70,47 @@ def _show(q, stored: StoredSession) -> None:
 
 def main(argv: list[str]) -> int:
     """List, show or export stored sessions; returns the exit status."""
-    parser = argparse.ArgumentParser(prog="kiosk results", description="List stored sessions, show one, or export it as FHIR R4 JSON or CSV (totals recomputed from the answers).")
-    parser.add_argument("session", nargs="?", help="session id or unique prefix (default: list sessions)")
-    parser.add_argument("--fhir", metavar="FILE", help="write the session as a FHIR R4 QuestionnaireResponse")
-    parser.add_argument("--fhir-questionnaire", metavar="FILE", help="write the FHIR R4 Questionnaire")
-    parser.add_argument("--csv", metavar="FILE", help="write the session (or, without SESSION, all) as CSV")
+    parser = argparse.ArgumentParser(prog="kiosk results", description="List stored sessions, show some, or export them as FHIR R4 JSON or CSV (totals recomputed from the answers).")
+    parser.add_argument("sessions", nargs="*", metavar="SESSION",
+                        help="session id or unique prefix (default: list sessions; exports cover all)")
+    parser.add_argument("--fhir", metavar="FILE", help="write the sessions as one FHIR R4 transaction Bundle")
+    parser.add_argument("--fhir-questionnaire", metavar="FILE",
+                        help="write the FHIR R4 Questionnaire (with --language: that language's; else a Bundle of all)")
+    parser.add_argument("--language", choices=("en", "es", "fr"), help="language of --fhir-questionnaire")
+    parser.add_argument("--csv", metavar="FILE", help="write the sessions as CSV, rows per item")
+    parser.add_argument("--csv-wide", metavar="FILE", help="write the sessions as CSV, one row per session")
+    parser.add_argument("--bom", action="store_true", help="start CSV files with a UTF-8 byte-order mark")
     parser.add_argument("--data-dir", help="data directory (default: from the kiosk configuration)")
     args = parser.parse_args(argv)
-    if args.fhir and not args.session:
-        parser.error("--fhir needs a SESSION")
+    if args.language and not args.fhir_questionnaire:
+        parser.error("--language says which language --fhir-questionnaire writes; give --fhir-questionnaire FILE")
     try:
         config = load_config()
         q = configured_questionnaire(config)
+        site = site_from_config(config)
         with open_store(args.data_dir) as store:
             if args.fhir_questionnaire:
-                write_json(args.fhir_questionnaire, fhir_questionnaire(q))
-            if args.session is None:
+                write_json(args.fhir_questionnaire, fhir_questionnaire(q, args.language, site) if args.language
+                           else questionnaire_bundle(q, site))
+            refs = [ref.removeprefix(ID_TAGS["session"]) for ref in args.sessions]
+            exporting = args.fhir or args.csv or args.csv_wide
+            chosen = ([store.session(ref) for ref in refs] if refs
+                      else [store.session(s.id) for s in store.sessions()] if exporting else [])
+            if args.fhir:
+                write_json(args.fhir, transaction_bundle(q, chosen, site=site))
+            if args.csv:
+                write_export(args.csv, csv_text(q, chosen, site=site, bom=args.bom))
+            if args.csv_wide:
+                write_export(args.csv_wide, wide_csv_text(q, chosen, site=site, bom=args.bom))
+            if not refs:
                 summaries = store.sessions()
-                if args.csv:
-                    write_export(args.csv, csv_text(q, [store.session(s.id) for s in summaries]))
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
                 for s in summaries:
                     print(f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.label:<9} {s.language}  "
                           f"{s.answered} answered, {s.not_answered} not answered")
-                return 0
-            stored = store.session(args.session)
-            if args.fhir:
-                write_json(args.fhir, fhir_response(q, stored))
-            if args.csv:
-                write_export(args.csv, csv_text(q, [stored]))
-            _show(q, stored)
+            for stored in chosen if refs else ():
+                _show(q, stored)
     except (ConfigError, StorageError, QuestionnaireError, ExportError) as exc:
         print(f"kiosk results: {exc}", file=sys.stderr)
         return 2

@@ -11,6 +11,7 @@ import json
 import math
 import os
 import re
+import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -64,7 +65,7 @@ def write_error(path: str | Path, exc: OSError) -> str:
 # UTF-8, binary, nested without end, an alias bomb, or full of NaN and thousand-digit numbers is
 # one `file:line:col: problem` before any loader sees it, in bounded time and memory.
 
-#: the largest file read (bytes): the biggest real one (a recorded trace) is a few hundred KB
+#: the largest file read (bytes): a JSON trace of a long session stays far below it
 MAX_BYTES = 4 * 1024 * 1024
 #: the largest YAML file: PyYAML composes a few hundred KB a second, and a bad file must be
 #: refused within one (the biggest real one, the questionnaire, is 22 KB)
@@ -106,13 +107,15 @@ def _position(data: bytes | str, offset: int) -> tuple[int, int]:
 
 def read_text(path: str | Path, limit: int = MAX_BYTES) -> str:
     """A UTF-8 text file's contents (a leading byte-order mark dropped); :class:`BadFile` when it
-    cannot be read, is larger than ``limit`` bytes, holds a NUL byte or is not UTF-8.
-
-    Reads at most ``limit + 1`` bytes, so a device or a FIFO named by mistake cannot exhaust memory.
-    """
+    cannot be read, is not a regular file (a device, a FIFO), is larger than ``limit`` bytes, holds
+    a NUL byte or is not UTF-8. Reads at most ``limit + 1`` bytes."""
     name = str(path)
     try:
-        with open(path, "rb") as handle:
+        # O_NONBLOCK: a FIFO named by mistake must not wait for a writer; it is refused just below
+        descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        with os.fdopen(descriptor, "rb") as handle:
+            if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+                raise BadFile(Problem(name, 1, 1, "not a regular file"))
             data = handle.read(limit + 1)
     except OSError as exc:
         raise BadFile(Problem(name, 1, 1, f"cannot read the file: {exc.strerror or exc}")) from None
@@ -181,8 +184,8 @@ class _BoundedComposer(Composer):
         return node
 
     def _check_number(self, node: yaml.ScalarNode) -> None:
-        if node.tag == "tag:yaml.org,2002:int":
-            if sum(c.isdigit() for c in node.value) > MAX_DIGITS:
+        if node.tag == "tag:yaml.org,2002:int":  # decimal, 0x hex, 0o octal or 1:30 sexagesimal
+            if len(node.value) > 2 * MAX_DIGITS or abs(self.construct_yaml_int(node)) >= 10**MAX_DIGITS:
                 raise self.fail(node.start_mark, f"the number {node.value[:20]}… is too large "
                                                  f"(more than {MAX_DIGITS} digits)")
         elif node.tag == "tag:yaml.org,2002:float":

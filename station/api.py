@@ -50,7 +50,7 @@ def _in_worker(request: Request, work: Any, urgent: bool = False, status: str | 
     hops, not the queries, are what a request waits for. Urgent work (a batch of alerts) runs on
     threads of its own, so a doctor call never queues behind the kiosks' routine rows."""
     token = _token(request)
-    engine, bus = request.app.state.engine, request.app.state.bus
+    bus = request.app.state.bus
 
     def run() -> Any:
         if token is None:

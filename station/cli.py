@@ -20,6 +20,7 @@ import logging
 import sys
 from pathlib import Path
 
+from qos.files import BadFile, read_text
 from station import auth, db
 
 ADMIN = ("add-user", "add-kiosk", "revoke-kiosk")
@@ -79,10 +80,11 @@ def _url(option: str | None) -> str:
 
 def _password(path: Path | None) -> str:
     if path is not None:
-        try:
-            return path.read_text(encoding="utf-8").splitlines()[0] if path.stat().st_size else ""
-        except (OSError, UnicodeDecodeError) as exc:
-            raise UsageError(f"cannot read the password file {path}: {exc}") from None
+        try:  # the project's bounded reader: a device or a huge file named by mistake is one line
+            text = read_text(path, 4096)
+        except BadFile as exc:
+            raise UsageError(f"the password file: {exc}") from None
+        return text.splitlines()[0] if text else ""
     if not sys.stdin.isatty():
         raise UsageError("no terminal to ask for the password: give --password-file FILE")
     first = getpass.getpass("Password: ")

@@ -7,6 +7,7 @@ publish what changed, redirect back (post/redirect/get, so a reload never repeat
 from __future__ import annotations
 
 from typing import Any
+from urllib.parse import quote
 
 import sqlalchemy as sa
 from starlette.applications import Starlette
@@ -15,7 +16,7 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export import csv_text, fhir_response, practice_outcomes
+from kiosk.export import ExportSite, csv_text, fhir_response, practice_outcomes
 from kiosk.questionnaire import Questionnaire
 from kiosk.storage import StoredSession
 from station import db, validation, ward
@@ -54,14 +55,12 @@ async def ward_page(request: Request) -> Response:
     views = await run_in_threadpool(ward.kiosk_views, engine)
     pending = await run_in_threadpool(ward.open_alerts, engine)
     recent = await run_in_threadpool(_session_rows, engine)
-    reviews = {row.id: await run_in_threadpool(validation.review, engine, row.id) for row in recent}
+    reviews = await run_in_threadpool(validation.reviews, engine, [row.id for row in recent])
     return render(request, "ward.html", kiosks=views, alerts=pending, sessions=recent, reviews=reviews,
                   now=db.now(), message=request.query_params.get("message"))
 
 
 def _back(request: Request, message: str | None = None, to: str = "/") -> Response:
-    from urllib.parse import quote
-
     return RedirectResponse(f"{to}?message={quote(message)}" if message else to, status_code=303)
 
 
@@ -87,16 +86,16 @@ async def command(request: Request) -> Response:
         return _back(request, str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "command", "kiosk": kiosk},
                             {"type": "ack", "kiosk": kiosk})
-    return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.", to=form.get("back", "/") if
-                 form.get("back", "/").startswith("/s") else "/")
+    return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.")
 
 
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:
     """One row per questionnaire item: what the kiosk recorded, what it is now, how it was answered."""
     answers = {a.item_id: a for a in stored.answers}
     options = review.options({a.item_id: a.option for a in stored.answers})
+    # a question's attempts timing out are logged as "ITEM attempt N"
     outcomes = sorted([(a.t, a.item_id) for a in stored.answers] + [
-        (e.t, e.detail) for e in stored.log if e.kind == "attempt_timed_out"])
+        (e.t, e.detail.split(" ")[0]) for e in stored.log if e.kind == "attempt_timed_out"])
     start = next((e.t for e in stored.log if e.kind == "start"), 0.0)
     rows, previous_t = [], start
     for number, item in enumerate(q.items, 1):
@@ -177,17 +176,18 @@ async def export(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id, fmt = request.path_params["session_id"], request.path_params["fmt"]
     try:
-        _, stored = await run_in_threadpool(_load, engine, session_id)
+        kiosk, stored = await run_in_threadpool(_load, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
     current = await run_in_threadpool(validation.review, engine, session_id)
+    site = ExportSite(kiosk_id=kiosk)  # the session's kiosk: the result's identifier is the one the kiosk exports
     if fmt == "json":
         import json
 
-        body = json.dumps(fhir_response(q, stored, current), indent=2, ensure_ascii=False)
+        body = json.dumps(fhir_response(q, stored, current, site), indent=2, ensure_ascii=False)
         media = "application/fhir+json"
     else:
-        body, media = csv_text(q, [stored], [current]), "text/csv"
+        body, media = csv_text(q, [stored], [current], site), "text/csv"
     return Response(body, media_type=media, headers={
         "content-disposition": f'attachment; filename="{session_id}.{"fhir.json" if fmt == "json" else "csv"}"'})
 

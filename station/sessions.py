@@ -19,7 +19,7 @@ from kiosk.storage import AdaptationRecord, LogEntry, MetricSample, PracticeReco
 from station.db import inbox, sessions
 
 #: the outbox kinds that change a session's status (they refresh the session list)
-LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted")
+LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted", "continue_session")
 
 
 @dataclass(frozen=True)
@@ -55,10 +55,12 @@ def status_of(rows: Iterable[Row]) -> dict[str, Any]:
                 state["status"] = "running"
         elif row.kind == "finish_session":
             state.update(status="finished", finished_at=row.payload.get("finished_at"))
-        elif row.kind == "abandon" and state["status"] in ("running", "pending"):
-            state["status"] = "abandoned"
+        elif row.kind == "abandon" and state["status"] in ("running", "pending", "interrupted"):
+            state["status"] = "abandoned"  # staff may end an interrupted test too
         elif row.kind == "mark_interrupted" and state["status"] in ("running", "pending"):
             state["status"] = "interrupted"
+        elif row.kind == "continue_session" and state["status"] == "interrupted":
+            state["status"] = "running"  # staff continued it on a kiosk
     return state
 
 
@@ -73,6 +75,7 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
     adaptations: list[AdaptationRecord] = []
     log: list[LogEntry] = []
     practice: list[PracticeRecord] = []
+    interrupted: dict[str, Any] = {}
     status = status_of(rows := list(rows))
     for row in rows:
         p = row.payload
@@ -106,6 +109,10 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
             adaptations.append(AdaptationRecord(float(p["t"]), p["name"], bool(p["active"]), p.get("reason", "")))
         elif row.kind == "record_event":
             log.append(LogEntry(float(p["t"]), p["kind"], p.get("detail", "")))
+        elif row.kind == "mark_interrupted":
+            interrupted = {"interrupted_reason": p.get("reason"), "interrupted_at": row.at}
+        elif row.kind == "continue_session":
+            interrupted = {}
         elif row.kind not in LIFECYCLE:
             log.append(LogEntry(float(p.get("t", 0.0)), f"unrecognised:{row.kind}", json.dumps(p)[:200]))
     ordered = sorted(answers.values(), key=lambda a: a.t)
@@ -115,7 +122,8 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
         timing=head.get("timing", {}), started_at=status["started_at"] or "", status=status["status"],
         finished_at=status["finished_at"], answers=tuple(ordered), not_answered=tuple(not_answered),
         trace=tuple(trace), metrics=tuple(metrics), adaptations=tuple(adaptations), log=tuple(log),
-        practice=tuple(practice),
+        practice=tuple(practice), simulated=bool(head.get("simulated", False)),
+        **(interrupted if status["status"] == "interrupted" else {}),
     )
 
 

@@ -38,10 +38,14 @@ class AuditEntry:
     previous_option: int | None
     reason: str
 
+    @classmethod
+    def of(cls, row: Any) -> AuditEntry:
+        return cls(row.at, row.author, row.action, row.item_id, row.option, row.previous_option, row.reason)
+
 
 def _entries(connection: Connection, session_id: str) -> list[AuditEntry]:
     rows = connection.execute(sa.select(audit).where(audit.c.session_id == session_id).order_by(audit.c.id)).all()
-    return [AuditEntry(r.at, r.author, r.action, r.item_id, r.option, r.previous_option, r.reason) for r in rows]
+    return [AuditEntry.of(r) for r in rows]
 
 
 def trail(engine: Engine, session_id: str) -> list[AuditEntry]:
@@ -72,6 +76,15 @@ def review_of(entries: list[AuditEntry]) -> Review:
 
 def review(engine: Engine, session_id: str) -> Review:
     return review_of(trail(engine, session_id))
+
+
+def reviews(engine: Engine, session_ids: list[str]) -> dict[str, Review]:
+    """The reviews of several sessions, read in one query (the ward page's result list)."""
+    entries: dict[str, list[AuditEntry]] = {session_id: [] for session_id in session_ids}
+    with engine.connect() as connection:
+        for r in connection.execute(sa.select(audit).where(audit.c.session_id.in_(session_ids)).order_by(audit.c.id)):
+            entries[r.session_id].append(AuditEntry.of(r))
+    return {session_id: review_of(found) for session_id, found in entries.items()}
 
 
 def change_item(engine: Engine, q: Questionnaire, session_id: str, item_id: str, option: int, reason: str,

@@ -27,9 +27,9 @@ from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
 from station import api, auth, pages
-from station.rendering import Forbidden, checked_form, current_user, render
 from station.bus import Bus
 from station.live import Live
+from station.rendering import Forbidden, checked_form, current_user, render
 
 HERE = Path(__file__).parent
 ROUTINE_WORKERS = 12

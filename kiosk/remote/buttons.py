@@ -50,10 +50,12 @@ def to_input(button: Button, detail: str) -> ChannelInput:
 
 
 #: the kiosk's own keys (channel KEYBOARD) and the button each stands for: answers 1-4, pause,
-#: call doctor, repeat
+#: call doctor, repeat, and C for "Change my answer" (undo; backspace too, the key a keyboard user
+#: reaches for to take something back)
 KIOSK_KEY_BUTTONS: dict[str, Button] = {
     "1": 1, "2": 2, "3": 3, "4": 4,
     "p": Command.PAUSE, "d": Command.CALL_DOCTOR, "r": Command.REPEAT,
+    "c": Command.UNDO, "backspace": Command.UNDO,
 }
 
 #: keys the kiosk itself binds; a keyboard-emulating remote must not claim them, or one key press

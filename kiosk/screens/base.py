@@ -16,6 +16,7 @@ from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
 from kiosk.widgets.bars import AdaptationBanner, VoiceAgainButton
 from kiosk.widgets.text import join_or, ui_text, ways_sentence
+from kiosk.widgets.waiting_sign import WaitingSign
 
 #: screen heights (rows) from which a patient screen uses its roomy layout: padded text and the
 #: big block digits on the answers; below, it packs everything tighter (a 1024x600 panel at a
@@ -59,6 +60,16 @@ class PatientView:
     #: the number of answers of the question on screen, when the patient pressed a number it
     #: does not have (a gentle "Please choose 1, 2 or 3" follows)
     hint_options: int | None = None
+    #: session time now (the waiting sign's slow dot follows it)
+    now: float = 0.0
+    #: the end screen shows the total and band (a site's choice; default: staff only)
+    show_score: bool = False
+
+    @property
+    def waiting(self) -> bool:
+        """An answer is awaited now (an attempt is open and nothing stops the clock)."""
+        snap = self.snapshot
+        return snap.attempt is not None and not (snap.paused or snap.halted) and snap.person_present
 
 
 def patient_notices(view: PatientView) -> str | None:
@@ -144,6 +155,10 @@ class PatientScreen(Screen):
             banner.show(patient_notices(view))
         for button in self.query(VoiceAgainButton):
             button.show(view.voice_again)
+        for sign in self.query(WaitingSign):
+            sign.show(view.waiting, view.now)
+        for sign in self.query(WaitingSign):
+            sign.show(view.waiting, view.now)
 
     def ways_text(self, view: PatientView) -> str:
         """The calm row of the ways the patient can answer: "You can: touch · remote · speak", on

@@ -11,6 +11,7 @@ from kiosk.screens.base import PatientScreen, PatientView
 from kiosk.widgets.bars import ControlBar
 from kiosk.widgets.question_panel import QuestionPanel
 from kiosk.widgets.text import ui_text
+from kiosk.widgets.waiting_sign import WaitingSign
 
 
 class FamiliarisationScreen(PatientScreen):
@@ -25,22 +26,34 @@ class FamiliarisationScreen(PatientScreen):
         return (practice.id if practice else None, view.snapshot.language)
 
     def compose(self) -> ComposeResult:
-        """Bars, the practice question with its answers (or the introduction), and the controls."""
+        """Bars, the introduction or the kind word after an answer, the practice question with its
+        answers (or the introduction alone), the waiting sign and the controls."""
         yield from self.compose_bars()
         practice = self.view.snapshot.practice
         if practice is None:
             yield Static(self.view.questionnaire.message("familiarisation", self.language),
                          classes="heading")
         else:
+            # in the flow above the question (the overlay that keeps real answers still is for
+            # the question screen's thank-you line)
+            yield Static("", id="interlude", classes="interlude -inline")
             yield QuestionPanel(practice.text[self.language],
                                 [o.label_in(self.language) for o in practice.options])
+        yield WaitingSign(self.language)
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 
     def show(self, view: PatientView) -> None:
-        """Offer Repeat only while the kiosk can speak."""
+        """Also the line above the question: "First, a few practice questions…" on the first one,
+        and the kind word ("Well done.") once it is answered, until the next one opens."""
         super().show(view)
-        for bar in self.query(ControlBar):
+        for bar in self.query(ControlBar):  # Repeat only while the kiosk can speak
             bar.show_repeat(view.ways.voice_out)
+        snap = view.snapshot
+        feedback = view.questionnaire.message(snap.interlude, self.language) if snap.interlude else ""
+        intro = view.questionnaire.message("familiarisation", self.language) if snap.practice_number == 1 else ""
+        for line in self.query("#interlude").results(Static):
+            line.update(feedback or intro)
+            line.display = bool(feedback or intro)
 
     def progress_text(self, view: PatientView) -> str:
         """"Practice 1 of 3" (of those asked on this kiosk, as the session counts them)."""

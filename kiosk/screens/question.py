@@ -12,8 +12,11 @@ from kiosk.questionnaire import Item
 from kiosk.screens.base import PatientScreen, PatientView
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar
+from kiosk.widgets.change_answer import ChangeAnswerButton
+from kiosk.widgets.confirm_panel import ConfirmPanel
 from kiosk.widgets.question_panel import QuestionPanel
 from kiosk.widgets.text import ui_text
+from kiosk.widgets.waiting_sign import WaitingSign
 
 
 class QuestionScreen(PatientScreen):
@@ -21,7 +24,10 @@ class QuestionScreen(PatientScreen):
 
     Between questions the last item (before the first, the explanation) stays on screen, its answer
     marked, under a calm line such as "Thank you. Next question…", as the session's
-    :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile.
+    :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile; during
+    that thank-you gap "Change my answer" is offered. While the session asks back an unsure answer
+    ("I heard: … Is that right?") the question's panel gives way to the Yes/No panel. While an
+    answer is awaited a gentle sign says so.
     """
 
     ASKS = True
@@ -31,6 +37,8 @@ class QuestionScreen(PatientScreen):
         super().__init__(view)
         #: the item whose panel is on screen
         self._item_id: str | None = None
+        #: the option the Yes/No panel on screen asks about (None: the question's panel is shown)
+        self._confirming: int | None = None
 
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
@@ -41,8 +49,10 @@ class QuestionScreen(PatientScreen):
         """Bars, the between-questions line, the question with its answers, and the controls."""
         yield from self.compose_bars()
         yield Static("", id="interlude", classes="interlude")
+        yield ChangeAnswerButton(self.language)
         if (panel := self._panel(self.view)) is not None:
             yield panel
+        yield WaitingSign(self.language)
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 
     def _panel(self, view: PatientView) -> Widget | None:
@@ -50,6 +60,10 @@ class QuestionScreen(PatientScreen):
         explanation the patient just read stays (None if the questionnaire has none)."""
         item = view.snapshot.item
         self._item_id = item.id if item else None
+        self._confirming = view.snapshot.confirming
+        prompt = view.snapshot.prompt
+        if self._confirming is not None and prompt is not None and prompt.kind == "confirm":
+            return ConfirmPanel(prompt.text, [o.label for o in prompt.options])
         if item is None:
             explanation = view.questionnaire.message("explanation", self.language)
             return Static(explanation, classes="notice", id="recap") if explanation else None
@@ -70,16 +84,20 @@ class QuestionScreen(PatientScreen):
             line.display = bool(key)
         if key:
             self.call_after_refresh(self._place_interlude)
+        for button in self.query(ChangeAnswerButton):
+            button.show(view.snapshot.can_undo)
         if not self.is_mounted:  # compose has not run yet: it will draw this view
             return
         item = view.snapshot.item
-        if (item.id if item else None) != self._item_id:
-            if item is not None and self._item_id is not None and self._reword(view, item):
+        confirming = view.snapshot.confirming
+        if (item.id if item else None) != self._item_id or confirming != self._confirming:
+            if (item is not None and self._item_id is not None and confirming is None
+                    and self._confirming is None and self._reword(view, item)):
                 return
-            for old in self.query("QuestionPanel, #recap"):
+            for old in self.query("QuestionPanel, ConfirmPanel, #recap"):
                 old.remove()
             if (panel := self._panel(view)) is not None:
-                self.mount(panel, before=self.query_one(ControlBar))
+                self.mount(panel, before=self.query_one(WaitingSign))
             return
         answer = view.snapshot.answers.get(item.id) if item else None
         for panel in self.query(QuestionPanel):

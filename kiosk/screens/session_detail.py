@@ -100,7 +100,8 @@ class SessionDetailScreen(ClinicianScreen):
     def _fhir(self) -> None:
         try:
             path = self._export_path(".fhir.json")
-            write_json(path, fhir_response(self.app.questionnaire, self.stored))  # type: ignore[attr-defined]
+            write_json(path, fhir_response(self.app.questionnaire, self.stored,  # type: ignore[attr-defined]
+                                           site=self.app.export_site))  # type: ignore[attr-defined]
         except (ExportError, OSError) as error:
             self._done(f"FHIR export failed: {error}")
             return
@@ -110,7 +111,8 @@ class SessionDetailScreen(ClinicianScreen):
     def _csv(self) -> None:
         try:
             path = self._export_path(".csv")
-            write_private(path, csv_text(self.app.questionnaire, [self.stored]))  # type: ignore[attr-defined]
+            write_private(path, csv_text(self.app.questionnaire, [self.stored],  # type: ignore[attr-defined]
+                                         site=self.app.export_site))  # type: ignore[attr-defined]
         except (ExportError, OSError) as error:
             self._done(f"CSV export failed: {error}")
             return

@@ -1,4 +1,6 @@
-"""Summary: thanks, and the total the session recomputed from the recorded answers."""
+"""The end: "Thank you, you are done. Please call the nurse." The total and band the session
+recomputed are shown to the patient only where the site chose so (``show_score_to_patient``); the
+kiosk goes back to the welcome for the next patient after ``next_patient_after_s``."""
 
 from __future__ import annotations
 
@@ -12,7 +14,8 @@ from kiosk.widgets.text import ui_text
 
 
 class SummaryScreen(PatientScreen):
-    """Thank-you, the total out of the maximum, the band, and how many items went unanswered."""
+    """Thank-you and what to do now; if the site shows it, the total out of the maximum, the band,
+    and how many items went unanswered."""
 
     def show(self, view: PatientView) -> None:
         """No notices once it is over: what the kiosk adapted no longer concerns the patient."""
@@ -29,7 +32,7 @@ class SummaryScreen(PatientScreen):
         yield Static(self.view.questionnaire.message("finished", self.language)
                      or ui_text(self.language, "summary_text"), classes="notice")
         score = self.view.snapshot.score
-        if score is not None:
+        if score is not None and self.view.show_score:  # a site's choice; staff always see it
             lines = [ui_text(self.language, "summary_total", total=score.total, maximum=score.max_total)]
             if score.band is not None:
                 lines.append(score.band.label[self.language])

@@ -10,11 +10,14 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.export import ITEM_WEIGHT, ExportError, csv_text, fhir_questionnaire, fhir_response, rescore
+from kiosk.export import ExportError, csv_text, rescore
+from kiosk.export import ITEM_WEIGHT, fhir_questionnaire, fhir_response
 from kiosk.replay import load_script, run_script
 from kiosk.results import main as results_main
 from kiosk.channels import Channel
 from kiosk.storage import Store
+
+from tests.fhir.standard import check_fhir
 
 from .helpers import QUESTIONNAIRE, TIMING, make_rig
 
@@ -44,19 +47,21 @@ def test_the_fhir_questionnaire_puts_each_items_points_on_its_options():
                for o in items[i.id]["answerOption"])
     assert items["feeding"]["code"][0]["code"] == "83184-2"
     assert items["total"]["readOnly"] and "calculatedExpression" in items["total"]["extension"][0]["url"]
-    json.dumps(resource)  # serialisable as is
+    check_fhir(resource)  # valid R4 for the official schema and fhir.resources
 
 
 def test_the_fhir_response_recomputes_the_total(export_store):
     complete = fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0001"))
+    check_fhir(complete)
     assert complete["status"] == "completed"
     assert complete["subject"]["identifier"]["value"] == "TB-0001"
     total = [i for i in complete["item"] if i["linkId"] == "total"][0]["answer"][0]["valueInteger"]
     assert total == 100
     partial = fhir_response(QUESTIONNAIRE, by_patient(export_store, "TB-0004"))
+    check_fhir(partial)
     answered = [i for i in partial["item"] if "answer" in i and i["linkId"] != "total"]
     assert len(answered) == 8
-    assert [i for i in partial["item"] if i["linkId"] == "total"][0]["answer"][0]["valueInteger"] == 65
+    assert "answer" not in [i for i in partial["item"] if i["linkId"] == "total"][0]  # no partial total
 
 
 def test_a_tampered_stored_total_is_ignored_and_tampered_points_are_refused(export_store):
@@ -77,7 +82,7 @@ def test_csv_has_a_row_per_item_and_a_recomputed_total(export_store):
     assert [r["item"] for r in rows] == [i.id for i in QUESTIONNAIRE.items] + ["total"]
     grooming = rows[2]
     assert (grooming["option"], grooming["label"]) == ("", "not answered")
-    assert (rows[-1]["points"], rows[-1]["label"]) == ("65", "incomplete")
+    assert (rows[-1]["points"], rows[-1]["label"]) == ("", "incomplete (65 points from 8 of 10 items)")
     assert rows[0]["channel"] == "voice" and rows[0]["attempt"] == "1"
 
 
@@ -93,7 +98,9 @@ def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path
     assert results_main([session_id[:6], "--data-dir", data, "--fhir", str(fhir), "--csv", str(table)]) == 0
     shown = capsys.readouterr().out
     assert "total 65/100 (incomplete, missing grooming, bladder)" in shown
-    assert json.loads(fhir.read_text())["resourceType"] == "QuestionnaireResponse"
+    bundle = json.loads(fhir.read_text())
+    check_fhir(bundle)
+    assert [e["resource"]["resourceType"] for e in bundle["entry"]] == ["Questionnaire", "Device", "QuestionnaireResponse"]
     assert fhir.stat().st_mode & 0o777 == 0o600 and table.stat().st_mode & 0o777 == 0o600
 
 
@@ -152,10 +159,11 @@ def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_
                         ("practice_read", "read", "2", "wrong (chose No)", "remote", ""),
                         ("practice_select", "select", "", "not answered", "", "")]
     assert [r["kind"] for r in rows] == ["practice"] * 3 + ["item"] * 10 + ["total"]
-    assert rows[-1]["points"] == "0" and rows[-1]["label"] == "incomplete"  # practice never scores
+    assert rows[-1]["points"] == "" and rows[-1]["label"] == "incomplete (0 points from 0 of 10 items)"  # practice never scores
 
     with Store.open(tmp_path / "data") as reopened:
         response = fhir_response(QUESTIONNAIRE, reopened.session(session_id))
+    check_fhir(response)
     assert {i["linkId"] for i in response["item"]} == {i.id for i in QUESTIONNAIRE.items} | {"total"}
 
 

@@ -115,7 +115,7 @@ def test_timing_overrides_are_checked():
     assert Q.timing.with_overrides({"attempt_window_s": 30}).attempt_window_s == 30
     with pytest.raises(ValueError, match="unknown timing setting 'window'"):
         Q.timing.with_overrides({"window": 3})
-    with pytest.raises(ValueError, match="must be a number of seconds >= 0"):
+    with pytest.raises(ValueError, match="must be a number of seconds from 0 to 86400"):
         Q.timing.with_overrides({"closing_s": -1})
 
 

@@ -63,7 +63,7 @@ def _check_exactly_once(db_url: str, kiosk_id: str, rows) -> None:
             assert stored.status == "finished"
             assert len(stored.trace) == sum(r.kind == "record_context" for r in own)
         alerts = connection.execute(sa.select(sa.func.count()).select_from(db.alerts)).scalar_one()
-        assert alerts == sum(r.alert and r.payload["kind"] in ("call_doctor", "doctor_called", "person_lost")
+        assert alerts == sum(r.alert and r.payload["kind"] in ("doctor_called", "person_lost")
                              for r in rows)
     engine.dispose()
 

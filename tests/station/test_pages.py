@@ -53,7 +53,7 @@ def open_page(browser, station, user: str, role: str, viewport):
 def test_an_alert_sounds_and_notifies_until_acknowledged(browser, ward, viewport):
     station, ward, kiosk = ward
     rows = record_patient(PATIENTS / "barthel6.yaml")
-    alert = next(r for r in rows if r.alert and r.payload["kind"] in ("call_doctor", "doctor_called", "person_lost"))
+    alert = next(r for r in rows if r.alert and r.payload["kind"] in ("doctor_called", "person_lost"))
     context, page = open_page(browser, station, "nurse.kim", "nurse", viewport)
     page.click("#enable-sound")
     page.wait_for_function("document.body.dataset.live === '1'")
@@ -79,7 +79,7 @@ def test_an_alert_sounds_and_notifies_until_acknowledged(browser, ward, viewport
 def test_continue_after_a_doctor_call_reaches_the_kiosk(browser, ward):
     station, ward, kiosk = ward
     rows = record_patient(PATIENTS / "barthel5.yaml")
-    call = next(r for r in rows if r.alert and r.payload["kind"] in ("call_doctor", "doctor_called"))
+    call = next(r for r in rows if r.alert and r.payload["kind"] == "doctor_called")
     kiosk.sync([r for r in rows if r.seq <= call.seq])
     context, page = open_page(browser, station, "nurse.kim", "nurse", PHONE)
     page.wait_for_function("document.body.dataset.live === '1'")

@@ -6,7 +6,8 @@ from __future__ import annotations
 import re
 
 from station.plot import qos_svg
-from station.sessions import Row as InboxRow, fold
+from station.sessions import Row as InboxRow
+from station.sessions import fold
 from tests.station.helpers import PATIENTS, record_patient
 
 
@@ -24,7 +25,7 @@ def test_each_metric_is_a_step_function_of_its_samples():
         xy = [tuple(map(float, p.split(","))) for p in points.split()]
         samples = [s for s in stored.metrics if name in s.metrics]
         assert len(xy) == 2 * len(samples)  # a rise or fall at each sample, a run after it
-        for (x0, y0), (x1, y1) in zip(xy, xy[1:]):
+        for (x0, y0), (x1, y1) in zip(xy, xy[1:], strict=False):
             assert x0 == x1 or y0 == y1  # only horizontal runs and vertical jumps, never slopes
 
 
@@ -32,7 +33,7 @@ def test_incidents_are_marked_with_what_happened():
     stored = _session("barthel5.yaml")
     svg = qos_svg(stored)
     marks = re.findall(r'class="incident incident-([a-z_]+)"><title>([^<]+)</title>', svg)
-    logged = [e.kind for e in stored.log if e.kind in ("pause", "call_doctor", "person_lost", "attempt_timed_out")]
+    logged = [e.kind for e in stored.log if e.kind in ("pause", "doctor_called", "person_lost", "attempt_timed_out")]
     assert logged and [kind for kind, _ in marks if kind in logged] == logged
     assert all(" s" in title for _, title in marks)
 

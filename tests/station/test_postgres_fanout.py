@@ -39,7 +39,7 @@ def test_an_alert_posted_to_one_station_appears_on_a_page_of_another(pg_url, sta
     name, initial = events.get(timeout=PATIENCE_S)
     assert name == "alerts" and initial["ids"] == []
     rows = record_patient(PATIENTS / "barthel6.yaml")
-    alert = next(r for r in rows if r.alert and r.payload["kind"] in ("person_lost", "call_doctor", "doctor_called"))
+    alert = next(r for r in rows if r.alert and r.payload["kind"] in ("person_lost", "doctor_called"))
     kiosk = KioskClient(first.url, ward.token, ward.kiosk_id)
     assert kiosk.sync([alert]).status_code == 200
     while True:

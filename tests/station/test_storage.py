@@ -6,14 +6,15 @@ from __future__ import annotations
 
 import pytest
 import sqlalchemy as sa
+from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
-from alembic.config import Config
 
 from kiosk.questionnaire import load_questionnaire
 from kiosk.review import ReviewState
 from station import auth, db, sync, validation
 from station.auth import User
+from station.sessions import load
 from tests.station.helpers import PATIENTS, record_patient
 
 
@@ -117,3 +118,33 @@ def test_passwords_are_argon2_hashed(engine):
     assert auth.login(engine, "dr.lopez", "wrong-password", "127.0.0.1") is None
     with pytest.raises(auth.AuthError, match="at least"):
         auth.add_user(engine, "nurse.kim", "nurse", "short")
+
+
+def test_a_withdrawn_answer_is_gone_and_the_session_follows_interruption_and_continuation(engine):
+    rows = record_patient(PATIENTS / "barthel1.yaml")
+    session_id = rows[0].session_id
+    first = next(r for r in rows if r.kind == "record_answer")
+    item = first.payload["item_id"]
+    seq = rows[-1].seq
+    extra = [  # the patient changed that answer, the kiosk died, staff continued the test elsewhere
+        {"seq": seq + 1, "kind": "withdraw_answer", "session_id": session_id, "at": first.at,
+         "payload": {"item_id": item, "t": first.t + 1, "at": first.at, "reason": "patient: change my answer"}},
+        {"seq": seq + 2, "kind": "mark_interrupted", "session_id": session_id, "at": first.at,
+         "payload": {"reason": "the kiosk stopped"}},
+    ]
+    events = [r.event() for r in rows if r.kind != "finish_session"] + extra
+    with engine.begin() as connection:
+        sync.intake(connection, "bed1", sync.parse({"events": events}))
+        stored = load(connection, session_id)[1]
+    assert item not in {a.item_id for a in stored.answers}
+    assert stored.status == "interrupted" and stored.interrupted_reason == "the kiosk stopped"
+    again = {"seq": seq + 3, "kind": "continue_session", "session_id": session_id, "at": first.at, "payload": {}}
+    answer = {"seq": seq + 4, "kind": "record_answer", "session_id": session_id, "at": first.at,
+              "payload": first.payload | {"option": 1, "points": load_questionnaire().item(item).option(1).points}}
+    with engine.begin() as connection:
+        sync.intake(connection, "bed1", sync.parse({"events": [again, answer]}))
+        stored = load(connection, session_id)[1]
+        listed = connection.execute(sa.select(db.sessions.c.status).where(db.sessions.c.id == session_id)).scalar()
+    assert stored.status == listed == "running" and stored.interrupted_reason is None
+    assert {a.item_id: a.option for a in stored.answers}[item] == 1
+    assert not [e for e in stored.log if e.kind.startswith("unrecognised")]

@@ -31,7 +31,9 @@ class UiKiosk:
 
     def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
                  language: str = "en", session_id: str = UI_SESSION_ID,
-                 voice=None, keyboard=None, sources=(), poll_interval: float = 3600, speaker=None) -> None:
+                 voice=None, keyboard=None, sources=(), poll_interval: float = 3600, speaker=None,
+                 show_score: bool = False, next_patient_after_s: float | None = None) -> None:
+        self.next_patient_after_s = next_patient_after_s
         self.clock = SimClock()
         self.questionnaire = load_questionnaire()
         self.store = Store.open(tmp_path / "data")
@@ -39,6 +41,7 @@ class UiKiosk:
             self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)), patient_id=UI_PATIENT_ID,
             store=self.store, language=language, session_id=session_id,
             adaptation=Adaptation(load_policy()) if adaptation else None, familiarisation=familiarisation,
+            next_patient_after_s=next_patient_after_s,
         )
         self.app = KioskApp(
             self.session, clinician_pin=UI_PIN, store=self.store, export_dir=tmp_path / "exports", voice=voice,
@@ -48,13 +51,14 @@ class UiKiosk:
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
             # of the real timer never finds anything due
             poll_interval=poll_interval,
-            resume=self._resume, new_session=self._fresh,
+            resume=self._resume, new_session=self._fresh, show_score=show_score,
         )
 
     def _fresh(self) -> Session:
         """A session for the next patient, as `kiosk run` builds it (a new id, so it can be stored)."""
         return Session(self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)),
-                       patient_id="P-TEST02", store=self.store, adaptation=Adaptation(load_policy()))
+                       patient_id="P-TEST02", store=self.store, adaptation=Adaptation(load_policy()),
+                       next_patient_after_s=self.next_patient_after_s)
 
     def _resume(self, stored) -> Session:
         """The session continuing ``stored``, as `kiosk run` builds it."""

@@ -13,6 +13,7 @@ from textual.widgets import DataTable, Label, Switch
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.session import AdaptationChanged
 from kiosk.widgets.metrics_plot import MetricsPlot
+from tests.fhir.standard import check_fhir
 
 from .conftest import UI_PIN
 from .helpers import answer_every_question, screen_name, settle, start_in_english, text_of
@@ -54,6 +55,7 @@ async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk,
             assert str(path) in text_of(screen.query_one("#export-result", Label))
             assert stat.S_IMODE(path.stat().st_mode) == 0o600
         response = json.loads((exports / f"session-{kiosk.session.id}.fhir.json").read_text())
+        check_fhir(response)  # valid R4 for the official schema and fhir.resources
         assert response["resourceType"] == "QuestionnaireResponse" and response["status"] == "completed"
         rows = list(csv.DictReader(io.StringIO((exports / f"session-{kiosk.session.id}.csv").read_text())))
         assert len(rows) == 11 and rows[-1]["points"] == "85"

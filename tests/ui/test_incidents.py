@@ -47,7 +47,7 @@ async def test_call_doctor_halts_until_a_clinician_continues_behind_the_pin(ui_k
         await _first_question(kiosk, pilot)
         await pilot.click("#call-doctor")
         await settle(pilot, lambda: screen_name(kiosk) == "DoctorCalledScreen")
-        await pilot.press("p", "1")  # the patient's keys do nothing while halted
+        await pilot.press("p", "2")  # other keys do nothing while halted (1 is "I am fine, carry on")
         await settle(pilot)
         assert kiosk.session.halted and kiosk.session.answers == {}
 

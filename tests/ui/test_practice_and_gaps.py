@@ -41,9 +41,13 @@ async def test_a_kiosk_without_voice_out_never_asks_which_word_was_heard(ui_kios
         assert _question_text(kiosk) == "Please choose the answer that says yes."
         assert _progress(kiosk) == "Practice 1 of 2"
         await pilot.press("1")
+        await settle(pilot, lambda: _interlude(kiosk) == "Well done.")  # a kind word first
+        kiosk.to_next_deadline()
         await settle(pilot, lambda: _question_text(kiosk) == "Please choose answer number 3.")
         assert _progress(kiosk) == "Practice 2 of 2"
         await pilot.press("3")
+        await settle(pilot, lambda: _interlude(kiosk) == "Well done.")
+        kiosk.to_next_deadline()
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
     outcomes = [(p.question_id, p.outcome, p.detail) for p in kiosk.store.session(kiosk.session.id).practice]
     assert outcomes == [("practice_hear", "skipped", "no voice out"), ("practice_read", "right", "key 1"),
@@ -128,8 +132,10 @@ async def test_the_clinician_sees_how_the_practice_went(ui_kiosk):
         await pilot.press("1")
         await settle(pilot, lambda: kiosk.session.snapshot().practice is not None)
         await pilot.press("2")  # "No" where "Yes" was asked for
+        kiosk.to_next_deadline()  # after the kind word
         await settle(pilot, lambda: kiosk.session.snapshot().practice.id == "practice_select")
         await pilot.press("3")
+        kiosk.to_next_deadline()
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         await _session_detail(kiosk, pilot)
         line = text_of(kiosk.app.screen.query_one("#practice", Label))

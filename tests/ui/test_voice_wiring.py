@@ -1,7 +1,9 @@
 """The app wired to the real voice channel: the kiosk's espeak-ng synthesiser speaks an answer into a WAV file, a thread
 plays it into the channel the way the microphone's thread delivers audio (no sound card here),
 pocketsphinx recognises it with the grammar the app set from the question's prompt, and the answer
-reaches the session through the app's sink -- recorded with channel voice."""
+reaches the session through the app's sink. A spoken answer is asked back ("I heard: … Is that
+right?") and stored -- with channel voice -- only once a spoken "yes" confirms it; a spoken "no,
+that's wrong" asks the question again and stores nothing."""
 
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel
 from kiosk.widgets.channel_board import VOICE_IN
 
-from .helpers import settle, start_in_english, until_thread
+from .helpers import settle, start_in_english, text_of, until_thread
 
 PATIENCE_S = 30.0
 
@@ -49,7 +51,10 @@ class WavMicrophone:
 
 
 async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp_path):
-    wav = Synthesiser().synthesise("independent", "en", tmp_path / "independent.wav")
+    synthesiser = Synthesiser()
+    wav = synthesiser.synthesise("independent", "en", tmp_path / "independent.wav")
+    no = synthesiser.synthesise("no, that's wrong", "en", tmp_path / "no.wav")
+    yes = synthesiser.synthesise("yes", "en", tmp_path / "yes.wav")
     microphones: list[WavMicrophone] = []
     voice = VoiceChannel(
         "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
@@ -62,6 +67,17 @@ async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp
         assert kiosk.session.current_item.id == "feeding"
         assert "Listening: listening" in str(kiosk.app.screen.query_one("#channels").render())
         microphones[0].play(wav)
+        await until_thread(lambda: kiosk.session.snapshot().confirming == 3, "the voice channel")
+        await settle(pilot, lambda: bool(kiosk.app.screen.query("ConfirmPanel")))
+        assert text_of(kiosk.app.screen.query_one("#confirm-question")) == "I heard: Independent. Is that right?"
+        assert kiosk.store.session(kiosk.session.id).answers == ()  # nothing stored yet
+        microphones[0].play(no)
+        await until_thread(lambda: kiosk.session.snapshot().confirming is None, "the voice channel")
+        await settle(pilot, lambda: bool(kiosk.app.screen.query("QuestionPanel")))
+        assert kiosk.store.session(kiosk.session.id).answers == () and kiosk.session.current_attempt == 1
+        microphones[0].play(wav)
+        await until_thread(lambda: kiosk.session.snapshot().confirming == 3, "the voice channel")
+        microphones[0].play(yes)
         await until_thread(lambda: "feeding" in kiosk.session.answers, "the voice channel")
         await settle(pilot)
     answer = kiosk.store.session(kiosk.session.id).answers[0]

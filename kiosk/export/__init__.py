@@ -1,0 +1,58 @@
+"""Exports of stored sessions a hospital and its researchers can take as they are.
+
+- :mod:`kiosk.export.result`: what every export states (answers after a clinician's review,
+  totals recomputed from the option numbers, complete or not, signed off or not) and who exports
+  (:class:`ExportSite`: the site, the kiosk, the site's FHIR systems and canonical URL).
+- :mod:`kiosk.export.fhir`: FHIR R4 — a Questionnaire per language with translations, the
+  QuestionnaireResponse, the total as an Observation, one transaction Bundle; its docstring
+  gives each choice and the part of R4 it follows.
+- :mod:`kiosk.export.tables`: CSV for researchers, long and wide, ids that stay text.
+
+Never a total for an incomplete result: a partial sum is only ever shown apart, as the points of
+the answered items. The station passes the session's :class:`kiosk.review.Review`; the kiosk on
+its own exports results as unreviewed.
+"""
+
+from kiosk.export.fhir import (
+    ITEM_WEIGHT,
+    ORDINAL_VALUE,
+    SIGNATURE,
+    TRANSLATION,
+    fhir_device,
+    fhir_questionnaire,
+    fhir_response,
+    fhir_total,
+    observation_status,
+    questionnaire_bundle,
+    questionnaire_canonical,
+    response_status,
+    transaction_bundle,
+)
+from kiosk.export.result import (
+    PRACTICE_CHECKS,
+    TOTAL_LINK,
+    ExportError,
+    ExportSite,
+    PracticeOutcome,
+    Result,
+    practice_outcome,
+    practice_outcomes,
+    questionnaire_version,
+    rescore,
+    result,
+    results,
+    site_from_config,
+    write_export,
+    write_json,
+    write_private,
+)
+from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, wide_columns, wide_csv_text
+
+__all__ = [
+    "CSV_COLUMNS", "ID_TAGS", "ITEM_WEIGHT", "ORDINAL_VALUE", "PRACTICE_CHECKS", "SIGNATURE", "TOTAL_LINK",
+    "TRANSLATION", "ExportError", "ExportSite", "PracticeOutcome", "Result", "csv_text", "fhir_device",
+    "fhir_questionnaire", "fhir_response", "fhir_total", "observation_status", "practice_outcome",
+    "practice_outcomes", "questionnaire_bundle", "questionnaire_canonical", "questionnaire_version", "rescore",
+    "response_status", "result", "results", "site_from_config", "transaction_bundle", "wide_columns",
+    "wide_csv_text", "write_export", "write_json", "write_private",
+]

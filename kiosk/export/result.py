@@ -1,0 +1,216 @@
+"""What every export of a stored session states: a :class:`Result` is the session's answers after
+a clinician's corrections (:class:`kiosk.review.Review`), their score recomputed from the option
+numbers (a stored total or stored points are never trusted), whether it is complete and whether a
+clinician signed it off; :class:`ExportSite` is who exports (site, kiosk, FHIR systems)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from kiosk.config import Config, default_kiosk_id
+from kiosk.questionnaire import Questionnaire, Score
+from kiosk.review import Review, ReviewState
+from kiosk.storage import PracticeRecord, StoredSession
+from qos.files import write_error, write_private  # the one owner-only writer; exports use it from here too
+
+TOTAL_LINK = "total"
+
+
+class ExportError(ValueError):
+    """A stored session does not fit the questionnaire (unknown item, option or points), a
+    review does not fit the session, or an export cannot be written."""
+
+
+@dataclass(frozen=True)
+class ExportSite:
+    """Who exports: the site and the kiosk, and the FHIR systems and URLs the site owns.
+
+    The defaults are URNs under ``urn:barthel-kiosk:`` with the site code in them; a hospital
+    sets its own (``site``, ``kiosk_id`` and ``fhir:`` in the kiosk's config,
+    :func:`site_from_config`).
+    """
+
+    site: str = "local"
+    kiosk_id: str = field(default_factory=default_kiosk_id)
+    #: the system of the patients' pseudonymous ids
+    patient_system: str = ""
+    #: the canonical URL of the questionnaire; one Questionnaire per language is ``URL-LANG``
+    #: (empty: ``urn:barthel-kiosk:SITE:questionnaire:ID``, ID the questionnaire file's id)
+    questionnaire_url: str = ""
+    #: the system of result identifiers: ``SITE/KIOSK/SESSION`` (+ ``/total`` for the Observation)
+    identifier_system: str = ""
+    #: the system of kiosk ids (the FHIR Device's identifier)
+    device_system: str = ""
+
+    def __post_init__(self) -> None:
+        defaults = {"patient_system": f"urn:barthel-kiosk:{self.site}:patient",
+                    "identifier_system": "urn:barthel-kiosk:result",
+                    "device_system": f"urn:barthel-kiosk:{self.site}:kiosk"}
+        for name, value in defaults.items():
+            if not getattr(self, name):
+                object.__setattr__(self, name, value)
+
+    def result_id(self, session_id: str) -> str:
+        """The stable business identifier of a session's result: site + kiosk + session."""
+        return f"{self.site}/{self.kiosk_id}/{session_id}"
+
+
+def site_from_config(config: Config) -> ExportSite:
+    """The export site of a :class:`kiosk.config.Config`."""
+    return ExportSite(site=config.site, kiosk_id=config.kiosk_id, **dict(config.fhir))
+
+
+def questionnaire_version(q: Questionnaire) -> str:
+    """The questionnaire's version as exports state it: the file's ``version`` and the start of
+    its content hash (``1.0-3f2a9c1b7e4d``), so that any edit of the file gives a new version."""
+    return f"{q.version}-{q.digest[:12]}" if q.version else q.digest[:12]
+
+
+def rescore(q: Questionnaire, stored: StoredSession) -> Score:
+    """The score recomputed from the stored option numbers (ExportError if they do not fit)."""
+    points = {}
+    for answer in stored.answers:
+        try:
+            option = q.item(answer.item_id).option(answer.option)
+        except KeyError as exc:
+            raise ExportError(f"session {stored.id}: {exc.args[0]}") from None
+        if option.points != answer.points:
+            raise ExportError(f"session {stored.id}: {answer.item_id} option {answer.option} is worth "
+                              f"{option.points} points in {q.id}, but {answer.points} were stored")
+        assert option.points is not None
+        points[answer.item_id] = option.points
+    return q.score(points)
+
+
+@dataclass(frozen=True)
+class Result:
+    """A stored session as exports state it: answers after review, their score, where it stands."""
+
+    stored: StoredSession
+    review: Review
+    #: item id -> option number, after the clinician's corrections
+    options: dict[str, int]
+    #: the score of ``options`` (complete, total and band only when every item has an answer)
+    score: Score
+
+    @property
+    def complete(self) -> bool:
+        """Every item answered (by the patient, or filled by a clinician)."""
+        return self.score.complete
+
+    @property
+    def final(self) -> bool:
+        """Signed off by a clinician (with or without corrections)."""
+        return self.review.final
+
+    @property
+    def changers(self) -> tuple[str, ...]:
+        """Who changed an answer the kiosk recorded (or filled one it had not), oldest first."""
+        return tuple(dict.fromkeys(c.author for c in self.review.corrections if self.recorded(c.item_id) != c.option))
+
+    @property
+    def amended(self) -> bool:
+        """Signed off with answers other than the kiosk recorded (state ``amended``, or a sign-off
+        that still carries corrections: a changed answer is never reported as the kiosk's)."""
+        return self.final and (self.review.state == ReviewState.AMENDED or bool(self.changers))
+
+    @property
+    def review_state(self) -> str:
+        """``unreviewed``, ``signed_off`` or ``amended`` (see :attr:`amended`)."""
+        return ReviewState.AMENDED.value if self.amended else ReviewState(self.review.state).value
+
+    def recorded(self, item_id: str) -> int | None:
+        """The option the kiosk stored for an item (None: not answered at the kiosk)."""
+        return next((a.option for a in self.stored.answers if a.item_id == item_id), None)
+
+    @property
+    def answered_points(self) -> int:
+        """Points of the answered items: the total only when complete."""
+        return self.score.total
+
+
+def result(q: Questionnaire, stored: StoredSession, review: Review | None = None) -> Result:
+    """A stored session with its review applied (ExportError if either does not fit ``q``)."""
+    review = review or Review.unreviewed()
+    if stored.questionnaire_id != q.id:
+        raise ExportError(f"session {stored.id} was answered on questionnaire {stored.questionnaire_id!r}, "
+                          f"not on {q.id!r} ({q.source}): export it with that questionnaire")
+    rescore(q, stored)  # the stored answers must fit the questionnaire before anything is said about them
+    options = review.options({a.item_id: a.option for a in stored.answers})
+    points = {}
+    for item_id, number in options.items():
+        try:
+            option = q.item(item_id).option(number)
+        except KeyError as exc:
+            raise ExportError(f"session {stored.id}: review: {exc.args[0]}") from None
+        assert option.points is not None
+        points[item_id] = option.points
+    return Result(stored, review, options, q.score(points))
+
+
+def results(q: Questionnaire, sessions: Sequence[StoredSession],
+            reviews: Sequence[Review | None] | None = None) -> list[Result]:
+    """Each session with its review (``reviews`` in the same order; None: all unreviewed)."""
+    if reviews is not None and len(reviews) != len(sessions):
+        raise ExportError(f"{len(sessions)} sessions but {len(reviews)} reviews: give one review per session")
+    return [result(q, stored, review) for stored, review in zip(sessions, reviews or [None] * len(sessions))]
+
+
+#: what each kind of practice question checks, as a clinician reads it
+PRACTICE_CHECKS = {"hear": "hearing", "read": "reading", "select": "selecting"}
+
+
+@dataclass(frozen=True)
+class PracticeOutcome:
+    """How one practice question went, in a clinician's words: "hearing: wrong (chose Chair)"."""
+
+    #: what it checks: "hearing", "reading" or "selecting"
+    what: str
+    #: "right", "wrong", "not answered" or "skipped"
+    outcome: str
+    #: the option chosen for a wrong answer ("chose Chair"), why it was skipped ("no voice out"), or ""
+    detail: str = ""
+
+    @property
+    def result(self) -> str:
+        """The outcome with its detail: "wrong (chose Chair)", "skipped (no voice out)", "right"."""
+        return f"{self.outcome} ({self.detail})" if self.detail else self.outcome
+
+    def __str__(self) -> str:
+        return f"{self.what}: {self.result}"
+
+
+def practice_outcome(q: Questionnaire, record: PracticeRecord, language: str) -> PracticeOutcome:
+    """A stored practice record in a clinician's words (a wrong answer names the option chosen)."""
+    what = PRACTICE_CHECKS.get(record.checks, record.checks)
+    if record.outcome == "wrong":
+        question = next((p for p in q.familiarisation if p.id == record.question_id), None)
+        chosen = (question.option(record.option).label_in(language)
+                  if question is not None and record.option is not None
+                  and 1 <= record.option <= len(question.options) else f"option {record.option}")
+        return PracticeOutcome(what, "wrong", f"chose {chosen}")
+    if record.outcome == "skipped":
+        return PracticeOutcome(what, "skipped", record.detail)
+    return PracticeOutcome(what, record.outcome.replace("_", " "))
+
+
+def practice_outcomes(q: Questionnaire, stored: StoredSession) -> list[PracticeOutcome]:
+    """The session's practice questions in the order they happened (empty without familiarisation)."""
+    return [practice_outcome(q, record, stored.language) for record in stored.practice]
+
+
+def write_export(path: str | Path, text: str) -> None:
+    """Write an export owner-only; ExportError ``cannot write PATH: reason`` when the path is unusable."""
+    try:
+        write_private(path, text)
+    except OSError as exc:
+        raise ExportError(write_error(path, exc)) from None
+
+
+def write_json(path: str | Path, resource: dict[str, Any]) -> None:
+    """Write a FHIR resource as JSON, owner-only (ExportError when the path is unusable)."""
+    write_export(path, json.dumps(resource, indent=2, ensure_ascii=False) + "\n")

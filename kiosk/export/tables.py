@@ -1,0 +1,137 @@
+"""CSV for researchers: :func:`csv_text` (long: rows per practice question, item and total) and
+:func:`wide_csv_text` (one row per session).
+
+Ids are written with a kind tag (``S:`` session, ``P:`` patient, ``K:`` kiosk) so that no reader
+(pandas, spreadsheets) takes ``00123``, ``8e1234567890``, ``NA`` or ``True`` for a number, a
+missing value or a boolean; strip the first two characters to get the id (``kiosk results``
+accepts the tagged session id too). ``complete`` and ``simulated`` (a scripted patient's session,
+from ``kiosk replay``) are ``true``/``false``. ``bom=True`` starts the
+text with a UTF-8 byte-order mark for spreadsheets that need it.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Sequence
+from typing import Any
+
+from kiosk.export.result import (
+    TOTAL_LINK,
+    ExportSite,
+    Result,
+    practice_outcomes,
+    questionnaire_version,
+    results,
+)
+from kiosk.questionnaire import Questionnaire
+from kiosk.review import Review
+from kiosk.storage import StoredSession
+
+#: the tags that keep ids text in CSV readers; see the module docstring
+ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
+
+
+#: The long CSV: ``kind`` tells rows apart: "practice" (one per practice question, first, in the
+#: order asked; ``checks`` says what it checks; never scored), "item" (one per questionnaire item, in
+#: order: the option after review; ``recorded_option`` the kiosk's own when a clinician changed it,
+#: ``corrected_by`` who did) and "total" (last: ``points`` the total, blank when incomplete, with
+#: ``label`` "incomplete (N points from K of M items)"; its band and ``band_set``, the set that
+#: gave it: "severe" is 21-60 in Shah's set but 20-35 in the Spanish one). Every row carries the
+#: session's columns (ids tagged, see the module docstring).
+CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
+               "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks", "finished_at",
+               "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by",
+               "simulated"]
+
+
+def tag(kind: str, value: str) -> str:
+    """An id as the CSV writes it (``S:``, ``P:`` or ``K:`` before it)."""
+    return ID_TAGS[kind] + value
+
+
+def _band(q: Questionnaire, r: Result) -> str:
+    return r.score.band.id if r.score.band else ""
+
+
+def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, str]:
+    stored = r.stored
+    return {"session": tag("session", stored.id), "patient": tag("patient", stored.patient_id),
+            "kiosk_id": tag("kiosk_id", site.kiosk_id), "started_at": stored.started_at,
+            "finished_at": stored.finished_at or "", "status": stored.status, "language": stored.language,
+            "answered_by": stored.answered_by.value, "questionnaire": q.id,
+            "questionnaire_version": questionnaire_version(q), "complete": "true" if r.complete else "false",
+            "review_state": r.review_state, "simulated": "true" if stored.simulated else "false"}
+
+
+def _writer(out: io.StringIO, columns: list[str]) -> csv.DictWriter:
+    writer = csv.DictWriter(out, columns, lineterminator="\n", extrasaction="ignore")
+    writer.writeheader()
+    return writer
+
+
+def csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
+             site: ExportSite | None = None, *, bom: bool = False) -> str:
+    """The long CSV (see :data:`CSV_COLUMNS`) of sessions with their reviews (None: unreviewed)."""
+    site = site or ExportSite()
+    out = io.StringIO()
+    writer = _writer(out, CSV_COLUMNS)
+    for r in results(q, sessions, reviews):
+        stored = r.stored
+        common = _session_columns(q, r, site)
+        for record, outcome in zip(stored.practice, practice_outcomes(q, stored)):
+            writer.writerow(common | {"item": record.question_id, "option": record.option or "", "label": outcome.result,
+                                      "channel": record.channel.value if record.channel else "",
+                                      "t": f"{record.t:g}", "kind": "practice", "checks": record.checks})
+        answers = {a.item_id: a for a in stored.answers}
+        corrections = {c.item_id: c for c in r.review.corrections}
+        for item in q.items:
+            row = common | {"item": item.id, "kind": "item", "answered_by": ""}
+            number = r.options.get(item.id)
+            if number is None:
+                writer.writerow(row | {"label": "not answered"})
+                continue
+            row |= {"option": number, "label": item.option(number).label_in(stored.language),
+                    "points": item.option(number).points}
+            a = answers.get(item.id)
+            if a is not None and a.option == number:
+                row |= {"attempt": a.attempt, "channel": a.channel.value, "answered_by": a.answered_by.value,
+                        "t": f"{a.t:g}"}
+            elif item.id in corrections:
+                row |= {"recorded_option": a.option if a else "", "corrected_by": corrections[item.id].author}
+            writer.writerow(row)
+        score = r.score
+        label = _band(q, r) if score.complete else (
+            f"incomplete ({score.total} points from {len(score.answered)} of {len(q.items)} items)")
+        writer.writerow(common | {"item": TOTAL_LINK, "label": label, "points": score.total if score.complete else "",
+                                  "band_set": score.band_set, "kind": "total"})
+    return ("\ufeff" if bom else "") + out.getvalue()
+
+
+def wide_columns(q: Questionnaire) -> list[str]:
+    """The wide CSV's columns: the session's, then each item's option number and points."""
+    return ["session", "patient", "kiosk_id", "started_at", "finished_at", "status", "language", "answered_by",
+            "questionnaire", "questionnaire_version", "complete", "review_state", "signed_by", "signed_at", "simulated",
+            "total", "answered_points", "missing", "band", "band_set"] + [
+        f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
+
+
+def wide_csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
+                  site: ExportSite | None = None, *, bom: bool = False) -> str:
+    """One row per session (see :func:`wide_columns`): ``total`` only when complete, the points of
+    the answered items apart in ``answered_points`` and the unanswered items in ``missing``."""
+    site = site or ExportSite()
+    out = io.StringIO()
+    writer = _writer(out, wide_columns(q))
+    for r in results(q, sessions, reviews):
+        row: dict[str, Any] = _session_columns(q, r, site) | {
+            "signed_by": r.review.signed_by or "", "signed_at": r.review.signed_at or "",
+            "total": r.score.total if r.complete else "", "answered_points": r.answered_points,
+            "missing": " ".join(r.score.missing), "band": _band(q, r), "band_set": r.score.band_set}
+        for item in q.items:
+            number = r.options.get(item.id)
+            if number is not None:
+                row |= {f"{item.id}_option": number, f"{item.id}_points": item.option(number).points}
+        writer.writerow(row)
+    return ("\ufeff" if bom else "") + out.getvalue()
+
