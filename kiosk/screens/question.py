@@ -82,10 +82,10 @@ class QuestionScreen(PatientScreen):
             line.update(view.questionnaire.message(key, self.language) or ui_text(self.language, key)
                         if key else "")
             line.display = bool(key)
-        if key:
-            self.call_after_refresh(self._place_interlude)
         for button in self.query(ChangeAnswerButton):
             button.show(view.snapshot.can_undo)
+        if key or view.snapshot.can_undo:
+            self.call_after_refresh(self._place_interlude)
         if not self.is_mounted:  # compose has not run yet: it will draw this view
             return
         item = view.snapshot.item
@@ -114,6 +114,10 @@ class QuestionScreen(PatientScreen):
                 question = questions.first().region
                 line.styles.offset = (0, question.y)
                 line.styles.height = max(1, question.height)
+                for button in self.query(ChangeAnswerButton):  # at the right, over the question
+                    width = len(str(button.label)) + 4
+                    button.styles.width = width
+                    button.styles.offset = (max(0, self.size.width - width - 1), question.y)
 
     def _reword(self, view: PatientView, item: Item) -> bool:
         """Put ``item`` into the panel on screen when it has as many answers (no remount); False
