@@ -11,7 +11,9 @@ import time
 
 import pytest
 
+from kiosk.questionnaire import load_questionnaire
 from kiosk.session import Phase
+from kiosk.widgets.text import language_name
 
 from .conftest import UiKiosk
 from .fit import problems
@@ -146,6 +148,8 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                     assert time.monotonic() < deadline, f"never saw {what}"
                     await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S
 
+            questionnaire = load_questionnaire()
+            explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
             answered = 0
             for name, target, regions in steps:
                 for region in regions:
