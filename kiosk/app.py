@@ -19,6 +19,8 @@ microphone, no espeak-ng, no remote) is shown as off with its reason and the ses
 from __future__ import annotations
 
 import argparse
+import contextlib
+import sqlite3
 import sys
 from functools import partial
 from collections.abc import Callable, Iterable
@@ -138,6 +140,7 @@ class KioskApp(App[int], inherit_bindings=False):
         resume: Callable[[StoredSession], Session] | None = None,
         new_session: Callable[[], Session] | None = None,
         show_score: bool = False,
+        sync: Any = None,
     ) -> None:
         super().__init__()
         # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
@@ -160,6 +163,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self._new_session = new_session
         #: the end screen shows the patient their total and band (config show_score_to_patient)
         self.show_score = show_score
+        #: the ward station's client (``kiosk.sync.SyncClient``), or None: no station, no threads
+        self.sync = sync
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is not None:  # its worker thread reports through these (it starts on mount)
             speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
@@ -195,10 +200,14 @@ class KioskApp(App[int], inherit_bindings=False):
         if self.store is not None:
             self.set_interval(LEASE_TTL_S / 3, self.keep_session)
         self._greet()
+        if self.sync is not None:
+            self.sync.start()
         self._render()
 
     def on_unmount(self) -> None:
-        """Stop every channel (each stop is safe to call twice)."""
+        """Stop every channel (each stop is safe to call twice) and the station's client."""
+        if self.sync is not None:
+            self.sync.stop()
         for source in self._input_sources():
             source.stop()
         if self.speaker is not None:
@@ -282,7 +291,8 @@ class KioskApp(App[int], inherit_bindings=False):
         old, self.session = self.session, session
         self._unsubscribe()
         if self.store is not None and old.id != session.id:
-            self.store.release(old.id)  # a finished one is let go; one still running is interrupted
+            with contextlib.suppress(sqlite3.Error):  # else keep_session lets it go later
+                self.store.release(old.id)  # a finished one is let go; one still running is interrupted
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -332,9 +342,13 @@ class KioskApp(App[int], inherit_bindings=False):
         except SessionTaken as taken:
             self._session_lost(str(taken))
             return
+        except sqlite3.Error as failed:  # the step was rolled back: the session in memory is ahead of it
+            self._session_lost(f"the kiosk could not store its last step ({failed})")
+            return
         if self._dirty:
             self._dirty = False
             self._render()
+        self._report_status()
 
     def _on_session_event(self, event: SessionEvent) -> None:
         """Carry out what an event asks of the channels; the redraw follows the operation."""
@@ -535,6 +549,34 @@ class KioskApp(App[int], inherit_bindings=False):
         self._greet()
         self.close_clinician()
 
+    # -- the ward station (kiosk.sync) ----------------------------------------------------------
+
+    def _report_status(self) -> None:
+        """Give the station's client what the ward view shows of this kiosk (sent when it changes)."""
+        if self.sync is not None:
+            from kiosk.sync.commands import live_status
+
+            self.sync.set_status(live_status(self.session))
+
+    def station_command(self, command: Any) -> tuple[str, str | None] | None:
+        """A command from the ward station (called on the client's thread): applied on the UI thread."""
+        from kiosk.sync.commands import apply_command
+
+        return self.call_from_thread(apply_command, self, dict(command))
+
+    def end_session(self, reason: str) -> None:
+        """Staff end the running test (stored as abandoned, with why); the kiosk welcomes the next patient."""
+        try:
+            self.session.abandon(reason)
+        except SessionTaken:
+            pass  # another kiosk holds it now: nothing of it is this kiosk's to end
+        if self._new_session is not None:
+            self._replace_session(self._new_session())
+            self._greet()
+        self._screen_key = None
+        self._render()
+        self._report_status()
+
     # -- interrupted tests and this kiosk's hold on its session ------------------------------------
 
     def interrupted_tests(self) -> list[StoredSession]:
@@ -561,12 +603,14 @@ class KioskApp(App[int], inherit_bindings=False):
         """Renew this kiosk's hold on its session and interrupt the tests whose kiosk is gone (a
         timer calls this); a running session this kiosk no longer holds is let go."""
         assert self.store is not None
-        self.store.renew()
-        self.store.interrupt_stale()
         session = self.session
-        if session.phase is Phase.WELCOME or session.finished:
-            return
-        why = self.store.why_not_held(session.id)
+        try:
+            self.store.renew()
+            self.store.release_others(session.id)  # one this kiosk dropped when it could not write
+            self.store.interrupt_stale()
+            why = None if session.phase is Phase.WELCOME or session.finished else self.store.why_not_held(session.id)
+        except sqlite3.Error:
+            return  # the database is busy or failing: the next round tries again
         if why is not None:
             self._session_lost(why)
 
@@ -612,9 +656,9 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     from kiosk.clock import SystemClock
     from kiosk.config import ConfigError, configured_questionnaire, load_config
     from kiosk.questionnaire import QuestionnaireError
-    from kiosk.records import MODEL
+    from kiosk.qos_model import load_kiosk_model
     from kiosk.storage import PATIENT_ID, StorageError, new_patient_id
-    from qos import Engine, load_model
+    from qos import Engine, ModelError
 
     if patient_id is not None and not PATIENT_ID.match(patient_id):
         raise SetupError(f"--patient {patient_id!r} is not a pseudonymous id: use letters, digits, '-' "
@@ -623,15 +667,17 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     try:
         config = load_config(config_path)
         questionnaire = configured_questionnaire(config)
-        policy = load_policy(config.adaptation_policy) if config.adaptation else None
+        model = load_kiosk_model(config.qos_model)
+        policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
         store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
                            outbox=config.station is not None)
+        sync = _station_client(config.station, store, lambda command: app.station_command(command))
         # what a kiosk that stopped left running is interrupted now: for staff, never a patient
         store.interrupt_stale()
     except QuestionnaireError as error:
         problems = getattr(error, "problems", None)
         raise SetupError("\n".join(str(p) for p in problems) if problems else str(error)) from None
-    except (ConfigError, PolicyError, StorageError) as error:
+    except (ConfigError, PolicyError, ModelError, StorageError) as error:
         raise SetupError(str(error)) from None
     statuses: list[ChannelStatus] = []
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
@@ -640,13 +686,13 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     clock = SystemClock()
 
     def fresh(patient: str | None = None) -> Session:
-        return Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)),
+        return Session(questionnaire, clock=clock, engine=Engine(model),
                        patient_id=patient or new_patient_id(), store=store, language=config.language,
                        timing=config.timing, adaptation=Adaptation(policy) if policy else None,
                        familiarisation=config.familiarisation, next_patient_after_s=config.next_patient_after_s)
 
     def resume(stored: StoredSession) -> Session:
-        return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(load_model(MODEL)),
+        return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(model),
                                    store=store, timing=config.timing,
                                    adaptation=Adaptation(policy) if policy else None,
                                    next_patient_after_s=config.next_patient_after_s)
@@ -655,8 +701,21 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports", export_site=site_from_config(config),
-                   resume=resume, new_session=fresh, show_score=config.show_score_to_patient)
+                   resume=resume, new_session=fresh, show_score=config.show_score_to_patient,
+                   sync=sync)
     return app, store.close
+
+
+def _station_client(station: Any, store: Store, on_command: Callable[[Any], Any]) -> Any:
+    """The ward station's client (started with the app), or None when no station is configured."""
+    if station is None:
+        return None
+    from kiosk.sync import SyncClient
+
+    client = SyncClient(store.path, url=station.url, token=station.token, kiosk_id=station.kiosk_id,
+                        on_command=on_command)
+    store.on_outbox = client.wake
+    return client
 
 
 def _remotes(profiles: Path | None, wanted: bool, statuses: list[ChannelStatus],

@@ -14,6 +14,7 @@ Example ``config.yaml`` (every key optional)::
     serve_max_sessions: 2             # browser connections `kiosk serve` runs at once
     adaptation: true                  # live adaptation on/off
     adaptation_policy: /etc/kiosk/adaptation.yaml
+    qos_model: /etc/kiosk/ward.roqme  # the QoS model (default: the bundled clarc; also kiosk_pace)
     questionnaire: /etc/kiosk/barthel.yaml
     bands: spanish                    # a band set of the questionnaire (default: the file's default)
     familiarisation: true             # practice questions before the questionnaire
@@ -55,6 +56,7 @@ import platformdirs
 from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
 from kiosk.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.yamlmarks import Problem, parse_file
+from qos import bundled_models
 from qos.files import BadFile, open_private, read_text
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
@@ -112,6 +114,8 @@ class Config:
     adaptation: bool = True
     #: an adaptation policy file (None: the bundled kiosk/adaptation.yaml)
     adaptation_policy: Path | None = None
+    #: the QoS model: a bundled model's name, or a .roqme file's absolute path (see kiosk.qos_model)
+    qos_model: str = "clarc"
     #: a questionnaire file (None: the bundled Barthel questionnaire)
     questionnaire: Path | None = None
     #: the questionnaire's band set that interprets totals (None: the file's default, Shah 1989)
@@ -255,8 +259,8 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "serve_max_sessions":
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 16:
                 raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
-        elif key == "language" and not isinstance(value, str):
-            raise fail((key,), "language must be en, es or fr")
+        elif key == "language" and (not isinstance(value, str) or value not in SCREEN_LANGUAGES):
+            raise fail((key,), f"language must be one of {', '.join(SCREEN_LANGUAGES)}")
         elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.match(value)):
             raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
         elif key == "fhir":
@@ -280,6 +284,15 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "interrupt_after_minutes":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
+        elif key == "qos_model":
+            from kiosk.qos_model import resolve_model
+
+            if not isinstance(value, str) or not value.strip():
+                raise fail((key,), "qos_model must name a bundled model (clarc, kiosk_pace) or a .roqme file")
+            value = resolve_model(value, path.parent)
+            if "/" not in value and value not in bundled_models():
+                raise fail((key,), f"no bundled model named {value!r} (bundled: {', '.join(bundled_models())}); "
+                                   "give a path to a .roqme file instead")
         elif key == "next_patient_after_s":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
                 raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")

@@ -24,11 +24,11 @@ def open_store(data_dir: str | None) -> Store:
     return Store.open(Path(data_dir) if data_dir else load_config().data_dir, create=False)
 
 
-def session_trace(stored: StoredSession):  # -> qos.Trace
-    """A stored session's context trace as a ``qos.Trace``."""
+def session_trace(stored: StoredSession, model: str = MODEL):  # -> qos.Trace
+    """A stored session's context trace as a ``qos.Trace`` of ``model`` (the kiosk's ``qos_model``)."""
     from qos import Trace
 
-    return Trace.from_events(MODEL, stored.trace, description=f"session {stored.id} (patient {stored.patient_id}, "
+    return Trace.from_events(model, stored.trace, description=f"session {stored.id} (patient {stored.patient_id}, "
                                                              f"started {stored.started_at})")
 
 
@@ -40,8 +40,10 @@ def trace_main(argv: list[str]) -> int:
     parser.add_argument("--json", action="store_true", help="JSON instead of YAML")
     parser.add_argument("-o", "--output", metavar="FILE", help="write to FILE (owner-only) instead of stdout")
     parser.add_argument("--data-dir", help="data directory (default: from the kiosk configuration)")
+    parser.add_argument("--model", help="the QoS model the session ran (default: the configuration's qos_model)")
     args = parser.parse_args(argv)
     try:
+        model = args.model or load_config().qos_model
         with open_store(args.data_dir) as store:
             stored = store.session(args.session)
     except (ConfigError, StorageError) as exc:
@@ -50,7 +52,7 @@ def trace_main(argv: list[str]) -> int:
     except KeyError as exc:
         print(f"kiosk qos trace: {exc.args[0]}", file=sys.stderr)
         return 2
-    trace = session_trace(stored)
+    trace = session_trace(stored, model)
     text = trace.to_json() + "\n" if args.json else trace.to_yaml()
     if args.output:
         from kiosk.export import ExportError, write_export

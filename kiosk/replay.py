@@ -38,10 +38,17 @@ from kiosk.session import (
     Session,
     SessionEvent,
 )
-from kiosk.adaptation import MODEL
+from kiosk.lease import SessionTaken
+from kiosk.qos_model import DEFAULT_MODEL
 from kiosk.yamlmarks import Problem, describe, parse_file, schema_problems
 from qos.errors import QosError
 from qos.trace import seconds
+
+#: ``attempt: any``: the patient answers ``after`` seconds into whichever attempt lets them (a slow
+#: patient: too slow for a window, they start again on the next); not answered if none does
+ANY = 0
+#: the confidence a scripted unsure voice answer (``unsure: true``) is heard with
+UNSURE_CONFIDENCE = 0.5
 
 #: incidents that are commands a patient gives through a channel
 _COMMANDS = {"pause": Command.PAUSE, "resume": Command.RESUME, "call_doctor": Command.CALL_DOCTOR,
@@ -72,14 +79,18 @@ def _schema() -> dict[str, Any]:
 class Step:
     """One timed action of a script: an answer, an incident, or a practice answer."""
 
-    #: "answer", "practice" or the incident ("pause", "continue", ...)
+    #: "answer", "practice", "confirm" (Yes/No to "Is that right?"), "undo", "then" (the answer
+    #: after a No or an undo) or the incident ("pause", "continue", ...)
     kind: str
-    #: the attempt this step is counted from (None: from the previous step of its question)
+    #: the attempt this step is counted from (None: from the previous step of its question;
+    #: :data:`ANY`: from whichever attempt is open)
     attempt: int | None
     after: float
     channel: Channel | None = None
     option: int | None = None
     say: str | None = None
+    #: a voice answer the recogniser was not sure of (the session asks it back)
+    unsure: bool = False
     #: where it is written, for messages: "file:line:col: questions[2].incidents[0]"
     where: str = ""
 
@@ -170,7 +181,46 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
             if isinstance(option, str):
                 add(p + ("say",), option)
                 return None
-        return Step(kind, attempt, float(entry.get("after", 0)), channel, option, entry.get("say"), where(p))
+        if entry.get("unsure") and channel is not Channel.VOICE:
+            add(p + ("unsure",), f"only a voice answer can be unsure, not a {channel.value} one")
+            return None
+        return Step(kind, attempt, float(entry.get("after", 0)), channel, option, entry.get("say"),
+                    bool(entry.get("unsure")), where(p))
+
+    def corrections(p: tuple[Any, ...], entry: dict[str, Any], item: Item, attempt: int) -> list[Step]:
+        """The steps after an answer: Yes/No to an unsure one, an undo, the answer that follows."""
+        steps: list[Step] = []
+        declined = False
+        if entry.get("unsure") and "confirm" not in entry:
+            add(p + ("unsure",), f"{describe(p)} is unsure: say what the patient replies (confirm:)", key=True)
+        if "confirm" in entry:
+            reply = entry["confirm"]
+            if not entry.get("unsure"):
+                add(p + ("confirm",), "only an unsure answer (unsure: true) is asked back", key=True)
+            channel = Channel(reply.get("channel", "voice"))
+            option = reply.get("option")
+            if "say" in reply:
+                option = _match_reply(language, reply["say"])
+                if isinstance(option, str):
+                    add(p + ("confirm", "say"), option)
+                    return steps
+            steps.append(Step("confirm", None, float(reply.get("after", 0)), channel, option, reply.get("say"),
+                              where=where(p + ("confirm",))))
+            declined = option == 2
+        if "undo" in entry:
+            if declined:
+                add(p + ("undo",), "a declined answer was never stored: there is nothing to undo", key=True)
+            undo = entry["undo"]
+            steps.append(Step("undo", None, float(undo.get("after", 0)), Channel(undo.get("channel", "touch")),
+                              say=undo.get("say"), where=where(p + ("undo",))))
+        if "then" in entry:
+            if not (declined or "undo" in entry):
+                add(p + ("then",), "'then' is the answer after a No (confirm) or an undo", key=True)
+            elif (step := answer_step(p + ("then",), entry["then"], item, "then", attempt)) is not None:
+                steps.append(step)
+        elif declined or "undo" in entry:
+            add(p, f"{describe(p)} takes its answer back: say what the patient answers next (then:)")
+        return steps
 
     practice: tuple[Step, ...] | None = None
     if isinstance(data.get("familiarisation"), list):
@@ -190,7 +240,7 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
         p = ("questions", i)
         if "item" in entry and entry["item"] != item.id:
             add(p + ("item",), f"question {i + 1} of the questionnaire is {item.id!r}, not {entry['item']!r}")
-        attempt = None if entry["attempt"] == "none" else int(entry["attempt"])
+        attempt = {"none": None, "any": ANY}.get(entry["attempt"], entry["attempt"])
         steps = []
         for j, incident in enumerate(entry.get("incidents", [])):
             ip = p + ("incidents", j)
@@ -200,13 +250,14 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
             channel = Channel(incident.get("channel", "touch"))
             steps.append(Step(incident["do"], anchor, float(incident.get("after", 0)), channel, where=where(ip)))
         if attempt is None:
-            for key in ("option", "say", "channel", "after"):
+            for key in ("option", "say", "channel", "after", "unsure", "confirm", "undo", "then"):
                 if key in entry:
                     add(p + (key,), f"{describe(p)} is not answered (attempt: none) but gives {key!r}", key=True)
         else:
             step = answer_step(p, entry, item, "answer", attempt)
             if step:
                 steps.append(step)
+                steps += corrections(p, entry, item, attempt)
         questions.append(Question(item, attempt, tuple(steps), where(p)))
     if problems:
         raise _script_error(problems)
@@ -216,6 +267,18 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
         start_at=float(data.get("start_at", 0)), acknowledge_after=float(data.get("acknowledge_after", 0)),
         timing=dict(data.get("timing", {})), practice=practice, questions=tuple(questions),
     )
+
+
+def _match_reply(language: str, utterance: str) -> int | str:
+    """Yes (1) or No (2), as the voice channel would hear ``utterance`` asked "Is that right?"."""
+    from kiosk.session.words import CONFIRM_WORDS
+    from kiosk.speech.matching import Matcher, OptionWords
+
+    words = CONFIRM_WORDS.get(language, CONFIRM_WORDS["en"])
+    match = Matcher([OptionWords(label, synonyms) for label, synonyms in words.values()], language).match(utterance)
+    if match.option is None:
+        return f"{utterance!r} is not a yes or a no: {match.reason or 'a command'}"
+    return match.option
 
 
 def _match(question: Item | PracticeQuestion, language: str, utterance: str) -> int | str:
@@ -291,6 +354,8 @@ class _Driver:
         self.next_step = [0] * len(script.questions)
         self.last_time: list[float | None] = [None] * len(script.questions)
         self.waiting = [False] * len(script.questions)
+        #: per question, the attempt an ``attempt: any`` answer was armed in (stale once it timed out)
+        self.armed_in: list[int | None] = [None] * len(script.questions)
         self.events: list[SessionEvent] = []
         session.subscribe(self._on_event)
 
@@ -317,7 +382,10 @@ class _Driver:
             index = event.number - 1
             question = self.script.questions[index]
             pending = question.steps[self.next_step[index]:]
-            if pending and pending[0].kind == "answer" and pending[0].attempt == event.attempt:
+            if pending and pending[0].attempt == ANY:  # too slow for this attempt: again on the next
+                self.waiting[index] = False
+                self.armed_in[index] = None
+            elif pending and pending[0].kind == "answer" and pending[0].attempt == event.attempt:
                 self.errors.append(
                     f"{pending[0].where}: the answer declared on attempt {event.attempt} "
                     f"({pending[0].after:g} s after it opened) never happened: attempt {event.attempt} "
@@ -326,10 +394,13 @@ class _Driver:
             index = event.number - 1
             question = self.script.questions[index]
             pending = question.steps[self.next_step[index]:]
-            if pending:
+            if isinstance(event, QuestionNotAnswered) and question.attempt == ANY and pending \
+                    and pending[0].kind == "answer":
+                self.next_step[index] = len(question.steps)  # never fast enough: not answered
+            elif pending and not (isinstance(event, AnswerRecorded) and pending[0].kind == "undo"):
                 self.errors.append(f"{pending[0].where}: the declared {pending[0].kind} never happened: "
                                    f"question {event.number} ({question.item.id}) ended at t={_num(event.t)} s")
-            elif isinstance(event, QuestionNotAnswered) and question.attempt is not None:
+            elif isinstance(event, QuestionNotAnswered) and question.attempt not in (None, ANY):
                 self.errors.append(f"{question.where}: declared answered on attempt {question.attempt} "
                                    f"but the question was not answered")
 
@@ -340,7 +411,13 @@ class _Driver:
             return
         step = question.steps[k]
         base = self.last_time[index]
-        if step.attempt is not None:
+        if step.attempt == ANY and step.kind == "answer":
+            attempt = self.session.current_attempt
+            if attempt is None or (index, attempt) not in self.opened:
+                return  # armed once an attempt of this question opens
+            self.armed_in[index] = attempt
+            base = self.opened[(index, attempt)]
+        elif step.attempt is not None and step.attempt != ANY:
             opened = self.opened.get((index, step.attempt))
             if opened is None:
                 return  # armed once that attempt opens
@@ -348,14 +425,29 @@ class _Driver:
         if base is None:
             return
         self.waiting[index] = True
-        self.arm(base + step.after, lambda: self._run_step(index, step))
+        armed_in = self.armed_in[index]
+        self.arm(base + step.after, lambda: self._run_step(index, step, armed_in))
 
-    def _run_step(self, index: int, step: Step) -> None:
+    def _run_step(self, index: int, step: Step, armed_in: int | None = None) -> None:
+        if step.attempt == ANY and step.kind == "answer" and self.armed_in[index] != armed_in:
+            return  # the attempt it was waiting in timed out first
         self.waiting[index] = False
         self.next_step[index] += 1
         self.last_time[index] = self.clock.now()
-        if step.kind == "answer":
+        if step.kind in ("answer", "then"):
             self._give_answer(step, index)
+        elif step.kind == "confirm":
+            if self.session.snapshot().confirming is None:
+                self.errors.append(f"{step.where}: the reply to 'Is that right?' came when nothing was asked back")
+            else:
+                self._give_answer(step, index, check=False)
+        elif step.kind == "undo":
+            assert step.channel is not None
+            undo = ChannelInput(step.channel, command=Command.UNDO, detail=step.say or "script")
+            self.session.handle(undo)
+            if any(isinstance(e, InputIgnored) and e.input is undo for e in self.events):
+                self.errors.append(f"{step.where}: the undo came too late: the answer could no longer be changed "
+                                   f"at t={_num(self.session.now())} s")
         elif step.kind in _COMMANDS:
             assert step.channel is not None
             self.session.handle(ChannelInput(step.channel, command=_COMMANDS[step.kind], detail="script"))
@@ -367,17 +459,20 @@ class _Driver:
             self.session.person_back()
         self._try_arm(index)
 
-    def _give_answer(self, step: Step, index: int | None) -> None:
+    def _give_answer(self, step: Step, index: int | None, check: bool = True) -> None:
         assert step.channel is not None and step.option is not None
-        if index is not None:
+        if index is not None and check:
             item = self.session.current_item
-            if self.session.current_attempt != step.attempt or item is None or item.number != index + 1:
+            attempt = self.session.current_attempt
+            if (attempt is None if step.attempt == ANY else attempt != step.attempt) \
+                    or item is None or item.number != index + 1:
                 state = (f"question {item.number} attempt {self.session.current_attempt}" if item
                          else f"phase {self.session.phase.value}")
                 self.errors.append(f"{step.where}: the answer declared on attempt {step.attempt} came when the "
                                    f"session was at {state}")
                 return
-        given = ChannelInput(step.channel, option=step.option, detail=step.say or "script")
+        given = ChannelInput(step.channel, option=step.option, detail=step.say or "script",
+                             confidence=UNSURE_CONFIDENCE if step.unsure else None, needs_confirmation=step.unsure)
         self.session.handle(given)
         ignored = [e for e in self.events if isinstance(e, InputIgnored) and e.input is given]
         if ignored:
@@ -421,25 +516,30 @@ class _Driver:
 
 
 def run_script(script: Script, questionnaire: Questionnaire | None = None, *, store: Any = None,
-               model: Any = None, policy: Any = None) -> ReplayResult:
+               model: str = DEFAULT_MODEL, policy: Any = None) -> ReplayResult:
     """Run a script through a real Session and QoS engine on a simulated clock, adapting by
-    ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on."""
+    ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on.
+
+    ``model`` is the QoS model (a bundled name or a .roqme path, as ``qos_model:`` in the
+    configuration); its timers fire on the simulated clock while nothing happens, as at the kiosk.
+    """
     from kiosk.adaptation import Adaptation, load_policy
-    from qos import Engine, Trace, load_model, replay
+    from kiosk.qos_model import load_kiosk_model
+    from qos import Engine, Trace, replay
 
     questionnaire = questionnaire or load_questionnaire()
-    model = model or load_model(MODEL)
+    reference, model = model, load_kiosk_model(model)
     clock = SimClock()
     session = Session(
         questionnaire, clock=clock, engine=Engine(model), store=store, patient_id=script.patient,
         language=script.language, answered_by=script.answered_by, timing=script.timing,
-        adaptation=Adaptation(policy or load_policy()) if script.adaptation else None,
+        adaptation=Adaptation(policy or load_policy(model=model)) if script.adaptation else None,
         familiarisation=script.practice is not None,
     )
     driver = _Driver(script, session, clock)
     try:
         driver.run()
-        trace = Trace.from_events(MODEL, session.trace)
+        trace = Trace.from_events(reference, session.trace)
         summary = replay(trace, model=model)
     except (ScriptError, QosError) as exc:
         if store is not None:
@@ -482,21 +582,25 @@ def main(argv: list[str]) -> int:
                         help="also store the replayed sessions in this data directory (see `kiosk results`)")
     parser.add_argument("--config", metavar="FILE",
                         help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
-                             "band set and adaptation policy are the ones replayed, as at the kiosk")
+                             "band set, adaptation policy and QoS model are the ones replayed, as at the kiosk")
+    parser.add_argument("--station-wait", metavar="S", type=float, default=30.0,
+                        help="with a station configured, how long to try delivering the stored sessions to it "
+                             "before exiting (default 30; what is left goes with the next kiosk run)")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
     from kiosk.adaptation import PolicyError, load_policy
     from kiosk.config import ConfigError, configured_questionnaire, load_config
+    from kiosk.qos_model import load_kiosk_model
 
     try:
         config = load_config(args.config)
         questionnaire = configured_questionnaire(config)
-        policy = load_policy(config.adaptation_policy)
+        policy = load_policy(config.adaptation_policy, model=load_kiosk_model(config.qos_model))
     except QuestionnaireError as exc:
         print(f"kiosk replay: the questionnaire is invalid: {exc}", file=sys.stderr)
         return 2
-    except (ConfigError, PolicyError) as exc:
+    except (ConfigError, PolicyError, QosError) as exc:
         print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     store = None
@@ -504,20 +608,31 @@ def main(argv: list[str]) -> int:
         from kiosk.storage import StorageError, Store
 
         try:
-            store = Store.open(args.data_dir, simulated=True)  # scripted patients: never offered to anyone
+            # scripted patients: never offered to anyone; queued for the station when there is one
+            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None)
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
     results = []
     try:
         for file in args.files:
-            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store, policy=policy))
+            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store,
+                                      model=config.qos_model, policy=policy))
     except ScriptError as exc:
         print(exc, file=sys.stderr)
+        return 2
+    except SessionTaken as exc:  # another kiosk on this data directory took the session over
+        print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     finally:
         if store is not None:
             store.close()
+    if store is not None and config.station is not None:
+        from kiosk.sync import deliver_pending
+
+        unsent = deliver_pending(store.path, config.station, max(0.0, args.station_wait))
+        if unsent:
+            print(f"kiosk replay: {unsent}", file=sys.stderr)
     if args.trace:
         from qos import dump_trace
         from qos.files import write_error

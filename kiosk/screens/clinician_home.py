@@ -47,6 +47,8 @@ class ClinicianHomeScreen(ClinicianScreen):
                 # the only way out of the locked-down kiosk, on the shorter row so it always shows
                 yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             yield Static(self._channels_text(), id="channel-reasons")
+            if app.sync is not None:  # type: ignore[attr-defined]
+                yield Static(self._station_text(), id="station")
             # continuing a test is the staff's decision: only with the same patient at the kiosk
             yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")
             yield DataTable(id="interrupted", cursor_type="row", zebra_stripes=True)
@@ -113,6 +115,13 @@ class ClinicianHomeScreen(ClinicianScreen):
         if session.metrics:
             line += " QoS now: " + ", ".join(f"{name} {value:.2f}" for name, value in session.metrics.items())
         return line
+
+    def _station_text(self) -> str:
+        sync, store = self.app.sync, self.app.store  # type: ignore[attr-defined]
+        waiting, parked = store.outbox_waiting()
+        state = f"not reachable ({sync.problem})" if sync.problem else "reachable"
+        text = f"Ward station {sync.station.url}: {state}; {waiting} stored changes waiting to be sent"
+        return text + (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
 
     def _channels_text(self) -> str:
         lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]

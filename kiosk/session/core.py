@@ -107,6 +107,12 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         #: the latest metrics from the QoS engine
         self.metrics: dict[str, float] = {}
         self._batch: Batch | None = None
+        #: batches the engine ran since the session last looked (see Publisher._take_qos_results)
+        self._qos_results: list[Any] = []
+        #: time of the latest batch the engine ran on its own (timers, time windows)
+        self._timed_t = -1.0
+        if engine is not None:
+            engine.subscribe(self._qos_results.append)
         self._listeners: list[Listener] = []
         self._queue: list[SessionEvent] = []
         self._depth = 0
@@ -127,11 +133,16 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         for event in stored.trace:
             if engine is not None:
                 engine.update(event["t"], set=event.get("set") or {}, emit=list(event.get("emit") or []))
+        last = max((e["t"] for e in stored.trace), default=0.0)
+        # the model's timers that fired after the last context (stored as metrics) are not run twice
+        last_timed = max((m.t for m in stored.metrics), default=last)
+        if engine is not None and last_timed > last:
+            engine.advance(last_timed)
         session = cls(
             questionnaire, clock=clock, engine=engine, store=store, patient_id=stored.patient_id,
             language=stored.language, answered_by=stored.answered_by, session_id=stored.id,
             # the crash took some time: resumed batches come a second after the stored ones
-            t_offset=max((e["t"] for e in stored.trace), default=0.0) + 1.0,
+            t_offset=max(last, last_timed) + 1.0,
             resume_answers={a.item_id: a for a in stored.answers},
             resume_not_answered=tuple(stored.not_answered), familiarisation=False, **kwargs,
         )
@@ -207,9 +218,11 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
     def next_deadline(self) -> float | None:
         """Clock time (``clock.now()`` scale) of the next time-out, or None if none is running.
 
-        A driver calls :meth:`poll` once the clock has reached it.
+        A driver calls :meth:`poll` once the clock has reached it. The QoS model's timers and
+        time windows count too: time passes for the engine on every operation and poll.
         """
-        return self._timers.next_deadline()
+        deadlines = [d for d in (self._timers.next_deadline(), self._qos_deadline()) if d is not None]
+        return min(deadlines, default=None)
 
     def score(self) -> Score:
         """The score of the answers recorded so far, recomputed from them."""
@@ -310,15 +323,16 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
                 self._repeating = False
                 self._context(t, {"TestState": "STARTED"})
 
-    def abandon(self) -> bool:
-        """The clinician starts over for the next patient: a started, unfinished session is logged
-        and marked abandoned in the store (its answers stay) so a restart does not offer to resume
-        it. True if it was abandoned; a session still on the welcome screen or finished is left as it is.
+    def abandon(self, reason: str = "a new session was started") -> bool:
+        """The clinician starts over for the next patient (or staff end the test from the ward
+        station; ``reason`` says which): a started, unfinished session is logged and marked
+        abandoned in the store (its answers stay) so a restart does not offer to resume it. True
+        if it was abandoned; a session still on the welcome screen or finished is left as it is.
         """
         with Operation(self) as t:
             if self.phase is Phase.WELCOME or self.finished:
                 return False
-            self._log(t, "abandoned", "a new session was started")
+            self._log(t, "abandoned", reason)
             if self.store is not None:
                 self.store.abandon(self.id)
             return True

@@ -258,12 +258,15 @@ class AdaptationChanged(SessionEvent):
 
 @dataclass(frozen=True)
 class MetricsUpdated(SessionEvent):
-    """The QoS engine took a batch of contexts; its metrics and fired observations after it."""
+    """The QoS engine took a batch of contexts, or ran one on its own as time passed (the model's
+    timers and time windows: ``set`` and ``emit`` empty); its metrics and fired observations after it."""
 
     metrics: Mapping[str, float]
     fired: tuple[str, ...]
     set: Mapping[str, Any]
     emit: tuple[str, ...]
+    #: the model's timers that fired in this batch
+    timers: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -75,3 +75,8 @@ class LiveAdaptation:
             self._update_listening(t)
         elif change.name == "slow_speech" and change.active and self.current_attempt is not None:
             self._prompt_question(t, repeat=True)
+        elif change.name == "longer_attempts" and change.active and self.current_attempt is not None:
+            # the attempt open now gets the extra time too (it opened with the normal window)
+            extra = self._attempt_window() - self.timing.attempt_window_s
+            if (remaining := self._timers.attempt_remaining()) is not None:
+                self._timers.at_least(remaining + extra)

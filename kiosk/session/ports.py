@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from typing import Any, Protocol
 
@@ -10,8 +10,20 @@ from typing import Any, Protocol
 class QosEngine(Protocol):
     """What the session needs of ``qos.Engine``."""
 
+    model: Any
+    t: float | None
+
     def update(self, t: float, set: Mapping[str, Any] | None = None, emit: list[str] | None = None) -> Any:
         """Apply one batch of context changes at ``t``; the result has ``.metrics`` and ``.fired``."""
+
+    def advance(self, t: float) -> list[Any]:
+        """Let time pass up to ``t``: the model's timers and time windows due by then run."""
+
+    def next_due(self) -> float | None:
+        """When a timer or time window next needs the engine (engine time), or None."""
+
+    def subscribe(self, callback: Callable[[Any], object]) -> Callable[[], None]:
+        """Call ``callback(result)`` after every batch the engine runs, its own included."""
 
 
 class SessionStore(Protocol):

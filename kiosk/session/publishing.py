@@ -43,6 +43,11 @@ USER_INTERACTION: Mapping[Channel, str] = {
     Channel.KEYBOARD: "TOUCH_SCREEN",
 }
 
+#: an eventtype the session emits when it asks a question (attempt 1 opens), for models that
+#: declare it (``qos/models/kiosk_pace.roqme`` times answers from it); CLARC does not, and its
+#: traces stay as the paper's context table says
+QUESTION_ASKED = "QuestionAsked"
+
 Listener = Callable[[SessionEvent], None]
 
 
@@ -99,16 +104,23 @@ class Publisher:
         self._batch.set.update(set or {})
         self._batch.emit.extend(e for e in emit or [] if e not in self._batch.emit)
 
+    def _emit_if_modelled(self: Session, t: float, eventtype: str) -> None:
+        """Emit an eventtype beyond CLARC's contexts only when the engine's model declares it."""
+        if self.engine is not None and eventtype in self.engine.model.contexts:
+            self._context(t, emit=[eventtype])
+
     def _flush(self: Session) -> None:
         batch, self._batch = self._batch, None
         if batch is None:
             return
-        if self.trace and batch.t <= self.trace[-1]["t"]:
+        last = max(self.trace[-1]["t"] if self.trace else -1.0, self._timed_t)
+        if batch.t <= last:
             # Two operations at one instant (say pause and resume in the same tick) cannot share a
-            # batch once the first went to the engine; a replay would merge them and fire
-            # observations differently. Recording the second a millisecond later keeps the trace
-            # exactly what the engine saw.
-            batch.t = round(self.trace[-1]["t"] + SAME_INSTANT_STEP_S, 6)
+            # batch once the first went to the engine, nor can a batch join a timer that already
+            # fired on its own at that instant; a replay would merge them and fire observations
+            # differently. Recording the second a millisecond later keeps the trace exactly what
+            # the engine saw.
+            batch.t = round(last + SAME_INSTANT_STEP_S, 6)
         event: dict[str, Any] = {"t": batch.t}
         if batch.set:
             event["set"] = dict(batch.set)
@@ -119,15 +131,49 @@ class Publisher:
             self.store.record_context(self.id, t=batch.t, set=batch.set, emit=batch.emit)
         if self.engine is None:
             return
-        result = self.engine.update(batch.t, set=dict(batch.set), emit=list(batch.emit))
-        self.metrics = dict(result.metrics)
-        fired = tuple(result.fired)
-        if self.store is not None:
-            self.store.record_metrics(self.id, t=batch.t, metrics=self.metrics, fired=list(fired))
-        self._emit(MetricsUpdated(batch.t, dict(self.metrics), fired, dict(batch.set), tuple(batch.emit)))
-        if self.adaptation is not None:
-            for change in self.adaptation.observe(self.metrics, answered=_is_answer(batch.set)):
-                self._apply_adaptation(batch.t, change)
+        own = self.engine.update(batch.t, set=dict(batch.set), emit=list(batch.emit))
+        self._take_qos_results(own, batch)
+
+    def _let_qos_time_pass(self: Session, t: float) -> None:
+        """Advance the engine to session time ``t``: its timers and time windows due by then run.
+
+        Only once the engine has had the session's first batch (its timers start then, at time 0,
+        as in a replay of the trace), so nothing happens before the patient starts, and only until
+        the test is over: what a model says about the time after it is about no one.
+        """
+        if self._qos_running() and t >= self.engine.t:
+            self.engine.advance(t)
+            self._take_qos_results(None, None)
+
+    def _qos_deadline(self: Session) -> float | None:
+        """Clock time at which the engine next needs time to pass (a timer, a time window), or None."""
+        due = self.engine.next_due() if self._qos_running() else None
+        return None if due is None else self._timers.origin + due
+
+    def _qos_running(self: Session) -> bool:
+        return self.engine is not None and self.engine.t is not None and not self.finished
+
+    def _take_qos_results(self: Session, own: Any, batch: Batch | None) -> None:
+        """Publish every batch the engine ran since the last call, in order: the ones it ran on its
+        own (timers, time windows, due before ``batch``) like the session's own ``batch`` (``own``
+        is its result): metrics stored, MetricsUpdated published, the adaptation policy told."""
+        results, self._qos_results[:] = list(self._qos_results), []
+        for result in results:
+            mine = batch if result is own else None
+            contexts = dict(mine.set) if mine is not None else {}
+            self.metrics = dict(result.metrics)
+            fired = tuple(result.fired)
+            if mine is None:
+                self._timed_t = result.t
+                if result.timers:
+                    self._log(result.t, "qos_timers", ", ".join(result.timers))
+            if self.store is not None:
+                self.store.record_metrics(self.id, t=result.t, metrics=self.metrics, fired=list(fired))
+            self._emit(MetricsUpdated(result.t, dict(self.metrics), fired, contexts,
+                                      tuple(mine.emit) if mine is not None else (), tuple(result.timers)))
+            if self.adaptation is not None:
+                for change in self.adaptation.observe(self.metrics, answered=_is_answer(contexts)):
+                    self._apply_adaptation(result.t, change)
 
     def _set_phase(self: Session, t: float, phase: Phase) -> None:
         previous, self._phase = self._phase, phase
@@ -161,7 +207,7 @@ class Publisher:
         self._emit(prompt)
 
     def _update_listening(self: Session, t: float) -> None:
-        # on the welcome once it was shown (say start), and while an attempt is open
+        # on the welcome once it was shown (say a language), and while an attempt is open
         wanted = (self._phase is Phase.WELCOME and self._greeted) or self.current_attempt is not None
         listening = wanted and not self._timers.frozen and "voice_off" not in self._active_adaptations()
         if listening != self._listening:
@@ -186,6 +232,8 @@ class Operation:
         self.s = session
         self.inclusive = inclusive
         self._transaction: AbstractContextManager[None] | None = None
+        #: session time of the operation
+        self.t = 0.0
 
     def __enter__(self) -> float:
         s = self.s
@@ -197,7 +245,8 @@ class Operation:
             now = s.clock.now()
             for kind, due in s._timers.due(now, self.inclusive):
                 s._fire(kind, due)
-            return s._timers.t(now)
+            self.t = s._timers.t(now)
+            return self.t
         except BaseException as error:  # `with` does not call __exit__ when __enter__ raises
             self.__exit__(type(error), error, error.__traceback__)
             raise
@@ -211,12 +260,14 @@ class Operation:
         try:
             if failure is None:
                 s._flush()
+                s._let_qos_time_pass(self.t)  # the model's timers, after what happened now
         except BaseException as error:
             failure = error
             raise
         finally:
             if failure is not None:
                 s._queue.clear()
+                s._qos_results.clear()
                 s._batch = None
             if self._transaction is not None:
                 if failure is None:

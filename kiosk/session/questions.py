@@ -26,7 +26,7 @@ from kiosk.session.events import (
     QuestionNotAnswered,
     VolumeChanged,
 )
-from kiosk.session.publishing import USER_INTERACTION
+from kiosk.session.publishing import QUESTION_ASKED, USER_INTERACTION
 from kiosk.session.snapshot import Answer
 
 if TYPE_CHECKING:
@@ -84,6 +84,8 @@ class QuestionFlow:
 
     def _open_question(self: Session, t: float, *, practice: bool, index: int) -> None:
         self._open = OpenQuestion(practice=practice, index=index)
+        if not practice:
+            self._emit_if_modelled(t, QUESTION_ASKED)
         self._open_attempt(t, 1)
 
     def _open_attempt(self: Session, t: float, attempt: int) -> None:

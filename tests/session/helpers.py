@@ -70,3 +70,17 @@ def started(**kwargs) -> Rig:
     if rig.session.phase.value == "explanation":
         rig.session.acknowledge()
     return rig
+
+
+def at_first_question(store, engine=None, patient_id: str = "P-TEST01") -> Rig:
+    """A stored session (the real engine unless ``engine`` is given) started and explained, with
+    its first question open."""
+    clock = SimClock()
+    session = Session(QUESTIONNAIRE, clock=clock, engine=engine or Engine(MODEL), store=store,
+                      patient_id=patient_id, timing=TIMING, familiarisation=False)
+    rig = Rig(session, clock)
+    session.subscribe(rig.events.append)
+    session.start()
+    session.acknowledge()
+    rig.run_until(session.now() + 15)
+    return rig

@@ -144,3 +144,15 @@ def test_an_exception_inside_a_transaction_keeps_none_of_its_writes(tmp_path):
     assert stored.answers == () and stored.trace == ()
     answer(store)  # the store is usable afterwards
     assert len(store.session("s1").answers) == 1
+
+
+def test_a_kiosk_leaves_a_running_replays_session_alone_whatever_its_simulated_start(tmp_path):
+    """`kiosk replay --data-dir` beside a running kiosk: the replay's session starts on the simulated
+    clock (2026-01-01), so its age is no reason to interrupt it while the replay runs."""
+    with process() as replay:
+        replayed = Store.open(tmp_path, simulated=True, owner=Owner(pid=replay.pid))
+        create(replayed, "sim1", patient="TB-0001", started_at="2026-01-01T00:00:05+00:00")
+        kiosk = Store.open(tmp_path, interrupt_after_s=2 * 3600)
+        assert kiosk.interrupt_stale() == []
+        answer(replayed, session_id="sim1")  # the replay goes on
+    assert kiosk.interrupt_stale() == ["sim1"]  # once it is gone, its session is interrupted

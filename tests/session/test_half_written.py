@@ -17,7 +17,7 @@ from kiosk.session import AnswerRecorded, Session
 from kiosk.storage import Store
 from qos import Engine
 
-from .helpers import MODEL, QUESTIONNAIRE, TIMING, Rig
+from .helpers import MODEL, QUESTIONNAIRE, TIMING, Rig, at_first_question
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -49,14 +49,8 @@ class Interrupting(Engine):
                          ids=["ctrl-c", "exception"])
 def test_an_answer_cut_short_before_its_metrics_stores_nothing_of_it(tmp_path, error):
     store = Store.open(tmp_path / "data")
-    clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=Interrupting(MODEL, error), store=store,
-                      patient_id="P-TEST01", timing=TIMING, familiarisation=False)
-    rig = Rig(session, clock)
-    session.subscribe(rig.events.append)
-    session.start()
-    session.acknowledge()
-    rig.run_until(session.now() + 15)
+    rig = at_first_question(store, engine=Interrupting(MODEL, error))
+    session = rig.session
     metrics_before = counts(store.path)[2]
     with pytest.raises(type(error)):
         rig.answer(2)

@@ -105,7 +105,7 @@ def test_a_voice_answer_after_voice_off_cannot_happen_and_the_script_says_where(
     (("patient: P-T1", "patient: P-T1\ncolour: red"), r":2:1: unknown key 'colour'"),
     (("{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
       "{attempt: 3, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2"),
-     r":5:15: questions\[0\]\.attempt: 3 is not one of \[1, 2, 'none'\]"),
+     r":5:15: questions\[0\]\.attempt: 3 is not one of \[1, 2, 'none', 'any'\]"),
     (("option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2", "say: hello, after: 4}\n"
       "  - {attempt: 1, channel: touch, option: 2"), r":5:\d+: 'say' needs channel voice, not touch"),
     (("channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",

@@ -32,13 +32,16 @@ class UiKiosk:
     def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
                  language: str = "en", session_id: str = UI_SESSION_ID,
                  voice=None, keyboard=None, sources=(), poll_interval: float = 3600, speaker=None,
-                 show_score: bool = False, next_patient_after_s: float | None = None) -> None:
+                 show_score: bool = False, next_patient_after_s: float | None = None,
+                 model: str = MODEL) -> None:
         self.next_patient_after_s = next_patient_after_s
         self.clock = SimClock()
+        #: the QoS model (``qos_model:``), loaded once as `kiosk run` does
+        self.model = load_model(model)
         self.questionnaire = load_questionnaire()
         self.store = Store.open(tmp_path / "data")
         self.session = Session(
-            self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)), patient_id=UI_PATIENT_ID,
+            self.questionnaire, clock=self.clock, engine=Engine(self.model), patient_id=UI_PATIENT_ID,
             store=self.store, language=language, session_id=session_id,
             adaptation=Adaptation(load_policy()) if adaptation else None, familiarisation=familiarisation,
             next_patient_after_s=next_patient_after_s,
@@ -56,13 +59,13 @@ class UiKiosk:
 
     def _fresh(self) -> Session:
         """A session for the next patient, as `kiosk run` builds it (a new id, so it can be stored)."""
-        return Session(self.questionnaire, clock=self.clock, engine=Engine(load_model(MODEL)),
+        return Session(self.questionnaire, clock=self.clock, engine=Engine(self.model),
                        patient_id="P-TEST02", store=self.store, adaptation=Adaptation(load_policy()),
                        next_patient_after_s=self.next_patient_after_s)
 
     def _resume(self, stored) -> Session:
         """The session continuing ``stored``, as `kiosk run` builds it."""
-        return Session.from_stored(self.questionnaire, stored, clock=self.clock, engine=Engine(load_model(MODEL)),
+        return Session.from_stored(self.questionnaire, stored, clock=self.clock, engine=Engine(self.model),
                                    store=self.store, adaptation=Adaptation(load_policy()))
 
     def advance(self, seconds: float) -> None:
@@ -85,7 +88,7 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    offer_resume, voice, keyboard, sources, poll_interval, speaker)."""
+    offer_resume, voice, keyboard, sources, poll_interval, speaker, model)."""
     made: list[UiKiosk] = []
 
     def make(**options: object) -> UiKiosk:

@@ -153,7 +153,7 @@ async def test_the_end_says_what_to_do_and_the_welcome_comes_back_for_the_next_p
         kiosk.to_next_deadline()  # 60 s later
         await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
         assert kiosk.app.session is not first and kiosk.app.session.phase is Phase.WELCOME
-        assert kiosk.app.session.listening  # "or say start"
+        assert kiosk.app.session.listening  # '…or say "English"'
         stored = kiosk.store.session(first.id)
         assert stored.status == "finished" and len(stored.answers) == 10  # kept for staff
 

@@ -1,0 +1,66 @@
+"""What the kiosk tells the ward view (protocol §2) and what a station command does (§3).
+
+Both work on the running kiosk through the same operations its clinician screen uses; the app
+calls them on its own thread (a command arrives on the client's thread and is handed over with
+``app.call_from_thread``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, Protocol
+
+from kiosk.session import Phase, Session
+from kiosk.sync.client import Outcome
+
+
+class Kiosk(Protocol):
+    """What a command needs of the kiosk app."""
+
+    session: Session
+    store: Any
+
+    def clinician_continue(self) -> None: ...
+    def person_lost(self) -> None: ...
+    def person_back(self) -> None: ...
+    def end_session(self, reason: str) -> None: ...
+
+
+def live_status(session: Session) -> dict[str, Any]:
+    """The kiosk as the ward view shows it (the client adds ``kiosk_id`` and ``at``)."""
+    snap = session.snapshot()
+    started = session.phase is not Phase.WELCOME
+    return {"session_id": session.id if started else None, "patient_id": session.patient_id if started else None,
+            "phase": snap.phase.value, "question": snap.number, "of": snap.count, "paused": snap.paused,
+            "person_away": not snap.person_present, "doctor_called": snap.halted, "simulated": False}
+
+
+def apply_command(kiosk: Kiosk, command: Mapping[str, Any]) -> Outcome | None:
+    """Carry out a station command on the running session: ("done", None) or ("refused", why);
+    None when another kiosk process on this data directory runs that session (it answers)."""
+    kind, session = command.get("kind"), kiosk.session
+    if command.get("session_id") != session.id and kiosk.store is not None \
+            and kiosk.store.held_elsewhere(str(command.get("session_id"))):
+        return None
+    if session.phase is Phase.WELCOME or command.get("session_id") != session.id:
+        return "refused", f"session {command.get('session_id')} is not the one running on this kiosk"
+    if session.finished:
+        return "refused", f"session {session.id} is finished"
+    snap = session.snapshot()
+    if kind == "continue":
+        if not (snap.halted or snap.paused):
+            return "refused", "the session is not waiting for a doctor"
+        kiosk.clinician_continue()
+    elif kind == "person_away":
+        if not snap.person_present:
+            return "refused", "the patient is already marked away"
+        kiosk.person_lost()
+    elif kind == "person_back":
+        if snap.person_present:
+            return "refused", "the patient is not marked away"
+        kiosk.person_back()
+    elif kind == "end":
+        kiosk.end_session(f"ended from the ward station by {command.get('by') or 'staff'}")
+    else:
+        return "refused", f"unknown command {kind!r}"
+    return "done", None
