@@ -38,7 +38,7 @@ from kiosk.export import ExportSite, site_from_config
 from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
-from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView
+from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView, Ways
 from kiosk.screens.clinician_home import ClinicianHomeScreen
 from kiosk.screens.doctor_called import DoctorCalledScreen
 from kiosk.screens.explanation import ExplanationScreen
@@ -51,6 +51,8 @@ from kiosk.screens.welcome import WelcomeScreen
 from kiosk.session import (
     AnswerRecorded,
     DoctorCalled,
+    IgnoreReason,
+    InputIgnored,
     ListeningChanged,
     NextPatient,
     Paused,
@@ -65,7 +67,7 @@ from kiosk.storage import Store, StoredSession
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.widgets.change_answer import ChangeAnswerButton
-from kiosk.widgets.channel_board import VOICE_IN, VOICE_OUT, ChannelBoard
+from kiosk.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT, ChannelBoard
 from kiosk.widgets.text import ui_text
 from kiosk.widgets.waiting_sign import WaitingSign
 
@@ -177,6 +179,10 @@ class KioskApp(App[int], inherit_bindings=False):
         self._dirty = False
         #: a repeated prompt on its way through the speaker: "queued", then "speaking"
         self._repeat: str | None = None
+        #: the session the clinician screens paused on opening (they resume it on leaving)
+        self._held: Session | None = None
+        #: the patient pressed a number the question on screen does not have (a hint shows)
+        self._no_such_option = False
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -354,7 +360,11 @@ class KioskApp(App[int], inherit_bindings=False):
             self._speak(event)
         elif isinstance(event, ListeningChanged):
             self.board.listening = event.listening
-        elif isinstance(event, (AnswerRecorded, Paused, DoctorCalled)):
+        elif isinstance(event, InputIgnored):
+            self._no_such_option = event.reason is IgnoreReason.NO_SUCH_OPTION
+        if isinstance(event, (Prompt, AnswerRecorded)):  # the hint was about the question before
+            self._no_such_option = False
+        if isinstance(event, (AnswerRecorded, Paused, DoctorCalled)):
             if self.speaker is not None:
                 self.speaker.stop_speaking()
         elif isinstance(event, VolumeChanged) and self.speaker is not None:
@@ -393,19 +403,18 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def _view(self) -> PatientView:
         snap = self.session.snapshot()
-        notices = []
-        if not snap.person_present:
-            notices.append(ui_text(snap.language, "person_lost"))
-        for name in sorted(snap.adaptations):
-            notices.append(self.questionnaire.message(name, snap.language)
-                           or ui_text(snap.language, name, default=name.replace("_", " ")))
+        voice_in = self.board.state(VOICE_IN)[0] is ChannelState.ON
         # the session lifts voice_off when voice in goes; checked here too so the button never
         # promises listening that cannot happen (and not over Continue while paused)
-        voice_again = ("voice_off" in snap.adaptations and not (snap.paused or snap.halted)
-                       and self.board.state(VOICE_IN)[0] is ChannelState.ON)
-        return PatientView(snap, self.questionnaire, self.board.lines(snap.language),
-                           " ".join(notices) or None, voice_again=voice_again, now=self.session.now(),
-                           show_score=self.show_score)
+        voice_again = ("voice_off" in snap.adaptations and not (snap.paused or snap.halted) and voice_in)
+        ways = Ways(remote=self.board.state(REMOTE)[0] is ChannelState.ON,
+                    voice=voice_in and "voice_off" not in snap.adaptations,
+                    listening=voice_in and self.board.listening,
+                    voice_out=self.board.state(VOICE_OUT)[0] is ChannelState.ON)
+        question = snap.item or snap.practice
+        hint = len(question.options) if self._no_such_option and question is not None else None
+        return PatientView(snap, self.questionnaire, ways, voice_again=voice_again, hint_options=hint,
+                           now=self.session.now(), show_score=self.show_score)
 
     @staticmethod
     def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:
@@ -464,8 +473,11 @@ class KioskApp(App[int], inherit_bindings=False):
         def unlocked(ok: bool | None) -> None:
             if ok:
                 self.push_screen(ClinicianHomeScreen())
+            else:
+                self._release_session()
 
         self.push_screen(PinScreen(self.pin_guard), unlocked)
+        self._hold_session()
 
     async def on_event(self, event: events.Event) -> None:
         """Watch every press for the staff corner before the screens see it (a button under the
@@ -483,8 +495,29 @@ class KioskApp(App[int], inherit_bindings=False):
         """Leave the clinician screens and show the patient's screen as the session now is."""
         while self.clinician_open:
             self.pop_screen()
+        self._release_session()
         self._screen_key = None
         self.call_after_refresh(self._render)
+
+    @property
+    def held_for_clinician(self) -> bool:
+        """The session is paused because the clinician screens are open (not by the patient)."""
+        return self._held is self.session and self.session.paused
+
+    def _hold_session(self) -> None:
+        """Pause a running session while the clinician screens are open, so nothing times out
+        unseen underneath (one already paused or halted stays as it is)."""
+        session = self.session
+        if session.phase in (Phase.FAMILIARISATION, Phase.EXPLANATION, Phase.QUESTIONS) and not (
+                session.paused or session.halted):
+            self._drive(session.pause)
+            self._held = session if session.paused else None
+
+    def _release_session(self) -> None:
+        """Resume the session the clinician screens paused (not one the patient paused)."""
+        if self.held_for_clinician and not self.session.halted:
+            self._drive(self.session.resume)
+        self._held = None
 
     def clinician_continue(self) -> None:
         """A clinician continues a session halted by call-doctor (or paused)."""

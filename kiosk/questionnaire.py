@@ -71,12 +71,18 @@ class Option:
     synonyms: Mapping[str, tuple[str, ...]]
     #: points scored (None for practice questions, which are not scored)
     points: int | None = None
+    #: the patient's wording, when it differs from the clinical ``label`` (empty: the label)
+    patient: Mapping[str, str] = field(default_factory=dict)
     #: a published answer code (LOINC LA...) for export; None: exports use a local code
     code: Code | None = None
 
     def label_in(self, language: str) -> str:
-        """The option's label in ``language``."""
+        """The option's clinical label in ``language`` (clinicians' screens, exports)."""
         return self.label[language]
+
+    def patient_label_in(self, language: str) -> str:
+        """The option as the patient's screen shows it in ``language``."""
+        return self.patient.get(language) or self.label[language]
 
     def synonyms_in(self, language: str) -> tuple[str, ...]:
         """Extra words a patient may say for this option in ``language`` (may be empty)."""
@@ -94,12 +100,18 @@ class Item:
     spoken: Mapping[str, str]
     options: tuple[Option, ...]
     code: Code | None = None
+    #: the question as the patient's screen shows it, when it differs from ``text`` (clinical)
+    patient: Mapping[str, str] = field(default_factory=dict)
 
     def option(self, number: int) -> Option:
         """The option with this 1-based number; ``KeyError`` if there is none."""
         if 1 <= number <= len(self.options):
             return self.options[number - 1]
         raise KeyError(f"item {self.id!r} has no option {number} (it has {len(self.options)})")
+
+    def patient_text_in(self, language: str) -> str:
+        """The question as the patient's screen shows it in ``language``."""
+        return self.patient.get(language) or self.text[language]
 
     @property
     def points(self) -> frozenset[int]:
@@ -124,6 +136,10 @@ class PracticeQuestion:
     options: tuple[Option, ...]
     #: the option number a patient who understood would choose
     expected: int
+
+    def patient_text_in(self, language: str) -> str:
+        """The question as the screen shows it (practice questions have one wording)."""
+        return self.text[language]
 
     def option(self, number: int) -> Option:
         """The option with this 1-based number; ``KeyError`` if there is none."""
@@ -409,6 +425,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
         codes: set[tuple[Any, Any]] = set()
         for i, option in dicts(value):
             texts(path + (i, "label"), option.get("label"))
+            texts(path + (i, "patient"), option.get("patient"))
             synonyms = option.get("synonyms")
             for lang in (synonyms if isinstance(synonyms, dict) else ()):
                 if languages and lang not in languages:
@@ -435,6 +452,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             elif isinstance(entry_id, str):
                 ids[entry_id] = path
             texts(path + ("text",), entry.get("text"))
+            texts(path + ("patient",), entry.get("patient"))
             texts(path + ("spoken",), entry.get("spoken"))
             options(path + ("options",), entry.get("options"), scored=section == "items")
             expected, opts = entry.get("expected"), entry.get("options")
@@ -521,6 +539,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
                 label=dict(v["label"]),
                 synonyms={lang: tuple(words) for lang, words in v.get("synonyms", {}).items()},
                 points=v.get("points"),
+                patient=dict(v.get("patient", {})),
                 code=code(v.get("code")),
             )
             for i, v in enumerate(values, start=1)
@@ -528,7 +547,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
 
     items = tuple(
         Item(id=v["id"], number=n, text=dict(v["text"]), spoken=dict(v["spoken"]),
-             options=opts(v["options"]), code=code(v.get("code")))
+             options=opts(v["options"]), code=code(v.get("code")), patient=dict(v.get("patient", {})))
         for n, v in enumerate(data["items"], start=1)
     )
     practice = tuple(

@@ -22,11 +22,15 @@ import hmac
 import html
 import logging
 import ssl
+from pathlib import Path
 from typing import Any
 
 from aiohttp import web
 from textual_serve.app_service import AppService
 from textual_serve.server import Server, to_int
+
+#: the folder of the page the browser loads (``app_index.html``)
+PAGE_DIR = Path(__file__).parent / "web"
 
 log = logging.getLogger("kiosk.serve")
 
@@ -80,7 +84,9 @@ class KioskServer(Server):
 
     def __init__(self, command: str, *, host: str, port: int, hosts: set[str], token_sha256: str,
                  max_sessions: int, ssl_context: ssl.SSLContext | None = None, title: str = "Barthel kiosk") -> None:
-        super().__init__(command, host=host, port=port, title=title)
+        # the kiosk's own page (kiosk/web: offline font, large text that fits the display) over
+        # textual-serve's static files
+        super().__init__(command, host=host, port=port, title=title, templates_path=PAGE_DIR)
         self.scheme = "https" if ssl_context is not None else "http"
         self.hosts = set(hosts)
         self.origins = {f"{self.scheme}://{name}" for name in self.hosts}

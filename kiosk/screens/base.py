@@ -1,4 +1,5 @@
-"""What every patient screen shares: the view it renders and the way it forwards keys."""
+"""What every patient screen shares: the view it renders, the top bar, the notices, the way it
+forwards keys, and the sizes it adapts its layout to."""
 
 from __future__ import annotations
 
@@ -13,9 +14,35 @@ from textual.widgets import Label
 
 from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
-from kiosk.widgets.bars import AdaptationBanner, ChannelBar, ChannelLine, VoiceAgainButton
-from kiosk.widgets.text import ui_text
+from kiosk.widgets.bars import AdaptationBanner, VoiceAgainButton
+from kiosk.widgets.text import join_or, ui_text, ways_sentence
 from kiosk.widgets.waiting_sign import WaitingSign
+
+#: screen heights (rows) from which a patient screen uses its roomy layout: padded text and the
+#: big block digits on the answers; below, it packs everything tighter (a 1024x600 panel at a
+#: large font is about 18 rows, an 80x24 terminal 24)
+ROOMY_ROWS = 28
+#: screen widths (columns) from which the top bar also shows the ways the patient can answer
+WIDE_COLUMNS = 90
+
+
+@dataclass(frozen=True)
+class Ways:
+    """The ways the patient can act right now, as the channels are: what instructions may promise.
+
+    ``voice`` means voice answers are heard (voice in works and adaptation has not paused it);
+    ``listening`` that the kiosk listens at this very moment (the welcome screen only promises
+    "say start" then); ``voice_out`` that the kiosk can speak (Repeat is only offered then).
+    """
+
+    remote: bool = False
+    voice: bool = False
+    listening: bool = False
+    voice_out: bool = False
+
+    def answering(self) -> tuple[str, ...]:
+        """The ways of answering a question: touch always, then the remote and voice when on."""
+        return ("touch",) + (("remote",) if self.remote else ()) + (("voice",) if self.voice else ())
 
 
 @dataclass(frozen=True)
@@ -24,12 +51,15 @@ class PatientView:
 
     snapshot: Snapshot
     questionnaire: Questionnaire
-    #: channel indicators, in display order
-    channels: tuple[ChannelLine, ...]
+    #: what the channels allow now (the instructions are built from it)
+    ways: Ways = Ways()
     #: a notice to show above the answers (an adaptation, "we cannot see you"), or None
     banner: str | None = None
     #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
     voice_again: bool = False
+    #: the number of answers of the question on screen, when the patient pressed a number it
+    #: does not have (a gentle "Please choose 1, 2 or 3" follows)
+    hint_options: int | None = None
     #: session time now (the waiting sign's slow dot follows it)
     now: float = 0.0
     #: the end screen shows the total and band (a site's choice; default: staff only)
@@ -42,16 +72,44 @@ class PatientView:
         return snap.attempt is not None and not (snap.paused or snap.halted) and snap.person_present
 
 
+def patient_notices(view: PatientView) -> str | None:
+    """The notices the patient sees above the question, in their language, or None: only what is
+    true with the channels on now (no "speaking more slowly" without a voice)."""
+    snap, lang = view.snapshot, view.snapshot.language
+    notices = []
+    if view.hint_options:
+        options = [str(n) for n in range(1, view.hint_options + 1)]
+        notices.append(ui_text(lang, "only_options", options=join_or(lang, options)))
+    if not snap.person_present:
+        notices.append(ui_text(lang, "person_lost"))
+    for name in sorted(snap.adaptations):
+        if name == "slow_speech" and not view.ways.voice_out:
+            continue
+        if name == "voice_off":
+            ways = ("touch", "remote") if view.ways.remote else ("touch",)
+            notices.append(ways_sentence(lang, "voice_off", ways, "_answer"))
+            continue
+        notices.append(view.questionnaire.message(name, lang)
+                       or ui_text(lang, name, default=name.replace("_", " ")))
+    return " ".join(notices) or None
+
+
 class PatientScreen(Screen):
     """Base of the patient's screens: built from a view, refreshed in place by :meth:`show`.
 
     The app switches to a new screen only when :meth:`key` of the new view differs (another
     phase, question or language); otherwise it calls :meth:`show` so a tick of the clock or a
-    channel change does not rebuild the screen.
+    channel change does not rebuild the screen. The screen carries the class ``-roomy`` when it
+    is tall enough for the spacious layout, ``-wide`` when wide enough for the ways row; the
+    stylesheet packs everything tighter otherwise, so every screen fits without scrolling.
     """
 
     #: nothing starts focused: a focused answer would look chosen; keys and touch need no focus
     AUTO_FOCUS = ""
+    HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (WIDE_COLUMNS, "-wide")]
+    #: the screen asks the patient for an answer (its top bar shows the ways they can give one)
+    ASKS = False
+    VERTICAL_BREAKPOINTS = [(0, "-short"), (ROOMY_ROWS, "-roomy")]
 
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``."""
@@ -69,11 +127,12 @@ class PatientScreen(Screen):
         return self.view.snapshot.language
 
     def compose_bars(self) -> ComposeResult:
-        """Progress and attempt, channel states, the adaptation banner and its voice-again button."""
+        """Progress, the ways to answer and the attempt; the notice banner and its voice-again
+        button. No channel or device words: those are for the clinician's screens."""
         with Horizontal(id="topbar"):
             yield Label("", id="progress")
+            yield Label("", id="ways")
             yield Label("", id="attempt")
-        yield ChannelBar(id="channels")
         yield AdaptationBanner(id="banner")
         yield VoiceAgainButton(self.language)
 
@@ -90,22 +149,42 @@ class PatientScreen(Screen):
         for attempt in self.query("#attempt").results(Label):
             attempt.update(ui_text(self.language, "attempt_of", number=snap.attempt, total=ATTEMPTS)
                            if snap.attempt else "")
-        for bar in self.query(ChannelBar):
-            bar.show(view.channels)
+        for ways in self.query("#ways").results(Label):
+            ways.update(self.ways_text(view))
         for banner in self.query(AdaptationBanner):
-            banner.show(view.banner)
+            banner.show(patient_notices(view))
         for button in self.query(VoiceAgainButton):
             button.show(view.voice_again)
         for sign in self.query(WaitingSign):
             sign.show(view.waiting, view.now)
+        for sign in self.query(WaitingSign):
+            sign.show(view.waiting, view.now)
+
+    def ways_text(self, view: PatientView) -> str:
+        """The calm row of the ways the patient can answer: "You can: touch · remote · speak", on
+        the screens that ask for an answer (:attr:`ASKS`)."""
+        if not self.ASKS:
+            return ""
+        words = [ui_text(self.language, f"ways_{way}") for way in view.ways.answering()]
+        return f"{ui_text(self.language, 'ways_title')} {' · '.join(words)}"
 
     def progress_text(self, view: PatientView) -> str:
-        """The left of the top bar: the questionnaire's title unless a screen says more."""
-        return view.questionnaire.title.get(self.language, "")
+        """The left of the top bar: "Question 3 of 10" while a question is under way (also on the
+        paused and doctor-called screens over it), else the questionnaire's title."""
+        snap = view.snapshot
+        if snap.number is None:
+            return view.questionnaire.title.get(self.language, "")
+        return ui_text(self.language, "question_of", number=snap.number, total=snap.count)
 
     def on_key(self, event: events.Key) -> None:
-        """Hand kiosk keys (1-4, P, D, R, a keyboard remote's keys) to the app."""
-        if self.app.patient_key(event.key):  # type: ignore[attr-defined]
+        """Hand kiosk keys (1-4, the control letters, a keyboard remote's keys) to the app. The
+        letters shown on the controls in this language (M for "Llamar al médico") stand for the
+        kiosk's own P, R and D, which keep working in every language."""
+        key = event.key
+        for command, letter in (("pause", "p"), ("repeat", "r"), ("call_doctor", "d")):
+            if key == ui_text(self.language, f"key_{command}"):
+                key = letter
+        if self.app.patient_key(key):  # type: ignore[attr-defined]
             event.stop()
             event.prevent_default()
 

@@ -13,6 +13,9 @@ from kiosk.screens.base import ClinicianScreen
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
 
+#: how often the running session's line is redrawn (seconds)
+REFRESH_S = 1.0
+
 
 class ClinicianHomeScreen(ClinicianScreen):
     """Reads the app's session and store; every action goes back through the app."""
@@ -30,20 +33,17 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Static(warning, id="pin-warning")
             yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
-                yield Button("Continue the session", id="continue", variant="primary",
-                             disabled=not (session.halted or session.paused))
-                yield Label(" Live adaptation ")
+                yield Button("Continue", id="continue", variant="primary")
+                yield Label("Adaptation", id="adaptation-label")
                 yield Switch(value=session.adaptation is not None and session.adaptation.enabled,
                              id="adaptation", disabled=session.adaptation is None)
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
-                yield Button("Back to the patient", id="back")
+                yield Button("Back", id="back")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
-            running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
-            present = session.snapshot().person_present
             with Horizontal(id="presence-actions"):
-                yield Button("Patient left", id="person-lost", disabled=not (running and present))
-                yield Button("Patient back", id="person-back", disabled=not (running and not present))
+                yield Button("Patient left", id="person-lost")
+                yield Button("Patient back", id="person-back")
                 # the only way out of the locked-down kiosk, on the shorter row so it always shows
                 yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             yield Static(self._channels_text(), id="channel-reasons")
@@ -59,7 +59,7 @@ class ClinicianHomeScreen(ClinicianScreen):
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
 
     def on_mount(self) -> None:
-        """Fill the session list from the store."""
+        """Fill the tables, and keep the running session's line current while it runs."""
         interrupted = self.query_one("#interrupted", DataTable)
         interrupted.add_columns("patient", "started", "progress", "why it stopped", "session")
         count = len(self.app.questionnaire.items)  # type: ignore[attr-defined]
@@ -70,16 +70,44 @@ class ClinicianHomeScreen(ClinicianScreen):
                                 test.interrupted_reason or "", test.id, key=test.id)
         self.query_one("#continue-test", Button).disabled = not interrupted.row_count
         table = self.query_one("#sessions", DataTable)
-        table.add_columns("session", "patient", "started", "status", "language", "answered", "not answered")
+        table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
+        self._fill_sessions()
+        self.refresh_session()
+        self.set_interval(REFRESH_S, self.refresh_session)
+
+    def _fill_sessions(self) -> None:
+        table = self.query_one("#sessions", DataTable)
         store = self.app.store  # type: ignore[attr-defined]
         for s in store.sessions() if store is not None else []:
-            table.add_row(s.id, s.patient_id, s.started_at[:19], s.label, s.language, str(s.answered),
-                          str(s.not_answered), key=s.id)
+            row = (s.id, s.patient_id, s.started_at[:19], s.label, s.language, str(s.answered), str(s.not_answered))
+            if s.id in table.rows:
+                for column, value in zip(table.columns, row):
+                    table.update_cell(s.id, column, value)
+            else:
+                table.add_row(*row, key=s.id)
+
+    def refresh_session(self) -> None:
+        """Redraw what a running session changes: its line, the channels, which actions apply,
+        and the stored sessions' progress."""
+        app = self.app
+        session = app.session  # type: ignore[attr-defined]
+        self.query_one("#current", Static).update(self._session_line())
+        self.query_one("#channel-reasons", Static).update(self._channels_text())
+        # Continue is for a session halted by call-doctor or paused by the patient, not for the
+        # pause that opening these screens made (leaving them resumes that one)
+        paused_by_patient = session.paused and not app.held_for_clinician  # type: ignore[attr-defined]
+        self.query_one("#continue", Button).disabled = not (session.halted or paused_by_patient)
+        running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
+        present = session.snapshot().person_present
+        self.query_one("#person-lost", Button).disabled = not (running and present)
+        self.query_one("#person-back", Button).disabled = not (running and not present)
+        self._fill_sessions()
 
     def _session_line(self) -> str:
         session = self.app.session  # type: ignore[attr-defined]
         state = "waiting for a clinician (doctor called)" if session.halted else (
-            "paused" if session.paused else session.phase.value)
+            "paused while you are here" if self.app.held_for_clinician  # type: ignore[attr-defined]
+            else "paused" if session.paused else session.phase.value)
         if not session.snapshot().person_present:
             state += ", patient away"
         line = (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "

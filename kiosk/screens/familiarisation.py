@@ -17,6 +17,8 @@ from kiosk.widgets.waiting_sign import WaitingSign
 class FamiliarisationScreen(PatientScreen):
     """A practice question laid out exactly like a real one, so the real ones feel familiar."""
 
+    ASKS = True
+
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
         """A new screen per practice question and language."""
@@ -32,16 +34,20 @@ class FamiliarisationScreen(PatientScreen):
             yield Static(self.view.questionnaire.message("familiarisation", self.language),
                          classes="heading")
         else:
-            yield Static("", id="interlude", classes="interlude")
+            # in the flow above the question (the overlay that keeps real answers still is for
+            # the question screen's thank-you line)
+            yield Static("", id="interlude", classes="interlude -inline")
             yield QuestionPanel(practice.text[self.language],
                                 [o.label_in(self.language) for o in practice.options])
         yield WaitingSign(self.language)
-        yield ControlBar(self.language)
+        yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 
     def show(self, view: PatientView) -> None:
         """Also the line above the question: "First, a few practice questions…" on the first one,
         and the kind word ("Well done.") once it is answered, until the next one opens."""
         super().show(view)
+        for bar in self.query(ControlBar):  # Repeat only while the kiosk can speak
+            bar.show_repeat(view.ways.voice_out)
         snap = view.snapshot
         feedback = view.questionnaire.message(snap.interlude, self.language) if snap.interlude else ""
         intro = view.questionnaire.message("familiarisation", self.language) if snap.practice_number == 1 else ""

@@ -30,6 +30,8 @@ class QuestionScreen(PatientScreen):
     answer is awaited a gentle sign says so.
     """
 
+    ASKS = True
+
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``'s item."""
         super().__init__(view)
@@ -51,7 +53,7 @@ class QuestionScreen(PatientScreen):
         if (panel := self._panel(self.view)) is not None:
             yield panel
         yield WaitingSign(self.language)
-        yield ControlBar(self.language)
+        yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 
     def _panel(self, view: PatientView) -> Widget | None:
         """The question and answers of the view's item; between the explanation and item 1 the
@@ -66,13 +68,15 @@ class QuestionScreen(PatientScreen):
             explanation = view.questionnaire.message("explanation", self.language)
             return Static(explanation, classes="notice", id="recap") if explanation else None
         answer = view.snapshot.answers.get(item.id)
-        return QuestionPanel(item.text[self.language], [o.label_in(self.language) for o in item.options],
+        return QuestionPanel(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
                              chosen=answer.option if answer else None)
 
     def show(self, view: PatientView) -> None:
         """Refresh the bars and the between-questions line; swap in the next item's panel, or mark
         the recorded answer."""
         super().show(view)
+        for bar in self.query(ControlBar):
+            bar.show_repeat(view.ways.voice_out)
         key = view.snapshot.interlude
         for line in self.query("#interlude").results(Static):
             line.update(view.questionnaire.message(key, self.language) or ui_text(self.language, key)
@@ -80,6 +84,8 @@ class QuestionScreen(PatientScreen):
             line.display = bool(key)
         for button in self.query(ChangeAnswerButton):
             button.show(view.snapshot.can_undo)
+        if key or view.snapshot.can_undo:
+            self.call_after_refresh(self._place_interlude)
         if not self.is_mounted:  # compose has not run yet: it will draw this view
             return
         item = view.snapshot.item
@@ -97,22 +103,31 @@ class QuestionScreen(PatientScreen):
         for panel in self.query(QuestionPanel):
             panel.mark_chosen(answer.option if answer else None)
 
+    def _place_interlude(self) -> None:
+        """Lay the between-questions line exactly over the question text, so the answers below do
+        not move when it comes and goes; over the explanation recap (no answers) it simply goes
+        above it."""
+        for line in self.query("#interlude").results(Static):
+            questions = self.query("#question")
+            line.set_class(not questions, "-inline")
+            if questions:
+                question = questions.first().region
+                line.styles.offset = (0, question.y)
+                line.styles.height = max(1, question.height)
+                for button in self.query(ChangeAnswerButton):  # at the right, over the question
+                    width = len(str(button.label)) + 4
+                    button.styles.width = width
+                    button.styles.offset = (max(0, self.size.width - width - 1), question.y)
+
     def _reword(self, view: PatientView, item: Item) -> bool:
         """Put ``item`` into the panel on screen when it has as many answers (no remount); False
         when it cannot, so the caller builds a new panel."""
         answer = view.snapshot.answers.get(item.id)
         for panel in self.query(QuestionPanel):
-            if panel.show_item(item.text[self.language], [o.label_in(self.language) for o in item.options],
+            if panel.show_item(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
                                chosen=answer.option if answer else None):
                 self._item_id = item.id
                 if isinstance(self.focused, AnswerButton):  # it would look chosen on the new item
                     self.set_focus(None)
                 return True
         return False
-
-    def progress_text(self, view: PatientView) -> str:
-        """"Question 3 of 10"."""
-        snap = view.snapshot
-        if snap.number is None:
-            return super().progress_text(view)
-        return ui_text(self.language, "question_of", number=snap.number, total=snap.count)

@@ -34,12 +34,14 @@ class SessionDetailScreen(ClinicianScreen):
             yield Label(self._practice_line(), id="practice")
             yield Static(metrics_key(), id="metrics-key")
             yield MetricsPlot(plot_data(s), id="metrics-plot")
+        # at the bottom, above the buttons, so an export's outcome shows at every size
+        with Vertical(id="detail-bottom"):
             yield Label("", id="export-result")
-        with Horizontal(id="detail-actions"):
-            yield Button("Export FHIR", id="export-fhir")
-            yield Button("Export CSV", id="export-csv")
-            yield Button("Save plot (PNG)", id="export-png")
-            yield Button("Back", id="back")
+            with Horizontal(id="detail-actions"):
+                yield Button("FHIR", id="export-fhir", tooltip="Export a FHIR QuestionnaireResponse")
+                yield Button("CSV", id="export-csv", tooltip="Export the answers as CSV")
+                yield Button("Plot PNG", id="export-png", tooltip="Save the QoS plot as a PNG")
+                yield Button("Back", id="back")
 
     def on_mount(self) -> None:
         """One row per item, in questionnaire order, answered or not."""

@@ -21,6 +21,10 @@ class SummaryScreen(PatientScreen):
         """No notices once it is over: what the kiosk adapted no longer concerns the patient."""
         super().show(replace(view, banner=None))
 
+    def progress_text(self, view: PatientView) -> str:
+        """The title: the questions are over."""
+        return view.questionnaire.title.get(self.language, "")
+
     def compose(self) -> ComposeResult:
         """Bars, thanks, the total and band."""
         yield from self.compose_bars()

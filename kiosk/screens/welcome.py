@@ -1,4 +1,4 @@
-"""Welcome: the patient chooses a language and starts; the channel states are listed in full."""
+"""Welcome: the patient chooses a language, which starts the test."""
 
 from __future__ import annotations
 
@@ -10,16 +10,27 @@ from textual.containers import Vertical
 from textual.message import Message
 from textual.widgets import Button, Static
 
-from kiosk.screens.base import PatientScreen, PatientView
-from kiosk.widgets.bars import channel_reasons
-from kiosk.widgets.text import ui_text
+from kiosk.screens.base import PatientScreen, PatientView, Ways
+from kiosk.widgets.text import language_name, ui_text, ways_sentence
 
-#: each language's start button, in that language: choosing the language starts the test
-START_IN = {"en": "Start in English", "es": "Empezar en español", "fr": "Commencer en français"}
+
+def welcome_line(view: PatientView, language: str) -> str:
+    """The welcome in ``language`` itself, and how to choose with the channels on now: "Welcome.
+    Please choose your language." alone when touching is the only way (the buttons say the rest)."""
+    ways = language_ways(view.ways)
+    how = ways_sentence(language, "choose_by", ways, "_language") if len(ways) > 1 else ui_text(
+        language, "choose_language")
+    return f"{view.questionnaire.message('welcome', language)} {how}".strip()
+
+
+def language_ways(ways: Ways) -> tuple[str, ...]:
+    """How a language can be chosen now: touch; a remote's number; "start" while the kiosk listens."""
+    return ("touch",) + (("remote",) if ways.remote else ()) + (("voice",) if ways.listening else ())
 
 
 class WelcomeScreen(PatientScreen):
-    """A welcome sentence, one big button per language, and which channels are on or off."""
+    """The welcome and "choose your language", each line in its own language, and one big button
+    per language (numbered like the remote)."""
 
     class LanguageChosen(Message):
         """The patient touched a language: start in it."""
@@ -31,25 +42,31 @@ class WelcomeScreen(PatientScreen):
 
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
-        """Rebuilt when the language changes (the welcome sentence changes with it)."""
+        """Rebuilt when the language changes."""
         return view.snapshot.language
 
     def compose(self) -> ComposeResult:
-        """Bars, the welcome message, the language buttons (numbered like the remote)."""
+        """Bars, the welcome lines, the language buttons."""
         yield from self.compose_bars()
         q = self.view.questionnaire
-        yield Static(q.message("welcome", self.language), classes="heading", id="welcome")
-        yield Static(ui_text(self.language, "choose_language"), classes="notice")
+        with Vertical(id="welcome"):
+            for language in q.languages:
+                yield Static(welcome_line(self.view, language), classes="welcome-line",
+                             id=f"welcome-{language}")
         with Vertical(id="languages"):
             for number, language in enumerate(q.languages, start=1):
-                yield Button(f"{number}  {START_IN.get(language, language)}", id=f"language-{language}")
-        yield Static(channel_reasons(self.view.channels), id="channel-reasons")
+                yield Button(f"{number}  {language_name(language)}", id=f"language-{language}")
 
     def show(self, view: PatientView) -> None:
-        """Also keep the list of channels that are off (and why) current."""
+        """Also keep the welcome lines true to the channels on now."""
         super().show(view)
-        for reasons in self.query("#channel-reasons").results(Static):
-            reasons.update(channel_reasons(view.channels))
+        for language in view.questionnaire.languages:
+            for line in self.query(f"#welcome-{language}").results(Static):
+                line.update(welcome_line(view, language))
+
+    def progress_text(self, view: PatientView) -> str:
+        """The title in every language: the patient has not chosen one yet."""
+        return " · ".join(dict.fromkeys(view.questionnaire.title.values()))
 
     @on(Button.Pressed, "#languages Button")
     def _language(self, event: Button.Pressed) -> None:

@@ -12,6 +12,7 @@ from textual.widgets import Digits, Label
 
 class AnswerButton(Widget, can_focus=True):
     """One answer option: its number in large digits (as printed on the remote) and its label.
+    The layout around it sets its height and the class ``-big`` when the digits fit.
 
     A click or tap posts :class:`AnswerButton.Chosen`; the screen forwards it to the session as a
     touch input. It never decides anything itself.
@@ -34,8 +35,10 @@ class AnswerButton(Widget, can_focus=True):
         self.label = label
 
     def compose(self) -> ComposeResult:
-        """The number in block digits beside the answer text."""
+        """The number -- in block digits when the button is tall enough, else in bold -- beside
+        the answer text."""
         yield Digits(str(self.option), classes="number")
+        yield Label(str(self.option), classes="small-number")
         yield Label(self.label, classes="label")
 
     def relabel(self, label: str) -> None:

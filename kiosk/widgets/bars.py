@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
-from rich.text import Text
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.message import Message
@@ -24,27 +22,6 @@ class ChannelLine:
     live: bool
     #: why it is off, for the clinician standing by ("no microphone found")
     reason: str = ""
-
-
-class ChannelBar(Static):
-    """Which channels are live (speaking, listening, remote connected) and which are off; the
-    reasons would not fit on one line, so the welcome and clinician screens list them."""
-
-    def show(self, lines: Sequence[ChannelLine]) -> None:
-        """Replace the shown channel states."""
-        text = Text()
-        for index, line in enumerate(lines):
-            if index:
-                text.append("   ")
-            text.append(f"{line.name}: ", style="bold")
-            text.append(line.state, style="bold #0b5d1e" if line.live else "bold #8b0000")
-        self.update(text)
-
-
-def channel_reasons(lines: Sequence[ChannelLine]) -> str:
-    """One line per channel that is not live, with why (for whoever sets the kiosk up)."""
-    return "\n".join(f"{line.name}: {line.state} ({line.reason})" for line in lines
-                     if not line.live and line.reason)
 
 
 class AdaptationBanner(Static):
@@ -92,11 +69,13 @@ class ControlBar(Horizontal):
             """What the patient asked for."""
             super().__init__()
 
-    def __init__(self, language: str, *, paused: bool = False) -> None:
-        """Label the buttons in ``language``; while ``paused`` the pause button resumes."""
+    def __init__(self, language: str, *, paused: bool = False, repeat: bool = True) -> None:
+        """Label the buttons in ``language``; while ``paused`` the pause button resumes. Repeat is
+        shown only while ``repeat`` (the kiosk can speak: without a voice it would do nothing)."""
         super().__init__(id="controls")
         self.language = language
         self.paused = paused
+        self.repeat = repeat
 
     def compose(self) -> ComposeResult:
         """Pause (or Continue), Repeat and Call doctor, each with its key letter."""
@@ -106,6 +85,16 @@ class ControlBar(Horizontal):
             yield Button(ui_text(self.language, "pause"), id="pause", classes="control")
             yield Button(ui_text(self.language, "repeat"), id="repeat", classes="control")
         yield Button(ui_text(self.language, "call_doctor"), id="call-doctor", classes="control")
+
+    def on_mount(self) -> None:
+        """Hide Repeat if the kiosk cannot speak."""
+        self.show_repeat(self.repeat)
+
+    def show_repeat(self, shown: bool) -> None:
+        """Offer Repeat or not (voice out came or went)."""
+        self.repeat = shown
+        for button in self.query("#repeat").results(Button):
+            button.display = shown
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         """Turn a touched control into the command it stands for."""

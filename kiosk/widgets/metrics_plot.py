@@ -75,6 +75,20 @@ def metrics_key() -> Text:
     return key
 
 
+def steps(times: list[float], values: list[float]) -> tuple[list[float], list[float]]:
+    """The corners of a step function through the samples: a metric keeps its value until the
+    next event changes it, so each value is held flat up to the next sample's time (the PNG draws
+    the same with matplotlib's ``step(where="post")``)."""
+    xs, ys = [], []
+    for index, (t, value) in enumerate(zip(times, values)):
+        if index:
+            xs.append(t)
+            ys.append(values[index - 1])
+        xs.append(t)
+        ys.append(value)
+    return xs, ys
+
+
 class MetricsPlot(PlotextPlot):
     """The three metrics in the terminal; incidents as grey lines, adaptations as red lines.
 
@@ -93,7 +107,7 @@ class MetricsPlot(PlotextPlot):
         plt.ylim(0, 1)
         for name, (times, values) in self.data.series.items():
             if times:  # no label: plotext would draw its legend box over the first seconds
-                plt.plot(times, values, color=_COLOURS[name], marker="braille")
+                plt.plot(*steps(times, values), color=_COLOURS[name], marker="braille")
         for mark in self.data.marks:
             plt.vline(mark.t, _MARK_COLOURS[mark.kind][0])
 

@@ -6,6 +6,7 @@ only the words around them.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import cache
 from importlib import resources
 
@@ -31,3 +32,24 @@ def ui_text(language: str, key: str, default: str | None = None, **values: objec
     if words is None:
         raise KeyError(f"no screen text {key!r}")
     return words.format(**values) if values else words
+
+
+def language_name(language: str) -> str:
+    """The language's own name for itself ("Español"), or its code for a language with no screen words."""
+    return _table().get(language, {}).get("language_name") or language
+
+
+def ways_sentence(language: str, sentence: str, ways: Sequence[str], suffix: str = "") -> str:
+    """A sentence listing the ways of doing something that are on now, e.g. ``answer_by`` with
+    ("touch", "remote"): "Answer by touching it on the screen or pressing its number on the
+    remote." Each way's words are ``way_<way><suffix>``; the last two are joined by ``or``."""
+    words = ui_text(language, sentence,
+                    ways=join_or(language, [ui_text(language, f"way_{way}{suffix}") for way in ways]))
+    return words[0].upper() + words[1:]
+
+
+def join_or(language: str, phrases: Sequence[str]) -> str:
+    """"a, b or c" in ``language``."""
+    if len(phrases) == 1:
+        return phrases[0]
+    return ", ".join(phrases[:-1]) + f" {ui_text(language, 'or')} {phrases[-1]}"

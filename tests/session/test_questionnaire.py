@@ -271,3 +271,23 @@ def test_validate_accepts_the_bundled_file_and_reports_unreadable_ones(tmp_path,
 def test_loading_a_missing_file_is_a_questionnaire_error(tmp_path):
     with pytest.raises(QuestionnaireError, match="missing.yaml:1:1: cannot read the file"):
         load_questionnaire(tmp_path / "missing.yaml")
+
+
+def test_a_patient_wording_needs_every_language_and_only_text(tmp_path):
+    path, text = broken(tmp_path, 'patient: {en: "Sometimes", es: "A veces", fr: "Parfois"}',
+                        'patient: {en: "Sometimes", es: "A veces"}')
+    where = position(text, '{en: "Sometimes", es: "A veces"}')
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{where}: items[4].options[1].patient has no 'fr' translation"]
+    path, text = broken(tmp_path, '    patient:\n      en: "How do you manage eating?"',
+                        '    patient:\n      en: ""')
+    problems = [p.message for p in check_questionnaire_file(path)]
+    assert len(problems) == 1 and "items[0].patient.en" in problems[0]
+
+
+def test_without_a_patient_wording_the_screen_shows_the_clinical_one(tmp_path):
+    path, _ = broken(tmp_path, '        patient: {en: "Sometimes", es: "A veces", fr: "Parfois"}\n', "")
+    questionnaire = load_questionnaire(path)
+    option = questionnaire.item("bowels").option(2)
+    assert option.patient_label_in("en") == option.label_in("en") == "Occasional accident"
+    assert questionnaire.item("bowels").option(3).patient_label_in("es") == "No, nunca"

@@ -99,3 +99,42 @@ async def test_a_new_patient_after_a_halted_session_abandons_it_and_welcomes_the
     statuses = {s.id: (s.status, s.answered) for s in kiosk.store.sessions()}
     assert statuses[kiosk.session.id] == ("abandoned", 1)  # the first answer stays stored
     assert statuses[kiosk.app.session.id] == ("running", 0)
+
+
+async def test_opening_the_clinician_screens_pauses_the_session_and_leaving_resumes_it(ui_kiosk):
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=(80, 24)) as pilot:
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        await _open_clinician(kiosk, pilot)
+        assert kiosk.session.paused and kiosk.session.next_deadline() is None  # nothing times out unseen
+        home = kiosk.app.screen
+        assert "paused while you are here" in text_of(home.query_one("#current"))
+        assert home.query_one("#continue").disabled  # leaving resumes; Continue is for a halt
+        # the home follows the running session (its timer calls this every second)
+        kiosk.app.person_lost()
+        home.refresh_session()
+        assert "patient away" in text_of(home.query_one("#current"))
+        # at 80x24 every button reads in full and the stored sessions show several rows
+        for button in home.query("Button"):
+            assert button.region.width >= len(str(button.label)) + 2, button
+        assert home.query_one("#sessions").region.height >= 4
+        await pilot.press("escape")
+        await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
+        assert not kiosk.session.paused and kiosk.session.current_attempt == 1
+
+        await pilot.press("p")  # paused by the patient: the clinician's visit leaves it paused
+        await settle(pilot, lambda: kiosk.session.paused)
+        await _open_clinician(kiosk, pilot)
+        assert not kiosk.app.screen.query_one("#continue").disabled
+        await pilot.press("escape")
+        await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
+        assert kiosk.session.paused
+
+
+def test_the_plot_draws_each_metric_as_steps():
+    from kiosk.widgets.metrics_plot import steps
+
+    assert steps([0.0, 2.0, 5.0], [0.5, 0.7, 0.4]) == ([0.0, 2.0, 2.0, 5.0, 5.0], [0.5, 0.5, 0.7, 0.7, 0.4])
+    assert steps([], []) == ([], [])

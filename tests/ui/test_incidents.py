@@ -95,7 +95,9 @@ async def test_the_voice_off_adaptation_appears_on_screen(ui_kiosk):
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await start_with_voice_off(kiosk, pilot)
         banner = kiosk.app.screen.query_one(AdaptationBanner)
-        assert banner.display and "touch your answer or press its number" in text_of(banner)
+        # no remote is connected here: the notice offers touch only, never a remote it has not got
+        assert banner.display and "Please touch your answer." in text_of(banner)
+        assert "remote" not in text_of(banner)
         # it stays on the next question's screen too
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)

@@ -9,7 +9,6 @@ from textual.widgets import DataTable, Label, Static
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.session import Phase
-from kiosk.widgets.bars import ChannelBar
 
 from .conftest import UI_PIN
 from .helpers import answer_every_question, deliver_from_thread, screen_name, settle, start_in_english, text_of
@@ -75,18 +74,23 @@ async def test_a_whole_session_answered_through_channel_messages_from_a_thread(u
         assert _stored_channels(kiosk) == {channel.value}
 
 
-async def test_a_remote_plugged_in_shows_as_connected_and_unplugged_as_lost(ui_kiosk):
+async def test_a_remote_plugged_in_is_offered_to_the_patient_and_device_words_stay_off_their_screen(ui_kiosk):
     kiosk = ui_kiosk()
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        bar = kiosk.app.screen.query_one(ChannelBar)
-        await settle(pilot, lambda: "Remote: off" in text_of(bar))
+        welcome = kiosk.app.screen.query_one("#welcome-en", Static)
+        await settle(pilot, lambda: "Welcome." in text_of(welcome))
+        assert "remote" not in text_of(welcome)
         deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.ON, "serial", "connected to /dev/ttyUSB0"))
-        await settle(pilot, lambda: "Remote: on" in text_of(bar))
+        await settle(pilot, lambda: "press its number on the remote" in text_of(welcome))
+        assert "mando" in text_of(kiosk.app.screen.query_one("#welcome-es", Static))
         deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.LOST, "serial", "unplugged"))
-        await settle(pilot, lambda: "Remote: lost" in text_of(bar))
-        assert "Listening: off" in text_of(bar) and "Touch: on" in text_of(bar)
-        reasons = text_of(kiosk.app.screen.query_one("#channel-reasons", Static))
-        assert "no microphone found" in reasons and "unplugged" in reasons
+        await settle(pilot, lambda: "remote" not in text_of(welcome))
+        shown = " ".join(text_of(w) for w in kiosk.app.screen.query(Static))
+        for technical in ("/dev/", "unplugged", "microphone", "Remote:", "Listening:", "off"):
+            assert technical not in shown
+        # the clinician still learns why (their screen lists every channel with its reason)
+        lines = {line.name: line for line in kiosk.app.board.lines("en")}
+        assert lines["Remote"].reason == "unplugged" and lines["Listening"].reason == "no microphone found"
 
 
 async def test_a_kiosk_restarted_mid_session_offers_the_test_to_staff_only_and_continues_it_there(ui_kiosk):
@@ -174,10 +178,10 @@ async def test_every_question_shows_its_own_text_and_answers_with_none_marked(ui
         async def check_then_answer(number: int, option: int) -> None:
             item = kiosk.session.current_item
             screen = kiosk.app.screen
-            assert text_of(screen.query_one("#question", Static)) == item.text["en"]
+            assert text_of(screen.query_one("#question", Static)) == item.patient_text_in("en")
             buttons = list(screen.query(AnswerButton))
             assert [(b.option, text_of(b.query_one(".label", Label))) for b in buttons] == [
-                (o.number, o.label_in("en")) for o in item.options]
+                (o.number, o.patient_label_in("en")) for o in item.options]
             assert not screen.query(".-chosen")
             await pilot.press(str(option))
 

@@ -93,7 +93,7 @@ async def test_every_gap_between_questions_shows_a_calm_line_over_the_last_conte
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         # after an answer: the question stays with its answer marked, under "next question"
         await settle(pilot, lambda: _interlude(kiosk) == "Thank you. Next question…")
-        assert _question_text(kiosk).startswith("Feeding")
+        assert _question_text(kiosk) == "How do you manage eating?"
         assert kiosk.app.screen.query_one("#answer-2").has_class("-chosen")
 
         kiosk.to_next_deadline()

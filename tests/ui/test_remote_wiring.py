@@ -11,7 +11,8 @@ from kiosk.channels import Channel, ChannelState
 from kiosk.remote.profiles import load_profiles
 from kiosk.remote.reconnect import Backoff
 from kiosk.remote.serial import SerialRemote
-from kiosk.widgets.bars import ChannelBar
+from textual.widgets import Label
+
 from kiosk.widgets.channel_board import REMOTE
 from tests.remote.boxes import PATIENCE, ButtonBox
 
@@ -27,7 +28,7 @@ async def test_a_serial_remote_answers_and_its_unplugging_shows(ui_kiosk, tmp_pa
         await start_in_english(kiosk, pilot)
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
-        assert "Remote: on" in str(kiosk.app.screen.query_one(ChannelBar).render())
+        assert "remote" in str(kiosk.app.screen.query_one("#ways", Label).render())
         box.write(b"BTN 2\n")
         await until_thread(lambda: "feeding" in kiosk.session.answers, "the remote's reader thread", PATIENCE)
         answer = kiosk.session.answers["feeding"]
@@ -36,7 +37,8 @@ async def test_a_serial_remote_answers_and_its_unplugging_shows(ui_kiosk, tmp_pa
         box.unplug()
         await until_thread(lambda: kiosk.app.board.state(REMOTE)[0] is not ChannelState.ON, "the remote's reader thread", PATIENCE)
         await settle(pilot)
-        assert "Remote: lost" in str(kiosk.app.screen.query_one(ChannelBar).render())
+        # the patient's row of ways to answer no longer offers it; no device words on their screen
+        assert "remote" not in str(kiosk.app.screen.query_one("#ways", Label).render())
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         await pilot.click("#answer-1")

@@ -107,7 +107,7 @@ async def test_a_tap_on_the_served_page_records_the_answer(served_kiosk, ui_kios
             await wait_until(page, lambda: _count(database, "sessions"), "the session stored")  # start() stores it
             await wait_until(page, shows(_first_words(QUESTIONNAIRE.message("explanation", "en"))), "the explanation")
             await tap(start)
-            await wait_until(page, shows(QUESTIONNAIRE.items[0].text["en"]), "the first question")
+            await wait_until(page, shows(QUESTIONNAIRE.items[0].patient_text_in("en")), "the first question")
             await tap(answer)
             await wait_until(page, lambda: _answers(database), "the answer stored")
             if os.environ.get("KIOSK_E2E_SCREENSHOT"):

@@ -4,6 +4,8 @@ no blinking cursor, no focus on the patient's screens, channel states given by t
 
 from __future__ import annotations
 
+import pytest
+
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.channels import Channel, ChannelInput
 
@@ -161,3 +163,64 @@ def test_session_detail(snap_compare, ui_kiosk):
         await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
 
     assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
+
+
+# The same screens on smaller displays: an 80x24 terminal, the 73x18 a 1024x600 panel gets at a
+# large font (the served page's floor of 24 px), and a cramped 60x18.
+SMALL = [(80, 24), (73, 18), (60, 18)]
+
+
+@pytest.mark.parametrize("size", SMALL, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_welcome_small(snap_compare, ui_kiosk, size):
+    kiosk = ui_kiosk()
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=size, run_before=run_before)
+
+
+@pytest.mark.parametrize("size", SMALL, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_four_answer_question_in_french_small(snap_compare, ui_kiosk, size):
+    kiosk = ui_kiosk(familiarisation=False, language="fr")
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.press("3")
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        await pilot.press("1")
+        while kiosk.session.current_item is None or kiosk.session.current_item.id != "transfers" \
+                or kiosk.session.current_attempt != 1:
+            if kiosk.session.current_attempt == 1:
+                await pilot.press("1")
+                await settle(pilot, lambda: kiosk.session.current_attempt is None)
+            kiosk.to_next_deadline()
+            await settle(pilot)
+
+    assert snap_compare(kiosk.app, terminal_size=size, run_before=run_before)
+
+
+@pytest.mark.parametrize("size", SMALL, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_explanation_small(snap_compare, ui_kiosk, size):
+    kiosk = ui_kiosk(familiarisation=False)
+
+    async def run_before(pilot) -> None:
+        await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
+        await pilot.press("1")
+        await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=size, run_before=run_before)
+
+
+@pytest.mark.parametrize("size", [(80, 24)], ids=["80x24"])
+def test_session_detail_small(snap_compare, ui_kiosk, size):
+    kiosk = ui_kiosk()
+
+    async def run_before(pilot) -> None:
+        await _finish(kiosk, pilot)
+        await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        await pilot.press("enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
+
+    assert snap_compare(kiosk.app, terminal_size=size, run_before=run_before)
