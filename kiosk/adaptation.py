@@ -21,8 +21,10 @@ from qos import Model, load_model
 MODEL = "clarc"
 
 #: adaptations the session knows how to carry out
-KNOWN = ("voice_off", "slow_speech")
-_RULE_KEYS = {"name", "metric", "below", "count", "count_on", "recover_above", "speech_rate"}
+KNOWN = ("voice_off", "slow_speech", "longer_attempts")
+_RULE_KEYS = {"name", "metric", "below", "count", "count_on", "recover_above", "speech_rate", "attempt_factor"}
+#: keys a rule may leave out, with their defaults
+_OPTIONAL = {"speech_rate": 1.0, "attempt_factor": 1.0}
 
 
 class PolicyError(ValueError):
@@ -43,6 +45,8 @@ class Rule:
     recover_above: float
     #: for slow_speech: the factor applied to the normal speech rate
     speech_rate: float = 1.0
+    #: for longer_attempts: the factor applied to the attempt window
+    attempt_factor: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -92,7 +96,7 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
         unknown = set(raw) - _RULE_KEYS
         if unknown:
             raise fail(p + (sorted(unknown)[0],), f"unknown key {sorted(unknown)[0]!r} in a rule", key=True)
-        missing = _RULE_KEYS - {"speech_rate"} - set(raw)
+        missing = _RULE_KEYS - set(_OPTIONAL) - set(raw)
         if missing:
             raise fail(p, f"rule is missing {sorted(missing)[0]!r}")
         if raw["name"] not in KNOWN:
@@ -104,16 +108,18 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
                                         f"{', '.join(properties)})")
         if raw["count_on"] not in ("answers", "updates"):
             raise fail(p + ("count_on",), "count_on is 'answers' or 'updates'")
-        for key, top in (("below", 1), ("recover_above", 1), ("speech_rate", 2)):
+        for key, low, top in (("below", 0, 1), ("recover_above", 0, 1), ("speech_rate", 0, 2),
+                              ("attempt_factor", 1, 4)):
             value = raw.get(key, 1.0)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= top:
-                raise fail(p + (key,), f"{key} must be a number between 0 and {top}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not low <= value <= top:
+                raise fail(p + (key,), f"{key} must be a number between {low} and {top}")
         if not isinstance(raw["count"], int) or isinstance(raw["count"], bool) or raw["count"] < 1:
             raise fail(p + ("count",), "count must be a whole number of at least 1")
         if raw["recover_above"] < raw["below"]:
             raise fail(p + ("recover_above",), "recover_above must not be below 'below' (that is the hysteresis)")
         rules.append(Rule(raw["name"], str(raw["metric"]), float(raw["below"]), raw["count"], raw["count_on"],
-                          float(raw["recover_above"]), float(raw.get("speech_rate", 1.0))))
+                          float(raw["recover_above"]), float(raw.get("speech_rate", 1.0)),
+                          float(raw.get("attempt_factor", 1.0))))
     return Policy(tuple(rules))
 
 
@@ -138,6 +144,13 @@ class Adaptation:
         """Factor on the normal speech rate (below 1 while slow_speech is on)."""
         rates = [r.speech_rate for r in self.policy.rules if r.name in self._active and r.name == "slow_speech"]
         return min(rates, default=1.0)
+
+    @property
+    def attempt_factor(self) -> float:
+        """Factor on the attempt window (above 1 while longer_attempts is on)."""
+        factors = [r.attempt_factor for r in self.policy.rules
+                   if r.name in self._active and r.name == "longer_attempts"]
+        return max(factors, default=1.0)
 
     def observe(self, metrics: Mapping[str, float], answered: bool) -> list[AdaptationChange]:
         """Take the metrics after one QoS update; returns the adaptations switched on or off."""

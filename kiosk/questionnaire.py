@@ -169,6 +169,9 @@ class Timing:
     person_back_grace_s: float = 5.0
     #: after the last question, before FINISHED and the summary
     closing_s: float = 5.0
+    #: how long "I heard: ... Is that right?" waits for Yes or No; no reply stores nothing and
+    #: ends the attempt as if it had timed out
+    confirm_window_s: float = 10.0
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Timing:
         """A copy with some values replaced; unknown names or negative values raise ValueError."""
@@ -182,8 +185,9 @@ class Timing:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
                 raise ValueError(f"timing setting {name!r} must be a number of seconds >= 0, got {value!r}")
             changes[name] = float(value)
-        if changes.get("attempt_window_s", self.attempt_window_s) <= 0:
-            raise ValueError("timing setting 'attempt_window_s' must be more than 0 seconds")
+        for name in ("attempt_window_s", "confirm_window_s"):
+            if changes.get(name, getattr(self, name)) <= 0:
+                raise ValueError(f"timing setting {name!r} must be more than 0 seconds")
         return replace(self, **changes)
 
 

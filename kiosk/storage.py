@@ -301,6 +301,20 @@ class Store:
             "INSERT INTO answers VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             (session_id, item_id, option, points, attempt, channel, answered_by, t, at, detail))
 
+    def withdraw_answer(self, session_id: str, *, item_id: str, t: float, at: str, reason: str) -> None:
+        """Take back a committed answer (the patient's "Change my answer"): its row is deleted and
+        the session log keeps what it was (an ``answer_withdrawn`` event, detail JSON), in one commit."""
+        row = self._db.execute("SELECT option, points, attempt, channel, answered_by, t, at, detail FROM answers"
+                               " WHERE session_id = ? AND item_id = ?", (session_id, item_id)).fetchone()
+        if row is None:
+            raise KeyError(f"session {session_id} has no answer to {item_id!r} to withdraw")
+        withdrawn = dict(zip(("option", "points", "attempt", "channel", "answered_by", "t", "at", "detail"), row))
+        with self.transaction():
+            self._record("withdraw_answer", session_id, {"item_id": item_id, "t": t, "at": at, "reason": reason},
+                         "DELETE FROM answers WHERE session_id = ? AND item_id = ?", (session_id, item_id))
+            self.record_event(session_id, t=t, kind="answer_withdrawn", detail=json.dumps(
+                {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False))
+
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None:
         """Store that both attempts of a question timed out."""
         self._record("record_not_answered", session_id, {"item_id": item_id, "t": t, "at": at},

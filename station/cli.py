@@ -36,8 +36,14 @@ def _db_option(parser: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="kiosk station", description="The ward station: kiosks report to it, "
-                                     "staff watch the ward, answer doctor calls and validate results.")
+    parser = argparse.ArgumentParser(
+        prog="kiosk station", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="The ward station: kiosks report to it, staff watch the ward, answer doctor calls and "
+                    "validate results.",
+        epilog="administration (each takes --db too):\n"
+               "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
+               "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
+               "  kiosk station revoke-kiosk NAME")
     _db_option(parser)
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
     parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
@@ -60,7 +66,15 @@ def _admin_parser(command: str) -> argparse.ArgumentParser:
 
 
 def _url(option: str | None) -> str:
-    return option or db.sqlite_url(db.default_data_dir())
+    """The database URL; a SQLite file, default or given, is created owner-only."""
+    try:
+        if option is None:
+            return db.sqlite_url(db.default_data_dir())
+        if option.startswith("sqlite:///") and option != "sqlite:///:memory:":
+            return db.private_sqlite(Path(option.removeprefix("sqlite:///")))
+    except OSError as exc:
+        raise UsageError(f"cannot create the station database {exc.filename}: {exc.strerror}") from None
+    return option
 
 
 def _password(path: Path | None) -> str:
@@ -127,7 +141,10 @@ def _serve(argv: list[str]) -> int:
     logging.basicConfig(level=logging.WARNING)
     uvicorn.run(app, host=args.host, port=args.port, log_level="warning", access_log=False,
                 ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
-                ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2)
+                ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2,
+                # kiosks keep their connection between batches; closing it after 5 s idle made
+                # them retry on a half-closed socket
+                timeout_keep_alive=75)
     return 0
 
 

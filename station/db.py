@@ -152,8 +152,15 @@ def sqlite_url(data_dir: Path) -> str:
     """The default database: one SQLite file in ``data_dir`` (directory 0700, file 0600)."""
     data_dir.mkdir(mode=0o700, parents=True, exist_ok=True)
     os.chmod(data_dir, 0o700)
-    path = data_dir / DB_NAME
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o600)  # SQLite gives its WAL/SHM files this mode
+    return private_sqlite(data_dir / DB_NAME)
+
+
+def private_sqlite(path: Path) -> str:
+    """The URL of a SQLite file made owner-only before SQLite opens it (SQLite gives its WAL and
+    SHM files the database file's mode); a directory made for it is 0700."""
+    path = path.expanduser()
+    path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o600)
     os.close(fd)
     os.chmod(path, 0o600)
     return f"sqlite:///{path}"

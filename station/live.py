@@ -27,6 +27,25 @@ def sse(event: str, data: dict[str, Any]) -> str:
     return f"event: {event}\ndata: {json.dumps(data)}\n\n"
 
 
+class _Changed:
+    """What the open pages have not been sent yet."""
+
+    def __init__(self) -> None:
+        self.kiosks: set[str] = set()
+        self.alerts = False
+        self.resync = False
+
+    def __bool__(self) -> bool:
+        return bool(self.kiosks) or self.alerts or self.resync
+
+    def take(self, message: dict[str, Any]) -> None:
+        kind = message.get("type")
+        if kind in ("kiosk", "alert") and message.get("kiosk"):
+            self.kiosks.add(message["kiosk"])
+        self.alerts |= kind in ("alert", "ack")
+        self.resync |= kind == "resync"
+
+
 class Live:
     """Renders bus messages into page events and fans them out to the open pages."""
 
@@ -52,39 +71,33 @@ class Live:
         return await asyncio.get_running_loop().run_in_executor(self._executor, render, *args)
 
     async def _run(self) -> None:
+        """Render what changed, one piece at a time, alerts before tiles: after each render the
+        messages that arrived meanwhile are taken in, so a new alert never waits behind a burst
+        of status reports."""
         queue = self._bus.subscribe()
+        changed = _Changed()
         while True:
-            message = await queue.get()
+            if not changed:
+                changed.take(await queue.get())
+            while not queue.empty():
+                changed.take(queue.get_nowait())
+            if not self._pages:
+                changed = _Changed()
+                continue
             try:
-                for text in await self._events(message, queue):
-                    for page in list(self._pages):
-                        page.put_nowait(text)
+                if changed.resync:
+                    changed = _Changed()
+                    text = sse("resync", {})
+                elif changed.alerts:
+                    changed.alerts = False
+                    text = sse("alerts", await self._render(self._render_alerts))
+                else:
+                    text = sse("kiosk", await self._render(self._render_kiosk, changed.kiosks.pop()))
             except Exception:  # a page must keep its feed even if one render fails
-                log.exception("station: could not render %s", message)
-
-    async def _events(self, message: dict[str, Any], queue: asyncio.Queue[dict[str, Any]]) -> list[str]:
-        """The page events for a message; messages already waiting are merged, so a burst of
-        status reports from one kiosk is rendered once."""
-        kiosks, alerts, resync = set(), False, False
-        while True:
-            kind = message.get("type")
-            if kind in ("kiosk", "alert") and message.get("kiosk"):
-                kiosks.add(message["kiosk"])
-            alerts |= kind in ("alert", "ack")
-            resync |= kind == "resync"
-            if queue.empty():
-                break
-            message = queue.get_nowait()
-        if not self._pages:
-            return []
-        if resync:
-            return [sse("resync", {})]
-        events = []
-        if alerts:  # alerts first: they are what a nurse must see soonest
-            events.append(sse("alerts", await self._render(self._render_alerts)))
-        for name in sorted(kiosks):
-            events.append(sse("kiosk", await self._render(self._render_kiosk, name)))
-        return events
+                log.exception("station: could not render a live update")
+                continue
+            for page in list(self._pages):
+                page.put_nowait(text)
 
     async def stream(self) -> AsyncIterator[str]:
         """The event stream of one open page (ends when the page goes away)."""

@@ -84,6 +84,8 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
                                            p.get("detail", ""))
             if p["item_id"] in not_answered:
                 not_answered.remove(p["item_id"])
+        elif row.kind == "withdraw_answer":  # the patient's "Change my answer": the answer is gone
+            answers.pop(p["item_id"], None)
         elif row.kind == "record_not_answered":
             if p["item_id"] not in answers and p["item_id"] not in not_answered:
                 not_answered.append(p["item_id"])

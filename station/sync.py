@@ -29,6 +29,7 @@ REQUIRED: dict[str, tuple[str, ...]] = {
     "create_session": ("session_id", "patient_id", "questionnaire_id", "language", "answered_by", "started_at"),
     "record_answer": ("item_id", "option", "points", "attempt", "channel", "answered_by", "t"),
     "record_not_answered": ("item_id", "t"),
+    "withdraw_answer": ("item_id", "t"),
     "record_practice": ("question_id", "checks", "outcome", "t"),
     "record_context": ("t",),
     "record_metrics": ("t", "metrics"),

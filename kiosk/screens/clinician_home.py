@@ -38,13 +38,14 @@ class ClinicianHomeScreen(ClinicianScreen):
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
                 yield Button("Back to the patient", id="back")
-                yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
             present = session.snapshot().person_present
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost", disabled=not (running and present))
                 yield Button("Patient back", id="person-back", disabled=not (running and not present))
+                # the only way out of the locked-down kiosk, on the shorter row so it always shows
+                yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             yield Static(self._channels_text(), id="channel-reasons")
             # continuing a test is the staff's decision: only with the same patient at the kiosk
             yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")

@@ -49,7 +49,7 @@ the touchscreen, and the CLARC model has no keyboard literal.
 
 The package, one concept a module: :mod:`.events` (what is published), :mod:`.snapshot` (what a
 screen renders), :mod:`.timers` (the attempt clock), :mod:`.questions` (attempts, answers,
-time-outs, finish), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor,
+time-outs, finish), :mod:`.corrections` (confirm an unsure answer, undo the last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor,
 presence), :mod:`.live` (live adaptation), :mod:`.publishing` (prompts, QoS batches, log,
 listeners), :mod:`.ports` (what it needs of the engine and the store) and :mod:`.core` (the
 session's state and the steps before the questions).
@@ -60,9 +60,13 @@ from kiosk.session.events import (
     ATTEMPTS,
     AdaptationChanged,
     AnsweredBy,
+    AnswerNotConfirmed,
     AnswerRecorded,
+    AnswerWithdrawn,
     AttemptOpened,
     AttemptTimedOut,
+    ConfirmationAsked,
+    DoctorCallCancelled,
     DoctorCalled,
     DoctorContinued,
     Finished,
@@ -71,6 +75,7 @@ from kiosk.session.events import (
     LanguageChanged,
     ListeningChanged,
     MetricsUpdated,
+    NextPatient,
     Paused,
     PersonBack,
     PersonLost,
@@ -91,9 +96,10 @@ from kiosk.session.snapshot import Answer, Snapshot
 
 __all__ = [
     "ATTEMPTS", "SAME_INSTANT_STEP_S", "USER_INTERACTION", "AdaptationChanged", "Answer", "AnsweredBy",
-    "AnswerRecorded", "AttemptOpened", "AttemptTimedOut", "DoctorCalled", "DoctorContinued", "Finished",
+    "AnswerNotConfirmed", "AnswerRecorded", "AnswerWithdrawn", "AttemptOpened", "AttemptTimedOut",
+    "ConfirmationAsked", "DoctorCallCancelled", "DoctorCalled", "DoctorContinued", "Finished",
     "IgnoreReason", "InputIgnored", "LanguageChanged", "Listener", "ListeningChanged", "MetricsUpdated",
-    "Paused", "PersonBack", "PersonLost", "Phase", "PhaseChanged", "PracticeAnswered", "PracticeSkipped",
+    "NextPatient", "Paused", "PersonBack", "PersonLost", "Phase", "PhaseChanged", "PracticeAnswered", "PracticeSkipped",
     "Prompt", "PromptOption", "QosEngine", "QuestionNotAnswered", "Resumed", "Session", "SessionEvent",
     "SessionStore", "Snapshot", "VolumeChanged",
 ]

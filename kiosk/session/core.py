@@ -13,12 +13,14 @@ from typing import Any
 from kiosk.channels import Channel, ChannelInput
 from kiosk.clock import Clock
 from kiosk.questionnaire import Item, Questionnaire, Score, Timing
+from kiosk.session.corrections import Corrections
 from kiosk.session.events import (
     AnsweredBy,
     IgnoreReason,
     LanguageChanged,
     Phase,
     Prompt,
+    PromptOption,
     SessionEvent,
 )
 from kiosk.session.incidents import Incidents
@@ -29,15 +31,18 @@ from kiosk.session.publishing import Batch, Listener, Operation, Publisher
 from kiosk.session.questions import OpenQuestion, QuestionFlow
 from kiosk.session.snapshot import Answer, Snapshot
 from kiosk.session.timers import AttemptClock
+from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
 
 
-class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
+class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Publisher):
     """One administration of a questionnaire. See the package docstring for the rules.
 
     ``engine`` is a ``qos.Engine`` (``None``: no QoS, contexts are still kept in :attr:`trace`).
     ``store`` commits every answer as it happens (``None``: nothing is stored).
     ``timing`` overrides the questionnaire's timing values. ``adaptation`` is a
     :class:`kiosk.adaptation.Adaptation` (``None``: no live adaptation).
+    ``next_patient_after_s``: how long the end screen stays before :class:`NextPatient` is
+    published (``None``: it stays).
     ``session_id``, ``t_offset``, ``resume_answers`` and ``resume_not_answered`` are for
     :meth:`from_stored` (continuing a stored session); other callers leave them alone.
     """
@@ -55,6 +60,7 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
         timing: Mapping[str, float] | Timing | None = None,
         adaptation: Any = None,
         familiarisation: bool = True,
+        next_patient_after_s: float | None = None,
         session_id: str | None = None,
         t_offset: float = 0.0,
         resume_answers: Mapping[str, Answer] | None = None,
@@ -72,6 +78,7 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
         self.id = session_id or uuid.uuid4().hex[:12]
         self.timing = timing if isinstance(timing, Timing) else questionnaire.timing.with_overrides(timing)
         self.adaptation = adaptation
+        self.next_patient_after_s = next_patient_after_s
         self._language = language
         self._answered_by = AnsweredBy(answered_by)
         self._familiarisation = familiarisation and bool(questionnaire.familiarisation)
@@ -79,6 +86,8 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
         self._resuming = resume_answers is not None
         self._stored = self._resuming and store is not None
         self._phase = Phase.WELCOME
+        #: the welcome prompt was published (see welcome()): listen for "start" until started
+        self._greeted = False
         self._open: OpenQuestion | None = None
         self._answers: dict[str, Answer] = dict(resume_answers or {})
         self._not_answered: list[str] = list(resume_not_answered)
@@ -221,11 +230,15 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
             speech_rate=self._speech_rate(), answers=dict(self._answers),
             not_answered=tuple(self._not_answered), score=self._score, prompt=self._prompt,
             interlude=self._interlude(), **self._practice_progress(),
+            confirming=self._open.unconfirmed.option if self._open and self._open.unconfirmed else None,
+            can_undo=self._can_undo() and not self._timers.frozen,
         )
 
     def _interlude(self) -> str | None:
         """What to show while the next question (or the summary) is being waited for."""
         kind = self._timers.kind
+        if self._phase is Phase.FAMILIARISATION and kind == "practice" and self._open is not None:
+            return self._open.feedback  # "Well done." stays while the next practice question waits
         if self._phase is not Phase.QUESTIONS or kind is None:
             return None
         if kind == "finish":
@@ -239,6 +252,15 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
         return "next_question"
 
     # -- inputs ------------------------------------------------------------------------------------
+
+    def welcome(self) -> None:
+        """The welcome is on screen: publish it as a prompt whose options are the languages to start
+        in (say "start", a language's name, or its number) and listen for them."""
+        with Operation(self) as t:
+            if self._phase is Phase.WELCOME:
+                self._greeted = True
+                self._publish_prompt(self._welcome_prompt(t))
+                self._update_listening(t)
 
     def start(self, answered_by: AnsweredBy | str | None = None) -> None:
         """The patient started at the welcome screen (publishes PersonDetected and TestState)."""
@@ -258,17 +280,20 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
     def handle(self, event: ChannelInput) -> None:
         """An input from a channel: an answer option or a command.
 
-        Before the questions an answer number means what the screen says: on the welcome screen
-        option n starts in the questionnaire's n-th language (a higher number starts in the current
-        language, as "press any button" promises); under the explanation any number acknowledges
-        it (unless paused or halted).
+        An answer number means what the screen says: on the welcome screen option n starts in the
+        questionnaire's n-th language (a higher number starts in the current language, as "press
+        any button" promises); under the explanation any number acknowledges it (unless paused);
+        after call-doctor 1 is "I'm fine, carry on"; while "Is that right?" is asked 1 is Yes and
+        2 is No.
         """
         with Operation(self) as t:
             if event.command is not None:
                 self._command(t, event)
             elif self._phase is Phase.WELCOME:
                 self._start_by_number(t, event)
-            elif self._phase is Phase.EXPLANATION and not (self.paused or self.halted):
+            elif self.halted:
+                self._doctor_reply(t, event)
+            elif self._phase is Phase.EXPLANATION and not self.paused:
                 self._acknowledge(t)
             else:
                 self._answer(t, event)
@@ -339,7 +364,9 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
         self._language = language
         self._log(t, "language", language)
         self._emit(LanguageChanged(t, language))
-        if self._phase is Phase.WELCOME:
+        if self._phase is Phase.WELCOME and self._greeted:
+            self._publish_prompt(self._welcome_prompt(t))
+        elif self._phase is Phase.WELCOME:
             self._message(t, "welcome")
         elif self._phase is Phase.EXPLANATION:
             self._message(t, "explanation")
@@ -354,6 +381,18 @@ class Session(QuestionFlow, Incidents, Practice, LiveAdaptation, Publisher):
         if event.option <= len(languages):
             self._choose_language(t, languages[event.option - 1])
         self._start(t, None)
+
+    def _welcome_prompt(self, t: float) -> Prompt:
+        """The welcome message with one option per language: its own name, what it is called in
+        the prompt's language, and (for the language shown) the words for "start"."""
+        lang = self._language
+        text = self.questionnaire.message("welcome", lang)
+        options = tuple(
+            PromptOption(number, OWN_NAME.get(language, language),
+                         (*LANGUAGE_NAMES.get(lang, {}).get(language, ()),
+                          *(START_WORDS.get(lang, ()) if language == lang else ())), None)
+            for number, language in enumerate(self.questionnaire.languages, start=1))
+        return Prompt(t, "welcome", "welcome", text, text, lang, options, speech_rate=self._speech_rate())
 
     def _acknowledge(self, t: float) -> None:
         if self._phase is not Phase.EXPLANATION:

@@ -50,6 +50,8 @@ class IgnoreReason(str, Enum):
     PERSON_ALREADY_LOST = "person_already_lost"
     PERSON_NOT_LOST = "person_not_lost"
     UNKNOWN_LANGUAGE = "unknown_language"
+    NOTHING_TO_UNDO = "nothing_to_undo"  # no answer can be taken back now
+    UNSURE_REPLY = "unsure_reply"  # an unsure "yes" never confirms an unsure answer
 
 
 #: attempts per question: the question is asked, then asked again, then it is not answered. Fixed
@@ -98,8 +100,10 @@ class PromptOption:
 class Prompt(SessionEvent):
     """Something to show and say now: a question, a practice question or a message.
 
-    ``kind`` is "question", "practice" or "message"; ``key`` is the item id, the practice
-    question id or the message name ("welcome", "explanation", "paused", "voice_off", ...).
+    ``kind`` is "question", "practice", "confirm" (is the answer heard right? options Yes and No),
+    "welcome" (options: start in each language) or "message"; ``key`` is the item id, the practice
+    question id or the message name ("welcome", "explanation", "paused", "voice_off", ...). The
+    voice channel listens for a prompt's options while the session is listening.
     """
 
     kind: str
@@ -260,6 +264,62 @@ class MetricsUpdated(SessionEvent):
     fired: tuple[str, ...]
     set: Mapping[str, Any]
     emit: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ConfirmationAsked(SessionEvent):
+    """An answer the channel was not sure of is not stored yet: the patient is asked "I heard:
+    <option>. Is that right?" (the prompt that follows has the Yes/No options)."""
+
+    item_id: str
+    number: int
+    #: the option heard, and the channel it came through
+    option: int
+    attempt: int
+    channel: Channel
+    #: session time the confirmation times out (the answer is then not stored)
+    deadline: float
+
+
+@dataclass(frozen=True)
+class AnswerNotConfirmed(SessionEvent):
+    """An answer waiting for confirmation was not stored: ``why`` is "declined" (No), "undone"
+    (the undo command) or "timed_out" (no reply: the attempt ends unanswered)."""
+
+    item_id: str
+    number: int
+    option: int
+    attempt: int
+    why: str
+
+
+@dataclass(frozen=True)
+class AnswerWithdrawn(SessionEvent):
+    """A stored answer was taken back ("Change my answer") and its question is asked again until
+    ``deadline``; ``by`` is the channel the undo came through."""
+
+    item_id: str
+    number: int
+    option: int
+    points: int
+    attempt: int
+    channel: Channel
+    by: Channel | None
+    deadline: float
+
+
+@dataclass(frozen=True)
+class DoctorCallCancelled(SessionEvent):
+    """The patient said "I'm fine, carry on" after calling the doctor; the test goes on."""
+
+    channel: Channel | None
+    deadline: float | None
+
+
+@dataclass(frozen=True)
+class NextPatient(SessionEvent):
+    """The end screen has been shown long enough: the kiosk goes back to the welcome for the next
+    patient (the finished session's result stays stored for staff)."""
 
 
 @dataclass(frozen=True)

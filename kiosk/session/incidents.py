@@ -1,8 +1,11 @@
 """Incidents: what interrupts the questions and how the session comes back from it.
 
 * Pause freezes the attempt clock; on resume at least ``resume_grace_s`` is left.
-* Call-doctor halts the session (answers are ignored) until :meth:`Incidents.clinician_continue`;
-  then at least ``resume_grace_s`` is left.
+* Call-doctor halts the session (answers are ignored) until :meth:`Incidents.clinician_continue`,
+  or until the patient says "I'm fine, carry on" (:meth:`Incidents.cancel_doctor_call`: the
+  button, or 1 on the keys or the remote -- never by voice, as a misheard phrase must not call
+  off help); then at least ``resume_grace_s`` is left. The cancel is logged
+  (``doctor_call_cancelled``) and published, so staff see the call was called off.
 * Person lost freezes the clock; person back leaves at least ``person_back_grace_s``.
 
 After each, an open question is asked again.
@@ -14,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from kiosk.channels import Channel, ChannelInput
 from kiosk.session.events import (
+    DoctorCallCancelled,
     DoctorCalled,
     DoctorContinued,
     IgnoreReason,
@@ -70,6 +74,12 @@ class Incidents:
             deadline = self._timers.attempt_deadline()
             self._emit(DoctorContinued(t, deadline) if was_halted else Resumed(t, deadline))
             self._reprompt_after_freeze(t)
+
+    def cancel_doctor_call(self: Session, channel: Channel | None = None) -> None:
+        """The patient says "I'm fine, carry on" after calling the doctor: the test goes on (a
+        pause from before the call stays); at least ``resume_grace_s`` left."""
+        with Operation(self) as t:
+            self._cancel_doctor(t, channel)
 
     def person_lost(self: Session) -> None:
         """The presence source (or the clinician) says the patient left; the clock stops."""
@@ -150,6 +160,26 @@ class Incidents:
         self._freeze("doctor")
         self._emit(DoctorCalled(t, channel))
         self._message(t, "doctor_called")
+
+    def _doctor_reply(self: Session, t: float, event: ChannelInput) -> None:
+        """An answer number while the doctor is called: 1 is "I'm fine, carry on" (not by voice)."""
+        if event.option == 1 and event.channel is not Channel.VOICE:
+            self._cancel_doctor(t, event.channel, event)
+        else:
+            self._ignore(t, event, IgnoreReason.DOCTOR_CALLED)
+
+    def _cancel_doctor(self: Session, t: float, channel: Channel | None, event: ChannelInput | None = None) -> None:
+        if not self.halted:
+            self._ignore(t, event, IgnoreReason.NOT_HALTED, "cancel_doctor_call")
+            return
+        self._context(t, {"TestState": "RESTARTED"})
+        self._log(t, "doctor_call_cancelled", channel.value if channel else "")
+        self._unfreeze({"doctor"}, self.timing.resume_grace_s)
+        self._emit(DoctorCallCancelled(t, channel, self._timers.attempt_deadline()))
+        if self.paused:  # called from the paused screen: back to it
+            self._message(t, "paused")
+        else:
+            self._reprompt_after_freeze(t)
 
     def _reprompt_after_freeze(self: Session, t: float) -> None:
         if not self._timers.frozen and self.current_attempt is not None:

@@ -1,6 +1,6 @@
 """Live adaptation inside a session: the policy (:class:`kiosk.adaptation.Adaptation`) decides from
 the QoS metrics; the session records each change and acts on it (stops or resumes listening,
-speaks more slowly)."""
+speaks more slowly, gives a slow patient longer attempts from the next one opened)."""
 
 from __future__ import annotations
 
@@ -58,6 +58,11 @@ class LiveAdaptation:
 
     def _speech_rate(self: Session) -> float:
         return self.adaptation.speech_rate if self.adaptation is not None else 1.0
+
+    def _attempt_window(self: Session) -> float:
+        """How long an attempt opened now waits: longer while ``longer_attempts`` is on."""
+        factor = self.adaptation.attempt_factor if self.adaptation is not None else 1.0
+        return self.timing.attempt_window_s * factor
 
     def _apply_adaptation(self: Session, t: float, change: Any) -> None:
         """Publish and store one adaptation change and act on it (voice on/off, slower speech)."""

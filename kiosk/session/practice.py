@@ -1,6 +1,9 @@
 """Familiarisation: the practice questions before the scored ones (hear, read, select).
 
-Practice answers are stored for the clinician but never reach the QoS engine. Practice questions
+Each answer gets a short, kind word ("Well done.") that stays for the thank-you gap
+(``between_questions_s``) before the next practice question. Practice answers are stored for the
+clinician but never reach the QoS engine; they are never asked back for confirmation (nothing
+scored depends on them). Practice questions
 that check hearing are skipped while voice out is unavailable: asking "which word did you hear?"
 when nothing was said only upsets the patient.
 """
@@ -101,8 +104,11 @@ class Practice:
         self._record_practice(t, question, "right" if correct else "wrong", option=event.option,
                               channel=event.channel, detail=event.detail)
         self._emit(PracticeAnswered(t, question.id, event.option, correct, event.channel))
-        self._message(t, "practice_right" if correct else "practice_wrong")
-        self._next_practice(t)
+        self._open.feedback = "practice_right" if correct else "practice_wrong"
+        self._message(t, self._open.feedback)
+        # the kind word stays on screen (and is said) before the next practice question
+        self._timers.set("practice", t, self.timing.between_questions_s)
+        self._update_listening(t)
 
     def _practice_not_answered(self: Session, t: float) -> None:
         """Both attempts at the open practice question timed out."""

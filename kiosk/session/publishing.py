@@ -140,7 +140,11 @@ class Publisher:
                                         speech_rate=self._speech_rate()))
 
     def _prompt_question(self: Session, t: float, repeat: bool) -> None:
+        """Ask the open question (or, while an answer waits for confirmation, "Is that right?")."""
         assert self._open is not None
+        if self._open.unconfirmed is not None:
+            self._publish_prompt(self._confirmation_prompt(t, repeat))
+            return
         lang = self._language
         question = self._question()
         options = tuple(PromptOption(o.number, o.label_in(lang), o.synonyms_in(lang), o.points)
@@ -157,8 +161,9 @@ class Publisher:
         self._emit(prompt)
 
     def _update_listening(self: Session, t: float) -> None:
-        listening = (self.current_attempt is not None and not self._timers.frozen
-                     and "voice_off" not in self._active_adaptations())
+        # on the welcome once it was shown (say start), and while an attempt is open
+        wanted = (self._phase is Phase.WELCOME and self._greeted) or self.current_attempt is not None
+        listening = wanted and not self._timers.frozen and "voice_off" not in self._active_adaptations()
         if listening != self._listening:
             self._listening = listening
             self._emit(ListeningChanged(t, listening))

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from kiosk.channels import Channel, ChannelInput, Command
 from kiosk.questionnaire import Item, PracticeQuestion
+from kiosk.session.corrections import Unconfirmed
 from kiosk.session.events import (
     ATTEMPTS,
     AnswerRecorded,
@@ -20,6 +21,7 @@ from kiosk.session.events import (
     AttemptTimedOut,
     Finished,
     IgnoreReason,
+    NextPatient,
     Phase,
     QuestionNotAnswered,
     VolumeChanged,
@@ -40,6 +42,13 @@ class OpenQuestion:
     attempt: int = 0
     #: None while open; "answered" or "not_answered" once over (it stays on screen until the next)
     outcome: str | None = None
+    #: an answer heard but waiting for Yes or No before it is stored
+    unconfirmed: Unconfirmed | None = None
+    #: asked again after its answer was taken back: the new answer publishes no attempt context,
+    #: and no answer in time leaves the question unanswered
+    correcting: bool = False
+    #: practice: the message that answered it ("practice_right"/"practice_wrong"), shown meanwhile
+    feedback: str | None = None
 
 
 class QuestionFlow:
@@ -53,8 +62,15 @@ class QuestionFlow:
             self._open_question(t, practice=False, index=index)
         elif kind == "attempt":
             self._attempt_timed_out(t)
+        elif kind == "confirm":
+            self._not_confirmed(t, "timed_out")
+        elif kind == "practice":
+            self._next_practice(t)
         elif kind == "finish":
             self._finish(t)
+        elif kind == "next_patient":
+            self._log(t, "next_patient", "the end screen was shown long enough")
+            self._emit(NextPatient(t))
 
     def _schedule_next_item(self: Session, t: float, after: float) -> None:
         if self._next_item_index() is not None:
@@ -73,10 +89,11 @@ class QuestionFlow:
     def _open_attempt(self: Session, t: float, attempt: int) -> None:
         assert self._open is not None
         self._open.attempt = attempt
-        self._timers.set("attempt", t, self.timing.attempt_window_s)
+        window = self._attempt_window()
+        self._timers.set("attempt", t, window)
         key, number = self._open_key()
         self._prompt_question(t, repeat=attempt > 1)
-        self._emit(AttemptOpened(t, key, number, attempt, t + self.timing.attempt_window_s, self._open.practice))
+        self._emit(AttemptOpened(t, key, number, attempt, t + window, self._open.practice))
         self._update_listening(t)
 
     def _open_key(self: Session) -> tuple[str, int]:
@@ -96,12 +113,12 @@ class QuestionFlow:
         assert self._open is not None
         attempt = self._open.attempt
         key, number = self._open_key()
-        if not self._open.practice:
+        if not (self._open.practice or self._open.correcting):
             name = "FirstAttemptAnswered" if attempt == 1 else "SecondAttemptAnswered"
             self._context(t, {name: False})
         self._log(t, "attempt_timed_out", f"{key} attempt {attempt}")
         self._emit(AttemptTimedOut(t, key, number, attempt, self._open.practice))
-        if attempt < ATTEMPTS:
+        if attempt < ATTEMPTS and not self._open.correcting:
             self._open_attempt(t, attempt + 1)
             return
         self._open.outcome = "not_answered"
@@ -123,28 +140,42 @@ class QuestionFlow:
             return
         assert self._open is not None and event.option is not None
         open_ = self._open
+        if open_.unconfirmed is not None:
+            self._confirmation_reply(t, event)
+        elif open_.practice:
+            open_.outcome = "answered"
+            self._timers.cancel()
+            self._practice_answered(t, event)
+        elif event.needs_confirmation:
+            self._ask_confirmation(t, event)
+        else:
+            self._record_answer(t, event.option, event.channel, event.detail)
+
+    def _record_answer(self: Session, t: float, number: int, channel: Channel, detail: str) -> None:
+        """Store option ``number`` as the open item's answer on its attempt, publish it, go on."""
+        open_ = self._open
+        assert open_ is not None
         attempt = open_.attempt
         open_.outcome = "answered"
         self._timers.cancel()
-        if open_.practice:
-            self._practice_answered(t, event)
-            return
         item = self.questionnaire.items[open_.index]
-        option = item.option(event.option)
+        option = item.option(number)
         assert option.points is not None
-        answer = Answer(item.id, option.number, option.points, attempt, event.channel, self._answered_by, t,
-                        event.detail)
+        answer = Answer(item.id, option.number, option.points, attempt, channel, self._answered_by, t, detail)
         if self.store is not None:  # committed before anything else learns of it (crash safety)
             self.store.record_answer(
                 self.id, item_id=item.id, option=option.number, points=option.points, attempt=attempt,
-                channel=event.channel.value, answered_by=self._answered_by.value, t=t, at=self._wall(t),
-                detail=event.detail,
+                channel=channel.value, answered_by=self._answered_by.value, t=t, at=self._wall(t),
+                detail=detail,
             )
         self._answers[item.id] = answer
-        name = "FirstAttemptAnswered" if attempt == 1 else "SecondAttemptAnswered"
-        self._context(t, {name: True, "UserInteraction": USER_INTERACTION[event.channel]})
+        contexts: dict[str, object] = {}
+        if not open_.correcting:  # attempt contexts are once per question
+            contexts["FirstAttemptAnswered" if attempt == 1 else "SecondAttemptAnswered"] = True
+        contexts["UserInteraction"] = USER_INTERACTION[channel]
+        self._context(t, contexts)
         self._emit(AnswerRecorded(t, item.id, item.number, option.number, option.points, attempt,
-                                  event.channel, self._answered_by, event.detail))
+                                  channel, self._answered_by, detail))
         self._update_listening(t)
         self._schedule_next_item(t, self.timing.between_questions_s)
 
@@ -163,7 +194,8 @@ class QuestionFlow:
             return IgnoreReason.NO_OPEN_ATTEMPT
         if event.channel is Channel.VOICE and "voice_off" in self._active_adaptations():
             return IgnoreReason.VOICE_OFF
-        if event.option is None or event.option > len(self._question().options):
+        choices = 2 if self._open.unconfirmed is not None else len(self._question().options)  # Yes/No
+        if event.option is None or event.option > choices:
             return IgnoreReason.NO_SUCH_OPTION
         return None
 
@@ -181,6 +213,8 @@ class QuestionFlow:
             self._call_doctor(t, event.channel, event)
         elif command is Command.REPEAT:
             self._repeat(t, event.channel, event)
+        elif command is Command.UNDO:
+            self._undo(t, event)
         elif command in (Command.VOLUME_UP, Command.VOLUME_DOWN):
             self._emit(VolumeChanged(t, 1 if command is Command.VOLUME_UP else -1))
 
@@ -214,3 +248,5 @@ class QuestionFlow:
         self._message(t, "finished")
         self._update_listening(t)
         self._emit(Finished(t, score))
+        if self.next_patient_after_s is not None:
+            self._timers.set("next_patient", t, self.next_patient_after_s)

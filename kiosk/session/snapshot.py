@@ -60,4 +60,9 @@ class Snapshot:
     #: (a hearing check skipped without voice out is not counted); None outside a practice question
     practice_number: int | None = None
     practice_count: int = 0
+    #: the option heard while "I heard: ... Is that right?" waits for Yes or No (the prompt has
+    #: the question and the two options); None otherwise
+    confirming: int | None = None
+    #: "Change my answer" can be offered: the thank-you gap after an answer is running
+    can_undo: bool = False
 

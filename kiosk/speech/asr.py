@@ -14,12 +14,16 @@ in [0, 1]:
   1. a whole phrase was reached (else 0);
   2. coverage: the recognised words cover the utterance's voiced audio (a sentence forced
      onto the grammar goes mostly into "silence": 5-45 % covered, an answer 80-100 %);
-  3. fit: the acoustic cost per voiced frame is low. PocketSphinx scores every frame against
-     the best-matching sound in that frame, so the path's cost measures how far the grammar
-     had to bend the audio: 3.9-6.5 for answers, 6.6-7.9 for other short words on espeak-ng
-     audio here. :data:`PS_COST_MIDPOINT` and :data:`PS_COST_SPREAD` map it to [0, 1]. The
-     utterance is scored with a fixed quiet tail (:func:`_fixed_tail`), so one the endpointer
-     closed early is scored like one closed late;
+  3. fit: the phrase fits the audio nearly as well as free phone decoding does. The cost per
+     voiced frame of the grammar's best path is compared with that of the best free phone
+     sequence for the same audio (the wheel's phone language model): an answer costs about as
+     much as free phones, a sentence forced onto the grammar much more. An absolute cost (the
+     first design) was tuned on the kiosk's own voice: right answers by other espeak-ng voices
+     cost 6-9.7 per frame against 3.9-6.5 for the kiosk's, so "yes" in a female voice scored 0;
+     the difference to free phones is the same yardstick for every voice and room.
+     :data:`PS_FIT_MIDPOINT` and :data:`PS_FIT_SPREAD` (set on bench/asr.py's dev voices) map
+     it to [0, 1]. The utterance is scored with a fixed quiet tail (:func:`_fixed_tail`), so
+     one the endpointer closed early is scored like one closed late;
   4. no confusable word (:data:`PS_CONFUSABLE_WORDS`): espeak-ng's "the first one" was heard
      as "the third one" on every question with a third option, and decoded against each phrase
      alone "the third one" even fits it better, so no score margin separates them. Such a
@@ -116,7 +120,7 @@ class Recogniser(Protocol):
 
 #: the fit (phrase cost minus free-phone cost per voiced frame) where the acoustic confidence
 #: is 0.5, and how fast it falls around it (see the docstring)
-PS_FIT_MIDPOINT, PS_FIT_SPREAD = 0.5, 0.3
+PS_FIT_MIDPOINT, PS_FIT_SPREAD = 2.2, 0.35
 #: the free phone-loop search's name in the decoder
 _PHONES = "phones"
 #: 10 ms frames of quiet after the last voiced one that the final decode scores: the long
@@ -130,6 +134,7 @@ PS_CONFUSABLE_WORDS: tuple[frozenset[str], ...] = (frozenset({"first", "third"})
 PS_EXTRA_WORDS = {
     "español": "EH S P AA N Y OW L", "espanol": "EH S P AA N Y OW L",
     "français": "F R AA N S EY", "francais": "F R AA N S EY",
+    "français(2)": "F R AA N S EH", "français(3)": "F R AO S EH", "français(4)": "F AA S EH",
     "empezar": "EH M P EY S AA R", "commencer": "K AO M AA N S EY",
 }
 
@@ -180,7 +185,7 @@ class PocketSphinxRecogniser:
         confusable where "the third one" selects something else.
         """
         grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name,
-                                lead_ins, fillers)
+                                lead_ins, fillers, meaning)
         self._end()
         # a fresh search name each time: pocketsphinx keeps searches by name
         self._grammars += 1
@@ -351,7 +356,7 @@ class VoskRecogniser:
         ``meaning`` is not needed: Vosk's own word confidences tell confusable words apart.
         """
         grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name,
-                                lead_ins, fillers)
+                                lead_ins, fillers, meaning)
         if not grammar.phrases:
             raise ValueError("a grammar needs at least one phrase the recogniser knows")
         self._recogniser = self._vosk.KaldiRecognizer(self._model, SAMPLE_RATE, to_vosk(grammar))
@@ -388,7 +393,13 @@ class VoskRecogniser:
             return Recognition("", 0.0)
         segments = [*self._segments, self._recogniser.FinalResult()]
         self._segments = []
-        return vosk_recognition(segments)
+        result = vosk_recognition(segments)
+        if self._grammar is not None and self._grammar.core(result.text) not in self._grammar.phrases:
+            # Vosk's grammar lets phrases follow one another, and a model without "[unk]" (the
+            # Korean one) forces any sentence into a run of them ("셋 셋 혼자", each word 0.65
+            # sure): only one phrase, maybe after a lead-in, is something a patient answered
+            return Recognition(result.text, 0.0)
+        return result
 
 
 def vosk_recognition(results: Sequence[str]) -> Recognition:

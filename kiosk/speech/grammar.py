@@ -27,31 +27,37 @@ def recogniser_words(phrase: str) -> list[str]:
 class Grammar:
     """The phrases a recogniser will listen for, and those left out (phrase, why).
 
-    ``lead_ins`` may come before any phrase ("i need" a lot of help); ``fillers`` are
-    non-answers ("um", "what") that give other speech somewhere to go but the nearest answer.
+    ``lead_ins`` may come before an answer phrase ("i need" a lot of help), not before a command;
+    ``fillers`` are non-answers ("um", "what") that give other speech somewhere to go but the
+    nearest answer.
     """
 
     phrases: tuple[str, ...]
     dropped: tuple[tuple[str, str], ...] = ()
     lead_ins: tuple[str, ...] = ()
     fillers: tuple[str, ...] = ()
+    #: the phrases that select an answer option (a lead-in may come before these)
+    answers: tuple[str, ...] = ()
 
     def core(self, text: str) -> str:
-        """``text`` without a lead-in, when what follows is a phrase; else ``text``."""
+        """``text`` without a lead-in, when what follows is an answer phrase; else ``text``."""
         for lead in sorted(self.lead_ins, key=len, reverse=True):
-            if text.startswith(lead + " ") and text[len(lead) + 1:] in self.phrases:
+            if text.startswith(lead + " ") and text[len(lead) + 1:] in self.answers:
                 return text[len(lead) + 1:]
         return text
 
 
 def build_grammar(phrases: Sequence[str], known: Callable[[str], bool], recogniser: str,
-                  lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
+                  lead_ins: Sequence[str] = (), fillers: Sequence[str] = (),
+                  meaning: Callable[[str], Hashable] | None = None) -> Grammar:
     """Keep the phrases whose every word ``known`` accepts; log and list the others. Lead-ins
-    and fillers with an unknown word, or that are also phrases, are left out silently."""
+    and fillers with an unknown word, or that are also phrases, are left out silently; lead-ins
+    go only before the phrases whose ``meaning`` is an option number."""
     kept = _known(phrases, known, recogniser, dropped := [])
     extra = [p for p in _known(lead_ins, known, "", []) if p not in kept]
     noise = [p for p in _known(fillers, known, "", []) if p not in kept]
-    return Grammar(tuple(kept), tuple(dropped), tuple(extra), tuple(noise))
+    answers = [p for p in kept if meaning is not None and isinstance(meaning(p), int)]
+    return Grammar(tuple(kept), tuple(dropped), tuple(extra) if answers else (), tuple(noise), tuple(answers))
 
 
 def _known(phrases: Sequence[str], known: Callable[[str], bool], recogniser: str,
@@ -119,19 +125,24 @@ def to_jsgf(grammar: Grammar, name: str = "answer") -> str:
         raise ValueError("a grammar needs at least one phrase the recogniser knows")
     lines = ["#JSGF V1.0;", f"grammar {name};"]
     top = "<phrase>"
+    others = [p for p in grammar.phrases if p not in grammar.answers]
     if grammar.lead_ins:
-        top = "[<lead>] <phrase>"
+        top = "[<lead>] <option>" + (" | <other>" if others else "")
         lines.append(f"<lead> = {' | '.join(grammar.lead_ins)} ;")
+        lines.append(f"<option> = {' | '.join(grammar.answers)} ;")
+        if others:
+            lines.append(f"<other> = {' | '.join(others)} ;")
     if grammar.fillers:
         # a filler is the likelier reading only where it fits clearly better than any phrase
-        top = f"/{1 - FILLER_WEIGHT}/ {top} | /{FILLER_WEIGHT}/ <filler>"
+        top = f"/{1 - FILLER_WEIGHT}/ ({top}) | /{FILLER_WEIGHT}/ <filler>"
         lines.append(f"<filler> = {' | '.join(grammar.fillers)} ;")
-    lines.append(f"<phrase> = {' | '.join(grammar.phrases)} ;")
+    if not grammar.lead_ins:
+        lines.append(f"<phrase> = {' | '.join(grammar.phrases)} ;")
     lines.append(f"public <{name}> = {top} ;")
     return "\n".join(lines) + "\n"
 
 
 def to_vosk(grammar: Grammar) -> str:
     """A Vosk grammar: a JSON list of phrases plus "[unk]", so other speech has somewhere to go."""
-    with_leads = [f"{lead} {p}" for lead in grammar.lead_ins for p in grammar.phrases]
+    with_leads = [f"{lead} {p}" for lead in grammar.lead_ins for p in grammar.answers]
     return json.dumps([*grammar.phrases, *with_leads, *grammar.fillers, "[unk]"], ensure_ascii=False)

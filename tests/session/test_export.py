@@ -135,7 +135,8 @@ def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_
     rig.session.start()
     rig.at(8)
     rig.answer(2, Channel.REMOTE)  # "No" where "Yes" was asked for
-    rig.run_until(8 + 2 * TIMING["attempt_window_s"])  # the selecting check gets no answer
+    # after the feedback gap, the selecting check gets no answer
+    rig.run_until(8 + TIMING["between_questions_s"] + 2 * TIMING["attempt_window_s"])
     assert rig.session.phase.value == "explanation"
     session_id = rig.session.id
     store.close()

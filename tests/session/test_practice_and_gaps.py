@@ -39,10 +39,12 @@ def test_without_voice_out_the_hearing_check_is_skipped_logged_and_stored(tmp_pa
     assert [e.item_id for e in rig.of(AttemptOpened)] == ["practice_read"]
     rig.at(7)
     rig.answer(1, Channel.TOUCH)
+    rig.run_until(7 + TIMING["between_questions_s"])  # "Well done." first
     snap = rig.session.snapshot()
     assert snap.practice.id == "practice_select" and (snap.practice_number, snap.practice_count) == (2, 2)
-    rig.at(9)
+    rig.at(30)
     rig.answer(3, Channel.REMOTE)  # "choose answer number 3"
+    rig.run_until(30 + TIMING["between_questions_s"])
     assert rig.session.phase is Phase.EXPLANATION
     assert _practice(store, rig.session.id) == [
         ("practice_hear", "hear", "skipped", None, None, "no voice out"),
@@ -63,11 +65,14 @@ def test_with_voice_out_every_practice_outcome_is_stored(tmp_path):
     assert snap.practice.id == "practice_hear" and (snap.practice_number, snap.practice_count) == (1, 3)
     rig.at(6)
     rig.answer(1, Channel.VOICE)  # "chair": the patient did not hear "apple"
+    rig.run_until(6 + TIMING["between_questions_s"])  # a kind word first
     assert (rig.session.snapshot().practice_number, rig.session.snapshot().practice_count) == (2, 3)
-    rig.run_until(6 + 2 * TIMING["attempt_window_s"])  # the reading check gets no answer at all
+    # the reading check gets no answer at all
+    rig.run_until(6 + TIMING["between_questions_s"] + 2 * TIMING["attempt_window_s"])
     assert (rig.session.snapshot().practice.id, rig.session.snapshot().practice_number) == ("practice_select", 3)
     rig.at(rig.session.now() + 3)
     rig.answer(2, Channel.TOUCH)  # touched "green", not answer number 3
+    rig.run_until(rig.session.now() + TIMING["between_questions_s"])
     assert rig.session.phase is Phase.EXPLANATION
     assert [(p.question_id, p.option, p.correct) for p in rig.of(PracticeAnswered)] == [
         ("practice_hear", 1, False), ("practice_read", None, False), ("practice_select", 2, False)]
@@ -94,6 +99,7 @@ def test_voice_out_lost_during_the_hearing_check_skips_it_and_its_return_does_no
     rig.session.set_voice_out_available(True)
     assert rig.session.snapshot().practice.id == "practice_read"
     rig.answer(1)
+    rig.run_until(rig.session.now() + TIMING["between_questions_s"])
     assert rig.session.snapshot().practice.id == "practice_select"
     assert [p[2] for p in _practice(store, rig.session.id)] == ["skipped", "right"]
     log = [(e.kind, e.detail) for e in store.session(rig.session.id).log]
@@ -109,6 +115,8 @@ def test_practice_with_or_without_voice_out_leaves_the_qos_trace_unchanged():
         rig.session.start()
         while rig.session.phase is Phase.FAMILIARISATION:
             rig.answer(rig.session.snapshot().practice.expected)
+            rig.run_until(rig.session.now() + TIMING["between_questions_s"])  # the kind word
+        rig.at(100)  # the same moment in both runs, however long the practice took
         rig.session.acknowledge()
         for _ in QUESTIONNAIRE.items:
             rig.run_until(rig.session.clock.now() + TIMING["between_questions_s"])

@@ -33,7 +33,7 @@ def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
         assert item.code is not None and item.code.system == "http://loinc.org"
     assert Q.item("transfers").points == {0, 5, 10, 15}
     assert [b.id for b in Q.bands] == ["total", "severe", "moderate", "slight", "independent"]
-    assert Q.timing == Timing(20, 2, 10, 5, 5)
+    assert Q.timing == Timing(20, 5, 10, 5, 5, 10)
     assert [p.checks for p in Q.familiarisation] == ["hear", "read", "select"]
 
 

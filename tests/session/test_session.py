@@ -27,7 +27,7 @@ from kiosk.session import (
     VolumeChanged,
 )
 
-from .helpers import QUESTIONNAIRE, make_rig, started
+from .helpers import QUESTIONNAIRE, TIMING, make_rig, started
 
 
 def test_plain_flow_asks_every_item_in_order_and_scores_the_answers():
@@ -250,11 +250,14 @@ def test_familiarisation_answers_are_checked_but_never_sent_to_qos():
     assert rig.session.snapshot().practice.id == "practice_hear"
     rig.at(8)
     rig.answer(2, Channel.VOICE)
-    rig.at(9)
+    rig.run_until(8 + TIMING["between_questions_s"])  # each practice answer gets a kind word first
+    rig.at(24)
     rig.answer(2, Channel.TOUCH)  # the reading check expects "yes", option 1
+    rig.run_until(24 + TIMING["between_questions_s"])
     assert rig.session.snapshot().practice.id == "practice_select"
-    rig.at(11)
+    rig.at(40)
     rig.answer(3, Channel.REMOTE)  # "choose answer number 3"
+    rig.run_until(40 + TIMING["between_questions_s"])
     assert [(p.question_id, p.correct) for p in rig.of(PracticeAnswered)] == [
         ("practice_hear", True), ("practice_read", False), ("practice_select", True)]
     assert rig.session.phase is Phase.EXPLANATION

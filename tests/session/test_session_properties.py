@@ -49,8 +49,10 @@ def step(rig, action) -> None:
     else:
         rig.session.choose_language(arg)
     snap = rig.session.snapshot()
-    # a gap's line only between questions; "Practice k of n" always makes sense
-    assert snap.interlude is None or (snap.phase is Phase.QUESTIONS and snap.attempt is None)
+    # a gap's line only between questions (or a practice answer's kind word); "Practice k of n"
+    # always makes sense
+    assert snap.interlude is None or (snap.phase in (Phase.QUESTIONS, Phase.FAMILIARISATION)
+                                      and snap.attempt is None)
     assert (snap.practice_number is None) == (snap.practice is None)
     assert snap.practice_number is None or 1 <= snap.practice_number <= snap.practice_count
     if not getattr(rig, "voice_out", True):  # nothing to hear: no hearing check on screen

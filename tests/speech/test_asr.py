@@ -38,9 +38,16 @@ def test_build_grammar_leaves_out_unknown_words_and_says_why(caplog):
 
 def test_grammar_formats():
     grammar = Grammar(("número dos", "l'option", "two"))
-    assert to_jsgf(grammar) == ("#JSGF V1.0;\ngrammar answer;\n"
-                                "public <answer> = número dos | l'option | two ;\n")
+    assert to_jsgf(grammar) == ("#JSGF V1.0;\ngrammar answer;\n<phrase> = número dos | l'option | two ;\n"
+                                "public <answer> = <phrase> ;\n")
     assert json.loads(to_vosk(grammar)) == ["número dos", "l'option", "two", "[unk]"]
+    full = build_grammar(["two", "help", "repeat"], lambda w: True, "test", ["i need"], ["um", "what"],
+                         lambda p: "repeat" if p == "repeat" else 2)
+    assert to_jsgf(full) == ("#JSGF V1.0;\ngrammar answer;\n<lead> = i need ;\n<option> = two | help ;\n"
+                             "<other> = repeat ;\n<filler> = um | what ;\n"
+                             "public <answer> = /0.95/ ([<lead>] <option> | <other>) | /0.05/ <filler> ;\n")
+    assert json.loads(to_vosk(full)) == ["two", "help", "repeat", "i need two", "i need help", "um", "what", "[unk]"]
+    assert full.core("i need help") == "help" and full.core("i need repeat") == "i need repeat"
     assert recogniser_words("Sube el volumen, ¿vale?") == ["sube", "el", "volumen", "vale"]
     with pytest.raises(ValueError, match="at least one phrase"):
         to_jsgf(Grammar(()))

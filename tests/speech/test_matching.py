@@ -33,7 +33,7 @@ CASES = {
         ("two", 2, None), ("number two", 2, None), ("the second", 2, None),
         ("the second one", 2, None), ("option 2", 2, None), ("3", 3, None), ("first", 1, None),
         ("repeat", None, Command.REPEAT), ("say that again", None, Command.REPEAT),
-        ("pause", None, Command.PAUSE), ("continue", None, Command.RESUME),
+        ("pause", None, Command.PAUSE),
         ("call the doctor", None, Command.CALL_DOCTOR), ("louder", None, Command.VOLUME_UP),
         ("quieter", None, Command.VOLUME_DOWN),
     ],
@@ -43,7 +43,7 @@ CASES = {
         ("dos", 2, None), ("la dos", 2, None), ("número dos", 2, None), ("numero dos", 2, None),
         ("la segunda", 2, None), ("opción 3", 3, None), ("la primera", 1, None), ("uno", 1, None),
         ("repite", None, Command.REPEAT), ("otra vez", None, Command.REPEAT),
-        ("pausa", None, Command.PAUSE), ("continúa", None, Command.RESUME),
+        ("pausa", None, Command.PAUSE), 
         ("llama al médico", None, Command.CALL_DOCTOR), ("LLAMA AL MEDICO", None, Command.CALL_DOCTOR),
         ("más alto", None, Command.VOLUME_UP), ("mas bajo", None, Command.VOLUME_DOWN),
     ],
@@ -53,7 +53,7 @@ CASES = {
         ("deux", 2, None), ("numéro deux", 2, None), ("le deuxième", 2, None),
         ("la seconde", 2, None), ("option 2", 2, None), ("trois", 3, None), ("un", 1, None),
         ("le premier", 1, None), ("répétez", None, Command.REPEAT), ("pause", None, Command.PAUSE),
-        ("continuez", None, Command.RESUME), ("appelez le médecin", None, Command.CALL_DOCTOR),
+        ("appelez le médecin", None, Command.CALL_DOCTOR),
         ("plus fort", None, Command.VOLUME_UP), ("moins fort", None, Command.VOLUME_DOWN),
     ],
 }
@@ -155,3 +155,76 @@ def test_every_label_and_synonym_of_the_bundled_questionnaire_selects_its_own_op
                     if (got := matcher.match(phrase)).option != option.number:
                         clashes.append((question.id, language, phrase, got))
     assert clashes == []
+
+
+@pytest.mark.parametrize("language,paused,heard", [("en", True, "continue"), ("en", False, None),
+                                                   ("es", True, "continúa"), ("fr", True, "continuez")])
+def test_resume_words_are_listened_for_only_while_paused(language, paused, heard):
+    """At a question "go on" / "continue" mean nothing, so they are not in its grammar, where
+    "go on" was taken for a patient's "one"."""
+    matcher = Matcher([] if paused else FEEDING[language], language, paused=paused)
+    phrases = " | ".join(matcher.phrases())
+    if heard:
+        assert matcher.match(heard).command is Command.RESUME
+    else:
+        assert "go on" not in phrases and "continue" not in phrases
+        assert not matcher.match("go on").matched
+
+
+CONFIRMATION = {"en": ("Yes", "No"), "es": ("Sí", "No"), "fr": ("Oui", "Non")}
+YES_NO_CASES = [
+    ("en", "yes", 1), ("en", "yes that's right", 1), ("en", "that's right", 1), ("en", "correct", 1),
+    ("en", "no", 2), ("en", "no that's wrong", 2), ("en", "that's wrong", 2), ("en", "change my answer", 2),
+    ("es", "sí", 1), ("es", "si", 1), ("es", "sí es correcto", 1), ("es", "no", 2), ("es", "no es correcto", 2),
+    ("es", "eso está mal", 2), ("es", "cambiar mi respuesta", 2),
+    ("fr", "oui", 1), ("fr", "oui c'est ça", 1), ("fr", "non", 2), ("fr", "c'est faux", 2),
+    ("fr", "changer ma réponse", 2), ("fr", "je me suis trompée", 2),
+]
+
+
+@pytest.mark.parametrize("language,utterance,option", YES_NO_CASES)
+def test_a_confirmation_takes_natural_yes_and_no(language, utterance, option):
+    """The session's "Is that right?" has only Yes/No options; the matcher knows the natural ways
+    of saying them, and taking back ("that's wrong") is the No."""
+    matcher = Matcher([OptionWords(label) for label in CONFIRMATION[language]], language)
+    assert matcher.match(utterance).option == option
+
+
+@pytest.mark.parametrize("language,utterance", [
+    ("en", "no that's wrong"), ("en", "change my answer"), ("es", "eso está mal"),
+    ("es", "cambiar mi respuesta"), ("fr", "c'est faux"), ("fr", "changer ma réponse")])
+def test_taking_back_the_last_answer_is_undo_at_a_question(language, utterance):
+    assert Matcher(FEEDING[language], language).match(utterance).command is Command.UNDO
+
+
+def test_no_inside_taking_back_is_not_the_no_option():
+    """Bathing's option 1 takes "no"; "no, that's wrong" is still taking back, not option 1."""
+    bathing = [OptionWords("I need help", ("dependent", "help", "no")), OptionWords("Independent", ("yes",))]
+    matcher = Matcher(bathing, "en")
+    assert matcher.match("no").option == 1
+    assert matcher.match("no that's wrong").command is Command.UNDO
+
+
+WELCOME = [OptionWords("Start in English"), OptionWords("Empezar en español"), OptionWords("Commencer en français")]
+
+
+@pytest.mark.parametrize("language,utterance,option", [
+    ("en", "start", 1), ("en", "begin", 1), ("en", "English", 1), ("en", "español", 2), ("en", "Spanish", 2),
+    ("en", "empezar", 2), ("en", "français", 3), ("en", "french", 3), ("en", "commencer", 3),
+    ("es", "empezar", 2), ("es", "inglés", 1), ("es", "francés", 3), ("fr", "commencer", 3), ("fr", "anglais", 1),
+    ("fr", "espagnol", 2),
+])
+def test_the_welcome_takes_start_and_language_names(language, utterance, option):
+    assert Matcher(WELCOME, language).match(utterance).option == option
+
+
+def test_lead_ins_and_fillers():
+    """"I need a lot of help" is the lot-of-help option; fillers ("um", "what") mean nothing, and
+    a filler that is an answer here is not offered as one."""
+    matcher = Matcher(TRANSFERS_EN, "en")
+    assert matcher.match("i need a lot of help").option == 2
+    assert matcher.match("i think two").option == 2
+    assert "um" in matcher.fillers() and not matcher.match("um").matched
+    assert not matcher.match("all the time").matched
+    yes_no = Matcher([OptionWords("Yes"), OptionWords("No")], "en")
+    assert all(not yes_no.match(f).matched for f in yes_no.fillers())

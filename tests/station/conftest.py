@@ -152,9 +152,13 @@ def new_kiosk(db_url: str) -> tuple[str, str]:
         engine.dispose()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def browser() -> Iterator:
-    """One headless Chromium (Debian's) for every page test."""
+    """One headless Chromium (Debian's) for every page test of this package.
+
+    Package scope, not session: Playwright's sync API keeps an event loop running in the main
+    thread while it is open, and every async (Textual Pilot) test after the station's would fail
+    with "Runner.run() cannot be called from a running event loop"."""
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:

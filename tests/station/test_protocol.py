@@ -168,3 +168,17 @@ def test_page_posts_need_the_csrf_token_and_logins_are_rate_limited(ward_station
     right = anonymous.post("/login", data={"csrf": token, "name": "dr.target", "password": "the-right-password"})
     assert right.status_code == 429
     assert anonymous.get("/", follow_redirects=False).status_code == 303
+
+
+def test_a_kiosk_silent_for_more_than_30_s_shows_offline_with_when_it_was_last_seen(ward_station):
+    ward, station, client = ward_station
+    client.status(session_id="abc124", patient_id="P-7K3QX8", phase="questions", question=5, of=10)
+    engine = db.make_engine(ward.db_url)
+    with engine.begin() as connection:  # as if its last heartbeat came two minutes ago
+        connection.execute(db.kiosks.update().where(db.kiosks.c.name == ward.kiosk_id).values(
+            last_seen=db.now() - 120))
+    engine.dispose()
+    page = Staff(station.url).http.get("/").text
+    tile = page[page.index(f'id="kiosk-{ward.kiosk_id}"'):]
+    tile = tile[:tile.index("</article>")]
+    assert "offline" in tile and "last seen" in tile and "12" in tile  # "120 s ago" (or a little more)
