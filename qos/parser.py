@@ -413,17 +413,21 @@ class _Checker(TermChecker):
     def _evidence(self, name: Token, tree: Tree) -> Evidence:
         verb, target, *options = tree.children
         level, survival, seen = "default", None, set()
+        previous = target
         for option in options:
+            if option.data == "strength":
+                word = option.children[0]
+                if str(word).lower().replace("_", "") not in INTENSITY_LR or str(word) == "default":
+                    # a misspelt keyword on the next line lands here too, so say what it came after
+                    raise self.error(word, f"expected a strength ({_STRENGTHS}) after {str(previous)!r}, found "
+                                           f"{str(word)!r}")
             if option.data in seen:
                 raise self.error(option, f"observation {name} gives {option.data.replace('evidence_', '')} twice "
                                          f"for {target}")
             seen.add(option.data)
+            previous = option.children[-1]
             if option.data == "strength":
-                word = option.children[0]
-                level = str(word).lower().replace("_", "")
-                if level not in INTENSITY_LR or level == "default":
-                    raise self.error(word, f"expected a strength ({_STRENGTHS}) after {str(target)!r}, found "
-                                           f"{str(word)!r}")
+                level = str(option.children[0]).lower().replace("_", "")
             else:
                 survival = seconds_of(option.children[1])
                 if survival <= 0:
