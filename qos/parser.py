@@ -66,6 +66,8 @@ def load_model_file(path: str | Path) -> Model:
     return parse_model(_read(path), path.name, path.parent)
 
 
+#: how many models deep imports may go (each level is a few nested calls)
+MAX_IMPORT_DEPTH = 32
 #: how deeply terms may nest (parentheses, chains of operators): checking and running a term recurse
 #: once per level, and no model a person writes comes near this
 MAX_NESTING = 200
@@ -162,6 +164,8 @@ class _Checker(TermChecker):
             return  # already merged (imported twice by different models)
         if not path.is_file():
             raise self.error(target, f"cannot import {relative}: no such model file")
+        if len(self.reading) >= MAX_IMPORT_DEPTH:
+            raise self.error(target, f"imports nest more than {MAX_IMPORT_DEPTH} models deep")
         outer = self.source
         self.source = _Source(_read(path), path.name, path.parent)
         self.reading.append(path)
