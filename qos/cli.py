@@ -1,4 +1,5 @@
-"""``python -m qos replay TRACE`` (also ``kiosk qos replay``): replay a context trace, print the figures."""
+"""``python -m qos replay TRACE`` (also ``kiosk qos replay``): replay a context trace, print the figures;
+``python -m qos check MODEL``: check a model and say what it holds."""
 
 from __future__ import annotations
 
@@ -10,8 +11,10 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from qos import load_model
 from qos.errors import QosError
 from qos.files import open_private, write_error
+from qos.model import Model, type_name
 from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
 
 
@@ -38,7 +41,31 @@ def build_parser(prog: str, epilog: str | None = None) -> argparse.ArgumentParse
     replay.add_argument("--sample-period", type=_positive_seconds, default=1.0, metavar="S",
                         help="seconds between metric samples (default 1)")
     replay.add_argument("--plot", type=Path, metavar="FILE.png", help="also draw the metrics over time")
+    check = commands.add_parser("check", help="check a RoQME model and say what it holds",
+                                description="Parse and check a model (a bundled name or a .roqme file): one "
+                                            "file:line:col line and exit 2 when it is malformed, otherwise what a "
+                                            "trace must provide and what the model computes and observes.")
+    check.add_argument("model", metavar="MODEL", help="a bundled model name (clarc) or a .roqme file")
     return parser
+
+
+def describe_model(model: Model) -> str:
+    """What a QoS engineer needs to know of a checked model, one section a kind."""
+    def names(items) -> str:
+        return ", ".join(items) or "none"
+
+    primitive = [f"{c.name} ({type_name(c.type)})" for c in model.contexts.values() if not c.derived]
+    lines = [f"model {model.name}: OK", *(model.description or "").splitlines()[:1], "",
+             f"contexts a trace sets or emits: {names(primitive)}",
+             f"derived contexts: {names(c.name for c in model.contexts.values() if c.derived)}",
+             f"properties (published): {names(model.properties)}",
+             f"belief variables: {names(model.beliefvars)}",
+             f"variables and parameters: {names(model.variables)}",
+             f"timers: {names(model.timers)}",
+             f"observations: {names(model.observations)}"]
+    if model.imports:
+        lines.append(f"imports: {names(Path(path).name for path in model.imports)}")
+    return "\n".join(lines)
 
 
 def format_table(result: dict) -> str:
@@ -87,6 +114,13 @@ def plot(samples: ReplaySamples, path: Path, title: str) -> None:
 def main(argv: Sequence[str] | None = None, prog: str = "python -m qos", epilog: str | None = None) -> int:
     """Run the tool; returns 0, or 2 after one line on stderr for a bad trace, model or plot path."""
     args = build_parser(prog, epilog).parse_args(list(sys.argv[1:] if argv is None else argv))
+    if args.command == "check":
+        try:
+            print(describe_model(load_model(args.model)))
+        except QosError as exc:
+            print(f"{prog} check: {exc}", file=sys.stderr)
+            return 2
+        return 0
     try:
         trace = load_trace(args.trace)
         samples = sample_trace(trace, args.sample_period)

@@ -66,6 +66,8 @@ def load_model_file(path: str | Path) -> Model:
     return parse_model(_read(path), path.name, path.parent)
 
 
+#: how many models deep imports may go (each level is a few nested calls)
+MAX_IMPORT_DEPTH = 32
 #: how deeply terms may nest (parentheses, chains of operators): checking and running a term recurse
 #: once per level, and no model a person writes comes near this
 MAX_NESTING = 200
@@ -162,6 +164,8 @@ class _Checker(TermChecker):
             return  # already merged (imported twice by different models)
         if not path.is_file():
             raise self.error(target, f"cannot import {relative}: no such model file")
+        if len(self.reading) >= MAX_IMPORT_DEPTH:
+            raise self.error(target, f"imports nest more than {MAX_IMPORT_DEPTH} models deep")
         outer = self.source
         self.source = _Source(_read(path), path.name, path.parent)
         self.reading.append(path)
@@ -413,17 +417,21 @@ class _Checker(TermChecker):
     def _evidence(self, name: Token, tree: Tree) -> Evidence:
         verb, target, *options = tree.children
         level, survival, seen = "default", None, set()
+        previous = target
         for option in options:
+            if option.data == "strength":
+                word = option.children[0]
+                if str(word).lower().replace("_", "") not in INTENSITY_LR or str(word) == "default":
+                    # a misspelt keyword on the next line lands here too, so say what it came after
+                    raise self.error(word, f"expected a strength ({_STRENGTHS}) after {str(previous)!r}, found "
+                                           f"{str(word)!r}")
             if option.data in seen:
                 raise self.error(option, f"observation {name} gives {option.data.replace('evidence_', '')} twice "
                                          f"for {target}")
             seen.add(option.data)
+            previous = option.children[-1]
             if option.data == "strength":
-                word = option.children[0]
-                level = str(word).lower().replace("_", "")
-                if level not in INTENSITY_LR or level == "default":
-                    raise self.error(word, f"expected a strength ({_STRENGTHS}) after {str(target)!r}, found "
-                                           f"{str(word)!r}")
+                level = str(option.children[0]).lower().replace("_", "")
             else:
                 survival = seconds_of(option.children[1])
                 if survival <= 0:

@@ -114,3 +114,16 @@ def test_a_reader_closing_the_pipe_early_is_not_an_error(command):
     child.stdout.close()
     assert child.wait(timeout=60) == 0
     assert child.stderr.read() == b""
+
+
+def test_check_says_what_a_model_holds_or_where_it_is_wrong(tmp_path, capsys):
+    assert main(["check", "kiosk_pace"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("model KioskPace: OK\n")
+    assert "derived contexts: Answered, AnswerTime, SlowStreak, Slowing, AnswersPerFiveMinutes" in out
+    assert "timers: Silence" in out and "imports: clarc.roqme" in out
+    (tmp_path / "bad.roqme").write_text("roqme X\nproperty P\ncontext A : boolean\nobservation O : A reinforces Q\n",
+                                        encoding="utf-8")
+    done = run("-m", "kiosk", "qos", "check", str(tmp_path / "bad.roqme"))
+    assert (done.returncode, done.stdout) == (2, "")
+    assert done.stderr == "kiosk qos check: bad.roqme:4:30: observation O reinforces unknown property Q\n"

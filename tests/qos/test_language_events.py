@@ -183,3 +183,11 @@ def test_a_traces_origin_places_scheduled_timers_on_the_calendar(tmp_path):
     (tmp_path / "t.yaml").write_text(trace.format(origin="tomorrow"), encoding="utf-8")
     with pytest.raises(TraceError, match="'origin' must be a date and time such as 2026-11-23T09:00:00Z"):
         replay(tmp_path / "t.yaml")
+
+
+def test_imports_nested_without_end_are_one_line(tmp_path):
+    for level in range(60):
+        (tmp_path / f"m{level}.roqme").write_text(f'import "m{level + 1}.roqme"\nproperty P{level}\n', encoding="utf-8")
+    (tmp_path / "m60.roqme").write_text("property Last\n", encoding="utf-8")
+    with pytest.raises(ModelError, match=r"^m31\.roqme:1:8: imports nest more than 32 models deep"):
+        load_model(tmp_path / "m0.roqme")
