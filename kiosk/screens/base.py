@@ -157,8 +157,6 @@ class PatientScreen(Screen):
             button.show(view.voice_again)
         for sign in self.query(WaitingSign):
             sign.show(view.waiting, view.now)
-        for sign in self.query(WaitingSign):
-            sign.show(view.waiting, view.now)
 
     def ways_text(self, view: PatientView) -> str:
         """The calm row of the ways the patient can answer: "You can: touch · remote · speak", on

@@ -46,11 +46,14 @@ class Practice:
             self._voice_out_available = available
             self._log(t, "voice_out", "available" if available else "unavailable")
             open_ = self._open
-            if open_ is not None and open_.practice and self.current_attempt is not None:
+            if open_ is not None and open_.practice:
                 question = self.questionnaire.familiarisation[open_.index]
                 if (reason := self._practice_skip_reason(question)) is not None:
                     self._timers.cancel()
-                    self._skip_practice(t, question, reason, shown=True)
+                    if self.current_attempt is not None:
+                        self._skip_practice(t, question, reason, shown=True)
+                    # an answered hearing check's feedback gap ends at once too: without voice out
+                    # it must not stay on screen (its outcome is already stored)
                     self._open_practice(t, open_.index + 1)
 
     def _practice_progress(self: Session) -> dict[str, Any]:
