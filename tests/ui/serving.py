@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import os
 import socket
 import subprocess
@@ -92,3 +93,36 @@ async def wait_until(page, check: Callable[[], bool], what: str) -> None:
     while not check():
         assert time.monotonic() < deadline, f"never saw {what}"
         await page.wait_for_timeout(50)  # lets Playwright deliver frames; bounded by PATIENCE_S
+
+
+#: the backgrounds of what a patient taps on the page (kiosk.tcss), as RGB
+ANSWER_RGB = (0xdc, 0xe6, 0xf5)
+ACTION_RGB = (0x0b, 0x3d, 0x91)
+
+
+async def drawn(page, left: float, top: float, right: float, bottom: float, cell_h: float,
+                rgb: tuple[int, int, int]) -> bool:
+    """The page shows a button of colour ``rgb`` exactly over this box, as a patient sees it before
+    they tap: its colour just inside the top and bottom rows, not in the row above (a button drawn a
+    row off, or in a frame laid out before the screen settled, fails one of them). The mouse is
+    moved off the box first, so a hover colour from the last tap does not hide the button."""
+    from PIL import Image
+
+    await page.mouse.move(1, 1)
+    shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
+    x = int(right) - 4  # the label's right padding: never a letter there
+
+    def colour(y: float) -> tuple[int, int, int]:
+        return shot.getpixel((x, min(max(int(y), 0), shot.height - 1)))
+
+    return (colour(top + 2) == rgb and colour(bottom - 2) == rgb
+            and (top < cell_h or colour(top - cell_h / 2) != rgb))
+
+
+async def wait_until_drawn(page, box: tuple[float, float, float, float], cell_h: float,
+                           rgb: tuple[int, int, int], what: str) -> None:
+    """Wait, at most :data:`PATIENCE_S`, until :func:`drawn` holds for ``box`` (left, top, right, bottom px)."""
+    deadline = time.monotonic() + PATIENCE_S
+    while not await drawn(page, *box, cell_h, rgb):
+        assert time.monotonic() < deadline, f"never saw {what} drawn where the headless layout put it"
+        await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S

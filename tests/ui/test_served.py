@@ -14,7 +14,8 @@ from kiosk.session import Phase
 from kiosk.widgets.text import ui_text
 
 from .helpers import screen_name, settle
-from .serving import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until
+from .serving import (ACTION_RGB, ANSWER_RGB, CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until,
+                      wait_until_drawn)
 
 #: the served page's font size: a touch display shows big cells
 FONT_SIZE = 20
@@ -96,19 +97,22 @@ async def test_a_tap_on_the_served_page_records_the_answer(served_kiosk, ui_kios
             box = await screen.bounding_box()
             cell_w, cell_h = box["width"] / size[0], box["height"] / size[1]
 
-            async def tap(region) -> None:
-                await page.mouse.click(box["x"] + (region.x + region.width / 2) * cell_w,
-                                       box["y"] + (region.y + region.height / 2) * cell_h)
+            async def tap(region, rgb: tuple[int, int, int], what: str) -> None:
+                """Tap the middle of ``region`` once the page draws it there (as a patient would)."""
+                left, top = box["x"] + region.x * cell_w, box["y"] + region.y * cell_h
+                right, bottom = box["x"] + region.right * cell_w, box["y"] + region.bottom * cell_h
+                await wait_until_drawn(page, (left, top, right, bottom), cell_h, rgb, what)
+                await page.mouse.click((left + right) / 2, (top + bottom) / 2)
 
             shows = painted.shows
 
             await wait_until(page, shows(ui_text("en", "choose_language")), "the welcome screen")
-            await tap(english)
+            await tap(english, ACTION_RGB, "English")
             await wait_until(page, lambda: _count(database, "sessions"), "the session stored")  # start() stores it
             await wait_until(page, shows(_first_words(QUESTIONNAIRE.message("explanation", "en"))), "the explanation")
-            await tap(start)
+            await tap(start, ACTION_RGB, "Start")
             await wait_until(page, shows(QUESTIONNAIRE.items[0].patient_text_in("en")), "the first question")
-            await tap(answer)
+            await tap(answer, ANSWER_RGB, "answer 2")
             await wait_until(page, lambda: _answers(database), "the answer stored")
             if os.environ.get("KIOSK_E2E_SCREENSHOT"):
                 await page.screenshot(path=os.environ["KIOSK_E2E_SCREENSHOT"])

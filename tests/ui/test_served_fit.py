@@ -6,8 +6,6 @@ size the page reports (as in test_served.py)."""
 
 from __future__ import annotations
 
-import io
-import time
 
 import pytest
 
@@ -18,7 +16,8 @@ from kiosk.widgets.text import language_name
 from .conftest import UiKiosk
 from .fit import problems
 from .helpers import screen_name, settle
-from .serving import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until
+from .serving import (ACTION_RGB, ANSWER_RGB, CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until,
+                      wait_until_drawn)
 from .test_served import _answers
 
 #: the smallest text the page may draw (px): what an 85-year-old can still read on the panel
@@ -55,25 +54,6 @@ async def _layout(folder, size: tuple[int, int], language: str) -> list:
         assert kiosk.session.phase in (Phase.QUESTIONS, Phase.SUMMARY)
     kiosk.store.close()
     return steps
-
-
-#: an answer button's background on the page (kiosk.tcss), as RGB
-ANSWER_RGB = (0xdc, 0xe6, 0xf5)
-
-
-async def answer_drawn(page, left: float, top: float, right: float, bottom: float, cell_h: float) -> bool:
-    """The page shows an unchosen answer button exactly over this box: its colour just inside the
-    top and bottom rows, not in the row above (a button drawn a row off would fail one of them)."""
-    from PIL import Image
-
-    shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
-    x = int(right) - 4  # the label's right padding: never a letter there
-
-    def colour(y: float) -> tuple[int, int, int]:
-        return shot.getpixel((x, min(max(int(y), 0), shot.height - 1)))
-
-    return (colour(top + 2) == ANSWER_RGB and colour(bottom - 2) == ANSWER_RGB
-            and (top < cell_h or colour(top - cell_h / 2) != ANSWER_RGB))
 
 
 def _opening(text: str, most: int = 40) -> str:
@@ -142,12 +122,6 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                 return (box["x"] + region.x * cell_w, box["y"] + region.y * cell_h,
                         box["x"] + region.right * cell_w, box["y"] + region.bottom * cell_h)
 
-            async def wait_until_async(check, what: str) -> None:
-                deadline = time.monotonic() + PATIENCE_S
-                while not await check():
-                    assert time.monotonic() < deadline, f"never saw {what}"
-                    await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S
-
             questionnaire = load_questionnaire()
             explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
             answered = 0
@@ -165,9 +139,9 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                     text = _opening(questionnaire.item(name).patient_text_in(language))
                     await wait_until(page, shown_since(text, tapped_at), f"{name} on the page")
                 left, top, right, bottom = pixels(target)
-                if regions:  # and its answers laid out where the headless app put them
-                    await wait_until_async(lambda: answer_drawn(page, left, top, right, bottom, cell_h),
-                                           f"{name}'s answers drawn in place")
+                # and what is tapped drawn where the headless app put it, as the patient sees it
+                await wait_until_drawn(page, (left, top, right, bottom), cell_h,
+                                       ANSWER_RGB if regions else ACTION_RGB, f"{name}'s button")
                 tapped_at = len(painted.data)
                 await page.mouse.click((left + right) / 2, (top + bottom) / 2)
                 if regions:
