@@ -32,7 +32,7 @@ class Ways:
 
     ``voice`` means voice answers are heard (voice in works and adaptation has not paused it);
     ``listening`` that the kiosk listens at this very moment (the welcome screen only promises
-    "say start" then); ``voice_out`` that the kiosk can speak (Repeat is only offered then).
+    "say English" then); ``voice_out`` that the kiosk can speak (Repeat is only offered then).
     """
 
     remote: bool = False

@@ -31,7 +31,7 @@ from kiosk.session.publishing import Batch, Listener, Operation, Publisher
 from kiosk.session.questions import OpenQuestion, QuestionFlow
 from kiosk.session.snapshot import Answer, Snapshot
 from kiosk.session.timers import AttemptClock
-from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
+from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_LABEL, START_WORDS
 
 
 class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Publisher):
@@ -268,7 +268,7 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
 
     def welcome(self) -> None:
         """The welcome is on screen: publish it as a prompt whose options are the languages to start
-        in (say "start", a language's name, or its number) and listen for them."""
+        in (say a language's name, "start", or its number) and listen for them."""
         with Operation(self) as t:
             if self._phase is Phase.WELCOME:
                 self._greeted = True
@@ -383,7 +383,7 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         elif self._phase is Phase.WELCOME:
             self._message(t, "welcome")
         elif self._phase is Phase.EXPLANATION:
-            self._message(t, "explanation")
+            self._publish_prompt(self._explanation_prompt(t))
         elif self.current_attempt is not None:
             self._prompt_question(t, repeat=False)
 
@@ -414,10 +414,19 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
             return
         self._set_phase(t, Phase.QUESTIONS)
         self._schedule_next_item(t, after=self.timing.between_questions_s)
+        self._update_listening(t)  # not in the gap before the first question
+
+    def _explanation_prompt(self, t: float) -> Prompt:
+        """The explanation, with one option: Start, and the words for it ("I'm ready"), which the
+        voice channel listens for while it is on screen."""
+        lang = self._language
+        text = self.questionnaire.message("explanation", lang)
+        options = (PromptOption(1, START_LABEL.get(lang, "Start"), tuple(START_WORDS.get(lang, ())), None),)
+        return Prompt(t, "message", "explanation", text, text, lang, options, speech_rate=self._speech_rate())
 
     def _to_explanation(self, t: float) -> None:
         self._set_phase(t, Phase.EXPLANATION)
-        self._message(t, "explanation")
+        self._publish_prompt(self._explanation_prompt(t))
         self._update_listening(t)
 
     def _started(self) -> bool:

@@ -207,8 +207,10 @@ class Publisher:
         self._emit(prompt)
 
     def _update_listening(self: Session, t: float) -> None:
-        # on the welcome once it was shown (say a language), and while an attempt is open
-        wanted = (self._phase is Phase.WELCOME and self._greeted) or self.current_attempt is not None
+        # on the welcome once it was shown (say a language), under the explanation (say "I'm
+        # ready"), and while an attempt is open
+        wanted = ((self._phase is Phase.WELCOME and self._greeted) or self._phase is Phase.EXPLANATION
+                  or self.current_attempt is not None)
         listening = wanted and not self._timers.frozen and "voice_off" not in self._active_adaptations()
         if listening != self._listening:
             self._listening = listening

@@ -37,6 +37,9 @@ LANGUAGE_NAMES: Mapping[str, Mapping[str, tuple[str, ...]]] = {
 #: each language's own name: the label of its start option on the welcome
 OWN_NAME: Mapping[str, str] = {"en": "English", "es": "Español", "fr": "Français"}
 
+#: the explanation's one option (any answer key, the remote's numbers and touching Start also start)
+START_LABEL: Mapping[str, str] = {"en": "Start", "es": "Empezar", "fr": "Commencer"}
+
 #: what a patient says to start, in each language
 START_WORDS: Mapping[str, tuple[str, ...]] = {
     "en": ("start", "begin", "let's start", "start please", "ready", "I'm ready"),

@@ -261,6 +261,8 @@ class PocketSphinxRecogniser:
         acoustic = _sigmoid((PS_FIT_MIDPOINT - fit) / PS_FIT_SPREAD)
         # a phrase the model cannot tell from another answer's is never taken as either
         distinct = 0.0 if core in self._confusable else 1.0
+        log.debug("pocketsphinx: %r coverage %.2f fit %.2f (confidence %.2f) distinct %s",
+                  hyp.hypstr, coverage, fit, acoustic, bool(distinct))
         return Recognition(hyp.hypstr, min(coverage, acoustic, distinct), fit=fit)
 
     def _free_cost(self, pcm: bytes, voiced: np.ndarray) -> float:

@@ -35,7 +35,7 @@ from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
 from kiosk.speech.audio import (
     AudioUnavailable, Endpointer, MicrophoneStream, PcmConsumer, Utterance, UtterancePipeline,
 )
-from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords
+from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords, welcome_commands
 
 log = logging.getLogger(__name__)
 
@@ -91,6 +91,9 @@ class VoiceChannel:
         #: whether the current options score points (a Barthel question): only those answers
         #: are ever confirmed; a confirmation's own yes/no or a language choice is not
         self._scored = False
+        #: the prompt comes before the test (the welcome, the explanation's Start): only "call the
+        #: doctor" besides its options (:func:`kiosk.speech.matching.welcome_commands`)
+        self._welcome = False
         self._lock = threading.RLock()
         self._sink: Sink | None = None
         self._recogniser: Recogniser | None = None
@@ -193,14 +196,18 @@ class VoiceChannel:
         """A session ``Prompt``: a question's options become the grammar (messages change nothing)."""
         if prompt.options:
             scored = any(getattr(o, "points", None) is not None for o in prompt.options)
-            self.set_question(option_words(prompt.options), prompt.language, scored=scored)
+            self.set_question(option_words(prompt.options), prompt.language, scored=scored,
+                              welcome=getattr(prompt, "kind", "") in ("welcome", "message"))
 
-    def set_question(self, options: Sequence[OptionWords], language: str, scored: bool = False) -> None:
+    def set_question(self, options: Sequence[OptionWords], language: str, scored: bool = False,
+                     welcome: bool = False) -> None:
         """Listen for this question's answers (and the commands) in ``language``; answers to a
-        ``scored`` question are confirmed unless heard with confidence (see :data:`CONFIRM_BELOW`)."""
+        ``scored`` question are confirmed unless heard with confidence (see :data:`CONFIRM_BELOW`).
+        At the ``welcome`` (or the explanation) the only command is calling the doctor, in whole phrases."""
         with self._lock:
             self._options = list(options)
             self._scored = scored
+            self._welcome = welcome
             if language != self.language:
                 self.language = language
                 # before start() the language is only noted; the model loads off the UI thread
@@ -285,9 +292,13 @@ class VoiceChannel:
         if self._recogniser is None or not (self._options or self._paused):
             return
         options = [] if self._paused else self._options
-        self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused)
-        self._recogniser.set_grammar(self._matcher.phrases(), self._matcher.meaning,
-                                     self._matcher.lead_ins(), self._matcher.fillers())
+        commands = welcome_commands(self.language) if self._welcome and not self._paused else None
+        self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused,
+                                commands=commands)
+        # before the test no "I need ..." leads in: "begin" was heard as "i need two" (Español)
+        lead_ins = () if commands is not None else self._matcher.lead_ins()
+        self._recogniser.set_grammar(self._matcher.phrases(), self._matcher.meaning, lead_ins,
+                                     self._matcher.fillers())
         self._gate()
 
     def _gate(self) -> None:

@@ -249,4 +249,6 @@ def test_listening_stays_on_while_the_answer_is_asked_back():
     rig.session.handle(unsure(3))
     rig.at(32)
     rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="yes"))
-    assert [(e.t, e.listening) for e in rig.of(ListeningChanged)] == [(25, True), (32, False)]
+    # on under the explanation ("I'm ready") until acknowledged at 10, then from Q1 at 25 through
+    # "Is that right?" until Yes at 32
+    assert [(e.t, e.listening) for e in rig.of(ListeningChanged)] == [(10, True), (10, False), (25, True), (32, False)]

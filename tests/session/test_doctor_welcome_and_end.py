@@ -72,7 +72,14 @@ def test_the_welcome_listens_for_start_and_for_a_language_name():
     rig.at(3)
     rig.session.handle(ChannelInput(Channel.VOICE, option=2, detail="espagnol"))
     assert rig.session.phase is Phase.EXPLANATION and rig.session.language == "es"
-    assert not rig.session.listening
+    # the explanation listens for its Start ("estoy listo"), as its text promises by voice
+    explanation = rig.of(Prompt)[-1]
+    assert (explanation.key, [o.number for o in explanation.options]) == ("explanation", [1])
+    assert "estoy listo" in explanation.options[0].synonyms and rig.session.listening
+    rig.at(5)
+    rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="estoy listo"))
+    assert rig.session.phase is Phase.QUESTIONS
+    assert not rig.session.listening  # nothing to hear before the first question opens
 
 
 def test_after_the_end_screen_the_kiosk_is_ready_for_the_next_patient(tmp_path):

@@ -13,10 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus
+from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command
 from kiosk.clock import SimClock
 from kiosk.questionnaire import load_questionnaire
-from kiosk.session import DoctorCalled, ListeningChanged, Paused, Prompt, Resumed, Session
+from kiosk.session import DoctorCalled, ListeningChanged, Paused, Phase, Prompt, Resumed, Session
 from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser, VoskRecogniser, open_recogniser
 from kiosk.speech.audio import feed_wav, list_input_devices, resample
 from kiosk.speech.models import find_model
@@ -171,6 +171,35 @@ def test_spoken_commands_reach_the_session(backend, spoken):
     assert any(isinstance(e, Resumed) for e in kiosk.events)
     kiosk.say(spoken("call the doctor"))
     assert any(isinstance(e, DoctorCalled) and e.channel is Channel.VOICE for e in kiosk.events)
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+def test_the_patient_starts_by_saying_the_language_then_im_ready(backend, spoken):
+    """What the welcome and the explanation promise by voice works: "English" on the welcome,
+    "I'm ready" under the explanation."""
+    kiosk = _Kiosk(backend)
+    kiosk.session.welcome()
+    assert kiosk.session.listening
+    kiosk.say(spoken("English"))
+    assert kiosk.session.phase is Phase.EXPLANATION and kiosk.session.language == "en"
+    assert kiosk.session.listening, "the explanation promises 'say I'm ready': the kiosk must listen"
+    kiosk.say(spoken("I'm ready"))
+    assert kiosk.session.phase is Phase.QUESTIONS
+    assert [i.channel for i in kiosk.inputs] == [Channel.VOICE, Channel.VOICE]
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+@pytest.mark.parametrize("said", ["stop", "doctor", "again"])
+def test_before_the_test_short_command_words_do_nothing(backend, spoken, said):
+    """On the welcome only "call the doctor" (whole phrases) is a command: "start" was heard as
+    "stop", "doctor" or "again" by other voices, which paused, called the doctor or repeated."""
+    kiosk = _Kiosk(backend)
+    kiosk.session.welcome()
+    kiosk.say(spoken(said))
+    assert all(i.command is None for i in kiosk.inputs)
+    assert not kiosk.session.paused and not kiosk.session.halted
+    kiosk.say(spoken("call the nurse"))  # a whole phrase is still heard (the session decides)
+    assert kiosk.inputs[-1].command is Command.CALL_DOCTOR
 
 
 @pytest.mark.parametrize("backend", _backends("en"))
