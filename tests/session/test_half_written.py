@@ -81,6 +81,9 @@ SIGINT_CHILD = textwrap.dedent("""
                 time.sleep(5)  # the signal's KeyboardInterrupt lands here, mid-operation
             return super().update(t, set=set, emit=emit)
 
+    # Python's own Ctrl-C handler, as in a kiosk started from a terminal (a shell that started the
+    # tests in the background hands its children SIGINT ignored, and Python then keeps it so)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     store = Store.open(sys.argv[1])
     clock = SimClock()
     session = Session(load_questionnaire(), clock=clock, engine=CtrlC(load_model("clarc")), store=store,
