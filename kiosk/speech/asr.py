@@ -56,6 +56,7 @@ from typing import Protocol
 import numpy as np
 
 from kiosk.speech.audio import SAMPLE_RATE
+from kiosk.speech.denoise import reduce_steady_noise
 from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, final_phrases, to_jsgf, to_vosk
 
 log = logging.getLogger(__name__)
@@ -233,7 +234,9 @@ class PocketSphinxRecogniser:
         """End the utterance and score it (see the module docstring)."""
         if not self._in_utterance:
             return Recognition("", 0.0)
-        pcm = bytes(self._pcm)
+        # a fan's or a corridor's steady noise is taken out first: it is scored as speech
+        # otherwise (see kiosk.speech.denoise)
+        pcm = reduce_steady_noise(bytes(self._pcm))
         voiced = _voiced_frames(pcm)
         self._end()
         self._settled = True
