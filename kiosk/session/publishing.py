@@ -208,9 +208,10 @@ class Publisher:
 
     def _update_listening(self: Session, t: float) -> None:
         # on the welcome once it was shown (say a language), under the explanation (say "I'm
-        # ready"), and while an attempt is open
+        # ready"), while an attempt is open, and in the thank-you gap after an answer, when it can
+        # be taken back ("No, that's wrong")
         wanted = ((self._phase is Phase.WELCOME and self._greeted) or self._phase is Phase.EXPLANATION
-                  or self.current_attempt is not None)
+                  or self.current_attempt is not None or self._can_undo())
         listening = wanted and not self._timers.frozen and "voice_off" not in self._active_adaptations()
         if listening != self._listening:
             self._listening = listening

@@ -71,6 +71,7 @@ class QuestionFlow:
         elif kind == "next_patient":
             self._log(t, "next_patient", "the end screen was shown long enough")
             self._emit(NextPatient(t))
+        self._update_listening(t)  # a gap that ended stops listening for "No, that's wrong"
 
     def _schedule_next_item(self: Session, t: float, after: float) -> None:
         if self._next_item_index() is not None:
@@ -178,8 +179,8 @@ class QuestionFlow:
         self._context(t, contexts)
         self._emit(AnswerRecorded(t, item.id, item.number, option.number, option.points, attempt,
                                   channel, self._answered_by, detail))
-        self._update_listening(t)
         self._schedule_next_item(t, self.timing.between_questions_s)
+        self._update_listening(t)  # on through the thank-you gap: "No, that's wrong" takes it back
 
     def _answer_blocked(self: Session, event: ChannelInput) -> IgnoreReason | None:
         if self._phase is Phase.SUMMARY:

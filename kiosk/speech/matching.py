@@ -118,6 +118,12 @@ def welcome_commands(language: str) -> dict[Command, tuple[str, ...]]:
     times in 12, "begin" as "again" (repeat)."""
     return {Command.CALL_DOCTOR: COMMAND_PHRASES[language][Command.CALL_DOCTOR]}
 
+
+def undo_commands(language: str) -> dict[Command, tuple[str, ...]]:
+    """What the kiosk listens for in the thank-you gap after an answer: taking it back ("No,
+    that's wrong", "change my answer") and calling the doctor."""
+    return {command: COMMAND_PHRASES[language][command] for command in (Command.UNDO, Command.CALL_DOCTOR)}
+
 #: natural ways to say yes / no, added to an option whose label is one of the first words (a
 #: confirmation: "I heard: Independent. Is that right?"); a no option also takes the UNDO phrases
 YES_NO: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {

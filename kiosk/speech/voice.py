@@ -11,8 +11,9 @@ answers and status changes go to the sink from that thread, as the channel contr
 Every answer to a scored question goes to the sink with ``needs_confirmation`` (see
 :data:`CONFIRM_BELOW`): the session asks "I heard: X. Is that right?" with a Yes/No prompt,
 whose options the matcher extends with the natural ways of saying them ("yes, that's right",
-"no, that's wrong"); at a question, "no, that's wrong" / "change my answer" is
-``Command.UNDO``. A prompt without points (a confirmation, the welcome's start / language
+"no, that's wrong"); after an answer is stored (``AnswerRecorded``), until the next prompt,
+only "no, that's wrong" / "change my answer" (``Command.UNDO``) and calling the doctor are
+listened for: the thank-you gap in which the session lets any answer be taken back. A prompt without points (a confirmation, the welcome's start / language
 choice) is never itself confirmed.
 
 Speech models load on the channel's own loader thread (seconds for vosk), never on the thread
@@ -35,7 +36,7 @@ from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
 from kiosk.speech.audio import (
     AudioUnavailable, Endpointer, MicrophoneStream, PcmConsumer, Utterance, UtterancePipeline,
 )
-from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords, welcome_commands
+from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords, undo_commands, welcome_commands
 
 log = logging.getLogger(__name__)
 
@@ -94,6 +95,8 @@ class VoiceChannel:
         #: the prompt comes before the test (the welcome, the explanation's Start): only "call the
         #: doctor" besides its options (:func:`kiosk.speech.matching.welcome_commands`)
         self._welcome = False
+        #: an answer was just stored: only "No, that's wrong" (and the doctor) until the next prompt
+        self._undo_only = False
         self._lock = threading.RLock()
         self._sink: Sink | None = None
         self._recogniser: Recogniser | None = None
@@ -191,6 +194,8 @@ class VoiceChannel:
             self._set_paused(True)
         elif kind in ("Resumed", "Finished"):
             self._set_paused(False)
+        elif kind == "AnswerRecorded":
+            self.expect_undo()
 
     def expect(self, prompt: Any) -> None:
         """A session ``Prompt``: a question's options become the grammar (messages change nothing)."""
@@ -208,11 +213,23 @@ class VoiceChannel:
             self._options = list(options)
             self._scored = scored
             self._welcome = welcome
+            self._undo_only = False
             if language != self.language:
                 self.language = language
                 # before start() the language is only noted; the model loads off the UI thread
                 if self._running:
                     self._load(language)
+            self._apply_grammar()
+
+    def expect_undo(self) -> None:
+        """An answer was stored: until the next prompt only taking it back ("No, that's wrong",
+        "change my answer") and calling the doctor are listened for. The answered question's own
+        words would mean nothing in the thank-you gap."""
+        with self._lock:
+            self._options = []
+            self._scored = False
+            self._welcome = False
+            self._undo_only = True
             self._apply_grammar()
 
     def listen(self, listening: bool) -> None:
@@ -289,10 +306,14 @@ class VoiceChannel:
         self._status(ChannelState.ON, f"voice answers on: {recogniser.name}")
 
     def _apply_grammar(self) -> None:
-        if self._recogniser is None or not (self._options or self._paused):
+        if self._recogniser is None or not (self._options or self._paused or self._undo_only):
             return
         options = [] if self._paused else self._options
-        commands = welcome_commands(self.language) if self._welcome and not self._paused else None
+        commands = None  # all of them: a question, or only commands while paused
+        if self._welcome and not self._paused:
+            commands = welcome_commands(self.language)
+        elif self._undo_only and not self._paused:
+            commands = undo_commands(self.language)
         self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused,
                                 commands=commands)
         # before the test no "I need ..." leads in: "begin" was heard as "i need two" (Español)

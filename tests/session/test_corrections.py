@@ -250,5 +250,6 @@ def test_listening_stays_on_while_the_answer_is_asked_back():
     rig.at(32)
     rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="yes"))
     # on under the explanation ("I'm ready") until acknowledged at 10, then from Q1 at 25 through
-    # "Is that right?" until Yes at 32
-    assert [(e.t, e.listening) for e in rig.of(ListeningChanged)] == [(10, True), (10, False), (25, True), (32, False)]
+    # "Is that right?", and after Yes at 32 through the thank-you gap ("No, that's wrong")
+    assert [(e.t, e.listening) for e in rig.of(ListeningChanged)] == [(10, True), (10, False), (25, True)]
+    assert rig.session.listening and rig.session.snapshot().can_undo

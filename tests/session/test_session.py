@@ -238,9 +238,22 @@ def test_listening_follows_open_attempts_and_freezes():
     rig.at(40)
     rig.session.resume()
     rig.answer(1)
-    # the explanation at 10 listens for "I'm ready" until acknowledged at once
+    # the explanation at 10 listens for "I'm ready" until acknowledged at once; the answer at 40
+    # leaves it on through the thank-you gap, in which "No, that's wrong" takes it back
     assert [(e.t, e.listening) for e in rig.of(ListeningChanged)] == [
-        (10, True), (10, False), (25, True), (30, False), (40, True), (40, False)]
+        (10, True), (10, False), (25, True), (30, False), (40, True)]
+
+
+def test_the_thank_you_gap_listens_until_the_next_question_or_the_end():
+    rig = started()
+    for number in range(1, len(QUESTIONNAIRE.items) + 1):
+        rig.run_until(rig.session.next_deadline())
+        assert rig.session.current_attempt == 1 and rig.session.listening
+        rig.answer(1)
+        assert rig.session.listening, f"the gap after question {number} listens for 'No, that's wrong'"
+    rig.run_until(rig.session.next_deadline())  # the closing gap ends: the summary hears nothing
+    assert rig.session.phase is Phase.SUMMARY and not rig.session.listening
+    assert rig.of(ListeningChanged)[-1].listening is False
 
 
 def test_familiarisation_answers_are_checked_but_never_sent_to_qos():

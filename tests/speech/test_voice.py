@@ -203,6 +203,24 @@ def test_before_the_test_short_command_words_do_nothing(backend, spoken, said):
 
 
 @pytest.mark.parametrize("backend", _backends("en"))
+def test_no_thats_wrong_in_the_thank_you_gap_takes_the_answer_back(backend, spoken):
+    """Any answer (here a touch) can be taken back by voice for the thank-you gap; in the gap the
+    question's own words mean nothing, and the doctor can still be called."""
+    kiosk = _Kiosk(backend)
+    kiosk.to_question("feeding")
+    kiosk.session.handle(ChannelInput(Channel.TOUCH, option=2))
+    assert kiosk.session.answers["feeding"].option == 2 and kiosk.session.listening
+    kiosk.say(spoken("independent"))  # an answer word in the gap is not an answer
+    assert not [i for i in kiosk.inputs if i.option is not None]
+    kiosk.say(spoken("no that's wrong"))
+    assert [i.command for i in kiosk.inputs] == [Command.UNDO]
+    assert "feeding" not in kiosk.session.answers
+    assert kiosk.session.current_item.id == "feeding" and kiosk.session.current_attempt is not None
+    kiosk.say(spoken("independent"))  # asked again: the question's words are heard again
+    assert kiosk.inputs[-1].option == 3
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
 @pytest.mark.parametrize("noise", ["the weather is nice today", "banana split"])
 def test_other_speech_is_never_an_answer(backend, spoken, noise):
     """Other speech is not an answer; at worst the channel sends an option it is unsure of with
