@@ -9,7 +9,8 @@ a moment of room before and after the words), and subtracted from every frame, n
 as phones: over-subtracting 3x with a 0.02 floor took the right phrases from 52 down to 39).
 Measured on the same 80 answers: 54 right phrases, 37 of them taken.
 
-Two cases are left alone. A quiet room (noise below :data:`QUIET_ROOM_DBFS`): there the
+Three cases are left alone. Background talk, which comes and goes (:data:`STEADY_SPREAD_DB`):
+subtracting its average spectrum took right answers at SNR 10 dB from 0.21 to 0.05. A quiet room (noise below :data:`QUIET_ROOM_DBFS`): there the
 quietest frames hold the ends of the words, and subtracting them took 8 of 55 answers below the
 confidence to take them. And an utterance with nothing above the noise: subtracting white noise
 from itself left warbling tones that pocketsphinx heard as "needs help" with confidence 0.84-0.95.
@@ -32,6 +33,9 @@ QUIET_SHARE = 0.2
 OVER_SUBTRACTION = 1.0
 #: the least of each frequency's magnitude that is kept
 FLOOR = 0.15
+#: steady noise: the quietest 20 % of the frames lie within this many dB of the quietest 5 %
+#: (white noise: 0.3 dB; background talk: 3-5 dB)
+STEADY_SPREAD_DB = 1.5
 #: below this noise level (dBFS) the room is quiet and nothing is done
 QUIET_ROOM_DBFS = -55.0
 #: the loudest tenth of the frames must stand this far above the noise, or nothing is done
@@ -52,7 +56,12 @@ def reduce_steady_noise(pcm: bytes) -> bytes:
     spectra = np.fft.rfft(samples[index] * window, axis=1)
     power = np.abs(spectra) ** 2
     energy = power.sum(axis=1)
-    noise = power[energy <= np.quantile(energy, QUIET_SHARE)].mean(axis=0)
+    quietest, quiet = np.quantile(energy, [0.05, QUIET_SHARE])
+    if quiet > quietest * 10 ** (STEADY_SPREAD_DB / 10):
+        # the room's sound comes and goes (people talking): no one spectrum to take out, and
+        # subtracting an average of it took right answers in background talk from 0.21 to 0.05
+        return pcm
+    noise = power[energy <= quiet].mean(axis=0)
     # the noise's level in dBFS (Parseval: a frame's spectral power over FRAME times the
     # window's power is its mean square)
     level = 10 * np.log10(max(noise.sum() / (FRAME * float((window ** 2).sum())), 1e-12) / 32768 ** 2)
