@@ -38,7 +38,7 @@ from kiosk.export import ExportSite, site_from_config
 from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
-from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView, Ways
+from kiosk.screens.base import ClinicianScreen, PatientScreen, PatientView, Ways, spoken_with_ways
 from kiosk.screens.clinician_home import ClinicianHomeScreen
 from kiosk.screens.doctor_called import DoctorCalledScreen
 from kiosk.screens.explanation import ExplanationScreen
@@ -391,7 +391,7 @@ class KioskApp(App[int], inherit_bindings=False):
             self.speaker.stop_speaking()
             self._repeat = "queued"
         self.speaker.rate = round(DEFAULT_RATE * prompt.speech_rate)
-        self.speaker.say(prompt.spoken, prompt.language)
+        self.speaker.say(spoken_with_ways(prompt.spoken, prompt.language, self._view().ways), prompt.language)
 
     def _tell_voice_available(self) -> None:
         """Tell the session whether voice in and voice out are on (it decides what that means for

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields, replace
 from functools import cache
@@ -454,6 +455,12 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             texts(path + ("text",), entry.get("text"))
             texts(path + ("patient",), entry.get("patient"))
             texts(path + ("spoken",), entry.get("spoken"))
+            spoken = entry.get("spoken")
+            for lang, said in (spoken.items() if isinstance(spoken, dict) else ()):
+                for mark in re.findall(r"\{[^}]*\}", said) if isinstance(said, str) else ():
+                    if mark != "{ways}":
+                        add(path + ("spoken", lang), f"{mark} would be said aloud: the only mark a spoken "
+                                                     "text may hold is {ways} (how to answer)")
             options(path + ("options",), entry.get("options"), scored=section == "items")
             expected, opts = entry.get("expected"), entry.get("options")
             if section == "familiarisation" and isinstance(expected, int) and isinstance(opts, list) \

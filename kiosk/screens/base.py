@@ -72,6 +72,15 @@ class PatientView:
         return snap.attempt is not None and not (snap.paused or snap.halted) and snap.person_present
 
 
+def spoken_with_ways(spoken: str, language: str, ways: Ways) -> str:
+    """A prompt's spoken words with ``{ways}`` replaced by how to choose an answer with the channels
+    on now ("Touch it, press its number on the remote or say its number."), so the voice never
+    promises a remote or a microphone that is off."""
+    if "{ways}" not in spoken:
+        return spoken
+    return spoken.replace("{ways}", ways_sentence(language, "choose_by", ways.answering(), "_select"))
+
+
 def patient_notices(view: PatientView) -> str | None:
     """The notices the patient sees above the question, in their language, or None: only what is
     true with the channels on now (no "speaking more slowly" without a voice)."""

@@ -8,6 +8,7 @@ in [0, 1]:
   ``KIOSK_VOSK_MODEL``), grammar as a JSON phrase list with "[unk]"; confidence is the lowest
   word confidence Vosk reports.
 - :class:`PocketSphinxRecogniser`: the English model in the pocketsphinx wheel, grammar as JSGF.
+  The finished utterance is first cleaned of steady noise (a fan; :mod:`kiosk.speech.denoise`).
   A grammar decoder always returns *some* phrase, so its confidence is the lowest of these
   checks, each simple enough to explain to a clinician:
 

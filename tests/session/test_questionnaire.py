@@ -291,3 +291,12 @@ def test_without_a_patient_wording_the_screen_shows_the_clinical_one(tmp_path):
     option = questionnaire.item("bowels").option(2)
     assert option.patient_label_in("en") == option.label_in("en") == "Occasional accident"
     assert questionnaire.item("bowels").option(3).patient_label_in("es") == "No, nunca"
+
+
+def test_a_spoken_text_holds_no_mark_but_ways(tmp_path):
+    """A clinician's typo in a mark ("{way}") would be read aloud to the patient."""
+    path, text = broken(tmp_path, "number three. {ways}\n      es:", "number three. {way}\n      es:")
+    (problem,) = check_questionnaire_file(path)
+    line = text.count("\n", 0, text.index("{way}")) + 1
+    assert str(problem).startswith(f"{path}:{line}:") and "{way} would be said aloud" in str(problem)
+    assert check_questionnaire_file(broken(tmp_path, "Sí", "Sí")[0]) == []  # the shipped text is fine

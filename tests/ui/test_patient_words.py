@@ -160,3 +160,15 @@ async def test_the_paused_screen_keeps_the_question_number(ui_kiosk):
         assert text_of(kiosk.app.screen.query_one("#paused-text")) == (
             "We are waiting for you. When you are ready, touch Continue.")
         assert kiosk.session.phase is Phase.QUESTIONS
+
+
+def test_spoken_ways_follow_the_channels_in_every_language():
+    from kiosk.screens.base import spoken_with_ways
+
+    said = next(p for p in QUESTIONNAIRE.familiarisation if p.id == "practice_select").spoken
+    assert spoken_with_ways(said["en"], "en", ALL) == (
+        "Please choose answer number three. Touch it, press its number on the remote or say its number.")
+    assert spoken_with_ways(said["es"], "es", Ways(voice=True)) == (
+        "Por favor, elija la respuesta número tres. Tóquela o diga su número.")
+    assert spoken_with_ways(said["fr"], "fr", TOUCH_ONLY) == "Veuillez choisir la réponse numéro trois. Touchez-la."
+    assert spoken_with_ways("Welcome.", "en", ALL) == "Welcome."

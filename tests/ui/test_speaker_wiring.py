@@ -68,3 +68,39 @@ async def test_trouble_hearing_is_never_said_while_voice_in_is_off(ui_kiosk):
         await until_thread(lambda: player.played >= len(prompts), "the speaker's worker")
         await settle(pilot)
         assert player.played == len(prompts)  # ...and the app said every prompt it was given
+
+
+class SaidSpeaker(Speaker):
+    """The real espeak-ng speaker, keeping the words it was given."""
+
+    def __init__(self, **options) -> None:
+        super().__init__(**options)
+        self.said: list[str] = []
+
+    def say(self, text: str, language: str | None = None) -> None:
+        self.said.append(text)
+        super().say(text, language)
+
+
+async def test_the_spoken_practice_promises_only_the_channels_that_are_on(ui_kiosk):
+    """"Please choose answer number three" goes on with the ways that work: with no remote and no
+    voice in (this kiosk's channels), only touching it is said."""
+    player = RecordingPlayer()
+    speaker = SaidSpeaker(player_factory=lambda: player)
+    kiosk = ui_kiosk(familiarisation=True, speaker=speaker)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await until_thread(lambda: kiosk.app.board.state(VOICE_OUT)[0] is ChannelState.ON, "the speaker's worker")
+        await settle(pilot, lambda: kiosk.session.snapshot().phase.value == "welcome")
+        await pilot.press("1")
+        for _ in range(6):  # hear, read, select: answer each practice question as it comes
+            practice = kiosk.session.snapshot().practice
+            if practice is not None and practice.id == "practice_select":
+                break
+            if practice is not None and kiosk.session.current_attempt:
+                await pilot.press(str(practice.expected))
+            kiosk.to_next_deadline()
+            await settle(pilot)
+        assert kiosk.session.snapshot().practice.id == "practice_select"
+    select = [text for text in speaker.said if text.startswith("Please choose answer number three")]
+    assert select == ["Please choose answer number three. Touch it."]
+    assert not [text for text in speaker.said if "{ways}" in text or "remote" in text]
