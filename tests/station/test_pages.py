@@ -6,6 +6,7 @@ phone's width and a desktop's."""
 from __future__ import annotations
 
 import threading
+import time
 from dataclasses import replace
 
 import pytest
@@ -49,6 +50,16 @@ def open_page(browser, station, user: str, role: str, viewport):
     return context, page
 
 
+def _wait_for_beeps(page) -> None:
+    """Until the page has beeped. Waits use selectors and one-off evaluations: the station's page
+    forbids eval (CSP ``default-src 'self'``), and Playwright's wait_for_function re-evaluates its
+    string predicate with eval once it has to poll, which failed the test whenever the state came late."""
+    deadline = time.monotonic() + PATIENCE_S
+    while page.evaluate("window.station.beeps") == 0:
+        assert time.monotonic() < deadline, "the page never beeped"
+        page.wait_for_timeout(50)  # lets the page run; bounded by PATIENCE_S
+
+
 @pytest.mark.parametrize("viewport", [PHONE, DESKTOP], ids=["phone", "desktop"])
 def test_an_alert_sounds_and_notifies_until_acknowledged(browser, ward, viewport):
     station, ward, kiosk = ward
@@ -56,17 +67,18 @@ def test_an_alert_sounds_and_notifies_until_acknowledged(browser, ward, viewport
     alert = next(r for r in rows if r.alert and r.payload["kind"] in ("doctor_called", "person_lost"))
     context, page = open_page(browser, station, "nurse.kim", "nurse", viewport)
     page.click("#enable-sound")
-    page.wait_for_function("document.body.dataset.live === '1'")
+    page.wait_for_selector("body[data-live='1']", state="attached")
     assert page.locator("#alerts li").count() == 0
     kiosk.sync([alert])
     item = page.locator(f"#alerts li:has-text('{ward.kiosk_id}')")
     item.wait_for()
-    page.wait_for_function("document.body.dataset.sounding === '1' && window.station.beeps > 0")
+    page.wait_for_selector("body[data-sounding='1']", state="attached")
+    _wait_for_beeps(page)
     assert any(ward.kiosk_id in title for title in page.evaluate("window.__shown"))
     assert item.locator("button.ack").is_visible()  # reachable at this width
     item.locator("button.ack").click()
     page.wait_for_selector(f"#alerts li:has-text('{ward.kiosk_id}')", state="detached")
-    page.wait_for_function("document.body.dataset.sounding === '0'")
+    page.wait_for_selector("body[data-sounding='0']", state="attached")
     engine = db.make_engine(ward.db_url)
     with engine.connect() as connection:
         row = connection.execute(sa.select(db.alerts.c.ack_by, db.alerts.c.ack_at).where(
@@ -82,7 +94,7 @@ def test_continue_after_a_doctor_call_reaches_the_kiosk(browser, ward):
     call = next(r for r in rows if r.alert and r.payload["kind"] == "doctor_called")
     kiosk.sync([r for r in rows if r.seq <= call.seq])
     context, page = open_page(browser, station, "nurse.kim", "nurse", PHONE)
-    page.wait_for_function("document.body.dataset.live === '1'")
+    page.wait_for_selector("body[data-live='1']", state="attached")
     kiosk.status(session_id=call.session_id, patient_id="TB-0005", phase="questions", question=4, of=10,
                  doctor_called=True)
     tile = page.locator(f"#kiosk-{ward.kiosk_id}")
