@@ -18,6 +18,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
+from qos.files import BadFile, load_json
 from station import auth, sync, ward
 
 #: the longest long poll the station holds open (seconds)
@@ -68,11 +69,30 @@ def _in_worker(request: Request, work: Any, urgent: bool = False, status: str | 
     return run_in_threadpool(run)
 
 
+class _TooLarge(ValueError):
+    status = 413
+
+
 async def _json(request: Request) -> Any:
-    body = await request.body()
-    if len(body) > MAX_BODY:
-        raise ValueError(f"the body is larger than {MAX_BODY} bytes")
-    return json.loads(body)
+    """The request's JSON body, read under the same limits as the kiosk's own files
+    (:func:`qos.files.load_json`: nesting, duplicate keys, NaN, huge numbers), at most
+    :data:`MAX_BODY` bytes and never buffered beyond that: a ``ValueError`` naming what is wrong."""
+    declared = request.headers.get("content-length", "")
+    if declared.isdigit() and int(declared) > MAX_BODY:
+        raise _TooLarge(f"the body is larger than {MAX_BODY} bytes")
+    body = bytearray()
+    async for chunk in request.stream():
+        body += chunk
+        if len(body) > MAX_BODY:
+            raise _TooLarge(f"the body is larger than {MAX_BODY} bytes")
+    try:
+        text = body.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"the body is not UTF-8 text (byte {exc.start})") from None
+    try:
+        return load_json(text, "the request body")
+    except BadFile as exc:
+        raise ValueError(str(exc)) from None
 
 
 def _unauthorised() -> JSONResponse:
@@ -114,7 +134,7 @@ async def post_status(request: Request) -> Response:
         body = await _json(request)
         status = ward.parse_status(body)
     except ValueError as exc:
-        return _error(400, str(exc))
+        return _error(getattr(exc, "status", 400), str(exc))
 
     def work(connection: Connection, kiosk: str) -> tuple[None, list[dict[str, Any]]]:
         _check_kiosk_id(body, kiosk)  # raising rolls the status back
@@ -172,7 +192,7 @@ async def post_command_ack(request: Request) -> Response:
     except ward.WardError as exc:
         return _error(404 if str(exc).startswith("no command") else 400, str(exc))
     except ValueError as exc:
-        return _error(400, str(exc))
+        return _error(getattr(exc, "status", 400), str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "kiosk", "kiosk": kiosk})
     return JSONResponse({"ok": True})
 

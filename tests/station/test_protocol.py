@@ -182,3 +182,24 @@ def test_a_kiosk_silent_for_more_than_30_s_shows_offline_with_when_it_was_last_s
     tile = page[page.index(f'id="kiosk-{ward.kiosk_id}"'):]
     tile = tile[:tile.index("</article>")]
     assert "offline" in tile and "last seen" in tile and "12" in tile  # "120 s ago" (or a little more)
+
+
+@pytest.mark.parametrize("body,status,words", [
+    (b"[" * 100_000 + b"]" * 100_000, 400, "nested more than"),
+    (b'{"kiosk_id": "a", "kiosk_id": "b", "events": []}', 400, "duplicate key"),
+    (b'{"events": [{"seq": NaN}]}', 400, "not a finite number"),
+    (b'{"events": [{"seq": 1' + b"0" * 5000 + b'}]}', 400, "too large"),
+    (b'{"events": "\xff\xfe"}', 400, "not UTF-8"),
+    (b'{"events": [' + b'"x",' * 1_500_000 + b'"x"]}', 413, "larger than"),
+])
+def test_a_bad_body_gets_one_clear_message_and_nothing_is_stored(ward_station, body, status, words):
+    """Bytes from a broken or hostile kiosk: deep nesting (which crashed json.loads with a
+    RecursionError, a 500), duplicate keys, NaN, a 5000-digit number, bad UTF-8, a body over the
+    limit. Each is refused with one sentence, and the station goes on taking good reports."""
+    ward, station, client = ward_station
+    for path in ("/api/v1/sync", "/api/v1/status"):
+        response = client.http.post(path, content=body)
+        assert response.status_code == status, (path, response.text[:200])
+        assert words in response.json()["error"]
+    assert client.status(session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3,
+                         of=10).status_code == 200
