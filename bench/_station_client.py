@@ -39,10 +39,11 @@ class Row:
         return self.kind == "record_event" and self.payload.get("kind") in ALERT_KINDS
 
 
-def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None) -> list[Row]:
+def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None,
+                   export: dict[str, str] | None = None) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
     on the kiosk's real :class:`kiosk.storage.Store` with a station configured, its outbox read
-    back and numbered from ``first_seq``."""
+    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity."""
     from dataclasses import replace
 
     from kiosk.replay import load_script, run_script
@@ -52,7 +53,7 @@ def record_patient(script: str | Path, first_seq: int = 1, patient: str | None =
     if patient is not None:
         loaded = replace(loaded, patient=patient)
     with tempfile.TemporaryDirectory() as directory:
-        with Store.open(directory, outbox=True) as store:
+        with Store.open(directory, outbox=True, export=export) as store:
             run_script(loaded, store=store)
         with sqlite3.connect(Path(directory) / DB_NAME) as connection:
             stored = connection.execute("SELECT kind, session_id, payload, at FROM outbox ORDER BY seq").fetchall()

@@ -34,7 +34,7 @@ from textual.binding import Binding
 from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
-from kiosk.export import ExportSite, site_from_config
+from kiosk.export import ExportSite, export_identity, site_from_config
 from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
@@ -670,7 +670,7 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
         model = load_kiosk_model(config.qos_model)
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
         store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
-                           outbox=config.station is not None)
+                           outbox=config.station is not None, export=export_identity(site_from_config(config)))
         sync = _station_client(config.station, store, lambda command: app.station_command(command))
         # what a kiosk that stopped left running is interrupted now: for staff, never a patient
         store.interrupt_stale()

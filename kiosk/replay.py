@@ -609,7 +609,10 @@ def main(argv: list[str]) -> int:
 
         try:
             # scripted patients: never offered to anyone; queued for the station when there is one
-            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None)
+            from kiosk.export import export_identity, site_from_config
+
+            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None,
+                               export=export_identity(site_from_config(config)))
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2

@@ -117,13 +117,18 @@ class Store(Custody):
     ``owner`` is this kiosk process (leases name it); ``simulated`` marks every session it creates
     as a scripted patient's; ``outbox`` queues every change for the ward station;
     ``interrupt_after_s`` is the age after which a running session counts as interrupted (None: no
-    limit); ``wall`` gives the epoch seconds leases are dated with.
+    limit); ``wall`` gives the epoch seconds leases are dated with; ``export`` (the fields of
+    :class:`kiosk.export.ExportSite`) goes to the station with each new session.
     """
 
     def __init__(self, connection: sqlite3.Connection, path: Path, *, owner: Owner | None = None,
                  simulated: bool = False, outbox: bool = False, interrupt_after_s: float | None = None,
-                 lease_ttl_s: float = LEASE_TTL_S, wall: Callable[[], float] = time.time) -> None:
+                 lease_ttl_s: float = LEASE_TTL_S, wall: Callable[[], float] = time.time,
+                 export: Mapping[str, str] | None = None) -> None:
         self._db = connection
+        #: how this kiosk's exports name things (site, kiosk, FHIR systems), sent to the station with
+        #: each new session so that the station's exports of it carry the same identifiers
+        self.export = dict(export or {})
         self.path = path
         self.owner = owner or Owner()
         self.simulated = simulated
@@ -295,7 +300,7 @@ class Store(Custody):
             self._queue("create_session", session_id, {
                 "session_id": session_id, "patient_id": patient_id, "questionnaire_id": questionnaire_id,
                 "language": language, "answered_by": answered_by, "started_at": started_at, "timing": dict(timing),
-                "simulated": self.simulated})
+                "simulated": self.simulated, **({"export": self.export} if self.export else {})})
 
     def record_answer(self, session_id: str, *, item_id: str, option: int, points: int, attempt: int,
                       channel: str, answered_by: str, t: float, at: str, detail: str = "") -> None:

@@ -16,13 +16,13 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export import ExportSite, csv_text, fhir_response, practice_outcomes
+from kiosk.export import csv_text, fhir_response, practice_outcomes, site_from_identity
 from kiosk.questionnaire import Questionnaire
 from kiosk.storage import StoredSession
 from station import db, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
-from station.sessions import NotFound, load
+from station.sessions import NotFound, export_identity, load
 
 #: session-list size on the ward page
 RECENT = 50
@@ -142,6 +142,11 @@ def _load(engine: Any, session_id: str) -> tuple[str, StoredSession]:
         return load(connection, session_id)
 
 
+def _identity(engine: Any, session_id: str) -> dict[str, Any]:
+    with engine.connect() as connection:
+        return export_identity(connection, session_id)
+
+
 async def change_item(request: Request) -> Response:
     form = await checked_form(request)
     engine, q = request.app.state.engine, request.app.state.questionnaire
@@ -180,7 +185,9 @@ async def export(request: Request) -> Response:
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
     current = await run_in_threadpool(validation.review, engine, session_id)
-    site = ExportSite(kiosk_id=kiosk)  # the session's kiosk: the result's identifier is the one the kiosk exports
+    # named as the kiosk names it in its own exports (its site, kiosk id and FHIR systems, sent
+    # with the session), so a hospital importing both gets one result, not two
+    site = site_from_identity(await run_in_threadpool(_identity, engine, session_id), kiosk)
     if fmt == "json":
         import json
 

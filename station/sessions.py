@@ -127,6 +127,16 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
     )
 
 
+def export_identity(connection: Connection, session_id: str) -> dict[str, Any]:
+    """How the session's kiosk names things in its own exports (site, kiosk, FHIR systems), as it
+    sent them with the session; empty from a kiosk that sent none."""
+    for row in rows_of(connection, session_id):
+        if row.kind == "create_session":
+            identity = row.payload.get("export")
+            return dict(identity) if isinstance(identity, dict) else {}
+    return {}
+
+
 def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
     """The kiosk a session came from, and the session (NotFound if it never arrived)."""
     kiosk = connection.execute(sa.select(sessions.c.kiosk_id).where(sessions.c.id == session_id)).scalar()

@@ -34,6 +34,7 @@ from kiosk.export.result import (
     ExportError,
     ExportSite,
     PracticeOutcome,
+    export_identity,
     Result,
     practice_outcome,
     practice_outcomes,
@@ -42,6 +43,7 @@ from kiosk.export.result import (
     result,
     results,
     site_from_config,
+    site_from_identity,
     write_export,
     write_json,
     write_private,
@@ -50,9 +52,11 @@ from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, wide_columns, wi
 
 __all__ = [
     "CSV_COLUMNS", "ID_TAGS", "ITEM_WEIGHT", "ORDINAL_VALUE", "PRACTICE_CHECKS", "SIGNATURE", "TOTAL_LINK",
-    "TRANSLATION", "ExportError", "ExportSite", "PracticeOutcome", "Result", "csv_text", "fhir_device",
+    "TRANSLATION", "ExportError", "ExportSite", "PracticeOutcome", "Result", "csv_text", "export_identity",
+    "fhir_device",
     "fhir_questionnaire", "fhir_response", "fhir_total", "observation_status", "practice_outcome",
     "practice_outcomes", "questionnaire_bundle", "questionnaire_canonical", "questionnaire_version", "rescore",
-    "response_status", "result", "results", "site_from_config", "transaction_bundle", "wide_columns",
+    "response_status", "result", "results", "site_from_config", "site_from_identity", "transaction_bundle",
+    "wide_columns",
     "wide_csv_text", "write_export", "write_json", "write_private",
 ]

@@ -6,8 +6,8 @@ clinician signed it off; :class:`ExportSite` is who exports (site, kiosk, FHIR s
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -62,6 +62,19 @@ class ExportSite:
 def site_from_config(config: Config) -> ExportSite:
     """The export site of a :class:`kiosk.config.Config`."""
     return ExportSite(site=config.site, kiosk_id=config.kiosk_id, **dict(config.fhir))
+
+
+def export_identity(site: ExportSite) -> dict[str, str]:
+    """``site`` as plain strings (what the kiosk sends the station with each session)."""
+    return {f.name: str(getattr(site, f.name)) for f in fields(site)}
+
+
+def site_from_identity(identity: Mapping[str, Any], kiosk_id: str) -> ExportSite:
+    """The :class:`ExportSite` a kiosk sent (:func:`export_identity`); its unknown or non-text
+    fields are ignored, and without one the station's default site for ``kiosk_id``."""
+    known = {f.name for f in fields(ExportSite)}
+    chosen = {k: v for k, v in identity.items() if k in known and isinstance(v, str) and v}
+    return ExportSite(**{"kiosk_id": kiosk_id, **chosen})
 
 
 def questionnaire_version(q: Questionnaire) -> str:

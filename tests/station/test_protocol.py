@@ -203,3 +203,29 @@ def test_a_bad_body_gets_one_clear_message_and_nothing_is_stored(ward_station, b
         assert words in response.json()["error"]
     assert client.status(session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3,
                          of=10).status_code == 200
+
+
+def test_the_stations_export_names_the_result_as_its_kiosk_does(ward_station, tmp_path):
+    """A hospital importing from both the kiosk and the station gets one result: the station's FHIR
+    export carries the identifiers of the kiosk's own (site, kiosk id and FHIR systems from the
+    kiosk's config, sent with the session), not the station's defaults."""
+    from kiosk.export import ExportSite, export_identity, fhir_response
+    from kiosk.questionnaire import load_questionnaire
+    from kiosk.storage import DB_NAME, Store
+
+    ward, station, client = ward_station
+    site = ExportSite(site="H1", kiosk_id="ward3-bed2", patient_system="https://h1.example/pseudonyms",
+                      identifier_system="https://h1.example/barthel-results",
+                      questionnaire_url="https://h1.example/Questionnaire/barthel",
+                      device_system="https://h1.example/devices")
+    rows = record_patient(PATIENTS / "barthel5.yaml", export=export_identity(site))
+    assert rows[0].kind == "create_session" and rows[0].payload["export"]["site"] == "H1"
+    client.sync(rows)
+    session_id = rows[0].session_id
+    exported = Staff(station.url).http.get(f"/sessions/{session_id}/export.json").json()
+    stored = _stored(ward.db_url, session_id)
+    own = fhir_response(load_questionnaire(), stored, None, site)  # what the kiosk itself exports
+    for key in ("identifier", "questionnaire", "subject"):
+        assert exported[key] == own[key], key
+    assert exported["identifier"] == {"system": "https://h1.example/barthel-results",
+                                      "value": f"H1/ward3-bed2/{session_id}"}
