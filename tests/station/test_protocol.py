@@ -229,3 +229,22 @@ def test_the_stations_export_names_the_result_as_its_kiosk_does(ward_station, tm
         assert exported[key] == own[key], key
     assert exported["identifier"] == {"system": "https://h1.example/barthel-results",
                                       "value": f"H1/ward3-bed2/{session_id}"}
+
+
+def test_an_incomplete_session_shows_no_total(ward_station):
+    """Barthel #5 leaves bathing unanswered: the page says there is no total yet and why, never a
+    partial sum as if it were the result (its exports leave the total out too)."""
+    ward, station, client = ward_station
+    rows = record_patient(PATIENTS / "barthel5.yaml")
+    client.sync(rows)
+    session_id = rows[0].session_id
+    staff = Staff(station.url)
+    page = staff.http.get(f"/sessions/{session_id}").text
+    assert '<b id="total">No total</b>: 1 of 10 questions not answered' in page
+    exported = staff.http.get(f"/sessions/{session_id}/export.json").json()
+    total = next(i for i in exported["item"] if i["linkId"] == "total")
+    assert "answer" not in total and exported["status"] != "completed"
+    complete = record_patient(PATIENTS / "barthel1.yaml", first_seq=rows[-1].seq + 1)
+    client.sync(complete)
+    page = staff.http.get(f"/sessions/{complete[0].session_id}").text
+    assert "No total" not in page and " of 100" in page
