@@ -65,9 +65,11 @@ class SessionDetailScreen(ClinicianScreen):
             score = rescore(q, self.stored)
         except ExportError as error:
             return f"Cannot score: {error}"
-        band = score.band.label["en"] if score.band else "no band (incomplete)"
-        done = "complete" if score.complete else f"incomplete: {len(score.missing)} of {len(q.items)} missing"
-        return f"Total {score.total} of {score.max_total} ({done}); {band}"
+        if not score.complete:  # a partial sum is no Barthel total: never shown as one
+            return (f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
+                    f"(the answered ones add up to {score.total})")
+        band = score.band.label["en"] if score.band else "no band"
+        return f"Total {score.total} of {score.max_total} (complete); {band}"
 
     def _practice_line(self) -> str:
         """How the familiarisation went: "Practice: hearing skipped (no voice out) / reading ✓"."""

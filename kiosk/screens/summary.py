@@ -33,9 +33,10 @@ class SummaryScreen(PatientScreen):
                      or ui_text(self.language, "summary_text"), classes="notice")
         score = self.view.snapshot.score
         if score is not None and self.view.show_score:  # a site's choice; staff always see it
-            lines = [ui_text(self.language, "summary_total", total=score.total, maximum=score.max_total)]
-            if score.band is not None:
-                lines.append(score.band.label[self.language])
-            if score.missing:
-                lines.append(ui_text(self.language, "summary_incomplete", missing=len(score.missing)))
+            if score.missing:  # a partial sum is no total: the patient is not shown one
+                lines = [ui_text(self.language, "summary_incomplete", missing=len(score.missing))]
+            else:
+                lines = [ui_text(self.language, "summary_total", total=score.total, maximum=score.max_total)]
+                if score.band is not None:
+                    lines.append(score.band.label[self.language])
             yield Static("\n".join(lines), id="summary-total")

@@ -169,3 +169,36 @@ async def test_a_site_may_show_the_patient_their_score(ui_kiosk):
         await answer_every_question(kiosk, pilot, by_key)
         total = text_of(kiosk.app.screen.query_one("#summary-total", Static))
         assert "Total: 100 of 100" in total and "Independent" in total
+
+
+async def test_an_incomplete_test_shows_no_total_to_the_patient_or_the_clinician(ui_kiosk):
+    """Feeding gets no answer in either attempt: the end screen (with the site showing scores) and
+    the clinician's detail say how many questions are unanswered, never a partial sum as a total."""
+    from textual.widgets import Label
+
+    from .test_clinician import _open_clinician
+
+    kiosk = ui_kiosk(familiarisation=False, show_score=True)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await start_in_english(kiosk, pilot)
+        kiosk.to_next_deadline()  # feeding opens
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+        kiosk.to_next_deadline()  # attempt 1 runs out
+        await settle(pilot, lambda: kiosk.session.current_attempt == 2)
+        kiosk.to_next_deadline()  # attempt 2 runs out: not answered
+        await settle(pilot, lambda: kiosk.session.current_attempt is None)
+        for _ in range(len(kiosk.questionnaire.items) - 1):
+            kiosk.to_next_deadline()
+            await settle(pilot, lambda: kiosk.session.current_attempt == 1)
+            item = kiosk.session.current_item
+            await pilot.press(str(len(item.options)))
+            await settle(pilot, lambda: item.id in kiosk.session.answers)
+        kiosk.to_next_deadline()
+        await settle(pilot, lambda: screen_name(kiosk) == "SummaryScreen")
+        shown = text_of(kiosk.app.screen.query_one("#summary-total", Static))
+        assert shown == "Questions not answered: 1" and "Total" not in shown
+        await _open_clinician(kiosk, pilot)
+        await pilot.press("enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
+        line = text_of(kiosk.app.screen.query_one("#total", Label))
+        assert line == "No total: 1 of 10 questions not answered (the answered ones add up to 90)"
