@@ -104,7 +104,9 @@ CREATE TABLE IF NOT EXISTS events (
 # Version 2: interrupted and simulated sessions, the one-kiosk-per-session lease, the station outbox.
 # SQLite cannot change a CHECK constraint in place, so the sessions table is rebuilt (foreign keys
 # are off while a migration runs). Sessions that `kiosk replay` stored before they were marked are
-# recognised by the simulated clock's epoch (its first hour; see kiosk.clock.SIM_EPOCH).
+# recognised by the simulated clock's epoch (its first hour; see kiosk.clock.SIM_EPOCH) in whole
+# seconds (scripts start on whole seconds; a real clock's start has microseconds, so a patient
+# tested on New Year's night is not taken for a script).
 V2 = """
 CREATE TABLE sessions_v2 (
     id TEXT PRIMARY KEY,
@@ -128,6 +130,7 @@ INSERT INTO sessions_v2 (id, patient_id, questionnaire_id, language, answered_by
     SELECT id, patient_id, questionnaire_id, language, answered_by, timing, started_at, status,
            finished_at, total, complete, band,
            started_at >= '2026-01-01T00:00:00' AND started_at < '2026-01-01T01:00:00'
+           AND started_at NOT LIKE '%.%'
     FROM sessions;
 DROP TABLE sessions;
 ALTER TABLE sessions_v2 RENAME TO sessions;

@@ -21,7 +21,8 @@ V1_SQL = (Path(__file__).parent / "data" / "schema_v1.sql").read_text(encoding="
 
 def v1_database(data: Path) -> Path:
     """A database as the pre-version kiosk left it: a finished session, one interrupted by a
-    power cut (still 'running'), and one `kiosk replay --data-dir` stored (simulated clock epoch)."""
+    power cut (still 'running'), one `kiosk replay --data-dir` stored (simulated clock epoch), and a
+    real one in the simulated clock's first hour (New Year's night)."""
     data.mkdir(mode=0o700)
     path = data / DB_NAME
     db = sqlite3.connect(path)
@@ -30,7 +31,9 @@ def v1_database(data: Path) -> Path:
     timing = json.dumps({"attempt_window_s": 30})
     for session_id, patient, started, status in [("aaaa00000001", "P-FIRST1", "2026-11-20T09:00:00+00:00", "finished"),
                                                  ("bbbb00000002", "P-CUTOFF", "2026-11-21T10:00:00+00:00", "running"),
-                                                 ("cccc00000003", "TB-0002", "2026-01-01T00:00:05+00:00", "running")]:
+                                                 ("cccc00000003", "TB-0002", "2026-01-01T00:00:05+00:00", "running"),
+                                                 ("dddd00000004", "P-NEWYEAR", "2026-01-01T00:20:41.532118+00:00",
+                                                  "finished")]:
         db.execute("INSERT INTO patients VALUES (?, ?)", (patient, started))
         db.execute("INSERT INTO sessions VALUES (?, ?, 'barthel', 'en', 'patient', ?, ?, ?, NULL, NULL, NULL, NULL)",
                    (session_id, patient, timing, started, status))
@@ -53,7 +56,7 @@ def test_a_database_from_before_schema_versions_upgrades_and_keeps_every_row(tmp
     with Store.open(tmp_path / "data") as store:
         assert schema.version(store._db) == schema.LATEST  # noqa: SLF001
         sessions = {s.id: s for s in store.sessions()}
-        assert set(sessions) == {"aaaa00000001", "bbbb00000002", "cccc00000003"}
+        assert set(sessions) == {"aaaa00000001", "bbbb00000002", "cccc00000003", "dddd00000004"}
         finished = store.session("aaaa00000001")
         assert (finished.status, finished.finished_at, [a.option for a in finished.answers]) == (
             "finished", "2026-11-20T09:12:00+00:00", [2])
@@ -64,9 +67,11 @@ def test_a_database_from_before_schema_versions_upgrades_and_keeps_every_row(tmp
         # the scripted patient is recognised as simulated and never offered at all
         assert [s.id for s in store.unfinished_sessions()] == ["bbbb00000002"]
         assert sessions["cccc00000003"].simulated and not sessions["bbbb00000002"].simulated
+        # a real patient tested in that very hour (a real clock's start has microseconds) is not
+        assert not sessions["dddd00000004"].simulated
     # opening again changes nothing more
     with Store.open(tmp_path / "data") as store:
-        assert len(store.sessions()) == 3
+        assert len(store.sessions()) == 4
     assert path.stat().st_mode & 0o077 == 0
 
 
@@ -102,7 +107,7 @@ def test_a_migration_that_fails_leaves_the_database_as_it_was(tmp_path):
     with sqlite3.connect(path) as db:
         assert db.execute("PRAGMA user_version").fetchone() == (0,)
         assert "leases" not in {r[0] for r in db.execute("SELECT name FROM sqlite_master")}
-        assert db.execute("SELECT COUNT(*) FROM sessions").fetchone() == (3,)
+        assert db.execute("SELECT COUNT(*) FROM sessions").fetchone() == (4,)
 
 
 def damage(path: Path) -> None:
