@@ -110,6 +110,8 @@ def _check_kiosk_id(body: Any, kiosk: str) -> None:
 
 
 async def post_sync(request: Request) -> Response:
+    if _token(request) is None:  # no key at all: refused before its body is read
+        return _unauthorised()
     try:
         body = await _json(request)
         events = sync.parse(body)
@@ -130,6 +132,8 @@ async def post_sync(request: Request) -> Response:
 
 
 async def post_status(request: Request) -> Response:
+    if _token(request) is None:  # no key at all: refused before its body is read
+        return _unauthorised()
     try:
         body = await _json(request)
         status = ward.parse_status(body)

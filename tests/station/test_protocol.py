@@ -9,6 +9,7 @@ import sys
 import threading
 from dataclasses import replace
 
+import httpx
 import pytest
 import sqlalchemy as sa
 
@@ -203,6 +204,9 @@ def test_a_bad_body_gets_one_clear_message_and_nothing_is_stored(ward_station, b
         assert words in response.json()["error"]
     assert client.status(session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3,
                          of=10).status_code == 200
+    # without a kiosk key the body is not even read
+    anonymous = httpx.post(f"{station.url}/api/v1/sync", content=body, timeout=30)
+    assert anonymous.status_code == 401 and "token" in anonymous.json()["error"]
 
 
 def test_the_stations_export_names_the_result_as_its_kiosk_does(ward_station, tmp_path):
