@@ -22,7 +22,7 @@ from kiosk.storage import StoredSession
 from station import db, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
-from station.sessions import NotFound, export_identity, load
+from station.sessions import NotFound, load, load_for_export
 
 #: session-list size on the ward page
 RECENT = 50
@@ -142,9 +142,9 @@ def _load(engine: Any, session_id: str) -> tuple[str, StoredSession]:
         return load(connection, session_id)
 
 
-def _identity(engine: Any, session_id: str) -> dict[str, Any]:
+def _load_for_export(engine: Any, session_id: str) -> tuple[str, StoredSession, dict[str, Any]]:
     with engine.connect() as connection:
-        return export_identity(connection, session_id)
+        return load_for_export(connection, session_id)
 
 
 async def change_item(request: Request) -> Response:
@@ -181,13 +181,13 @@ async def export(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id, fmt = request.path_params["session_id"], request.path_params["fmt"]
     try:
-        kiosk, stored = await run_in_threadpool(_load, engine, session_id)
+        kiosk, stored, identity = await run_in_threadpool(_load_for_export, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
     current = await run_in_threadpool(validation.review, engine, session_id)
     # named as the kiosk names it in its own exports (its site, kiosk id and FHIR systems, sent
     # with the session), so a hospital importing both gets one result, not two
-    site = site_from_identity(await run_in_threadpool(_identity, engine, session_id), kiosk)
+    site = site_from_identity(identity, kiosk)
     if fmt == "json":
         import json
 

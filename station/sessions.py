@@ -127,19 +127,30 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
     )
 
 
-def export_identity(connection: Connection, session_id: str) -> dict[str, Any]:
+def export_identity(rows: Iterable[Row]) -> dict[str, Any]:
     """How the session's kiosk names things in its own exports (site, kiosk, FHIR systems), as it
     sent them with the session; empty from a kiosk that sent none."""
-    for row in rows_of(connection, session_id):
+    for row in rows:
         if row.kind == "create_session":
             identity = row.payload.get("export")
             return dict(identity) if isinstance(identity, dict) else {}
     return {}
 
 
-def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
-    """The kiosk a session came from, and the session (NotFound if it never arrived)."""
+def _kiosk_and_rows(connection: Connection, session_id: str) -> tuple[str, list[Row]]:
     kiosk = connection.execute(sa.select(sessions.c.kiosk_id).where(sessions.c.id == session_id)).scalar()
     if kiosk is None:
         raise NotFound(session_id)
-    return kiosk, fold(session_id, rows_of(connection, session_id))
+    return kiosk, rows_of(connection, session_id)
+
+
+def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
+    """The kiosk a session came from, and the session (NotFound if it never arrived)."""
+    kiosk, rows = _kiosk_and_rows(connection, session_id)
+    return kiosk, fold(session_id, rows)
+
+
+def load_for_export(connection: Connection, session_id: str) -> tuple[str, StoredSession, dict[str, Any]]:
+    """:func:`load`, and the kiosk's export identity, from one read of the session's rows."""
+    kiosk, rows = _kiosk_and_rows(connection, session_id)
+    return kiosk, fold(session_id, rows), export_identity(rows)
