@@ -13,7 +13,8 @@ Every answer to a scored question goes to the sink with ``needs_confirmation`` (
 whose options the matcher extends with the natural ways of saying them ("yes, that's right",
 "no, that's wrong"); after an answer is stored (``AnswerRecorded``), until the next prompt,
 only "no, that's wrong" / "change my answer" (``Command.UNDO``) and calling the doctor are
-listened for: the thank-you gap in which the session lets any answer be taken back. A prompt without points (a confirmation, the welcome's start / language
+listened for: the thank-you gap in which the session lets any answer be taken back. A prompt
+without points (a confirmation, the welcome's start / language
 choice) is never itself confirmed.
 
 Speech models load on the channel's own loader thread (seconds for vosk), never on the thread
@@ -316,10 +317,8 @@ class VoiceChannel:
             commands = undo_commands(self.language)
         self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused,
                                 commands=commands)
-        # before the test no "I need ..." leads in: "begin" was heard as "i need two" (Español)
-        lead_ins = () if commands is not None else self._matcher.lead_ins()
-        self._recogniser.set_grammar(self._matcher.phrases(), self._matcher.meaning, lead_ins,
-                                     self._matcher.fillers())
+        self._recogniser.set_grammar(self._matcher.phrases(), self._matcher.meaning,
+                                     self._matcher.lead_ins(), self._matcher.fillers())
         self._gate()
 
     def _gate(self) -> None:
