@@ -228,9 +228,9 @@ class _Timed:
         #: processor seconds of the latest finish(): the endpoint → result part of the latency
         self.last_finish = 0.0
 
-    def set_grammar(self, *args):
+    def set_grammar(self, *args, **kwargs):
         """Forward."""
-        return self.inner.set_grammar(*args)
+        return self.inner.set_grammar(*args, **kwargs)
 
     def reset(self) -> None:
         """Forward."""
@@ -299,17 +299,19 @@ class Patient:
         self.audio_seconds += waited
         return next((i for i in self.inputs if isinstance(i, ChannelInput)), None)
 
-    def question(self, options: list[OptionWords]) -> None:
+    def question(self, options: list[OptionWords], key: str) -> None:
         """A Barthel question's options become the grammar."""
-        self.channel.set_question(options, "en", scored=True)
+        self.channel.set_question(options, "en", scored=True, key=key)
 
     def answer(self, options: list[OptionWords], text: str, expected, key: int) -> dict:
-        """Two attempts at one question, with confirmations; what was stored or done."""
+        """Two attempts at one question, with confirmations; what was stored or done. A declined
+        option is told to the channel as the session's ``AnswerNotConfirmed`` does."""
         first = None
         out = {"confirmations": 0, "attempts": 0, "stored": None, "command": None}
+        item = f"q{key}"
         for attempt in (1, 2):
             out["attempts"] = attempt
-            self.question(options)
+            self.question(options, item)
             got = self.say(text, slower=0 if attempt == 1 else 20)  # a repeat comes slower
             if attempt == 1:
                 first = got
@@ -322,16 +324,19 @@ class Patient:
                 continue
             if got.needs_confirmation:
                 out["confirmations"] += 1
-                if not self.confirm(got.option == expected, key):
+                confirmed = self.confirm(got.option == expected, key)
+                if confirmed is False:  # a No heard: the session tells the channel
+                    self.channel.declined(item, got.option)
+                if not confirmed:
                     continue
             out["stored"] = got.option
             break
         out["first"] = first
         return out
 
-    def confirm(self, meant: bool, key: int) -> bool:
+    def confirm(self, meant: bool, key: int) -> bool | None:
         """"I heard X, is that right?": the patient says yes only if X is what they meant;
-        whether the kiosk heard yes (asked once more if it heard neither)."""
+        whether the kiosk heard yes (asked once more if it heard neither; None if it never did)."""
         reply = (YES_EN if meant else NO_EN)[key % 4]
         for _ in range(2):
             self.channel.set_question([OptionWords("Yes"), OptionWords("No")], "en", scored=False)
@@ -340,7 +345,7 @@ class Patient:
                 return got.option == 1
             if got is not None and got.command is Command.UNDO:
                 return False
-        return False
+        return None
 
 
 def _p(values: list[float], q: float) -> float | None:

@@ -25,12 +25,16 @@ in [0, 1]:
      :data:`PS_FIT_MIDPOINT` and :data:`PS_FIT_SPREAD` (set on bench/asr.py's dev voices) map
      it to [0, 1]. The utterance is scored with a fixed quiet tail (:func:`_fixed_tail`), so
      one the endpointer closed early is scored like one closed late;
-  4. no confusable word (:data:`PS_CONFUSABLE_WORDS`): espeak-ng's "the first one" was heard
-     as "the third one" on every question with a third option, and decoded against each phrase
-     alone "the third one" even fits it better, so no score margin separates them. Such a
-     phrase is 0 wherever its partner selects another answer
-     (:func:`kiosk.speech.grammar.confusable_phrases`): the patient is asked again and can say
-     "one", instead of the kiosk inventing option 3.
+  Besides the confidence, a phrase holding a confusable word (:data:`PS_CONFUSABLE_WORDS`) is
+  flagged (``Recognition.confusable``) wherever its partner selects another answer
+  (:func:`kiosk.speech.grammar.confusable_phrases`). The kiosk's own voice's "the first one"
+  was heard as "the third one" on every question with a third option, and decoded against
+  each phrase alone "the third one" even fits it better, so no score margin separates them.
+  Such a phrase is never taken on its own: the voice channel always asks "I heard: X. Is that
+  right?" for it, and refuses it where nothing can be asked back. It used to score 0 (asked
+  again), which cost 12 of 115 answers on bench/asr.py's dev voices in a quiet room although
+  they heard it right 11 times in 13. A lone confusable word ("first") still scores 0: white
+  noise switched on mid-answer was heard as "first" with confidence 0.998.
 
   Not used: a margin over the best phrase of another meaning (the utterance decoded again
   under a grammar without the recognised phrase's meaning). Measured here it rejected right
@@ -89,6 +93,12 @@ class Recognition:
     #: pocketsphinx: how much worse the phrase fits the audio than free phones do (cost per
     #: voiced frame); the acoustic part of the confidence, kept for bench/asr.py's calibration
     fit: float | None = None
+    #: the phrase holds a word the model cannot tell from one of another answer ("first" /
+    #: "third"): never taken without asking the patient back (see :class:`PocketSphinxRecogniser`)
+    confusable: bool = False
+    #: pocketsphinx, a yes/no reply: how much better it fits than the best phrase of the other
+    #: meaning (cost per voiced frame), kept for bench/asr.py's calibration
+    margin: float | None = None
 
 
 class Recogniser(Protocol):
@@ -99,9 +109,10 @@ class Recogniser(Protocol):
     language: str
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (), rivals: bool = False) -> Grammar:
         """Listen only for these phrases (each maybe after one lead-in, or one of the fillers)
-        from the next utterance on; returns what was kept.
+        from the next utterance on; returns what was kept. ``rivals``: a yes/no question, where
+        an answer must fit clearly better than any phrase of the other answer.
 
         ``meaning(phrase)`` says what a phrase selects (an option number, a command): phrases
         with the same meaning are not rivals of one another (see :class:`PocketSphinxRecogniser`).
@@ -140,6 +151,13 @@ PS_EXTRA_WORDS = {
     "empezar": "EH M P EY S AA R", "commencer": "K AO M AA N S EY",
 }
 
+#: how British and other accents say words the wheel's US dictionary spells one way only, added
+#: as alternative pronunciations: "one" with the vowel of "lot" (espeak-ng's en-gb voices, the
+#: North of England), which the dictionary's only "W AH N" lost to the filler "what" (W AA T)
+PS_ACCENT_WORDS = {"one": ("W AA N",)}
+#: the dictionary's vowels (CMU phones), for the non-rhotic rule in :func:`accent_variants`
+_VOWELS = frozenset("AA AE AH AO AW AY EH ER EY IH IY OW OY UH UW".split())
+
 #: lattice entries that are not words the patient said
 _FILLERS = {"<s>", "</s>", "<sil>", "(NULL)", "[NOISE]", "[SPEECH]"}
 
@@ -168,6 +186,11 @@ class PocketSphinxRecogniser:
         for word, phones in PS_EXTRA_WORDS.items():
             if self._decoder.lookup_word(word) is None:
                 self._decoder.add_word(word, phones, False)
+        #: with ``rivals``: an option → the search over every phrase of another meaning
+        self._rivals: dict[int, str] = {}
+        self._meaning: Callable[[str], Hashable] = lambda p: p
+        #: words whose accent variants (:func:`accent_variants`) have been added
+        self._accented: set[str] = set()
         self._in_utterance = False
         self._grammar: Grammar | None = None
         self._grammars = 0
@@ -180,27 +203,54 @@ class PocketSphinxRecogniser:
         self._pcm = bytearray()
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (), rivals: bool = False) -> Grammar:
         """Compile the phrases the dictionary knows to JSGF and make it the active search.
 
         ``meaning`` groups phrases that select the same thing: "the first one" is only
-        confusable where "the third one" selects something else.
+        confusable where "the third one" selects something else. With ``rivals`` (a yes/no
+        question), an answer must also fit clearly better than the best phrase of another
+        meaning (see :data:`PS_RIVAL_MARGIN`).
         """
         grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name,
                                 lead_ins, fillers, meaning)
+        for phrase in (*grammar.phrases, *grammar.lead_ins, *grammar.fillers):
+            for word in phrase.split():
+                self._add_accents(word)
         self._end()
         # a fresh search name each time: pocketsphinx keeps searches by name
         self._grammars += 1
         name = f"q{self._grammars}"
         self._decoder.add_jsgf_string(name, to_jsgf(grammar))
         self._decoder.activate_search(name)
-        if self._grammars > 1:
-            self._decoder.remove_search(f"q{self._grammars - 1}")
+        for old in [f"q{self._grammars - 1}"] * (self._grammars > 1) + list(self._rivals.values()):
+            self._decoder.remove_search(old)
         self._grammar = grammar
         meaning = meaning or (lambda p: p)
+        self._meaning = meaning
+        self._rivals = {}
+        answers = {meaning(p) for p in grammar.phrases if isinstance(meaning(p), int)}
+        for option in sorted(answers) if rivals else ():
+            others = tuple(p for p in grammar.phrases if meaning(p) != option)
+            if others:
+                self._rivals[option] = f"{name}-{option}"
+                self._decoder.add_jsgf_string(self._rivals[option], to_jsgf(Grammar(others, fillers=grammar.fillers)))
         self._confusable = confusable_phrases(grammar.phrases, meaning, PS_CONFUSABLE_WORDS)
         self._final = final_phrases(grammar.phrases, meaning)
         return grammar
+
+    def _add_accents(self, word: str) -> None:
+        """Add the word's accent variants to the dictionary as alternatives ("number(2)")."""
+        if word in self._accented:
+            return
+        self._accented.add(word)
+        known: list[str] = []
+        while (phones := self._decoder.lookup_word(word if not known else f"{word}({len(known) + 1})")):
+            known.append(phones)
+        wanted = [*PS_ACCENT_WORDS.get(word, ()), *(v for p in known for v in accent_variants(p))]
+        for phones in dict.fromkeys(wanted):
+            if phones not in known:
+                known.append(phones)
+                self._decoder.add_word(f"{word}({len(known)})", phones, False)
 
     def _end(self) -> None:
         if self._in_utterance:
@@ -260,19 +310,28 @@ class PocketSphinxRecogniser:
         for seg in words:
             in_words[seg.start_frame:seg.end_frame + 1] = True
         coverage = float((voiced & in_words).sum() / voiced.sum())
-        free = self._free_cost(pcm, voiced)
-        fit = _cost(hyp.score, voiced) - free if math.isfinite(free) else math.inf
+        cost = _cost(hyp.score, voiced)
+        free = self._search_cost(_PHONES, pcm, voiced)
+        fit = cost - free if math.isfinite(free) else math.inf
         acoustic = _sigmoid((PS_FIT_MIDPOINT - fit) / PS_FIT_SPREAD)
-        # a phrase the model cannot tell from another answer's is never taken as either
-        distinct = 0.0 if core in self._confusable else 1.0
-        log.debug("pocketsphinx: %r coverage %.2f fit %.2f (confidence %.2f) distinct %s",
-                  hyp.hypstr, coverage, fit, acoustic, bool(distinct))
-        return Recognition(hyp.hypstr, min(coverage, acoustic, distinct), fit=fit)
+        margin = None
+        rival = self._rivals.get(self._meaning(core))
+        if rival is not None:
+            margin = self._search_cost(rival, pcm, voiced) - cost
+        # a phrase the model cannot tell from another answer's is only taken once confirmed; a
+        # lone such word not at all: a fan switched on mid-answer was heard as "first" (0.998)
+        confusable = core in self._confusable
+        if confusable and len(core.split()) == 1:
+            acoustic = 0.0
+        log.debug("pocketsphinx: %r coverage %.2f fit %.2f (confidence %.2f) confusable %s",
+                  hyp.hypstr, coverage, fit, acoustic, confusable)
+        return Recognition(hyp.hypstr, min(coverage, acoustic), fit=fit, confusable=confusable, margin=margin)
 
-    def _free_cost(self, pcm: bytes, voiced: np.ndarray) -> float:
-        """The cost per voiced frame of the best free phone sequence for the same audio."""
+    def _search_cost(self, search: str, pcm: bytes, voiced: np.ndarray) -> float:
+        """The cost per voiced frame of another search's best path for the same audio: free phones
+        (:data:`_PHONES`), or a rival grammar."""
         grammar = self._decoder.current_search()
-        self._decoder.activate_search(_PHONES)
+        self._decoder.activate_search(search)
         try:
             self._decoder.start_utt()
             self._decoder.process_raw(pcm, False, True)
@@ -281,6 +340,21 @@ class PocketSphinxRecogniser:
         finally:
             self._decoder.activate_search(grammar)
         return _cost(hyp.score, voiced) if hyp is not None else math.inf
+
+
+def accent_variants(phones: str) -> list[str]:
+    """Other ways accents say a pronunciation (CMU phones): the non-rhotic one (British English,
+    much of the world), where an "r" not followed by a vowel is not spoken and a word's final
+    "-er" is a schwa: "number" N AH M B ER → N AH M B AH, "four" F AO R → F AO."""
+    out = phones.split()
+    for i in range(len(out) - 1, -1, -1):
+        follows_vowel = i + 1 < len(out) and out[i + 1] in _VOWELS
+        if out[i] == "R" and i > 0 and out[i - 1] in _VOWELS and out[i - 1] != "ER" and not follows_vowel:
+            del out[i]
+        elif out[i] == "ER" and i == len(out) - 1:
+            out[i] = "AH"
+    variant = " ".join(out)
+    return [variant] if variant != phones and out else []
 
 
 def _fixed_tail(pcm: bytes, voiced: np.ndarray) -> tuple[bytes, np.ndarray]:
@@ -356,10 +430,11 @@ class VoskRecogniser:
         self._final: frozenset[str] = frozenset()
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (), rivals: bool = False) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]").
 
-        ``meaning`` is not needed: Vosk's own word confidences tell confusable words apart.
+        ``meaning`` and ``rivals`` are not needed: Vosk's own word confidences tell confusable
+        words apart.
         """
         grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name,
                                 lead_ins, fillers, meaning)

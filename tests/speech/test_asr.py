@@ -12,6 +12,7 @@ from kiosk.speech.asr import (
     PocketSphinxRecogniser,
     Recognition,
     VoskRecogniser,
+    accent_variants,
     vosk_recognition,
 )
 from kiosk.speech.audio import UtterancePipeline, feed_wav
@@ -116,21 +117,41 @@ def test_confusable_phrases_only_where_the_partner_means_something_else():
     assert confusable_phrases(["first", "third"], lambda p: p, first_third) == {"first", "third"}
 
 
-def test_pocketsphinx_never_turns_first_into_third(spoken):
+def test_pocketsphinx_flags_first_and_third_as_confusable(spoken):
     """espeak-ng's "the first one" sounds like "the third one" to the wheel's model: with a third
-    option it is not an answer (asked again), with two options it is understood."""
+    option the result is flagged confusable (the voice channel then always asks the patient),
+    with two options it is an ordinary answer."""
     path = spoken("the first one")
     recogniser = PocketSphinxRecogniser("en")
     heard = []
     pipeline = UtterancePipeline(recogniser, heard.append)
-    for options in (3, 2):
-        matcher = Matcher([OptionWords(w) for w in ("unable", "needs help", "independent")[:options]], "en")
+    matchers = [Matcher([OptionWords(w) for w in ("unable", "needs help", "independent")[:n]], "en") for n in (3, 2)]
+    for matcher in matchers:
         recogniser.set_grammar(matcher.phrases(), matcher.meaning)
         feed_wav(path, pipeline)
     with_third, with_two = (u.result for u in heard)
-    assert not matcher.match(with_third.text, with_third.confidence).matched
-    assert with_third.confidence == 0.0
+    assert with_third.confusable and matchers[0].match(with_third.text).option in (1, 3)
+    assert not with_two.confusable
     assert matcher.match(with_two.text, with_two.confidence).option == 1
+
+
+def test_accent_variants_drop_an_r_before_no_vowel():
+    assert accent_variants("N AH M B ER") == ["N AH M B AH"]
+    assert accent_variants("F AO R") == ["F AO"]
+    assert accent_variants("W IY L CH EH R") == ["W IY L CH EH"]
+    assert accent_variants("S T AA R T") == ["S T AA T"]
+    # an r before a vowel is spoken; "first" keeps its vowel; nothing to change gives nothing
+    assert accent_variants("S AA R IY") == accent_variants("F ER S T") == accent_variants("Y EH S") == []
+
+
+def test_pocketsphinx_adds_accent_pronunciations_for_the_grammars_words():
+    recogniser = PocketSphinxRecogniser("en")
+    recogniser.set_grammar(["number one", "four", "yes"])
+    lookup = recogniser._decoder.lookup_word
+    assert lookup("number(2)") == "N AH M B AH" and lookup("four(2)") == "F AO"
+    assert lookup("one(2)") == "W AA N" and lookup("yes(2)") is None
+    recogniser.set_grammar(["number one"])  # added once, not again
+    assert lookup("number(3)") is None
 
 
 def test_final_phrases_are_those_nothing_of_another_meaning_continues():
@@ -155,3 +176,21 @@ def test_pocketsphinx_says_when_a_whole_answer_was_heard(spoken):
     assert not first.complete  # a fresh decoder: the long hangover
     assert second.complete and second.result.text == "independent" and second.result.confidence > 0.9
     assert second.endpoint - second.speech_end < first.endpoint - first.speech_end
+
+
+def test_a_yes_no_reply_is_measured_against_the_other_answer(spoken):
+    """With rivals (a yes/no question) the recogniser reports how much better the reply fits than
+    the best phrase of the other meaning; a clear "yes" or "no" fits its own answer better."""
+    recogniser = PocketSphinxRecogniser("en")
+    matcher = Matcher([OptionWords("Yes"), OptionWords("No")], "en")
+    assert matcher.yes_no
+    heard = []
+    pipeline = UtterancePipeline(recogniser, heard.append)
+    for rivals in (True, False):
+        recogniser.set_grammar(matcher.phrases(), matcher.meaning, rivals=rivals)
+        for text in ("yes", "no that's wrong"):
+            feed_wav(spoken(text), pipeline)
+    yes, no, plain_yes, plain_no = (u.result for u in heard)
+    assert matcher.match(yes.text).option == 1 and yes.margin > 0
+    assert matcher.match(no.text).option == 2 and no.margin > 0
+    assert plain_yes.margin is None and plain_no.margin is None

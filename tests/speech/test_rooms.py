@@ -200,3 +200,30 @@ def test_the_welcome_hears_start_and_the_language_names(voice_of, text, voice, o
                               for lang in ("en", "es", "fr")], "en")
     got = ear.hear(_in_noise(voice_of(text, voice, 150), None))
     assert got is not None and got.option == option and not got.needs_confirmation
+
+
+def test_a_british_one_is_heard(voice_of):
+    """"one" with the vowel of "lot" (espeak-ng's en-gb voice, the North of England): the US
+    dictionary's only "W AH N" lost it to the filler "what"; the accent variant hears it."""
+    ear = Ear()
+    ear.confirmation().hear(_in_noise(voice_of("yes", "en-gb+klatt", 150), None))  # heard before (practice)
+    got = ear.question("grooming").hear(_in_noise(voice_of("one", "en-gb+klatt", 150), None))
+    assert got is not None and got.option == 1 and got.needs_confirmation, got
+
+
+def test_the_first_one_is_asked_about_and_a_declined_mishearing_is_not_offered_again(voice_of):
+    """"the first one" in a voice the model hears as "the third one" (espeak-ng's en-us): the
+    option is only ever offered for confirmation (never refused outright, never taken as sure);
+    once the patient says No to the third option, asked again, the same words are heard as the
+    first."""
+    ear = Ear()
+    speech = _in_noise(voice_of("the first one", "en-us", 160), None)
+    got = ear.question("feeding").hear(speech)
+    assert got is not None and got.option == 3 and got.needs_confirmation  # the mishearing
+    ear.channel.declined("feeding", 3)
+    ear.channel.set_question(_options("feeding"), "en", scored=True, key="feeding")  # asked again
+    got = ear.hear(speech)
+    assert got is not None and got.option == 1 and got.needs_confirmation
+    # another question listens for every option again
+    ear.channel.set_question(_options("feeding"), "en", scored=True, key="grooming")
+    assert ear.hear(speech).option == 3

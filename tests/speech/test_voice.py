@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import threading
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -247,6 +248,73 @@ def test_every_voice_answer_to_a_scored_question_asks_for_confirmation(backend, 
     kiosk.voice.listen(True)
     kiosk.say(spoken("yes"))
     assert (kiosk.inputs[-1].option, kiosk.inputs[-1].needs_confirmation) == (1, False)
+
+
+def test_a_confusable_answer_is_always_confirmed_and_refused_where_it_cannot_be(spoken):
+    """"the first one" where "the third one" selects another option: asked back even by a channel
+    told to confirm nothing, and not taken at all on a prompt whose answers are never confirmed."""
+    inputs, unmatched = [], []
+    voice = VoiceChannel("en", recogniser_factory=PocketSphinxRecogniser, confirm_below=0.0,
+                         on_unmatched=lambda u, r: unmatched.append(r))
+    assert voice.attach(lambda i: inputs.append(i) if isinstance(i, ChannelInput) else None)
+    voice.listen(True)
+    options = [OptionWords(w) for w in ("unable", "needs help", "independent")]
+    voice.set_question(options, "en", scored=True)
+    feed_wav(spoken("the first one"), voice)
+    (got,) = inputs
+    assert got.option in (1, 3) and got.needs_confirmation
+    voice.set_question(options, "en", scored=False)
+    feed_wav(spoken("the first one"), voice)
+    assert inputs == [got] and "confusable" in unmatched[-1]
+
+
+def test_a_yes_that_fits_a_no_as_well_is_not_taken(spoken):
+    """A "yes" to "Is that right?" stores an answer: when a "no" phrase fits the same audio as
+    well (reverb once turned "no it isn't" into "yes it is", confidence 0.998), it is not taken.
+    The real decode of a real "yes", with its margin over the rival set to 0 as that one's was."""
+
+    class Even(PocketSphinxRecogniser):
+        def finish(self):
+            result = super().finish()
+            return replace(result, margin=0.0 if result.margin is not None else None)
+
+    for recogniser, taken in ((PocketSphinxRecogniser, True), (Even, False)):
+        inputs, unmatched = [], []
+        voice = VoiceChannel("en", recogniser_factory=recogniser, on_unmatched=lambda u, r: unmatched.append(r))
+        assert voice.attach(lambda i: inputs.append(i) if isinstance(i, ChannelInput) else None)
+        voice.listen(True)
+        voice.set_question([OptionWords("Yes"), OptionWords("No")], "en")
+        feed_wav(spoken("yes"), voice)
+        assert [i.option for i in inputs] == ([1] if taken else [])
+        assert taken or "fits a no as well" in unmatched[-1]
+
+
+@pytest.mark.parametrize("backend", _backends("en"))
+def test_an_option_declined_is_not_heard_again_on_that_question(backend, spoken):
+    """The patient says No to "I heard: Independent": asked again, "independent" is no longer
+    listened for on that question (the same mishearing is not offered twice); touch still
+    chooses it, and the next question listens for its own words again."""
+    kiosk = _Kiosk(backend)
+    kiosk.to_question("feeding")
+    kiosk.say(spoken("independent"))
+    assert kiosk.inputs[-1].option == 3 and kiosk.inputs[-1].needs_confirmation
+    kiosk.say(spoken("no"))
+    assert kiosk.inputs[-1].option == 2  # No
+    assert kiosk.session.current_item.id == "feeding" and "feeding" not in kiosk.session.answers
+    sent = len(kiosk.inputs)
+    kiosk.say(spoken("independent"))
+    assert all(i.option != 3 for i in kiosk.inputs[sent:])
+    for i in kiosk.inputs[sent:]:  # whatever else was heard was asked about: the patient says no
+        if i.option is not None:
+            kiosk.say(spoken("no"))
+    kiosk.session.handle(ChannelInput(Channel.TOUCH, option=3))
+    assert kiosk.session.answers["feeding"].option == 3
+    while kiosk.session.current_item.id == "feeding" or not kiosk.session.listening:
+        kiosk.clock.advance(0.5)
+        kiosk.session.poll()
+    assert kiosk.session.current_item.id == "bathing"  # Unable / Independent
+    kiosk.say(spoken("independent"))
+    assert kiosk.inputs[-1].option == 2
 
 
 @pytest.mark.parametrize("backend", _backends("en"))
