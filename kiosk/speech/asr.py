@@ -40,9 +40,15 @@ in [0, 1]:
   under a grammar without the recognised phrase's meaning). Measured here it rejected right
   answers and commands ("call the doctor", a first "independent") because the smaller
   grammar's search found rivals such as "go on" that the full search had pruned, even from
-  the same cepstral mean; on the benchmark it traded 9 right answers for 2 wrong ones.
-  espeak-ng's "number one" is rejected for a safe reason: the model's silence fits its
-  "number" better than the word does, so the decoded "one" covers a third of the voiced audio.
+  the same cepstral mean; on the benchmark it traded 9 right answers for 2 wrong ones. Tried
+  again for a confirmation's "yes" (one "no it isn't" in reverb was heard as "yes it is",
+  confidence 0.998, margin -0.24): the smaller grammar gives each phrase a larger share, so
+  the margin leans against the phrase heard, and two held-out voices' "that's right" never
+  got past it (held-out right answers in a quiet room 0.79 -> 0.74).
+
+  The dictionary's one pronunciation per word is widened for accents (:func:`accent_variants`,
+  :data:`PS_ACCENT_WORDS`): a British "number" ends in a schwa, and the model's silence fitted
+  it better than N AH M B ER, so "number two" was heard as "two" with half its audio uncovered.
 
 :func:`open_recogniser` picks Vosk when a model for the language is installed, else
 PocketSphinx for English, else raises :class:`AsrUnavailable` with the reason voice in is off.
@@ -96,9 +102,6 @@ class Recognition:
     #: the phrase holds a word the model cannot tell from one of another answer ("first" /
     #: "third"): never taken without asking the patient back (see :class:`PocketSphinxRecogniser`)
     confusable: bool = False
-    #: pocketsphinx, a yes/no reply: how much better it fits than the best phrase of the other
-    #: meaning (cost per voiced frame), kept for bench/asr.py's calibration
-    margin: float | None = None
 
 
 class Recogniser(Protocol):
@@ -109,10 +112,9 @@ class Recogniser(Protocol):
     language: str
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (), rivals: bool = False) -> Grammar:
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
         """Listen only for these phrases (each maybe after one lead-in, or one of the fillers)
-        from the next utterance on; returns what was kept. ``rivals``: a yes/no question, where
-        an answer must fit clearly better than any phrase of the other answer.
+        from the next utterance on; returns what was kept.
 
         ``meaning(phrase)`` says what a phrase selects (an option number, a command): phrases
         with the same meaning are not rivals of one another (see :class:`PocketSphinxRecogniser`).
@@ -186,9 +188,6 @@ class PocketSphinxRecogniser:
         for word, phones in PS_EXTRA_WORDS.items():
             if self._decoder.lookup_word(word) is None:
                 self._decoder.add_word(word, phones, False)
-        #: with ``rivals``: an option → the search over every phrase of another meaning
-        self._rivals: dict[int, str] = {}
-        self._meaning: Callable[[str], Hashable] = lambda p: p
         #: words whose accent variants (:func:`accent_variants`) have been added
         self._accented: set[str] = set()
         self._in_utterance = False
@@ -203,13 +202,11 @@ class PocketSphinxRecogniser:
         self._pcm = bytearray()
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (), rivals: bool = False) -> Grammar:
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
         """Compile the phrases the dictionary knows to JSGF and make it the active search.
 
         ``meaning`` groups phrases that select the same thing: "the first one" is only
-        confusable where "the third one" selects something else. With ``rivals`` (a yes/no
-        question), an answer must also fit clearly better than the best phrase of another
-        meaning (see :data:`PS_RIVAL_MARGIN`).
+        confusable where "the third one" selects something else.
         """
         grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name,
                                 lead_ins, fillers, meaning)
@@ -222,18 +219,10 @@ class PocketSphinxRecogniser:
         name = f"q{self._grammars}"
         self._decoder.add_jsgf_string(name, to_jsgf(grammar))
         self._decoder.activate_search(name)
-        for old in [f"q{self._grammars - 1}"] * (self._grammars > 1) + list(self._rivals.values()):
-            self._decoder.remove_search(old)
+        if self._grammars > 1:
+            self._decoder.remove_search(f"q{self._grammars - 1}")
         self._grammar = grammar
         meaning = meaning or (lambda p: p)
-        self._meaning = meaning
-        self._rivals = {}
-        answers = {meaning(p) for p in grammar.phrases if isinstance(meaning(p), int)}
-        for option in sorted(answers) if rivals else ():
-            others = tuple(p for p in grammar.phrases if meaning(p) != option)
-            if others:
-                self._rivals[option] = f"{name}-{option}"
-                self._decoder.add_jsgf_string(self._rivals[option], to_jsgf(Grammar(others, fillers=grammar.fillers)))
         self._confusable = confusable_phrases(grammar.phrases, meaning, PS_CONFUSABLE_WORDS)
         self._final = final_phrases(grammar.phrases, meaning)
         return grammar
@@ -310,14 +299,9 @@ class PocketSphinxRecogniser:
         for seg in words:
             in_words[seg.start_frame:seg.end_frame + 1] = True
         coverage = float((voiced & in_words).sum() / voiced.sum())
-        cost = _cost(hyp.score, voiced)
-        free = self._search_cost(_PHONES, pcm, voiced)
-        fit = cost - free if math.isfinite(free) else math.inf
+        free = self._free_cost(pcm, voiced)
+        fit = _cost(hyp.score, voiced) - free if math.isfinite(free) else math.inf
         acoustic = _sigmoid((PS_FIT_MIDPOINT - fit) / PS_FIT_SPREAD)
-        margin = None
-        rival = self._rivals.get(self._meaning(core))
-        if rival is not None:
-            margin = self._search_cost(rival, pcm, voiced) - cost
         # a phrase the model cannot tell from another answer's is only taken once confirmed; a
         # lone such word not at all: a fan switched on mid-answer was heard as "first" (0.998)
         confusable = core in self._confusable
@@ -325,13 +309,12 @@ class PocketSphinxRecogniser:
             acoustic = 0.0
         log.debug("pocketsphinx: %r coverage %.2f fit %.2f (confidence %.2f) confusable %s",
                   hyp.hypstr, coverage, fit, acoustic, confusable)
-        return Recognition(hyp.hypstr, min(coverage, acoustic), fit=fit, confusable=confusable, margin=margin)
+        return Recognition(hyp.hypstr, min(coverage, acoustic), fit=fit, confusable=confusable)
 
-    def _search_cost(self, search: str, pcm: bytes, voiced: np.ndarray) -> float:
-        """The cost per voiced frame of another search's best path for the same audio: free phones
-        (:data:`_PHONES`), or a rival grammar."""
+    def _free_cost(self, pcm: bytes, voiced: np.ndarray) -> float:
+        """The cost per voiced frame of the best free phone sequence for the same audio."""
         grammar = self._decoder.current_search()
-        self._decoder.activate_search(search)
+        self._decoder.activate_search(_PHONES)
         try:
             self._decoder.start_utt()
             self._decoder.process_raw(pcm, False, True)
@@ -430,11 +413,10 @@ class VoskRecogniser:
         self._final: frozenset[str] = frozenset()
 
     def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (), rivals: bool = False) -> Grammar:
+                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = ()) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]").
 
-        ``meaning`` and ``rivals`` are not needed: Vosk's own word confidences tell confusable
-        words apart.
+        ``meaning`` is not needed: Vosk's own word confidences tell confusable words apart.
         """
         grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name,
                                 lead_ins, fillers, meaning)

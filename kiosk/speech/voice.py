@@ -49,13 +49,6 @@ log = logging.getLogger(__name__)
 #: with every answer confirmed (and the confirmation's own yes/no recognised) none was stored wrong
 CONFIRM_BELOW = 1.01
 
-#: a "yes" to "Is that right?" stores an answer, so it is taken only when it fits the audio better
-#: than every "no" phrase does (pocketsphinx's ``Recognition.margin``, cost per voiced frame).
-#: Measured on bench/asr.py's 16 voices (clean, white and babble noise at SNR 10 dB, reverb):
-#: the one "no it isn't" heard as "yes it is" (reverb, confidence 0.998) had margin -0.24, and
-#: 4 of 142 yeses heard with confidence had a margin <= 0 (they are asked again)
-YES_MIN_MARGIN = 0.0
-
 #: how long attach()/wait_loaded() wait for a speech model (a large vosk model takes seconds)
 LOAD_TIMEOUT_S = 60.0
 
@@ -349,7 +342,7 @@ class VoiceChannel:
         if self._scored and not self._paused and self._declined:
             phrases = [p for p in phrases if self._matcher.meaning(p) not in self._declined]
         self._recogniser.set_grammar(phrases, self._matcher.meaning, self._matcher.lead_ins(),
-                                     self._matcher.fillers(), rivals=self._matcher.yes_no)
+                                     self._matcher.fillers())
         self._gate()
 
     def _gate(self) -> None:
@@ -365,12 +358,6 @@ class VoiceChannel:
         if not match.matched:
             log.info("voice: %s", match.reason)
             self.on_unmatched(result.text, match.reason)
-            return
-        if self._matcher.yes_no and match.option == 1 and result.margin is not None \
-                and result.margin <= YES_MIN_MARGIN:
-            reason = f"{result.text!r} fits a no as well as a yes (margin {result.margin:.2f})"
-            log.info("voice: %s", reason)
-            self.on_unmatched(result.text, reason)
             return
         confirm = self._scored and match.option is not None and result.confidence < self.confirm_below
         if result.confusable and match.option is not None and not self._scored:

@@ -177,20 +177,3 @@ def test_pocketsphinx_says_when_a_whole_answer_was_heard(spoken):
     assert second.complete and second.result.text == "independent" and second.result.confidence > 0.9
     assert second.endpoint - second.speech_end < first.endpoint - first.speech_end
 
-
-def test_a_yes_no_reply_is_measured_against_the_other_answer(spoken):
-    """With rivals (a yes/no question) the recogniser reports how much better the reply fits than
-    the best phrase of the other meaning; a clear "yes" or "no" fits its own answer better."""
-    recogniser = PocketSphinxRecogniser("en")
-    matcher = Matcher([OptionWords("Yes"), OptionWords("No")], "en")
-    assert matcher.yes_no
-    heard = []
-    pipeline = UtterancePipeline(recogniser, heard.append)
-    for rivals in (True, False):
-        recogniser.set_grammar(matcher.phrases(), matcher.meaning, rivals=rivals)
-        for text in ("yes", "no that's wrong"):
-            feed_wav(spoken(text), pipeline)
-    yes, no, plain_yes, plain_no = (u.result for u in heard)
-    assert matcher.match(yes.text).option == 1 and yes.margin > 0
-    assert matcher.match(no.text).option == 2 and no.margin > 0
-    assert plain_yes.margin is None and plain_no.margin is None

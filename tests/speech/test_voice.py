@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import threading
-from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -266,27 +265,6 @@ def test_a_confusable_answer_is_always_confirmed_and_refused_where_it_cannot_be(
     voice.set_question(options, "en", scored=False)
     feed_wav(spoken("the first one"), voice)
     assert inputs == [got] and "confusable" in unmatched[-1]
-
-
-def test_a_yes_that_fits_a_no_as_well_is_not_taken(spoken):
-    """A "yes" to "Is that right?" stores an answer: when a "no" phrase fits the same audio as
-    well (reverb once turned "no it isn't" into "yes it is", confidence 0.998), it is not taken.
-    The real decode of a real "yes", with its margin over the rival set to 0 as that one's was."""
-
-    class Even(PocketSphinxRecogniser):
-        def finish(self):
-            result = super().finish()
-            return replace(result, margin=0.0 if result.margin is not None else None)
-
-    for recogniser, taken in ((PocketSphinxRecogniser, True), (Even, False)):
-        inputs, unmatched = [], []
-        voice = VoiceChannel("en", recogniser_factory=recogniser, on_unmatched=lambda u, r: unmatched.append(r))
-        assert voice.attach(lambda i: inputs.append(i) if isinstance(i, ChannelInput) else None)
-        voice.listen(True)
-        voice.set_question([OptionWords("Yes"), OptionWords("No")], "en")
-        feed_wav(spoken("yes"), voice)
-        assert [i.option for i in inputs] == ([1] if taken else [])
-        assert taken or "fits a no as well" in unmatched[-1]
 
 
 @pytest.mark.parametrize("backend", _backends("en"))
