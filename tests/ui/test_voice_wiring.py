@@ -55,6 +55,7 @@ async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp
     wav = synthesiser.synthesise("independent", "en", tmp_path / "independent.wav")
     no = synthesiser.synthesise("no, that's wrong", "en", tmp_path / "no.wav")
     yes = synthesiser.synthesise("yes", "en", tmp_path / "yes.wav")
+    two = synthesiser.synthesise("two", "en", tmp_path / "two.wav")
     microphones: list[WavMicrophone] = []
     voice = VoiceChannel(
         "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
@@ -76,13 +77,16 @@ async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp
         await until_thread(lambda: kiosk.session.snapshot().confirming is None, "the voice channel")
         await settle(pilot, lambda: bool(kiosk.app.screen.query("QuestionPanel")))
         assert kiosk.store.session(kiosk.session.id).answers == () and kiosk.session.current_attempt == 1
-        microphones[0].play(wav)
-        await until_thread(lambda: kiosk.session.snapshot().confirming == 3, "the voice channel")
+        # the patient meant the second option; the declined one is not listened for again here
+        microphones[0].play(two)
+        await until_thread(lambda: kiosk.session.snapshot().confirming == 2, "the voice channel")
+        await settle(pilot, lambda: bool(kiosk.app.screen.query("ConfirmPanel")))
+        assert text_of(kiosk.app.screen.query_one("#confirm-question")).startswith("I heard: Needs help")
         microphones[0].play(yes)
         await until_thread(lambda: "feeding" in kiosk.session.answers, "the voice channel")
         await settle(pilot)
     answer = kiosk.store.session(kiosk.session.id).answers[0]
-    assert (answer.item_id, answer.option, answer.channel) == ("feeding", 3, Channel.VOICE)
+    assert (answer.item_id, answer.option, answer.channel) == ("feeding", 2, Channel.VOICE)
 
 
 async def test_the_welcome_listens_and_the_spoken_language_starts(ui_kiosk, tmp_path):
