@@ -49,6 +49,13 @@ log = logging.getLogger(__name__)
 #: with every answer confirmed (and the confirmation's own yes/no recognised) none was stored wrong
 CONFIRM_BELOW = 1.01
 
+#: an answer heard with less than the matcher's minimum confidence, but at least this, twice in a
+#: row on the same question (the attempt and the patient's repeat), is asked back: two hearings
+#: that agree are worth an "Is that right?". On bench/asr.py's 16 voices in a quiet room the right
+#: option was heard twice at 0.25-0.55 for short answers ("one", "three", "help", "immobile") that
+#: were otherwise lost; it is never stored without the patient's yes
+AGREE_MIN_CONFIDENCE = 0.2
+
 #: how long attach()/wait_loaded() wait for a speech model (a large vosk model takes seconds)
 LOAD_TIMEOUT_S = 60.0
 
@@ -101,6 +108,9 @@ class VoiceChannel:
         #: options the patient declined ("Is that right?" No) on the question ``_declined_on``
         self._declined: set[int] = set()
         self._declined_on: str | None = None
+        #: the option the latest utterance on this scored question was unsure of (see
+        #: :data:`AGREE_MIN_CONFIDENCE`)
+        self._unsure: int | None = None
         self._lock = threading.RLock()
         self._sink: Sink | None = None
         self._recogniser: Recogniser | None = None
@@ -220,7 +230,7 @@ class VoiceChannel:
         declined on it are not listened for (see :meth:`declined`)."""
         with self._lock:
             if scored and (key is None or key != self._declined_on):
-                self._declined_on, self._declined = key, set()
+                self._declined_on, self._declined, self._unsure = key, set(), None
             self._options = list(options)
             self._scored = scored
             self._welcome = welcome
@@ -242,6 +252,7 @@ class VoiceChannel:
             if key != self._declined_on:
                 self._declined_on, self._declined = key, set()
             self._declined.add(option)
+            self._unsure = None
 
     def expect_undo(self) -> None:
         """An answer was stored: until the next prompt only taking it back ("No, that's wrong",
@@ -355,7 +366,9 @@ class VoiceChannel:
         self.on_utterance(utterance)
         result = utterance.result
         match = self._matcher.match(result.text, result.confidence)
-        if not match.matched:
+        if not match.matched and self._heard_twice(result):
+            match = self._matcher.match(result.text)
+        elif not match.matched:
             log.info("voice: %s", match.reason)
             self.on_unmatched(result.text, match.reason)
             return
@@ -367,11 +380,26 @@ class VoiceChannel:
             log.info("voice: %s", reason)
             self.on_unmatched(result.text, reason)
             return
-        confirm = confirm or (result.confusable and match.option is not None)
+        # a confusable phrase, or one heard twice unsure, is always asked back
+        unsure = result.confusable or result.confidence < self.min_confidence
+        confirm = confirm or (match.option is not None and unsure)
+        self._unsure = None
         if self._sink is not None:
             self._sink(ChannelInput(Channel.VOICE, option=match.option, command=match.command,
                                     detail=result.text, confidence=round(result.confidence, 3),
                                     needs_confirmation=confirm))
+
+    def _heard_twice(self, result: Any) -> bool:
+        """Whether this unsure recognition selects the same option as the one just before it on
+        the same scored question, both at least :data:`AGREE_MIN_CONFIDENCE` sure."""
+        if not self._scored or self._paused:
+            return False
+        unsure = self._matcher.match(result.text).option
+        if result.confidence < AGREE_MIN_CONFIDENCE:
+            unsure = None
+        agreed = unsure is not None and unsure == self._unsure
+        self._unsure = None if agreed else unsure
+        return agreed
 
     def _status(self, state: ChannelState, reason: str, reason_key: str = "") -> None:
         """Every status under the one source name, so the latest always wins on the channel

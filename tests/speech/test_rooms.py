@@ -227,3 +227,23 @@ def test_the_first_one_is_asked_about_and_a_declined_mishearing_is_not_offered_a
     # another question listens for every option again
     ear.channel.set_question(_options("feeding"), "en", scored=True, key="grooming")
     assert ear.hear(speech).option == 3
+
+
+@pytest.mark.parametrize("voice,rate,item_id,text,option", [("en-gb+klatt", 150, "grooming", "number one", 1)])
+def test_an_unsure_answer_heard_twice_alike_is_asked_about(voice_of, voice, rate, item_id, text, option):
+    """A British "number one": too unsure to offer the first time (0.26-0.36);
+    repeated on the same question and heard as the same option again, the kiosk asks "Is that
+    right?". An unsure hearing on another question does not count."""
+    ear = Ear()
+    ear.confirmation().hear(_in_noise(voice_of("yes", voice, rate), None))  # heard before (practice)
+    ask = lambda key: ear.channel.set_question(_options(item_id), "en", scored=True, key=key)  # noqa: E731
+    ask(item_id)
+    assert ear.hear(_in_noise(voice_of(text, voice, rate), None)) is None
+    assert 0.2 <= ear.utterances[-1].result.confidence < 0.6
+    ask("the next question")  # the same unsure hearing on another question does not count
+    assert ear.hear(_in_noise(voice_of(text, voice, rate - 20), None)) is None
+    assert 0.2 <= ear.utterances[-1].result.confidence < 0.6
+    ask("the next question")  # its second attempt: heard alike twice on it
+    got = ear.hear(_in_noise(voice_of(text, voice, rate), None))
+    assert got is not None and got.option == option and got.needs_confirmation
+    assert got.confidence < 0.6  # sent because it agreed, not because it was sure
