@@ -37,7 +37,9 @@ from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
 from kiosk.speech.audio import (
     AudioUnavailable, Endpointer, MicrophoneStream, PcmConsumer, Utterance, UtterancePipeline,
 )
-from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, Matcher, OptionWords, undo_commands, welcome_commands
+from kiosk.speech.matching import (
+    DEFAULT_MIN_CONFIDENCE, Match, Matcher, OptionWords, undo_commands, welcome_commands,
+)
 
 log = logging.getLogger(__name__)
 
@@ -229,8 +231,8 @@ class VoiceChannel:
         ``key`` names the question: asked again under the same key, the options the patient
         declined on it are not listened for (see :meth:`declined`)."""
         with self._lock:
-            if scored and (key is None or key != self._declined_on):
-                self._declined_on, self._declined, self._unsure = key, set(), None
+            if scored:
+                self._on_question(key)
             self._options = list(options)
             self._scored = scored
             self._welcome = welcome
@@ -249,10 +251,15 @@ class VoiceChannel:
         "the third one" again and again for some voices; "sometimes" as "never"). The option
         can still be touched or chosen with the remote; the next question listens for all."""
         with self._lock:
-            if key != self._declined_on:
-                self._declined_on, self._declined = key, set()
+            self._on_question(key)
             self._declined.add(option)
             self._unsure = None
+
+    def _on_question(self, key: str | None) -> None:
+        """What was declined or heard unsure belongs to one question: another one (or one
+        without a name) starts afresh."""
+        if key is None or key != self._declined_on:
+            self._declined_on, self._declined, self._unsure = key, set(), None
 
     def expect_undo(self) -> None:
         """An answer was stored: until the next prompt only taking it back ("No, that's wrong",
@@ -366,13 +373,12 @@ class VoiceChannel:
         self.on_utterance(utterance)
         result = utterance.result
         match = self._matcher.match(result.text, result.confidence)
-        if not match.matched and self._heard_twice(result):
-            match = self._matcher.match(result.text)
-        elif not match.matched:
+        if not match.matched:
+            match = self._heard_twice(result) or match
+        if not match.matched:
             log.info("voice: %s", match.reason)
             self.on_unmatched(result.text, match.reason)
             return
-        confirm = self._scored and match.option is not None and result.confidence < self.confirm_below
         if result.confusable and match.option is not None and not self._scored:
             # "the first one" heard where "the third one" means something else, and nothing to
             # ask back with (only a scored question's answers are confirmed): asked again
@@ -380,26 +386,26 @@ class VoiceChannel:
             log.info("voice: %s", reason)
             self.on_unmatched(result.text, reason)
             return
-        # a confusable phrase, or one heard twice unsure, is always asked back
-        unsure = result.confusable or result.confidence < self.min_confidence
-        confirm = confirm or (match.option is not None and unsure)
+        # a scored answer below confirm_below is asked back, and always a confusable phrase or
+        # one heard twice unsure
+        unsure = result.confusable or result.confidence < max(self.min_confidence, self.confirm_below)
+        confirm = self._scored and match.option is not None and unsure
         self._unsure = None
         if self._sink is not None:
             self._sink(ChannelInput(Channel.VOICE, option=match.option, command=match.command,
                                     detail=result.text, confidence=round(result.confidence, 3),
                                     needs_confirmation=confirm))
 
-    def _heard_twice(self, result: Any) -> bool:
-        """Whether this unsure recognition selects the same option as the one just before it on
-        the same scored question, both at least :data:`AGREE_MIN_CONFIDENCE` sure."""
+    def _heard_twice(self, result: Any) -> Match | None:
+        """An unsure recognition that selects the same option as the one just before it on the
+        same scored question, both at least :data:`AGREE_MIN_CONFIDENCE` sure: its match."""
         if not self._scored or self._paused:
-            return False
-        unsure = self._matcher.match(result.text).option
-        if result.confidence < AGREE_MIN_CONFIDENCE:
-            unsure = None
+            return None
+        match = self._matcher.match(result.text)
+        unsure = match.option if result.confidence >= AGREE_MIN_CONFIDENCE else None
         agreed = unsure is not None and unsure == self._unsure
         self._unsure = None if agreed else unsure
-        return agreed
+        return match if agreed else None
 
     def _status(self, state: ChannelState, reason: str, reason_key: str = "") -> None:
         """Every status under the one source name, so the latest always wins on the channel
