@@ -235,9 +235,9 @@ class _Timed:
         #: processor seconds of the latest finish(): the endpoint → result part of the latency
         self.last_finish = 0.0
 
-    def set_grammar(self, *args, **kwargs):
+    def set_grammar(self, *args):
         """Forward."""
-        return self.inner.set_grammar(*args, **kwargs)
+        return self.inner.set_grammar(*args)
 
     def reset(self) -> None:
         """Forward."""

@@ -32,6 +32,11 @@ def _error(status: int, message: str) -> JSONResponse:
     return JSONResponse({"error": message}, status_code=status)
 
 
+def _refused(exc: ValueError) -> JSONResponse:
+    """A request refused for what it sent: 413 for a body over :data:`MAX_BODY`, else 400."""
+    return _error(getattr(exc, "status", 400), str(exc))
+
+
 def _token(request: Request) -> str | None:
     scheme, _, token = request.headers.get("authorization", "").partition(" ")
     return token.strip() if scheme.lower() == "bearer" and token.strip() else None
@@ -116,7 +121,7 @@ async def post_sync(request: Request) -> Response:
         body = await _json(request)
         events = sync.parse(body)
     except ValueError as exc:  # json errors are ValueErrors too
-        return _error(getattr(exc, "status", 400), str(exc))
+        return _refused(exc)
 
     def work(connection: Connection, kiosk: str) -> tuple[list[int], list[dict[str, Any]]]:
         _check_kiosk_id(body, kiosk)
@@ -127,7 +132,7 @@ async def post_sync(request: Request) -> Response:
     except _Unauthorised:
         return _unauthorised()
     except ValueError as exc:
-        return _error(getattr(exc, "status", 400), str(exc))
+        return _refused(exc)
     return JSONResponse({"stored": stored})
 
 
@@ -138,7 +143,7 @@ async def post_status(request: Request) -> Response:
         body = await _json(request)
         status = ward.parse_status(body)
     except ValueError as exc:
-        return _error(getattr(exc, "status", 400), str(exc))
+        return _refused(exc)
 
     def work(connection: Connection, kiosk: str) -> tuple[None, list[dict[str, Any]]]:
         _check_kiosk_id(body, kiosk)  # raising rolls the status back
@@ -149,7 +154,7 @@ async def post_status(request: Request) -> Response:
     except _Unauthorised:
         return _unauthorised()
     except ValueError as exc:
-        return _error(getattr(exc, "status", 400), str(exc))
+        return _refused(exc)
     return JSONResponse({"ok": True})
 
 
@@ -196,7 +201,7 @@ async def post_command_ack(request: Request) -> Response:
     except ward.WardError as exc:
         return _error(404 if str(exc).startswith("no command") else 400, str(exc))
     except ValueError as exc:
-        return _error(getattr(exc, "status", 400), str(exc))
+        return _refused(exc)
     await run_in_threadpool(request.app.state.bus.publish, {"type": "kiosk", "kiosk": kiosk})
     return JSONResponse({"ok": True})
 

@@ -127,7 +127,7 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
     )
 
 
-def export_identity(rows: Iterable[Row]) -> dict[str, Any]:
+def sent_export_identity(rows: Iterable[Row]) -> dict[str, Any]:
     """How the session's kiosk names things in its own exports (site, kiosk, FHIR systems), as it
     sent them with the session; empty from a kiosk that sent none."""
     for row in rows:
@@ -153,4 +153,4 @@ def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
 def load_for_export(connection: Connection, session_id: str) -> tuple[str, StoredSession, dict[str, Any]]:
     """:func:`load`, and the kiosk's export identity, from one read of the session's rows."""
     kiosk, rows = _kiosk_and_rows(connection, session_id)
-    return kiosk, fold(session_id, rows), export_identity(rows)
+    return kiosk, fold(session_id, rows), sent_export_identity(rows)
