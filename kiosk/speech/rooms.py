@@ -21,14 +21,18 @@ import numpy as np
 from kiosk.speech.audio import SAMPLE_RATE
 
 
-def active_power(speech: np.ndarray) -> float:
-    """Mean power of the speech's active 10 ms frames (within 30 dB of the loudest)."""
+def frame_powers(speech: np.ndarray) -> np.ndarray:
+    """Mean power of each whole 10 ms frame (int16 units squared)."""
     x = speech.astype(np.float64)
     step = SAMPLE_RATE // 100
-    frames = x[: len(x) - len(x) % step].reshape(-1, step)
-    if len(frames) == 0:
+    return (x[: len(x) - len(x) % step].reshape(-1, step) ** 2).mean(axis=1)
+
+
+def active_power(speech: np.ndarray) -> float:
+    """Mean power of the speech's active 10 ms frames (within 30 dB of the loudest)."""
+    power = frame_powers(speech)
+    if len(power) == 0:
         return 0.0
-    power = (frames ** 2).mean(axis=1)
     active = power[power >= power.max() * 1e-3]
     return float(active.mean()) if len(active) else 0.0
 
