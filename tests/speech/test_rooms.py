@@ -163,6 +163,20 @@ def test_background_talk_ends_each_answer_where_the_speech_ends(voice_of, snr_db
             assert end - 0.15 <= answer.speech_end <= end + 0.3, (voice, text)
 
 
+def test_a_microphone_opened_in_background_talk_does_not_run_to_the_cut_off(voice_of):
+    """Talk heard as the microphone opens starts an utterance before the room is known; it ends
+    once a window of the room has been heard, not at the 10 s cut-off, and the answer after it
+    is heard on its own."""
+    ear = Ear().question("feeding")
+    rng = np.random.default_rng(3)
+    speech = voice_of("independent", *PATIENTS[0])
+    ear.hear(_in_noise(speech, _babble(voice_of, 12 + len(speech) / SAMPLE_RATE, rng), 10, lead_s=9))
+    assert ear.utterances
+    assert [u.cut_off for u in ear.utterances] == [False] * len(ear.utterances)
+    assert ear.utterances[0].speech_end - ear.utterances[0].speech_start < 5
+    assert any(8.5 < u.speech_start < 9.3 for u in ear.utterances), "the answer is an utterance of its own"
+
+
 @pytest.mark.parametrize("item_id,text,meant", [
     ("mobility", "um", None), ("mobility", "is it time for lunch yet", None), ("mobility", "<babble>", None),
     ("transfers", "I need a lot of help", 2), ("feeding", "independent", 3), ("stairs", "one", 1),
