@@ -283,6 +283,17 @@ class Patient:
                                     on_utterance=self._heard, endpointer_factory=vad)
         self.channel.attach(self.inputs.append)
         self.channel.listen(True)
+        # Before the first question the kiosk has listened on its welcome screen ("or say
+        # start"), so its endpointer has heard the room (it keeps it across prompts and
+        # questions). What it made of the room there is not one of the answers measured.
+        self.channel.set_question([OptionWords("Start")], "en")
+        for _ in range(2):
+            room = self.room.scene(np.zeros(0, dtype=np.int16))
+            feed_samples(room, self.channel)
+            self.audio_seconds += len(room) / SAMPLE_RATE  # the recogniser's time on it counts too
+        self.inputs.clear()
+        self.utterances.clear()
+        self.latency.clear()
 
     def _heard(self, utterance) -> None:
         self.utterances.append(utterance)
