@@ -17,7 +17,7 @@ from kiosk.channels import ChannelInput, Command
 from kiosk.questionnaire import load_questionnaire
 from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
 from kiosk.speech import rooms
-from kiosk.speech.asr import PocketSphinxRecogniser
+from kiosk.speech.asr import PocketSphinxRecogniser, _above_room, _voiced_frames
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav
 from kiosk.speech.matching import OptionWords
 from kiosk.speech.tts import Synthesiser
@@ -175,6 +175,26 @@ def test_a_microphone_opened_in_background_talk_does_not_run_to_the_cut_off(voic
     assert [u.cut_off for u in ear.utterances] == [False] * len(ear.utterances)
     assert ear.utterances[0].speech_end - ear.utterances[0].speech_start < 5
     assert any(8.5 < u.speech_start < 9.3 for u in ear.utterances), "the answer is an utterance of its own"
+
+
+def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
+    """Only what stands out of the room heard in the pre-roll counts towards coverage: the
+    talkers around a short answer are not the patient's words; a quiet room and audio handed
+    over without a pre-roll count every voiced frame."""
+    speech = voice_of("two", *PATIENTS[0])
+    talk = _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.0, np.random.default_rng(5)),
+                     10, lead_s=0.3)
+    level = 10 * np.log10(np.maximum(rooms.frame_powers(talk) / 32768.0 ** 2, 1e-10))
+    counted = _above_room(talk.tobytes(), len(level))
+    words = np.zeros(len(level), dtype=bool)
+    active = 10 * np.log10(np.maximum(rooms.frame_powers(speech), 1e-9))
+    words[30 + np.flatnonzero(active >= active.max() - 15)] = True  # the loud part of the word
+    assert counted[words].mean() > 0.8
+    assert counted[~words].mean() < 0.2, "the talk before and after the word is not counted"
+    quiet = _in_noise(speech, None, lead_s=0.3).tobytes()
+    voiced = _voiced_frames(quiet)
+    assert (voiced & _above_room(quiet, len(voiced)) == voiced).all(), "a quiet room: every voiced frame"
+    assert _above_room(speech.tobytes(), len(active)).all(), "no pre-roll: nothing to go by"
 
 
 @pytest.mark.parametrize("item_id,text,meant", [
