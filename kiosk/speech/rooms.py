@@ -92,6 +92,8 @@ def reverberate(speech: np.ndarray, rt60: float, rng: np.random.Generator) -> np
 
 def telephone_band(speech: np.ndarray, low: float = 300.0, high: float = 3400.0) -> np.ndarray:
     """The speech through a telephone-quality microphone: only ``low``-``high`` Hz kept."""
+    if len(speech) == 0:
+        return speech.copy()
     spectrum = np.fft.rfft(speech.astype(np.float64))
     freqs = np.fft.rfftfreq(len(speech), 1 / SAMPLE_RATE)
     spectrum[(freqs < low) | (freqs > high)] = 0

@@ -89,6 +89,16 @@ def _in_noise(speech: np.ndarray, noise: np.ndarray | None, snr_db: float = 0, l
     return np.clip(np.round(out), -32768, 32767).astype(np.int16)
 
 
+def test_telephone_band_keeps_the_band_and_takes_no_audio_at_all():
+    """Only 300-3400 Hz pass; an empty stretch (the room between answers) stays empty."""
+    t = np.arange(SAMPLE_RATE) / SAMPLE_RATE
+    tones = (3000 * (np.sin(2 * np.pi * 100 * t) + np.sin(2 * np.pi * 1000 * t) + np.sin(2 * np.pi * 6000 * t)))
+    out = rooms.telephone_band(tones.astype(np.int16)).astype(np.float64)
+    spectrum = np.abs(np.fft.rfft(out)) / len(out)
+    assert spectrum[1000] > 1000 and spectrum[100] < 10 and spectrum[6000] < 10
+    assert len(rooms.telephone_band(np.zeros(0, dtype=np.int16))) == 0
+
+
 @pytest.mark.parametrize("snr_db", [20, 10])
 def test_steady_noise_does_not_run_to_the_cut_off(voice_of, snr_db):
     """A fan at SNR 20 or 10 dB: each answer ends where the speech ends, not at the 10 s cut-off,
