@@ -60,9 +60,9 @@ babble 10 dB again at `--cases 20` (160 utterances per split), whose figures are
   away and 10 of 29 real ones, so it was not kept;
 - RTF 0.02-0.06 (processor time); end of speech → answer p50 390-580 ms, p95 640-750 ms.
 
-Unconfirmed answers at confidence >= 0.95 would have been stored wrong for up to 6.3 % of
-utterances (held-out reverb, dev white 20 dB and babble 5 dB; 9.4 % in an earlier run), which is
-why every voice answer is confirmed.
+Unconfirmed answers at confidence >= 0.95 would have been stored wrong for up to 20 % of
+utterances (held-out white 10 dB at `--cases 20`; 6-13 % in several conditions at `--cases 4`),
+which is why every voice answer is confirmed.
 """
 
 from __future__ import annotations
