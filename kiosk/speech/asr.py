@@ -68,7 +68,7 @@ from typing import Protocol
 
 import numpy as np
 
-from kiosk.speech.audio import SAMPLE_RATE
+from kiosk.speech.audio import SAMPLE_RATE, frame_powers
 from kiosk.speech.denoise import reduce_steady_noise
 from kiosk.speech.grammar import Grammar, build_grammar, confusable_phrases, final_phrases, to_jsgf, to_vosk
 
@@ -411,10 +411,7 @@ def _above_room(pcm: bytes, frames: int) -> np.ndarray:
 
 def _frame_levels(pcm: bytes) -> np.ndarray:
     """Level (dBFS) of each whole 10 ms frame."""
-    samples = np.frombuffer(pcm, dtype="<i2").astype(np.float64)
-    step = SAMPLE_RATE // 100
-    frames = samples[: len(samples) - len(samples) % step].reshape(-1, step)
-    power = (frames ** 2).mean(axis=1) / 32768.0 ** 2
+    power = frame_powers(np.frombuffer(pcm, dtype="<i2")) / 32768.0 ** 2
     return 10 * np.log10(np.maximum(power, 1e-10))
 
 

@@ -152,6 +152,14 @@ def read_wav(path: str | Path) -> np.ndarray:
 # --- endpointing -----------------------------------------------------------------------------
 
 
+def frame_powers(samples: np.ndarray) -> np.ndarray:
+    """Mean power of each whole 10 ms frame of int16 samples (int16 units squared): the frame
+    rate of the recognisers' features and of :mod:`kiosk.speech.rooms`' levels."""
+    x = samples.astype(np.float64)
+    step = SAMPLE_RATE // 100
+    return (x[: len(x) - len(x) % step].reshape(-1, step) ** 2).mean(axis=1)
+
+
 def frame_level_db(frame: np.ndarray) -> float:
     """RMS level of int16 samples in dB relative to full scale (-100 for digital silence)."""
     if len(frame) == 0:

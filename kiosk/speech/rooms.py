@@ -18,14 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from kiosk.speech.audio import SAMPLE_RATE
-
-
-def frame_powers(speech: np.ndarray) -> np.ndarray:
-    """Mean power of each whole 10 ms frame (int16 units squared)."""
-    x = speech.astype(np.float64)
-    step = SAMPLE_RATE // 100
-    return (x[: len(x) - len(x) % step].reshape(-1, step) ** 2).mean(axis=1)
+from kiosk.speech.audio import SAMPLE_RATE, frame_powers
 
 
 def active_power(speech: np.ndarray) -> float:

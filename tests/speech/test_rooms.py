@@ -18,7 +18,7 @@ from kiosk.questionnaire import load_questionnaire
 from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
 from kiosk.speech import rooms
 from kiosk.speech.asr import PocketSphinxRecogniser, _above_room, _voiced_frames
-from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav
+from kiosk.speech.audio import SAMPLE_RATE, feed_samples, frame_powers, read_wav
 from kiosk.speech.matching import OptionWords
 from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel
@@ -156,7 +156,7 @@ def test_background_talk_ends_each_answer_where_the_speech_ends(voice_of, snr_db
             ear.utterances.clear()
             # where the voice is: _in_noise puts the recording 1.5 s in, and espeak-ng's own
             # quiet around the words is not speech
-            level = 10 * np.log10(np.maximum(rooms.frame_powers(speech), 1e-9))
+            level = 10 * np.log10(np.maximum(frame_powers(speech), 1e-9))
             voiced = np.flatnonzero(level >= level.max() - 30) / 100
             start = ear.channel._pipeline.stream_time + 1.5 + voiced[0]
             end = ear.channel._pipeline.stream_time + 1.5 + voiced[-1] + 0.01
@@ -194,10 +194,10 @@ def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
     speech = voice_of("two", *PATIENTS[0])
     talk = _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.0, np.random.default_rng(5)),
                      10, lead_s=0.3)
-    level = 10 * np.log10(np.maximum(rooms.frame_powers(talk) / 32768.0 ** 2, 1e-10))
+    level = 10 * np.log10(np.maximum(frame_powers(talk) / 32768.0 ** 2, 1e-10))
     counted = _above_room(talk.tobytes(), len(level))
     words = np.zeros(len(level), dtype=bool)
-    active = 10 * np.log10(np.maximum(rooms.frame_powers(speech), 1e-9))
+    active = 10 * np.log10(np.maximum(frame_powers(speech), 1e-9))
     words[30 + np.flatnonzero(active >= active.max() - 15)] = True  # the loud part of the word
     assert counted[words].mean() > 0.8
     assert counted[~words].mean() < 0.2, "the talk before and after the word is not counted"
