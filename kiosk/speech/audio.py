@@ -267,10 +267,12 @@ class Endpointer:
         self._quiet_run = 0
         self._speech_frames = 0
 
-    def is_voiced(self, level_db: float, margin_db: float | None = None, ceiling_db: float | None = None) -> bool:
-        """Whether a frame at ``level_db`` stands out of the current noise floor (and ceiling) as speech."""
+    def is_voiced(self, level_db: float, margin_db: float | None = None,
+                  ceiling_margin_db: float | None = None) -> bool:
+        """Whether a frame at ``level_db`` stands ``margin_db`` out of the current noise floor and
+        ``ceiling_margin_db`` above its ceiling (the start margins by default) as speech."""
         margin = self.settings.margin_db if margin_db is None else margin_db
-        above = self.settings.ceiling_margin_db if ceiling_db is None else ceiling_db
+        above = self.settings.ceiling_margin_db if ceiling_margin_db is None else ceiling_margin_db
         return level_db >= max(self.settings.min_speech_db, self.noise_db + margin, self.ceiling_db + above)
 
     def _learn(self, level_db: float) -> None:
