@@ -359,8 +359,10 @@ class VoiceChannel:
         phrases = self._matcher.phrases()
         if self._scored and not self._paused and self._declined:
             phrases = [p for p in phrases if self._matcher.meaning(p) not in self._declined]
+        # a scored question's answers are asked back unless the channel confirms none of them
+        asked_back = self._scored and not self._paused and self.confirm_below > 1
         self._recogniser.set_grammar(phrases, self._matcher.meaning, self._matcher.lead_ins(),
-                                     self._matcher.fillers())
+                                     self._matcher.fillers(), not asked_back)
         self._gate()
 
     def _gate(self) -> None:

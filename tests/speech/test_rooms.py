@@ -17,7 +17,7 @@ from kiosk.channels import ChannelInput, Command
 from kiosk.questionnaire import load_questionnaire
 from kiosk.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
 from kiosk.speech import rooms
-from kiosk.speech.asr import PocketSphinxRecogniser, _above_room, _voiced_frames
+from kiosk.speech.asr import PocketSphinxRecogniser, _above_room, _gate_talk, _voiced_frames
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, frame_powers, read_wav
 from kiosk.speech.matching import OptionWords
 from kiosk.speech.tts import Synthesiser
@@ -205,6 +205,48 @@ def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
     voiced = _voiced_frames(quiet)
     assert (voiced & _above_room(quiet, len(voiced)) == voiced).all(), "a quiet room: every voiced frame"
     assert _above_room(speech.tobytes(), len(active)).all(), "no pre-roll: nothing to go by"
+
+
+def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
+    """Where people talk nearby, what does not stand out of the room heard in the pre-roll is
+    turned down by 30 dB (100 ms kept either side of the words); the loud part of the word is
+    left as it is. A quiet room and audio without a pre-roll are scored as they were heard."""
+    speech = voice_of("yes", *PATIENTS[0])
+    talk = _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.5, np.random.default_rng(5)),
+                     10, lead_s=0.5)
+    gated = np.frombuffer(_gate_talk(talk.tobytes()), dtype="<i2")
+    assert len(gated) == len(talk)
+    before = 10 * np.log10(np.maximum(frame_powers(talk), 1e-9))
+    after = 10 * np.log10(np.maximum(frame_powers(gated), 1e-9))
+    active = 10 * np.log10(np.maximum(frame_powers(speech), 1e-9))
+    word = 50 + np.flatnonzero(active >= active.max() - 10)  # the loud part of the word
+    assert np.abs(after[word] - before[word]).max() < 0.5, "the patient's word is not touched"
+    # talk louder than the pre-roll's stands out of the room as the patient does, and is kept
+    # with its 100 ms either side (and the gate's 5 ms ramp, in the frame after that); the rest
+    # is turned down
+    loud = _above_room(talk.tobytes(), len(before))
+    near = np.convolve(loud, np.ones(2 * 11 + 1), mode="same") > 0
+    assert (~near).mean() > 0.2, "a good part of the talk is quieter than the word"
+    assert (before[~near] - after[~near]).min() > 25, "the talk around it is turned down"
+    assert np.abs(after[loud] - before[loud]).max() < 3
+    quiet = _in_noise(speech, None, lead_s=0.5)
+    quiet += np.round(np.random.default_rng(1).normal(0, 6, len(quiet))).astype(np.int16)  # a microphone's hiss
+    assert _gate_talk(quiet.tobytes()) == quiet.tobytes(), "a quiet room is left as it was heard"
+    assert _gate_talk(speech.tobytes()) == speech.tobytes(), "no pre-roll: nothing to go by"
+
+
+def test_yes_and_no_in_background_talk_are_not_taken_for_commands(voice_of):
+    """A short "yes" or "no" among people talking at SNR 10 dB: never heard as a command (a
+    doctor called, the question repeated) nor as the other reply. With the talk around it left
+    in, "yes" by en+f2 called the doctor: the grammar's longer phrases absorbed the talk."""
+    for voice, rate in PATIENTS:
+        rng = np.random.default_rng(1)
+        ear = Ear().confirmation()
+        ear.hear(_in_noise(np.zeros(0), _babble(voice_of, 4, rng), 10))  # the ward was talking before
+        for text in ("yes", "yes", "yes", "no", "no", "no"):
+            speech = voice_of(text, voice, rate)
+            got = ear.confirmation().hear(_in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 3, rng), 10))
+            assert got is None or got.option == (1 if text == "yes" else 2), (voice, text, got)
 
 
 @pytest.mark.parametrize("item_id,text,meant", [

@@ -519,3 +519,32 @@ def test_stop_while_the_microphone_opens_leaves_it_closed():
     (microphone,) = microphones
     assert not microphone.open
     assert statuses == []  # a stopped channel loads nothing and reports nothing
+
+
+class _Recording(PocketSphinxRecogniser):
+    """The real recogniser, noting whether each grammar's options are taken as heard."""
+
+    def __init__(self, language: str) -> None:
+        super().__init__(language)
+        self.taken_as_heard: list[bool] = []
+
+    def set_grammar(self, phrases, meaning=None, lead_ins=(), fillers=(), taken_as_heard=False):
+        self.taken_as_heard.append(taken_as_heard)
+        return super().set_grammar(phrases, meaning, lead_ins, fillers, taken_as_heard)
+
+
+@pytest.mark.parametrize("confirm_below,scored_taken", [(1.01, False), (0.9, True)])
+def test_options_acted_on_without_asking_back_are_marked_for_the_recogniser(confirm_below, scored_taken):
+    """A confirmation's yes/no and the welcome's choice act as heard, so the recogniser is told
+    to make its two hearings agree (pocketsphinx in background talk); a scored question's
+    answers are asked back, unless the channel is set to take sure answers without asking."""
+    recognisers: list[_Recording] = []
+    channel = VoiceChannel("en", recogniser_factory=lambda lang: recognisers.append(_Recording(lang)) or recognisers[-1],
+                           confirm_below=confirm_below)
+    assert channel.attach(lambda item: None)
+    item = QUESTIONNAIRE.items[0]
+    channel.set_question([OptionWords(o.label_in("en")) for o in item.options], "en", scored=True, key="q1")
+    channel.set_question([OptionWords("Yes"), OptionWords("No")], "en")
+    channel.set_question([OptionWords("English"), OptionWords("Español")], "en", welcome=True)
+    assert recognisers[-1].taken_as_heard[-3:] == [scored_taken, True, True]
+    channel.stop()
