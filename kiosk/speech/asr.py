@@ -165,10 +165,12 @@ PS_ROOM_FRAMES = 20
 PS_ABOVE_ROOM_DB = 2.0
 #: only a start at least this far below the loudest frame is taken for room
 PS_ROOM_BELOW_SPEECH_DB = 6.0
-#: a room whose own sound before the answer (the pre-roll's loudest tenth) is this loud is one
-#: where people talk nearby: the level the endpointer takes for speech at all
-#: (:attr:`kiosk.speech.audio.EndpointerSettings.min_speech_db`). A microphone's hiss (-75 dBFS)
-#: and a quiet ward are far below it; a fan's noise is subtracted instead (:mod:`denoise`)
+#: a room whose sound even at the quietest tenth of an utterance (the pre-roll and the hangover
+#: hold at least half a second of it) is this loud is one where people talk nearby: the level
+#: the endpointer takes for speech at all (:attr:`kiosk.speech.audio.EndpointerSettings.min_speech_db`).
+#: A microphone's hiss (-75 dBFS) and a quiet ward are far below it, also where an answer was
+#: cut in two and the second part's pre-roll holds the first (the pre-roll alone took 1 of 21
+#: answers in the -20 dB and telephone rooms); a fan's noise is subtracted instead (:mod:`denoise`)
 PS_TALKING_ROOM_DB = -55.0
 #: in such a room the talk around the patient's words is turned down by this much before the
 #: utterance is scored (:func:`_gate_talk`) ...
@@ -459,7 +461,7 @@ def _gate_talk(pcm: bytes) -> bytes:
     """The utterance with other people's talk turned down by :data:`PS_TALK_GATE_DB` wherever
     it does not stand out of the room heard in the pre-roll (:func:`_above_room`), keeping
     :data:`PS_TALK_GATE_KEEP_FRAMES` around the patient's words; unchanged where the room
-    before the answer was quieter than :data:`PS_TALKING_ROOM_DB` (a quiet room).
+    is quieter than :data:`PS_TALKING_ROOM_DB` (a quiet room).
 
     The pre-roll, the hangover and the fixed tail (:func:`_fixed_tail`) of an answer given in
     background talk are talk: the grammar's longer phrases absorbed it, so a short "yes" or
@@ -475,7 +477,7 @@ def _gate_talk(pcm: bytes) -> bytes:
     step = 2 * SAMPLE_RATE // 100  # bytes per 10 ms frame
     frames = len(pcm) // step
     level = _frame_levels(pcm)
-    if frames <= PS_ROOM_FRAMES or np.percentile(level[:PS_ROOM_FRAMES], 90) < PS_TALKING_ROOM_DB:
+    if frames <= PS_ROOM_FRAMES or np.percentile(level, 10) < PS_TALKING_ROOM_DB:
         return pcm
     words = _above_room(pcm, frames)
     if words.all() or not words.any():

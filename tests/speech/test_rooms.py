@@ -210,7 +210,8 @@ def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
 def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     """Where people talk nearby, what does not stand out of the room heard in the pre-roll is
     turned down by 30 dB (100 ms kept either side of the words); the loud part of the word is
-    left as it is. A quiet room and audio without a pre-roll are scored as they were heard."""
+    left as it is. A quiet room (also where an answer was cut in two, the pre-roll holding its
+    first part) and audio without a pre-roll are scored as they were heard."""
     speech = voice_of("yes", *PATIENTS[0])
     talk = _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.5, np.random.default_rng(5)),
                      10, lead_s=0.5)
@@ -233,6 +234,16 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     quiet += np.round(np.random.default_rng(1).normal(0, 6, len(quiet))).astype(np.int16)  # a microphone's hiss
     assert _gate_talk(quiet.tobytes()) == quiet.tobytes(), "a quiet room is left as it was heard"
     assert _gate_talk(speech.tobytes()) == speech.tobytes(), "no pre-roll: nothing to go by"
+    # an answer cut in two in a quiet room: the second part's pre-roll holds the first part's
+    # words, at speech level, but the room around them is the microphone's hiss
+    first, second = voice_of("needs", *PATIENTS[0]), voice_of("help", *PATIENTS[0])
+    level = 10 * np.log10(np.maximum(frame_powers(first), 1e-9))
+    said = (np.flatnonzero(level >= level.max() - 15)[-1] + 1) * SAMPLE_RATE // 100  # where "needs" ends
+    trailing_off = rooms.scale_db(first[said - int(0.3 * SAMPLE_RATE):said], -12)
+    cut = np.concatenate([trailing_off, second, np.zeros(int(0.5 * SAMPLE_RATE), np.int16)])
+    assert np.percentile(10 * np.log10(frame_powers(cut[:int(0.2 * SAMPLE_RATE)]) / 32768.0 ** 2), 90) > -55
+    cut += np.round(np.random.default_rng(2).normal(0, 6, len(cut))).astype(np.int16)
+    assert _gate_talk(cut.tobytes()) == cut.tobytes(), "a quiet room's answer cut in two is left as heard"
 
 
 def test_yes_and_no_in_background_talk_are_not_taken_for_commands(voice_of):
