@@ -34,31 +34,38 @@ this machine's sources do not carry; where they are installed, pass e.g. ``--voi
 silero-vad's ONNX model (see ``bench/_vads.py``): neither is a kiosk dependency.
 
 Measured here (pocketsphinx, 2 shared cores), dev / held-out. The full matrix at `--cases 4`
-(32 utterances per condition and split; one answer is about 5 %), and clean, white 10 dB and
-babble 10 dB again at `--cases 20` (160 utterances per split), whose figures are the ones to trust:
+(32 utterances per condition and split; one answer is about 5 %); clean, white 10 dB and the
+three babble rooms again at `--cases 20` (160 utterances per split) and babble 10 dB at
+`--cases 40` (320), whose figures are the ones to trust:
 
-- wrong option stored (answers and non-answers): 0 % in all 11 conditions, both splits, and in
-  the 960 utterances of the larger run (every answer confirmed; "Is that right?" taken in words
-  only: with "number one" in its grammar a "no, that's wrong" was once heard as Yes);
-- cut-offs: none in any condition (babble used to run 7-11 of 32 to the cut-off, before the
-  endpointer learned the room's ceiling);
-- right within two attempts, `--cases 20`: clean 0.82 / 0.81 (target 0.8: met), white 10 dB
-  0.68 / 0.70 (target 0.5: met; 0.52 / 0.54 before the fan's residue stopped counting as speech),
-  babble 10 dB 0.46 / 0.55 (target 0.5: NOT met on the dev voices; 0.16 / 0.26 at `--cases 4`
-  before the room's ceiling and the coverage above the room). Other settings of the two babble
-  margins gave 0.44-0.53 on the dev voices, a spread no larger than the sampling's (one answer
-  is 1 %), and moved babble's end of speech or counted less of the word, so they were not taken;
+- wrong option stored (answers and non-answers): 0 in every condition at `--cases 4`, in the
+  larger runs of clean, white 10 dB, babble 20 dB and babble 10 dB (960 utterances per split
+  and code version), and 1 of 160 at babble 5 dB (held-out, 0.6 %: target 0.5 % NOT met there).
+  That one, before the talk gate as after it (another case each time), is a "no" to "Is that
+  right?" heard as "yes" among talkers nearly as loud as the patient (0.86-0.98 sure). Refusing
+  a yes that stands less than 7 dB out of the talk caught both, but in the 40-case babble 10 dB
+  run with it two other "no"s (standing further out) were heard as "yes": one event in a few
+  hundred replies cannot credit or blame a rule, so it was not kept. Every voice answer is
+  confirmed; "Is that right?" is taken in words only;
+- cut-offs: none in any condition;
+- right within two attempts: clean 0.82 / 0.81 (target 0.8: met), white 10 dB 0.68 / 0.70
+  (target 0.5: met), babble 10 dB 0.58 / 0.61 at `--cases 40` and 0.61 / 0.62 at `--cases 20`
+  (target 0.5: met; 0.54 / 0.50 and 0.46 / 0.55 before the talk around the patient's words was
+  turned down), babble 20 dB 0.80 / 0.82 (0.71 / 0.78 before), babble 5 dB 0.33 / 0.23 (0.23 /
+  0.23 before);
 - right within two attempts, `--cases 4`: clean 0.82 / 0.85, white 20 dB 0.69 / 0.94, white
-  10 dB 0.76 / 0.87, white 5 dB 0.30 / 0.17, babble 20 dB 0.67 / 0.90, 10 dB 0.58 / 0.42, 5 dB
-  0.19 / 0.29, reverb 0.40 / 0.25, telephone 0.05 / 0.19, -20 dB 0.81 / 0.85, 4 s of silence
+  10 dB 0.76 / 0.87, white 5 dB 0.30 / 0.17, babble 20 dB 0.67 / 0.90, 10 dB 0.47 / 0.58, 5 dB
+  0.14 / 0.24, reverb 0.40 / 0.25, telephone 0.05 / 0.19, -20 dB 0.81 / 0.85, 4 s of silence
   first 0.74 / 0.81. What still fails: short words heard with too little confidence ("help",
-  "two" from whispering voices), in babble a "yes" heard as something else (about half the
-  time at 10 dB), in reverb and the telephone band the model's fit;
-- wrong commands per 160: clean 3 / 5, white 10 dB 15 / 23, babble 10 dB 28 / 32 (calls of the
-  doctor among them: "my daughter is coming later", "sorry?", "all the time", "i can't"). Holding
-  commands in babble to the coverage that counts the talkers too took 3 of 15 false doctor calls
-  away and 10 of 29 real ones, so it was not kept;
-- RTF 0.02-0.06 (processor time); end of speech → answer p50 390-580 ms, p95 640-750 ms.
+  "two" from whispering voices), in babble a "yes" heard as something else (about a third of
+  the time at 10 dB), in reverb and the telephone band the model's fit;
+- wrong commands per 160 (`--cases 20`): clean 3 / 5, white 10 dB 15 / 23, babble 20 dB 5 / 9
+  (12 / 14 before the talk gate), 10 dB 15 / 24 (28 / 32), 5 dB 16 / 26 (21 / 21); at babble
+  10 dB, `--cases 40`, 32 / 41 per 320 (57 / 73), the doctor called among them 17 / 19 (31 /
+  43): "all the time", "i can't", "is it time for lunch yet". Holding commands in babble to the
+  coverage that counts the talkers too took 3 of 15 false doctor calls away and 10 of 29 real
+  ones, so it was not kept;
+- RTF 0.02-0.05 (processor time); end of speech → answer p50 340-550 ms, p95 600-700 ms.
 
 Unconfirmed answers at confidence >= 0.95 would have been stored wrong for up to 20 % of
 utterances (held-out white 10 dB at `--cases 20`; 6-13 % in several conditions at `--cases 4`),
@@ -237,9 +244,9 @@ class _Timed:
         #: processor seconds of the latest finish(): the endpoint → result part of the latency
         self.last_finish = 0.0
 
-    def set_grammar(self, *args):
+    def set_grammar(self, *args, **kwargs):
         """Forward."""
-        return self.inner.set_grammar(*args)
+        return self.inner.set_grammar(*args, **kwargs)
 
     def reset(self) -> None:
         """Forward."""

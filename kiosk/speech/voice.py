@@ -362,7 +362,7 @@ class VoiceChannel:
         # a scored question's answers are asked back unless the channel confirms none of them
         asked_back = self._scored and not self._paused and self.confirm_below > 1
         self._recogniser.set_grammar(phrases, self._matcher.meaning, self._matcher.lead_ins(),
-                                     self._matcher.fillers(), not asked_back)
+                                     self._matcher.fillers(), taken_as_heard=not asked_back)
         self._gate()
 
     def _gate(self) -> None:
