@@ -337,11 +337,12 @@ class PocketSphinxRecogniser:
         self._end()
         self._settled = True
         result, core = self._score(gated, cleaned)
-        if self._taken_as_heard and gated is not pcm and result.confidence > 0 and isinstance(self._meaning(core), int):
+        answers = self._grammar.answers
+        if self._taken_as_heard and gated is not pcm and result.confidence > 0 and core in answers:
             # acted on without asking back: heard with the talk turned down and as it came in,
             # one reply must not be two different options, each taken (see _gate_talk)
             other, other_core = self._score(pcm, cleaned)
-            if other.confidence >= PS_OTHER_HEARING_MIN and isinstance(self._meaning(other_core), int) \
+            if other.confidence >= PS_OTHER_HEARING_MIN and other_core in answers \
                     and self._meaning(other_core) != self._meaning(core):
                 log.debug("pocketsphinx: %r, but %r with the talk left in", result.text, other.text)
                 return Recognition(result.text, 0.0)

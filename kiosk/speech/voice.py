@@ -360,7 +360,7 @@ class VoiceChannel:
         if self._scored and not self._paused and self._declined:
             phrases = [p for p in phrases if self._matcher.meaning(p) not in self._declined]
         # a scored question's answers are all asked back unless the channel takes sure ones as heard
-        asked_back = self._scored and not self._paused and self.confirm_below > 1
+        asked_back = self._scored and self.confirm_below > 1
         self._recogniser.set_grammar(phrases, self._matcher.meaning, self._matcher.lead_ins(),
                                      self._matcher.fillers(), taken_as_heard=not asked_back)
         self._gate()
