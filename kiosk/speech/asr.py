@@ -204,6 +204,9 @@ PS_ACCENT_WORDS = {"one": ("W AA N",)}
 #: the dictionary's vowels (CMU phones), for the non-rhotic rule in :func:`accent_variants`
 _VOWELS = frozenset("AA AE AH AO AW AY EH ER EY IH IY OW OY UH UW".split())
 
+#: bytes per 10 ms frame, pocketsphinx's frame rate
+_FRAME_BYTES = 2 * SAMPLE_RATE // 100
+
 #: lattice entries that are not words the patient said
 _FILLERS = {"<s>", "</s>", "<sil>", "(NULL)", "[NOISE]", "[SPEECH]"}
 
@@ -433,7 +436,7 @@ def _fixed_tail(pcm: bytes, voiced: np.ndarray) -> tuple[bytes, np.ndarray]:
     same one closed after the long hangover. Cutting a longer tail, and lengthening a shorter
     one by repeating the quiet actually heard (the room's own noise), scores both alike.
     """
-    step = 2 * SAMPLE_RATE // 100  # bytes per 10 ms frame
+    step = _FRAME_BYTES
     end = (int(np.flatnonzero(voiced)[-1]) + 1) * step
     tail = pcm[end:end + PS_TRAILING_FRAMES * step] or b"\0" * step
     tail = (tail * (PS_TRAILING_FRAMES * step // len(tail) + 1))[:PS_TRAILING_FRAMES * step]
@@ -452,13 +455,18 @@ def _above_room(pcm: bytes, frames: int) -> np.ndarray:
     """
     level = _frame_levels(pcm)[:frames]
     out = np.ones(frames, dtype=bool)
+    out[:len(level)] = _stands_out(level)
+    return out
+
+
+def _stands_out(level: np.ndarray) -> np.ndarray:
+    """:func:`_above_room` for frame levels (dBFS) already measured."""
     if len(level) <= PS_ROOM_FRAMES:
-        return out
+        return np.ones(len(level), dtype=bool)
     room = float(np.percentile(level[:PS_ROOM_FRAMES], 90))
     if room > level.max() - PS_ROOM_BELOW_SPEECH_DB:
-        return out
-    out[:len(level)] = level >= room + PS_ABOVE_ROOM_DB
-    return out
+        return np.ones(len(level), dtype=bool)
+    return level >= room + PS_ABOVE_ROOM_DB
 
 
 def _gate_talk(pcm: bytes) -> bytes:
@@ -481,19 +489,17 @@ def _gate_talk(pcm: bytes) -> bytes:
     stored wrong, 1 in 160. Set on the dev voices among -15 dB (8 frames kept) and -30 dB (5 and
     10 frames).
     """
-    step = 2 * SAMPLE_RATE // 100  # bytes per 10 ms frame
-    frames = len(pcm) // step
     level = _frame_levels(pcm)
-    if frames <= PS_ROOM_FRAMES or np.percentile(level, 10) < PS_TALKING_ROOM_DB:
+    if len(level) <= PS_ROOM_FRAMES or np.percentile(level, 10) < PS_TALKING_ROOM_DB:
         return pcm
-    words = _above_room(pcm, frames)
+    words = _stands_out(level)
     if words.all() or not words.any():
         return pcm  # no room to go by, or nothing stands out of it: nothing to tell apart
     keep = words.copy()
     for shift in range(1, PS_TALK_GATE_KEEP_FRAMES + 1):
         keep[shift:] |= words[:-shift]
         keep[:-shift] |= words[shift:]
-    gain = np.repeat(np.where(keep, 1.0, 10 ** (PS_TALK_GATE_DB / 20)), step // 2)
+    gain = np.repeat(np.where(keep, 1.0, 10 ** (PS_TALK_GATE_DB / 20)), _FRAME_BYTES // 2)
     # a 5 ms ramp at each edge, so the gate does not click (a click is a consonant to the model)
     gain = np.convolve(gain, np.ones(80) / 80, mode="same")
     samples = np.frombuffer(pcm, dtype="<i2").astype(np.float64)
