@@ -332,6 +332,16 @@ class Endpointer:
         return None
 
     @property
+    def room_db(self) -> float | None:
+        """The room's level (dBFS, mean power) over the frames heard outside utterances in the
+        last ``floor_window_s``: a fan's, or people talking nearby. None until a third of a
+        second of it has been heard (the microphone has just opened)."""
+        if len(self._room) < self.start_frames * 3:
+            return None
+        power = float(np.mean(np.power(10.0, np.asarray(self._room) / 10)))
+        return 10 * math.log10(max(power, 1e-10))
+
+    @property
     def quiet_frames(self) -> int:
         """Quiet frames since the last voiced one while in speech (the hangover so far)."""
         return self._quiet_run
@@ -377,6 +387,21 @@ class Utterance:
     complete: bool = False
     #: whether it ran to the endpointer's ``max_utterance_s`` instead of ending in quiet
     cut_off: bool = False
+    #: the level (dBFS, mean power) of the utterance's frames that stood above the room's
+    #: ceiling: the speaker's voice with whatever the room added to it (None: no such frame)
+    speech_db: float | None = None
+    #: the room's level as the utterance started (:attr:`Endpointer.room_db`; None: not known)
+    room_db: float | None = None
+
+    @property
+    def above_room_db(self) -> float | None:
+        """How far the speaker's voice stood above the room (dB): the speech's own power (its
+        frames' power less the room's) over the room's. None where either is not known; a
+        voice no louder than the room is -30."""
+        if self.speech_db is None or self.room_db is None:
+            return None
+        speech, room = 10 ** (self.speech_db / 10), 10 ** (self.room_db / 10)
+        return max(-30.0, 10 * math.log10(max(speech - room, room * 1e-3) / room))
 
 
 class UtterancePipeline:
@@ -408,6 +433,11 @@ class UtterancePipeline:
         self._muted = False
         #: whether the recogniser's latest partial result is a whole answer
         self._complete = False
+        #: the utterance's frames' powers (int16 units squared) that stood above the room's
+        #: ceiling, and the room's level as it started (see Utterance.speech_db, room_db)
+        self._loud: list[float] = []
+        self._room_db: float | None = None
+        self._ceiling_db = -90.0
 
     @property
     def muted(self) -> bool:
@@ -450,6 +480,7 @@ class UtterancePipeline:
         event = self.endpointer.push(np.frombuffer(chunk, dtype="<i2"), self._complete)
         if event is None:
             if self.endpointer.in_speech:
+                self._measure(chunk)
                 self._hear(chunk)
             else:
                 self._preroll.append(chunk)
@@ -460,6 +491,12 @@ class UtterancePipeline:
             self._start = self.stream_time - self.endpointer.start_frames * frame_s
             self.recogniser.reset()
             self._complete = False
+            # the room as the patient began (the endpointer keeps the frames that started the
+            # utterance out of it), and the frames that started it, which are speech
+            self._room_db, self._ceiling_db, self._loud = self.endpointer.room_db, self.endpointer.ceiling_db, []
+            run = list(self._preroll)[max(0, len(self._preroll) - self.endpointer.start_frames + 1):]
+            for frame in (*run, chunk):
+                self._measure(frame)
             self._hear(b"".join(self._preroll) + chunk)
             self._preroll.clear()
             return
@@ -481,8 +518,16 @@ class UtterancePipeline:
                 finish_seconds=finish_seconds,
                 complete=complete,
                 cut_off=self.endpointer.cut_off,
+                speech_db=10 * math.log10(max(float(np.mean(self._loud)) / 32768.0 ** 2, 1e-10)) if self._loud else None,
+                room_db=self._room_db,
             )
         )
+
+    def _measure(self, chunk: bytes) -> None:
+        """Note the frame's power if it stands above the room's ceiling (the speaker's words)."""
+        frame = np.frombuffer(chunk, dtype="<i2")
+        if frame_level_db(frame) >= self._ceiling_db:
+            self._loud.append(float(np.mean(frame.astype(np.float64) ** 2)))
 
     def _hear(self, chunk: bytes) -> None:
         """Pass audio of the utterance to the recogniser and note whether it is a whole answer."""

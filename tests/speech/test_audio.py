@@ -142,6 +142,34 @@ def test_pipeline_passes_preroll_speech_and_hangover_and_mutes():
     assert len(got) == 2
 
 
+def test_each_utterance_says_how_far_the_voice_stood_above_the_room():
+    """The speech's own power (its loud frames' less the room's) over the room's, the room being
+    what was heard outside utterances just before: about 20 dB for a tone 20 dB above a steady
+    hiss, and not known when the microphone had only just opened."""
+    rng = np.random.default_rng(4)
+
+    def hiss(seconds: float) -> np.ndarray:
+        return rng.normal(0, 32768 * 10 ** (-60 / 20), int(seconds * SAMPLE_RATE))
+
+    got = []
+    pipe = UtterancePipeline(_Recorder(), got.append)
+    signal = np.concatenate([hiss(2.0), hiss(0.5) + _tone(0.5, -40), hiss(1.5)])
+    pipe.feed(np.round(signal).astype(np.int16).tobytes())
+    (utt,) = got
+    assert utt.room_db == pytest.approx(-60, abs=0.5)
+    # the tone and the hiss under it; the hangover's few hiss frames above the room's ceiling
+    # (its 90th percentile) count too, and take a little off
+    assert utt.speech_db == pytest.approx(10 * np.log10(10 ** -4 + 10 ** -6), abs=1.0)
+    assert utt.above_room_db == pytest.approx(20, abs=1.0)
+    # as loud as the room, and a room not yet heard
+    assert audio.Utterance(0, 0, 0, 0, 0, speech_db=-50.0, room_db=-50.0).above_room_db == -30
+    got.clear()
+    pipe = UtterancePipeline(_Recorder(), got.append)
+    pipe.feed(np.concatenate([_tone(0.5, -40), _silence(1.0)]).tobytes())
+    (utt,) = got
+    assert utt.room_db is None and utt.above_room_db is None
+
+
 def test_read_wav_resamples_espeak_output(spoken):
     path = spoken("two")
     with wave.open(str(path)) as w:
