@@ -297,6 +297,10 @@ class Patient:
         self.latency: list[float] = []
         self.timed: list[_Timed] = []
         self.audio_seconds = 0.0
+        #: spoken yeses the channel sent as unsure (see VoiceChannel.reply_min_above_room_db)
+        self.asked_to_press = 0
+        #: ... of which the option heard was the one meant (pressing Yes would have stored it)
+        self.asked_to_press_right = 0
 
         def recogniser(language: str) -> _Timed:
             self.timed.append(_Timed(PocketSphinxRecogniser(language)))
@@ -380,8 +384,14 @@ class Patient:
         whether the kiosk heard yes (asked once more if it heard neither; None if it never did)."""
         reply = (YES_EN if meant else NO_EN)[key % 4]
         for _ in range(2):
-            self.channel.set_question([OptionWords("Yes"), OptionWords("No")], "en", scored=False)
+            self.channel.set_question([OptionWords("Yes"), OptionWords("No")], "en", scored=False, confirming=True)
             got = self.say(reply)
+            if got is not None and got.option == 1 and got.needs_confirmation:
+                # the room was too loud to take a spoken yes: the session asks the patient to
+                # press Yes or No, which this voice-only patient does not do
+                self.asked_to_press += 1
+                self.asked_to_press_right += meant
+                return None
             if got is not None and got.option is not None:
                 return got.option == 1
             if got is not None and got.command is Command.UNDO:
@@ -400,7 +410,8 @@ def run_condition(name: str, voices, cases, audio: Audio, args) -> dict:
     options_of = {item.id: [OptionWords(o.label_in("en"), tuple(o.synonyms_in("en"))) for o in item.options]
                   for item in questionnaire.items}
     tally = dict(utterances=0, answers=0, non_answers=0, commands=0, right=0, right_first=0, wrong_stored=0,
-                 non_answers_stored=0, wrong_commands=0, asked_again=0, confirmations=0, unresolved=0)
+                 non_answers_stored=0, wrong_commands=0, asked_again=0, confirmations=0, unresolved=0,
+                 asked_to_press=0, asked_to_press_right=0)
     first_inputs: list[tuple[float, bool]] = []
     latency, cut_off, seconds, audio_seconds, mistakes = [], 0, 0.0, 0.0, []
     for v, (voice, rate) in enumerate(voices):
@@ -431,6 +442,8 @@ def run_condition(name: str, voices, cases, audio: Audio, args) -> dict:
                 tally["asked_again"] += outcome["attempts"] > 1
                 tally["unresolved"] += outcome["stored"] is None and outcome["command"] != expected
         latency += patient.latency
+        tally["asked_to_press"] += patient.asked_to_press
+        tally["asked_to_press_right"] += patient.asked_to_press_right
         cut_off += sum(u.cut_off for u in patient.utterances)
         seconds += sum(t.seconds for t in patient.timed)
         audio_seconds += patient.audio_seconds

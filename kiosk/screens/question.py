@@ -99,6 +99,10 @@ class QuestionScreen(PatientScreen):
             if (panel := self._panel(view)) is not None:
                 self.mount(panel, before=self.query_one(WaitingSign))
             return
+        prompt = view.snapshot.prompt
+        if confirming is not None and prompt is not None and prompt.kind == "confirm":
+            for confirm in self.query(ConfirmPanel):
+                confirm.ask(prompt.text)
         answer = view.snapshot.answers.get(item.id) if item else None
         for panel in self.query(QuestionPanel):
             panel.mark_chosen(answer.option if answer else None)

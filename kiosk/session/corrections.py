@@ -7,7 +7,10 @@
   meanwhile; the confirmation has ``confirm_window_s``.
 
   - Yes stores the answer, on the attempt it was given in (with the channel that gave it).
-    An unsure "yes" never confirms: the question "Is that right?" is asked again.
+    An unsure "yes" never confirms: the question "Is that right?" is asked again, now asking
+    the patient to press Yes or No (``confirm_answer_press``), with the whole window again to
+    do it. The voice channel sends a spoken reply as unsure where the room was nearly as loud
+    as the patient's voice (:data:`kiosk.speech.voice.REPLY_MIN_ABOVE_ROOM_DB`).
   - No (or the undo command) asks the question again in the same attempt, with what was left
     of its window (at least ``resume_grace_s``).
   - No reply stores nothing: the attempt ends as if it had timed out.
@@ -61,6 +64,8 @@ class Unconfirmed:
     confidence: float | None
     #: what was left of the attempt's window when the confirmation was asked
     remaining: float
+    #: a "yes" came too unsure to store the answer: the patient is asked to press Yes or No
+    press: bool = False
 
 
 class Corrections:
@@ -98,6 +103,9 @@ class Corrections:
             return
         if event.needs_confirmation:
             self._ignore(t, event, IgnoreReason.UNSURE_REPLY)
+            pending.press = True
+            # finding and pressing the button takes longer than saying yes
+            self._timers.at_least(self.timing.confirm_window_s)
             self._prompt_question(t, repeat=True)
             return
         open_.unconfirmed = None
@@ -157,7 +165,8 @@ class Corrections:
         lang = self._language
         item = self.questionnaire.items[open_.index]
         heard = item.option(open_.unconfirmed.option).label_in(lang)
-        template = self.questionnaire.message("confirm_answer", lang) or "{answer}?"
+        template = ((open_.unconfirmed.press and self.questionnaire.message("confirm_answer_press", lang))
+                    or self.questionnaire.message("confirm_answer", lang) or "{answer}?")
         text = template.replace("{answer}", heard)
         words: Mapping[int, tuple[str, tuple[str, ...]]] = CONFIRM_WORDS.get(lang, CONFIRM_WORDS["en"])
         options = tuple(PromptOption(number, label, synonyms, None) for number, (label, synonyms) in words.items())

@@ -13,7 +13,10 @@ Every answer to a scored question goes to the sink with ``needs_confirmation`` (
 whose options the matcher extends with the natural ways of saying them ("yes, that's right",
 "no, that's wrong"); after an answer is stored (``AnswerRecorded``), until the next prompt,
 only "no, that's wrong" / "change my answer" (``Command.UNDO``) and calling the doctor are
-listened for: the thank-you gap in which the session lets any answer be taken back. A prompt
+listened for: the thank-you gap in which the session lets any answer be taken back. A reply to
+"Is that right?" spoken where the room was nearly as loud as the voice
+(:data:`REPLY_MIN_ABOVE_ROOM_DB`) is sent as unsure: a "yes" then stores nothing and the session
+asks for Yes or No to be pressed. A prompt
 without points (a confirmation, the welcome's start / language
 choice) is never itself confirmed.
 
@@ -58,6 +61,18 @@ CONFIRM_BELOW = 1.01
 #: were otherwise lost; it is never stored without the patient's yes
 AGREE_MIN_CONFIDENCE = 0.2
 
+#: a reply to "Is that right?" spoken less than this far above the room (dB, see
+#: :attr:`kiosk.speech.audio.Utterance.above_room_db`) is sent as unsure, so a "yes" stores
+#: nothing: the session asks the patient to press Yes or No (a "no" still declines). Where
+#: people talk nearly as loud as the patient, a "no" was now and then heard as "yes" (at SNR
+#: 5 dB 2 of 480 on bench/asr.py's held-out voices, one of them storing a wrong answer), and
+#: the recogniser's confidence did not tell. Set on the dev voices' replies (80 yes and 80 no
+#: per room): a true yes measured below 8 dB in background talk at SNR 10 dB 0 of 80, in white
+#: noise at 10 dB 1 of 80, in talk at 7.5 dB 6 of 80, at 5 dB 74 of 80 (and the one "no" heard
+#: as "yes" there measured 5.1 dB); in the quiet, -20 dB, reverb and telephone rooms every reply
+#: measured above 30 dB. At 9 dB white noise at 10 dB would have lost 7 of 80 true yeses
+REPLY_MIN_ABOVE_ROOM_DB = 8.0
+
 #: how long attach()/wait_loaded() wait for a speech model (a large vosk model takes seconds)
 LOAD_TIMEOUT_S = 60.0
 
@@ -85,6 +100,7 @@ class VoiceChannel:
         on_unmatched: Callable[[str, str], None] = lambda utterance, reason: None,
         on_utterance: Callable[[Utterance], None] = lambda utterance: None,
         endpointer_factory: Callable[[], Endpointer] = Endpointer,
+        reply_min_above_room_db: float = REPLY_MIN_ABOVE_ROOM_DB,
     ) -> None:
         self.language = language
         #: language → recogniser; by default vosk with ``vosk_model`` (the config's) or an
@@ -99,6 +115,10 @@ class VoiceChannel:
         #: called with every utterance the endpointer closed (timings, cut-offs: for the bench)
         self.on_utterance = on_utterance
         self._endpointer_factory = endpointer_factory
+        #: a reply to "Is that right?" spoken less far above the room than this is sent as unsure
+        self.reply_min_above_room_db = reply_min_above_room_db
+        #: whether the current prompt asks "Is that right?" (a reply stores an answer)
+        self._confirming = False
         #: whether the current options score points (a Barthel question): only those answers
         #: are ever confirmed; a confirmation's own yes/no or a language choice is not
         self._scored = False
@@ -221,12 +241,14 @@ class VoiceChannel:
             scored = any(getattr(o, "points", None) is not None for o in prompt.options)
             self.set_question(option_words(prompt.options), prompt.language, scored=scored,
                               welcome=getattr(prompt, "kind", "") in ("welcome", "message"),
-                              key=getattr(prompt, "key", None))
+                              key=getattr(prompt, "key", None), confirming=getattr(prompt, "kind", "") == "confirm")
 
     def set_question(self, options: Sequence[OptionWords], language: str, scored: bool = False,
-                     welcome: bool = False, key: str | None = None) -> None:
+                     welcome: bool = False, key: str | None = None, confirming: bool = False) -> None:
         """Listen for this question's answers (and the commands) in ``language``; answers to a
         ``scored`` question are confirmed unless heard with confidence (see :data:`CONFIRM_BELOW`).
+        ``confirming``: the options reply to "Is that right?"; one spoken in a room nearly as
+        loud as the voice is sent as unsure (see :data:`REPLY_MIN_ABOVE_ROOM_DB`).
         At the ``welcome`` (or the explanation) the only command is calling the doctor, in whole phrases.
         ``key`` names the question: asked again under the same key, the options the patient
         declined on it are not listened for (see :meth:`declined`)."""
@@ -236,6 +258,7 @@ class VoiceChannel:
             self._options = list(options)
             self._scored = scored
             self._welcome = welcome
+            self._confirming = confirming
             self._undo_only = False
             if language != self.language:
                 self.language = language
@@ -267,7 +290,7 @@ class VoiceChannel:
         words would mean nothing in the thank-you gap."""
         with self._lock:
             self._options = []
-            self._scored = False
+            self._scored = self._confirming = False
             self._welcome = False
             self._undo_only = True
             self._apply_grammar()
@@ -392,11 +415,22 @@ class VoiceChannel:
         # one heard twice unsure
         unsure = result.confusable or result.confidence < max(self.min_confidence, self.confirm_below)
         confirm = self._scored and match.option is not None and unsure
+        if self._confirming and match.option is not None and not self._paused and self._too_loud(utterance):
+            confirm = True
         self._unsure = None
         if self._sink is not None:
             self._sink(ChannelInput(Channel.VOICE, option=match.option, command=match.command,
                                     detail=result.text, confidence=round(result.confidence, 3),
                                     needs_confirmation=confirm))
+
+    def _too_loud(self, utterance: Utterance) -> bool:
+        """Whether the room was nearly as loud as the voice (see :data:`REPLY_MIN_ABOVE_ROOM_DB`)."""
+        above = utterance.above_room_db
+        if above is None or above >= self.reply_min_above_room_db:
+            return False
+        log.info("voice: %r spoken %.1f dB above the room, too little to take as said",
+                 utterance.result.text, above)
+        return True
 
     def _heard_twice(self, result: Any) -> Match | None:
         """An unsure recognition that selects the same option as the one just before it on the

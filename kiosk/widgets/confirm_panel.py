@@ -24,6 +24,14 @@ class ConfirmPanel(Vertical):
         self.question = question
         self.replies = tuple(replies)
 
+    def ask(self, question: str) -> None:
+        """Put ``question`` in place of the one shown (asked again in other words: "Please press
+        Yes or No" where a spoken yes could not be told from the room)."""
+        if question != self.question:
+            self.question = question
+            for line in self.query("#confirm-question").results(Static):
+                line.update(question)
+
     def compose(self) -> ComposeResult:
         """The question back, then the replies taking the height left."""
         yield Static(self.question, id="confirm-question")

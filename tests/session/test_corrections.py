@@ -120,16 +120,41 @@ def test_a_confirmation_without_reply_never_stores_the_answer(tmp_path):
 
 
 def test_an_unsure_yes_does_not_confirm_an_unsure_answer(tmp_path):
+    """An unsure "yes" (the voice channel's, spoken in a room nearly as loud as the patient) is
+    asked again with the plea to press Yes or No, and the whole window again to do it."""
     rig, store = stored_rig(tmp_path)
     rig.at(30)
     rig.session.handle(unsure(3))
-    rig.at(33)
-    rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="yes", confidence=0.5, needs_confirmation=True))
+    rig.at(38)
+    rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="yes", confidence=0.9, needs_confirmation=True))
     assert rig.of(InputIgnored)[-1].reason is IgnoreReason.UNSURE_REPLY
-    assert (rig.of(Prompt)[-1].kind, rig.of(Prompt)[-1].repeat) == ("confirm", True)
+    prompt = rig.of(Prompt)[-1]
+    assert (prompt.kind, prompt.repeat) == ("confirm", True)
+    assert prompt.text == ("I could not hear you clearly. I heard: Independent. Is that right? "
+                           "Please press Yes or No.") == prompt.spoken
+    assert rig.session.snapshot().confirming == 3
     assert store.session(rig.session.id).answers == ()
-    rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="yes", confidence=0.9))
-    assert [a.option for a in store.session(rig.session.id).answers] == [3]
+    # the 10 s window would have ended at 40: pressing takes longer than saying yes
+    rig.run_until(38 + QUESTIONNAIRE.timing.confirm_window_s - 0.5)
+    assert not rig.of(AnswerNotConfirmed) and rig.session.snapshot().confirming == 3
+    rig.session.handle(ChannelInput(Channel.TOUCH, option=1, detail="touch"))
+    (answer,) = store.session(rig.session.id).answers
+    assert (answer.option, answer.channel, answer.attempt) == (3, Channel.VOICE, 1)
+
+
+def test_the_plea_to_press_is_in_the_patients_language_and_a_spoken_no_still_declines(tmp_path):
+    rig, store = stored_rig(tmp_path, language="fr")
+    rig.at(30)
+    rig.session.handle(unsure(3, "autonome"))
+    rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="oui", confidence=0.9, needs_confirmation=True))
+    assert rig.of(Prompt)[-1].text == ("Je ne vous ai pas bien entendu. J'ai compris : Autonome. Est-ce bien cela ? "
+                                       "Appuyez sur Oui ou Non, s'il vous plaît.")
+    rig.session.handle(ChannelInput(Channel.VOICE, option=2, detail="non", confidence=0.9, needs_confirmation=True))
+    assert rig.of(AnswerNotConfirmed)[-1].why == "declined"
+    assert rig.session.snapshot().confirming is None and store.session(rig.session.id).answers == ()
+    # heard again, it is asked back in the usual words: the plea was for that one reply
+    rig.session.handle(unsure(3, "autonome"))
+    assert rig.of(Prompt)[-1].text == "J'ai compris : Autonome. Est-ce bien cela ?"
 
 
 def test_the_question_back_is_in_the_patients_language_and_survives_pause_and_language_change(tmp_path):
