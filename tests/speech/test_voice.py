@@ -2,12 +2,11 @@
 recogniser hear it under the question's grammar, and the real session records it as a voice answer.
 
 Runs with pocketsphinx (bundled English model) everywhere, and with vosk when a model is
-present (``KIOSK_VOSK_MODEL``, or ``../shared/models`` beside the repository).
+present (``KIOSK_VOSK_MODEL``, or one installed with ``kiosk models install``).
 """
 
 from __future__ import annotations
 
-import os
 import threading
 from pathlib import Path
 
@@ -26,18 +25,11 @@ from kiosk.speech.voice import VoiceChannel
 from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
 
 QUESTIONNAIRE = load_questionnaire()
-DEVELOPER_MODELS = Path(__file__).resolve().parents[2].parent / "shared" / "models"
 
 
 def _vosk_model(language: str) -> Path | None:
-    """A developer's vosk model for ``language``: configured, installed, or in ../shared/models."""
-    if "KIOSK_VOSK_MODEL" in os.environ or not DEVELOPER_MODELS.is_dir():
-        return find_model(language)
-    os.environ["KIOSK_VOSK_MODEL"] = str(DEVELOPER_MODELS)
-    try:
-        return find_model(language)
-    finally:
-        del os.environ["KIOSK_VOSK_MODEL"]
+    """A vosk model for ``language`` as the kiosk would find it: ``KIOSK_VOSK_MODEL``, or installed."""
+    return find_model(language)
 
 
 def _backends(language: str):
@@ -48,7 +40,7 @@ def _backends(language: str):
     params.append(pytest.param(
         lambda lang, model=model: VoskRecogniser(model, lang), id="vosk",
         marks=pytest.mark.skipif(model is None, reason=f"no vosk model for {language!r}: set "
-                                 "KIOSK_VOSK_MODEL or put one in ../shared/models (none can be downloaded here)"),
+                                 "KIOSK_VOSK_MODEL or run `kiosk models install` (none can be downloaded here)"),
     ))
     return params
 
