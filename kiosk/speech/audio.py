@@ -518,7 +518,8 @@ class UtterancePipeline:
                 finish_seconds=finish_seconds,
                 complete=complete,
                 cut_off=self.endpointer.cut_off,
-                speech_db=10 * math.log10(max(float(np.mean(self._loud)) / 32768.0 ** 2, 1e-10)) if self._loud else None,
+                speech_db=(10 * math.log10(max(float(np.mean(self._loud)) / 32768.0 ** 2, 1e-10))
+                           if self._loud else None),
                 room_db=self._room_db,
             )
         )

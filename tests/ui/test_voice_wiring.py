@@ -120,8 +120,8 @@ async def test_a_yes_too_close_to_the_rooms_noise_asks_for_a_press_and_a_touch_s
     answer = _in_a_fan(tmp_path / "a.wav", synthesiser.synthesise("independent", "en", tmp_path / "independent.wav"))
     yes = _in_a_fan(tmp_path / "y.wav", synthesiser.synthesise("yes", "en", tmp_path / "yes.wav"))
     microphones: list[WavMicrophone] = []
-    voice = VoiceChannel("en", reply_min_above_room_db=30.0,
-                         microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
+    voice = VoiceChannel("en", reply_min_above_room_db=30.0, microphone_factory=lambda consumer: (
+        microphones.append(WavMicrophone(consumer)) or microphones[-1]))
     kiosk = ui_kiosk(familiarisation=False, voice=voice)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await until_thread(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON, "the voice channel")
