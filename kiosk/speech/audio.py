@@ -266,6 +266,11 @@ class Endpointer:
         self._voiced_run = 0
         self._quiet_run = 0
         self._speech_frames = 0
+        #: the room's level and ceiling as the utterance started, and the levels of its frames
+        #: above that ceiling (see :attr:`speech_db`, :attr:`room_at_start_db`)
+        self.room_at_start_db: float | None = None
+        self._start_ceiling_db = -90.0
+        self._loud: list[float] = []
 
     def is_voiced(self, level_db: float, margin_db: float | None = None,
                   ceiling_margin_db: float | None = None) -> bool:
@@ -319,6 +324,11 @@ class Endpointer:
                         self._room.pop()  # the run that started it was speech, not the room
                     self._update_ceiling()
                     self._speech_frames = self._voiced_run
+                    # the room as the patient began, and the run that started it (the last levels
+                    # learned, all above min_speech_db), which is speech
+                    self.room_at_start_db, self._start_ceiling_db = self.room_db, self.ceiling_db
+                    run = list(self._levels)[-self._voiced_run:]
+                    self._loud = [v for v in run if v >= self._start_ceiling_db]
                     return "start"
             else:
                 self._voiced_run = 0
@@ -329,7 +339,17 @@ class Endpointer:
         if self._quiet_run >= end_frames or self._speech_frames >= self._max_frames:
             self.in_speech, self._voiced_run = False, 0
             return "end"
+        if level >= self._start_ceiling_db:
+            self._loud.append(level)
         return None
+
+    @property
+    def speech_db(self) -> float | None:
+        """The level (dBFS, mean power) of the current or last utterance's frames that stood
+        above the room's ceiling as it started (None: no such frame)."""
+        if not self._loud:
+            return None
+        return 10 * math.log10(float(np.mean(np.power(10.0, np.asarray(self._loud) / 10))))
 
     @property
     def room_db(self) -> float | None:
@@ -433,11 +453,6 @@ class UtterancePipeline:
         self._muted = False
         #: whether the recogniser's latest partial result is a whole answer
         self._complete = False
-        #: the utterance's frames' powers (int16 units squared) that stood above the room's
-        #: ceiling, and the room's level as it started (see Utterance.speech_db, room_db)
-        self._loud: list[float] = []
-        self._room_db: float | None = None
-        self._ceiling_db = -90.0
 
     @property
     def muted(self) -> bool:
@@ -480,7 +495,6 @@ class UtterancePipeline:
         event = self.endpointer.push(np.frombuffer(chunk, dtype="<i2"), self._complete)
         if event is None:
             if self.endpointer.in_speech:
-                self._measure(chunk)
                 self._hear(chunk)
             else:
                 self._preroll.append(chunk)
@@ -491,12 +505,6 @@ class UtterancePipeline:
             self._start = self.stream_time - self.endpointer.start_frames * frame_s
             self.recogniser.reset()
             self._complete = False
-            # the room as the patient began (the endpointer keeps the frames that started the
-            # utterance out of it), and the frames that started it, which are speech
-            self._room_db, self._ceiling_db, self._loud = self.endpointer.room_db, self.endpointer.ceiling_db, []
-            run = list(self._preroll)[max(0, len(self._preroll) - self.endpointer.start_frames + 1):]
-            for frame in (*run, chunk):
-                self._measure(frame)
             self._hear(b"".join(self._preroll) + chunk)
             self._preroll.clear()
             return
@@ -518,17 +526,10 @@ class UtterancePipeline:
                 finish_seconds=finish_seconds,
                 complete=complete,
                 cut_off=self.endpointer.cut_off,
-                speech_db=(10 * math.log10(max(float(np.mean(self._loud)) / 32768.0 ** 2, 1e-10))
-                           if self._loud else None),
-                room_db=self._room_db,
+                speech_db=self.endpointer.speech_db,
+                room_db=self.endpointer.room_at_start_db,
             )
         )
-
-    def _measure(self, chunk: bytes) -> None:
-        """Note the frame's power if it stands above the room's ceiling (the speaker's words)."""
-        frame = np.frombuffer(chunk, dtype="<i2")
-        if frame_level_db(frame) >= self._ceiling_db:
-            self._loud.append(float(np.mean(frame.astype(np.float64) ** 2)))
 
     def _hear(self, chunk: bytes) -> None:
         """Pass audio of the utterance to the recogniser and note whether it is a whole answer."""
