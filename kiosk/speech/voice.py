@@ -415,7 +415,7 @@ class VoiceChannel:
         # one heard twice unsure
         unsure = result.confusable or result.confidence < max(self.min_confidence, self.confirm_below)
         confirm = self._scored and match.option is not None and unsure
-        if self._confirming and match.option is not None and not self._paused and self._too_loud(utterance):
+        if self._confirming and match.option is not None and self._too_loud(utterance):
             confirm = True
         self._unsure = None
         if self._sink is not None:
