@@ -27,16 +27,11 @@ from kiosk.widgets.channel_board import VOICE_IN, ChannelBoard
 QUESTIONNAIRE = load_questionnaire()
 
 
-def _vosk_model(language: str) -> Path | None:
-    """A vosk model for ``language`` as the kiosk would find it: ``KIOSK_VOSK_MODEL``, or installed."""
-    return find_model(language)
-
-
 def _backends(language: str):
     params = []
     if language == "en":
         params.append(pytest.param(lambda lang: PocketSphinxRecogniser(lang), id="pocketsphinx"))
-    model = _vosk_model(language)
+    model = find_model(language)  # as the kiosk finds one: KIOSK_VOSK_MODEL, or installed
     params.append(pytest.param(
         lambda lang, model=model: VoskRecogniser(model, lang), id="vosk",
         marks=pytest.mark.skipif(model is None, reason=f"no vosk model for {language!r}: set "
