@@ -1,0 +1,115 @@
+"""Start-up: launch to the welcome, the kiosk against a two-widget Textual app started the same way
+(goal: ratio at most 1.5).
+
+Both run as ``python -m …`` on a pseudo-terminal of 100x32, fresh data directory, no station; the
+clock stops when the welcome's "English" button is on the terminal (escape sequences stripped),
+which is what a patient waits for. Rounds alternate the two apps so machine load hits both alike;
+the medians' ratio is the figure. Also reports ``python -X importtime`` of ``kiosk.app``'s heaviest
+imports. Prints JSON. Run: uv run python bench/startup.py [--rounds N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import fcntl
+import json
+import os
+import pty
+import re
+import select
+import signal
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import termios
+import time
+
+#: the baseline: two widgets, the same first words a patient sees
+TWO_WIDGET_APP = """
+from textual.app import App
+from textual.widgets import Button, Static
+
+class TwoWidgets(App):
+    def compose(self):
+        yield Static("Welcome. Please choose your language.")
+        yield Button("1  English")
+
+TwoWidgets().run()
+"""
+MARKER = b"English"
+_ANSI = re.compile(rb"\x1b\[[0-9;?<>=]*[A-Za-z~]|\x1b[()][A-Z0-9]|\x1b\][^\x07\x1b]*(\x07|\x1b\\)|\x1b[=>]")
+
+
+def time_to_marker(argv: list[str], env: dict[str, str], timeout_s: float = 60.0) -> float:
+    """Seconds from fork to MARKER drawn on a 100x32 pseudo-terminal; the process is then killed."""
+    began = time.perf_counter()
+    pid, fd = pty.fork()
+    if pid == 0:  # pragma: no cover - the child
+        os.execvpe(argv[0], argv, env)
+    fcntl.ioctl(fd, termios.TIOCSWINSZ, struct.pack("HHHH", 32, 100, 0, 0))
+    seen = b""
+    try:
+        while MARKER not in _ANSI.sub(b"", seen):
+            ready, _, _ = select.select([fd], [], [], max(0.0, began + timeout_s - time.perf_counter()))
+            if not ready:
+                raise TimeoutError(f"{argv[-1]} drew no {MARKER!r} within {timeout_s} s")
+            try:
+                seen += os.read(fd, 65536)
+            except OSError:  # the child closed the terminal: it exited before the welcome
+                raise RuntimeError(f"{argv[-1]} exited before the welcome: "
+                                   f"{_ANSI.sub(b'', seen)[-400:].decode(errors='replace')}") from None
+        return time.perf_counter() - began
+    finally:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        os.close(fd)
+
+
+def heaviest_imports(n: int = 8) -> list[dict[str, object]]:
+    """The ``n`` largest cumulative import times (ms) under ``import kiosk.app``."""
+    err = subprocess.run([sys.executable, "-X", "importtime", "-c", "import kiosk.app"],
+                         capture_output=True, text=True, check=True).stderr
+    rows = []
+    for line in err.splitlines():
+        parts = line.split("|")
+        if len(parts) == 3 and parts[1].strip().isdigit():
+            rows.append({"module": parts[2].strip(), "cumulative_ms": int(parts[1]) / 1000})
+    return sorted(rows, key=lambda r: -float(r["cumulative_ms"]))[:n]
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=7)
+    args = parser.parse_args(argv)
+    with tempfile.TemporaryDirectory() as tmp:
+        baseline = os.path.join(tmp, "two_widgets.py")
+        with open(baseline, "w", encoding="utf-8") as f:
+            f.write(TWO_WIDGET_APP)
+        config = os.path.join(tmp, "config.yaml")
+        with open(config, "w", encoding="utf-8") as f:
+            f.write("{}\n")
+        env = dict(os.environ, TERM="xterm-256color", KIOSK_DATA_DIR=os.path.join(tmp, "data"),
+                   KIOSK_CONFIG=config)
+        env.pop("KIOSK_STATION_URL", None)
+        two, kiosk = [], []
+        for _ in range(args.rounds):
+            two.append(time_to_marker([sys.executable, baseline], env))
+            kiosk.append(time_to_marker([sys.executable, "-m", "kiosk"], env))
+    ratio = statistics.median(kiosk) / statistics.median(two)
+    print(json.dumps({
+        "rounds": args.rounds,
+        "two_widget_s_median": round(statistics.median(two), 3),
+        "kiosk_s_median": round(statistics.median(kiosk), 3),
+        "kiosk_s_best": round(min(kiosk), 3),
+        "ratio_median": round(ratio, 2),
+        "goal_ratio": 1.5,
+        "goal_met": ratio <= 1.5,
+        "heaviest_imports_ms": heaviest_imports(),
+    }, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
