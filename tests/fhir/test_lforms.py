@@ -93,7 +93,9 @@ def test_lhc_forms_shows_every_answer_and_the_same_total(lforms_page, replayed, 
         shown = rendered["shown"][item.id]
         if item.id in expected.options:
             option = item.option(expected.options[item.id])
-            assert shown == f"{option.label_in(language)} - {option.points}", (item.id, shown)
+            # the Coding's display is LOINC's for the code (the wording is in the extension beside it)
+            display = option.code.display if option.code and option.code.display else option.label_in(language)
+            assert shown == f"{display} - {option.points}", (item.id, shown)
         else:
             assert shown == "", (item.id, shown)
     assert rendered["shown"]["total"] == (str(expected.score.total) if expected.complete else "")
