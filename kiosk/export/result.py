@@ -139,7 +139,7 @@ class Result:
     @property
     def changed(self) -> bool:
         """Answers other than the kiosk recorded, signed off or not."""
-        return self.state in (ReviewState.AMENDED, ReviewState.CORRECTED)
+        return self.options != {a.item_id: a.option for a in self.stored.answers}
 
     @property
     def review_state(self) -> str:
