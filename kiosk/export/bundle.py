@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import quote
 
-from kiosk.export.fhir import _response, _total, fhir_device, fhir_questionnaire, questionnaire_canonical
+from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of, total_of
 from kiosk.export.provenance import fhir_provenances
 from kiosk.export.result import ExportSite, Result, questionnaire_version, results
 from kiosk.questionnaire import Questionnaire
@@ -62,14 +62,14 @@ def _questionnaire_entry(q: Questionnaire, site: ExportSite, language: str) -> d
 
 def _result_entries(d: Described, device_url: str) -> list[dict[str, Any]]:
     q, r, site = d.questionnaire, d.result, d.site
-    response = _response(q, r, site)
+    response = response_of(q, r, site)
     response["author"] = response["author"] | {"reference": device_url}
     value = site.result_id(r.stored.id)
     response_url = _full_url(site.identifier_system, value)
     entries = [_entry(response, response_url, _query(identifier=f"{site.identifier_system}|{value}"),
                       update=r.final)]
-    total = _total(q, r, site, {"reference": response_url, "type": "QuestionnaireResponse",
-                                "identifier": response["identifier"]})
+    total = total_of(q, r, site, {"reference": response_url, "type": "QuestionnaireResponse",
+                                  "identifier": response["identifier"]})
     if total is not None:
         total["device"] |= {"reference": device_url}
         entries.append(_entry(total, _full_url(site.identifier_system, value + "/total"),

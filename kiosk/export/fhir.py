@@ -57,11 +57,9 @@ Choices, each from the R4 specification:
 from __future__ import annotations
 
 import re
-import uuid
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from datetime import datetime, timezone
 from typing import Any
-from urllib.parse import quote
 
 from kiosk.export.result import (
     TOTAL_LINK,
@@ -70,7 +68,6 @@ from kiosk.export.result import (
     Result,
     questionnaire_version,
     result,
-    results,
 )
 from kiosk.questionnaire import Code, Questionnaire
 from kiosk.review import Review, ReviewState
@@ -124,7 +121,7 @@ def _coding(code: Code, display: str | None = None) -> dict[str, str]:
     return {"system": code.system, "code": code.code} | ({"display": shown} if shown else {})
 
 
-def _option_coding(q: Questionnaire, item_id: str, number: int, language: str) -> dict[str, Any]:
+def option_coding(q: Questionnaire, item_id: str, number: int, language: str) -> dict[str, Any]:
     """An option's Coding: the code system's display for its code; a local code (no published
     one) shows the option's label, with the other languages as translations."""
     option = q.item(item_id).option(number)
@@ -173,7 +170,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
             {"extension": [{"url": ITEM_WEIGHT, "valueDecimal": option.points},
                            {"url": ORDINAL_VALUE, "valueDecimal": option.points},
                            wording(language, clinical=option.label, patient=option.patient)],
-             "valueCoding": _option_coding(q, item.id, option.number, language)}
+             "valueCoding": option_coding(q, item.id, option.number, language)}
             for option in item.options
         ]
         items.append(entry)
@@ -236,10 +233,11 @@ def _authored(r: Result) -> str:
 def fhir_response(q: Questionnaire, stored: StoredSession, review: Review | None = None,
                   site: ExportSite | None = None) -> dict[str, Any]:
     """A stored session (with its clinician's review, if any) as an R4 QuestionnaireResponse."""
-    return _response(q, result(q, stored, review), site or ExportSite())
+    return response_of(q, result(q, stored, review), site or ExportSite())
 
 
-def _response(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
+def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
+    """A :class:`Result` as an R4 QuestionnaireResponse (what :func:`fhir_response` and Bundles say)."""
     stored, language = r.stored, r.stored.language
     changed = {c.item_id for c in r.review.corrections}
     items = []
@@ -251,7 +249,7 @@ def _response(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
         entry |= {"extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
                   "linkId": item.id, "text": item.text[language],
                   "answer": [{"extension": [wording(language, clinical=option.label, patient=option.patient)],
-                              "valueCoding": _option_coding(q, item.id, option.number, language)}]}
+                              "valueCoding": option_coding(q, item.id, option.number, language)}]}
         items.append(entry)
     if r.complete:
         items.append({"linkId": TOTAL_LINK, "text": TOTAL_TEXT.get(language, TOTAL_TEXT["en"]),
@@ -297,10 +295,12 @@ def fhir_total(q: Questionnaire, stored: StoredSession, review: Review | None = 
     site = site or ExportSite()
     response = {"type": "QuestionnaireResponse",
                 "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)}}
-    return _total(q, result(q, stored, review), site, response)
+    return total_of(q, result(q, stored, review), site, response)
 
 
-def _total(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
+def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
+    """A :class:`Result`'s total as an Observation derived from ``response`` (a Reference); None
+    when incomplete."""
     if not r.complete or q.total_code is None:
         return None
     stored, language = r.stored, r.stored.language

@@ -25,7 +25,7 @@ from __future__ import annotations
 import uuid
 from typing import Any
 
-from kiosk.export.fhir import _option_coding, device_reference, instant, practitioner
+from kiosk.export.fhir import device_reference, instant, option_coding, practitioner
 from kiosk.export.result import ExportSite, Result
 from kiosk.questionnaire import Questionnaire
 
@@ -47,7 +47,7 @@ def _replaced(q: Questionnaire, r: Result, item_id: str, option: int, kiosk_answ
               device: dict[str, Any], author: str | None) -> dict[str, Any]:
     language = r.stored.language
     choice = q.item(item_id).option(option)
-    coding = _option_coding(q, item_id, option, language)
+    coding = option_coding(q, item_id, option, language)
     source = "the kiosk" if kiosk_answer else (author or "staff")
     what = (f"{item_id} as recorded by {source}: option {option} {choice.label_in(language)!r} "
             f"({coding['code']}, {choice.points} points)")

@@ -121,11 +121,6 @@ class Result:
         return self.review.final
 
     @property
-    def changers(self) -> tuple[str, ...]:
-        """Who changed an answer the kiosk recorded (or filled one it had not), oldest first."""
-        return tuple(dict.fromkeys(c.author for c in self.review.corrections if self.recorded(c.item_id) != c.option))
-
-    @property
     def state(self) -> ReviewState:
         """Where the result stands (:func:`kiosk.review.review_state`: the one answer the CSV,
         the FHIR response and Observation, and the station's pages all give)."""

@@ -13,7 +13,7 @@ from datetime import UTC, datetime
 import pytest
 
 from kiosk.export import REPLACED_ANSWER
-from tests.station.conftest import new_kiosk, shared_station  # noqa: F401,F811 - the station fixture
+from tests.station.conftest import new_kiosk, shared_station  # noqa: F401 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 
 from .standard import check_fhir
