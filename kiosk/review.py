@@ -121,7 +121,7 @@ def review_from_steps(steps: Iterable[Step], staff_system: str = STAFF_SYSTEM) -
             reopenings.append(Reopening(step.author, step.at, step.reason, sign.author, sign.at))
             sign = None
     if sign is None:
-        state = ReviewState.CORRECTED if corrections else ReviewState.UNREVIEWED
+        state = ReviewState.CORRECTED if corrections or reopenings else ReviewState.UNREVIEWED
         return Review(state, tuple(corrections), reopenings=tuple(reopenings), staff_system=staff_system)
     state = ReviewState.AMENDED if corrections else ReviewState.SIGNED_OFF
     return Review(state, tuple(corrections), sign.author, sign.at, tuple(reopenings), staff_system)

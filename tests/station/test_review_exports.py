@@ -61,7 +61,7 @@ def test_amending_keeps_every_step_and_the_period_export_follows_the_sign_offs(e
     with pytest.raises(validation.ValidationError, match="not signed off"):
         validation.amend(engine, unsigned, "nothing to reopen", DOCTOR)
     validation.amend(engine, signed, "physio: stairs need help", DOCTOR)
-    assert validation.review(engine, signed).state is ReviewState.UNREVIEWED  # not final any more
+    assert validation.review(engine, signed).state is ReviewState.CORRECTED  # not final any more
     assert exports.period_bundle(engine, q, today, today) == {"resourceType": "Bundle", "type": "transaction"}
     validation.change_item(engine, q, signed, "stairs", 2, "seen on the stairs", DOCTOR)
     validation.sign_off(engine, signed, DOCTOR)
