@@ -43,17 +43,17 @@ def provenance_id(site: ExportSite, r: Result, n: int) -> str:
     return str(uuid.uuid5(uuid.NAMESPACE_URL, f"{site.identifier_system}|{site.result_id(r.stored.id)}/change/{n}"))
 
 
-def _replaced(q: Questionnaire, r: Result, item_id: str, option: int, kiosk_answer: bool,
-              device: dict[str, Any], author: str | None) -> dict[str, Any]:
+def _replaced(q: Questionnaire, r: Result, item_id: str, option: int, device: dict[str, Any],
+              author: str | None) -> dict[str, Any]:
+    """The answer a change replaced, and who gave it (``author`` None: the kiosk ``device``)."""
     language = r.stored.language
     choice = q.item(item_id).option(option)
     coding = option_coding(q, item_id, option, language)
-    source = "the kiosk" if kiosk_answer else (author or "staff")
-    what = (f"{item_id} as recorded by {source}: option {option} {choice.label_in(language)!r} "
+    what = (f"{item_id} as recorded by {author or 'the kiosk'}: option {option} {choice.label_in(language)!r} "
             f"({coding['code']}, {choice.points} points)")
     return {"extension": [{"url": REPLACED_ANSWER, "valueCoding": coding}], "role": "revision",
             "what": {"display": what},
-            "agent": [{"who": device if kiosk_answer else practitioner(author or "", r.review.staff_system)}]}
+            "agent": [{"who": practitioner(author, r.review.staff_system) if author else device}]}
 
 
 def fhir_provenances(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any],
@@ -64,10 +64,9 @@ def fhir_provenances(q: Questionnaire, r: Result, site: ExportSite, response: di
     device = device or device_reference(site)
     staff = r.review.staff_system
     events: list[tuple[str, dict[str, Any]]] = []
-    authors: dict[str, str | None] = {}  # item -> who gave its current answer (None: the kiosk)
+    authors: dict[str, str] = {}  # item -> who last changed it (absent: its answer is the kiosk's)
     for c in r.review.corrections:
-        kiosk_answer = c.previous_option is not None and authors.get(c.item_id, None) is None \
-            and r.recorded(c.item_id) == c.previous_option
+        kiosk_answer = c.item_id not in authors  # no earlier change: the answer replaced is the kiosk's
         resource: dict[str, Any] = {
             "resourceType": "Provenance",
             "target": [response | {"extension": [{"url": TARGET_ELEMENT, "valueUri": c.item_id}]}],
@@ -78,8 +77,8 @@ def fhir_provenances(q: Questionnaire, r: Result, site: ExportSite, response: di
             "agent": [{"type": AUTHOR, "who": practitioner(c.author, staff)}],
         }
         if c.previous_option is not None:
-            resource["entity"] = [_replaced(q, r, c.item_id, c.previous_option, kiosk_answer, device,
-                                            authors.get(c.item_id))]
+            resource["entity"] = [_replaced(q, r, c.item_id, c.previous_option, device,
+                                            None if kiosk_answer else authors[c.item_id])]
         authors[c.item_id] = c.author
         events.append((c.at, resource))
     for reopening in r.review.reopenings:

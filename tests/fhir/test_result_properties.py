@@ -7,7 +7,7 @@ from __future__ import annotations
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from kiosk.export import ExportSite, fhir_response, fhir_total
+from kiosk.export import ExportSite, fhir_response, fhir_total, transaction_bundle
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
 
@@ -56,3 +56,10 @@ def test_the_export_never_states_a_total_or_a_state_it_does_not_have(replayed, p
         check_fhir(observation)
         assert observation["valueQuantity"]["value"] == expected
         assert (observation["status"] == "preliminary") == (not review.final)
+    bundle = transaction_bundle(QUESTIONNAIRE, [stored], [review], SITE)
+    check_fhir(bundle)  # the Provenance of every change too
+    provenances = [e for e in bundle["entry"] if e["resource"]["resourceType"] == "Provenance"]
+    assert len(provenances) == len(review.corrections)
+    assert all(e["resource"]["agent"][0]["who"]["identifier"]["value"] == "nurse.kim" for e in provenances)
+    requests = {e["resource"]["resourceType"]: e["request"]["method"] for e in bundle["entry"]}
+    assert requests["QuestionnaireResponse"] == ("PUT" if review.final else "POST")
