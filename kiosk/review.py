@@ -131,9 +131,8 @@ def review_state(review: Review, recorded: Mapping[str, int]) -> ReviewState:
     """Where a result stands, the one answer every export and page gives: ``amended`` (signed off
     with answers other than the kiosk ``recorded``), ``signed_off`` (signed off as recorded),
     ``corrected`` (answers changed, or a signed result reopened to amend, and not signed off)
-    or ``unreviewed``. Changes that came back to
-    the kiosk's answer count as none, so a changed answer is never reported as the kiosk's and
-    an unchanged one never as changed."""
+    or ``unreviewed``. Changes that came back to the kiosk's answer count as none, so a changed
+    answer is never reported as the kiosk's and an unchanged one never as changed."""
     changed = review.options(dict(recorded)) != dict(recorded)
     if review.final:
         return ReviewState.AMENDED if changed else ReviewState.SIGNED_OFF

@@ -59,7 +59,7 @@ async def ward_page(request: Request) -> Response:
     recent = await run_in_threadpool(_session_rows, engine)
     reviews = await run_in_threadpool(validation.reviews, engine, [row.id for row in recent])
     return render(request, "ward.html", kiosks=views, alerts=pending, sessions=recent, reviews=reviews,
-                  now=db.now(), message=request.query_params.get("message"))
+                  now=db.now(), today=db.now_iso()[:10], message=request.query_params.get("message"))
 
 
 def _back(request: Request, message: str | None = None, to: str = "/") -> Response:

@@ -5,6 +5,7 @@ phone's width and a desktop's."""
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from dataclasses import replace
@@ -172,4 +173,10 @@ def test_a_doctor_reopens_a_signed_result_amends_it_and_signs_again(browser, war
     trail = page.locator("table.trail").inner_text()
     assert trail.count("sign off") == 2 and "physiotherapist: needs help on stairs" in trail
     assert page.locator("#amend").count() == 1  # signed again: it can be amended again
+    page.goto(station.url + "/")  # the ward page's period export: today's signed-off results
+    with page.expect_download() as download:
+        page.locator("form.period-export button").click()
+    bundle = json.loads(download.value.path().read_text(encoding="utf-8"))
+    assert any(e["resource"]["identifier"]["value"].endswith(session) for e in bundle["entry"]
+               if e["resource"]["resourceType"] == "QuestionnaireResponse")
     context.close()
