@@ -59,6 +59,8 @@ def test_the_hospital_ends_with_one_result_per_session_the_amended_one_with_its_
         client.close()
     page = f"/sessions/{session_id}"
     nurse, doctor = Staff(station.url, "nurse.kim", "nurse"), Staff(station.url)
+    # one code path: before any review the station's Bundle is the kiosk's, entry for entry
+    assert doctor.http.get(f"{page}/export.json").json() == json.loads(kiosk_bundle.read_text(encoding="utf-8"))
     assert nurse.post(f"{page}/items/feeding", option="2", reason="needs help cutting").status_code == 303
     assert doctor.post(f"{page}/sign-off").status_code == 303
     signed = tmp_path / "station-signed.json"
