@@ -391,3 +391,15 @@ def test_one_review_state_from_the_trail_for_every_export():
                                           step("sign_off", at="2026-11-23T17:00:00Z")])
     assert again.final and again.signed_at == "2026-11-23T17:00:00Z"
     assert review_state(again, recorded) is ReviewState.AMENDED
+
+
+def test_kiosk_validate_refuses_one_code_with_two_displays(tmp_path):
+    copy = tmp_path / "barthel.yaml"
+    text = (ROOT / "kiosk/questionnaires/barthel.yaml").read_text(encoding="utf-8")
+    copy.write_text(text.replace('code: "LA12304-4", display: "Dependent"', 'code: "LA12304-4", display: "I need help"', 1),
+                    encoding="utf-8")
+    problems = [str(p) for p in check_questionnaire_file(copy)]
+    assert problems and all(p.startswith(f"{copy}:") for p in problems)
+    assert any("code 'LA12304-4' has the display 'Dependent' here but 'I need help' at items[1].options[0].code: "
+               "one code, one display" in p for p in problems), problems
+    assert check_questionnaire_file(ROOT / "kiosk/questionnaires/barthel.yaml") == []
