@@ -4,10 +4,13 @@ response has every required item, and only a signed-off result is final."""
 
 from __future__ import annotations
 
+import csv
+import io
+
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from kiosk.export import ExportSite, fhir_response, fhir_total, transaction_bundle
+from kiosk.export import ExportSite, csv_text, fhir_response, fhir_total, transaction_bundle
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
 
@@ -63,3 +66,14 @@ def test_the_export_never_states_a_total_or_a_state_it_does_not_have(replayed, p
     assert all(e["resource"]["agent"][0]["who"]["identifier"]["value"] == "nurse.kim" for e in provenances)
     requests = {e["resource"]["resourceType"]: e["request"]["method"] for e in bundle["entry"]}
     assert requests["QuestionnaireResponse"] == ("PUT" if review.final else "POST")
+    # one story: the CSV's review state is what the response and the Observation say
+    (state,) = {row["review_state"] for row in csv.DictReader(io.StringIO(csv_text(QUESTIONNAIRE, [stored], [review],
+                                                                                   SITE)))}
+    assert (state in ("corrected", "amended")) == changed_now(stored, options)
+    if complete:
+        assert (response["status"] == "amended") == (state in ("corrected", "amended"))
+        assert observation["status"] == {"amended": "amended", "signed_off": "final"}.get(state, "preliminary")
+
+
+def changed_now(stored, options) -> bool:
+    return options != {a.item_id: a.option for a in stored.answers}
