@@ -10,7 +10,13 @@ import io
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from kiosk.export import ExportSite, csv_text, fhir_response, fhir_total, transaction_bundle
+from kiosk.export import (
+    ExportSite,
+    csv_text,
+    fhir_response,
+    fhir_total,
+    transaction_bundle,
+)
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
 
