@@ -40,10 +40,12 @@ class Row:
 
 
 def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None,
-                   export: dict[str, str] | None = None) -> list[Row]:
+                   export: dict[str, str] | None = None, data_dir: Path | None = None) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
     on the kiosk's real :class:`kiosk.storage.Store` with a station configured, its outbox read
-    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity."""
+    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity. The store is
+    thrown away, unless ``data_dir`` names where to keep it (for the kiosk's own exports)."""
+    import contextlib
     from dataclasses import replace
 
     from kiosk.replay import load_script, run_script
@@ -52,7 +54,8 @@ def record_patient(script: str | Path, first_seq: int = 1, patient: str | None =
     loaded = load_script(script)
     if patient is not None:
         loaded = replace(loaded, patient=patient)
-    with tempfile.TemporaryDirectory() as directory:
+    kept = contextlib.nullcontext(str(data_dir)) if data_dir is not None else tempfile.TemporaryDirectory()
+    with kept as directory:
         with Store.open(directory, outbox=True, export=export) as store:
             run_script(loaded, store=store)
         with sqlite3.connect(Path(directory) / DB_NAME) as connection:

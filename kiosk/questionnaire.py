@@ -61,6 +61,8 @@ class Code:
 
     system: str
     code: str
+    #: the code system's own display for the code (LOINC's), exported as ``Coding.display``
+    display: str = ""
 
 
 @dataclass(frozen=True)
@@ -443,6 +445,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                     add(path + (i, "points"), f"two options of {describe(path[:-1])} score {points} points")
                 seen.add(points)
 
+    _check_displays(data, dicts, add)
     ids: dict[str, tuple[Any, ...]] = {}
     for section in ("items", "familiarisation"):
         for i, entry in dicts(data.get(section)):
@@ -468,6 +471,25 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                 add(path + ("expected",), f"expected option {expected} but there are only {len(opts)} options")
 
     _check_bands(data, dicts, texts, add)
+
+
+def _check_displays(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
+                    add: Callable[..., None]) -> None:
+    """One code, one display: a code system gives a code one display, so two places of the
+    file giving one code two displays is a mistake (an export would say both)."""
+    first: dict[tuple[Any, Any], tuple[str, tuple[Any, ...]]] = {}
+    places: list[tuple[tuple[Any, ...], Any]] = [(("code",), data.get("code")), (("total_code",), data.get("total_code"))]
+    for i, item in dicts(data.get("items")):
+        places.append((("items", i, "code"), item.get("code")))
+        places += [(("items", i, "options", j, "code"), option.get("code")) for j, option in dicts(item.get("options"))]
+    for path, code in places:
+        if not isinstance(code, dict) or not isinstance(code.get("display"), str):
+            continue
+        key = (code.get("system"), code.get("code"))
+        if key in first and first[key][0] != code["display"]:
+            add(path + ("display",), f"code {key[1]!r} has the display {code['display']!r} here but "
+                                     f"{first[key][0]!r} at {describe(first[key][1])}: one code, one display")
+        first.setdefault(key, (code["display"], path))
 
 
 def _reachable_totals(items: list[tuple[int, dict[str, Any]]]) -> set[int] | None:
@@ -537,7 +559,7 @@ def _check_bands(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, di
 
 def _build(data: dict[str, Any], source: str) -> Questionnaire:
     def code(value: Mapping[str, str] | None) -> Code | None:
-        return Code(value["system"], value["code"]) if value else None
+        return Code(value["system"], value["code"], value.get("display", "")) if value else None
 
     def opts(values: list[dict[str, Any]]) -> tuple[Option, ...]:
         return tuple(

@@ -6,6 +6,7 @@ publish what changed, redirect back (post/redirect/get, so a reload never repeat
 
 from __future__ import annotations
 
+import json
 from typing import Any
 from urllib.parse import quote
 
@@ -16,13 +17,14 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export import csv_text, fhir_response, practice_outcomes, site_from_identity
+from kiosk.export import ExportError, practice_outcomes
 from kiosk.questionnaire import Questionnaire
+from kiosk.review import review_state
 from kiosk.storage import StoredSession
-from station import db, validation, ward
+from station import db, exports, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
-from station.sessions import NotFound, load, load_for_export
+from station.sessions import NotFound, load
 
 #: session-list size on the ward page
 RECENT = 50
@@ -57,7 +59,7 @@ async def ward_page(request: Request) -> Response:
     recent = await run_in_threadpool(_session_rows, engine)
     reviews = await run_in_threadpool(validation.reviews, engine, [row.id for row in recent])
     return render(request, "ward.html", kiosks=views, alerts=pending, sessions=recent, reviews=reviews,
-                  now=db.now(), message=request.query_params.get("message"))
+                  now=db.now(), today=db.now_iso()[:10], message=request.query_params.get("message"))
 
 
 def _back(request: Request, message: str | None = None, to: str = "/") -> Response:
@@ -129,22 +131,19 @@ async def session_page(request: Request) -> Response:
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
     score = validation.corrected(stored, q, current)["score"]
-    return render(request, "session.html", s=stored, kiosk=kiosk, review=current, trail=entries,
+    state = review_state(current, {a.item_id: a.option for a in stored.answers})
+    return render(request, "session.html", s=stored, kiosk=kiosk, review=current, state=state, trail=entries,
                   items=_items(q, stored, current), score=score, practice=practice_outcomes(q, stored),
                   plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
                   incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
                   reviewable=stored.status in validation.REVIEWABLE and not current.final,
+                  reopened=bool(current.reopenings) and not current.final,
                   message=request.query_params.get("message"))
 
 
 def _load(engine: Any, session_id: str) -> tuple[str, StoredSession]:
     with engine.connect() as connection:
         return load(connection, session_id)
-
-
-def _load_for_export(engine: Any, session_id: str) -> tuple[str, StoredSession, dict[str, Any]]:
-    with engine.connect() as connection:
-        return load_for_export(connection, session_id)
 
 
 async def change_item(request: Request) -> Response:
@@ -175,28 +174,60 @@ async def sign_off(request: Request) -> Response:
     return _back(request, "Signed off.", to=page)
 
 
+async def amend(request: Request) -> Response:
+    form = await checked_form(request)
+    session_id = request.path_params["session_id"]
+    page = f"/sessions/{session_id}"
+    try:
+        await run_in_threadpool(validation.amend, request.app.state.engine, session_id, form.get("reason", ""),
+                                request.state.user)
+    except (validation.ValidationError, NotFound) as exc:
+        return _back(request, str(exc), to=page)
+    return _back(request, "Reopened to amend: change the answers, then sign off again.", to=page)
+
+
+def _attachment(body: str, media: str, filename: str) -> Response:
+    return Response(body, media_type=media, headers={"content-disposition": f'attachment; filename="{filename}"'})
+
+
 async def export(request: Request) -> Response:
-    """FHIR QuestionnaireResponse or CSV of the session as it stands: corrections applied, and
-    the review state said (unreviewed, signed off, amended)."""
+    """The session as it stands (corrections applied, the review state said): a FHIR transaction
+    Bundle (response, total, Device, Questionnaire, Provenance) or CSV, from the kiosk's own
+    export code (:mod:`station.exports`)."""
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id, fmt = request.path_params["session_id"], request.path_params["fmt"]
+    if fmt not in ("json", "csv"):
+        return PlainTextResponse(f"no export .{fmt[:20]}: choose export.json (FHIR) or export.csv",
+                                 status_code=404)
     try:
-        kiosk, stored, identity = await run_in_threadpool(_load_for_export, engine, session_id)
+        if fmt == "json":
+            bundle = await run_in_threadpool(exports.result_bundle, engine, q, session_id)
+            return _attachment(json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json",
+                               f"{session_id}.fhir.json")
+        body = await run_in_threadpool(exports.result_csv, engine, q, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
-    current = await run_in_threadpool(validation.review, engine, session_id)
-    # named as the kiosk names it in its own exports (its site, kiosk id and FHIR systems, sent
-    # with the session), so a hospital importing both gets one result, not two
-    site = site_from_identity(identity, kiosk)
-    if fmt == "json":
-        import json
+    except ExportError as exc:
+        return PlainTextResponse(f"session {session_id} cannot be exported: {exc}", status_code=422)
+    return _attachment(body, "text/csv", f"{session_id}.csv")
 
-        body = json.dumps(fhir_response(q, stored, current, site), indent=2, ensure_ascii=False)
-        media = "application/fhir+json"
-    else:
-        body, media = csv_text(q, [stored], [current], site), "text/csv"
-    return Response(body, media_type=media, headers={
-        "content-disposition": f'attachment; filename="{session_id}.{"fhir.json" if fmt == "json" else "csv"}"'})
+
+async def period_export(request: Request) -> Response:
+    """Every result signed off in a period (``?from=YYYY-MM-DD&to=YYYY-MM-DD``, UTC days, both
+    included) as one FHIR transaction Bundle."""
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    start, end = request.query_params.get("from", ""), request.query_params.get("to", "")
+    try:
+        first, last = exports.period(start, end)
+    except exports.PeriodError as exc:
+        return PlainTextResponse(str(exc), status_code=400)
+    try:
+        bundle = await run_in_threadpool(exports.period_bundle, engine, q, first, last)
+    except ExportError as exc:
+        return PlainTextResponse(f"the results signed off from {first} to {last} cannot be exported: {exc}",
+                                 status_code=422)
+    return _attachment(json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json",
+                       f"signed-off-{first}-{last}.fhir.json")
 
 
 routes = [
@@ -206,5 +237,7 @@ routes = [
     Route("/sessions/{session_id}", session_page),
     Route("/sessions/{session_id}/items/{item_id}", change_item, methods=["POST"]),
     Route("/sessions/{session_id}/sign-off", sign_off, methods=["POST"]),
+    Route("/sessions/{session_id}/amend", amend, methods=["POST"]),
     Route("/sessions/{session_id}/export.{fmt:str}", export),
+    Route("/exports/signed-off.json", period_export),
 ]

@@ -1,7 +1,9 @@
 """Clinicians validate a session: correct an item (new option and why; the kiosk's answer is
-kept), fill an item the patient did not answer, then a doctor signs off. Every change is a row of
-the append-only audit trail, and the :class:`kiosk.review.Review` exports take is derived from
-those rows, so what an export says can always be traced to who did it and why.
+kept), fill an item the patient did not answer, then a doctor signs off; a doctor may reopen a
+signed result to amend it (with a reason), after which it is changed and signed off again. Every
+step is a row of the append-only audit trail, and the :class:`kiosk.review.Review` exports take
+is derived from those rows (:func:`kiosk.review.review_from_steps`), so what an export says can
+always be traced to who did it and why.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
 from kiosk.questionnaire import Questionnaire
-from kiosk.review import Correction, Review, ReviewState
+from kiosk.review import Review, review_from_steps
 from kiosk.storage import StoredSession
 from station import db
 from station.auth import User
@@ -64,14 +66,13 @@ def _locked(connection: Connection, session_id: str) -> tuple[StoredSession, lis
 
 
 def review_of(entries: list[AuditEntry]) -> Review:
-    """The review the audit trail amounts to."""
-    corrections = tuple(Correction(e.item_id or "", e.option or 0, e.previous_option, e.reason, e.author, e.at)
-                        for e in entries if e.action in ("correct", "fill"))
-    sign = next((e for e in entries if e.action == "sign_off"), None)
-    if sign is None:
-        return Review(ReviewState.UNREVIEWED, corrections)
-    state = ReviewState.AMENDED if corrections else ReviewState.SIGNED_OFF
-    return Review(state, corrections, sign.author, sign.at)
+    """The review the audit trail amounts to (the kiosk core's one reading of a trail)."""
+    return review_from_steps(entries)
+
+
+def review_in(connection: Connection, session_id: str) -> Review:
+    """The session's review, read on an open connection (an export reads it with the session)."""
+    return review_of(_entries(connection, session_id))
 
 
 def review(engine: Engine, session_id: str) -> Review:
@@ -121,11 +122,29 @@ def sign_off(engine: Engine, session_id: str, by: User) -> None:
                                                  action="sign_off", reason=""))
 
 
+def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
+    """A doctor reopens a signed-off result to amend it: it can be changed again, and is final
+    once a doctor signs it off again (the earlier sign-off stays in the trail)."""
+    if not by.is_doctor:
+        raise ValidationError("only a doctor can amend a signed-off result")
+    reason = reason.strip()
+    if not reason:
+        raise ValidationError("say why: amending a signed-off result needs a reason (e.g. 'new information "
+                              "from the physiotherapist')")
+    with engine.begin() as connection:
+        _, entries = _locked(connection, session_id)
+        if not review_of(entries).final:
+            raise ValidationError("the result is not signed off: change it directly, no need to amend")
+        connection.execute(audit.insert().values(session_id=session_id, at=db.now_iso(), author=by.name,
+                                                 action="amend", reason=reason[:1000]))
+
+
 def _check_open(stored: StoredSession, current: Review) -> None:
     if stored.status not in REVIEWABLE:
         raise ValidationError(f"the session is {stored.status}: it can be validated once it is over")
     if current.final:
-        raise ValidationError(f"signed off by {current.signed_by} at {current.signed_at}: the result is final")
+        raise ValidationError(f"signed off by {current.signed_by} at {current.signed_at}: the result is final "
+                              "(a doctor can amend it, giving a reason)")
 
 
 def corrected(stored: StoredSession, q: Questionnaire, current: Review) -> dict[str, Any]:

@@ -4,30 +4,34 @@
   totals recomputed from the option numbers, complete or not, signed off or not) and who exports
   (:class:`ExportSite`: the site, the kiosk, the site's FHIR systems and canonical URL).
 - :mod:`kiosk.export.fhir`: FHIR R4 — a Questionnaire per language with translations, the
-  QuestionnaireResponse, the total as an Observation, one transaction Bundle; its docstring
-  gives each choice and the part of R4 it follows.
+  QuestionnaireResponse, the total as an Observation; its docstring gives each choice and the
+  part of R4 it follows. :mod:`kiosk.export.provenance`: each staff change as a Provenance.
+  :mod:`kiosk.export.bundle`: transaction Bundles (the kiosk's and the station's, one code path).
 - :mod:`kiosk.export.tables`: CSV for researchers, long and wide, ids that stay text.
 
 Never a total for an incomplete result: a partial sum is only ever shown apart, as the points of
 the answered items. The station passes the session's :class:`kiosk.review.Review`; the kiosk on
-its own exports results as unreviewed.
+its own exports results as unreviewed. Every function takes the questionnaire and the identity
+(:class:`ExportSite`) it is given, and reads no file or configuration.
 """
 
+from kiosk.export.bundle import Described, bundle_of, questionnaire_bundle, transaction_bundle
 from kiosk.export.fhir import (
     ITEM_WEIGHT,
     ORDINAL_VALUE,
     SIGNATURE,
     TRANSLATION,
+    WORDING,
     fhir_device,
     fhir_questionnaire,
     fhir_response,
     fhir_total,
     observation_status,
-    questionnaire_bundle,
+    practitioner,
     questionnaire_canonical,
     response_status,
-    transaction_bundle,
 )
+from kiosk.export.provenance import REPLACED_ANSWER, fhir_provenances
 from kiosk.export.result import (
     PRACTICE_CHECKS,
     TOTAL_LINK,
@@ -52,7 +56,8 @@ from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, wide_columns, wi
 
 __all__ = [
     "CSV_COLUMNS", "ID_TAGS", "ITEM_WEIGHT", "ORDINAL_VALUE", "PRACTICE_CHECKS", "SIGNATURE", "TOTAL_LINK",
-    "TRANSLATION", "ExportError", "ExportSite", "PracticeOutcome", "Result", "csv_text", "export_identity",
+    "TRANSLATION", "WORDING", "REPLACED_ANSWER", "Described", "bundle_of", "fhir_provenances", "practitioner",
+    "ExportError", "ExportSite", "PracticeOutcome", "Result", "csv_text", "export_identity",
     "fhir_device",
     "fhir_questionnaire", "fhir_response", "fhir_total", "observation_status", "practice_outcome",
     "practice_outcomes", "questionnaire_bundle", "questionnaire_canonical", "questionnaire_version", "rescore",

@@ -12,39 +12,54 @@ Choices, each from the R4 specification:
 - **Answers**: LOINC answer codes where the YAML has them (else a local code per option); each
   option's points ride on the option with ``itemWeight`` and R4's ``ordinalValue`` (older
   readers), never on a code, since the same LOINC code scores differently on different items.
+- **Codes and words**: a ``Coding.display`` is the code system's display for the code (the
+  ``display`` the YAML gives each LOINC code, LOINC's English display; one code, one display in
+  every Questionnaire and response), never our wording. The words the kiosk used travel beside it
+  in the extension :data:`WORDING` (``urn:barthel-kiosk:fhir:StructureDefinition:wording``, a
+  complex extension in the resource's language with ``clinical`` (the clinicians' text or label),
+  ``patient`` (what the patient's screen showed) and ``spoken`` (what the kiosk said, questions
+  only) as ``valueString`` sub-extensions): on each Questionnaire item and ``answerOption``, and
+  on each response item (the question) and answer (the option). A local code without a display
+  takes the option's label as display, with the other languages as ``translation`` extensions.
 - **Status** says what happened: ``completed`` only when every item has an answer;
   ``in-progress`` for a session still running or finished with items unanswered (a clinician is
   expected to complete it), ``stopped`` for one abandoned or signed off incomplete; ``amended``
   once a clinician's corrections changed the kiosk's answers (signed off or still in review: the
-  signature and the Observation's status tell which). The ``total`` item (LOINC 96761-2) has an answer
-  only when the result is complete, and its calculatedExpression gives none otherwise.
+  signature and the Observation's status tell which). Where a result stands comes from one
+  function, :func:`kiosk.review.review_state`, which the CSV's ``review_state`` also states.
+  As SDC does, an unanswered item is left out of the response, and the ``total`` item (LOINC
+  96761-2) is there only when the result is complete (its calculatedExpression gives none otherwise).
 - **Review**: a sign-off is the R4 ``questionnaireresponse-signature`` extension (a Verification
-  Signature: who and when). ``author`` ("who recorded the answers") is the kiosk (a Device), or
-  the clinician who last changed an answer; ``authored`` is when the answers last changed (the
-  latest correction, else the end of the session).
+  Signature: when, and who as a Practitioner reference carrying the staff account's name as its
+  identifier in the station's staff system, :attr:`kiosk.review.Review.staff_system`). ``author``
+  ("who recorded the answers") stays the kiosk (a Device), which recorded every answer nobody
+  changed; each change is a Provenance (:mod:`kiosk.export.provenance`: who, when, why, and the
+  answer it replaced with that answer's author). ``authored`` is when the answers last changed
+  (the latest correction, else the end of the session).
 - **Identity**: ``identifier`` ``SITE/KIOSK/SESSION`` in the site's system (stable, so re-exports
   never duplicate); the patient's pseudonym in the site's patient system (a logical reference:
-  no Patient resource is made); the kiosk as a Device identified by its kiosk id.
+  no Patient resource is made); the kiosk as a Device identified by its kiosk id. Every function
+  takes the questionnaire and the identity (:class:`ExportSite`) it is given: it reads no file
+  and no configuration.
 - **Total Observation** (LOINC 96761-2, ``derivedFrom`` the response, ``device`` the kiosk, the
   band and its band set as ``interpretation``) only for a complete result: ``preliminary`` until
   signed off, then ``final`` (``amended`` with corrections, each correction as a ``note``).
 - **Test data**: a session stored by ``kiosk replay`` (a scripted patient) is labelled ``HTEST``
   (``meta.security``, "test health data") on its response and total, so no EHR takes it for a
   patient's result.
-- **Bundle** (transaction): the Questionnaires used and the kiosk Device are conditional creates
-  (``ifNoneExist`` on url+version / identifier). Results not yet signed off are conditional creates
-  on their identifier, so re-sending never duplicates and never overwrites; signed-off results are
-  conditional updates (``PUT Type?identifier=…``), so the final version replaces the preliminary.
+- **Bundle** (transaction, :mod:`kiosk.export.bundle`): the Questionnaires used and the kiosk
+  Device are conditional creates (``ifNoneExist`` on url+version / identifier). Results not yet
+  signed off are conditional creates on their identifier, so re-sending never duplicates and never
+  overwrites; signed-off results are conditional updates (``PUT Type?identifier=…``), so the final
+  version replaces the preliminary, and an amended one replaces the final (a new version each time).
 """
 
 from __future__ import annotations
 
 import re
-import uuid
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from datetime import datetime, timezone
 from typing import Any
-from urllib.parse import quote
 
 from kiosk.export.result import (
     TOTAL_LINK,
@@ -53,7 +68,6 @@ from kiosk.export.result import (
     Result,
     questionnaire_version,
     result,
-    results,
 )
 from kiosk.questionnaire import Code, Questionnaire
 from kiosk.review import Review, ReviewState
@@ -73,6 +87,8 @@ TEST_DATA = {"system": "http://terminology.hl7.org/CodeSystem/v3-ActReason", "co
 SURVEY = {"system": "http://terminology.hl7.org/CodeSystem/observation-category", "code": "survey",
           "display": "Survey"}
 TOTAL_TEXT = {"en": "Total score", "es": "Puntuación total", "fr": "Score total"}
+#: the words the kiosk used beside a code (see the module docstring): ``clinical``, ``patient``, ``spoken``
+WORDING = "urn:barthel-kiosk:fhir:StructureDefinition:wording"
 
 
 def instant(value: str) -> str:
@@ -101,13 +117,28 @@ def _text(key: str, texts: Mapping[str, str], language: str) -> dict[str, Any]:
 
 
 def _coding(code: Code, display: str | None = None) -> dict[str, str]:
-    return {"system": code.system, "code": code.code} | ({"display": display} if display else {})
+    shown = code.display or display
+    return {"system": code.system, "code": code.code} | ({"display": shown} if shown else {})
 
 
-def _option_coding(q: Questionnaire, item_id: str, number: int, language: str) -> dict[str, Any]:
+def option_coding(q: Questionnaire, item_id: str, number: int, language: str) -> dict[str, Any]:
+    """An option's Coding: the code system's display for its code; a local code (no published
+    one) shows the option's label, with the other languages as translations."""
     option = q.item(item_id).option(number)
+    if option.code is not None and option.code.display:
+        return _coding(option.code)
     code = option.code or Code(f"urn:barthel-kiosk:option:{q.id}:{item_id}", str(number))
-    return _coding(code, option.label_in(language))
+    return {"system": code.system, "code": code.code} | _text("display", option.label, language)
+
+
+def wording(language: str, *, clinical: Mapping[str, str], patient: Mapping[str, str] | None = None,
+            spoken: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """The :data:`WORDING` extension: the words in ``language`` (patient's wording defaults to
+    the clinical one, as on the kiosk's screen; ``spoken`` only where given)."""
+    parts = [("clinical", clinical[language]), ("patient", (patient or {}).get(language) or clinical[language])]
+    if spoken and spoken.get(language):
+        parts.append(("spoken", spoken[language]))
+    return {"url": WORDING, "extension": [{"url": name, "valueString": text} for name, text in parts]}
 
 
 def _total_expression(q: Questionnaire) -> str:
@@ -130,15 +161,16 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
     site = site or ExportSite()
     items = []
     for item in q.items:
-        entry: dict[str, Any] = {"linkId": item.id, **_text("text", item.text, language), "type": "choice",
-                                 "required": True}
+        entry: dict[str, Any] = {
+            "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+            "linkId": item.id, **_text("text", item.text, language), "type": "choice", "required": True}
         if item.code:
             entry["code"] = [_coding(item.code)]
         entry["answerOption"] = [
             {"extension": [{"url": ITEM_WEIGHT, "valueDecimal": option.points},
-                           {"url": ORDINAL_VALUE, "valueDecimal": option.points}],
-             "valueCoding": _option_coding(q, item.id, option.number, language)
-             | _text("display", option.label, language)}
+                           {"url": ORDINAL_VALUE, "valueDecimal": option.points},
+                           wording(language, clinical=option.label, patient=option.patient)],
+             "valueCoding": option_coding(q, item.id, option.number, language)}
             for option in item.options
         ]
         items.append(entry)
@@ -167,7 +199,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
 def response_status(r: Result) -> str:
     """The QuestionnaireResponse status of a result (see the module docstring)."""
     if r.complete:
-        return "amended" if r.amended or r.changers else "completed"
+        return "amended" if r.changed else "completed"
     return "stopped" if r.stored.status == "abandoned" or r.final else "in-progress"
 
 
@@ -187,8 +219,10 @@ def _patient(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
     return {"type": "Patient", "identifier": {"system": site.patient_system, "value": stored.patient_id}}
 
 
-def _clinician(name: str) -> dict[str, Any]:
-    return {"type": "Practitioner", "display": name}
+def practitioner(name: str, staff_system: str) -> dict[str, Any]:
+    """A staff account as a logical Practitioner reference: its name as identifier in the
+    station's staff system (and as display)."""
+    return {"type": "Practitioner", "identifier": {"system": staff_system, "value": name}, "display": name}
 
 
 def _authored(r: Result) -> str:
@@ -199,31 +233,38 @@ def _authored(r: Result) -> str:
 def fhir_response(q: Questionnaire, stored: StoredSession, review: Review | None = None,
                   site: ExportSite | None = None) -> dict[str, Any]:
     """A stored session (with its clinician's review, if any) as an R4 QuestionnaireResponse."""
-    return _response(q, result(q, stored, review), site or ExportSite())
+    return response_of(q, result(q, stored, review), site or ExportSite())
 
 
-def _response(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
+def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
+    """A :class:`Result` as an R4 QuestionnaireResponse (what :func:`fhir_response` and Bundles say)."""
     stored, language = r.stored, r.stored.language
+    changed = {c.item_id for c in r.review.corrections}
     items = []
     for item in q.items:
-        entry: dict[str, Any] = {"linkId": item.id, "text": item.text[language]}
-        if item.id in r.options:
-            entry["answer"] = [{"valueCoding": _option_coding(q, item.id, r.options[item.id], language)}]
+        if item.id not in r.options:
+            continue  # unanswered: left out, as SDC does
+        option = item.option(r.options[item.id])
+        entry: dict[str, Any] = {"id": item.id} if item.id in changed else {}  # a Provenance's targetElement
+        entry |= {"extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+                  "linkId": item.id, "text": item.text[language],
+                  "answer": [{"extension": [wording(language, clinical=option.label, patient=option.patient)],
+                              "valueCoding": option_coding(q, item.id, option.number, language)}]}
         items.append(entry)
-    total: dict[str, Any] = {"linkId": TOTAL_LINK, "text": TOTAL_TEXT.get(language, TOTAL_TEXT["en"])}
     if r.complete:
-        total["answer"] = [{"valueInteger": r.score.total}]
-    items.append(total)
+        items.append({"linkId": TOTAL_LINK, "text": TOTAL_TEXT.get(language, TOTAL_TEXT["en"]),
+                      "answer": [{"valueInteger": r.score.total}]})
     resource: dict[str, Any] = {
         "resourceType": "QuestionnaireResponse", "id": stored.id, "language": language,
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
         "questionnaire": f"{questionnaire_canonical(q, site, language)}|{questionnaire_version(q)}",
         "status": response_status(r), "subject": _patient(site, stored), "authored": _authored(r),
-        "author": _clinician(r.changers[-1]) if r.changers else device_reference(site),
+        "author": device_reference(site),
         "source": _patient(site, stored) if stored.answered_by.value == "patient"
         else {"type": "RelatedPerson", "display": stored.answered_by.value},
-        "item": items,
     }
+    if items:  # FHIR JSON has no empty arrays
+        resource["item"] = items
     if r.final:
         resource["extension"] = [_signature(r.review)]
     return _labelled(resource, stored)
@@ -239,12 +280,12 @@ def _signature(review: Review) -> dict[str, Any]:
     if not review.signed_by or not review.signed_at:
         raise ExportError(f"a review in state {ReviewState(review.state).value} needs who signed it off and when")
     return {"url": SIGNATURE, "valueSignature": {"type": [VERIFICATION], "when": instant(review.signed_at),
-                                                 "who": _clinician(review.signed_by)}}
+                                                 "who": practitioner(review.signed_by, review.staff_system)}}
 
 
 def observation_status(r: Result) -> str:
     """``preliminary`` until a clinician signs off; then ``final``, or ``amended`` with corrections."""
-    return ("amended" if r.amended else "final") if r.final else "preliminary"
+    return {ReviewState.AMENDED: "amended", ReviewState.SIGNED_OFF: "final"}.get(r.state, "preliminary")
 
 
 def fhir_total(q: Questionnaire, stored: StoredSession, review: Review | None = None,
@@ -254,10 +295,12 @@ def fhir_total(q: Questionnaire, stored: StoredSession, review: Review | None = 
     site = site or ExportSite()
     response = {"type": "QuestionnaireResponse",
                 "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)}}
-    return _total(q, result(q, stored, review), site, response)
+    return total_of(q, result(q, stored, review), site, response)
 
 
-def _total(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
+def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
+    """A :class:`Result`'s total as an Observation derived from ``response`` (a Reference); None
+    when incomplete."""
     if not r.complete or q.total_code is None:
         return None
     stored, language = r.stored, r.stored.language
@@ -279,70 +322,10 @@ def _total(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, An
             "text": f"{r.score.band.label[language]} ({band_set.id}: {band_set.source})"}]
     if r.final:
         observation["issued"] = instant(r.review.signed_at or "")
-        observation["performer"] = [_clinician(r.review.signed_by or "")]
+        observation["performer"] = [practitioner(r.review.signed_by or "", r.review.staff_system)]
     notes = [{"authorString": c.author, "time": instant(c.at),
               "text": f"{c.item_id}: option {c.previous_option or 'none'} -> {c.option} ({c.reason})"}
              for c in r.review.corrections]
     if notes:
         observation["note"] = notes
     return _labelled(observation, stored)
-
-
-def _full_url(system: str, value: str) -> str:
-    return f"urn:uuid:{uuid.uuid5(uuid.NAMESPACE_URL, f'{system}|{value}')}"
-
-
-def _query(**params: str) -> str:
-    return "&".join(f"{name}={quote(value, safe='')}" for name, value in params.items())
-
-
-def _entry(resource: dict[str, Any], full_url: str, condition: str, update: bool) -> dict[str, Any]:
-    kind = resource["resourceType"]
-    request = ({"method": "PUT", "url": f"{kind}?{condition}"} if update
-               else {"method": "POST", "url": kind, "ifNoneExist": condition})
-    return {"fullUrl": full_url, "resource": {k: v for k, v in resource.items() if k != "id"}, "request": request}
-
-
-def transaction_bundle(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
-                       site: ExportSite | None = None) -> dict[str, Any]:
-    """Sessions with their reviews (same order; None: unreviewed) as one R4 transaction Bundle with
-    the Questionnaires they answer and the kiosk Device (see the module docstring for the
-    conditional requests)."""
-    site = site or ExportSite()
-    reviewed = results(q, sessions, reviews)
-    version = questionnaire_version(q)
-    entries = []
-    for language in dict.fromkeys(r.stored.language for r in reviewed):
-        url = questionnaire_canonical(q, site, language)
-        entries.append(_entry(fhir_questionnaire(q, language, site), _full_url(url, version),
-                              _query(url=url, version=version), update=False))
-    device_url = _full_url(site.device_system, site.kiosk_id)
-    if reviewed:
-        entries.append(_entry(fhir_device(site), device_url,
-                              _query(identifier=f"{site.device_system}|{site.kiosk_id}"), update=False))
-    for r in reviewed:
-        response = _response(q, r, site)
-        response["author"] = response["author"] | ({"reference": device_url} if response["author"]["type"] == "Device"
-                                                   else {})
-        value = site.result_id(r.stored.id)
-        response_url = _full_url(site.identifier_system, value)
-        entries.append(_entry(response, response_url, _query(identifier=f"{site.identifier_system}|{value}"),
-                              update=r.final))
-        total = _total(q, r, site, {"reference": response_url, "type": "QuestionnaireResponse",
-                                    "identifier": response["identifier"]})
-        if total is not None:
-            total["device"] |= {"reference": device_url}
-            entries.append(_entry(total, _full_url(site.identifier_system, value + "/total"),
-                                  _query(identifier=f"{site.identifier_system}|{value}/total"), update=r.final))
-    # FHIR JSON has no empty arrays: a Bundle of nothing has no entry at all
-    return {"resourceType": "Bundle", "type": "transaction"} | ({"entry": entries} if entries else {})
-
-
-def questionnaire_bundle(q: Questionnaire, site: ExportSite | None = None) -> dict[str, Any]:
-    """The questionnaire in every language as a transaction Bundle of conditional creates."""
-    site = site or ExportSite()
-    version = questionnaire_version(q)
-    return {"resourceType": "Bundle", "type": "transaction", "entry": [
-        _entry(fhir_questionnaire(q, language, site), _full_url(questionnaire_canonical(q, site, language), version),
-               _query(url=questionnaire_canonical(q, site, language), version=version), update=False)
-        for language in q.languages]}

@@ -13,7 +13,7 @@ from typing import Any
 
 from kiosk.config import Config, default_kiosk_id
 from kiosk.questionnaire import Questionnaire, Score
-from kiosk.review import Review, ReviewState
+from kiosk.review import Review, ReviewState, review_state
 from kiosk.storage import PracticeRecord, StoredSession
 from qos.files import write_error, write_private  # the one owner-only writer; exports use it from here too
 
@@ -121,20 +121,25 @@ class Result:
         return self.review.final
 
     @property
-    def changers(self) -> tuple[str, ...]:
-        """Who changed an answer the kiosk recorded (or filled one it had not), oldest first."""
-        return tuple(dict.fromkeys(c.author for c in self.review.corrections if self.recorded(c.item_id) != c.option))
+    def state(self) -> ReviewState:
+        """Where the result stands (:func:`kiosk.review.review_state`: the one answer the CSV,
+        the FHIR response and Observation, and the station's pages all give)."""
+        return review_state(self.review, {a.item_id: a.option for a in self.stored.answers})
 
     @property
     def amended(self) -> bool:
-        """Signed off with answers other than the kiosk recorded (state ``amended``, or a sign-off
-        that still carries corrections: a changed answer is never reported as the kiosk's)."""
-        return self.final and (self.review.state == ReviewState.AMENDED or bool(self.changers))
+        """Signed off with answers other than the kiosk recorded."""
+        return self.state is ReviewState.AMENDED
+
+    @property
+    def changed(self) -> bool:
+        """Answers other than the kiosk recorded, signed off or not."""
+        return self.options != {a.item_id: a.option for a in self.stored.answers}
 
     @property
     def review_state(self) -> str:
-        """``unreviewed``, ``signed_off`` or ``amended`` (see :attr:`amended`)."""
-        return ReviewState.AMENDED.value if self.amended else ReviewState(self.review.state).value
+        """``unreviewed``, ``corrected``, ``signed_off`` or ``amended`` (see :attr:`state`)."""
+        return self.state.value
 
     def recorded(self, item_id: str) -> int | None:
         """The option the kiosk stored for an item (None: not answered at the kiosk)."""

@@ -38,7 +38,8 @@ ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
 #: ``corrected_by`` who did) and "total" (last: ``points`` the total, blank when incomplete, with
 #: ``label`` "incomplete (N points from K of M items)"; its band and ``band_set``, the set that
 #: gave it: "severe" is 21-60 in Shah's set but 20-35 in the Spanish one). Every row carries the
-#: session's columns (ids tagged, see the module docstring).
+#: session's columns (ids tagged, see the module docstring); ``review_state`` is
+#: :func:`kiosk.review.review_state`'s (unreviewed, corrected, signed_off, amended), as in FHIR.
 CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
                "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks", "finished_at",
                "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by",

@@ -48,7 +48,7 @@ def entries(bundle, kind):
 
 
 def total_answer(response):
-    return next(i for i in response["item"] if i["linkId"] == "total").get("answer")
+    return next((i for i in response.get("item", []) if i["linkId"] == "total"), {}).get("answer")
 
 
 def test_every_replayed_session_exports_as_valid_r4_in_one_transaction_bundle(replayed):
@@ -70,6 +70,7 @@ def test_an_incomplete_session_has_no_total_anywhere_and_is_not_completed(replay
     assert response["status"] == "in-progress"
     assert total_answer(response) is None
     assert sum("answer" in i for i in response["item"]) == 8
+    assert {i["linkId"] for i in response["item"]} & {"grooming", "bladder", "total"} == set()  # left out, as SDC does
     assert fhir_total(QUESTIONNAIRE, stored, site=SITE) is None
     bundle = transaction_bundle(QUESTIONNAIRE, [stored], site=SITE)
     assert not entries(bundle, "Observation")
@@ -99,7 +100,8 @@ def test_a_complete_unreviewed_session_is_completed_with_a_preliminary_total(rep
     assert "meta" not in response["resource"]  # a patient's session, not test data
     total = observation["resource"]
     assert total["status"] == "preliminary"
-    assert total["code"]["coding"] == [{"system": "http://loinc.org", "code": "96761-2"}]
+    assert total["code"]["coding"] == [{"system": "http://loinc.org", "code": "96761-2",
+                                        "display": "Total score Barthel Index"}]
     assert total["valueQuantity"]["value"] == 100
     assert total["derivedFrom"][0]["reference"] == response["fullUrl"]
     assert total["interpretation"][0]["coding"][0]["code"] == "independent"
@@ -119,7 +121,9 @@ def test_a_signed_off_result_is_final_and_carries_who_signed_and_when(replayed):
     assert response["author"]["type"] == "Device"  # the kiosk recorded these answers
     total = fhir_total(QUESTIONNAIRE, stored, signed(), SITE)
     check_fhir(total)
-    assert total["status"] == "final" and total["performer"][0]["display"] == "dr.lopez"
+    assert total["status"] == "final" and total["performer"][0]["identifier"] == {
+        "system": "urn:barthel-kiosk:station:staff", "value": "dr.lopez"}
+    assert signature["valueSignature"]["who"]["identifier"]["value"] == "dr.lopez"
     bundle = transaction_bundle(QUESTIONNAIRE, [stored], [signed()], SITE)
     check_fhir(bundle)
     request = entries(bundle, "QuestionnaireResponse")[0]["request"]
@@ -133,7 +137,7 @@ def test_a_clinician_completing_an_incomplete_session_makes_it_amended_with_a_to
     check_fhir(response)
     assert response["status"] == "amended"
     assert total_answer(response) == [{"valueInteger": 80}]  # 65 + 5 + 10
-    assert response["author"] == {"type": "Practitioner", "display": "dr.lopez"}
+    assert response["author"]["type"] == "Device"  # the kiosk recorded the other answers; changes are Provenance
     assert response["authored"] == "2026-11-23T15:00:00+00:00"
     total = fhir_total(QUESTIONNAIRE, stored, review, SITE)
     check_fhir(total)
@@ -220,7 +224,7 @@ def test_kiosk_validate_checks_answer_codes(tmp_path):
     copy = tmp_path / "barthel.yaml"
     text = (ROOT / "kiosk/questionnaires/barthel.yaml").read_text(encoding="utf-8")
     copy.write_text(text.replace('code: "LA31630-9"', 'code: "LA24937-7"').replace(
-        'code: "LA31644-0"}', 'cod: "LA31644-0"}'), encoding="utf-8")
+        'code: "LA31644-0",', 'cod: "LA31644-0",'), encoding="utf-8")
     problems = [p.message for p in check_questionnaire_file(copy)]
     assert any("two options of items[0] have the answer code 'LA24937-7'" in m or
                ("answer code 'LA24937-7'" in m) for m in problems), problems
@@ -286,7 +290,7 @@ def test_corrections_still_in_review_are_the_nurses_answers_not_the_kiosks(repla
     response = fhir_response(QUESTIONNAIRE, stored, review, SITE)
     check_fhir(response)
     assert response["status"] == "amended" and "extension" not in response  # changed, not signed off
-    assert response["author"] == {"type": "Practitioner", "display": "nurse.kim"}
+    assert response["author"]["type"] == "Device"
     assert response["authored"] == "2026-11-23T14:00:00+00:00"
     assert fhir_total(QUESTIONNAIRE, stored, review, SITE)["status"] == "preliminary"
 
@@ -299,3 +303,103 @@ def test_a_questionnaire_in_one_language_has_no_empty_translations():
     resource = fhir_questionnaire(english, "en", SITE)
     check_fhir(resource)
     assert "_text" not in json.dumps(resource) and "_display" not in json.dumps(resource)
+
+
+def test_each_code_carries_loincs_display_once_and_the_kiosks_words_travel_beside_it(replayed):
+    from kiosk.export import WORDING
+
+    displays: dict[str, set[str]] = {}
+    for language in ("en", "es", "fr"):
+        questionnaire = fhir_questionnaire(QUESTIONNAIRE, language, SITE)
+        for item in questionnaire["item"][:-1]:
+            for option in item["answerOption"]:
+                coding = option["valueCoding"]
+                displays.setdefault(coding["code"], set()).add(coding["display"])
+                assert "_display" not in coding  # LOINC's display is not translated into our wording
+    assert all(len(shown) == 1 for shown in displays.values()), displays  # one code, one display, every language
+    assert displays["LA12304-4"] == {"Dependent"} and displays["LA31643-2"] == {"Needs help with personal care"}
+    spanish = fhir_questionnaire(QUESTIONNAIRE, "es", SITE)
+    bathing = next(i for i in spanish["item"] if i["linkId"] == "bathing")
+    words = {e["url"]: e for e in bathing["extension"]}[WORDING]
+    assert {w["url"]: w["valueString"] for w in words["extension"]} == {
+        "clinical": QUESTIONNAIRE.item("bathing").text["es"], "patient": QUESTIONNAIRE.item("bathing").patient["es"],
+        "spoken": QUESTIONNAIRE.item("bathing").spoken["es"]}
+    option = {e["url"]: e for e in bathing["answerOption"][0]["extension"]}[WORDING]
+    assert {w["url"]: w["valueString"] for w in option["extension"]} == {"clinical": "Necesito ayuda",
+                                                                         "patient": "Necesito ayuda"}
+    response = fhir_response(QUESTIONNAIRE, replayed["P-ES-0001"], site=SITE)
+    for item in response["item"][:-1]:
+        said = {w["url"]: w["valueString"] for w in item["extension"][0]["extension"]}
+        assert said["patient"] == QUESTIONNAIRE.item(item["linkId"]).patient_text_in("es")
+        chosen = {w["url"]: w["valueString"] for w in item["answer"][0]["extension"][0]["extension"]}
+        assert chosen["patient"] in [o.patient_label_in("es") for o in QUESTIONNAIRE.item(item["linkId"]).options]
+
+
+def test_a_correction_is_a_provenance_naming_who_when_why_and_the_kiosks_answer(replayed):
+    from kiosk.export import REPLACED_ANSWER
+
+    stored = replayed["TB-0001"]  # feeding: option 3 (LA12302-8) at the kiosk
+    nurse = Correction("feeding", 2, 3, "needs help cutting", "nurse.kim", "2026-11-23T14:00:00Z")
+    doctor = Correction("feeding", 1, 2, "cannot feed at all", "dr.lopez", "2026-11-23T14:30:00Z")
+    bundle = transaction_bundle(QUESTIONNAIRE, [stored], [signed(ReviewState.AMENDED, nurse, doctor)], SITE)
+    check_fhir(bundle)
+    response = entries(bundle, "QuestionnaireResponse")[0]
+    first, second = (e["resource"] for e in entries(bundle, "Provenance"))
+    assert first["recorded"] == "2026-11-23T14:00:00+00:00" and first["reason"] == [{"text": "needs help cutting"}]
+    assert first["target"][0]["reference"] == response["fullUrl"]
+    assert first["target"][0]["extension"][0]["valueUri"] == "feeding"
+    assert next(i for i in response["resource"]["item"] if i["linkId"] == "feeding")["id"] == "feeding"
+    assert first["agent"][0]["who"]["identifier"] == {"system": "urn:barthel-kiosk:station:staff", "value": "nurse.kim"}
+    (kiosk_answer,) = first["entity"]
+    assert kiosk_answer["extension"][0] == {"url": REPLACED_ANSWER, "valueCoding": {
+        "system": "http://loinc.org", "code": "LA12302-8", "display": "Independent"}}
+    assert kiosk_answer["agent"][0]["who"]["reference"] == entries(bundle, "Device")[0]["fullUrl"]
+    assert "as recorded by the kiosk" in kiosk_answer["what"]["display"]
+    (nurses_answer,) = second["entity"]  # the doctor's change replaced the nurse's answer, not the kiosk's
+    assert nurses_answer["agent"][0]["who"]["identifier"]["value"] == "nurse.kim"
+    assert nurses_answer["extension"][0]["valueCoding"]["code"] == "LA31630-9"
+    again = transaction_bundle(QUESTIONNAIRE, [stored], [signed(ReviewState.AMENDED, nurse, doctor)], SITE)
+    assert [e["request"] for e in entries(again, "Provenance")] == [e["request"] for e in entries(bundle, "Provenance")]
+    assert all(e["request"]["method"] == "PUT" and e["request"]["url"].startswith("Provenance/")
+               for e in entries(bundle, "Provenance"))
+
+
+def test_one_review_state_from_the_trail_for_every_export():
+    from types import SimpleNamespace
+
+    from kiosk.review import review_from_steps, review_state
+
+    def step(action, author="dr.lopez", item=None, option=None, previous=None, reason="", at="2026-11-23T15:00:00Z"):
+        return SimpleNamespace(action=action, author=author, item_id=item, option=option, previous_option=previous,
+                               reason=reason, at=at)
+
+    recorded = {"feeding": 3, "stairs": 3}
+    assert review_state(review_from_steps([]), recorded) is ReviewState.UNREVIEWED
+    corrected = [step("correct", "nurse.kim", "feeding", 2, 3, "help")]
+    assert review_state(review_from_steps(corrected), recorded) is ReviewState.CORRECTED
+    assert review_state(review_from_steps(corrected + [step("sign_off")]), recorded) is ReviewState.AMENDED
+    back = corrected + [step("correct", "nurse.kim", "feeding", 3, 2, "misread"), step("sign_off")]
+    assert review_state(review_from_steps(back), recorded) is ReviewState.SIGNED_OFF  # the kiosk's answer again
+    reopened = [step("sign_off", at="2026-11-23T15:00:00Z"), step("amend", reason="new findings",
+                                                                  at="2026-11-23T16:00:00Z")]
+    review = review_from_steps(reopened)
+    assert not review.final and review_state(review, recorded) is ReviewState.CORRECTED
+    (reopening,) = review.reopenings
+    assert (reopening.reason, reopening.signed_by, reopening.signed_at) == ("new findings", "dr.lopez",
+                                                                           "2026-11-23T15:00:00Z")
+    again = review_from_steps(reopened + [step("correct", item="stairs", option=2, previous=3, reason="lift"),
+                                          step("sign_off", at="2026-11-23T17:00:00Z")])
+    assert again.final and again.signed_at == "2026-11-23T17:00:00Z"
+    assert review_state(again, recorded) is ReviewState.AMENDED
+
+
+def test_kiosk_validate_refuses_one_code_with_two_displays(tmp_path):
+    copy = tmp_path / "barthel.yaml"
+    text = (ROOT / "kiosk/questionnaires/barthel.yaml").read_text(encoding="utf-8")
+    copy.write_text(text.replace('code: "LA12304-4", display: "Dependent"', 'code: "LA12304-4", display: "I need help"', 1),
+                    encoding="utf-8")
+    problems = [str(p) for p in check_questionnaire_file(copy)]
+    assert problems and all(p.startswith(f"{copy}:") for p in problems)
+    assert any("code 'LA12304-4' has the display 'Dependent' here but 'I need help' at items[1].options[0].code: "
+               "one code, one display" in p for p in problems), problems
+    assert check_questionnaire_file(ROOT / "kiosk/questionnaires/barthel.yaml") == []

@@ -16,6 +16,7 @@ from kiosk.export import ExportSite, result
 from kiosk.export import fhir_questionnaire, fhir_response
 from kiosk.review import Correction, Review, ReviewState
 from tests.session.helpers import QUESTIONNAIRE
+from tests.station.conftest import shared_station  # noqa: F401 - the station fixture
 
 from .standard import JS
 
@@ -93,7 +94,9 @@ def test_lhc_forms_shows_every_answer_and_the_same_total(lforms_page, replayed, 
         shown = rendered["shown"][item.id]
         if item.id in expected.options:
             option = item.option(expected.options[item.id])
-            assert shown == f"{option.label_in(language)} - {option.points}", (item.id, shown)
+            # the Coding's display is LOINC's for the code (the wording is in the extension beside it)
+            display = option.code.display if option.code and option.code.display else option.label_in(language)
+            assert shown == f"{display} - {option.points}", (item.id, shown)
         else:
             assert shown == "", (item.id, shown)
     assert rendered["shown"]["total"] == (str(expected.score.total) if expected.complete else "")
@@ -102,3 +105,38 @@ def test_lhc_forms_shows_every_answer_and_the_same_total(lforms_page, replayed, 
     assert {k: [a["valueCoding"]["code"] for a in v] for k, v in back.items() if v and k != "total"} == \
            {k: [a["valueCoding"]["code"] for a in v] for k, v in ours.items() if v and k != "total"}
     assert back.get("total") == ours.get("total")
+
+
+def test_lhc_forms_shows_a_station_bundles_corrected_and_signed_result(lforms_page, shared_station):  # noqa: F811
+    """The station's own export (a real station process): the response of its Bundle, on the
+    Questionnaire of that Bundle, shows the corrected answers and the corrected total."""
+    from tests.station.conftest import new_kiosk
+    from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
+
+    station, ward = shared_station
+    name, token = new_kiosk(ward.db_url)
+    rows = record_patient(PATIENTS / "barthel4.yaml")  # grooming and bladder unanswered
+    client = KioskClient(station.url, token, name)
+    try:
+        assert client.sync(rows).status_code == 200
+    finally:
+        client.close()
+    session = f"/sessions/{rows[0].session_id}"
+    doctor = Staff(station.url)
+    for item, option, why in (("grooming", "2", "asked again"), ("bladder", "3", "asked again"),
+                              ("feeding", "2", "needs help cutting")):
+        assert doctor.post(f"{session}/items/{item}", option=option, reason=why).status_code == 303
+    assert doctor.post(f"{session}/sign-off").status_code == 303
+    bundle = doctor.http.get(f"{session}/export.json").json()
+    (questionnaire,) = [e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "Questionnaire"]
+    (response,) = [e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse"]
+    page, errors = lforms_page
+    rendered = page.evaluate(RENDER, [questionnaire, response])
+    assert not errors, errors
+    ours = {i["linkId"]: i["answer"][0] for i in response["item"]}
+    assert ours["total"] == {"valueInteger": 75}  # 65 from 8 items, +5 +10 filled, feeding 10 -> 5
+    assert rendered["shown"]["total"] == "75"
+    for item in QUESTIONNAIRE.items:
+        coding = ours[item.id]["valueCoding"]
+        weight = next(o for o in item.options if o.code and o.code.code == coding["code"]).points
+        assert rendered["shown"][item.id] == f"{coding['display']} - {weight}", item.id

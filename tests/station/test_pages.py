@@ -5,6 +5,7 @@ phone's width and a desktop's."""
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from dataclasses import replace
@@ -142,4 +143,40 @@ def test_a_clinician_corrects_an_item_and_only_a_doctor_signs_off(browser, ward)
     trail = page.locator("table.trail").inner_text()
     assert "nurse.kim" in trail and "stairs" in trail and "sign off" in trail
     assert page.locator("details summary").count() == 0  # final: nothing left to change
+    context.close()
+
+
+def test_a_doctor_reopens_a_signed_result_amends_it_and_signs_again(browser, ward):
+    station, ward, kiosk = ward
+    rows = record_patient(PATIENTS / "barthel1.yaml")
+    assert kiosk.sync(rows).status_code == 200
+    session = rows[0].session_id
+    context, page = open_page(browser, station, "dr.lopez", "doctor", PHONE)
+    page.goto(f"{station.url}/sessions/{session}")
+    page.locator("#sign-off").click()
+    page.locator("text=Signed off by").wait_for()
+    assert page.locator("#review-state").inner_text() == "signed off"
+    page.locator("input[name=reason]").fill("physiotherapist: needs help on stairs")
+    page.locator("#amend").click()
+    page.locator("#reopened").wait_for()
+    assert page.locator("#review-state").inner_text() == "corrected" and page.locator("#amend").count() == 0
+    row = page.locator("#item-stairs")
+    row.locator("summary").click()
+    row.locator("select[name=option]").select_option("2")
+    row.locator("input[name=reason]").fill("seen on the stairs")
+    row.locator("button[type=submit]").click()
+    page.locator("text=Change recorded.").wait_for()
+    page.locator("#sign-off").click()
+    page.locator("text=Signed off by").wait_for()
+    assert page.locator("#review-state").inner_text() == "amended"
+    assert page.locator("#total").inner_text() == "95"
+    trail = page.locator("table.trail").inner_text()
+    assert trail.count("sign off") == 2 and "physiotherapist: needs help on stairs" in trail
+    assert page.locator("#amend").count() == 1  # signed again: it can be amended again
+    page.goto(station.url + "/")  # the ward page's period export: today's signed-off results
+    with page.expect_download() as download:
+        page.locator("form.period-export button").click()
+    bundle = json.loads(download.value.path().read_text(encoding="utf-8"))
+    assert any(e["resource"]["identifier"]["value"].endswith(session) for e in bundle["entry"]
+               if e["resource"]["resourceType"] == "QuestionnaireResponse")
     context.close()
