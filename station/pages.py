@@ -2,6 +2,9 @@
 
 Thin handlers: check the form (CSRF), call :mod:`station.ward` or :mod:`station.validation`,
 publish what changed, redirect back (post/redirect/get, so a reload never repeats an action).
+A session is shown and exported with the questionnaire it ran and the identity its kiosk recorded
+it under (:mod:`kiosk.captured`), never with the station's bundled file; what of a session does
+not fit its questionnaire (rows stored before they were checked) is left out, never a 500.
 """
 
 from __future__ import annotations
@@ -16,13 +19,14 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export import csv_text, fhir_response, practice_outcomes, site_from_identity
-from kiosk.questionnaire import Questionnaire
+from kiosk.captured import questionnaire_of, site_of
+from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes
+from kiosk.questionnaire import Questionnaire, Score
 from kiosk.storage import StoredSession
 from station import db, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
-from station.sessions import NotFound, load, load_for_export
+from station.sessions import NotFound, load
 
 #: session-list size on the ward page
 RECENT = 50
@@ -89,9 +93,21 @@ async def command(request: Request) -> Response:
     return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.")
 
 
+def _fits(item: Any, option: int | None) -> bool:
+    return option is not None and 1 <= option <= len(item.options)
+
+
+def _score(q: Questionnaire, stored: StoredSession, review: Any) -> Score:
+    """The score of the answers (after corrections) that fit the questionnaire."""
+    items = {item.id: item for item in q.items}
+    options = review.options({a.item_id: a.option for a in stored.answers})
+    return q.score({i: items[i].option(o).points for i, o in options.items() if i in items and _fits(items[i], o)})
+
+
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:
     """One row per questionnaire item: what the kiosk recorded, what it is now, how it was answered."""
-    answers = {a.item_id: a for a in stored.answers}
+    items = {item.id for item in q.items}
+    answers = {a.item_id: a for a in stored.answers if a.item_id in items}
     options = review.options({a.item_id: a.option for a in stored.answers})
     # a question's attempts timing out are logged as "ITEM attempt N"
     outcomes = sorted([(a.t, a.item_id) for a in stored.answers] + [
@@ -106,31 +122,45 @@ def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[st
             previous_t = a.t
         elif item.id in stored.not_answered:
             previous_t = max([t for t, i in outcomes if i == item.id] + [previous_t])
-        option = options.get(item.id)
+        option = options.get(item.id) if _fits(item, options.get(item.id)) else None
         changes = [c for c in review.corrections if c.item_id == item.id]
         rows.append({
-            "number": number, "id": item.id, "text": item.text.get(stored.language, item.text["en"]),
-            "recorded": a, "recorded_label": item.option(a.option).label_in(stored.language) if a else None,
-            "option": option, "label": item.option(option).label_in(stored.language) if option else None,
+            "number": number, "id": item.id, "text": _in(item.text, stored.language),
+            "recorded": a, "recorded_label": _in(item.option(a.option).label, stored.language)
+            if a and _fits(item, a.option) else None,
+            "option": option, "label": _in(item.option(option).label, stored.language) if option else None,
             "points": item.option(option).points if option else None, "taken": taken,
             "not_answered": item.id in stored.not_answered, "changes": changes,
-            "options": [(o.number, o.label_in(stored.language), o.points) for o in item.options],
+            "options": [(o.number, _in(o.label, stored.language), o.points) for o in item.options],
         })
     return rows
 
 
+def _in(texts: Any, language: str) -> str:
+    """A text in ``language``, else in the first language it has."""
+    return texts.get(language) or next(iter(texts.values()), "")
+
+
+def _practice(q: Questionnaire, stored: StoredSession) -> list[Any]:
+    try:
+        return practice_outcomes(q, stored)
+    except (ExportError, KeyError, ValueError):
+        return ["the practice questions do not fit this session's questionnaire"]
+
+
 async def session_page(request: Request) -> Response:
-    engine, q = request.app.state.engine, request.app.state.questionnaire
+    engine = request.app.state.engine
     session_id = request.path_params["session_id"]
     try:
         kiosk, stored = await run_in_threadpool(_load, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
+    q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
-    score = validation.corrected(stored, q, current)["score"]
-    return render(request, "session.html", s=stored, kiosk=kiosk, review=current, trail=entries,
-                  items=_items(q, stored, current), score=score, practice=practice_outcomes(q, stored),
+    score = _score(q, stored, current)
+    return render(request, "session.html", s=stored, kiosk=kiosk, review=current, trail=entries, q=q,
+                  items=_items(q, stored, current), score=score, practice=_practice(q, stored),
                   plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
                   incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
                   reviewable=stored.status in validation.REVIEWABLE and not current.final,
@@ -142,14 +172,9 @@ def _load(engine: Any, session_id: str) -> tuple[str, StoredSession]:
         return load(connection, session_id)
 
 
-def _load_for_export(engine: Any, session_id: str) -> tuple[str, StoredSession, dict[str, Any]]:
-    with engine.connect() as connection:
-        return load_for_export(connection, session_id)
-
-
 async def change_item(request: Request) -> Response:
     form = await checked_form(request)
-    engine, q = request.app.state.engine, request.app.state.questionnaire
+    engine = request.app.state.engine
     session_id = request.path_params["session_id"]
     page = f"/sessions/{session_id}"
     try:
@@ -157,6 +182,8 @@ async def change_item(request: Request) -> Response:
     except ValueError:
         return _back(request, "Choose the new answer.", to=page)
     try:
+        _, stored = await run_in_threadpool(_load, engine, session_id)
+        q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
         await run_in_threadpool(validation.change_item, engine, q, session_id, request.path_params["item_id"],
                                 option, form.get("reason", ""), request.state.user)
     except (validation.ValidationError, NotFound) as exc:
@@ -178,23 +205,27 @@ async def sign_off(request: Request) -> Response:
 async def export(request: Request) -> Response:
     """FHIR QuestionnaireResponse or CSV of the session as it stands: corrections applied, and
     the review state said (unreviewed, signed off, amended)."""
-    engine, q = request.app.state.engine, request.app.state.questionnaire
+    engine = request.app.state.engine
     session_id, fmt = request.path_params["session_id"], request.path_params["fmt"]
     try:
-        kiosk, stored, identity = await run_in_threadpool(_load_for_export, engine, session_id)
+        kiosk, stored = await run_in_threadpool(_load, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
     current = await run_in_threadpool(validation.review, engine, session_id)
-    # named as the kiosk names it in its own exports (its site, kiosk id and FHIR systems, sent
-    # with the session), so a hospital importing both gets one result, not two
-    site = site_from_identity(identity, kiosk)
-    if fmt == "json":
-        import json
+    # described with the questionnaire the session ran and named as its kiosk names it in its own
+    # exports (site, kiosk id and FHIR systems, sent with the session): one result, not two
+    site = site_of(stored, kiosk)
+    try:
+        q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
+        if fmt == "json":
+            import json
 
-        body = json.dumps(fhir_response(q, stored, current, site), indent=2, ensure_ascii=False)
-        media = "application/fhir+json"
-    else:
-        body, media = csv_text(q, [stored], [current], site), "text/csv"
+            body = json.dumps(fhir_response(q, stored, current, site), indent=2, ensure_ascii=False)
+            media = "application/fhir+json"
+        else:
+            body, media = csv_text(q, [stored], [current], site), "text/csv"
+    except ExportError as exc:  # rows stored before rows were checked may not fit the questionnaire
+        return PlainTextResponse(f"session {session_id} cannot be exported: {exc}", status_code=409)
     return Response(body, media_type=media, headers={
         "content-disposition": f'attachment; filename="{session_id}.{"fhir.json" if fmt == "json" else "csv"}"'})
 
