@@ -162,6 +162,7 @@ async def session_page(request: Request) -> Response:
     return render(request, "session.html", s=stored, kiosk=kiosk, review=current, trail=entries, q=q,
                   items=_items(q, stored, current), score=score, practice=_practice(q, stored),
                   plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
+                  unfit=[e for e in stored.log if e.kind.startswith(("unfit:", "unreadable:"))],
                   incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
                   reviewable=stored.status in validation.REVIEWABLE and not current.final,
                   message=request.query_params.get("message"))

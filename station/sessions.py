@@ -19,6 +19,9 @@ from sqlalchemy.engine import Connection
 from kiosk.channels import Channel
 from kiosk.session import Answer, AnsweredBy
 from kiosk.storage import AdaptationRecord, LogEntry, MetricSample, PracticeRecord, StoredSession
+from kiosk.captured import questionnaire_of
+from kiosk.export import ExportError
+from kiosk.questionnaire import Questionnaire
 from station.db import definitions, inbox, sessions
 
 #: the outbox kinds that change a session's status (they refresh the session list)
@@ -172,14 +175,47 @@ def _kiosk_and_rows(connection: Connection, session_id: str) -> tuple[str, list[
 
 
 def _with_definition(connection: Connection, stored: StoredSession) -> StoredSession:
-    """``stored`` with the definition it runs (None if its create_session never arrived)."""
+    """``stored`` with the definition it runs (None if its create_session never arrived), and only
+    what fits it (see :func:`fitted`)."""
     row = connection.execute(sa.select(sessions.c.definition_sha256, sessions.c.definition_attached_later,
                                        definitions.c.body).select_from(sessions.outerjoin(
         definitions, definitions.c.sha256 == sessions.c.definition_sha256)).where(sessions.c.id == stored.id)).first()
     if row is None or row.body is None:
         return stored
-    return replace(stored, definition=json.loads(row.body), definition_sha256=row.definition_sha256,
-                   definition_attached_later=bool(row.definition_attached_later))
+    stored = replace(stored, definition=json.loads(row.body), definition_sha256=row.definition_sha256,
+                     definition_attached_later=bool(row.definition_attached_later))
+    try:
+        return fitted(stored, questionnaire_of(stored))
+    except ExportError:
+        return stored
+
+
+def fitted(stored: StoredSession, q: Questionnaire) -> StoredSession:
+    """``stored`` without what does not fit ``q``: rows stored before the station checked them (an
+    option the item lacks, an unknown item or practice question, a language ``q`` lacks). Each is
+    listed in the session's log instead (``unfit:...``), so the rest can be shown, corrected,
+    signed off and exported."""
+    items = {item.id: item for item in q.items}
+    practice_ids = {p.id for p in q.familiarisation}
+    log = list(stored.log)
+
+    def fits(a: Answer) -> bool:
+        item = items.get(a.item_id)
+        return item is not None and 1 <= a.option <= len(item.options) and item.option(a.option).points == a.points
+
+    answers = tuple(a for a in stored.answers if fits(a))
+    log += [LogEntry(a.t, "unfit:answer", f"{a.item_id} option {a.option} ({a.points} points)")
+            for a in stored.answers if not fits(a)]
+    practice = tuple(p for p in stored.practice if p.question_id in practice_ids)
+    log += [LogEntry(p.t, "unfit:practice", p.question_id) for p in stored.practice if p.question_id not in practice_ids]
+    language = stored.language
+    if language not in q.languages:
+        log.append(LogEntry(0.0, "unfit:language", f"{language!r}; shown in {q.languages[0]}"))
+        language = q.languages[0]
+    if len(log) == len(stored.log):
+        return stored
+    return replace(stored, answers=answers, practice=practice, language=language, log=tuple(log),
+                   not_answered=tuple(i for i in stored.not_answered if i in items))
 
 
 def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:

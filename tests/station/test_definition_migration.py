@@ -15,7 +15,13 @@ from kiosk.definition import canonical, digest
 from kiosk.questionnaire import load_questionnaire
 from station import auth, db
 from tests.station.conftest import PASSWORDS
-from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
+from tests.station.helpers import PATIENTS, KioskClient, Row, Staff, record_patient
+
+
+def rows_answer(rows: list, **changes) -> dict:
+    """The session's feeding answer with some fields changed (replacing it, as a later row does)."""
+    answer = next(r.payload for r in rows if r.kind == "record_answer" and r.payload["item_id"] == "feeding")
+    return answer | changes
 
 pytestmark = pytest.mark.slow
 
@@ -36,6 +42,11 @@ def test_old_sessions_get_the_bundled_definition_marked_attached_later(engine_na
     engine = _at_0001(url)
     rows = record_patient(PATIENTS / "barthel4.yaml")
     session_id = rows[0].session_id
+    # and odd rows a station stored before it checked them: option 99, an unknown item, a time as text
+    rows = rows + [Row(900 + n, kind, session_id, payload, 0.0, "2026-01-01T00:20:00Z") for n, (kind, payload) in
+                   enumerate([("record_answer", rows_answer(rows, option=99, points=99)),
+                              ("record_answer", rows_answer(rows, item_id="swimming")),
+                              ("record_event", {"t": "soon", "kind": "note", "detail": "odd"})])]
     with engine.begin() as connection:  # what a station before 0003 stored: no definition anywhere
         connection.execute(sa.text("INSERT INTO sessions (id, kiosk_id, patient_id, started_at, status, updated_at)"
                                    " VALUES (:id, 'old-kiosk', :patient, :started, 'finished', 0)"),
@@ -62,7 +73,15 @@ def test_old_sessions_get_the_bundled_definition_marked_attached_later(engine_na
     staff = Staff(station.url)
     page = staff.http.get(f"/sessions/{session_id}")
     assert page.status_code == 200 and "attached later" in page.text
-    assert staff.http.get(f"/sessions/{session_id}/export.json").status_code == 200
+    assert "Left out" in page.text and "feeding option 99" in page.text and "swimming" in page.text
+    exported = staff.http.get(f"/sessions/{session_id}/export.json")
+    assert exported.status_code == 200
+    answered = {i["linkId"] for i in exported.json()["item"] if i.get("answer")}
+    assert "swimming" not in answered and "feeding" not in answered and "bathing" in answered
+    # what did not fit can still be corrected and signed off
+    assert staff.post(f"/sessions/{session_id}/items/feeding", option="2", reason="asked again").status_code == 303
+    assert staff.post(f"/sessions/{session_id}/sign-off").status_code == 303
+    assert staff.http.get(f"/sessions/{session_id}/export.csv").status_code == 200
     # a kiosk that sends no definition yet: the bundled one, attached later, checked against it
     newer = record_patient(PATIENTS / "barthel5.yaml")
     for row in newer:
