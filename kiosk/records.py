@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import argparse
 import sys
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
 from kiosk.adaptation import MODEL
-from datetime import datetime, timezone
-
 from kiosk.config import Config, ConfigError, configured_questionnaire, load_config
 from kiosk.definition import canonical
 from kiosk.schema import InForce

@@ -46,8 +46,8 @@ from typing import Any
 
 from kiosk.channels import Channel
 from kiosk.custody import Custody
-from kiosk.lease import LEASE_TTL_S, Owner, SessionTaken
 from kiosk.definition import canonical
+from kiosk.lease import LEASE_TTL_S, Owner, SessionTaken
 from kiosk.questionnaire import load_questionnaire
 from kiosk.schema import InForce, SchemaError, migrate, store_definition
 from kiosk.session import Answer, AnsweredBy

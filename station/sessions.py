@@ -16,12 +16,18 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.channels import Channel
-from kiosk.session import Answer, AnsweredBy
-from kiosk.storage import AdaptationRecord, LogEntry, MetricSample, PracticeRecord, StoredSession
 from kiosk.captured import questionnaire_of
+from kiosk.channels import Channel
 from kiosk.export import ExportError
 from kiosk.questionnaire import Questionnaire
+from kiosk.session import Answer, AnsweredBy
+from kiosk.storage import (
+    AdaptationRecord,
+    LogEntry,
+    MetricSample,
+    PracticeRecord,
+    StoredSession,
+)
 from station.db import definitions, inbox, sessions
 
 #: the outbox kinds that change a session's status (they refresh the session list)

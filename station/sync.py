@@ -26,8 +26,17 @@ from sqlalchemy.engine import Connection
 from kiosk.definition import canonical, canonical_json, digest
 from kiosk.questionnaire import Questionnaire, load_questionnaire
 from station import db
-from station.checks import ID_MAX, NEEDS_DEFINITION, RowRefused, check_create, check_definition, check_row, \
-    iso_time, sha_of, text
+from station.checks import (
+    ID_MAX,
+    NEEDS_DEFINITION,
+    RowRefused,
+    check_create,
+    check_definition,
+    check_row,
+    iso_time,
+    sha_of,
+    text,
+)
 from station.db import alerts, definitions, inbox, sessions
 from station.sessions import LIFECYCLE, rows_of, status_of
 

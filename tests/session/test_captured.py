@@ -10,7 +10,13 @@ import pytest
 
 from kiosk import schema
 from kiosk.captured import questionnaire_of, site_of
-from kiosk.definition import DefinitionError, canonical, canonical_json, digest, questionnaire_from
+from kiosk.definition import (
+    DefinitionError,
+    canonical,
+    canonical_json,
+    digest,
+    questionnaire_from,
+)
 from kiosk.questionnaire import bundled_path, load_questionnaire
 from kiosk.results import main as results_main
 from kiosk.storage import DB_NAME, Store
