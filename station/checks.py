@@ -30,7 +30,7 @@ from kiosk.storage import PATIENT_ID
 #: the longest id (item, session, kind, name) and time the station's columns hold
 ID_MAX, TIME_MAX = 64, 40
 #: the longest free text (detail, reason) and the longest identity value
-TEXT_MAX, IDENTITY_MAX = 4000, 200
+TEXT_MAX, IDENTITY_MAX = 10000, 200
 #: times a kiosk writes: date, time, optional fraction and zone (what datetime.isoformat gives)
 ISO_TIME = re.compile(r"^\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}(\.\d{1,6})?(Z|[+-]\d{2}:\d{2})?$")
 #: session times (seconds from its start) within reason: no session lasts a year

@@ -68,9 +68,13 @@ def is_alert(event: Event) -> bool:
 
 class SyncError(ValueError):
     """A batch the station refuses; ``status`` is the HTTP status (400 malformed, 409 conflict,
-    422 a row that breaks a rule)."""
+    422 a row that breaks a rule); ``seq`` the row at fault, when one is."""
 
     status = 400
+
+    def __init__(self, message: str, seq: int | None = None) -> None:
+        super().__init__(message)
+        self.seq = seq
 
 
 class Conflict(SyncError):
@@ -78,13 +82,9 @@ class Conflict(SyncError):
 
 
 class Refused(SyncError):
-    """A row that breaks a rule; ``seq`` is the row's."""
+    """A row that breaks a rule."""
 
     status = 422
-
-    def __init__(self, message: str, seq: int | None = None) -> None:
-        super().__init__(message)
-        self.seq = seq
 
 
 @dataclass(frozen=True)
@@ -167,7 +167,7 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
     for event in events:
         if event.seq in known and not _same(known[event.seq], event):
             raise Conflict(f"seq {event.seq}: already stored with different content (was this kiosk's "
-                           "database replaced? its rows are kept apart until someone checks)")
+                           "database replaced? its rows are kept apart until someone checks)", event.seq)
     new = [e for e in events if e.seq not in known]
     _claim_sessions(connection, kiosk_id, new, received)
     _check_against_definitions(connection, new, received)
@@ -260,7 +260,7 @@ def _claim_sessions(connection: Connection, kiosk_id: str, new: Sequence[Event],
         owner = owners.get(session_id)
         if owner is not None and owner != kiosk_id:
             seq = next(e.seq for e in new if e.session_id == session_id)
-            raise Conflict(f"seq {seq}: session {session_id} belongs to kiosk {owner}, not {kiosk_id}")
+            raise Conflict(f"seq {seq}: session {session_id} belongs to kiosk {owner}, not {kiosk_id}", seq)
     db.insert_ignore(connection, sessions, [{"id": s, "kiosk_id": kiosk_id, "status": "pending", "updated_at": received}
                                    for s in ids if s not in owners], ["id"])
 
