@@ -16,9 +16,11 @@ import json
 import sqlite3
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from datetime import datetime, timezone
 from typing import Any
 
-from kiosk.definition import canonical_json, digest
+from kiosk.definition import canonical, canonical_json, digest
+from kiosk.questionnaire import load_questionnaire
 
 V1 = """
 CREATE TABLE IF NOT EXISTS patients (
@@ -192,6 +194,14 @@ class InForce:
     identity: Mapping[str, str]
     #: when the upgrade ran (ISO 8601 UTC)
     at: str = ""
+
+
+def bundled_in_force(export: Mapping[str, str], wall: Callable[[], float]) -> Callable[[], InForce]:
+    """The default :class:`InForce`: the bundled questionnaire (loaded only when asked) and ``export``."""
+    def now() -> InForce:
+        at = datetime.fromtimestamp(wall(), timezone.utc).isoformat().replace("+00:00", "Z")
+        return InForce(canonical(load_questionnaire()), dict(export), at)
+    return now
 
 
 def store_definition(db: sqlite3.Connection, definition: Mapping[str, Any], at: str) -> str:

@@ -46,10 +46,14 @@ from typing import Any
 
 from kiosk.channels import Channel
 from kiosk.custody import Custody
-from kiosk.definition import canonical
 from kiosk.lease import LEASE_TTL_S, Owner, SessionTaken
-from kiosk.questionnaire import load_questionnaire
-from kiosk.schema import InForce, SchemaError, migrate, store_definition
+from kiosk.schema import (
+    InForce,
+    SchemaError,
+    bundled_in_force,
+    migrate,
+    store_definition,
+)
 from kiosk.session import Answer, AnsweredBy
 from kiosk.stored import (
     AdaptationRecord,
@@ -73,14 +77,6 @@ BUSY_TIMEOUT_S = 10.0
 #: session-log kinds that are alerts for the ward, with the name the station protocol gives them
 ALERT_EVENTS = {"call_doctor": "doctor_called", "clinician_continue": "doctor_continued",
                 "person_lost": "person_lost", "person_back": "person_back"}
-
-
-def _in_force_now(export: Mapping[str, str], wall: Callable[[], float]) -> Callable[[], InForce]:
-    """The default :class:`InForce`: the bundled questionnaire (loaded only when asked) and ``export``."""
-    def now() -> InForce:
-        at = datetime.fromtimestamp(wall(), timezone.utc).isoformat().replace("+00:00", "Z")
-        return InForce(canonical(load_questionnaire()), dict(export), at)
-    return now
 
 
 class StorageError(RuntimeError):
@@ -150,7 +146,7 @@ class Store(Custody):
         #: how this kiosk's exports name things (site, kiosk, FHIR systems), sent to the station with
         #: each new session so that the station's exports of it carry the same identifiers
         self.export = dict(export or {})
-        self._in_force = in_force or _in_force_now(self.export, wall)
+        self._in_force = in_force or bundled_in_force(self.export, wall)
         self.path = path
         self.owner = owner or Owner()
         self.simulated = simulated
@@ -175,7 +171,7 @@ class Store(Custody):
         become an empty database) a missing directory or database is a StorageError. ``options``
         are the constructor's keywords."""
         directory = Path(data_dir).expanduser()
-        in_force = options.setdefault("in_force", _in_force_now(options.get("export") or {},
+        in_force = options.setdefault("in_force", bundled_in_force(options.get("export") or {},
                                                                 options.get("wall", time.time)))
         path = directory / DB_NAME
         if not create:
