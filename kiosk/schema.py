@@ -274,7 +274,13 @@ def migrate(db: sqlite3.Connection, name: str, in_force: Callable[[], InForce] |
                 if in_force is None:
                     raise SchemaError(f"{name}: upgrading to schema version {LATEST} needs the questionnaire and "
                                       "identity in force to attach to the sessions stored before; nothing was changed")
-                attach_in_force(db, in_force())
+                try:
+                    now = in_force()
+                except ValueError as exc:  # the configuration or questionnaire file in force is unusable
+                    raise SchemaError(f"{name}: upgrading to schema version {LATEST} attaches the questionnaire "
+                                      f"in force to the sessions stored before, but it cannot be read ({exc}); "
+                                      "nothing was changed") from None
+                attach_in_force(db, now)
             problems = db.execute("PRAGMA foreign_key_check").fetchall()
             if problems:
                 raise SchemaError(f"{name}: upgrading to schema version {LATEST} found rows pointing nowhere "

@@ -123,3 +123,20 @@ def test_an_upgrade_without_anything_in_force_is_refused_and_changes_nothing(tmp
     assert schema.version(db) == 2
     assert db.execute("SELECT COUNT(*) FROM sqlite_master WHERE name = 'definitions'").fetchone() == (0,)
     db.close()
+
+
+def test_an_upgrade_with_an_unusable_questionnaire_in_force_is_one_message_and_changes_nothing(tmp_path,
+                                                                                             monkeypatch, capsys):
+    data = tmp_path / "data"
+    _v2_database(data)
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("id: barthel\nitems: [\n", encoding="utf-8")
+    monkeypatch.setenv("KIOSK_CONFIG", str(_config(tmp_path / "a.yaml", "sitea", "kiosk-a", broken)))
+    from kiosk.records import trace_main
+
+    assert trace_main(["aaaa00000001", "--data-dir", str(data), "--model", "clarc"]) == 2
+    error = capsys.readouterr().err
+    assert "broken.yaml" in error and "nothing was changed" in error and "Traceback" not in error
+    db = sqlite3.connect(data / DB_NAME)
+    assert schema.version(db) == 2
+    db.close()
