@@ -21,7 +21,7 @@ from datetime import datetime
 from typing import Any
 
 from kiosk.channels import Channel
-from kiosk.definition import DefinitionError, digest, questionnaire_from
+from kiosk.definition import DefinitionError, questionnaire_from
 from kiosk.export import ExportError, ExportSite, fhir_questionnaire
 from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
 from kiosk.session import AnsweredBy
@@ -113,13 +113,11 @@ def _words(value: Any, where: str) -> None:
         text(name, f"{where}[{i}]", ID_MAX)
 
 
-def check_definition(definition: Any, where: str, sha: Any = None) -> Questionnaire:
+def check_definition(definition: Any, where: str) -> Questionnaire:
     """The questionnaire a kiosk's captured definition describes, checked to be one the station
     can show and export in each of its languages (RowRefused naming what does not fit)."""
     if not isinstance(definition, dict):
         raise _fail(where, "must be an object (the kiosk's captured questionnaire definition)")
-    if sha is not None and (not isinstance(sha, str) or sha != digest(definition)):
-        raise _fail(where + "_sha256", "is not the SHA-256 of the definition's canonical JSON")
     try:
         q = questionnaire_from(definition)
     except DefinitionError as exc:

@@ -23,7 +23,7 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.definition import canonical, canonical_json, digest
+from kiosk.definition import canonical, canonical_json, digest, questionnaire_from
 from kiosk.questionnaire import Questionnaire, load_questionnaire
 from station import db
 from station.checks import (
@@ -136,13 +136,18 @@ def parse(body: Any) -> list[Event]:
             if missing:
                 raise RowRefused(f"{where}: {kind} without {', '.join(missing)}")
             definition = None
+            if kind == "create_session" and "definition_sha256" in payload:
+                sha_of(payload["definition_sha256"], f"{where}: create_session.definition_sha256")
             if kind == "create_session" and "definition" in payload:
                 payload = dict(payload)
-                definition = payload.pop("definition")
-                check_definition(definition, f"{where}: create_session.definition", payload.get("definition_sha256"))
+                definition = payload.pop("definition")  # stored once by its hash; checked after the token
+                if not isinstance(definition, dict):
+                    raise RowRefused(f"{where}: create_session.definition: must be an object")
+                sent = payload.get("definition_sha256")
                 payload["definition_sha256"] = digest(definition)
-            elif kind == "create_session" and "definition_sha256" in payload:
-                sha_of(payload["definition_sha256"], f"{where}: create_session.definition_sha256")
+                if sent is not None and sent != payload["definition_sha256"]:
+                    raise RowRefused(f"{where}: create_session.definition_sha256: is not the SHA-256 of the "
+                                     "definition's canonical JSON")
         except RowRefused as exc:
             raise Refused(str(exc), seq) from None
         events.append(Event(seq, kind, session_id, payload, at, definition))
@@ -170,7 +175,7 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
                            "database replaced? its rows are kept apart until someone checks)", event.seq)
     new = [e for e in events if e.seq not in known]
     _claim_sessions(connection, kiosk_id, new, received)
-    _check_against_definitions(connection, new, received)
+    _check_against_definitions(connection, new)
     db.insert_ignore(connection, inbox, [{"kiosk_id": kiosk_id, "seq": e.seq, "kind": e.kind,
                                           "session_id": e.session_id, "payload": json.dumps(e.payload), "at": e.at,
                                           "received_at": received} for e in new], ["kiosk_id", "seq"])
@@ -187,33 +192,28 @@ def _definition_of(connection: Connection, session_id: str) -> str | None:
 
 
 def _questionnaire(connection: Connection, sha: str, cache: dict[str, Questionnaire]) -> Questionnaire:
+    """The questionnaire of a stored definition (rebuilt once per content in this process)."""
     if sha not in cache:
         body = connection.execute(sa.select(definitions.c.body).where(definitions.c.sha256 == sha)).scalar()
-        cache[sha] = questionnaire_for(sha, body)
+        cache[sha] = _rebuilt(body or canonical_json(_bundled()[0]))
     return cache[sha]
 
 
-def questionnaire_for(sha: str, body: str | None) -> Questionnaire:
-    """The questionnaire of a stored definition (rebuilt once per content in this process)."""
-    return _rebuilt(sha, body or canonical_json(_bundled()[0]))
-
-
 @lru_cache(maxsize=64)
-def _rebuilt(sha: str, body: str) -> Questionnaire:
-    from kiosk.definition import questionnaire_from
-
+def _rebuilt(body: str) -> Questionnaire:
     return questionnaire_from(json.loads(body))
 
 
-def _store_definition(connection: Connection, definition: dict[str, Any], sha: str, received: float) -> None:
+def _store_definition(connection: Connection, definition: dict[str, Any], sha: str) -> None:
     db.insert_ignore(connection, definitions, [{
         "sha256": sha, "questionnaire_id": str(definition.get("id", "")), "version": str(definition.get("version", "")),
         "body": canonical_json(definition), "stored_at": db.now_iso()}], ["sha256"])
 
 
-def _check_against_definitions(connection: Connection, new: Sequence[Event], received: float) -> None:
-    """Check each new row against its session's definition, in seq order; store the definitions a
-    create_session brings and note which one each new session runs (Refused naming the row)."""
+def _check_against_definitions(connection: Connection, new: Sequence[Event]) -> None:
+    """Check each new row against its session's definition, in seq order; check and store the
+    definitions a create_session brings (each content once) and note which one each new session
+    runs (Refused naming the row)."""
     running: dict[str, str | None] = {}
     cache: dict[str, Questionnaire] = {}
     for event in sorted(new, key=lambda e: e.seq):
@@ -227,10 +227,14 @@ def _check_against_definitions(connection: Connection, new: Sequence[Event], rec
                 later = event.definition is None and "definition_sha256" not in event.payload
                 if event.definition is not None:
                     sha = event.payload["definition_sha256"]
-                    _store_definition(connection, event.definition, sha, received)
+                    known = connection.execute(sa.select(definitions.c.sha256).where(
+                        definitions.c.sha256 == sha)).scalar()
+                    if sha not in cache and known is None:  # stored ones were checked as they came
+                        cache[sha] = check_definition(event.definition, f"{where}.definition")
+                        _store_definition(connection, event.definition, sha)
                 elif later:
                     definition, sha = _bundled()
-                    _store_definition(connection, definition, sha, received)
+                    _store_definition(connection, definition, sha)
                 else:
                     sha = event.payload["definition_sha256"]
                     if connection.execute(sa.select(definitions.c.sha256).where(definitions.c.sha256 == sha)).scalar() \
