@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Mapping, Sequence
+import json
+from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
@@ -30,13 +31,11 @@ from kiosk.questionnaire import Questionnaire
 from kiosk.review import Review
 from kiosk.stored import StoredSession
 
-__all__ = ["bundle_of", "csv_of", "identity_of", "questionnaire_of", "site_of", "wide_csv_of"]
+__all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of"]
 
 
 @lru_cache(maxsize=64)
 def _rebuilt(text: str) -> Questionnaire:
-    import json
-
     return questionnaire_from(json.loads(text))
 
 
@@ -154,7 +153,3 @@ def wide_csv_of(sessions: Sequence[StoredSession], reviews: Sequence[Review | No
     return ("\ufeff" if bom else "") + _merge_csv(
         [wide_csv_text(q, group, _reviews(found), site) for q, site, group, found in groups])
 
-
-def identity_of(stored: StoredSession) -> Mapping[str, str]:
-    """The captured identity as plain strings (what a station export names)."""
-    return {k: str(v) for k, v in vars(site_of(stored)).items()}

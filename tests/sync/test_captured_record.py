@@ -10,6 +10,7 @@ recorded after the edit, at B, is described with the edited file, at the kiosk a
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import subprocess
@@ -122,12 +123,17 @@ def test_a_result_keeps_its_identity_and_questionnaire_after_the_file_and_the_co
         edited = _kiosk("replay", str(ROOT / "recordings/patients/barthel5.yaml"), "--data-dir", str(data),
                         config=site_b)
         assert edited.returncode == 0, edited.stderr
-        both = _kiosk("results", "--data-dir", str(data), "--fhir", str(tmp_path / "both.json"), config=site_b)
+        both = _kiosk("results", "--data-dir", str(data), "--fhir", str(tmp_path / "both.json"),
+                      "--csv", str(tmp_path / "both.csv"), config=site_b)
         assert both.returncode == 0, both.stderr
         bundle = json.loads((tmp_path / "both.json").read_text(encoding="utf-8"))
         responses = {r["identifier"]["value"].split("/")[0]: r for r in
                      (e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse")}
         assert set(responses) == {"sitea", "siteb"}
+        table = list(csv.DictReader((tmp_path / "both.csv").open(encoding="utf-8")))
+        assert {(r["kiosk_id"], r["questionnaire_version"]) for r in table} == {
+            ("K:kiosk-a", responses["sitea"]["questionnaire"].split("|")[1]),
+            ("K:laptop-7", responses["siteb"]["questionnaire"].split("|")[1])}
         newer = responses["siteb"]
         assert newer["questionnaire"].split("|")[1] != first["questionnaire"].split("|")[1]  # another version
         assert next(i for i in newer["item"] if i["linkId"] == "feeding")["text"] == EDITED_TEXT
