@@ -95,22 +95,25 @@ def main(argv: list[str]) -> int:
         parser.error("--language says which language --fhir-questionnaire writes; give --fhir-questionnaire FILE")
     try:
         config = load_config()
-        q = configured_questionnaire(config)
         site = site_from_config(config)
+        # today's questionnaire file is read only for what it describes: itself (--fhir-questionnaire)
+        # and an export of no session; stored sessions are described by what they captured
+        if args.fhir_questionnaire:
+            q = configured_questionnaire(config)
+            write_json(args.fhir_questionnaire, fhir_questionnaire(q, args.language, site) if args.language
+                       else questionnaire_bundle(q, site))
         with open_store(args.data_dir, in_force=lambda: in_force_of(config), export=export_identity(site)) as store:
-            if args.fhir_questionnaire:
-                write_json(args.fhir_questionnaire, fhir_questionnaire(q, args.language, site) if args.language
-                           else questionnaire_bundle(q, site))
             refs = [ref.removeprefix(ID_TAGS["session"]) for ref in args.sessions]
             exporting = args.fhir or args.csv or args.csv_wide
             chosen = ([store.session(ref) for ref in refs] if refs
                       else [store.session(s.id) for s in store.sessions()] if exporting else [])
+            empty = None if chosen or not exporting else (configured_questionnaire(config), site)
             if args.fhir:
-                write_json(args.fhir, bundle_of(chosen, empty=(q, site)))
+                write_json(args.fhir, bundle_of(chosen, empty=empty))
             if args.csv:
-                write_export(args.csv, csv_of(chosen, bom=args.bom, empty=(q, site)))
+                write_export(args.csv, csv_of(chosen, bom=args.bom, empty=empty))
             if args.csv_wide:
-                write_export(args.csv_wide, wide_csv_of(chosen, bom=args.bom, empty=(q, site)))
+                write_export(args.csv_wide, wide_csv_of(chosen, bom=args.bom, empty=empty))
             if not refs:
                 summaries = store.sessions()
                 if not summaries:

@@ -109,6 +109,13 @@ def test_a_result_keeps_its_identity_and_questionnaire_after_the_file_and_the_co
         assert (tmp_path / "later.csv").read_bytes() == (tmp_path / "once.csv").read_bytes()
         shown = _kiosk("results", session, "--data-dir", str(data), config=site_b)
         assert shown.returncode == 0 and "recorded at sitea/kiosk-a" in shown.stdout, shown.stderr
+        # even a file broken since then does not stop the recorded session's export
+        good = questionnaire.read_text(encoding="utf-8")
+        questionnaire.write_text(good.replace("points: 10", "points: 11", 1), encoding="utf-8")
+        broken = _kiosk("results", "--data-dir", str(data), "--fhir", str(tmp_path / "broken.json"), config=site_b)
+        assert broken.returncode == 0, broken.stderr
+        assert (tmp_path / "broken.json").read_bytes() == (tmp_path / "once.json").read_bytes()
+        questionnaire.write_text(good, encoding="utf-8")
 
         # the station describes it as the kiosk does: the kiosk's identity, canonical, texts and displays
         station_later = staff.http.get(f"/sessions/{session}/export.json").json()
