@@ -35,6 +35,8 @@ from textual.message import Message
 
 from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
 from kiosk.export import ExportSite, export_identity, site_from_config
+from kiosk.captured import questionnaire_of
+from kiosk.records import in_force_of
 from kiosk.pin import CornerTaps, PinGuard
 from kiosk.questionnaire import Questionnaire
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
@@ -670,7 +672,8 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
         model = load_kiosk_model(config.qos_model)
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
         store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
-                           outbox=config.station is not None, export=export_identity(site_from_config(config)))
+                           outbox=config.station is not None, export=export_identity(site_from_config(config)),
+                           in_force=lambda: in_force_of(config))
         sync = _station_client(config.station, store, lambda command: app.station_command(command))
         # what a kiosk that stopped left running is interrupted now: for staff, never a patient
         store.interrupt_stale()
@@ -692,7 +695,9 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
                        familiarisation=config.familiarisation, next_patient_after_s=config.next_patient_after_s)
 
     def resume(stored: StoredSession) -> Session:
-        return Session.from_stored(questionnaire, stored, clock=clock, engine=Engine(model),
+        # the test goes on with the questionnaire it started with, whatever the file says now
+        return Session.from_stored(questionnaire_of(stored, fallback=questionnaire), stored, clock=clock,
+                                   engine=Engine(model),
                                    store=store, timing=config.timing,
                                    adaptation=Adaptation(policy) if policy else None,
                                    next_patient_after_s=config.next_patient_after_s)

@@ -9,19 +9,36 @@ from __future__ import annotations
 
 import argparse
 import sys
+from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
 from kiosk.adaptation import MODEL
-from kiosk.config import ConfigError, load_config
+from kiosk.config import Config, ConfigError, configured_questionnaire, load_config
+from kiosk.definition import canonical
+from kiosk.schema import InForce
 from kiosk.storage import StorageError, Store, StoredSession
 
-__all__ = ["MODEL", "open_store", "session_trace", "trace_main"]
+__all__ = ["MODEL", "in_force_of", "open_store", "session_trace", "trace_main"]
 
 
-def open_store(data_dir: str | None) -> Store:
+def in_force_of(config: Config) -> InForce:
+    """What an upgrade of the kiosk database attaches to the sessions stored before definitions
+    and identities were captured: the configuration's questionnaire (with its band set) and its
+    site, kiosk and FHIR systems, dated now."""
+    from kiosk.export import export_identity, site_from_config
+
+    return InForce(canonical(configured_questionnaire(config)), export_identity(site_from_config(config)),
+                   datetime.now(timezone.utc).isoformat().replace("+00:00", "Z"))
+
+
+def open_store(data_dir: str | None, **options: Any) -> Store:
     """The existing store in ``data_dir``, or in the configured data directory; never creates one
-    (ConfigError/StorageError)."""
-    return Store.open(Path(data_dir) if data_dir else load_config().data_dir, create=False)
+    (ConfigError/StorageError). ``options`` are :class:`Store`'s (``in_force``: what an upgrade
+    attaches to sessions stored before definitions were captured; default: the configuration's,
+    :func:`in_force_of`)."""
+    options.setdefault("in_force", lambda: in_force_of(load_config()))
+    return Store.open(Path(data_dir) if data_dir else load_config().data_dir, create=False, **options)
 
 
 def session_trace(stored: StoredSession, model: str = MODEL):  # -> qos.Trace

@@ -610,9 +610,11 @@ def main(argv: list[str]) -> int:
         try:
             # scripted patients: never offered to anyone; queued for the station when there is one
             from kiosk.export import export_identity, site_from_config
+            from kiosk.records import in_force_of
 
             store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None,
-                               export=export_identity(site_from_config(config)))
+                               export=export_identity(site_from_config(config)),
+                               in_force=lambda: in_force_of(config))
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2

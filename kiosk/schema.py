@@ -12,7 +12,15 @@ Add a migration by appending to :data:`MIGRATIONS`; never edit one that has ship
 
 from __future__ import annotations
 
+import json
 import sqlite3
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from typing import Any
+
+from kiosk.definition import canonical, canonical_json, digest
+from kiosk.questionnaire import load_questionnaire
 
 V1 = """
 CREATE TABLE IF NOT EXISTS patients (
@@ -153,9 +161,77 @@ CREATE TABLE outbox (
 );
 """
 
+# Version 3: the instrument definition each session ran, stored once per content (SHA-256 of its
+# canonical JSON, kiosk.definition), and the identity it was recorded under (site, kiosk id, FHIR
+# systems). Sessions stored before have neither: the upgrade attaches the definition and identity
+# in force when it runs (:func:`attach_in_force`) and marks them attached later.
+V3 = """
+CREATE TABLE definitions (
+    sha256 TEXT PRIMARY KEY CHECK (length(sha256) = 64),
+    questionnaire_id TEXT NOT NULL,
+    version TEXT NOT NULL,
+    body TEXT NOT NULL,
+    stored_at TEXT NOT NULL
+);
+ALTER TABLE sessions ADD COLUMN definition TEXT REFERENCES definitions(sha256);
+ALTER TABLE sessions ADD COLUMN definition_attached_later INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE sessions ADD COLUMN identity TEXT;
+ALTER TABLE sessions ADD COLUMN identity_attached_later INTEGER NOT NULL DEFAULT 0;
+"""
+
 #: (version, script) in order; a database at version v runs every script after v
-MIGRATIONS: tuple[tuple[int, str], ...] = ((1, V1), (2, V2))
+MIGRATIONS: tuple[tuple[int, str], ...] = ((1, V1), (2, V2), (3, V3))
 LATEST = MIGRATIONS[-1][0]
+
+
+@dataclass(frozen=True)
+class InForce:
+    """What describes sessions recorded before definitions were captured: the definition (canonical
+    JSON, :func:`kiosk.definition.canonical`) and identity (site, kiosk id, FHIR systems) in force
+    when the database is upgraded."""
+
+    definition: Mapping[str, Any]
+    identity: Mapping[str, str]
+    #: when the upgrade ran (ISO 8601 UTC)
+    at: str = ""
+
+
+def bundled_in_force(export: Mapping[str, str], wall: Callable[[], float]) -> Callable[[], InForce]:
+    """The default :class:`InForce`: the bundled questionnaire (loaded only when asked) and ``export``."""
+    def now() -> InForce:
+        at = datetime.fromtimestamp(wall(), timezone.utc).isoformat().replace("+00:00", "Z")
+        return InForce(canonical(load_questionnaire()), dict(export), at)
+    return now
+
+
+def store_definition(db: sqlite3.Connection, definition: Mapping[str, Any], at: str) -> str:
+    """Store a definition once (by its content address) in the current transaction; returns its SHA-256."""
+    sha = digest(definition)
+    db.execute("INSERT OR IGNORE INTO definitions (sha256, questionnaire_id, version, body, stored_at)"
+               " VALUES (?, ?, ?, ?, ?)", (sha, str(definition.get("id", "")), str(definition.get("version", "")),
+                                           canonical_json(definition), at))
+    return sha
+
+
+def attach_in_force(db: sqlite3.Connection, in_force: InForce) -> None:
+    """Give every session without a captured definition or identity the ones in force, marked
+    attached later; pending outbox rows that create such a session carry them too (the station
+    then marks them alike)."""
+    missing = db.execute("SELECT COUNT(*) FROM sessions WHERE definition IS NULL OR identity IS NULL").fetchone()[0]
+    if not missing:
+        return
+    sha = store_definition(db, in_force.definition, in_force.at)
+    db.execute("UPDATE sessions SET definition = ?, definition_attached_later = 1 WHERE definition IS NULL", (sha,))
+    db.execute("UPDATE sessions SET identity = ?, identity_attached_later = 1 WHERE identity IS NULL",
+               (json.dumps(dict(in_force.identity), sort_keys=True),))
+    for seq, payload in db.execute("SELECT seq, payload FROM outbox WHERE kind = 'create_session'").fetchall():
+        body = json.loads(payload)
+        if "definition" in body:
+            continue
+        body |= {"definition": dict(in_force.definition), "definition_sha256": sha, "definition_attached_later": True}
+        if not body.get("export"):
+            body |= {"export": dict(in_force.identity), "export_attached_later": True}
+        db.execute("UPDATE outbox SET payload = ? WHERE seq = ?", (json.dumps(body, ensure_ascii=False), seq))
 
 
 class SchemaError(RuntimeError):
@@ -174,9 +250,11 @@ def _refuse_newer(found: int, name: str) -> None:
                           "nothing was changed")
 
 
-def migrate(db: sqlite3.Connection, name: str) -> int:
+def migrate(db: sqlite3.Connection, name: str, in_force: Callable[[], InForce] | None = None) -> int:
     """Bring the database up to :data:`LATEST`; returns the version it had. ``db`` is in
-    autocommit mode (``isolation_level=None``); ``name`` names the file in messages."""
+    autocommit mode (``isolation_level=None``); ``name`` names the file in messages; ``in_force``
+    gives what version 3 attaches to the sessions stored before it (asked only when there are
+    some; without it such an upgrade is refused)."""
     found = version(db)
     _refuse_newer(found, name)
     if found == LATEST:
@@ -192,6 +270,17 @@ def migrate(db: sqlite3.Connection, name: str) -> int:
                 if number > found:
                     for statement in _statements(script):
                         db.execute(statement)
+            if found < 3 and db.execute("SELECT 1 FROM sessions WHERE definition IS NULL LIMIT 1").fetchone():
+                if in_force is None:
+                    raise SchemaError(f"{name}: upgrading to schema version {LATEST} needs the questionnaire and "
+                                      "identity in force to attach to the sessions stored before; nothing was changed")
+                try:
+                    now = in_force()
+                except ValueError as exc:  # the configuration or questionnaire file in force is unusable
+                    raise SchemaError(f"{name}: upgrading to schema version {LATEST} attaches the questionnaire "
+                                      f"in force to the sessions stored before, but it cannot be read ({exc}); "
+                                      "nothing was changed") from None
+                attach_in_force(db, now)
             problems = db.execute("PRAGMA foreign_key_check").fetchall()
             if problems:
                 raise SchemaError(f"{name}: upgrading to schema version {LATEST} found rows pointing nowhere "

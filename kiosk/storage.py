@@ -22,6 +22,12 @@ attempt, channel, who answered, time), questions not answered, the familiarisati
 outcomes (right, wrong, not answered, skipped; never part of the QoS trace), the QoS context trace, a metric
 sample after each QoS update, adaptation events and the session log (incidents, ignored inputs).
 A stored total is kept for listing only; results always recompute it from the answers.
+
+Each session also keeps what describes it: the exact instrument definition it ran (canonical JSON,
+:mod:`kiosk.definition`, stored once per content in ``definitions`` and referenced by SHA-256) and
+the identity it was recorded under (site, kiosk id, FHIR systems: the ``export`` the store was
+opened with). Exports, the clinician's screens and the station describe the session with those,
+never with the questionnaire file or configuration current when they run.
 """
 
 from __future__ import annotations
@@ -41,7 +47,13 @@ from typing import Any
 from kiosk.channels import Channel
 from kiosk.custody import Custody
 from kiosk.lease import LEASE_TTL_S, Owner, SessionTaken
-from kiosk.schema import SchemaError, migrate
+from kiosk.schema import (
+    InForce,
+    SchemaError,
+    bundled_in_force,
+    migrate,
+    store_definition,
+)
 from kiosk.session import Answer, AnsweredBy
 from kiosk.stored import (
     AdaptationRecord,
@@ -118,17 +130,23 @@ class Store(Custody):
     as a scripted patient's; ``outbox`` queues every change for the ward station;
     ``interrupt_after_s`` is the age after which a running session counts as interrupted (None: no
     limit); ``wall`` gives the epoch seconds leases are dated with; ``export`` (the fields of
-    :class:`kiosk.export.ExportSite`) goes to the station with each new session.
+    :class:`kiosk.export.ExportSite`) is the identity each new session is recorded under, and goes
+    to the station with it (without it none is sent, and exports name the defaults: site ``local``,
+    the kiosk id of the host or of the station's kiosk); ``in_force``
+    gives the definition and identity attached to sessions stored before they were captured (an
+    upgrade) and the definition of a session created without one (default: the bundled
+    questionnaire and ``export``).
     """
 
     def __init__(self, connection: sqlite3.Connection, path: Path, *, owner: Owner | None = None,
                  simulated: bool = False, outbox: bool = False, interrupt_after_s: float | None = None,
                  lease_ttl_s: float = LEASE_TTL_S, wall: Callable[[], float] = time.time,
-                 export: Mapping[str, str] | None = None) -> None:
+                 export: Mapping[str, str] | None = None, in_force: Callable[[], InForce] | None = None) -> None:
         self._db = connection
         #: how this kiosk's exports name things (site, kiosk, FHIR systems), sent to the station with
         #: each new session so that the station's exports of it carry the same identifiers
         self.export = dict(export or {})
+        self._in_force = in_force or bundled_in_force(self.export, wall)
         self.path = path
         self.owner = owner or Owner()
         self.simulated = simulated
@@ -153,6 +171,8 @@ class Store(Custody):
         become an empty database) a missing directory or database is a StorageError. ``options``
         are the constructor's keywords."""
         directory = Path(data_dir).expanduser()
+        in_force = options.setdefault("in_force", bundled_in_force(options.get("export") or {},
+                                                                options.get("wall", time.time)))
         path = directory / DB_NAME
         if not create:
             if not directory.is_dir():
@@ -170,7 +190,7 @@ class Store(Custody):
             check = db.execute("PRAGMA quick_check").fetchall()
             if check != [("ok",)]:
                 raise _damaged(path, "; ".join(str(row[0]) for row in check[:3]))
-            migrate(db, str(path))
+            migrate(db, str(path), in_force)
         except SchemaError as exc:
             db.close() if db else None
             raise StorageError(str(exc)) from None
@@ -283,24 +303,34 @@ class Store(Custody):
     # -- writing (kiosk.session.SessionStore) ----------------------------------------------------
 
     def create_session(self, *, session_id: str, patient_id: str, questionnaire_id: str, language: str,
-                       answered_by: str, started_at: str, timing: Mapping[str, float]) -> None:
-        """Record a new running session (and its patient, the first time), held by this kiosk."""
+                       answered_by: str, started_at: str, timing: Mapping[str, float],
+                       definition: Mapping[str, Any] | None = None) -> None:
+        """Record a new running session (and its patient, the first time), held by this kiosk, with
+        the definition it runs (:func:`kiosk.definition.canonical`; None: the one in force, marked
+        attached later) and this store's identity."""
         if not PATIENT_ID.match(patient_id):
             raise ValueError(f"patient id {patient_id!r} is not a pseudonymous id "
                              "(2-64 letters, digits, '-' or '_'; never a name)")
+        later = definition is None
+        if definition is None:
+            definition = self._in_force().definition
         with self.transaction():
             self._write("INSERT OR IGNORE INTO patients (id, created_at) VALUES (?, ?)", (patient_id, started_at))
+            sha = store_definition(self._db, definition, self._iso_now())
             self._write(
                 "INSERT INTO sessions (id, patient_id, questionnaire_id, language, answered_by, timing, started_at,"
-                " status, simulated) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?)",
+                " status, simulated, definition, definition_attached_later, identity)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?)",
                 (session_id, patient_id, questionnaire_id, language, answered_by, json.dumps(dict(timing)), started_at,
-                 int(self.simulated)),
+                 int(self.simulated), sha, int(later), json.dumps(self.export, sort_keys=True)),
             )
             self._take(session_id)
             self._queue("create_session", session_id, {
                 "session_id": session_id, "patient_id": patient_id, "questionnaire_id": questionnaire_id,
                 "language": language, "answered_by": answered_by, "started_at": started_at, "timing": dict(timing),
-                "simulated": self.simulated, **({"export": self.export} if self.export else {})})
+                "simulated": self.simulated, **({"export": self.export} if self.export else {}),
+                "definition": dict(definition),
+                "definition_sha256": sha, **({"definition_attached_later": True} if later else {})})
 
     def record_answer(self, session_id: str, *, item_id: str, option: int, points: int, attempt: int,
                       channel: str, answered_by: str, t: float, at: str, detail: str = "") -> None:
@@ -426,8 +456,11 @@ class Store(Custody):
         """Everything stored about one session (full id or unique prefix)."""
         session_id = self.resolve(ref)
         row = self._db.execute(
-            "SELECT id, patient_id, questionnaire_id, language, answered_by, timing, started_at, status, finished_at,"
-            " simulated, interrupted_reason, interrupted_at FROM sessions WHERE id = ?", (session_id,)).fetchone()
+            "SELECT s.id, patient_id, s.questionnaire_id, language, answered_by, timing, started_at, status, finished_at,"
+            " simulated, interrupted_reason, interrupted_at, s.definition, d.body, definition_attached_later,"
+            " identity, identity_attached_later"
+            " FROM sessions s LEFT JOIN definitions d ON d.sha256 = s.definition WHERE s.id = ?",
+            (session_id,)).fetchone()
         answers = tuple(
             Answer(item_id, option, points, attempt, Channel(channel), AnsweredBy(by), t, detail)
             for item_id, option, points, attempt, channel, by, t, detail in self._db.execute(
@@ -461,4 +494,7 @@ class Store(Custody):
             timing=json.loads(row[5]), started_at=row[6], status=row[7], finished_at=row[8], answers=answers,
             not_answered=not_answered, trace=tuple(trace), metrics=metrics, adaptations=adaptations, log=log,
             practice=practice, simulated=bool(row[9]), interrupted_reason=row[10], interrupted_at=row[11],
+            definition=json.loads(row[13]) if row[13] else None, definition_sha256=row[12] or "",
+            definition_attached_later=bool(row[14]), identity=json.loads(row[15]) if row[15] else {},
+            identity_attached_later=bool(row[16]),
         )

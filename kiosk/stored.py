@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from kiosk.channels import Channel
@@ -104,5 +104,16 @@ class StoredSession:
     #: why an "interrupted" session stopped, and when (ISO 8601 UTC)
     interrupted_reason: str | None = None
     interrupted_at: str | None = None
+    #: the instrument definition the session ran, as captured (canonical JSON, kiosk.definition);
+    #: None only for a session read from a source that never had one
+    definition: Mapping[str, Any] | None = None
+    #: its content address (SHA-256 of the canonical JSON)
+    definition_sha256: str = ""
+    #: the definition was attached when the database was upgraded, not captured as the session started
+    definition_attached_later: bool = False
+    #: the identity the session was recorded under: site, kiosk_id and FHIR systems (ExportSite's fields)
+    identity: Mapping[str, str] = field(default_factory=dict)
+    #: the identity was attached when the database was upgraded, from the configuration then
+    identity_attached_later: bool = False
 
 

@@ -33,8 +33,11 @@ def _error(status: int, message: str) -> JSONResponse:
 
 
 def _refused(exc: ValueError) -> JSONResponse:
-    """A request refused for what it sent: 413 for a body over :data:`MAX_BODY`, else 400."""
-    return _error(getattr(exc, "status", 400), str(exc))
+    """A request refused for what it sent: 413 for a body over :data:`MAX_BODY`, 422 for a row
+    that breaks a rule (the body names its ``seq`` too), else 400."""
+    seq = getattr(exc, "seq", None)
+    return JSONResponse({"error": str(exc)} | ({"seq": seq} if seq is not None else {}),
+                        status_code=getattr(exc, "status", 400))
 
 
 def _token(request: Request) -> str | None:

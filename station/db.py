@@ -80,6 +80,20 @@ sessions = sa.Table(
     sa.Column("status", sa.String(16), nullable=False),
     sa.Column("finished_at", sa.String(40)),
     sa.Column("updated_at", sa.Float, nullable=False),
+    #: the definition the session ran (its kiosk sent it with create_session), by content address
+    sa.Column("definition_sha256", sa.String(64)),
+    #: the definition was attached by the station (an upgrade, or a kiosk that sent none): the bundled one
+    sa.Column("definition_attached_later", sa.Boolean, nullable=False, server_default=sa.false()),
+)
+
+#: questionnaire definitions, stored once per content (kiosk.definition: canonical JSON, SHA-256)
+definitions = sa.Table(
+    "definitions", metadata,
+    sa.Column("sha256", sa.String(64), primary_key=True),
+    sa.Column("questionnaire_id", sa.Text, nullable=False),
+    sa.Column("version", sa.Text, nullable=False),
+    sa.Column("body", sa.Text, nullable=False),
+    sa.Column("stored_at", sa.String(40), nullable=False),
 )
 
 alerts = sa.Table(

@@ -2,9 +2,11 @@
 transaction Bundles, and one result as CSV, all through the kiosk's own export code
 (:mod:`kiosk.export`), so a result reads the same from the kiosk and from the station.
 
-Each result is named as its kiosk names it (the site, kiosk id and FHIR systems the kiosk sent
-with the session), so a hospital importing both gets one result, not two; the station's review
-(:mod:`station.validation`) says where it stands. The questionnaire is given by the caller.
+Each result is described with what its session captured as it started (:mod:`kiosk.captured`):
+the questionnaire definition it ran and the identity it was recorded under (site, kiosk id, FHIR
+systems), so a hospital importing the kiosk's and the station's exports gets one result, not two;
+the station's review (:mod:`station.validation`) says where it stands. The caller's questionnaire
+only stands in for a session that captured none.
 """
 
 from __future__ import annotations
@@ -14,21 +16,23 @@ from datetime import date, timedelta
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
-from kiosk.export import Described, bundle_of, csv_text, result, site_from_identity
+from kiosk.captured import questionnaire_of, site_of
+from kiosk.export import Described, bundle_of, csv_text, result
 from kiosk.questionnaire import Questionnaire
 from station import validation
 from station.db import audit
-from station.sessions import load_for_export
+from station.sessions import load
 
 
 class PeriodError(ValueError):
     """A period the station cannot read (message says which part and why)."""
 
 
-def _described(connection: Connection, q: Questionnaire, session_id: str) -> Described:
-    kiosk, stored, identity = load_for_export(connection, session_id)
+def _described(connection: Connection, fallback: Questionnaire, session_id: str) -> Described:
+    kiosk, stored = load(connection, session_id)
     review = validation.review_in(connection, session_id)
-    return Described(q, result(q, stored, review), site_from_identity(identity, kiosk))
+    q = questionnaire_of(stored, fallback=fallback)
+    return Described(q, result(q, stored, review), site_of(stored, kiosk))
 
 
 def result_bundle(engine: Engine, q: Questionnaire, session_id: str) -> dict:
@@ -41,7 +45,7 @@ def result_csv(engine: Engine, q: Questionnaire, session_id: str) -> str:
     """One result as the long CSV (the same review state as its FHIR)."""
     with engine.connect() as connection:
         d = _described(connection, q, session_id)
-    return csv_text(q, [d.result.stored], [d.result.review], d.site)
+    return csv_text(d.questionnaire, [d.result.stored], [d.result.review], d.site)
 
 
 def period(start: str, end: str) -> tuple[date, date]:

@@ -2,6 +2,9 @@
 
 Thin handlers: check the form (CSRF), call :mod:`station.ward` or :mod:`station.validation`,
 publish what changed, redirect back (post/redirect/get, so a reload never repeats an action).
+A session is shown and exported with the questionnaire it ran and the identity its kiosk recorded
+it under (:mod:`kiosk.captured`), never with the station's bundled file; what of a session does
+not fit its questionnaire (rows stored before they were checked) is left out, never a 500.
 """
 
 from __future__ import annotations
@@ -17,8 +20,9 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
+from kiosk.captured import questionnaire_of
 from kiosk.export import ExportError, practice_outcomes
-from kiosk.questionnaire import Questionnaire
+from kiosk.questionnaire import Questionnaire, Score
 from kiosk.review import review_state
 from kiosk.storage import StoredSession
 from station import db, exports, validation, ward
@@ -91,9 +95,21 @@ async def command(request: Request) -> Response:
     return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.")
 
 
+def _fits(item: Any, option: int | None) -> bool:
+    return option is not None and 1 <= option <= len(item.options)
+
+
+def _score(q: Questionnaire, stored: StoredSession, review: Any) -> Score:
+    """The score of the answers (after corrections) that fit the questionnaire."""
+    items = {item.id: item for item in q.items}
+    options = review.options({a.item_id: a.option for a in stored.answers})
+    return q.score({i: items[i].option(o).points for i, o in options.items() if i in items and _fits(items[i], o)})
+
+
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:
     """One row per questionnaire item: what the kiosk recorded, what it is now, how it was answered."""
-    answers = {a.item_id: a for a in stored.answers}
+    items = {item.id for item in q.items}
+    answers = {a.item_id: a for a in stored.answers if a.item_id in items}
     options = review.options({a.item_id: a.option for a in stored.answers})
     # a question's attempts timing out are logged as "ITEM attempt N"
     outcomes = sorted([(a.t, a.item_id) for a in stored.answers] + [
@@ -108,33 +124,48 @@ def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[st
             previous_t = a.t
         elif item.id in stored.not_answered:
             previous_t = max([t for t, i in outcomes if i == item.id] + [previous_t])
-        option = options.get(item.id)
+        option = options.get(item.id) if _fits(item, options.get(item.id)) else None
         changes = [c for c in review.corrections if c.item_id == item.id]
         rows.append({
-            "number": number, "id": item.id, "text": item.text.get(stored.language, item.text["en"]),
-            "recorded": a, "recorded_label": item.option(a.option).label_in(stored.language) if a else None,
-            "option": option, "label": item.option(option).label_in(stored.language) if option else None,
+            "number": number, "id": item.id, "text": _in(item.text, stored.language),
+            "recorded": a, "recorded_label": _in(item.option(a.option).label, stored.language)
+            if a and _fits(item, a.option) else None,
+            "option": option, "label": _in(item.option(option).label, stored.language) if option else None,
             "points": item.option(option).points if option else None, "taken": taken,
             "not_answered": item.id in stored.not_answered, "changes": changes,
-            "options": [(o.number, o.label_in(stored.language), o.points) for o in item.options],
+            "options": [(o.number, _in(o.label, stored.language), o.points) for o in item.options],
         })
     return rows
 
 
+def _in(texts: Any, language: str) -> str:
+    """A text in ``language``, else in the first language it has."""
+    return texts.get(language) or next(iter(texts.values()), "")
+
+
+def _practice(q: Questionnaire, stored: StoredSession) -> list[Any]:
+    try:
+        return practice_outcomes(q, stored)
+    except (ExportError, KeyError, ValueError):
+        return ["the practice questions do not fit this session's questionnaire"]
+
+
 async def session_page(request: Request) -> Response:
-    engine, q = request.app.state.engine, request.app.state.questionnaire
+    engine = request.app.state.engine
     session_id = request.path_params["session_id"]
     try:
         kiosk, stored = await run_in_threadpool(_load, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
+    q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
-    score = validation.corrected(stored, q, current)["score"]
+    score = _score(q, stored, current)
     state = review_state(current, {a.item_id: a.option for a in stored.answers})
     return render(request, "session.html", s=stored, kiosk=kiosk, review=current, state=state, trail=entries,
-                  items=_items(q, stored, current), score=score, practice=practice_outcomes(q, stored),
+                  q=q, items=_items(q, stored, current), score=score, practice=_practice(q, stored),
                   plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
+                  unfit=[e for e in stored.log if e.kind.startswith(("unfit:", "unreadable:"))],
                   incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
                   reviewable=stored.status in validation.REVIEWABLE and not current.final,
                   reopened=bool(current.reopenings) and not current.final,
@@ -148,7 +179,7 @@ def _load(engine: Any, session_id: str) -> tuple[str, StoredSession]:
 
 async def change_item(request: Request) -> Response:
     form = await checked_form(request)
-    engine, q = request.app.state.engine, request.app.state.questionnaire
+    engine = request.app.state.engine
     session_id = request.path_params["session_id"]
     page = f"/sessions/{session_id}"
     try:
@@ -156,6 +187,8 @@ async def change_item(request: Request) -> Response:
     except ValueError:
         return _back(request, "Choose the new answer.", to=page)
     try:
+        _, stored = await run_in_threadpool(_load, engine, session_id)
+        q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
         await run_in_threadpool(validation.change_item, engine, q, session_id, request.path_params["item_id"],
                                 option, form.get("reason", ""), request.state.user)
     except (validation.ValidationError, NotFound) as exc:

@@ -1,22 +1,34 @@
 """A session read back from what its kiosk sent: the inbox rows folded in ``seq`` order into the
 kiosk's own :class:`kiosk.storage.StoredSession`, so scoring, labels and exports are the session
 core's, not a copy. A row that arrived late (alerts go first) simply takes its place in the order.
+The session carries the definition it ran and the identity its kiosk recorded it under (what the
+kiosk sent with ``create_session``), so pages and exports describe it as it was recorded. A row the
+station cannot read (stored before rows were checked) is listed in the log, never a failure.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
+from kiosk.captured import questionnaire_of
 from kiosk.channels import Channel
+from kiosk.export import ExportError
+from kiosk.questionnaire import Questionnaire
 from kiosk.session import Answer, AnsweredBy
-from kiosk.storage import AdaptationRecord, LogEntry, MetricSample, PracticeRecord, StoredSession
-from station.db import inbox, sessions
+from kiosk.storage import (
+    AdaptationRecord,
+    LogEntry,
+    MetricSample,
+    PracticeRecord,
+    StoredSession,
+)
+from station.db import definitions, inbox, sessions
 
 #: the outbox kinds that change a session's status (they refresh the session list)
 LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted", "continue_session")
@@ -78,63 +90,77 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
     interrupted: dict[str, Any] = {}
     status = status_of(rows := list(rows))
     for row in rows:
-        p = row.payload
-        if row.kind == "create_session":
-            head = p
-        elif row.kind == "record_answer":
-            answers[p["item_id"]] = Answer(p["item_id"], int(p["option"]), int(p["points"]), int(p["attempt"]),
-                                           Channel(p["channel"]), AnsweredBy(p["answered_by"]), float(p["t"]),
-                                           p.get("detail", ""))
-            if p["item_id"] in not_answered:
-                not_answered.remove(p["item_id"])
-        elif row.kind == "withdraw_answer":  # the patient's "Change my answer": the answer is gone
-            answers.pop(p["item_id"], None)
-        elif row.kind == "record_not_answered":
-            if p["item_id"] not in answers and p["item_id"] not in not_answered:
-                not_answered.append(p["item_id"])
-        elif row.kind == "record_practice":
-            practice.append(PracticeRecord(p["question_id"], p["checks"], p["outcome"], p.get("option"),
-                                           Channel(p["channel"]) if p.get("channel") else None, float(p["t"]),
-                                           p.get("detail", "")))
-        elif row.kind == "record_context":
-            event: dict[str, Any] = {"t": float(p["t"])}
-            if p.get("set"):
-                event["set"] = p["set"]
-            if p.get("emit"):
-                event["emit"] = p["emit"]
-            trace.append(event)
-        elif row.kind == "record_metrics":
-            metrics.append(MetricSample(float(p["t"]), p["metrics"], tuple(p.get("fired", ()))))
-        elif row.kind == "record_adaptation":
-            adaptations.append(AdaptationRecord(float(p["t"]), p["name"], bool(p["active"]), p.get("reason", "")))
-        elif row.kind == "record_event":
-            log.append(LogEntry(float(p["t"]), p["kind"], p.get("detail", "")))
-        elif row.kind == "mark_interrupted":
-            interrupted = {"interrupted_reason": p.get("reason"), "interrupted_at": row.at}
-        elif row.kind == "continue_session":
-            interrupted = {}
-        elif row.kind not in LIFECYCLE:
-            log.append(LogEntry(float(p.get("t", 0.0)), f"unrecognised:{row.kind}", json.dumps(p)[:200]))
+        try:
+            _apply(row, head, answers, not_answered, trace, metrics, adaptations, log, practice, interrupted)
+        except (KeyError, TypeError, ValueError, AttributeError):
+            log.append(LogEntry(0.0, f"unreadable:{row.kind}", json.dumps(row.payload)[:200]))
     ordered = sorted(answers.values(), key=lambda a: a.t)
+    language = head.get("language") if isinstance(head.get("language"), str) else "en"
+    try:
+        answered_by = AnsweredBy(head.get("answered_by", "patient"))
+    except ValueError:
+        answered_by = AnsweredBy.PATIENT
     return StoredSession(
-        id=session_id, patient_id=status["patient_id"] or "?", questionnaire_id=head.get("questionnaire_id", "barthel"),
-        language=head.get("language", "en"), answered_by=AnsweredBy(head.get("answered_by", "patient")),
-        timing=head.get("timing", {}), started_at=status["started_at"] or "", status=status["status"],
+        id=session_id, patient_id=status["patient_id"] or "?",
+        questionnaire_id=str(head.get("questionnaire_id", "barthel")), language=language, answered_by=answered_by,
+        timing=head.get("timing", {}) if isinstance(head.get("timing"), dict) else {},
+        started_at=str(status["started_at"] or ""), status=status["status"],
         finished_at=status["finished_at"], answers=tuple(ordered), not_answered=tuple(not_answered),
         trace=tuple(trace), metrics=tuple(metrics), adaptations=tuple(adaptations), log=tuple(log),
-        practice=tuple(practice), simulated=bool(head.get("simulated", False)),
+        practice=tuple(practice), simulated=head.get("simulated") is True,
+        identity=_identity(head), identity_attached_later=bool(head.get("export_attached_later")),
         **(interrupted if status["status"] == "interrupted" else {}),
     )
 
 
-def sent_export_identity(rows: Iterable[Row]) -> dict[str, Any]:
-    """How the session's kiosk names things in its own exports (site, kiosk, FHIR systems), as it
-    sent them with the session; empty from a kiosk that sent none."""
-    for row in rows:
-        if row.kind == "create_session":
-            identity = row.payload.get("export")
-            return dict(identity) if isinstance(identity, dict) else {}
-    return {}
+def _identity(head: dict[str, Any]) -> dict[str, str]:
+    identity = head.get("export")
+    return {k: v for k, v in identity.items() if isinstance(v, str)} if isinstance(identity, dict) else {}
+
+
+def _apply(row: Row, head: dict[str, Any], answers: dict[str, Answer], not_answered: list[str],
+           trace: list[dict[str, Any]], metrics: list[MetricSample], adaptations: list[AdaptationRecord],
+           log: list[LogEntry], practice: list[PracticeRecord], interrupted: dict[str, Any]) -> None:
+    """Fold one row into the session being read."""
+    p = row.payload
+    if row.kind == "create_session":
+        head.clear()
+        head.update(p)
+    elif row.kind == "record_answer":
+        answers[p["item_id"]] = Answer(p["item_id"], int(p["option"]), int(p["points"]), int(p["attempt"]),
+                                       Channel(p["channel"]), AnsweredBy(p["answered_by"]), float(p["t"]),
+                                       p.get("detail", ""))
+        if p["item_id"] in not_answered:
+            not_answered.remove(p["item_id"])
+    elif row.kind == "withdraw_answer":  # the patient's "Change my answer": the answer is gone
+        answers.pop(p["item_id"], None)
+    elif row.kind == "record_not_answered":
+        if p["item_id"] not in answers and p["item_id"] not in not_answered:
+            not_answered.append(p["item_id"])
+    elif row.kind == "record_practice":
+        practice.append(PracticeRecord(p["question_id"], p["checks"], p["outcome"], p.get("option"),
+                                       Channel(p["channel"]) if p.get("channel") else None, float(p["t"]),
+                                       p.get("detail", "")))
+    elif row.kind == "record_context":
+        event: dict[str, Any] = {"t": float(p["t"])}
+        if p.get("set"):
+            event["set"] = p["set"]
+        if p.get("emit"):
+            event["emit"] = p["emit"]
+        trace.append(event)
+    elif row.kind == "record_metrics":
+        metrics.append(MetricSample(float(p["t"]), p["metrics"], tuple(p.get("fired", ()))))
+    elif row.kind == "record_adaptation":
+        adaptations.append(AdaptationRecord(float(p["t"]), p["name"], bool(p["active"]), p.get("reason", "")))
+    elif row.kind == "record_event":
+        log.append(LogEntry(float(p["t"]), p["kind"], p.get("detail", "")))
+    elif row.kind == "mark_interrupted":
+        interrupted.clear()
+        interrupted.update(interrupted_reason=p.get("reason"), interrupted_at=row.at)
+    elif row.kind == "continue_session":
+        interrupted.clear()
+    elif row.kind not in LIFECYCLE:
+        log.append(LogEntry(float(p.get("t", 0.0)), f"unrecognised:{row.kind}", json.dumps(p)[:200]))
 
 
 def _kiosk_and_rows(connection: Connection, session_id: str) -> tuple[str, list[Row]]:
@@ -144,13 +170,53 @@ def _kiosk_and_rows(connection: Connection, session_id: str) -> tuple[str, list[
     return kiosk, rows_of(connection, session_id)
 
 
+def _with_definition(connection: Connection, stored: StoredSession) -> StoredSession:
+    """``stored`` with the definition it runs (None if its create_session never arrived), and only
+    what fits it (see :func:`fitted`)."""
+    row = connection.execute(sa.select(sessions.c.definition_sha256, sessions.c.definition_attached_later,
+                                       definitions.c.body).select_from(sessions.outerjoin(
+        definitions, definitions.c.sha256 == sessions.c.definition_sha256)).where(sessions.c.id == stored.id)).first()
+    if row is None or row.body is None:
+        return stored
+    stored = replace(stored, definition=json.loads(row.body), definition_sha256=row.definition_sha256,
+                     definition_attached_later=bool(row.definition_attached_later))
+    try:
+        return fitted(stored, questionnaire_of(stored))
+    except ExportError:
+        return stored
+
+
+def fitted(stored: StoredSession, q: Questionnaire) -> StoredSession:
+    """``stored`` without what does not fit ``q``: rows stored before the station checked them (an
+    option the item lacks, an unknown item or practice question, a language ``q`` lacks). Each is
+    listed in the session's log instead (``unfit:...``), so the rest can be shown, corrected,
+    signed off and exported."""
+    items = {item.id: item for item in q.items}
+    practice_ids = {p.id for p in q.familiarisation}
+    log = list(stored.log)
+
+    def fits(a: Answer) -> bool:
+        item = items.get(a.item_id)
+        return item is not None and 1 <= a.option <= len(item.options) and item.option(a.option).points == a.points
+
+    answers = tuple(a for a in stored.answers if fits(a))
+    log += [LogEntry(a.t, "unfit:answer", f"{a.item_id} option {a.option} ({a.points} points)")
+            for a in stored.answers if not fits(a)]
+    practice = tuple(p for p in stored.practice if p.question_id in practice_ids)
+    log += [LogEntry(p.t, "unfit:practice", p.question_id) for p in stored.practice if p.question_id not in practice_ids]
+    language = stored.language
+    if language not in q.languages:
+        log.append(LogEntry(0.0, "unfit:language", f"{language!r}; shown in {q.languages[0]}"))
+        language = q.languages[0]
+    if len(log) == len(stored.log):
+        return stored
+    return replace(stored, answers=answers, practice=practice, language=language, log=tuple(log),
+                   not_answered=tuple(i for i in stored.not_answered if i in items))
+
+
 def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
-    """The kiosk a session came from, and the session (NotFound if it never arrived)."""
+    """The kiosk a session came from, and the session with its definition and identity (NotFound
+    if it never arrived)."""
     kiosk, rows = _kiosk_and_rows(connection, session_id)
-    return kiosk, fold(session_id, rows)
+    return kiosk, _with_definition(connection, fold(session_id, rows))
 
-
-def load_for_export(connection: Connection, session_id: str) -> tuple[str, StoredSession, dict[str, Any]]:
-    """:func:`load`, and the kiosk's export identity, from one read of the session's rows."""
-    kiosk, rows = _kiosk_and_rows(connection, session_id)
-    return kiosk, fold(session_id, rows), sent_export_identity(rows)

@@ -3,9 +3,13 @@
 A batch is stored in one transaction, idempotently on ``(kiosk_id, seq)``: a row already stored
 is acknowledged again, never stored twice; the same seq with different content is refused
 (:class:`Conflict`, so the kiosk parks that row instead of the station silently keeping either).
-A row is checked before anything is stored: known kinds carry the fields their ``Store`` method
-takes, a new session's patient id is pseudonymous, and a session belongs to the kiosk that
-created it -- so an answer can never land under another kiosk's patient.
+A row is checked before anything is stored (:mod:`station.checks`): known kinds carry the fields
+their ``Store`` method takes, with the types, values and lengths the pages, exports and both
+engines take, and what a row says about the questionnaire fits the definition its session runs --
+the one the kiosk sent with ``create_session`` (stored once per content in ``definitions``; a kiosk
+that sends none gets the bundled questionnaire, marked attached later). A session belongs to the
+kiosk that created it, so an answer can never land under another kiosk's patient. A refused row is
+a 422 naming its seq (and the body's ``seq``), so the kiosk parks it and delivers the rest.
 """
 
 from __future__ import annotations
@@ -13,14 +17,27 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.storage import PATIENT_ID
+from kiosk.definition import canonical, canonical_json, digest, questionnaire_from
+from kiosk.questionnaire import Questionnaire, load_questionnaire
 from station import db
-from station.db import alerts, inbox, sessions
+from station.checks import (
+    ID_MAX,
+    NEEDS_DEFINITION,
+    RowRefused,
+    check_create,
+    check_definition,
+    check_row,
+    iso_time,
+    sha_of,
+    text,
+)
+from station.db import alerts, definitions, inbox, sessions
 from station.sessions import LIFECYCLE, rows_of, status_of
 
 MAX_BATCH = 500
@@ -51,9 +68,13 @@ def is_alert(event: Event) -> bool:
 
 class SyncError(ValueError):
     """A batch the station refuses; ``status`` is the HTTP status (400 malformed, 409 conflict,
-    422 a row that breaks a rule)."""
+    422 a row that breaks a rule); ``seq`` the row at fault, when one is."""
 
     status = 400
+
+    def __init__(self, message: str, seq: int | None = None) -> None:
+        super().__init__(message)
+        self.seq = seq
 
 
 class Conflict(SyncError):
@@ -61,6 +82,8 @@ class Conflict(SyncError):
 
 
 class Refused(SyncError):
+    """A row that breaks a rule."""
+
     status = 422
 
 
@@ -69,8 +92,23 @@ class Event:
     seq: int
     kind: str
     session_id: str
+    #: as stored: a create_session's definition is kept apart (``definition``), by its SHA-256
     payload: dict[str, Any]
     at: str
+    #: the definition a create_session carried, checked (None: none sent)
+    definition: dict[str, Any] | None = None
+
+
+def _bundled() -> tuple[dict[str, Any], str]:
+    """The bundled questionnaire's definition and its SHA-256 (what a kiosk that sends none runs)."""
+    global _BUNDLED
+    if _BUNDLED is None:
+        definition = canonical(load_questionnaire())
+        _BUNDLED = (definition, digest(definition))
+    return _BUNDLED
+
+
+_BUNDLED: tuple[dict[str, Any], str] | None = None
 
 
 def parse(body: Any) -> list[Event]:
@@ -85,23 +123,34 @@ def parse(body: Any) -> list[Event]:
         if not isinstance(raw, dict):
             raise SyncError(f"{where}: not an object")
         seq, kind, session_id, payload, at = (raw.get(k) for k in ("seq", "kind", "session_id", "payload", "at"))
-        if not isinstance(seq, int) or isinstance(seq, bool) or seq < 0:
+        if not isinstance(seq, int) or isinstance(seq, bool) or not 0 <= seq < 2 ** 63:
             raise SyncError(f"{where}: 'seq' must be a non-negative integer")
         where = f"seq {seq}"
-        for name, value in (("kind", kind), ("session_id", session_id), ("at", at)):
-            if not isinstance(value, str) or not value or len(value) > 64:
-                raise SyncError(f"{where}: '{name}' must be a non-empty string of at most 64 characters")
-        if not isinstance(payload, dict):
-            raise SyncError(f"{where}: 'payload' must be an object")
-        missing = [k for k in REQUIRED.get(kind, ()) if k not in payload]
-        if missing:
-            raise Refused(f"{where}: {kind} without {', '.join(missing)}")
-        if kind == "create_session":
-            if payload["session_id"] != session_id:
-                raise Refused(f"{where}: create_session for {payload['session_id']!r} in a row of {session_id!r}")
-            if not isinstance(payload["patient_id"], str) or not PATIENT_ID.match(payload["patient_id"]):
-                raise Refused(f"{where}: the patient id is not pseudonymous (2-64 letters, digits, '-' or '_')")
-        events.append(Event(seq, kind, session_id, payload, at))
+        try:
+            for name, value in (("kind", kind), ("session_id", session_id)):
+                text(value, f"{where}: {name}", ID_MAX, empty=False)
+            iso_time(at, f"{where}: at")
+            if not isinstance(payload, dict):
+                raise RowRefused(f"{where}: payload: must be an object")
+            missing = [k for k in REQUIRED.get(kind, ()) if k not in payload]
+            if missing:
+                raise RowRefused(f"{where}: {kind} without {', '.join(missing)}")
+            definition = None
+            if kind == "create_session" and "definition_sha256" in payload:
+                sha_of(payload["definition_sha256"], f"{where}: create_session.definition_sha256")
+            if kind == "create_session" and "definition" in payload:
+                payload = dict(payload)
+                definition = payload.pop("definition")  # stored once by its hash; checked after the token
+                if not isinstance(definition, dict):
+                    raise RowRefused(f"{where}: create_session.definition: must be an object")
+                sent = payload.get("definition_sha256")
+                payload["definition_sha256"] = digest(definition)
+                if sent is not None and sent != payload["definition_sha256"]:
+                    raise RowRefused(f"{where}: create_session.definition_sha256: is not the SHA-256 of the "
+                                     "definition's canonical JSON")
+        except RowRefused as exc:
+            raise Refused(str(exc), seq) from None
+        events.append(Event(seq, kind, session_id, payload, at, definition))
     return events
 
 
@@ -123,9 +172,10 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
     for event in events:
         if event.seq in known and not _same(known[event.seq], event):
             raise Conflict(f"seq {event.seq}: already stored with different content (was this kiosk's "
-                           "database replaced? its rows are kept apart until someone checks)")
+                           "database replaced? its rows are kept apart until someone checks)", event.seq)
     new = [e for e in events if e.seq not in known]
     _claim_sessions(connection, kiosk_id, new, received)
+    _check_against_definitions(connection, new)
     db.insert_ignore(connection, inbox, [{"kiosk_id": kiosk_id, "seq": e.seq, "kind": e.kind,
                                           "session_id": e.session_id, "payload": json.dumps(e.payload), "at": e.at,
                                           "received_at": received} for e in new], ["kiosk_id", "seq"])
@@ -135,6 +185,73 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
     if new:
         messages += _alerts(connection, kiosk_id, new, received)
     return seqs, messages
+
+
+def _definition_of(connection: Connection, session_id: str) -> str | None:
+    return connection.execute(sa.select(sessions.c.definition_sha256).where(sessions.c.id == session_id)).scalar()
+
+
+def _questionnaire(connection: Connection, sha: str, cache: dict[str, Questionnaire]) -> Questionnaire:
+    """The questionnaire of a stored definition (rebuilt once per content in this process)."""
+    if sha not in cache:
+        body = connection.execute(sa.select(definitions.c.body).where(definitions.c.sha256 == sha)).scalar()
+        cache[sha] = _rebuilt(body or canonical_json(_bundled()[0]))
+    return cache[sha]
+
+
+@lru_cache(maxsize=64)
+def _rebuilt(body: str) -> Questionnaire:
+    return questionnaire_from(json.loads(body))
+
+
+def _store_definition(connection: Connection, definition: dict[str, Any], sha: str) -> None:
+    db.insert_ignore(connection, definitions, [{
+        "sha256": sha, "questionnaire_id": str(definition.get("id", "")), "version": str(definition.get("version", "")),
+        "body": canonical_json(definition), "stored_at": db.now_iso()}], ["sha256"])
+
+
+def _check_against_definitions(connection: Connection, new: Sequence[Event]) -> None:
+    """Check each new row against its session's definition, in seq order; check and store the
+    definitions a create_session brings (each content once) and note which one each new session
+    runs (Refused naming the row)."""
+    running: dict[str, str | None] = {}
+    cache: dict[str, Questionnaire] = {}
+    for event in sorted(new, key=lambda e: e.seq):
+        where = f"seq {event.seq}: {event.kind}"
+        if event.session_id not in running:
+            running[event.session_id] = _definition_of(connection, event.session_id)
+        try:
+            if event.kind == "create_session":
+                if running[event.session_id] is not None:
+                    raise RowRefused(f"{where}: session {event.session_id} was created already")
+                later = event.definition is None and "definition_sha256" not in event.payload
+                if event.definition is not None:
+                    sha = event.payload["definition_sha256"]
+                    known = connection.execute(sa.select(definitions.c.sha256).where(
+                        definitions.c.sha256 == sha)).scalar()
+                    if sha not in cache and known is None:  # stored ones were checked as they came
+                        cache[sha] = check_definition(event.definition, f"{where}.definition")
+                        _store_definition(connection, event.definition, sha)
+                elif later:
+                    definition, sha = _bundled()
+                    _store_definition(connection, definition, sha)
+                else:
+                    sha = event.payload["definition_sha256"]
+                    if connection.execute(sa.select(definitions.c.sha256).where(definitions.c.sha256 == sha)).scalar() \
+                            is None:
+                        raise RowRefused(f"{where}.definition_sha256: this station has no definition {sha[:12]}; "
+                                         "send the definition with the session")
+                check_create(event.payload, where, event.session_id, _questionnaire(connection, sha, cache))
+                connection.execute(sessions.update().where(sessions.c.id == event.session_id).values(
+                    definition_sha256=sha, definition_attached_later=later))
+                running[event.session_id] = sha
+            sha = running[event.session_id]
+            if event.kind in NEEDS_DEFINITION and sha is None:
+                raise RowRefused(f"{where}: session {event.session_id} has no questionnaire at this station "
+                                 "(its create_session has not arrived)")
+            check_row(event.kind, event.payload, where, _questionnaire(connection, sha, cache) if sha else None)
+        except RowRefused as exc:
+            raise Refused(str(exc), event.seq) from None
 
 
 def _claim_sessions(connection: Connection, kiosk_id: str, new: Sequence[Event], received: float) -> None:
@@ -147,7 +264,7 @@ def _claim_sessions(connection: Connection, kiosk_id: str, new: Sequence[Event],
         owner = owners.get(session_id)
         if owner is not None and owner != kiosk_id:
             seq = next(e.seq for e in new if e.session_id == session_id)
-            raise Conflict(f"seq {seq}: session {session_id} belongs to kiosk {owner}, not {kiosk_id}")
+            raise Conflict(f"seq {seq}: session {session_id} belongs to kiosk {owner}, not {kiosk_id}", seq)
     db.insert_ignore(connection, sessions, [{"id": s, "kiosk_id": kiosk_id, "status": "pending", "updated_at": received}
                                    for s in ids if s not in owners], ["id"])
 

@@ -9,6 +9,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
+from kiosk.captured import questionnaire_of
 from kiosk.screens.base import ClinicianScreen
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
@@ -62,8 +63,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         """Fill the tables, and keep the running session's line current while it runs."""
         interrupted = self.query_one("#interrupted", DataTable)
         interrupted.add_columns("patient", "started", "progress", "why it stopped", "session")
-        count = len(self.app.questionnaire.items)  # type: ignore[attr-defined]
         for test in self.app.interrupted_tests():  # type: ignore[attr-defined]
+            count = len(questionnaire_of(test, fallback=self.app.questionnaire).items)  # type: ignore[attr-defined]
             progress = f"{len(test.answers)} of {count} answered" + (
                 f", {len(test.not_answered)} not answered" if test.not_answered else "")
             interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,

@@ -10,6 +10,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Label, Static
 
+from kiosk.captured import questionnaire_of, site_of
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.screens.base import ClinicianScreen
 from kiosk.storage import StoredSession
@@ -43,9 +44,14 @@ class SessionDetailScreen(ClinicianScreen):
                 yield Button("Plot PNG", id="export-png", tooltip="Save the QoS plot as a PNG")
                 yield Button("Back", id="back")
 
+    @property
+    def q(self):  # -> Questionnaire
+        """The questionnaire this session ran (captured as it started), not today's file."""
+        return questionnaire_of(self.stored, fallback=self.app.questionnaire)  # type: ignore[attr-defined]
+
     def on_mount(self) -> None:
         """One row per item, in questionnaire order, answered or not."""
-        q = self.app.questionnaire  # type: ignore[attr-defined]
+        q = self.q
         table = self.query_one("#answers-table", DataTable)
         table.add_columns("#", "item", "option", "answer", "points", "attempt", "channel")
         answers = {a.item_id: a for a in self.stored.answers}
@@ -60,7 +66,7 @@ class SessionDetailScreen(ClinicianScreen):
                               str(a.attempt), a.channel.value)
 
     def _total_line(self) -> str:
-        q = self.app.questionnaire  # type: ignore[attr-defined]
+        q = self.q
         try:
             score = rescore(q, self.stored)
         except ExportError as error:
@@ -75,7 +81,7 @@ class SessionDetailScreen(ClinicianScreen):
         """How the familiarisation went: "Practice: hearing skipped (no voice out) / reading ✓"."""
         if not self.stored.practice:
             return "Practice: none (no practice questions in this session)"
-        q = self.app.questionnaire  # type: ignore[attr-defined]
+        q = self.q
         parts = []
         for outcome in practice_outcomes(q, self.stored):
             if outcome.outcome == "right":
@@ -102,8 +108,7 @@ class SessionDetailScreen(ClinicianScreen):
     def _fhir(self) -> None:
         try:
             path = self._export_path(".fhir.json")
-            write_json(path, fhir_response(self.app.questionnaire, self.stored,  # type: ignore[attr-defined]
-                                           site=self.app.export_site))  # type: ignore[attr-defined]
+            write_json(path, fhir_response(self.q, self.stored, site=site_of(self.stored)))
         except (ExportError, OSError) as error:
             self._done(f"FHIR export failed: {error}")
             return
@@ -113,8 +118,7 @@ class SessionDetailScreen(ClinicianScreen):
     def _csv(self) -> None:
         try:
             path = self._export_path(".csv")
-            write_private(path, csv_text(self.app.questionnaire, [self.stored],  # type: ignore[attr-defined]
-                                         site=self.app.export_site))  # type: ignore[attr-defined]
+            write_private(path, csv_text(self.q, [self.stored], site=site_of(self.stored)))
         except (ExportError, OSError) as error:
             self._done(f"CSV export failed: {error}")
             return

@@ -12,6 +12,7 @@ from typing import Any
 
 from kiosk.channels import Channel, ChannelInput
 from kiosk.clock import Clock
+from kiosk.definition import canonical
 from kiosk.questionnaire import Item, Questionnaire, Score, Timing
 from kiosk.session.corrections import Corrections
 from kiosk.session.events import (
@@ -356,6 +357,7 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
                 session_id=self.id, patient_id=self.patient_id, questionnaire_id=self.questionnaire.id,
                 language=self._language, answered_by=self._answered_by.value,
                 started_at=self.clock.wall().isoformat(), timing=vars(self.timing),
+                definition=canonical(self.questionnaire),  # what describes this session from now on
             )
             self._stored = True
         self._person_present = True

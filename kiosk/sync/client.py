@@ -5,8 +5,9 @@
   stored, so a connection cut after the station stored a batch but before its reply only means
   the batch is sent again and acknowledged again (the station is idempotent on the seq); retries
   with exponential backoff (0.5 s doubling to 60 s, jittered) on any connection error, timeout,
-  5xx, 401 or 429; narrows a batch the station refuses (another 4xx) down to the row at fault
-  and parks it. It also posts the live status on every change and as a heartbeat.
+  5xx, 401 or 429; parks the row a refusal names (a 422's ``seq``), or narrows a batch the
+  station refuses (another 4xx) down to the row at fault and parks it, and goes on with the rest:
+  one bad row never holds the outbox up. It also posts the live status on every change and as a heartbeat.
 * **commands** (§3): long-polls the station and hands each command to ``on_command`` -- the app
   runs it on its own thread through the same operations as the clinician screen -- then acks it.
 
@@ -177,9 +178,11 @@ class SyncClient:
             return True
         if status in (401, 429) or status >= 500 or status < 400:
             raise Refused(f"the station answered {status}{_reason(body)}")
-        # the station refuses something in this batch: narrow it down to the row, and park that one
-        if len(rows) == 1:
-            self.outbox.park(rows[0].seq, f"{status}{_reason(body)}")
+        # the station refuses something in this batch: park the row it names (protocol: a 422 body's
+        # "seq"), else narrow the batch down to the row; the rest goes on in the next request
+        named = body.get("seq") if isinstance(body, dict) else None
+        if len(rows) == 1 or any(r.seq == named for r in rows):
+            self.outbox.park(named if len(rows) > 1 else rows[0].seq, f"{status}{_reason(body)}")
         else:
             self._batch = max(1, len(rows) // 2)
         return True

@@ -7,11 +7,15 @@ from pathlib import Path
 
 import pytest
 
+from kiosk.export import ExportSite, export_identity
 from kiosk.replay import load_script, run_script
 from kiosk.storage import Store, StoredSession
 
 ROOT = Path(__file__).resolve().parents[2]
 PATIENTS = sorted((ROOT / "recordings/patients").glob("*.yaml"))
+#: the identity the replayed sessions are recorded under (a kiosk's site, kiosk id and FHIR systems)
+RECORDED_AT = export_identity(ExportSite(site="hosp-north", kiosk_id="ward3-bed2",
+                                         questionnaire_url="https://hosp-north.example/fhir/Questionnaire/barthel"))
 
 
 @pytest.fixture(scope="session")
@@ -19,7 +23,8 @@ def replay_dir(tmp_path_factory) -> Path:
     """A data directory whose real SQLite store holds every scripted patient of
     recordings/patients/ replayed through the real session (English, Spanish, French)."""
     data = tmp_path_factory.mktemp("fhir") / "data"
-    with Store.open(data) as store:
+    # recorded at hosp-north on ward3-bed2: the identity every export of these sessions carries
+    with Store.open(data, export=RECORDED_AT) as store:
         for path in PATIENTS:
             run_script(load_script(path), store=store)
     return data

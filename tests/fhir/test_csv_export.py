@@ -74,9 +74,9 @@ def test_kiosk_results_writes_both_layouts_with_a_bom_and_accepts_tagged_ids(rep
     from kiosk.replay import load_script, run_script
     from kiosk.storage import Store
 
-    from .conftest import ROOT
+    from .conftest import RECORDED_AT, ROOT
 
-    store = Store.open(tmp_path / "data")
+    store = Store.open(tmp_path / "data", export=RECORDED_AT)  # recorded on ward3-bed2
     run_script(load_script(ROOT / "recordings/patients/spanish_voice.yaml"), store=store)
     session_id = store.sessions()[0].id
     store.close()
