@@ -30,3 +30,9 @@ class Staff:
     def post(self, path: str, **form: str) -> httpx.Response:
         token = self.csrf(self.http.get("/").text)
         return self.http.post(path, data={"csrf": token, **form})
+
+
+def response_in(bundle: dict) -> dict:
+    """The one QuestionnaireResponse of an exported transaction Bundle."""
+    (response,) = [e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse"]
+    return response

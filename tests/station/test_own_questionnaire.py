@@ -12,7 +12,7 @@ import pytest
 
 from kiosk.definition import digest
 from tests.station.conftest import new_kiosk, shared_station  # noqa: F401 - the station fixture
-from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
+from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient, response_in
 
 pytestmark = pytest.mark.slow
 KEPT = ("feeding", "bathing", "grooming")
@@ -44,7 +44,7 @@ def test_a_sites_own_questionnaire_is_shown_and_exported_with_its_own_definition
     assert "Dressing" not in page.text  # a Barthel item this questionnaire does not have
     fhir = staff.http.get(f"/sessions/{session_id}/export.json")
     assert fhir.status_code == 200, fhir.text
-    response = fhir.json()
+    response = response_in(fhir.json())
     assert "site-adl" in response["questionnaire"]
     assert [i["linkId"] for i in response["item"] if i["linkId"] != "total"] == list(KEPT)
     assert response["item"][0]["text"] == OWN_TEXT
