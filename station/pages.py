@@ -20,6 +20,7 @@ from kiosk.export import csv_text, fhir_response, practice_outcomes, site_from_i
 from kiosk.questionnaire import Questionnaire
 from kiosk.storage import StoredSession
 from station import db, validation, ward
+from station.download import attachment
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
 from station.sessions import NotFound, load, load_for_export
@@ -196,7 +197,7 @@ async def export(request: Request) -> Response:
     else:
         body, media = csv_text(q, [stored], [current], site), "text/csv"
     return Response(body, media_type=media, headers={
-        "content-disposition": f'attachment; filename="{session_id}.{"fhir.json" if fmt == "json" else "csv"}"'})
+        "content-disposition": attachment(session_id, ".fhir.json" if fmt == "json" else ".csv")})
 
 
 routes = [
