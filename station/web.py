@@ -27,6 +27,7 @@ from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
 from station import api, auth, pages
+from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
 from station.rendering import Forbidden, checked_form, current_user, render
@@ -165,6 +166,7 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
     ]
     middleware = [
         Middleware(SecurityHeaders),
+        Middleware(BodyLimit),
         Middleware(SessionMiddleware, secret_key=auth.secret_key(engine), session_cookie="station_session",
                    max_age=12 * 3600, same_site="strict", https_only=https),
         Middleware(LoginRequired),
