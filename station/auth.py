@@ -22,7 +22,7 @@ from argon2.exceptions import InvalidHashError, VerificationError
 from sqlalchemy.engine import Connection, Engine
 
 from station import db
-from station.db import kiosks, login_failures, settings, users
+from station.db import kiosks, login_failures, settings, staff_sessions, users
 
 ROLES = ("nurse", "doctor")
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
@@ -63,19 +63,49 @@ def check_name(name: str, what: str) -> str:
     return name
 
 
+def _check_password(password: str) -> None:
+    if len(password) < MIN_PASSWORD:
+        raise AuthError(f"the password must have at least {MIN_PASSWORD} characters")
+
+
 def add_user(engine: Engine, name: str, role: str, password: str) -> None:
-    """Create a user, or set the role and password of an existing one."""
+    """Create a user, or set the role and password of an existing one (ending its logins)."""
     check_name(name, "user name")
     if role not in ROLES:
         raise AuthError(f"role {role!r}: choose one of {', '.join(ROLES)}")
-    if len(password) < MIN_PASSWORD:
-        raise AuthError(f"the password must have at least {MIN_PASSWORD} characters")
+    _check_password(password)
     values = {"role": role, "password_hash": _hasher.hash(password)}
     with engine.begin() as connection:
         if connection.execute(sa.select(users.c.name).where(users.c.name == name)).first():
             connection.execute(users.update().where(users.c.name == name).values(**values))
+            end_sessions(connection, name)
         else:
             connection.execute(users.insert().values(name=name, created_at=db.now_iso(), **values))
+
+
+def set_password(engine: Engine, name: str, password: str) -> int:
+    """Change a user's password and end every login of that user; returns how many ended."""
+    _check_password(password)
+    with engine.begin() as connection:
+        if not connection.execute(users.update().where(users.c.name == name).values(
+                password_hash=_hasher.hash(password))).rowcount:
+            raise AuthError(f"no user {name!r}")
+        return end_sessions(connection, name)
+
+
+def remove_user(engine: Engine, name: str) -> int:
+    """Delete a user and end every login of that user (what they did stays in the audit trail);
+    returns how many logins ended."""
+    with engine.begin() as connection:
+        ended = end_sessions(connection, name)
+        if not connection.execute(users.delete().where(users.c.name == name)).rowcount:
+            raise AuthError(f"no user {name!r}")
+    return ended
+
+
+def end_sessions(connection: Connection, name: str) -> int:
+    """End every login session of user ``name``, in the caller's transaction; returns how many."""
+    return connection.execute(staff_sessions.delete().where(staff_sessions.c.user_name == name)).rowcount
 
 
 def throttled(engine: Engine, name: str, address: str) -> bool:
@@ -105,13 +135,6 @@ def login(engine: Engine, name: str, password: str, address: str) -> User | None
         connection.execute(login_failures.delete().where(login_failures.c.at < db.now() - WINDOW_S))
         connection.execute(login_failures.insert().values(name=name[:64], address=address[:64], at=db.now()))
     return None
-
-
-def user(engine: Engine, name: str) -> User | None:
-    """The user by name (None if deleted since the cookie was issued)."""
-    with engine.connect() as connection:
-        role = connection.execute(sa.select(users.c.role).where(users.c.name == name)).scalar()
-    return User(name, role) if role else None
 
 
 def _digest(token: str) -> str:

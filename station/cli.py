@@ -2,6 +2,8 @@
 
     kiosk station [--db URL] [--host H] [--port P] [--tls-cert F --tls-key F] [--insecure-lan]
     kiosk station add-user NAME --role nurse|doctor [--password-file F] [--db URL]
+    kiosk station passwd NAME [--password-file F] [--db URL]    ends every login of NAME
+    kiosk station remove-user NAME [--db URL]                   ends every login of NAME
     kiosk station add-kiosk NAME [--db URL]        prints the kiosk's token (shown once)
     kiosk station revoke-kiosk NAME [--db URL]
 
@@ -23,7 +25,7 @@ from pathlib import Path
 from qos.files import BadFile, read_text
 from station import auth, db
 
-ADMIN = ("add-user", "add-kiosk", "revoke-kiosk")
+ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk")
 
 
 class UsageError(Exception):
@@ -43,6 +45,8 @@ def _parser() -> argparse.ArgumentParser:
                     "validate results.",
         epilog="administration (each takes --db too):\n"
                "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
+               "  kiosk station passwd NAME [--password-file F]   a new password; ends NAME's logins\n"
+               "  kiosk station remove-user NAME                  ends NAME's logins too\n"
                "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
                "  kiosk station revoke-kiosk NAME")
     _db_option(parser)
@@ -61,6 +65,7 @@ def _admin_parser(command: str) -> argparse.ArgumentParser:
     _db_option(parser)
     if command == "add-user":
         parser.add_argument("--role", required=True, choices=auth.ROLES)
+    if command in ("add-user", "passwd"):
         parser.add_argument("--password-file", type=Path,
                             help="read the password from this file's first line (default: ask)")
     return parser
@@ -95,12 +100,18 @@ def _password(path: Path | None) -> str:
 
 def _admin(command: str, argv: list[str]) -> int:
     args = _admin_parser(command).parse_args(argv)
-    if command == "add-user":
+    if command in ("add-user", "passwd"):
         password = _password(args.password_file)  # ask before touching the database
     engine = db.open_database(_url(args.db))
     if command == "add-user":
         auth.add_user(engine, args.name, args.role, password)
         print(f"user {args.name} ({args.role}) saved")
+    elif command == "passwd":
+        ended = auth.set_password(engine, args.name, password)
+        print(f"user {args.name}: password changed; {ended} login(s) ended")
+    elif command == "remove-user":
+        ended = auth.remove_user(engine, args.name)
+        print(f"user {args.name} removed; {ended} login(s) ended")
     elif command == "add-kiosk":
         token = auth.add_kiosk(engine, args.name)
         print(f"kiosk {args.name} added; its token (shown only now; put it in the kiosk's config as station.token):")

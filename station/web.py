@@ -26,7 +26,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, auth, pages
+from station import api, auth, logins, pages
 from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
@@ -85,8 +85,9 @@ async def login_post(request: Request) -> Response:
     found = await run_in_threadpool(auth.login, engine, name, password, address)
     if found is None:
         return render(request, "login.html", status=401, next=target, error="Wrong user name or password.")
+    session_id = await run_in_threadpool(logins.start, engine, found.name)
     request.session.clear()  # a new session on login: no fixation of an earlier cookie
-    request.session.update(user=found.name, csrf=auth.new_csrf_token())
+    request.session.update(sid=session_id, csrf=auth.new_csrf_token())
     return RedirectResponse(target, status_code=303)
 
 
@@ -95,6 +96,9 @@ async def logout(request: Request) -> Response:
         await checked_form(request)
     except Forbidden as exc:
         return PlainTextResponse(str(exc), status_code=403)
+    session_id = request.session.get("sid")
+    if isinstance(session_id, str):  # ended on the server: a copy of the cookie opens nothing
+        await run_in_threadpool(logins.end, request.app.state.engine, session_id)
     request.session.clear()
     return RedirectResponse("/login", status_code=303)
 
@@ -168,7 +172,7 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
         Middleware(SecurityHeaders),
         Middleware(BodyLimit),
         Middleware(SessionMiddleware, secret_key=auth.secret_key(engine), session_cookie="station_session",
-                   max_age=12 * 3600, same_site="strict", https_only=https),
+                   max_age=logins.MAX_AGE_S, same_site="strict", https_only=https),
         Middleware(LoginRequired),
     ]
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
