@@ -1,6 +1,7 @@
 """``kiosk station``: start the ward station, or administer it.
 
     kiosk station [--db URL] [--host H] [--port P] [--tls-cert F --tls-key F] [--insecure-lan]
+                  [--trusted-proxy ADDRESS]...
     kiosk station add-user NAME --role nurse|doctor [--password-file F] [--db URL]
     kiosk station passwd NAME [--password-file F] [--db URL]    ends every login of NAME
     kiosk station remove-user NAME [--db URL]                   ends every login of NAME
@@ -23,7 +24,7 @@ import sys
 from pathlib import Path
 
 from qos.files import BadFile, read_text
-from station import auth, db
+from station import auth, db, throttle
 
 ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk")
 
@@ -54,6 +55,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
     parser.add_argument("--tls-cert", type=Path, metavar="PEM", help="TLS certificate chain (PEM)")
     parser.add_argument("--tls-key", type=Path, metavar="PEM", help="TLS private key (PEM)")
+    parser.add_argument("--trusted-proxy", action="append", default=[], metavar="ADDRESS",
+                        help="a reverse proxy (address or network) whose X-Forwarded-For names the client; "
+                             "repeat for each (default: none, the peer's own address counts)")
     parser.add_argument("--insecure-lan", action="store_true",
                         help="allow a non-loopback --host without TLS (only on a network you trust)")
     return parser
@@ -142,17 +146,25 @@ def _check_listen(args: argparse.Namespace) -> None:
 def _serve(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
     _check_listen(args)
+    try:
+        proxies = throttle.parse_proxies(args.trusted_proxy)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     import uvicorn
 
     from station.web import create_app
 
     engine = db.open_database(_url(args.db))
-    app = create_app(engine, https=bool(args.tls_cert))
+    app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies)
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})",
           flush=True)
-    logging.basicConfig(level=logging.WARNING)
+    # failed and refused logins are logged here (station.security), one line each
+    logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     uvicorn.run(app, host=args.host, port=args.port, log_level="warning", access_log=False,
+                # uvicorn would trust X-Forwarded-For from 127.0.0.1 by default: the station
+                # reads it itself, from --trusted-proxy only (station.throttle)
+                proxy_headers=False,
                 ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
                 ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2,
                 # kiosks keep their connection between batches; closing it after 5 s idle made

@@ -9,6 +9,7 @@ one; the login cookie is HttpOnly, SameSite=Strict, and Secure when served over 
 from __future__ import annotations
 
 import asyncio
+import math
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from pathlib import Path
@@ -26,7 +27,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, auth, logins, pages
+from station import api, auth, logins, pages, throttle
 from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
@@ -75,13 +76,20 @@ async def login_post(request: Request) -> Response:
         return render(request, "login.html", status=403, error=str(exc), next="/")
     engine = request.app.state.engine
     name, password = form.get("name", "").strip(), form.get("password", "")
-    address = request.client.host if request.client else "?"
+    address = throttle.client_address(request.client.host if request.client else None,
+                                      request.headers.getlist("x-forwarded-for"), request.app.state.trusted_proxies)
     target = form.get("next", "/")
     if not target.startswith("/") or target.startswith("//"):
         target = "/"
-    if await run_in_threadpool(auth.throttled, engine, name, address):
-        return render(request, "login.html", status=429, next=target,
-                      error=f"Too many failed logins: wait {auth.WINDOW_S // 60} minutes, or ask an administrator.")
+    wait = await run_in_threadpool(throttle.wait_s, engine, name, address)
+    if wait > 0:
+        throttle.log_refused(name, address, wait)
+        seconds = math.ceil(wait)
+        response = render(request, "login.html", status=429, next=target,
+                          error=f"Too many failed logins for this name from your address: try again in {seconds} "
+                                "seconds, or ask an administrator.")
+        response.headers["retry-after"] = str(seconds)
+        return response
     found = await run_in_threadpool(auth.login, engine, name, password, address)
     if found is None:
         return render(request, "login.html", status=401, next=target, error="Wrong user name or password.")
@@ -142,8 +150,10 @@ async def healthz(request: Request) -> Response:
     return PlainTextResponse("ok")
 
 
-def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https: bool = False) -> Starlette:
-    """The station application on ``engine`` (already migrated)."""
+def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https: bool = False,
+               trusted_proxies: tuple[throttle.Network, ...] = ()) -> Starlette:
+    """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
+    from ``trusted_proxies``."""
     bus = Bus(engine)
     q = questionnaire or load_questionnaire()
 
@@ -177,5 +187,6 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
     ]
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
+    app.state.trusted_proxies = trusted_proxies
     app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app))
     return app
