@@ -6,12 +6,14 @@
     kiosk station passwd NAME [--password-file F] [--db URL]    ends every login of NAME
     kiosk station remove-user NAME [--db URL]                   ends every login of NAME
     kiosk station add-kiosk NAME [--db URL]        prints the kiosk's token (shown once)
+    kiosk station migrate --db OWNER_URL [--grant APP_ROLE]...   PostgreSQL: the owner migrates
     kiosk station revoke-kiosk NAME [--db URL]
 
 Without ``--db`` the station keeps one SQLite file in its data directory (``$KIOSK_STATION_DIR``
 or the user's data directory; directory 0700, file 0600). It listens on 127.0.0.1 unless told
 otherwise, and refuses any other address without TLS unless ``--insecure-lan`` says the network
-is trusted.
+is trusted. On PostgreSQL the schema's owner runs ``migrate --grant APP_ROLE`` and the station
+runs as the app role, which cannot switch off the audit trail's guard (:mod:`station.roles`).
 """
 
 from __future__ import annotations
@@ -24,9 +26,9 @@ import sys
 from pathlib import Path
 
 from qos.files import BadFile, read_text
-from station import auth, db, throttle
+from station import auth, db, roles, throttle
 
-ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk")
+ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate")
 
 
 class UsageError(Exception):
@@ -49,7 +51,9 @@ def _parser() -> argparse.ArgumentParser:
                "  kiosk station passwd NAME [--password-file F]   a new password; ends NAME's logins\n"
                "  kiosk station remove-user NAME                  ends NAME's logins too\n"
                "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
-               "  kiosk station revoke-kiosk NAME")
+               "  kiosk station revoke-kiosk NAME\n"
+               "  kiosk station migrate --db OWNER_URL --grant APP_ROLE   (PostgreSQL) migrate as the owner; the\n"
+               "      station then runs as APP_ROLE, which cannot change or switch off the audit trail")
     _db_option(parser)
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
     parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
@@ -65,8 +69,13 @@ def _parser() -> argparse.ArgumentParser:
 
 def _admin_parser(command: str) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=f"kiosk station {command}")
-    parser.add_argument("name", help="the user's or kiosk's name")
     _db_option(parser)
+    if command == "migrate":
+        parser.add_argument("--grant", action="append", default=[], metavar="APP_ROLE",
+                            help="PostgreSQL: let this role run the station (tables read and written, the audit "
+                                 "trail only read and added to); repeat for several")
+        return parser
+    parser.add_argument("name", help="the user's or kiosk's name")
     if command == "add-user":
         parser.add_argument("--role", required=True, choices=auth.ROLES)
     if command in ("add-user", "passwd"):
@@ -106,6 +115,8 @@ def _admin(command: str, argv: list[str]) -> int:
     args = _admin_parser(command).parse_args(argv)
     if command in ("add-user", "passwd"):
         password = _password(args.password_file)  # ask before touching the database
+    if command == "migrate":
+        return _migrate(args)
     engine = db.open_database(_url(args.db))
     if command == "add-user":
         auth.add_user(engine, args.name, args.role, password)
@@ -123,6 +134,18 @@ def _admin(command: str, argv: list[str]) -> int:
     else:
         auth.revoke_kiosk(engine, args.name)
         print(f"kiosk {args.name}: token revoked")
+    return 0
+
+
+def _migrate(args: argparse.Namespace) -> int:
+    if args.grant and not (args.db or "").startswith(("postgresql:", "postgresql+", "postgres:")):
+        raise UsageError("--grant is for PostgreSQL: a SQLite station is one owner-only file, with no roles")
+    engine = db.make_engine(_url(args.db))
+    db.migrate(engine)
+    print(f"database {engine.url.render_as_string()} migrated to the newest schema")
+    for role in args.grant:
+        roles.grant_app_role(engine, role)
+        print(f"role {role}: may read and write the station's tables; the audit trail only read and added to")
     return 0
 
 
@@ -155,6 +178,9 @@ def _serve(argv: list[str]) -> int:
     from station.web import create_app
 
     engine = db.open_database(_url(args.db))
+    warning = roles.guard_warning(engine)
+    if warning:
+        print(warning, file=sys.stderr, flush=True)
     app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies)
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})",
@@ -179,6 +205,6 @@ def main(argv: list[str]) -> int:
         if argv and argv[0] in ADMIN:
             return _admin(argv[0], argv[1:])
         return _serve(argv)
-    except (UsageError, auth.AuthError, db.DatabaseError) as exc:
+    except (UsageError, auth.AuthError, roles.RoleError, db.DatabaseError) as exc:
         print(f"kiosk station: {exc}", file=sys.stderr)
         return 2
