@@ -104,21 +104,20 @@ def end_sessions(connection: Connection, name: str) -> int:
 
 
 def login(engine: Engine, name: str, password: str, address: str) -> User | None:
-    """The user when the password is right (earlier failures of this name from this address are
-    then forgiven); a failure is recorded and logged (ask :func:`station.throttle.wait_s` first)."""
+    """The user when the password is right, and then the failures of this name from this address
+    are forgiven; None otherwise. Throttling is the caller's: :func:`station.throttle.admit`
+    first (it counts the try as a failure until this proves it right)."""
     with engine.connect() as connection:
         row = connection.execute(sa.select(users.c.role, users.c.password_hash).where(users.c.name == name)).first()
     try:
         _hasher.verify(row.password_hash if row else _dummy_hash(), password)
-        if row is not None:
-            with engine.begin() as connection:
-                throttle.record_success(connection, name, address)
-            return User(name, row.role)
     except (VerificationError, InvalidHashError):
-        pass
+        return None
+    if row is None:
+        return None
     with engine.begin() as connection:
-        throttle.record_failure(connection, name, address)
-    return None
+        throttle.record_success(connection, name, address)
+    return User(name, row.role)
 
 
 def _digest(token: str) -> str:

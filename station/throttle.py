@@ -79,39 +79,45 @@ def pause_after(failures: int, free: int = FREE_FAILURES) -> float:
     return min(FIRST_PAUSE_S * 2 ** min(failures - free, 32), MAX_PAUSE_S)
 
 
-def wait_s(engine: Engine, name: str, address: str) -> float:
-    """How long this name from this address must still wait before a password is checked."""
-    now = db.now()
-    recent = login_failures.c.at > now - WINDOW_S
-    with engine.connect() as connection:
-        pair = connection.execute(sa.select(sa.func.count(), sa.func.max(login_failures.c.at)).where(
-            recent, login_failures.c.name == name[:64], login_failures.c.address == address[:64])).one()
-        names = connection.execute(sa.select(sa.func.count(sa.distinct(login_failures.c.name)),
-                                             sa.func.max(login_failures.c.at)).where(
-            recent, login_failures.c.address == address[:64])).one()
-    waits = [0.0]
-    if pair[0]:
-        waits.append(pair[1] + pause_after(pair[0]) - now)
-    if names[0]:
-        waits.append(names[1] + pause_after(names[0], FREE_NAMES) - now)
-    return max(waits)
+def _lock(connection: Connection, address: str) -> None:
+    """Serialise admissions from one address, so parallel tries cannot all pass the count before
+    any is recorded: PostgreSQL takes an advisory lock for the transaction; on SQLite the first
+    write (the clean-up that follows) takes the database's write lock until commit."""
+    if connection.dialect.name == "postgresql":
+        connection.execute(sa.text("SELECT pg_advisory_xact_lock(727275, hashtext(:a))"), {"a": address})
 
 
-def record_failure(connection: Connection, name: str, address: str) -> int:
-    """Count a wrong password for this name from this address (and forget old failures);
-    returns the pair's failures in the window, this one included."""
+def admit(engine: Engine, name: str, address: str) -> tuple[float, int]:
+    """May a password be checked now for this name from this address? ``(0, n)`` when it may: the
+    try is then already counted as the pair's n-th failure, until :func:`record_success` forgives
+    it; ``(seconds left, n)`` when the pair or the address is paused (nothing is counted)."""
+    name, address = name[:64], address[:64]
     now = db.now()
-    connection.execute(login_failures.delete().where(login_failures.c.at < now - WINDOW_S))
-    connection.execute(login_failures.insert().values(name=name[:64], address=address[:64], at=now))
-    count = connection.execute(sa.select(sa.func.count()).where(
-        login_failures.c.name == name[:64], login_failures.c.address == address[:64])).scalar_one()
+    with engine.begin() as connection:
+        _lock(connection, address)
+        connection.execute(login_failures.delete().where(login_failures.c.at < now - WINDOW_S))
+        pair_count, pair_last = connection.execute(sa.select(sa.func.count(), sa.func.max(login_failures.c.at)).where(
+            login_failures.c.name == name, login_failures.c.address == address)).one()
+        names, address_last = connection.execute(sa.select(sa.func.count(sa.distinct(login_failures.c.name)),
+                                                           sa.func.max(login_failures.c.at)).where(
+            login_failures.c.address == address)).one()
+        wait = max(0.0, pair_last + pause_after(pair_count) - now if pair_count else 0.0,
+                   address_last + pause_after(names, FREE_NAMES) - now if names else 0.0)
+        if wait > 0:
+            return wait, pair_count
+        connection.execute(login_failures.insert().values(name=name, address=address, at=now))
+    return 0.0, pair_count + 1
+
+
+def log_failure(name: str, address: str, count: int) -> None:
+    """Note a wrong name or password (``count``: the pair's failures in the window)."""
     log.warning("login failed: name %r from %s (wrong name or password; %d failure(s) in the last hour)",
                 name[:64], address[:64], count)
-    return count
 
 
 def record_success(connection: Connection, name: str, address: str) -> None:
-    """The right password from this address: its earlier failures for this name are forgiven."""
+    """The right password from this address: its failures for this name (this try's included)
+    are forgiven."""
     connection.execute(login_failures.delete().where(
         login_failures.c.name == name[:64], login_failures.c.address == address[:64]))
 

@@ -81,7 +81,7 @@ async def login_post(request: Request) -> Response:
     target = form.get("next", "/")
     if not target.startswith("/") or target.startswith("//"):
         target = "/"
-    wait = await run_in_threadpool(throttle.wait_s, engine, name, address)
+    wait, failures = await run_in_threadpool(throttle.admit, engine, name, address)
     if wait > 0:
         throttle.log_refused(name, address, wait)
         seconds = math.ceil(wait)
@@ -92,6 +92,7 @@ async def login_post(request: Request) -> Response:
         return response
     found = await run_in_threadpool(auth.login, engine, name, password, address)
     if found is None:
+        throttle.log_failure(name, address, failures)
         return render(request, "login.html", status=401, next=target, error="Wrong user name or password.")
     session_id = await run_in_threadpool(logins.start, engine, found.name)
     request.session.clear()  # a new session on login: no fixation of an earlier cookie

@@ -9,6 +9,7 @@ from __future__ import annotations
 import ipaddress
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import httpx
 import pytest
@@ -107,6 +108,23 @@ def test_forged_forwarded_for_from_an_untrusted_peer_does_not_bypass_the_limit(d
     assert log.count("login failed: name 'dr.lopez' from 127.0.0.1 ") == checked
     assert log.count("login refused: name 'dr.lopez' from 127.0.0.1 ") == statuses.count(429)
     assert "198.51.100." not in log and "Traceback" not in log
+
+
+def test_parallel_tries_cannot_slip_through_together(db_url, station_factory):
+    make_ward(db_url)
+    station = station_factory(db_url)
+    browsers = [Browser(station.url) for _ in range(24)]
+    ready = threading.Barrier(len(browsers))
+
+    def guess(browser: Browser) -> int:
+        ready.wait(PATIENCE_S)
+        return browser.login("dr.lopez", "a-parallel-guess").status_code
+
+    started = time.monotonic()
+    with ThreadPoolExecutor(len(browsers)) as pool:
+        statuses = list(pool.map(guess, browsers))
+    assert set(statuses) <= {401, 429}
+    assert throttle.FREE_FAILURES <= statuses.count(401) <= most_checked(time.monotonic() - started), statuses
 
 
 def test_behind_a_named_proxy_each_client_address_is_throttled_alone(station_factory, tmp_path):
