@@ -6,6 +6,7 @@ SQLite and PostgreSQL, the real command line, HTTP as a browser would send it.""
 from __future__ import annotations
 
 import httpx
+import sqlalchemy as sa
 import pytest
 
 from station import auth, db, logins
@@ -92,4 +93,30 @@ def test_a_role_change_ends_logins_and_the_cookie_holds_no_session_in_clear(db_u
     auth.add_user(engine, "nurse.kim", "doctor", PASSWORDS["nurse"])
     assert logins.user_of(engine, session_id) is None
     assert logins.user_of(engine, "made-up") is None
+    engine.dispose()
+
+
+def test_a_station_made_before_0002_upgrades_and_keeps_its_users(db_url):
+    from alembic import command
+    from alembic.config import Config
+
+    config = Config()
+    config.set_main_option("script_location", str(db.MIGRATIONS))
+    engine = db.make_engine(db_url)
+
+    def run(step, revision: str) -> None:
+        with engine.begin() as connection:
+            config.attributes["connection"] = connection
+            step(config, revision)
+
+    run(command.upgrade, "0001")
+    with engine.begin() as connection:
+        assert "staff_sessions" not in sa.inspect(connection).get_table_names()
+    auth.add_user(engine, "nurse.kim", "nurse", PASSWORDS["nurse"])  # users exist before 0002
+    db.migrate(engine)
+    assert auth.login(engine, "nurse.kim", PASSWORDS["nurse"], "127.0.0.1") == auth.User("nurse.kim", "nurse")
+    assert logins.user_of(engine, logins.start(engine, "nurse.kim")) is not None
+    run(command.downgrade, "0001")
+    run(command.upgrade, "head")
+    assert auth.login(engine, "nurse.kim", PASSWORDS["nurse"], "127.0.0.1") is not None
     engine.dispose()
