@@ -51,6 +51,11 @@ def _grant(engine: Engine, role: str) -> None:
                                            "AND schemaname = current_schema()")).scalar()
         if owner == role:
             raise RoleError(f"role {role!r} owns the tables: the app role must be another role than the owner")
+        me, superuser = connection.execute(sa.text(
+            "SELECT current_user, rolsuper FROM pg_roles WHERE rolname = current_user")).one()
+        if me != owner and not superuser:  # PostgreSQL would only warn, and grant nothing
+            raise RoleError(f"only the tables' owner ({owner!r}) can grant them; this is role {me!r}: give the "
+                            "owner's URL as --db")
         who, schema = _quote(connection, role), _quote(connection, connection.execute(
             sa.text("SELECT current_schema()")).scalar_one())
         app_tables = [name for name in db.metadata.tables if name != db.audit.name]

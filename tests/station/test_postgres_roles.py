@@ -117,5 +117,7 @@ def test_running_as_the_owner_warns_and_grant_mistakes_are_one_line(roles, stati
     assert "no role 'nobody_here'" in one_line(kiosk_station("migrate", "--db", owner_url, "--grant", "nobody_here"))
     owner = owner_url.rsplit("@", 1)[0].rsplit("/", 1)[1]
     assert "owns the tables" in one_line(kiosk_station("migrate", "--db", owner_url, "--grant", owner))
+    assert kiosk_station("migrate", "--db", owner_url, "--grant", app).returncode == 0
+    assert "only the tables' owner" in one_line(kiosk_station("migrate", "--db", app_url, "--grant", app))
     station = station_factory(owner_url)
     assert "could switch off the audit trail's append-only guard" in station.log.read_text()
