@@ -46,7 +46,8 @@ def _grant(engine: Engine, role: str) -> None:
         if not connection.execute(sa.text("SELECT 1 FROM pg_roles WHERE rolname = :r"), {"r": role}).first():
             raise RoleError(f"no role {role!r} on this server: create it first (CREATE ROLE {role} LOGIN PASSWORD ...)")
         if connection.execute(sa.text("SELECT rolsuper FROM pg_roles WHERE rolname = :r"), {"r": role}).scalar():
-            raise RoleError(f"role {role!r} is a superuser, so it can change anything: give the station an ordinary role")
+            raise RoleError(f"role {role!r} is a superuser, so it can change anything: give the station an "
+                            "ordinary role")
         owner = connection.execute(sa.text("SELECT tableowner FROM pg_tables WHERE tablename = 'audit' "
                                            "AND schemaname = current_schema()")).scalar()
         if owner == role:
@@ -64,7 +65,8 @@ def _grant(engine: Engine, role: str) -> None:
             connection.execute(sa.text(f"REVOKE ALL ON {schema}.{_quote(connection, table)} FROM {who}"))
         for table in app_tables:
             connection.execute(sa.text(f"GRANT {APP_PRIVILEGES} ON {schema}.{_quote(connection, table)} TO {who}"))
-        connection.execute(sa.text(f"GRANT {AUDIT_PRIVILEGES} ON {schema}.{_quote(connection, db.audit.name)} TO {who}"))
+        audit = f"{schema}.{_quote(connection, db.audit.name)}"
+        connection.execute(sa.text(f"GRANT {AUDIT_PRIVILEGES} ON {audit} TO {who}"))
         connection.execute(sa.text(f"GRANT SELECT ON {schema}.alembic_version TO {who}"))
         connection.execute(sa.text(f"GRANT USAGE ON ALL SEQUENCES IN SCHEMA {schema} TO {who}"))
 

@@ -57,7 +57,8 @@ def one_line(done) -> str:
 def test_the_app_role_runs_the_station_and_cannot_touch_the_audit_guard(roles, station_factory, tmp_path):
     owner_url, app_url, app = roles
     # before the owner migrates, the app role is told what to run, in one line
-    assert f"kiosk station migrate --db OWNER_URL --grant {app}" in one_line(kiosk_station("add-kiosk", "bed1", "--db", app_url))
+    refused = one_line(kiosk_station("add-kiosk", "bed1", "--db", app_url))
+    assert f"kiosk station migrate --db OWNER_URL --grant {app}" in refused
     done = kiosk_station("migrate", "--db", owner_url, "--grant", app)
     assert done.returncode == 0 and f"role {app}:" in done.stdout, done.stderr
     password = tmp_path / "pw"
