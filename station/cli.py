@@ -118,6 +118,7 @@ def _admin(command: str, argv: list[str]) -> int:
     if command == "migrate":
         return _migrate(args)
     engine = db.open_database(_url(args.db))
+    roles.check_privileges(engine)
     if command == "add-user":
         auth.add_user(engine, args.name, args.role, password)
         print(f"user {args.name} ({args.role}) saved")
@@ -178,6 +179,7 @@ def _serve(argv: list[str]) -> int:
     from station.web import create_app
 
     engine = db.open_database(_url(args.db))
+    roles.check_privileges(engine)
     warning = roles.guard_warning(engine)
     if warning:
         print(warning, file=sys.stderr, flush=True)

@@ -71,6 +71,24 @@ def _grant(engine: Engine, role: str) -> None:
         connection.execute(sa.text(f"GRANT USAGE ON ALL SEQUENCES IN SCHEMA {schema} TO {who}"))
 
 
+def check_privileges(engine: Engine) -> None:
+    """On PostgreSQL, refuse to run (DatabaseError, one sentence) when the station's role lacks a
+    privilege it needs on a table, as after an upgrade the owner migrated without ``--grant``:
+    better than an error on the first request that touches that table."""
+    if not db.is_postgres(engine):
+        return
+    needed = {name: APP_PRIVILEGES for name in db.metadata.tables} | {db.audit.name: AUDIT_PRIVILEGES}
+    with engine.connect() as connection:
+        for table, privileges in needed.items():
+            for privilege in privileges.split(", "):
+                if not connection.execute(sa.text("SELECT has_table_privilege(:t, :p)"),
+                                          {"t": table, "p": privilege}).scalar():
+                    role = connection.execute(sa.text("SELECT current_user")).scalar()
+                    raise db.DatabaseError(
+                        f"role {role!r} may not {privilege} on table {table}: run 'kiosk station migrate --db "
+                        f"OWNER_URL --grant {role}' as the schema's owner")
+
+
 def guard_warning(engine: Engine) -> str | None:
     """A sentence for the operator when the station's own role could switch the audit trail's
     guard off (it owns ``audit`` or is a superuser); None on SQLite or under an app role."""

@@ -119,6 +119,11 @@ def test_running_as_the_owner_warns_and_grant_mistakes_are_one_line(roles, stati
     owner = owner_url.rsplit("@", 1)[0].rsplit("/", 1)[1]
     assert "owns the tables" in one_line(kiosk_station("migrate", "--db", owner_url, "--grant", owner))
     assert kiosk_station("migrate", "--db", owner_url, "--grant", app).returncode == 0
+    # the owner upgraded (here: a new table) without granting it: the app role is told, in one line
+    with psycopg.connect(owner_url, autocommit=True) as connection:
+        connection.execute(f"REVOKE ALL ON staff_sessions FROM {app}")
+    assert "may not SELECT on table staff_sessions" in one_line(kiosk_station("--db", app_url))
+    assert kiosk_station("migrate", "--db", owner_url, "--grant", app).returncode == 0
     assert "only the tables' owner" in one_line(kiosk_station("migrate", "--db", app_url, "--grant", app))
     station = station_factory(owner_url)
     assert "could switch off the audit trail's append-only guard" in station.log.read_text()
