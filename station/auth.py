@@ -1,10 +1,10 @@
 """Who may use the station: staff (argon2-hashed passwords, roles nurse and doctor), kiosks
-(bearer tokens stored as SHA-256 digests, revocable), login rate limiting and CSRF tokens.
+(bearer tokens stored as SHA-256 digests, revocable) and CSRF tokens; login throttling is
+:mod:`station.throttle`, login sessions :mod:`station.logins`.
 
 Kiosk tokens are 256-bit random strings, so a plain SHA-256 digest is enough to make a stolen
 database useless for impersonating a kiosk and still lets a request find its kiosk by digest;
-passwords are low-entropy, so they get argon2. Failed logins are counted in the database, so
-every station process behind one PostgreSQL shares the limit.
+passwords are low-entropy, so they get argon2.
 """
 
 from __future__ import annotations
@@ -21,17 +21,12 @@ from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
 from sqlalchemy.engine import Connection, Engine
 
-from station import db
-from station.db import kiosks, login_failures, settings, users
+from station import db, throttle
+from station.db import kiosks, settings, staff_sessions, users
 
 ROLES = ("nurse", "doctor")
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
 MIN_PASSWORD = 10
-#: failed logins allowed per user name within the window (guessing one person's password), and
-#: per address (guessing across names; higher, as a ward's devices may share one address)
-MAX_FAILURES = 5
-MAX_FAILURES_PER_ADDRESS = 20
-WINDOW_S = 15 * 60
 
 _hasher = PasswordHasher()
 
@@ -63,55 +58,66 @@ def check_name(name: str, what: str) -> str:
     return name
 
 
+def _check_password(password: str) -> None:
+    if len(password) < MIN_PASSWORD:
+        raise AuthError(f"the password must have at least {MIN_PASSWORD} characters")
+
+
 def add_user(engine: Engine, name: str, role: str, password: str) -> None:
-    """Create a user, or set the role and password of an existing one."""
+    """Create a user, or set the role and password of an existing one (ending its logins)."""
     check_name(name, "user name")
     if role not in ROLES:
         raise AuthError(f"role {role!r}: choose one of {', '.join(ROLES)}")
-    if len(password) < MIN_PASSWORD:
-        raise AuthError(f"the password must have at least {MIN_PASSWORD} characters")
+    _check_password(password)
     values = {"role": role, "password_hash": _hasher.hash(password)}
     with engine.begin() as connection:
         if connection.execute(sa.select(users.c.name).where(users.c.name == name)).first():
             connection.execute(users.update().where(users.c.name == name).values(**values))
+            end_sessions(connection, name)
         else:
             connection.execute(users.insert().values(name=name, created_at=db.now_iso(), **values))
 
 
-def throttled(engine: Engine, name: str, address: str) -> bool:
-    """Whether logins for this name or from this address are paused after too many failures."""
-    since = db.now() - WINDOW_S
-    with engine.connect() as connection:
-        for column, value, limit in ((login_failures.c.name, name, MAX_FAILURES),
-                                     (login_failures.c.address, address, MAX_FAILURES_PER_ADDRESS)):
-            count = connection.execute(sa.select(sa.func.count()).select_from(login_failures).where(
-                column == value, login_failures.c.at > since)).scalar_one()
-            if count >= limit:
-                return True
-    return False
+def set_password(engine: Engine, name: str, password: str) -> int:
+    """Change a user's password and end every login of that user; returns how many ended."""
+    _check_password(password)
+    with engine.begin() as connection:
+        if not connection.execute(users.update().where(users.c.name == name).values(
+                password_hash=_hasher.hash(password))).rowcount:
+            raise AuthError(f"no user {name!r}")
+        return end_sessions(connection, name)
+
+
+def remove_user(engine: Engine, name: str) -> int:
+    """Delete a user and end every login of that user (what they did stays in the audit trail);
+    returns how many logins ended."""
+    with engine.begin() as connection:
+        ended = end_sessions(connection, name)
+        if not connection.execute(users.delete().where(users.c.name == name)).rowcount:
+            raise AuthError(f"no user {name!r}")
+    return ended
+
+
+def end_sessions(connection: Connection, name: str) -> int:
+    """End every login session of user ``name``, in the caller's transaction; returns how many."""
+    return connection.execute(staff_sessions.delete().where(staff_sessions.c.user_name == name)).rowcount
 
 
 def login(engine: Engine, name: str, password: str, address: str) -> User | None:
-    """The user when the password is right; a failure is counted (call :func:`throttled` first)."""
+    """The user when the password is right, and then the failures of this name from this address
+    are forgiven; None otherwise. Throttling is the caller's: :func:`station.throttle.admit`
+    first (it counts the try as a failure until this proves it right)."""
     with engine.connect() as connection:
         row = connection.execute(sa.select(users.c.role, users.c.password_hash).where(users.c.name == name)).first()
     try:
         _hasher.verify(row.password_hash if row else _dummy_hash(), password)
-        if row is not None:
-            return User(name, row.role)
     except (VerificationError, InvalidHashError):
-        pass
+        return None
+    if row is None:
+        return None
     with engine.begin() as connection:
-        connection.execute(login_failures.delete().where(login_failures.c.at < db.now() - WINDOW_S))
-        connection.execute(login_failures.insert().values(name=name[:64], address=address[:64], at=db.now()))
-    return None
-
-
-def user(engine: Engine, name: str) -> User | None:
-    """The user by name (None if deleted since the cookie was issued)."""
-    with engine.connect() as connection:
-        role = connection.execute(sa.select(users.c.role).where(users.c.name == name)).scalar()
-    return User(name, role) if role else None
+        throttle.record_success(connection, name, address)
+    return User(name, row.role)
 
 
 def _digest(token: str) -> str:

@@ -1,14 +1,19 @@
 """``kiosk station``: start the ward station, or administer it.
 
     kiosk station [--db URL] [--host H] [--port P] [--tls-cert F --tls-key F] [--insecure-lan]
+                  [--trusted-proxy ADDRESS]...
     kiosk station add-user NAME --role nurse|doctor [--password-file F] [--db URL]
+    kiosk station passwd NAME [--password-file F] [--db URL]    ends every login of NAME
+    kiosk station remove-user NAME [--db URL]                   ends every login of NAME
     kiosk station add-kiosk NAME [--db URL]        prints the kiosk's token (shown once)
+    kiosk station migrate --db OWNER_URL [--grant APP_ROLE]...   PostgreSQL: the owner migrates
     kiosk station revoke-kiosk NAME [--db URL]
 
 Without ``--db`` the station keeps one SQLite file in its data directory (``$KIOSK_STATION_DIR``
 or the user's data directory; directory 0700, file 0600). It listens on 127.0.0.1 unless told
 otherwise, and refuses any other address without TLS unless ``--insecure-lan`` says the network
-is trusted.
+is trusted. On PostgreSQL the schema's owner runs ``migrate --grant APP_ROLE`` and the station
+runs as the app role, which cannot switch off the audit trail's guard (:mod:`station.roles`).
 """
 
 from __future__ import annotations
@@ -21,9 +26,9 @@ import sys
 from pathlib import Path
 
 from qos.files import BadFile, read_text
-from station import auth, db
+from station import auth, db, roles, throttle
 
-ADMIN = ("add-user", "add-kiosk", "revoke-kiosk")
+ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate")
 
 
 class UsageError(Exception):
@@ -43,13 +48,20 @@ def _parser() -> argparse.ArgumentParser:
                     "validate results.",
         epilog="administration (each takes --db too):\n"
                "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
+               "  kiosk station passwd NAME [--password-file F]   a new password; ends NAME's logins\n"
+               "  kiosk station remove-user NAME                  ends NAME's logins too\n"
                "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
-               "  kiosk station revoke-kiosk NAME")
+               "  kiosk station revoke-kiosk NAME\n"
+               "  kiosk station migrate --db OWNER_URL --grant APP_ROLE   (PostgreSQL) migrate as the owner; the\n"
+               "      station then runs as APP_ROLE, which cannot change or switch off the audit trail")
     _db_option(parser)
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
     parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
     parser.add_argument("--tls-cert", type=Path, metavar="PEM", help="TLS certificate chain (PEM)")
     parser.add_argument("--tls-key", type=Path, metavar="PEM", help="TLS private key (PEM)")
+    parser.add_argument("--trusted-proxy", action="append", default=[], metavar="ADDRESS",
+                        help="a reverse proxy (address or network) whose X-Forwarded-For names the client; "
+                             "repeat for each (default: none, the peer's own address counts)")
     parser.add_argument("--insecure-lan", action="store_true",
                         help="allow a non-loopback --host without TLS (only on a network you trust)")
     return parser
@@ -57,10 +69,16 @@ def _parser() -> argparse.ArgumentParser:
 
 def _admin_parser(command: str) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=f"kiosk station {command}")
-    parser.add_argument("name", help="the user's or kiosk's name")
     _db_option(parser)
+    if command == "migrate":
+        parser.add_argument("--grant", action="append", default=[], metavar="APP_ROLE",
+                            help="PostgreSQL: let this role run the station (tables read and written, the audit "
+                                 "trail only read and added to); repeat for several")
+        return parser
+    parser.add_argument("name", help="the user's or kiosk's name")
     if command == "add-user":
         parser.add_argument("--role", required=True, choices=auth.ROLES)
+    if command in ("add-user", "passwd"):
         parser.add_argument("--password-file", type=Path,
                             help="read the password from this file's first line (default: ask)")
     return parser
@@ -95,12 +113,21 @@ def _password(path: Path | None) -> str:
 
 def _admin(command: str, argv: list[str]) -> int:
     args = _admin_parser(command).parse_args(argv)
-    if command == "add-user":
+    if command in ("add-user", "passwd"):
         password = _password(args.password_file)  # ask before touching the database
+    if command == "migrate":
+        return _migrate(args)
     engine = db.open_database(_url(args.db))
+    roles.check_privileges(engine)
     if command == "add-user":
         auth.add_user(engine, args.name, args.role, password)
         print(f"user {args.name} ({args.role}) saved")
+    elif command == "passwd":
+        ended = auth.set_password(engine, args.name, password)
+        print(f"user {args.name}: password changed; {ended} login(s) ended")
+    elif command == "remove-user":
+        ended = auth.remove_user(engine, args.name)
+        print(f"user {args.name} removed; {ended} login(s) ended")
     elif command == "add-kiosk":
         token = auth.add_kiosk(engine, args.name)
         print(f"kiosk {args.name} added; its token (shown only now; put it in the kiosk's config as station.token):")
@@ -108,6 +135,18 @@ def _admin(command: str, argv: list[str]) -> int:
     else:
         auth.revoke_kiosk(engine, args.name)
         print(f"kiosk {args.name}: token revoked")
+    return 0
+
+
+def _migrate(args: argparse.Namespace) -> int:
+    if args.grant and not (args.db or "").startswith(("postgresql:", "postgresql+", "postgres:")):
+        raise UsageError("--grant is for PostgreSQL: a SQLite station is one owner-only file, with no roles")
+    engine = db.make_engine(_url(args.db))
+    db.migrate(engine)
+    print(f"database {engine.url.render_as_string()} migrated to the newest schema")
+    for role in args.grant:
+        roles.grant_app_role(engine, role)
+        print(f"role {role}: may read and write the station's tables; the audit trail only read and added to")
     return 0
 
 
@@ -131,17 +170,29 @@ def _check_listen(args: argparse.Namespace) -> None:
 def _serve(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
     _check_listen(args)
+    try:
+        proxies = throttle.parse_proxies(args.trusted_proxy)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     import uvicorn
 
     from station.web import create_app
 
     engine = db.open_database(_url(args.db))
-    app = create_app(engine, https=bool(args.tls_cert))
+    roles.check_privileges(engine)
+    warning = roles.guard_warning(engine)
+    if warning:
+        print(warning, file=sys.stderr, flush=True)
+    app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies)
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})",
           flush=True)
-    logging.basicConfig(level=logging.WARNING)
+    # failed and refused logins are logged here (station.security), one line each
+    logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     uvicorn.run(app, host=args.host, port=args.port, log_level="warning", access_log=False,
+                # uvicorn would trust X-Forwarded-For from 127.0.0.1 by default: the station
+                # reads it itself, from --trusted-proxy only (station.throttle)
+                proxy_headers=False,
                 ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
                 ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2,
                 # kiosks keep their connection between batches; closing it after 5 s idle made
@@ -156,6 +207,6 @@ def main(argv: list[str]) -> int:
         if argv and argv[0] in ADMIN:
             return _admin(argv[0], argv[1:])
         return _serve(argv)
-    except (UsageError, auth.AuthError, db.DatabaseError) as exc:
+    except (UsageError, auth.AuthError, roles.RoleError, db.DatabaseError) as exc:
         print(f"kiosk station: {exc}", file=sys.stderr)
         return 2

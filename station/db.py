@@ -40,6 +40,14 @@ users = sa.Table(
     sa.Column("created_at", sa.String(40), nullable=False),
 )
 
+staff_sessions = sa.Table(
+    "staff_sessions", metadata,
+    sa.Column("id_hash", sa.String(64), primary_key=True),
+    sa.Column("user_name", sa.String(64), sa.ForeignKey("users.name", ondelete="CASCADE"), nullable=False),
+    sa.Column("created_at", sa.Float, nullable=False),
+    sa.Column("expires_at", sa.Float, nullable=False),
+)
+
 login_failures = sa.Table(
     "login_failures", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -192,6 +200,14 @@ def make_engine(url: str) -> Engine:
     """An engine for ``url``; SQLite in WAL mode with foreign keys and a busy timeout, so the
     web threads and a long poll share it."""
     url = _normalise(url)
+    try:
+        return _make_engine(url)
+    except (sa.exc.ArgumentError, ImportError):  # not a URL, or a database the station does not run on
+        raise DatabaseError(f"--db {url!r}: not a station database URL (postgresql://user@host/dbname or "
+                            "sqlite:///path)") from None
+
+
+def _make_engine(url: str) -> Engine:
     if url.startswith("sqlite"):
         engine = sa.create_engine(url, connect_args={"timeout": 30, "check_same_thread": False})
 
@@ -225,7 +241,9 @@ def insert_ignore(connection: Connection, table: sa.Table, rows: list[dict[str, 
 
 def migrate(engine: Engine) -> None:
     """Bring the schema to the newest Alembic revision. On PostgreSQL an advisory lock makes
-    several station processes starting together migrate one after the other."""
+    several station processes starting together migrate one after the other; a schema already
+    current needs no privilege beyond reading ``alembic_version``, so an app role
+    (:mod:`station.roles`) starts a station the owner has migrated."""
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS))
     try:
@@ -235,6 +253,11 @@ def migrate(engine: Engine) -> None:
             config.attributes["connection"] = connection
             command.upgrade(config, "head")
     except sa.exc.SQLAlchemyError as exc:
+        if getattr(getattr(exc, "orig", None), "sqlstate", None) == "42501":  # insufficient privilege
+            role = engine.url.username or "this role"
+            raise DatabaseError(f"the station database {engine.url.render_as_string()} needs migrating, and role "
+                                f"{role!r} may not change its schema: run 'kiosk station migrate --db OWNER_URL "
+                                f"--grant {role}' as the schema's owner first") from None
         raise DatabaseError(f"cannot open the station database {engine.url!r}: {exc.__class__.__name__}: "
                             f"{str(exc).splitlines()[0]}") from None
 

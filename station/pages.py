@@ -26,6 +26,7 @@ from kiosk.questionnaire import Questionnaire, Score
 from kiosk.review import review_state
 from kiosk.storage import StoredSession
 from station import db, exports, validation, ward
+from station.download import attachment
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
 from station.sessions import NotFound, load
@@ -219,8 +220,9 @@ async def amend(request: Request) -> Response:
     return _back(request, "Reopened to amend: change the answers, then sign off again.", to=page)
 
 
-def _attachment(body: str, media: str, filename: str) -> Response:
-    return Response(body, media_type=media, headers={"content-disposition": f'attachment; filename="{filename}"'})
+def _attachment(body: str, media: str, stem: str, suffix: str) -> Response:
+    """A download of ``<stem><suffix>``; the stem may come from a kiosk, so it is made safe."""
+    return Response(body, media_type=media, headers={"content-disposition": attachment(stem, suffix)})
 
 
 async def export(request: Request) -> Response:
@@ -236,13 +238,13 @@ async def export(request: Request) -> Response:
         if fmt == "json":
             bundle = await run_in_threadpool(exports.result_bundle, engine, q, session_id)
             return _attachment(json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json",
-                               f"{session_id}.fhir.json")
+                               session_id, ".fhir.json")
         body = await run_in_threadpool(exports.result_csv, engine, q, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
     except ExportError as exc:
         return PlainTextResponse(f"session {session_id} cannot be exported: {exc}", status_code=422)
-    return _attachment(body, "text/csv", f"{session_id}.csv")
+    return _attachment(body, "text/csv", session_id, ".csv")
 
 
 async def period_export(request: Request) -> Response:
@@ -260,7 +262,7 @@ async def period_export(request: Request) -> Response:
         return PlainTextResponse(f"the results signed off from {first} to {last} cannot be exported: {exc}",
                                  status_code=422)
     return _attachment(json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json",
-                       f"signed-off-{first}-{last}.fhir.json")
+                       f"signed-off-{first}-{last}", ".fhir.json")
 
 
 routes = [

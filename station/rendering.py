@@ -13,7 +13,7 @@ from starlette.requests import Request
 from starlette.responses import Response
 from starlette.templating import Jinja2Templates
 
-from station import auth, ward
+from station import auth, logins, ward
 
 templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
 templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
@@ -24,8 +24,9 @@ class Forbidden(Exception):
 
 
 def current_user(request: Request) -> auth.User | None:
-    name = request.session.get("user")
-    return auth.user(request.app.state.engine, name) if name else None
+    """The user of the request's login session, if that session is still live on the server."""
+    session_id = request.session.get("sid")
+    return logins.user_of(request.app.state.engine, session_id) if isinstance(session_id, str) else None
 
 
 def csrf_token(request: Request) -> str:

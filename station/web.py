@@ -9,6 +9,7 @@ one; the login cookie is HttpOnly, SameSite=Strict, and Secure when served over 
 from __future__ import annotations
 
 import asyncio
+import math
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from pathlib import Path
@@ -26,7 +27,8 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, auth, pages
+from station import api, auth, logins, pages, throttle
+from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
 from station.rendering import Forbidden, checked_form, current_user, render
@@ -74,18 +76,27 @@ async def login_post(request: Request) -> Response:
         return render(request, "login.html", status=403, error=str(exc), next="/")
     engine = request.app.state.engine
     name, password = form.get("name", "").strip(), form.get("password", "")
-    address = request.client.host if request.client else "?"
+    address = throttle.client_address(request.client.host if request.client else None,
+                                      request.headers.getlist("x-forwarded-for"), request.app.state.trusted_proxies)
     target = form.get("next", "/")
     if not target.startswith("/") or target.startswith("//"):
         target = "/"
-    if await run_in_threadpool(auth.throttled, engine, name, address):
-        return render(request, "login.html", status=429, next=target,
-                      error=f"Too many failed logins: wait {auth.WINDOW_S // 60} minutes, or ask an administrator.")
+    wait, failures = await run_in_threadpool(throttle.admit, engine, name, address)
+    if wait > 0:
+        throttle.log_refused(name, address, wait)
+        seconds = math.ceil(wait)
+        response = render(request, "login.html", status=429, next=target,
+                          error=f"Too many failed logins for this name from your address: try again in {seconds} "
+                                "seconds, or ask an administrator.")
+        response.headers["retry-after"] = str(seconds)
+        return response
     found = await run_in_threadpool(auth.login, engine, name, password, address)
     if found is None:
+        throttle.log_failure(name, address, failures)
         return render(request, "login.html", status=401, next=target, error="Wrong user name or password.")
+    session_id = await run_in_threadpool(logins.start, engine, found.name)
     request.session.clear()  # a new session on login: no fixation of an earlier cookie
-    request.session.update(user=found.name, csrf=auth.new_csrf_token())
+    request.session.update(sid=session_id, csrf=auth.new_csrf_token())
     return RedirectResponse(target, status_code=303)
 
 
@@ -94,6 +105,9 @@ async def logout(request: Request) -> Response:
         await checked_form(request)
     except Forbidden as exc:
         return PlainTextResponse(str(exc), status_code=403)
+    session_id = request.session.get("sid")
+    if isinstance(session_id, str):  # ended on the server: a copy of the cookie opens nothing
+        await run_in_threadpool(logins.end, request.app.state.engine, session_id)
     request.session.clear()
     return RedirectResponse("/login", status_code=303)
 
@@ -137,8 +151,10 @@ async def healthz(request: Request) -> Response:
     return PlainTextResponse("ok")
 
 
-def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https: bool = False) -> Starlette:
-    """The station application on ``engine`` (already migrated)."""
+def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https: bool = False,
+               trusted_proxies: tuple[throttle.Network, ...] = ()) -> Starlette:
+    """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
+    from ``trusted_proxies``."""
     bus = Bus(engine)
     q = questionnaire or load_questionnaire()
 
@@ -165,11 +181,13 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
     ]
     middleware = [
         Middleware(SecurityHeaders),
+        Middleware(BodyLimit),
         Middleware(SessionMiddleware, secret_key=auth.secret_key(engine), session_cookie="station_session",
-                   max_age=12 * 3600, same_site="strict", https_only=https),
+                   max_age=logins.MAX_AGE_S, same_site="strict", https_only=https),
         Middleware(LoginRequired),
     ]
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
+    app.state.trusted_proxies = trusted_proxies
     app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app))
     return app

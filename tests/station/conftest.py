@@ -75,12 +75,13 @@ class Station:
                 self.kill()
 
 
-def start_station(db_url: str, log: Path, port: int | None = None) -> Station:
-    """Start `kiosk station` on ``db_url`` and wait until it answers."""
+def start_station(db_url: str, log: Path, port: int | None = None, args: tuple[str, ...] = ()) -> Station:
+    """Start `kiosk station` on ``db_url`` (with more command-line ``args``) and wait until it answers."""
     port = port or free_port()
     env = os.environ | {"PYTHONUNBUFFERED": "1"}
     with open(log, "ab") as out:
-        process = subprocess.Popen([sys.executable, "-m", "kiosk", "station", "--db", db_url, "--port", str(port)],
+        process = subprocess.Popen([sys.executable, "-m", "kiosk", "station", "--db", db_url, "--port", str(port),
+                                    *args],
                                    stdout=out, stderr=subprocess.STDOUT, cwd=ROOT, env=env)
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + PATIENCE_S
@@ -121,8 +122,8 @@ def station_factory(tmp_path: Path) -> Iterator:
     """Start stations; all are stopped at the end of the test."""
     started: list[Station] = []
 
-    def start(db_url: str, port: int | None = None) -> Station:
-        station = start_station(db_url, tmp_path / f"station{len(started)}.log", port)
+    def start(db_url: str, port: int | None = None, args: tuple[str, ...] = ()) -> Station:
+        station = start_station(db_url, tmp_path / f"station{len(started)}.log", port, args)
         started.append(station)
         return station
 
