@@ -280,12 +280,12 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "fhir":
             if not isinstance(value, dict):
                 raise fail((key,), "fhir must be a mapping such as {patient_system: https://example.org/sid/patient}")
-            for name, uri in value.items():
-                if name not in FHIR_KEYS:
-                    raise fail((key, name), f"unknown fhir setting {name!r} (known: {', '.join(FHIR_KEYS)})")
+            for setting, uri in value.items():  # not `name`: that is the file's, which fail() names
+                if setting not in FHIR_KEYS:
+                    raise fail((key, setting), f"unknown fhir setting {setting!r} (known: {', '.join(FHIR_KEYS)})")
                 if not isinstance(uri, str) or not _URI.fullmatch(uri):
-                    raise fail((key, name), f"fhir {name} must be an absolute URI without spaces or '|', "
-                                            "such as https://example.org/sid/patient")
+                    raise fail((key, setting), f"fhir {setting} must be an absolute URI without spaces or '|', "
+                                               "such as https://example.org/sid/patient")
             value = dict(value)
         elif key == "station":
             if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \

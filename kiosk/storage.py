@@ -27,6 +27,7 @@ A stored total is kept for listing only; results always recompute it from the an
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import re
@@ -106,6 +107,25 @@ def _damaged(path: Path, exc: BaseException | str) -> StorageError:
         "and restore a backup, or start with an empty database")
 
 
+#: the tables every database of this schema has (a dropped one is damage, found at open)
+_TABLES = ("patients", "sessions", "answers", "not_answered", "practice", "contexts", "metric_samples",
+           "adaptations", "events", "leases", "outbox")
+
+
+def _reading(method: Callable[..., Any]) -> Callable[..., Any]:
+    """A reading method whose rows this code cannot read (a value no kiosk writes, such as an
+    unknown channel, or SQL that fails on an edited file) raises one StorageError naming the
+    database, instead of a traceback from deep inside. KeyError (no such session) passes."""
+    @functools.wraps(method)
+    def read(self: Store, *args: Any) -> Any:
+        try:
+            return method(self, *args)
+        except (sqlite3.Error, ValueError, TypeError) as exc:
+            raise StorageError(f"{self.path} holds what this kiosk cannot read ({exc}); nothing was changed. "
+                               "Keep a copy for the engineers and restore a backup") from None
+    return read
+
+
 def _is_damage(exc: sqlite3.DatabaseError) -> bool:
     message = str(exc).lower()
     return type(exc) is sqlite3.DatabaseError or "malformed" in message or "not a database" in message
@@ -171,6 +191,9 @@ class Store(Custody):
             if check != [("ok",)]:
                 raise _damaged(path, "; ".join(str(row[0]) for row in check[:3]))
             migrate(db, str(path))
+            tables = {row[0] for row in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+            if missing := [t for t in _TABLES if t not in tables]:
+                raise _damaged(path, f"the table {missing[0]} is missing")
         except SchemaError as exc:
             db.close() if db else None
             raise StorageError(str(exc)) from None
@@ -388,6 +411,7 @@ class Store(Custody):
 
     # -- reading ------------------------------------------------------------------------------------
 
+    @_reading
     def sessions(self) -> list[SessionSummary]:
         """Every stored session, newest first."""
         rows = self._db.execute(
@@ -406,12 +430,14 @@ class Store(Custody):
             " ORDER BY started_at DESC, rowid DESC")]
         return [self.session(i) for i in ids]
 
+    @_reading
     def outbox_waiting(self) -> tuple[int, int]:
         """Outbox rows waiting for the station, and rows it refused (parked, kept for an engineer)."""
         waiting, parked = self._db.execute(
             "SELECT COUNT(*) - COUNT(parked), COUNT(parked) FROM outbox").fetchone()
         return int(waiting), int(parked)
 
+    @_reading
     def resolve(self, ref: str) -> str:
         """A session id from a full id or a unique prefix; KeyError naming the problem otherwise."""
         rows = [r[0] for r in self._db.execute("SELECT id FROM sessions WHERE substr(id, 1, ?) = ?",
@@ -422,6 +448,7 @@ class Store(Custody):
             return rows[0]
         raise KeyError(f"no session {ref!r}" if not rows else f"{ref!r} matches {len(rows)} sessions; give more of the id")
 
+    @_reading
     def session(self, ref: str) -> StoredSession:
         """Everything stored about one session (full id or unique prefix)."""
         session_id = self.resolve(ref)
