@@ -103,14 +103,14 @@ def test_validate_and_run_refuse_invalid_unicode_written_as_an_escape(tmp_path, 
 
 def test_validate_refuses_blank_texts_and_synonyms_where_they_are(tmp_path):
     text = _questionnaire("  en: Barthel Index", '  en: "  "')
-    text = text.replace("      en: Feeding\n", '      en: " \\t "\n', 1)
-    assert '" \\t "' in text, "the first item's English text moved: update the test"
-    questionnaire = write(tmp_path, "q.yaml", text)
+    item = '      en: "Feeding: how do you manage eating?"\n'
+    assert item in text, "the first item's English text moved: update the test"
+    line = text[:text.index(item)].count("\n") + 1
+    questionnaire = write(tmp_path, "q.yaml", text.replace(item, '      en: " \\t "\n', 1))
     done = kiosk("validate", str(questionnaire), cwd=tmp_path)
     assert done.returncode == 1 and "Traceback" not in done.stderr, done
-    lines = done.stdout.splitlines()
-    assert lines[0] == f"{questionnaire}:31:7: title in 'en' is blank: write the words"
-    assert len(lines) == 2 and lines[1].startswith(f"{questionnaire}:") and "text in 'en' is blank" in lines[1]
+    assert done.stdout.splitlines() == [f"{questionnaire}:31:7: title in 'en' is blank: write the words",
+                                        f"{questionnaire}:{line}:11: items[0].text in 'en' is blank: write the words"]
 
 
 @pytest.mark.parametrize("rate", ["0", "0.4", "-1"])
