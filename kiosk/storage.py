@@ -172,7 +172,12 @@ class Store(Custody):
         date; with ``create=False`` (the tools that only read, where a mistyped directory must not
         become an empty database) a missing directory or database is a StorageError. ``options``
         are the constructor's keywords."""
-        directory = Path(data_dir).expanduser()
+        if any(not c.isprintable() for c in str(data_dir)):
+            raise StorageError(f"the data directory {str(data_dir)!r} holds a control character")
+        try:
+            directory = Path(data_dir).expanduser()
+        except RuntimeError:  # ~user for a user this machine does not have
+            raise StorageError(f"no data directory {data_dir} (no such user to expand ~ for)") from None
         path = directory / DB_NAME
         if not create:
             if not directory.is_dir():

@@ -78,6 +78,13 @@ def test_a_hostile_environment_override_is_one_line(tmp_path, variable, value, w
         one_line(kiosk(*command, cwd=tmp_path, env=env), where)
 
 
+@pytest.mark.parametrize("command", [("run", "--no-voice", "--no-remote"), ("replay", str(SCRIPT)), ("results",),
+                                     ("qos", "trace", "abc")])
+def test_a_data_dir_option_of_an_unknown_user_is_one_line(tmp_path, command):
+    one_line(kiosk(*command, "--data-dir", "~nosuchuser/x", cwd=tmp_path),
+             "no data directory ~nosuchuser/x (no such user to expand ~ for)")
+
+
 def _questionnaire(old: str, new: str) -> str:
     text = bundled_path().read_text(encoding="utf-8")
     assert text.count(old) >= 1, old
