@@ -33,7 +33,7 @@ def data_dir(tmp_path: Path) -> Path:
 def results(data: Path, *args: str) -> subprocess.CompletedProcess:
     """A real `kiosk results` process on ``data``, with no user configuration."""
     return subprocess.run([sys.executable, "-m", "kiosk", "results", "--data-dir", str(data), *args],
-                          capture_output=True, text=True, cwd=ROOT, timeout=HANG_S,
+                          capture_output=True, text=True, cwd=ROOT, timeout=HANG_S, check=False,
                           env={"PATH": "/usr/bin:/bin", "HOME": str(data.parent)})
 
 

@@ -23,7 +23,7 @@ SCRIPT = ROOT / "recordings/patients/barthel6.yaml"
 def kiosk(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
     """A real `kiosk` process with a clean environment (no user configuration)."""
     return subprocess.run([sys.executable, "-m", "kiosk", *args], capture_output=True, text=True, cwd=ROOT,
-                          timeout=HANG_S, env={"PATH": "/usr/bin:/bin", "HOME": str(cwd), **(env or {})})
+                          timeout=HANG_S, check=False, env={"PATH": "/usr/bin:/bin", "HOME": str(cwd), **(env or {})})
 
 
 def one_line(done: subprocess.CompletedProcess, where: str, stream: str = "stderr") -> str:
