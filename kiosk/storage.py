@@ -59,8 +59,9 @@ __all__ = [
 ]
 
 DB_NAME = "kiosk.sqlite3"
-#: a pseudonymous patient id: letters, digits, '-' and '_', no spaces (so not "Ann Smith")
-PATIENT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
+#: a pseudonymous patient id: letters, digits, '-' and '_', no spaces (so not "Ann Smith"); the
+#: (?!\n) keeps a final line break out, which a bare '$' lets through (the script schema's pattern)
+PATIENT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{1,63}(?!\n)$")
 #: how long a write waits for another kiosk's transaction on the same file before giving up
 BUSY_TIMEOUT_S = 10.0
 #: session-log kinds that are alerts for the ward, with the name the station protocol gives them

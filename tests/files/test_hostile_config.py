@@ -142,3 +142,14 @@ def test_a_port_glob_over_the_file_system_is_refused_at_once(tmp_path, port, whe
     config = write(tmp_path, "config.yaml", f"remote_profiles: {profiles}\n")
     one_line(kiosk("run", "--config", str(config), "--data-dir", str(tmp_path / "data"), "--no-voice",
                    cwd=tmp_path), f"{profiles}{where}")
+
+
+def test_an_id_or_language_ending_in_a_line_break_is_refused(tmp_path):
+    """A pattern ending in a bare '$' lets a final line break through: ids go into exports."""
+    item = "  - id: feeding\n"
+    text = bundled_path().read_text(encoding="utf-8")
+    line = text[:text.index(item)].count("\n") + 1
+    questionnaire = write(tmp_path, "q.yaml", text.replace(item, '  - id: "feeding\\n"\n', 1))
+    done = kiosk("validate", str(questionnaire), cwd=tmp_path)
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done
+    assert done.stdout.startswith(f"{questionnaire}:{line}:9: items[0].id: 'feeding\\n' does not match"), done.stdout
