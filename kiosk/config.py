@@ -323,8 +323,8 @@ def _path(value: object, name: str) -> Path:
     if not isinstance(value, str) or not value:
         raise ConfigError(f"{name} must be a path")
     if any(ord(c) < 32 or ord(c) == 127 for c in value) or any(0xD800 <= ord(c) <= 0xDFFF for c in value):
-        raise ConfigError(f"{name} {value!r} holds a control character or an invalid character; "
-                          "write the path on one line")
+        raise ConfigError(f"{name} {value!r} holds a control character or bytes that are not UTF-8; "
+                          "write the path on one line, in UTF-8")
     try:
         return Path(value).expanduser()
     except RuntimeError:  # no such user, or no home directory to expand ~ to

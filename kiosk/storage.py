@@ -174,7 +174,8 @@ class Store(Custody):
         become an empty database) a missing directory or database is a StorageError. ``options``
         are the constructor's keywords."""
         if any(not c.isprintable() for c in str(data_dir)):
-            raise StorageError(f"the data directory {str(data_dir)!r} holds a control character")
+            raise StorageError(f"the data directory {str(data_dir)!r} holds a control character or bytes that "
+                               "are not UTF-8")
         try:
             directory = Path(data_dir).expanduser()
         except RuntimeError:  # ~user for a user this machine does not have
