@@ -54,6 +54,7 @@ def ensure_npm_packages(js: Path = JS) -> Path:
                 if done.returncode != 0:
                     last = (done.stderr.strip() or done.stdout.strip()).splitlines()[-1:] or ["(no output)"]
                     pytest.fail(f"`npm ci` in {js} failed with exit {done.returncode}: {last[0]}", pytrace=False)
+                (js / "node_modules").mkdir(exist_ok=True)  # npm makes none for a lock without packages
                 (js / "node_modules" / STAMP.name).write_text(_lock_hash(js) + "\n", encoding="ascii")
         finally:
             fcntl.flock(lock, fcntl.LOCK_UN)
