@@ -285,7 +285,7 @@ def _read(path: Path) -> dict[str, Any]:
                     raise fail((key, setting), f"unknown fhir setting {setting!r} (known: {', '.join(FHIR_KEYS)})")
                 if not isinstance(uri, str) or not _URI.fullmatch(uri):
                     raise fail((key, setting), f"fhir {setting} must be an absolute URI without spaces or '|', "
-                                               "such as https://example.org/sid/patient")
+                                               "in ASCII, such as https://example.org/sid/patient")
             value = dict(value)
         elif key == "station":
             if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \

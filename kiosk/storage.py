@@ -122,6 +122,8 @@ def _reading(method: Callable[..., Any]) -> Callable[..., Any]:
         try:
             return method(self, *args)
         except (sqlite3.Error, ValueError, TypeError) as exc:
+            if isinstance(exc, sqlite3.OperationalError) and "locked" in str(exc):  # busy, not damaged
+                raise StorageError(f"{self.path} is busy (another kiosk is writing); try again") from None
             raise StorageError(f"{self.path} holds what this kiosk cannot read ({exc}); nothing was changed. "
                                "Keep a copy for the engineers and restore a backup") from None
     return read
