@@ -108,7 +108,9 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
                                         f"{', '.join(properties)})")
         if raw["count_on"] not in ("answers", "updates"):
             raise fail(p + ("count_on",), "count_on is 'answers' or 'updates'")
-        for key, low, top in (("below", 0, 1), ("recover_above", 0, 1), ("speech_rate", 0, 2),
+        # speech_rate: a factor on the normal rate; below half the kiosk's words would come with
+        # pauses of seconds between them (0 would stop it speaking at all)
+        for key, low, top in (("below", 0, 1), ("recover_above", 0, 1), ("speech_rate", 0.5, 2),
                               ("attempt_factor", 1, 4)):
             value = raw.get(key, 1.0)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not low <= value <= top:

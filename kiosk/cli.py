@@ -2,7 +2,9 @@
 
 The dispatcher only routes: every sub-command module exposes ``main(argv: list[str]) -> int`` and
 parses its own arguments, so adding an option never touches this file. Modules are imported
-lazily, so `kiosk validate` does not pay for Textual or the speech stack.
+lazily, so `kiosk validate` does not pay for Textual or the speech stack. Ctrl-C in any command is
+one line ("kiosk replay: interrupted") and exit status 130; what each command stores is stored in
+transactions, so an interruption leaves nothing half-written.
 """
 
 from __future__ import annotations
@@ -26,6 +28,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+#: the exit status of a command stopped by Ctrl-C (128 + SIGINT, as shells report it)
+INTERRUPTED = 130
+
+
 def _usage() -> str:
     width = max(len(name) for name in COMMANDS)
     lines = ["usage: kiosk [COMMAND] [ARGS...]", "", "commands:"]
@@ -44,10 +50,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     if name not in COMMANDS:
         print(f"kiosk: unknown command {name!r}\n\n{_usage()}", file=sys.stderr)
         return 2
-    module = importlib.import_module(COMMANDS[name][0])
-    from qos.cli import run_command
+    try:
+        module = importlib.import_module(COMMANDS[name][0])
+        from qos.cli import run_command
 
-    return run_command(lambda: int(module.main(args) or 0))
+        return run_command(lambda: int(module.main(args) or 0))
+    except KeyboardInterrupt:  # Ctrl-C: the user's choice, not a failure to explain with a traceback
+        print(f"kiosk {name}: interrupted", file=sys.stderr)
+        return INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover - `python -m kiosk.cli`

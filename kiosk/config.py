@@ -50,6 +50,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import platformdirs
 
@@ -61,19 +62,31 @@ from qos.files import BadFile, open_private, read_text
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
-_URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\s|]+$")
+#: an absolute URI of visible ASCII: no space, control character or '|' (matched whole: fullmatch)
+_URI = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*:[!-{}~]+")
+#: a station address: http(s), a host of visible ASCII (IDN names in their xn-- form), an optional path
+_STATION_URL = re.compile(r'https?://[!"$-.0->@-~]+(/[!"$->@-~]*)?')
+#: a bearer token as RFC 6750 spells it (token68): it goes verbatim into an HTTP header
+_TOKEN = re.compile(r"[A-Za-z0-9._~+/-]{1,512}=*")
 #: browser connections `kiosk serve` runs at once unless configured: each is a kiosk process
 #: of about 55 MB, and a ward kiosk has one screen
 SERVE_MAX_SESSIONS = 2
 
 
 class ConfigError(ValueError):
-    """The configuration file (or an environment override) is unusable."""
+    """The configuration file (or an environment override) is unusable.
+
+    ``setting`` is the path of the setting at fault inside its mapping (such as ``("token",)``),
+    where the file's line and column can be found."""
+
+    def __init__(self, message: str, setting: tuple[str, ...] = ()) -> None:
+        super().__init__(message)
+        self.setting = setting
 
 
 #: a kiosk's name at the station, and a site's code: letters, digits, '.', '-' and '_' (both go
 #: into exported identifiers, so no spaces, '/' or '|')
-KIOSK_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+KIOSK_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")  # fullmatch: '$' would let a final newline in
 
 
 def default_kiosk_id() -> str:
@@ -184,7 +197,7 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     overrides = {"KIOSK_DATA_DIR": "data_dir", "KIOSK_LANGUAGE": "language", "KIOSK_VOSK_MODEL": "vosk_model"}
     for var, key in overrides.items():
         if env.get(var):
-            values[key] = Path(env[var]).expanduser() if key in _PATHS else env[var]
+            values[key] = _path(env[var], var) if key in _PATHS else env[var]
     station = values.get("station") or {}
     # one kiosk id for exports and the station: kiosk_id, or station.kiosk_id, never two different ones
     if station.get("kiosk_id") and values.get("kiosk_id", station["kiosk_id"]) != station["kiosk_id"]:
@@ -223,9 +236,10 @@ def _read(path: Path) -> dict[str, Any]:
         if key not in _KEYS:
             raise fail((key,), f"unknown setting {key!r} (known: {', '.join(sorted(_KEYS))})")
         if key in _PATHS:
-            if not isinstance(value, str) or not value:
-                raise fail((key,), f"{key} must be a path")
-            value = Path(value).expanduser()
+            try:
+                value = _path(value, key)
+            except ConfigError as exc:
+                raise fail((key,), str(exc)) from None
             if not value.is_absolute():  # relative paths are relative to the config file
                 value = path.parent / value
         elif key in _BOOLS:
@@ -261,17 +275,17 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
         elif key == "language" and (not isinstance(value, str) or value not in SCREEN_LANGUAGES):
             raise fail((key,), f"language must be one of {', '.join(SCREEN_LANGUAGES)}")
-        elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.match(value)):
+        elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.fullmatch(value)):
             raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
         elif key == "fhir":
             if not isinstance(value, dict):
                 raise fail((key,), "fhir must be a mapping such as {patient_system: https://example.org/sid/patient}")
-            for name, uri in value.items():
-                if name not in FHIR_KEYS:
-                    raise fail((key, name), f"unknown fhir setting {name!r} (known: {', '.join(FHIR_KEYS)})")
-                if not isinstance(uri, str) or not _URI.match(uri):
-                    raise fail((key, name), f"fhir {name} must be an absolute URI without spaces or '|', "
-                                            "such as https://example.org/sid/patient")
+            for setting, uri in value.items():  # not `name`: that is the file's, which fail() names
+                if setting not in FHIR_KEYS:
+                    raise fail((key, setting), f"unknown fhir setting {setting!r} (known: {', '.join(FHIR_KEYS)})")
+                if not isinstance(uri, str) or not _URI.fullmatch(uri):
+                    raise fail((key, setting), f"fhir {setting} must be an absolute URI without spaces or '|', "
+                                               "in ASCII, such as https://example.org/sid/patient")
             value = dict(value)
         elif key == "station":
             if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \
@@ -280,7 +294,8 @@ def _read(path: Path) -> dict[str, Any]:
             try:
                 _station(value, "station")
             except ConfigError as exc:
-                raise fail((key,), str(exc)) from None
+                line, col = positions.of((key, *exc.setting))
+                raise ConfigError(str(Problem(name, line, col, str(exc)))) from None
         elif key == "interrupt_after_minutes":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
@@ -302,20 +317,50 @@ def _read(path: Path) -> dict[str, Any]:
     return values
 
 
+def _path(value: object, name: str) -> Path:
+    """A path setting, ``~`` and ``~user`` expanded; ConfigError for one no command could use (not
+    text, empty, a control character such as a line break or NUL, or an unknown user's ``~``)."""
+    if not isinstance(value, str) or not value:
+        raise ConfigError(f"{name} must be a path")
+    if any(ord(c) < 32 or ord(c) == 127 for c in value) or any(0xD800 <= ord(c) <= 0xDFFF for c in value):
+        raise ConfigError(f"{name} {value!r} holds a control character or bytes that are not UTF-8; "
+                          "write the path on one line, in UTF-8")
+    try:
+        return Path(value).expanduser()
+    except RuntimeError:  # no such user, or no home directory to expand ~ to
+        user = value[1:].split("/", 1)[0]
+        raise ConfigError(f"{name} {value!r}: " + (f"there is no user {user!r} to expand ~{user} for" if user
+                                                   else "there is no home directory to expand ~ to")) from None
+
+
 def _station(values: Mapping[str, str], where: str) -> Station | None:
     """The station settings, checked; None without a url (a token alone is harmless)."""
     url = values.get("url", "")
     if not url:
         return None
-    if not re.match(r"^https?://[^\s/?#]+(/[^\s?#]*)?$", url):
-        raise ConfigError(f"{where}: url {url!r} must be an http:// or https:// address such as "
-                          "https://ward.example:8443")
-    if not values.get("token"):
+    if not _STATION_URL.fullmatch(url):
+        raise ConfigError(f"{where}: url {url!r} must be an http:// or https:// address of visible ASCII "
+                          "characters (no spaces, line breaks or query) such as https://ward.example:8443",
+                          ("url",))
+    try:
+        port = urlsplit(url).port
+    except ValueError:  # not digits, or past 65535
+        port = 0
+    if port == 0 or not urlsplit(url).hostname:
+        raise ConfigError(f"{where}: url {url!r} needs a host and, if it names a port, one from 1 to 65535",
+                          ("url",))
+    token = values.get("token")
+    if not token:
         raise ConfigError(f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
-                          "the station issues it with `kiosk station add-kiosk NAME`)")
+                          "the station issues it with `kiosk station add-kiosk NAME`)", ("url",))
+    if not _TOKEN.fullmatch(token):
+        raise ConfigError(f"{where}: the token is not one the station issues (letters, digits and -._~+/ only; "
+                          "no spaces or line breaks): copy it again from `kiosk station add-kiosk NAME`",
+                          ("token",))
     kiosk_id = values.get("kiosk_id") or default_kiosk_id()
-    if not KIOSK_ID.match(kiosk_id):
-        raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'")
+    if not KIOSK_ID.fullmatch(kiosk_id):
+        raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'",
+                          ("kiosk_id",))
     return Station(url.rstrip("/"), values["token"], kiosk_id)
 
 

@@ -9,11 +9,17 @@ After :data:`FREE_FAILURES` wrong PINs in a row each further attempt must wait, 
 time (:data:`FIRST_DELAY_S`, doubling, at most :data:`MAX_DELAY_S`); after :data:`LOCKOUT_FAILURES`
 the PIN pad is locked for :data:`LOCKOUT_S`. A right PIN clears the count. Through the served page
 this turns 12 guesses a second into about 20 guesses an hour.
+
+The count is the data directory's, not the process's: every kiosk process on one data directory (a
+`kiosk run` and the served page's `kiosk serve` sessions) reads, checks and updates it under one
+exclusive file lock (:data:`LOCK_FILE`), so two processes together get no more guesses than one.
 """
 
 from __future__ import annotations
 
 import base64
+import contextlib
+import fcntl
 import hashlib
 import hmac
 import json
@@ -21,7 +27,7 @@ import math
 import os
 import secrets
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,6 +46,8 @@ MAX_DELAY_S = 300.0
 LOCKOUT_FAILURES = 10
 LOCKOUT_S = 3600.0
 STATE_FILE = "pin_lockout.json"
+#: held (flock, exclusive) while a process reads, checks and rewrites the count
+LOCK_FILE = "pin_lockout.lock"
 LOG_FILE = "security.log"
 
 
@@ -119,7 +127,10 @@ class PinGuard:
         self.secret = secret
         self._dir = Path(data_dir) if data_dir is not None else None
         self._now = now
-        self.failures, self.not_before = self._load()
+        #: the count as last read from the data directory (another process may have moved it since)
+        self.failures, self.not_before = 0, 0.0
+        with self._shared_count():
+            pass
 
     @property
     def is_default(self) -> bool:
@@ -141,28 +152,47 @@ class PinGuard:
         return None
 
     def wait_left(self) -> float:
-        """Seconds before the next attempt is checked (0: now)."""
-        return max(0.0, self.not_before - self._now())
+        """Seconds before the next attempt is checked (0: now), by the data directory's count."""
+        with self._shared_count():
+            return max(0.0, self.not_before - self._now())
 
     def attempt(self, pin: str) -> Verdict:
-        """Check one attempt; a failure is counted, logged and delays the next."""
-        if (left := self.wait_left()) > 0:
-            return Verdict(False, left, locked=self.failures >= LOCKOUT_FAILURES, early=True)
-        if matches(self.secret, pin):
-            if self.failures:
-                self._log("pin_accepted", f"after {self.failures} failed attempts")
-            self.failures, self.not_before = 0, 0.0
+        """Check one attempt; a failure is counted, logged and delays the next. The whole
+        read-check-write holds the data directory's lock, so attempts of other processes wait."""
+        with self._shared_count():
+            if (left := max(0.0, self.not_before - self._now())) > 0:
+                return Verdict(False, left, locked=self.failures >= LOCKOUT_FAILURES, early=True)
+            if matches(self.secret, pin):
+                if self.failures:
+                    self._log("pin_accepted", f"after {self.failures} failed attempts")
+                self.failures, self.not_before = 0, 0.0
+                self._save()
+                return Verdict(True)
+            self.failures += 1
+            delay = self._delay(self.failures)
+            self.not_before = self._now() + delay
             self._save()
-            return Verdict(True)
-        self.failures += 1
-        delay = self._delay(self.failures)
-        self.not_before = self._now() + delay
-        self._save()
-        locked = self.failures >= LOCKOUT_FAILURES
-        self._log("pin_failed", f"failure {self.failures} in a row; next attempt in {delay:g} s")
-        if locked:
-            self._log("pin_locked", f"{self.failures} failures in a row: the PIN pad is locked for {delay:g} s")
-        return Verdict(False, delay, locked=locked)
+            locked = self.failures >= LOCKOUT_FAILURES
+            self._log("pin_failed", f"failure {self.failures} in a row; next attempt in {delay:g} s")
+            if locked:
+                self._log("pin_locked", f"{self.failures} failures in a row: the PIN pad is locked for {delay:g} s")
+            return Verdict(False, delay, locked=locked)
+
+    @contextlib.contextmanager
+    def _shared_count(self) -> Iterator[None]:
+        """Hold the data directory's PIN lock and read the count into ``failures``/``not_before``
+        (in memory only without a data directory)."""
+        if self._dir is None:
+            yield
+            return
+        self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
+        descriptor = os.open(self._dir / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o600)
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX)
+            self.failures, self.not_before = self._load()
+            yield
+        finally:
+            os.close(descriptor)  # closing releases the lock
 
     @staticmethod
     def _delay(failures: int) -> float:
@@ -179,9 +209,12 @@ class PinGuard:
             state = load_json(read_text(self._dir / STATE_FILE, 4096), STATE_FILE)
             failures, not_before = int(state["failures"]), float(state["not_before"])
         except (BadFile, KeyError, TypeError, ValueError):
-            # a damaged count must not open the pad: treat it as a lockout starting now
+            # a damaged count must not open the pad: treat it as a lockout starting now, written
+            # back so that every process (and every later read) sees the same lockout
             self._log("pin_state_damaged", "the failure count could not be read; locking the PIN pad")
-            return LOCKOUT_FAILURES, self._now() + LOCKOUT_S
+            self.failures, self.not_before = LOCKOUT_FAILURES, self._now() + LOCKOUT_S
+            self._save()
+            return self.failures, self.not_before
         # a clock set back must not shorten a lockout by more than its own length
         return max(0, failures), min(not_before, self._now() + LOCKOUT_S)
 

@@ -413,10 +413,12 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
         for lang in languages:
             if lang not in value:
                 add(path, f"{describe(path)} has no {lang!r} translation")
-        for lang in value:
+        for lang, text in value.items():
             if languages and lang not in languages:
                 add(path + (lang,), f"{describe(path)} has a {lang!r} text but {lang!r} is not in 'languages'",
                     key=True)
+            if isinstance(text, str) and text and not text.strip():  # "" is the schema's to report
+                add(path + (lang,), f"{describe(path)} in {lang!r} is blank: write the words")
 
     texts(("title",), data.get("title"))
     messages = data.get("messages")
@@ -430,9 +432,12 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             texts(path + (i, "label"), option.get("label"))
             texts(path + (i, "patient"), option.get("patient"))
             synonyms = option.get("synonyms")
-            for lang in (synonyms if isinstance(synonyms, dict) else ()):
+            for lang, words in (synonyms.items() if isinstance(synonyms, dict) else ()):
                 if languages and lang not in languages:
                     add(path + (i, "synonyms", lang), f"synonyms in {lang!r}, which is not in 'languages'", key=True)
+                for n, word in enumerate(words if isinstance(words, list) else ()):
+                    if isinstance(word, str) and word and not word.strip():
+                        add(path + (i, "synonyms", lang, n), f"a synonym in {lang!r} is blank: write the words")
             answer_code = option.get("code")
             if isinstance(answer_code, dict):
                 key = (answer_code.get("system"), answer_code.get("code"))

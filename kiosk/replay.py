@@ -541,6 +541,11 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
         driver.run()
         trace = Trace.from_events(reference, session.trace)
         summary = replay(trace, model=model)
+    except KeyboardInterrupt:
+        if store is not None:
+            # Ctrl-C mid-script: the half-replayed patient is closed, never left for anyone to resume
+            store.abandon(session.id)
+        raise
     except (ScriptError, QosError) as exc:
         if store is not None:
             # a scripted patient that went wrong must not be offered for resuming at the kiosk

@@ -33,6 +33,7 @@ never with the questionnaire file or configuration current when they run.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import re
@@ -70,8 +71,9 @@ __all__ = [
 ]
 
 DB_NAME = "kiosk.sqlite3"
-#: a pseudonymous patient id: letters, digits, '-' and '_', no spaces (so not "Ann Smith")
-PATIENT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
+#: a pseudonymous patient id: letters, digits, '-' and '_', no spaces (so not "Ann Smith"); the
+#: (?!\n) keeps a final line break out, which a bare '$' lets through (the script schema's pattern)
+PATIENT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{1,63}(?!\n)$")
 #: how long a write waits for another kiosk's transaction on the same file before giving up
 BUSY_TIMEOUT_S = 10.0
 #: session-log kinds that are alerts for the ward, with the name the station protocol gives them
@@ -116,6 +118,27 @@ def _damaged(path: Path, exc: BaseException | str) -> StorageError:
         f"{path} is damaged ({exc}); nothing was changed. Stop the kiosk, keep a copy of {path.name} "
         f"(and {path.name}-wal, -shm if present) for the engineers, then move them out of {path.parent} "
         "and restore a backup, or start with an empty database")
+
+
+#: the tables every database of this schema has (a dropped one is damage, found at open)
+_TABLES = ("patients", "sessions", "answers", "not_answered", "practice", "contexts", "metric_samples",
+           "adaptations", "events", "leases", "outbox", "definitions")
+
+
+def _reading(method: Callable[..., Any]) -> Callable[..., Any]:
+    """A reading method whose rows this code cannot read (a value no kiosk writes, such as an
+    unknown channel, or SQL that fails on an edited file) raises one StorageError naming the
+    database, instead of a traceback from deep inside. KeyError (no such session) passes."""
+    @functools.wraps(method)
+    def read(self: Store, *args: Any) -> Any:
+        try:
+            return method(self, *args)
+        except (sqlite3.Error, ValueError, TypeError) as exc:
+            if isinstance(exc, sqlite3.OperationalError) and "locked" in str(exc):  # busy, not damaged
+                raise StorageError(f"{self.path} is busy (another kiosk is writing); try again") from None
+            raise StorageError(f"{self.path} holds what this kiosk cannot read ({exc}); nothing was changed. "
+                               "Keep a copy for the engineers and restore a backup") from None
+    return read
 
 
 def _is_damage(exc: sqlite3.DatabaseError) -> bool:
@@ -170,7 +193,13 @@ class Store(Custody):
         date; with ``create=False`` (the tools that only read, where a mistyped directory must not
         become an empty database) a missing directory or database is a StorageError. ``options``
         are the constructor's keywords."""
-        directory = Path(data_dir).expanduser()
+        if any(not c.isprintable() for c in str(data_dir)):
+            raise StorageError(f"the data directory {str(data_dir)!r} holds a control character or bytes that "
+                               "are not UTF-8")
+        try:
+            directory = Path(data_dir).expanduser()
+        except RuntimeError:  # ~user for a user this machine does not have
+            raise StorageError(f"no data directory {data_dir} (no such user to expand ~ for)") from None
         in_force = options.setdefault("in_force", bundled_in_force(options.get("export") or {},
                                                                 options.get("wall", time.time)))
         path = directory / DB_NAME
@@ -191,6 +220,9 @@ class Store(Custody):
             if check != [("ok",)]:
                 raise _damaged(path, "; ".join(str(row[0]) for row in check[:3]))
             migrate(db, str(path), in_force)
+            tables = {row[0] for row in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+            if missing := [t for t in _TABLES if t not in tables]:
+                raise _damaged(path, f"the table {missing[0]} is missing")
         except SchemaError as exc:
             db.close() if db else None
             raise StorageError(str(exc)) from None
@@ -418,6 +450,7 @@ class Store(Custody):
 
     # -- reading ------------------------------------------------------------------------------------
 
+    @_reading
     def sessions(self) -> list[SessionSummary]:
         """Every stored session, newest first."""
         rows = self._db.execute(
@@ -436,12 +469,14 @@ class Store(Custody):
             " ORDER BY started_at DESC, rowid DESC")]
         return [self.session(i) for i in ids]
 
+    @_reading
     def outbox_waiting(self) -> tuple[int, int]:
         """Outbox rows waiting for the station, and rows it refused (parked, kept for an engineer)."""
         waiting, parked = self._db.execute(
             "SELECT COUNT(*) - COUNT(parked), COUNT(parked) FROM outbox").fetchone()
         return int(waiting), int(parked)
 
+    @_reading
     def resolve(self, ref: str) -> str:
         """A session id from a full id or a unique prefix; KeyError naming the problem otherwise."""
         rows = [r[0] for r in self._db.execute("SELECT id FROM sessions WHERE substr(id, 1, ?) = ?",
@@ -452,6 +487,7 @@ class Store(Custody):
             return rows[0]
         raise KeyError(f"no session {ref!r}" if not rows else f"{ref!r} matches {len(rows)} sessions; give more of the id")
 
+    @_reading
     def session(self, ref: str) -> StoredSession:
         """Everything stored about one session (full id or unique prefix)."""
         session_id = self.resolve(ref)

@@ -132,6 +132,25 @@ def read_text(path: str | Path, limit: int = MAX_BYTES) -> str:
                               f"not UTF-8 text (byte 0x{data[exc.start]:02x}); save the file as UTF-8")) from None
 
 
+#: characters no text of the project may hold, even written as an escape ("\\ud800", "\\x00",
+#: "\\e"): lone surrogates (not characters: they cannot be encoded, printed or stored), control
+#: characters other than tab and line breaks, and the two non-characters; the same set YAML refuses
+#: when written raw
+_BAD_CHARACTER = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x84\x86-\x9f\ud800-\udfff\ufffe\uffff]")
+
+
+def bad_character(text: str) -> str | None:
+    """What is wrong with ``text`` if it holds a character no file may (see :data:`_BAD_CHARACTER`),
+    as the end of a sentence naming the character; None when it holds none."""
+    found = _BAD_CHARACTER.search(text)
+    if found is None:
+        return None
+    code = ord(found.group())
+    kind = "a lone surrogate, not a character" if 0xD800 <= code <= 0xDFFF else \
+        "a non-character" if code >= 0xFFFE else "a control character"
+    return f"holds U+{code:04X}, {kind}; remove it"
+
+
 class _BoundedComposer(Composer):
     """PyYAML's safe loader, composing under limits: nesting depth, values after alias expansion,
     digits of an integer, and no NaN or infinity (no file of the project has a use for them).
@@ -168,6 +187,8 @@ class _BoundedComposer(Composer):
             size, height = self._sizes[id(node)]
         elif isinstance(node, yaml.ScalarNode):
             self._check_number(node)
+            if (problem := bad_character(node.value)) is not None:
+                raise self.fail(node.start_mark, f"the text {problem}")
             size, height = 1, 0
         else:
             children = [self._sizes[id(child)] for pair in node.value
@@ -219,7 +240,8 @@ _FastComposer = type("_FastComposer", (_BoundedComposer, yaml.CSafeLoader), {}) 
 def compose_yaml(text: str, name: str) -> yaml.Node | None:
     """The node tree of one YAML document (None when empty), with its marks; :class:`BadFile` for a
     syntax error, duplicate keys, nesting deeper than :data:`MAX_DEPTH`, aliases expanding past
-    :data:`MAX_NODES` values, integers of more than :data:`MAX_DIGITS` digits, NaN or infinity."""
+    :data:`MAX_NODES` values, integers of more than :data:`MAX_DIGITS` digits, NaN or infinity, or
+    a text holding a lone surrogate or control character (:func:`bad_character`), escaped or not."""
     if len(text) > MAX_YAML_BYTES:
         raise BadFile(Problem(name, 1, 1, f"the file is larger than {MAX_YAML_BYTES // 1024} KB of YAML; "
                                           "is it the right file?"))
@@ -313,6 +335,8 @@ def _scan_json(text: str, name: str) -> None:
             if objects:
                 objects.pop()
         elif kind.startswith('"'):
+            if "\\" in kind and (problem := bad_character(_json_string(kind))) is not None:
+                raise fail(f"the text {problem}")
             keys = objects[-1] if objects else None
             if keys is not None and _COLON.match(text, token.end()):
                 if kind in keys:
@@ -325,9 +349,18 @@ def _scan_json(text: str, name: str) -> None:
                 raise fail(str(exc)) from None
 
 
+def _json_string(token: str) -> str:
+    """A JSON string token's text ('' for a malformed one: json.loads reports it, with its place)."""
+    try:
+        return json.loads(token)
+    except ValueError:
+        return ""
+
+
 def load_json(text: str, name: str) -> Any:
     """A JSON document's value; :class:`BadFile` for a syntax error, duplicate keys, nesting deeper
-    than :data:`MAX_DEPTH`, integers of more than :data:`MAX_DIGITS` digits, NaN or infinity."""
+    than :data:`MAX_DEPTH`, integers of more than :data:`MAX_DIGITS` digits, NaN or infinity, or an
+    escape of a lone surrogate or control character (:func:`bad_character`)."""
     _scan_json(text, name)
     try:
         return json.loads(text, parse_float=_finite, parse_int=_bounded_int, parse_constant=_refuse_constant)

@@ -260,6 +260,27 @@ def _build(fields: _Fields) -> Profile:
     return _build_keyboard(fields, common)
 
 
+#: path components a serial port's pattern may have under /dev (/dev/serial/by-id/usb-* is three)
+MAX_PORT_DEPTH = 4
+
+
+def port_problem(port: str) -> str | None:
+    """Why ``port`` cannot be a serial port's path or glob, or None. A port is a device file:
+    an absolute path under /dev, at most :data:`MAX_PORT_DEPTH` components deep, without '..',
+    '**', spaces or control characters. Why: the kiosk globs it on every connection attempt, and
+    ``/**/*`` walked the whole file system (11-15 s each time)."""
+    parts = port.split("/")
+    if not port.startswith("/dev/") or port == "/dev/":
+        return f"must be a device path under /dev such as /dev/ttyUSB0 or /dev/ttyUSB*, got {port!r}"
+    if any(c.isspace() or not c.isprintable() for c in port):
+        return f"may not hold spaces or control characters, got {port!r}"
+    if ".." in parts or "**" in port:
+        return f"may not hold '..' or '**' (one '*' matches within a name), got {port!r}"
+    if len(parts) - 2 > MAX_PORT_DEPTH or "" in parts[2:]:
+        return f"must be at most {MAX_PORT_DEPTH} names below /dev, without '//' or a final '/', got {port!r}"
+    return None
+
+
 def _build_serial(fields: _Fields, common: dict[str, Any]) -> SerialProfile:
     max_line = fields.integer("max_line", 64, low=1, high=4096)
     lines: dict[str, Button] = {}
@@ -272,8 +293,11 @@ def _build_serial(fields: _Fields, common: dict[str, Any]) -> SerialProfile:
         if len(text.encode("utf-8")) > max_line:
             raise fields.fail("lines", f"is longer than max_line ({max_line} bytes)", sub)
         lines[text] = fields.button("lines", value, sub)
+    port = fields.text("port")
+    if (problem := port_problem(port)) is not None:
+        raise fields.fail("port", problem)
     return SerialProfile(
-        port=fields.text("port"),
+        port=port,
         baud=fields.integer("baud", 9600, low=1),
         lines=lines,
         max_line=max_line,

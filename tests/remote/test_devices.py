@@ -51,15 +51,16 @@ def test_devices_lists_every_kind_and_what_the_kiosk_would_use(capsys):
 def test_devices_shows_which_port_a_site_profile_would_take(tmp_path, capsys):
     box = ButtonBox(tmp_path / "ttyUSB-test0")
     site = tmp_path / "site.yaml"
-    site.write_text(f"profiles:\n  - name: serial-usb\n    port: {tmp_path}/ttyUSB-test*\n")
+    port = box.slave_name  # a profile's port is under /dev: the box's own pty
+    site.write_text(f"profiles:\n  - name: serial-usb\n    port: {port}\n")
     try:
         assert main(["devices", "--profiles", str(site)]) == 0
     finally:
         box.unplug()
     out = capsys.readouterr().out
     assert f"Remote profiles (built-in devices.yaml + {site}):" in out
-    assert f"serial-usb: serial {tmp_path}/ttyUSB-test* at 9600 baud -> would use {box.link}" in out
-    assert f"{box.link} -> remote, profile serial-usb" in section(out, "Serial ports:")
+    assert f"serial-usb: serial {port} at 9600 baud -> would use {port}" in out
+    assert f"{port} -> remote, profile serial-usb" in section(out, "Serial ports:")
 
 
 def test_the_site_file_named_in_the_config_is_used(tmp_path, capsys, monkeypatch):

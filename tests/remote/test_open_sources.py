@@ -13,12 +13,13 @@ from .boxes import ButtonBox, Collector
 
 def test_each_source_reports_its_own_state_and_the_connected_one_delivers(tmp_path):
     site = tmp_path / "site.yaml"
-    # keep the test off any real /dev/ttyUSB*/ttyACM* the machine may have
-    site.write_text(f"profiles:\n  - name: serial-usb\n    port: {tmp_path}/ttyUSB-test*\n"
-                    f"  - name: serial-acm\n    port: {tmp_path}/ttyACM-test*\n")
     box = ButtonBox(tmp_path / "ttyUSB-test0")
+    # keep the test off any real /dev/ttyUSB*/ttyACM* the machine may have: the box's own pty, and
+    # a pattern under /dev that matches nothing
+    site.write_text(f"profiles:\n  - name: serial-usb\n    port: {box.slave_name}\n"
+                    f"  - name: serial-acm\n    port: /dev/ttyACM-kiosk-test*\n")
     sources = open_sources(site, backoff=Backoff(0.01, 2, 0.05))
-    assert [s.name for s in sources] == [f"serial {tmp_path}/ttyUSB-test*", f"serial {tmp_path}/ttyACM-test*",
+    assert [s.name for s in sources] == [f"serial {box.slave_name}", "serial /dev/ttyACM-kiosk-test*",
                                          "hid 1209:0001"]
     sink = Collector()
     for source in sources:

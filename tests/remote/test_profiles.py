@@ -77,6 +77,16 @@ profiles:
         ("profiles: [\n", ":2:1: YAML syntax: expected the node content"),
         ("profiles:\n  - name: serial-usb\n    baud: 1\n    baud: 2\n", ":4:5: duplicate key 'baud'"),
         ("- just a list\n", "expected a mapping with one key, 'profiles'"),
+        # a port is globbed on every connection attempt: /**/* walked the whole file system
+        ("profiles:\n  - name: serial-usb\n    port: /**/*\n",
+         ":3:5: profile 'serial-usb', field 'port': must be a device path under /dev"),
+        ("profiles:\n  - name: serial-usb\n    port: /dev/**\n",
+         ":3:5: profile 'serial-usb', field 'port': may not hold '..' or '**'"),
+        ("profiles:\n  - name: serial-usb\n    port: /dev/../etc/*\n", "field 'port': may not hold '..' or '**'"),
+        ("profiles:\n  - name: serial-usb\n    port: ttyUSB0\n", "field 'port': must be a device path under /dev"),
+        ("profiles:\n  - name: serial-usb\n    port: /dev/*/*/*/*/*\n", "field 'port': must be at most 4 names"),
+        ("profiles:\n  - name: serial-usb\n    port: \"/dev/tty\\nUSB0\"\n",
+         "field 'port': may not hold spaces or control characters"),
     ],
 )
 def test_a_mistake_is_one_message_naming_file_profile_and_field(tmp_path, text, message):

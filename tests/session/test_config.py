@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -57,6 +58,15 @@ def test_bad_environment(tmp_path, monkeypatch):
         load_config(environ={"KIOSK_CONFIG": str(tmp_path / "missing.yaml")})
     with pytest.raises(ConfigError, match="language 'de' is not one of en, es, fr"):
         load_config(environ={"KIOSK_CONFIG": "", "KIOSK_LANGUAGE": "de"})
+    with pytest.raises(ConfigError, match="^KIOSK_DATA_DIR '~nosuchuser/x': there is no user 'nosuchuser'"):
+        load_config(environ={"KIOSK_DATA_DIR": "~nosuchuser/x"})
+    with pytest.raises(ConfigError, match="^" + re.escape("KIOSK_DATA_DIR '/tmp/a\\nb' holds a control character")):
+        load_config(environ={"KIOSK_DATA_DIR": "/tmp/a\nb"})
+    station = {"KIOSK_STATION_URL": "http://127.0.0.1:8443", "KIOSK_STATION_TOKEN": "abc"}
+    with pytest.raises(ConfigError, match="^KIOSK_STATION_URL: the token is not one the station issues"):
+        load_config(environ={**station, "KIOSK_STATION_TOKEN": "ab\ncd"})
+    with pytest.raises(ConfigError, match="^KIOSK_STATION_URL: url 'http://127.0.0.1:65536' needs a host"):
+        load_config(environ={**station, "KIOSK_STATION_URL": "http://127.0.0.1:65536"})
 
 
 def test_clocks():
@@ -111,11 +121,33 @@ def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypa
 
 
 @pytest.mark.parametrize(("text", "message"), [
-    ("station: {url: 'ftp://x', token: a}\n", ":1:1: station: url 'ftp://x' must be an http:// or https://"),
-    ("station: {url: 'http://x:1'}\n", ":1:1: station: a token is needed with the url"),
-    ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:1: station: kiosk_id 'bed 2' must be"),
+    ("station: {url: 'ftp://x', token: a}\n", ":1:16: station: url 'ftp://x' must be an http:// or https://"),
+    ("station: {url: 'http://x:1'}\n", ":1:16: station: a token is needed with the url"),
+    ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:50: station: kiosk_id 'bed 2' must be"),
     ("station: {url: 'http://x:1', tokn: a}\n", ":1:1: station must be a mapping"),
     ("interrupt_after_minutes: 0\n", ":1:1: interrupt_after_minutes must be a number of minutes"),
+    # ports out of range, no host, control characters in the url, the token or an id (real
+    # processes: tests/files/test_hostile_config.py)
+    ("station: {url: 'http://127.0.0.1:99999', token: a}\n", ":1:16: station: url 'http://127.0.0.1:99999' needs"),
+    ("station: {url: 'http://127.0.0.1:0', token: a}\n", ":1:16: station: url 'http://127.0.0.1:0' needs a host"),
+    ("station: {url: 'http://127.0.0.1:-1', token: a}\n", ":1:16: station: url 'http://127.0.0.1:-1' needs"),
+    ("station: {url: 'https://:8443', token: a}\n", ":1:16: station: url 'https://:8443' needs a host"),
+    ("station: {url: 'http://x:8443x', token: a}\n", ":1:16: station: url 'http://x:8443x' needs a host"),
+    ('station: {url: "http://x:1\\r\\nX-Evil: 1", token: a}\n', ":1:16: station: url 'http://x:1\\r\\nX-Evil: 1' must"),
+    ('station: {url: "http://x:1\\n", token: a}\n', ":1:16: station: url 'http://x:1\\n' must be an http://"),
+    ('station: {url: "http://wärd:1", token: a}\n', ":1:16: station: url 'http://wärd:1' must be an http://"),
+    ('station:\n  url: "http://x:1"\n  token: "ab\\ncd"\n', ":3:10: station: the token is not one the station"),
+    ('station: {url: "http://x:1", token: "ab cd"}\n', ":1:37: station: the token is not one the station issues"),
+    ('station: {url: "http://x:1", token: "ab\\u0085"}\n', ":1:37: station: the token is not one the station"),
+    ('station: {url: "http://x:1", token: a, kiosk_id: "bed2\\n"}\n', ":1:50: station: kiosk_id 'bed2\\n' must be"),
+    ('kiosk_id: "ward3\\n"\n', ":1:1: kiosk_id must be 1-64 letters"),
+    ('site: "north\\n"\n', ":1:1: site must be 1-64 letters"),
+    ('fhir: {patient_system: "https://h.example/p\\n"}\n', ":1:8: fhir patient_system must be an absolute URI"),
+    ("data_dir: ~nosuchuser/x\n", ":1:1: data_dir '~nosuchuser/x': there is no user 'nosuchuser' to expand"),
+    ("questionnaire: ~nosuchuser\n", ":1:1: questionnaire '~nosuchuser': there is no user 'nosuchuser'"),
+    ('vosk_model: "/opt/vosk\\nmodel"\n', ":1:1: vosk_model '/opt/vosk\\nmodel' holds a control character"),
+    ('data_dir: "/tmp/a\\0b"\n', ":1:11: the text holds U+0000, a control character"),
+    ('language: "\\ud800"\n', ":1:11: the text holds U+D800, a lone surrogate"),
 ])
 def test_bad_station_settings_say_where(tmp_path, text, message):
     path = tmp_path / "config.yaml"

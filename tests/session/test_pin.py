@@ -80,6 +80,41 @@ def test_failures_grow_the_delay_then_lock_and_a_restart_does_not_reset_them(tmp
         assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o600
 
 
+GUESSER = """
+import sys
+from kiosk.pin import PinGuard
+# a kiosk process's PIN pad on the shared data directory; its wall clock stands still, so no wait
+# ever runs out and every attempt after the free ones must come back early, unchecked
+guard = PinGuard(sys.argv[2], sys.argv[1], now=lambda: 1_800_000_000.0)
+print("ready", guard.failures, flush=True)
+sys.stdin.readline()
+verdicts = [guard.attempt("000000") for _ in range(int(sys.argv[3]))]
+print(sum(not v.early for v in verdicts), flush=True)
+"""
+
+
+def test_two_kiosk_processes_on_one_data_directory_share_one_failure_count(tmp_path):
+    secret, tries = hash_pin("482193"), 2 * FREE_FAILURES + 2
+    guessers = [subprocess.Popen([sys.executable, "-c", GUESSER, str(tmp_path), secret, str(tries)],
+                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    try:
+        # both have read the count (0) before either guesses: a count kept per process stays there
+        assert [g.stdout.readline().split() for g in guessers] == [["ready", "0"]] * 2
+        for guesser in guessers:  # go, both at once
+            guesser.stdin.write("go\n")
+            guesser.stdin.flush()
+        checked = [int(g.stdout.readline()) for g in guessers]
+    finally:
+        for guesser in guessers:
+            guesser.stdin.close()
+            guesser.wait(timeout=60)
+    # together they got the free guesses of one kiosk, not one set each (it was 2 x 3)
+    assert sum(checked) == FREE_FAILURES, checked
+    assert json.loads((tmp_path / STATE_FILE).read_text())["failures"] == FREE_FAILURES
+    log = [json.loads(line)["event"] for line in (tmp_path / LOG_FILE).read_text().splitlines()]
+    assert log.count("pin_failed") == FREE_FAILURES
+
+
 def test_a_damaged_failure_count_locks_instead_of_opening(tmp_path):
     (tmp_path / STATE_FILE).write_text('{"failures": "many"')
     guard = PinGuard("482193", tmp_path, now=WallClock())

@@ -208,3 +208,19 @@ def test_a_scripted_patient_named_by_name_is_rejected_where_it_is_written(tmp_pa
     # the script schema and the store accept the same ids
     schema = json.loads((ROOT / "kiosk/patient.schema.json").read_text())
     assert schema["properties"]["patient"]["pattern"] == PATIENT_ID.pattern
+
+
+@pytest.mark.parametrize("data_dir", [False, True])
+def test_a_patient_id_ending_in_a_line_break_is_rejected(tmp_path, capsys, data_dir):
+    from kiosk.storage import PATIENT_ID
+
+    assert PATIENT_ID.match("P-T1") and not PATIENT_ID.match("P-T1\n")  # a bare '$' let this through
+    path = write(tmp_path, GOOD.replace("patient: P-T1", 'patient: "P-T1\\n"'))
+    extra = ["--data-dir", str(tmp_path / "data")] if data_dir else []
+    assert main([str(path), *extra]) == 2
+    assert capsys.readouterr().err.startswith(f"{path}:1:10: patient: 'P-T1\\n' does not match")
+    if data_dir:
+        from kiosk.storage import Store
+
+        with Store.open(tmp_path / "data", create=False) as store:
+            assert store.sessions() == []  # nothing of the script was stored

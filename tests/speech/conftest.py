@@ -10,7 +10,7 @@ from kiosk.speech.tts import Synthesiser
 
 
 @pytest.fixture(scope="session")
-def spoken(tmp_path_factory):
+def spoken(tmp_path_factory, espeak_ng):
     """say(text, language) → a WAV of the kiosk's own espeak-ng synthesiser saying it at its
     default rate (cached for the session): the answers a patient speaks in these tests."""
     folder = tmp_path_factory.mktemp("spoken")

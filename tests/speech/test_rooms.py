@@ -35,7 +35,7 @@ def _options(item_id: str) -> list[OptionWords]:
 
 
 @pytest.fixture(scope="module")
-def voice_of(tmp_path_factory):
+def voice_of(tmp_path_factory, espeak_ng):
     """say(text, voice, rate) → 16 kHz samples at -20 dBFS active level (cached)."""
     folder = tmp_path_factory.mktemp("patients")
     synthesiser = Synthesiser()

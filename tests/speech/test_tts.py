@@ -37,7 +37,7 @@ class _RecordingPlayer:
 
 
 @pytest.fixture(scope="module")
-def tts_speaker():
+def tts_speaker(espeak_ng):
     speaker = Speaker()
     speaker.start()
     speaker.wait_ready()
@@ -76,7 +76,7 @@ def test_languages_sound_different(tts_speaker, tmp_path):
     assert len(set(lengths.values())) == 3
 
 
-def test_rate_and_volume_change_the_speech(tmp_path):
+def test_rate_and_volume_change_the_speech(tmp_path, espeak_ng):
     speaker = Speaker(rate=DEFAULT_RATE)
     speaker.start()
     text = QUESTIONNAIRE.items[0].spoken["en"]
@@ -98,7 +98,7 @@ def _voiced_words_per_minute(samples: np.ndarray, rate: int, words: int) -> floa
     return words * 60 / (voiced * 0.02)
 
 
-def test_slower_speech_is_pauses_not_slower_words(tmp_path):
+def test_slower_speech_is_pauses_not_slower_words(tmp_path, espeak_ng):
     """slow_speech asks for 0.85 x 160 = 136 wpm: the prompt takes longer, its words do not."""
     text = f"{QUESTIONNAIRE.message('repeat', 'en')} {QUESTIONNAIRE.items[0].spoken['en']}"
     words = len(text.split())

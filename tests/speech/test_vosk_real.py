@@ -32,7 +32,7 @@ def korean() -> VoskRecogniser:
 
 
 @pytest.fixture(scope="module")
-def korean_speech(tmp_path_factory):
+def korean_speech(tmp_path_factory, espeak_ng):
     folder = tmp_path_factory.mktemp("ko")
     synthesiser = Synthesiser()
 

@@ -19,6 +19,7 @@ import pytest
 
 from bench._postgres import create_database, free_port, pg_bin, start_postgres
 from station import auth, db
+from tests.prerequisites import require_debian
 
 ROOT = Path(__file__).resolve().parents[2]
 #: how long a real process may take to start or answer on a loaded 2-core CI machine
@@ -31,9 +32,7 @@ def postgres() -> Iterator[str]:
     """A PostgreSQL server for this test session; yields its URL (superuser, trust on 127.0.0.1)."""
     bin_dir = pg_bin()
     if bin_dir is None:
-        if os.environ.get("CI"):
-            pytest.fail("PostgreSQL is not installed (.ci/run installs the Debian package 'postgresql')")
-        pytest.skip("PostgreSQL is not installed (apt-get install postgresql)")
+        require_debian("postgresql", path="/usr/lib/postgresql/*/bin/initdb")
     url, stop = start_postgres(bin_dir)
     try:
         yield url
@@ -154,7 +153,7 @@ def new_kiosk(db_url: str) -> tuple[str, str]:
 
 
 @pytest.fixture(scope="package")
-def browser() -> Iterator:
+def browser(chromium: str) -> Iterator:
     """One headless Chromium (Debian's) for every page test of this package.
 
     Package scope, not session: Playwright's sync API keeps an event loop running in the main
@@ -164,7 +163,7 @@ def browser() -> Iterator:
 
     with sync_playwright() as playwright:
         chromium = playwright.chromium.launch(
-            executable_path="/usr/bin/chromium",
+            executable_path=chromium,
             args=["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync"])
         yield chromium

@@ -80,17 +80,24 @@ def test_the_station_killed_mid_sync_loses_and_duplicates_nothing(sqlite_url, st
     station = station_factory(sqlite_url, port)
     rows = _patients()
     client = KioskClient(station.url, ward.token, ward.kiosk_id, timeout=5)
-    some_stored = threading.Event()
+    some_stored, killed = threading.Event(), threading.Event()
     result: dict = {}
 
+    def stored(n: int) -> None:
+        # a third is stored: the kiosk's next batch goes to a killed station, however fast it sends
+        # (without this hold a busy machine could let it send the rest before the kill landed)
+        if n >= len(rows) // 3 and not some_stored.is_set():
+            some_stored.set()
+            assert killed.wait(PATIENCE_S)
+
     def kiosk() -> None:
-        result["failures"] = deliver(client, rows, batch=7,
-                                     on_stored=lambda n: n >= len(rows) // 3 and some_stored.set())
+        result["failures"] = deliver(client, rows, batch=7, on_stored=stored)
 
     sender = threading.Thread(target=kiosk)
     sender.start()
     assert some_stored.wait(PATIENCE_S)
-    station.kill()  # while the kiosk keeps sending
+    station.kill()  # with two thirds of the rows still to send
+    killed.set()
     station_factory(sqlite_url, port)  # back on the same address, as after a reboot
     sender.join(PATIENCE_S * 3)
     client.close()
@@ -162,5 +169,7 @@ def test_a_connection_cut_after_the_station_stored_a_batch_stores_nothing_twice(
     failures = deliver(client, rows, batch=50)
     client.close()
     proxy.close()
-    assert failures == 3
+    # each cut answer was a failure the kiosk retried; a request slower than the client's timeout
+    # on a busy machine is one more retry, not a fault of the protocol, so the count is a floor
+    assert proxy.cut == 3 and failures >= 3
     _check_exactly_once(sqlite_url, ward.kiosk_id, rows)

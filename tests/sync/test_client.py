@@ -4,6 +4,7 @@ station that is down, drops connections after storing, answers 500 or refuses a 
 
 from __future__ import annotations
 
+import itertools
 import sqlite3
 import threading
 
@@ -84,8 +85,11 @@ def test_a_station_down_then_up_gets_everything_once_with_the_alerts_first(tmp_p
         assert len(alerts) == 2
         server.start()
         server.until(lambda w: {s for _, s in w.stored} == everything, "every row")
-        first = server.ward.requests[0]
-        assert set(first) == alerts  # the alerts went first, in a request of their own
+        # the alerts went first, in requests of their own: one, or two when the delivery thread
+        # read the outbox between the two alerts and reached the station only once it was up (a
+        # busy machine does that; which happens depends on scheduling, what matters does not)
+        leading = list(itertools.takewhile(lambda request: set(request) <= alerts, server.ward.requests))
+        assert leading and set().union(*map(set, leading)) == alerts, server.ward.requests
         assert all(seq in everything for request in server.ward.requests for seq in request)
         assert len(server.ward.stored) == len(everything)
         server.until(lambda w: not waiting(store), "the outbox emptied")
