@@ -25,7 +25,7 @@ from station import db, throttle
 from station.db import kiosks, settings, staff_sessions, users
 
 ROLES = ("nurse", "doctor")
-NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}\Z")
 MIN_PASSWORD = 10
 
 _hasher = PasswordHasher()

@@ -32,12 +32,12 @@ ID_MAX, TIME_MAX = 64, 40
 #: the longest free text (detail, reason) and the longest identity value
 TEXT_MAX, IDENTITY_MAX = 10000, 200
 #: times a kiosk writes: date, time, optional fraction and zone (what datetime.isoformat gives)
-ISO_TIME = re.compile(r"^\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}(\.\d{1,6})?(Z|[+-]\d{2}:\d{2})?$")
+ISO_TIME = re.compile(r"^\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}(\.\d{1,6})?(Z|[+-]\d{2}:\d{2})?\Z")
 #: session times (seconds from its start) within reason: no session lasts a year
 T_MAX = 365 * 86400.0
 YEARS = (2000, 2200)
-_URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\s|]+$")
-_SHA256 = re.compile(r"^[0-9a-f]{64}$")
+_URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\s|]+\Z")
+_SHA256 = re.compile(r"^[0-9a-f]{64}\Z")
 IDENTITY_FIELDS = ("site", "kiosk_id", "patient_system", "questionnaire_url", "identifier_system", "device_system")
 #: kinds whose rows say something about the questionnaire (they need the session's definition)
 NEEDS_DEFINITION = ("record_answer", "withdraw_answer", "record_not_answered", "record_practice")
