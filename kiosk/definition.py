@@ -42,7 +42,11 @@ class DefinitionError(ValueError):
 
 
 def _code(code: Code | None) -> dict[str, str] | None:
-    return {"system": code.system, "code": code.code} if code else None
+    """A code as captured; its code system's display only where it has one (a definition
+    captured before displays existed keeps its digest)."""
+    if code is None:
+        return None
+    return {"system": code.system, "code": code.code} | ({"display": code.display} if code.display else {})
 
 
 def _option(o: Option) -> dict[str, Any]:
@@ -106,7 +110,7 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
         return {lang: value[lang] for lang in order}
 
     def code(value: Mapping[str, str] | None) -> Code | None:
-        return Code(str(value["system"]), str(value["code"])) if value else None
+        return Code(str(value["system"]), str(value["code"]), str(value.get("display", ""))) if value else None
 
     def options(values: list[Mapping[str, Any]]) -> tuple[Option, ...]:
         built = tuple(Option(number=int(v["number"]), label=texts(v["label"]),
