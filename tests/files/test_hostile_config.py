@@ -91,16 +91,23 @@ def _questionnaire(old: str, new: str) -> str:
     return text.replace(old, new, 1)
 
 
+def _line_of(text: str, line: str) -> int:
+    """The 1-based number of the first line of ``text`` that is ``line``."""
+    return text.splitlines().index(line) + 1
+
+
 @pytest.mark.parametrize(("old", "new", "where"), [
     # a lone surrogate passed validate and then crashed the kiosk when it drew or stored the text
-    ("  es: Índice de Barthel", '  es: "Índice\\ud800"', ":32:7: the text holds U+D800, a lone surrogate"),
-    ("  es: Índice de Barthel", '  es: "Índice\\udfff de Barthel"', ":32:7: the text holds U+DFFF"),
-    ("  es: Índice de Barthel", '  es: "\\e[2JÍndice"', ":32:7: the text holds U+001B, a control character"),
-    ("  es: Índice de Barthel", '  es: "Índice\\x00"', ":32:7: the text holds U+0000, a control character"),
-    ("  es: Índice de Barthel", '  es: "Índice\\uffff"', ":32:7: the text holds U+FFFF, a non-character"),
+    ("  es: Índice de Barthel", '  es: "Índice\\ud800"', ":LINE:7: the text holds U+D800, a lone surrogate"),
+    ("  es: Índice de Barthel", '  es: "Índice\\udfff de Barthel"', ":LINE:7: the text holds U+DFFF"),
+    ("  es: Índice de Barthel", '  es: "\\e[2JÍndice"', ":LINE:7: the text holds U+001B, a control character"),
+    ("  es: Índice de Barthel", '  es: "Índice\\x00"', ":LINE:7: the text holds U+0000, a control character"),
+    ("  es: Índice de Barthel", '  es: "Índice\\uffff"', ":LINE:7: the text holds U+FFFF, a non-character"),
 ])
 def test_validate_and_run_refuse_invalid_unicode_written_as_an_escape(tmp_path, old, new, where):
-    questionnaire = write(tmp_path, "q.yaml", _questionnaire(old, new))
+    text = _questionnaire(old, new)
+    questionnaire = write(tmp_path, "q.yaml", text)
+    where = where.replace(":LINE:", f":{_line_of(text, new)}:")
     validated = kiosk("validate", str(questionnaire), cwd=tmp_path)
     one_line(validated, f"{questionnaire}{where}", stream="stdout")
     config = write(tmp_path, "config.yaml", f"questionnaire: {questionnaire}\n")
@@ -116,7 +123,8 @@ def test_validate_refuses_blank_texts_and_synonyms_where_they_are(tmp_path):
     questionnaire = write(tmp_path, "q.yaml", text.replace(item, '      en: " \\t "\n', 1))
     done = kiosk("validate", str(questionnaire), cwd=tmp_path)
     assert done.returncode == 1 and "Traceback" not in done.stderr, done
-    assert done.stdout.splitlines() == [f"{questionnaire}:31:7: title in 'en' is blank: write the words",
+    title = _line_of(text, '  en: "  "')
+    assert done.stdout.splitlines() == [f"{questionnaire}:{title}:7: title in 'en' is blank: write the words",
                                         f"{questionnaire}:{line}:11: items[0].text in 'en' is blank: write the words"]
 
 

@@ -129,9 +129,10 @@ def test_the_configured_band_set_interprets_the_session_its_export_and_kiosk_res
     assert ("total 75/100 (complete); Mild dependence (bands: spanish, Spanish clinical practice "
             "(unconfirmed source))") in capsys.readouterr().out
     assert list(csv.DictReader(table.open()))[-1]["band_set"] == "spanish"
-    config.write_text("bands: castilian\n")
-    assert results_main([stored.id, "--data-dir", str(tmp_path / "data")]) == 2
-    assert "bands: 'castilian' is not a band set" in capsys.readouterr().err
+    # the session keeps the band set it was recorded with, whatever the configuration says today
+    config.write_text("bands: shah\n")
+    assert results_main([stored.id, "--data-dir", str(tmp_path / "data")]) == 0
+    assert "Mild dependence (bands: spanish" in capsys.readouterr().out
 
 
 def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_path, capsys):
