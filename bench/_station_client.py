@@ -40,10 +40,11 @@ class Row:
 
 
 def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None,
-                   export: dict[str, str] | None = None) -> list[Row]:
+                   export: dict[str, str] | None = None, visit: str | None = None) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
     on the kiosk's real :class:`kiosk.storage.Store` with a station configured, its outbox read
-    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity."""
+    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity, ``visit`` the
+    session's ``visit`` log entry (``order ID`` for an ordered visit)."""
     from dataclasses import replace
 
     from kiosk.replay import load_script, run_script
@@ -54,7 +55,7 @@ def record_patient(script: str | Path, first_seq: int = 1, patient: str | None =
         loaded = replace(loaded, patient=patient)
     with tempfile.TemporaryDirectory() as directory:
         with Store.open(directory, outbox=True, export=export) as store:
-            run_script(loaded, store=store)
+            run_script(loaded, store=store, visit=visit)
         with sqlite3.connect(Path(directory) / DB_NAME) as connection:
             stored = connection.execute("SELECT kind, session_id, payload, at FROM outbox ORDER BY seq").fetchall()
     rows, t = [], 0.0
@@ -88,6 +89,15 @@ class KioskClient:
         response = self.http.get("/api/v1/commands", params={"wait": wait}, timeout=wait + 30)
         response.raise_for_status()
         return response.json()["commands"]
+
+    def orders(self, wait: float = 0.0, version: str | None = None) -> dict[str, Any]:
+        params: dict[str, Any] = {"wait": wait} | ({"version": version} if version else {})
+        response = self.http.get("/api/v1/orders", params=params, timeout=wait + 30)
+        response.raise_for_status()
+        return response.json()
+
+    def start_order(self, code: str) -> httpx.Response:
+        return self.http.post("/api/v1/orders/start", json={"code": code})
 
     def ack(self, command_id: int, result: str = "done", reason: str | None = None) -> httpx.Response:
         body = {"result": result} | ({"reason": reason} if reason else {})

@@ -19,7 +19,7 @@ from starlette.routing import Route
 from kiosk.export import csv_text, fhir_response, practice_outcomes, site_from_identity
 from kiosk.questionnaire import Questionnaire
 from kiosk.storage import StoredSession
-from station import db, validation, ward
+from station import db, orders, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
 from station.sessions import NotFound, load, load_for_export
@@ -172,6 +172,8 @@ async def sign_off(request: Request) -> Response:
         await run_in_threadpool(validation.sign_off, request.app.state.engine, session_id, request.state.user)
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
+    await run_in_threadpool(orders.signed_off, request.app.state.engine, session_id, request.state.user)
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Signed off.", to=page)
 
 

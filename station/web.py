@@ -26,7 +26,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, auth, pages
+from station import api, api_orders, auth, order_pages, pages
 from station.bus import Bus
 from station.live import Live
 from station.rendering import Forbidden, checked_form, current_user, render
@@ -160,7 +160,9 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
         Route("/events", events),
         Route("/healthz", healthz),
         *pages.routes,
+        *order_pages.routes,
         *api.routes,
+        *api_orders.routes,
         Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),
     ]
     middleware = [

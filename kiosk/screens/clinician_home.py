@@ -39,6 +39,8 @@ class ClinicianHomeScreen(ClinicianScreen):
                              id="adaptation", disabled=session.adaptation is None)
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
+                yield Button("Start a visit", id="start-visit",
+                             disabled=app.visits is None)  # type: ignore[attr-defined]
                 yield Button("Back", id="back")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             with Horizontal(id="presence-actions"):
@@ -157,6 +159,12 @@ class ClinicianHomeScreen(ClinicianScreen):
     @on(Button.Pressed, "#new-session")
     def _new_session(self) -> None:
         self.app.start_new_session()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#start-visit")
+    def _start_visit(self) -> None:
+        from kiosk.screens.start_visit import StartVisitScreen
+
+        self.app.push_screen(StartVisitScreen())
 
     @on(Button.Pressed, "#back")
     def _back(self) -> None:
