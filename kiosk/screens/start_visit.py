@@ -9,6 +9,7 @@ from textual.containers import Grid, Horizontal, Vertical
 from textual.widgets import Button, Label, Static, Switch
 
 from kiosk.screens.base import ClinicianScreen
+from kiosk.screens.visit_ready import pad_key
 from kiosk.widgets.text import language_name
 
 _KEYS = tuple("1234567890ABCDEFGHIJKLMNOPQRSTUVWXYZ-_") + ("⌫",)
@@ -44,7 +45,7 @@ class StartVisitScreen(ClinicianScreen):
             yield Static(" ", id="typed-id")
             with Grid(id="id-keys"):
                 for label in _KEYS:
-                    yield Button(label, id=_key_id(label))
+                    yield pad_key(Button(label, id=_key_id(label)))
             with Horizontal(id="visit-languages"):
                 for language in app.questionnaire.languages:  # type: ignore[attr-defined]
                     yield Button(language_name(language), id=f"visit-lang-{language}",

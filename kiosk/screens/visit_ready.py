@@ -22,6 +22,13 @@ _KEYS = ("1", "2", "3", "4", "5", "6", "7", "8", "9", "⌫", "0", "OK")
 CODE_DIGITS = 4
 
 
+def pad_key(button: Button) -> Button:
+    """A pad key that takes every tap: a Button ignores a press within its 0.2 s press effect, so
+    "0000" typed quickly would lose digits."""
+    button.active_effect_duration = 0
+    return button
+
+
 def order_line(order: Order) -> str:
     """One ordered visit as staff read it: patient, instruments, language, who answers."""
     who = "a relative answers" if order.relative else "the patient answers"
@@ -70,7 +77,7 @@ class VisitReadyScreen(PatientScreen):
                 with Grid(id="visit-keys"):
                     for label in _KEYS:
                         key_id = {"⌫": "visit-key-delete", "OK": "visit-key-ok"}.get(label, f"visit-key-{label}")
-                        yield Button(label, id=key_id, variant="primary" if label == "OK" else "default")
+                        yield pad_key(Button(label, id=key_id, variant="primary" if label == "OK" else "default"))
             else:
                 yield Static("No visit is ready on this kiosk", classes="visit-heading", id="visit-heading")
                 yield Label("Staff: order a visit on the ward station, or start one on the clinician screen.")
