@@ -31,6 +31,7 @@ from sqlalchemy.engine import Connection, Engine
 
 from station import db
 from station.db import audit, kiosks
+from station.sessions import LIFECYCLE
 
 #: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
 #: No spaces, dots or apostrophes, and a digit required, so "Maria Lopez", "O'Neill" or "LOPEZ"
@@ -276,6 +277,8 @@ def on_rows(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[d
     waiting (its order awaits validation); an abandoned one puts its order back to ordered.
     Returns the bus messages to publish."""
     messages: list[dict[str, Any]] = []
+    if any(e.kind in LIFECYCLE for e in new):  # the Results lists show statuses: they follow live
+        messages.append({"type": "sessions", "kiosk": kiosk_id})
     for event in sorted(new, key=lambda e: e.seq):
         p = event.payload
         if event.kind == "record_event" and p.get("kind") == "visit":
@@ -286,7 +289,7 @@ def on_rows(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[d
             db.insert_ignore(connection, visits, [{"session_id": event.session_id, "kind": kind,
                                                    "order_id": order_id}], ["session_id"])
         elif event.kind == "finish_session":
-            messages.append({"type": "result", "kiosk": kiosk_id, "session": event.session_id})
+            messages.append({"type": "result", "kiosk": kiosk_id, "session": event.session_id, "finished": True})
             _move(connection, event.session_id, "in_progress", "awaiting_validation", "order_result",
                   f"session {event.session_id} finished on {kiosk_id}: the result waits for validation")
         elif event.kind == "abandon":

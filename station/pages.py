@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import Any
 from urllib.parse import quote
 
-import sqlalchemy as sa
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
@@ -23,10 +22,6 @@ from station import db, orders, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
 from station.sessions import NotFound, load, load_for_export
-
-#: session-list size on the ward page
-RECENT = 50
-
 
 def kiosk_event(app: Starlette, name: str) -> dict[str, Any]:
     """A kiosk's tile, rendered for the live feed."""
@@ -44,19 +39,14 @@ def alerts_event(app: Starlette) -> dict[str, Any]:
                         "text": f"{a.text} — {a.kiosk_id}"} for a in pending]}
 
 
-def _session_rows(engine: Any, limit: int = RECENT) -> list[Any]:
-    with engine.connect() as connection:
-        return connection.execute(sa.select(db.sessions).where(db.sessions.c.status != "pending").order_by(
-            db.sessions.c.started_at.desc()).limit(limit)).all()
-
-
 async def ward_page(request: Request) -> Response:
     engine = request.app.state.engine
     views = await run_in_threadpool(ward.kiosk_views, engine)
     pending = await run_in_threadpool(ward.open_alerts, engine)
-    recent = await run_in_threadpool(_session_rows, engine)
-    reviews = await run_in_threadpool(validation.reviews, engine, [row.id for row in recent])
-    return render(request, "ward.html", kiosks=views, alerts=pending, sessions=recent, reviews=reviews,
+    from station.result_pages import ward_results
+
+    recent = await run_in_threadpool(ward_results, engine, request.app.state.questionnaire)
+    return render(request, "ward.html", kiosks=views, alerts=pending, results=recent,
                   now=db.now(), message=request.query_params.get("message"))
 
 
@@ -86,7 +76,7 @@ async def command(request: Request) -> Response:
         return _back(request, str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "command", "kiosk": kiosk},
                             {"type": "ack", "kiosk": kiosk})
-    return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.")
+    return _back(request, ward.COMMAND_WORDS[form.get("kind", "")].format(kiosk=kiosk))
 
 
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:

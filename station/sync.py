@@ -19,7 +19,7 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
 from kiosk.storage import PATIENT_ID
-from station import db, orders
+from station import alert_rules, db, orders
 from station.db import alerts, inbox, sessions
 from station.sessions import LIFECYCLE, rows_of, status_of
 
@@ -134,6 +134,7 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
             updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE))))
     if new:
         messages += _alerts(connection, kiosk_id, new, received)
+        messages += alert_rules.settle(connection, kiosk_id, new)  # staff's own doing, situations ended
         messages += orders.on_rows(connection, kiosk_id, new)  # visits, orders, results waiting
     return seqs, messages
 

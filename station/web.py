@@ -26,7 +26,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, api_orders, auth, order_pages, pages
+from station import api, api_orders, auth, order_pages, pages, result_pages
 from station.bus import Bus
 from station.live import Live
 from station.rendering import Forbidden, checked_form, current_user, render
@@ -161,6 +161,7 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
         Route("/healthz", healthz),
         *pages.routes,
         *order_pages.routes,
+        *result_pages.routes,
         *api.routes,
         *api_orders.routes,
         Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),
@@ -173,5 +174,6 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
     ]
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
-    app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app))
+    app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app),
+                          lambda finished: result_pages.results_event(app, finished))
     return app
