@@ -26,7 +26,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, api_orders, auth, order_pages, pages, result_pages
+from station import api, api_orders, auth, order_pages, pages, result_pages, signoff_pages
 from station.bus import Bus
 from station.live import Live
 from station.rendering import Forbidden, checked_form, current_user, render
@@ -162,6 +162,7 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
         *pages.routes,
         *order_pages.routes,
         *result_pages.routes,
+        *signoff_pages.routes,
         *api.routes,
         *api_orders.routes,
         Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),

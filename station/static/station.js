@@ -100,8 +100,10 @@
 
   function beep() {
     station.beeps += 1;
+    document.body.dataset.beeps = String(station.beeps);
     if (!playing()) return;
     station.audible += 1;
+    document.body.dataset.audible = String(station.audible);
     const now = audio.currentTime;
     for (const [start, freq] of [[0, 880], [0.25, 660]]) {
       const osc = audio.createOscillator();
