@@ -14,13 +14,12 @@ import json
 from typing import Any
 
 from sqlalchemy.engine import Connection
-from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
-from station import orders
-from station.api import MAX_WAIT_S, _error, _in_worker, _json, _kiosk, _refused, _unauthorised, _Unauthorised
+from station import auth, orders
+from station.api import ALERT_LANE, MAX_WAIT_S, _error, _in_worker, _json, _refused, _token, _unauthorised, _Unauthorised
 
 
 def _ready(engine: Any, kiosk: str) -> dict[str, Any]:
@@ -35,7 +34,11 @@ async def get_orders(request: Request) -> Response:
     """Long poll: the list at once when its version differs from ``version`` (or none was given),
     else when an order of this kiosk changes (by any station process) or ``wait`` seconds pass.
     Subscribing before looking means a change in between is not missed."""
-    kiosk = await _kiosk(request)
+    token = _token(request)
+    loop = asyncio.get_running_loop()
+    # the whole poll on the urgent lane (cheap reads): a waiting visit never queues behind the
+    # kiosks' routine rows in the shared worker threads
+    kiosk = await loop.run_in_executor(ALERT_LANE, auth.kiosk_for, request.app.state.engine, token) if token else None
     if kiosk is None:
         return _unauthorised()
     try:
@@ -46,10 +49,10 @@ async def get_orders(request: Request) -> Response:
     engine, bus = request.app.state.engine, request.app.state.bus
     queue = bus.subscribe()
     try:
-        current = await run_in_threadpool(_ready, engine, kiosk)
-        deadline = asyncio.get_running_loop().time() + wait
+        current = await loop.run_in_executor(ALERT_LANE, _ready, engine, kiosk)
+        deadline = loop.time() + wait
         while current["version"] == known:
-            left = deadline - asyncio.get_running_loop().time()
+            left = deadline - loop.time()
             if left <= 0:
                 break
             try:
@@ -57,7 +60,7 @@ async def get_orders(request: Request) -> Response:
             except TimeoutError:
                 break
             if message.get("type") in ("order", "resync") and message.get("kiosk") in (kiosk, None):
-                current = await run_in_threadpool(_ready, engine, kiosk)
+                current = await loop.run_in_executor(ALERT_LANE, _ready, engine, kiosk)
     finally:
         bus.unsubscribe(queue)
     return JSONResponse(current)

@@ -6,6 +6,7 @@ publish what changed (the kiosk's long poll wakes), redirect (post/redirect/get)
 
 from __future__ import annotations
 
+import asyncio
 from typing import Any
 from urllib.parse import quote
 
@@ -15,6 +16,7 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from station import orders, validation, ward
+from station.api import ALERT_LANE
 from station.rendering import checked_form, render
 
 
@@ -39,16 +41,21 @@ async def create_order(request: Request) -> Response:
     form = await checked_form(request)
     engine, q = request.app.state.engine, request.app.state.questionnaire
     multi = await request.form()
-    try:
-        order = await run_in_threadpool(lambda: orders.create(
+    def place() -> orders.Order:
+        order = orders.create(
             engine, kiosk_id=form.get("kiosk", ""), patient_id=form.get("patient_id", ""),
             instruments=[str(v) for v in multi.getlist("instrument")], language=form.get("language", ""),
             relative=form.get("relative") == "yes", by=request.state.user, known_instruments=[q.id],
-            languages=q.languages))
+            languages=q.languages)
+        request.app.state.bus.publish({"type": "order", "kiosk": order.kiosk_id})
+        return order
+
+    try:
+        # on the urgent lane, as alerts: the kiosk's welcome must not wait behind routine rows
+        order = await asyncio.get_running_loop().run_in_executor(ALERT_LANE, place)
     except orders.OrderError as exc:
         keep = "&".join(f"{k}={quote(form.get(k, ''))}" for k in ("kiosk", "patient_id", "language"))
         return RedirectResponse(f"/orders?error={quote(str(exc))}&{keep}", status_code=303)
-    await run_in_threadpool(request.app.state.bus.publish, {"type": "order", "kiosk": order.kiosk_id})
     return RedirectResponse(f"/orders/{order.id}", status_code=303)
 
 

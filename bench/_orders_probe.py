@@ -1,0 +1,64 @@
+"""The clinician's loop under load, for ``bench/station.py``: each simulated kiosk long-polls its
+orders as the kiosk's own watcher does (``kiosk/sync/orders.py``), a logged-in member of staff
+orders one visit per kiosk while the kiosks replay their patients, and the page's event stream
+notes when each finished result reaches it.
+
+- order to kiosk: from the moment staff send the order form to the moment that kiosk's long poll
+  lists the order (its welcome then shows it: drawing is local to the kiosk). Staff start ordering
+  once every kiosk is waiting on its long poll, as on a ward where the kiosks were on before the
+  round; the replays' rows keep flowing meanwhile;
+- result stored to inbox: from the station storing a ``finish_session`` row (``inbox.received_at``,
+  the station's clock) to the open page receiving the ``results`` event that rings for it (the
+  same machine's clock).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import re
+import time
+
+import httpx
+
+CSRF = re.compile(r'name="csrf" content="([^"]+)"')
+
+
+async def poll_orders(http: httpx.AsyncClient, seen: dict[str, float], stop: asyncio.Event,
+                      listening: asyncio.Event) -> None:
+    """One kiosk's order watcher: the first time each order id is listed (monotonic seconds);
+    ``listening`` is set once its first answer came (the kiosk is then waiting on a long poll)."""
+    version = None
+    while not stop.is_set():
+        params = {"wait": 20} | ({"version": version} if version else {})
+        try:
+            response = await http.get("/api/v1/orders", params=params, timeout=40)
+            response.raise_for_status()
+        except httpx.HTTPError:
+            await asyncio.sleep(0.5)
+            continue
+        now = time.monotonic()
+        body = response.json()
+        version = body["version"]
+        listening.set()
+        for order in body["orders"]:
+            seen.setdefault(order["id"], now)
+
+
+async def place_orders(url: str, user: str, password: str, kiosks: list[str], every_s: float,
+                       placed: dict[str, float], placed_wall: dict[str, float]) -> None:
+    """Staff order one visit per kiosk, ``every_s`` apart: order id -> when the form was sent
+    (monotonic, and the wall clock in ``placed_wall``)."""
+    async with httpx.AsyncClient(base_url=url, timeout=60) as http:
+        token = CSRF.search((await http.get("/login")).text).group(1)
+        await http.post("/login", data={"csrf": token, "name": user, "password": password, "next": "/orders"})
+        token = CSRF.search((await http.get("/orders")).text).group(1)
+        for index, kiosk in enumerate(kiosks):
+            await asyncio.sleep(every_s)
+            sent, wall = time.monotonic(), time.time()
+            response = await http.post("/orders", data={
+                "csrf": token, "patient_id": f"NHC-B{index:04d}", "kiosk": kiosk, "instrument": "barthel",
+                "language": "en"})
+            location = response.headers.get("location", "")
+            if response.status_code == 303 and location.startswith("/orders/order-"):
+                placed[location.rsplit("/", 1)[1]] = sent
+                placed_wall[location.rsplit("/", 1)[1]] = wall
