@@ -123,7 +123,11 @@ class ClinicianHomeScreen(ClinicianScreen):
         waiting, parked = store.outbox_waiting()
         state = f"not reachable ({sync.problem})" if sync.problem else "reachable"
         text = f"Ward station {sync.station.url}: {state}; {waiting} stored changes waiting to be sent"
-        return text + (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
+        text += (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
+        visits = self.app.visits  # type: ignore[attr-defined]
+        if visits is not None and visits.problems:  # ordered visits this kiosk cannot run (kiosk.visits)
+            text += " Orders this kiosk cannot run: " + "; ".join(visits.problems) + "."
+        return text
 
     def _channels_text(self) -> str:
         lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
