@@ -24,6 +24,7 @@ import re
 import secrets
 from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from typing import Any
 
 import sqlalchemy as sa
@@ -48,6 +49,10 @@ MAX_CODE_FAILURES = 5
 CODE_WINDOW_S = 10 * 60
 #: who may order (every staff role) and who signs off (doctors: station.validation)
 ORDER_ROLES = ("nurse", "doctor")
+#: orders one member of staff may place within the window (a ward round is a few dozen at most:
+#: more is a script or a session left open on a stolen phone)
+MAX_ORDERS_PER_USER = 30
+ORDER_WINDOW_S = 10 * 60
 
 orders = sa.Table(
     "orders", db.metadata,
@@ -168,7 +173,13 @@ def create(engine: Engine, *, kiosk_id: str, patient_id: str, instruments: Seque
     if language not in languages:
         raise OrderError(f"language {language!r}: choose one of {', '.join(languages)}")
     now = db.now_iso()
+    since = datetime.fromtimestamp(db.now() - ORDER_WINDOW_S, UTC).isoformat(timespec="milliseconds")
     with engine.begin() as connection:
+        recent = connection.execute(sa.select(sa.func.count()).select_from(orders).where(
+            orders.c.ordered_by == by.name, orders.c.ordered_at > since)).scalar_one()
+        if recent >= MAX_ORDERS_PER_USER:
+            raise OrderError(f"you have ordered {recent} visits in the last {ORDER_WINDOW_S // 60} minutes: "
+                             "wait a little, or ask a colleague")
         row = connection.execute(sa.select(kiosks.c.revoked_at).where(kiosks.c.name == kiosk_id)).first()
         if row is None or row.revoked_at is not None:
             raise OrderError(f"kiosk {kiosk_id!r}: no such kiosk with a valid token")

@@ -7,6 +7,8 @@ GET shows the step (no change); its form POSTs to the sign-off route (:mod:`stat
 
 from __future__ import annotations
 
+from urllib.parse import quote
+
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
@@ -32,6 +34,9 @@ async def confirm_page(request: Request) -> Response:
     current = await run_in_threadpool(validation.review, engine, session_id)
     if current.final or stored.status not in validation.REVIEWABLE:  # type: ignore[attr-defined]
         return RedirectResponse(f"/sessions/{session_id}", status_code=303)
+    if not request.state.user.is_doctor:
+        return RedirectResponse(f"/sessions/{session_id}?message={quote('Only a doctor can sign off.')}",
+                                status_code=303)
     score = validation.corrected(stored, q, current)["score"]
     labels = {item.id: item.text.get("en", item.id) for item in q.items}
     return render(request, "sign_off.html", s=stored, kiosk=kiosk, review=current, score=score, labels=labels)

@@ -123,3 +123,20 @@ def test_guessing_codes_is_stopped_and_staff_forms_need_their_token(shared_stati
     assert forged.status_code == 403
     assert kiosk.orders()["orders"] == []
     kiosk.close()
+
+
+def test_staff_order_at_most_thirty_visits_in_ten_minutes_and_a_nurse_never_signs_off(request, station_factory):
+    ward = make_ward(request.getfixturevalue("sqlite_url"))
+    station = station_factory(ward.db_url)
+    nurse = Staff(station.url, "nurse.kim", "nurse")
+    answers = [order(nurse, ward.kiosk_id, patient=f"NHC-{n:04d}").headers["location"] for n in range(31)]
+    assert all(a.startswith("/orders/order-") for a in answers[:30])
+    assert answers[30].startswith("/orders?error=") and "30 visits in the last 10 minutes" in nurse.http.get(
+        answers[30]).text
+    assert len(KioskClient(station.url, ward.token, ward.kiosk_id).orders()["orders"]) == 30
+    rows = record_patient(PATIENTS / "barthel1.yaml")
+    assert KioskClient(station.url, ward.token, ward.kiosk_id).sync(rows).status_code == 200
+    asked = nurse.http.get(f"/sessions/{rows[0].session_id}/sign-off")
+    assert asked.status_code == 303 and "Only%20a%20doctor" in asked.headers["location"]
+    assert "only a doctor can sign off" in nurse.post(f"/sessions/{rows[0].session_id}/sign-off").headers[
+        "location"].replace("%20", " ")
