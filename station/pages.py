@@ -124,6 +124,7 @@ async def session_page(request: Request) -> Response:
                   plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
                   incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
                   reviewable=stored.status in validation.REVIEWABLE and not current.final,
+                  visit=(await run_in_threadpool(orders.visit_kinds, engine, [session_id])).get(session_id),
                   message=request.query_params.get("message"))
 
 

@@ -116,6 +116,8 @@ def test_order_greet_confirm_answer_ring_sign_off_course(browser, request, stati
     # the doctor opens it, asks to sign off, sees the total, confirms
     doctor.click("#inbox li.result a.open-result")
     doctor.wait_for_selector("#total")
+    assert doctor.locator("#visit-line").inner_text().startswith("Ordered visit")  # the result links to its order
+    assert doctor.get_attribute("#visit-order", "href").startswith("/orders/order-")
     fits(doctor, viewport)
     total = doctor.locator("#total").inner_text()
     doctor.click("#sign-off")
