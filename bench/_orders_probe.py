@@ -62,3 +62,33 @@ async def place_orders(url: str, user: str, password: str, kiosks: list[str], ev
             if response.status_code == 303 and location.startswith("/orders/order-"):
                 placed[location.rsplit("/", 1)[1]] = sent
                 placed_wall[location.rsplit("/", 1)[1]] = wall
+
+
+def ward_round(url: str, kiosks: dict[str, str], users: tuple[str, ...], password: str, every_s: float,
+               placed: dict[str, float], placed_wall: dict[str, float], seen: dict[str, float]) -> None:
+    """In a thread of its own (its own event loop, as each real kiosk and phone has its own
+    process): every kiosk's order long poll, and staff ordering one visit per kiosk, ``every_s``
+    apart overall, split between ``users``, once every kiosk is waiting. ``seen``: order id ->
+    when its kiosk first listed it. Returns when every order was listed, or 15 s after the last."""
+
+    async def run() -> None:
+        stop = asyncio.Event()
+        clients = {name: httpx.AsyncClient(base_url=url, headers={"Authorization": f"Bearer {token}"}, timeout=60)
+                   for name, token in kiosks.items()}
+        listening = {name: asyncio.Event() for name in kiosks}
+        polls = [asyncio.create_task(poll_orders(clients[name], seen, stop, listening[name])) for name in kiosks]
+        await asyncio.gather(*(event.wait() for event in listening.values()))
+        names = list(kiosks)
+        await asyncio.gather(*(place_orders(url, user, password, names[index::len(users)], every_s * len(users),
+                                            placed, placed_wall) for index, user in enumerate(users)))
+        deadline = time.monotonic() + 15
+        while time.monotonic() < deadline and not all(o in seen for o in placed):
+            await asyncio.sleep(0.05)
+        stop.set()
+        for poll in polls:
+            poll.cancel()
+        await asyncio.gather(*polls, return_exceptions=True)
+        for client in clients.values():
+            await client.aclose()
+
+    asyncio.run(run())

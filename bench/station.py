@@ -42,7 +42,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench._postgres import create_database, pg_bin, start_postgres  # noqa: E402
-from bench._orders_probe import place_orders, poll_orders  # noqa: E402
+from bench._orders_probe import ward_round  # noqa: E402
 from bench._station_client import PATIENTS, Row, record_patient  # noqa: E402
 
 SCRIPTS = ["barthel5.yaml", "barthel6.yaml", "relative_french.yaml", "barthel1.yaml", "voice_dropout.yaml",
@@ -72,9 +72,6 @@ class Kiosk:
         self.errors = 0
         self.error_kinds: Counter[str] = Counter()
         self.pending: list[Row] = []
-        #: order id -> when this kiosk's order long poll first listed it (bench/_orders_probe.py)
-        self.orders_seen: dict[str, float] = {}
-        self.listening = asyncio.Event()
 
     def _renumber(self, patients: list[list[Row]]) -> list[tuple[float, Row]]:
         """The patients one after another, each with a fresh session id and this kiosk's seqs."""
@@ -122,11 +119,10 @@ class Kiosk:
             batch, self.pending = self.pending[:500], self.pending[500:]
             await self._send(batch)
 
-    async def run(self, orders_done: asyncio.Event | None = None) -> None:
+    async def run(self) -> None:
         start = time.monotonic()
         done = asyncio.Event()
         sender = asyncio.create_task(self._routine(done))
-        watcher = asyncio.create_task(poll_orders(self.http, self.orders_seen, orders_done or done, self.listening))
         urgent = []
         question = 0
         for due, row in self.rows:
@@ -152,28 +148,11 @@ class Kiosk:
         done.set()
         await sender
         await asyncio.gather(*urgent)
-        if orders_done is not None:
-            await orders_done.wait()
-        watcher.cancel()
         await self.http.aclose()
 
 
-async def run_kiosks(kiosks: list[Kiosk], url: str, placed: dict[str, float], every_s: float,
-                     placed_wall: dict[str, float]) -> None:
-    """The kiosks replay; meanwhile staff order one visit per kiosk, ``every_s`` apart."""
-    orders_done = asyncio.Event()
-
-    async def staff() -> None:
-        await asyncio.gather(*(k.listening.wait() for k in kiosks))
-        await place_orders(url, "bench.nurse", "bench-password-1", [k.name for k in kiosks], every_s, placed,
-                           placed_wall)
-        deadline = time.monotonic() + 10  # every order listed by its kiosk, or give up
-        while time.monotonic() < deadline and not all(
-                any(o in k.orders_seen for k in kiosks) for o in placed):
-            await asyncio.sleep(0.05)
-        orders_done.set()
-
-    await asyncio.gather(staff(), *(kiosk.run(orders_done) for kiosk in kiosks))
+async def run_kiosks(kiosks: list[Kiosk]) -> None:
+    await asyncio.gather(*(kiosk.run() for kiosk in kiosks))
 
 
 def listen(url: str, user: str, password: str, seen: dict, ready: threading.Event, stop: threading.Event) -> None:
@@ -235,6 +214,7 @@ def main() -> int:
         url_db = create_database(server, "bench")
         engine = db.open_database(url_db)
         auth.add_user(engine, "bench.nurse", "nurse", "bench-password-1")
+        auth.add_user(engine, "bench.nurse2", "nurse", "bench-password-1")
         tokens = {f"bed{i:02d}": auth.add_kiosk(engine, f"bed{i:02d}") for i in range(args.kiosks)}
         from bench._postgres import free_port
 
@@ -260,8 +240,15 @@ def main() -> int:
         cpu0, wall0 = cpu_seconds(station.pid), time.monotonic()
         placed: dict[str, float] = {}
         placed_wall: dict[str, float] = {}
-        asyncio.run(run_kiosks(kiosks, url, placed, every_s=0.1, placed_wall=placed_wall))
+        orders_seen: dict[str, float] = {}
+        # two nurses on the round, each ordering for half the kiosks (one person may order at most
+        # 30 visits in 10 minutes: station.orders.MAX_ORDERS_PER_USER)
+        round_thread = threading.Thread(target=ward_round, args=(
+            url, tokens, ("bench.nurse", "bench.nurse2"), "bench-password-1", 0.1, placed, placed_wall, orders_seen))
+        round_thread.start()
+        asyncio.run(run_kiosks(kiosks))
         cpu1, wall1 = cpu_seconds(station.pid), time.monotonic()
+        round_thread.join(120)
         deadline = time.monotonic() + 10
         while len(seen.keys() & marks.keys()) < len(marks) and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -289,13 +276,10 @@ def main() -> int:
         alert_ms = [(seen[key] - marks[key]) * 1000 for key in marks if key in seen]
         closed_before_shown = sum(1 for key in marks if key not in seen and key in closed_unseen)
         lag_ms = [(k.stored[seq] - k.written[seq]) * 1000 for k in kiosks for seq in k.written if seq in k.stored]
-        order_ms = [(min(k.orders_seen[o] for k in kiosks if o in k.orders_seen) - sent) * 1000
-                    for o, sent in placed.items() if any(o in k.orders_seen for k in kiosks)]
+        order_ms = [(orders_seen[o] - sent) * 1000 for o, sent in placed.items() if o in orders_seen]
         # the same orders from the moment the station stored them (wall clocks of this machine)
-        first_seen = {o: min(k.orders_seen[o] for k in kiosks if o in k.orders_seen) for o in placed
-                      if any(o in k.orders_seen for k in kiosks)}
-        stored_ms = [(first_seen[o] - placed[o] + placed_wall[o] - ordered_at[o]) * 1000
-                     for o in first_seen if o in ordered_at]
+        stored_ms = [(orders_seen[o] - placed[o] + placed_wall[o] - ordered_at[o]) * 1000
+                     for o in placed if o in orders_seen and o in ordered_at]
         result_ms = [(seen[("result", s)] - at) * 1000 for s, at in finished.items() if ("result", s) in seen]
         result = {
             "kiosks": args.kiosks, "speed": args.speed, "patients_per_kiosk": args.patients,

@@ -16,7 +16,7 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from station import orders, validation, ward
-from station.api import ALERT_LANE
+from station.api_orders import ORDER_LANE
 from station.rendering import checked_form, render
 
 
@@ -51,8 +51,8 @@ async def create_order(request: Request) -> Response:
         return order
 
     try:
-        # on the urgent lane, as alerts: the kiosk's welcome must not wait behind routine rows
-        order = await asyncio.get_running_loop().run_in_executor(ALERT_LANE, place)
+        # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
+        order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
     except orders.OrderError as exc:
         keep = "&".join(f"{k}={quote(form.get(k, ''))}" for k in ("kiosk", "patient_id", "language"))
         return RedirectResponse(f"/orders?error={quote(str(exc))}&{keep}", status_code=303)
