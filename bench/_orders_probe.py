@@ -10,6 +10,22 @@ notes when each finished result reaches it.
 - result stored to inbox: from the station storing a ``finish_session`` row (``inbox.received_at``,
   the station's clock) to the open page receiving the ``results`` event that rings for it (the
   same machine's clock).
+
+Figures, 2026-11-26, ``uv run python bench/station.py --kiosks 50`` (PostgreSQL, 100x), three runs
+on this shared 2-core machine with other work running (load average 3.7-4.2)::
+
+    order sent -> kiosk p50/p99 ms    59 / 355     19 / 1452     45 / 469
+    order stored -> kiosk p99 ms           304           451          287
+    result stored -> inbox p50/p99 ms 121 / 406   205 / 731    131 / 431
+    alert -> page p99 ms (same runs)       703          1433         1318
+
+The second run's slow orders were slow before they were stored: the staff's POST waits for its
+login check in the station's shared worker threads (``LoginRequired``), behind the kiosks' rows;
+the order's own work (its write, the kiosk's long poll) runs on a lane of its own
+(``station.api_orders.ORDER_LANE``). Before that lane, with the orders' reads in the shared
+workers, order sent -> kiosk p99 was 1.9-5.0 s (load average 7.6-8.1). An earlier version rendered
+each finished result's score for the ring, on the live feed's one thread that alerts share; the
+ring now reads two small queries.
 """
 
 from __future__ import annotations
