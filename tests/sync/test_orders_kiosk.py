@@ -42,7 +42,7 @@ def text_of(app, selector: str) -> str:
 
 async def type_code(pilot, code: str) -> None:
     for digit in code:
-        await pilot.click(f"#visit-key-{digit}")
+        assert await pilot.click(f"#visit-key-{digit}"), f"the tap on {digit} missed its key"
     await pilot.click("#visit-key-ok")
 
 
@@ -60,6 +60,7 @@ async def test_an_ordered_visit_starts_at_the_kiosk_only_with_its_code(tmp_path)
             code = CODE.search(nurse.http.get(placed.headers["location"]).text).group(1)
 
             await until_thread(lambda: screen(app) == "VisitReadyScreen", "the visit on the kiosk's welcome")
+            await pilot.pause()  # the keypad laid out
             assert "Patient NHC-4242" in text_of(app, ".visit-order") and "a relative answers" in text_of(
                 app, ".visit-order")
             await pilot.press("1")  # a remote's 1 (a keyboard remote): a digit of the code, nothing starts
@@ -123,3 +124,23 @@ async def test_without_a_station_staff_start_a_visit_by_touch_and_no_walk_up_sta
             assert visit_of(app.store.session(app.session.id).log) == "staff"
     finally:
         close()
+
+
+async def test_a_code_typed_while_the_station_is_down_says_so_and_starts_nothing(tmp_path):
+    ward = make_ward(db.sqlite_url(tmp_path / "station"))
+    station = start_station(ward.db_url, tmp_path / "station.log")
+    app, close = build_app(config_path=config_for(tmp_path, station.url, ward.token), voice=False, remote=False)
+    try:
+        async with app.run_test(size=KIOSK_SIZE) as pilot:
+            nurse = Staff(station.url, "nurse.kim", "nurse")
+            placed = nurse.post("/orders", patient_id="NHC-9", kiosk="ward3-bed2", instrument="barthel", language="en")
+            code = CODE.search(nurse.http.get(placed.headers["location"]).text).group(1)
+            await until_thread(lambda: screen(app) == "VisitReadyScreen", "the visit on the kiosk's welcome")
+            await pilot.pause()  # the keypad laid out
+            station.stop()
+            await type_code(pilot, code)
+            await until_thread(lambda: "cannot be reached" in text_of(app, "#visit-error"), "the station's absence said")
+            assert app.session.phase is Phase.WELCOME and screen(app) == "VisitReadyScreen"
+    finally:
+        close()
+        station.stop()
