@@ -43,6 +43,7 @@ class VisitReadyScreen(PatientScreen):
     VisitReadyScreen .visit-heading { text-style: bold; padding: 1 0 0 0; }
     VisitReadyScreen #visit-code { text-style: bold; height: 1; }
     VisitReadyScreen #visit-error { color: #a4161a; }
+    VisitReadyScreen Static { width: 1fr; }
     VisitReadyScreen #visit-keys { grid-size: 3 4; grid-gutter: 0 1; grid-columns: 12; grid-rows: 3;
                                    width: 40; height: 12; }
     VisitReadyScreen #visit-keys Button { width: 12; height: 3; min-width: 8; }
@@ -71,7 +72,7 @@ class VisitReadyScreen(PatientScreen):
                 yield Static("A visit is ready", classes="visit-heading", id="visit-heading")
                 for order in self.orders:
                     yield Static(order_line(order), classes="visit-order")
-                yield Label("Staff: with the patient here, type the code the ward station shows for this visit.")
+                yield Static("Staff: with the patient here, type the code the ward station shows for this visit.")
                 yield Static(" ", id="visit-code")
                 yield Label("", id="visit-error")
                 with Grid(id="visit-keys"):
@@ -80,7 +81,7 @@ class VisitReadyScreen(PatientScreen):
                         yield pad_key(Button(label, id=key_id, variant="primary" if label == "OK" else "default"))
             else:
                 yield Static("No visit is ready on this kiosk", classes="visit-heading", id="visit-heading")
-                yield Label("Staff: order a visit on the ward station, or start one on the clinician screen.")
+                yield Static("Staff: order a visit on the ward station, or start one on the clinician screen.")
             if self.walk_up:
                 yield Button("Start a test without an order", id="walk-up")
 
