@@ -14,8 +14,8 @@ from html import escape
 from kiosk.questionnaire import Questionnaire
 from station.results import Result
 
-WIDTH, HEIGHT = 640, 220
-LEFT, RIGHT, TOP, BOTTOM = 40, 16, 12, 34
+WIDTH, HEIGHT = 480, 220
+LEFT, RIGHT, TOP, BOTTOM = 44, 16, 12, 34
 BAND_FILLS = ("#fde8e7", "#fff1d6", "#fff7d6", "#eaf5e4", "#dff0e6")
 
 
