@@ -12,7 +12,7 @@ import pytest
 import sqlalchemy as sa
 
 from station import db
-from tests.station.conftest import PASSWORDS, PATIENCE_S, new_kiosk
+from tests.station.conftest import PASSWORDS, PATIENCE_S, make_ward, new_kiosk
 from tests.station.helpers import PATIENTS, KioskClient, Row, record_patient
 
 pytestmark = pytest.mark.slow
@@ -47,8 +47,10 @@ def alert_rows(db_url: str, kiosk: str) -> list:
     return [tuple(r) for r in rows]
 
 
-def test_sound_stays_on_own_actions_are_quiet_and_alerts_close_themselves(browser, shared_station):
-    station, ward = shared_station
+@pytest.mark.parametrize("database", ["sqlite", "postgres"])
+def test_sound_stays_on_own_actions_are_quiet_and_alerts_close_themselves(browser, request, station_factory, database):
+    ward = make_ward(request.getfixturevalue("sqlite_url" if database == "sqlite" else "pg_url"))
+    station = station_factory(ward.db_url)
     name, token = new_kiosk(ward.db_url)
     kiosk = KioskClient(station.url, token, name)
     rows = record_patient(PATIENTS / "barthel1.yaml", patient="NHC-5150")
