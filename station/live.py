@@ -49,7 +49,7 @@ class _Changed:
         self.resync |= kind == "resync"
         if kind == "result" and message.get("finished") and message.get("session"):
             self.finished.append(message["session"])
-        self.results |= kind in ("result", "sessions")
+        self.results |= kind in ("result", "sessions", "order")  # an order's page follows its state too
 
 
 class Live:

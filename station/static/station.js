@@ -168,6 +168,18 @@
       .catch(() => {});
   }
 
+  // a part of the page that follows what changed (an order's state): the page's own HTML again,
+  // that part swapped in place, so nothing reloads (and the sound stays on)
+  function refresh(part) {
+    fetch(window.location.href, { credentials: "same-origin" })
+      .then((response) => (response.ok ? response.text() : Promise.reject(response.status)))
+      .then((html) => {
+        const fresh = new DOMParser().parseFromString(html, "text/html").getElementById(part.id);
+        if (fresh && fresh.innerHTML !== part.innerHTML) part.innerHTML = fresh.innerHTML;
+      })
+      .catch(() => {});
+  }
+
   function showResults(data) {
     const count = document.getElementById("waiting-count");
     count.textContent = String(data.count);
@@ -179,6 +191,7 @@
       beep();
     }
     refill("results", "/fragments/results");
+    for (const part of document.querySelectorAll("[data-refresh]")) refresh(part);
     const inbox = document.getElementById("inbox");
     if (inbox) {
       refill("inbox", "/fragments/inbox?" + new URLSearchParams({ state: inbox.dataset.state, kiosk: inbox.dataset.kiosk }));

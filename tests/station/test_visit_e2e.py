@@ -109,8 +109,8 @@ def test_order_greet_confirm_answer_ring_sign_off_course(browser, request, stati
     assert doctor.locator("#waiting-count").inner_text() == "1"
     doctor.wait_for_selector("#inbox li.result:has-text('NHC-0042')")
     assert any("Result waiting: NHC-0042" in title for title in doctor.evaluate("window.__shown"))
-    nurse.reload()
-    assert nurse.locator("#order-state").inner_text() == "awaiting validation"
+    nurse.wait_for_selector("#order-state:text-is('awaiting validation')")  # the order's page follows live
+    assert nurse.locator("#order-code").count() == 0
     fits(doctor, viewport)
 
     # the doctor opens it, asks to sign off, sees the total, confirms
@@ -140,7 +140,6 @@ def test_order_greet_confirm_answer_ring_sign_off_course(browser, request, stati
     assert f"{total}/100" in visit and "signed off" in visit and "ordered" in visit
     assert doctor.locator("svg.course-plot circle.visit-point").count() == 1
     fits(doctor, viewport)
-    nurse.reload()
-    assert nurse.locator("#order-state").inner_text() == "signed off"
+    nurse.wait_for_selector("#order-state:text-is('signed off')")
     doctor_context.close()
     nurse_context.close()
