@@ -262,7 +262,8 @@ def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
     row = None
     if code.isdigit() and len(code) == CODE_DIGITS:
         row = connection.execute(sa.select(orders).where(
-            orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered", orders.c.code == code).with_for_update()).first()
+            orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered",
+            orders.c.code == code).with_for_update()).first()
     if row is None:
         connection.execute(code_failures.delete().where(code_failures.c.at < since))
         connection.execute(code_failures.insert().values(kiosk_id=kiosk_id, at=db.now()))

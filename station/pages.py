@@ -21,6 +21,7 @@ from kiosk.storage import StoredSession
 from station import db, orders, validation, ward
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
+from station.result_pages import ward_results
 from station.sessions import NotFound, load, load_for_export
 
 def kiosk_event(app: Starlette, name: str) -> dict[str, Any]:
@@ -43,8 +44,6 @@ async def ward_page(request: Request) -> Response:
     engine = request.app.state.engine
     views = await run_in_threadpool(ward.kiosk_views, engine)
     pending = await run_in_threadpool(ward.open_alerts, engine)
-    from station.result_pages import ward_results
-
     recent = await run_in_threadpool(ward_results, engine, request.app.state.questionnaire)
     return render(request, "ward.html", kiosks=views, alerts=pending, results=recent,
                   now=db.now(), message=request.query_params.get("message"))

@@ -70,7 +70,8 @@ def results_event(app: Any, finished: list[str]) -> dict[str, Any]:
     rung = []
     if finished:
         with engine.connect() as connection:
-            rows = connection.execute(sa.select(db.sessions.c.id, db.sessions.c.patient_id, db.sessions.c.kiosk_id).where(
+            columns = (db.sessions.c.id, db.sessions.c.patient_id, db.sessions.c.kiosk_id)
+            rows = connection.execute(sa.select(*columns).where(
                 db.sessions.c.id.in_(finished), db.sessions.c.status == "finished")).all()
         rung = [{"session": r.id, "href": f"/sessions/{r.id}",
                  "text": f"Result waiting: {r.patient_id}, kiosk {r.kiosk_id}"} for r in rows]
@@ -93,7 +94,7 @@ def ward_results(engine: Any, q: Any) -> list[results.Result]:
     with engine.connect() as connection:
         ids = connection.execute(sa.select(db.sessions.c.id).where(db.sessions.c.status != "pending").order_by(
             db.sessions.c.started_at.desc()).limit(RECENT)).all()
-    return results._results(engine, q, ids)
+    return results.results_of(engine, q, ids)
 
 
 async def ward_rows(request: Request) -> Response:

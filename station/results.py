@@ -65,7 +65,8 @@ def waiting_count(engine: Engine) -> int:
             sessions.c.status == "finished", sessions.c.id.not_in(_signed(engine)))).scalar_one())
 
 
-def _results(engine: Engine, q: Questionnaire, rows: list[Any]) -> list[Result]:
+def results_of(engine: Engine, q: Questionnaire, rows: list[Any]) -> list[Result]:
+    """The results of these session rows (anything with an ``id``), in their order."""
     ids = [r.id for r in rows]
     reviews = validation.reviews(engine, ids)
     kinds = orders.visit_kinds(engine, ids)
@@ -98,7 +99,7 @@ def inbox(engine: Engine, q: Questionnaire, *, state: str = "waiting", kiosk_id:
         query = query.where(sessions.c.id.in_(_signed(engine)))
     with engine.connect() as connection:
         rows = connection.execute(query).all()
-    return _results(engine, q, rows)
+    return results_of(engine, q, rows)
 
 
 def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
@@ -108,7 +109,7 @@ def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
         rows = connection.execute(sa.select(sessions.c.id).where(
             sessions.c.patient_id == patient_id, sessions.c.status != "pending").order_by(
             sessions.c.started_at)).all()
-    return _results(engine, q, rows)
+    return results_of(engine, q, rows)
 
 
 def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, str]]:
