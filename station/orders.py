@@ -20,7 +20,6 @@ order's id (``order-…``), so an order's history reads like a session's.
 from __future__ import annotations
 
 import json
-import re
 import secrets
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -30,14 +29,16 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
+from kiosk.visits import HOSPITAL_ID
 from station import db
 from station.db import audit, kiosks
 from station.sessions import LIFECYCLE
 
 #: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
 #: No spaces, dots or apostrophes, and a digit required, so "Maria Lopez", "O'Neill" or "LOPEZ"
-#: are refused: identifiers such as "NHC-0012345" or "12345678" are what a ward types.
-PATIENT_ID = re.compile(r"^(?=.*[0-9])[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
+#: are refused: identifiers such as "NHC-0012345" or "12345678" are what a ward types. The kiosk's
+#: clinician screen checks the same rule (one definition, in kiosk.visits).
+PATIENT_ID = HOSPITAL_ID
 STATES = ("ordered", "in_progress", "awaiting_validation", "signed_off", "cancelled")
 WORDS = {"ordered": "ordered", "in_progress": "in progress", "awaiting_validation": "awaiting validation",
          "signed_off": "signed off", "cancelled": "cancelled"}
