@@ -41,9 +41,9 @@ def settle(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[di
         before = connection.execute(sa.select(sa.func.max(alerts.c.received_at)).where(
             alerts.c.session_id == alert.session_id, alerts.c.kind == "person_lost",
             alerts.c.id != alert.id)).scalar()
-        query = sa.select(commands.c.by).where(
-            commands.c.session_id == alert.session_id, commands.c.kind == "person_away").order_by(
-            commands.c.id.desc())
+        query = sa.select(commands.c.by).where(  # sent, and not refused by the kiosk
+            commands.c.session_id == alert.session_id, commands.c.kind == "person_away",
+            sa.or_(commands.c.result.is_(None), commands.c.result == "done")).order_by(commands.c.id.desc())
         if before is not None:
             query = query.where(commands.c.at > _iso(before))
         sender = connection.execute(query).scalar()
