@@ -40,11 +40,13 @@ class Row:
 
 
 def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None,
-                   export: dict[str, str] | None = None, data_dir: Path | None = None) -> list[Row]:
+                   export: dict[str, str] | None = None, data_dir: Path | None = None,
+                   visit: str | None = None) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
     on the kiosk's real :class:`kiosk.storage.Store` with a station configured, its outbox read
-    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity. The store is
-    thrown away, unless ``data_dir`` names where to keep it (for the kiosk's own exports)."""
+    back and numbered from ``first_seq``; ``export`` is the kiosk's export identity, ``visit`` the
+    session's ``visit`` log entry (``order ID`` for an ordered visit). The store is thrown away,
+    unless ``data_dir`` names where to keep it (for the kiosk's own exports)."""
     import contextlib
     from dataclasses import replace
 
@@ -57,7 +59,7 @@ def record_patient(script: str | Path, first_seq: int = 1, patient: str | None =
     kept = contextlib.nullcontext(str(data_dir)) if data_dir is not None else tempfile.TemporaryDirectory()
     with kept as directory:
         with Store.open(directory, outbox=True, export=export) as store:
-            run_script(loaded, store=store)
+            run_script(loaded, store=store, visit=visit)
         with sqlite3.connect(Path(directory) / DB_NAME) as connection:
             stored = connection.execute("SELECT kind, session_id, payload, at FROM outbox ORDER BY seq").fetchall()
     rows, t = [], 0.0
@@ -91,6 +93,15 @@ class KioskClient:
         response = self.http.get("/api/v1/commands", params={"wait": wait}, timeout=wait + 30)
         response.raise_for_status()
         return response.json()["commands"]
+
+    def orders(self, wait: float = 0.0, version: str | None = None) -> dict[str, Any]:
+        params: dict[str, Any] = {"wait": wait} | ({"version": version} if version else {})
+        response = self.http.get("/api/v1/orders", params=params, timeout=wait + 30)
+        response.raise_for_status()
+        return response.json()
+
+    def start_order(self, code: str) -> httpx.Response:
+        return self.http.post("/api/v1/orders/start", json={"code": code})
 
     def ack(self, command_id: int, result: str = "done", reason: str | None = None) -> httpx.Response:
         body = {"result": result} | ({"reason": reason} if reason else {})

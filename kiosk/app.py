@@ -49,6 +49,7 @@ from kiosk.screens.paused import PausedScreen
 from kiosk.screens.pin import PinScreen
 from kiosk.screens.question import QuestionScreen
 from kiosk.screens.summary import SummaryScreen
+from kiosk.screens.visit_ready import VisitReadyScreen
 from kiosk.screens.welcome import WelcomeScreen
 from kiosk.session import (
     AnswerRecorded,
@@ -143,6 +144,9 @@ class KioskApp(App[int], inherit_bindings=False):
         new_session: Callable[[], Session] | None = None,
         show_score: bool = False,
         sync: Any = None,
+        visits: Any = None,
+        orders: Any = None,
+        start_order: Callable[[str], Any] | None = None,
     ) -> None:
         super().__init__()
         # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
@@ -167,6 +171,11 @@ class KioskApp(App[int], inherit_bindings=False):
         self.show_score = show_score
         #: the ward station's client (``kiosk.sync.SyncClient``), or None: no station, no threads
         self.sync = sync
+        #: how visits begin (``kiosk.visits.VisitDesk``; None: every welcome is a walk-up, as before);
+        #: ``orders`` the station's order watcher, ``start_order(code)`` the call that starts one
+        self.visits = visits
+        self.orders = orders
+        self._start_order = start_order
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is not None:  # its worker thread reports through these (it starts on mount)
             speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
@@ -204,12 +213,16 @@ class KioskApp(App[int], inherit_bindings=False):
         self._greet()
         if self.sync is not None:
             self.sync.start()
+        if self.orders is not None:
+            self.orders.start()
         self._render()
 
     def on_unmount(self) -> None:
         """Stop every channel (each stop is safe to call twice) and the station's client."""
         if self.sync is not None:
             self.sync.stop()
+        if self.orders is not None:
+            self.orders.stop()
         for source in self._input_sources():
             source.stop()
         if self.speaker is not None:
@@ -287,7 +300,8 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def on_welcome_screen_language_chosen(self, message: WelcomeScreen.LanguageChosen) -> None:
         """Start in the language the patient touched."""
-        self._start(message.language)
+        if not self._welcome_held():
+            self._start(message.language)
 
     def _replace_session(self, session: Session) -> None:
         old, self.session = self.session, session
@@ -297,10 +311,13 @@ class KioskApp(App[int], inherit_bindings=False):
                 self.store.release(old.id)  # a finished one is let go; one still running is interrupted
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
+        if self.visits is not None:
+            self.visits.next_visit()
 
     def _greet(self) -> None:
-        """A fresh session's welcome is said, and listened to: "start", or a language's name."""
-        if self.session.phase is Phase.WELCOME:
+        """A fresh session's welcome is said, and listened to: "start", or a language's name
+        (not while the welcome waits for staff to confirm an ordered visit)."""
+        if self.session.phase is Phase.WELCOME and not self._welcome_held():
             self._drive(self.session.welcome)
 
     def on_change_answer_button_requested(self, message: ChangeAnswerButton.Requested) -> None:
@@ -316,7 +333,10 @@ class KioskApp(App[int], inherit_bindings=False):
         self._drive(self.session.acknowledge)
 
     def forward(self, item: ChannelInput) -> None:
-        """Hand an input to the session (what a number means on each screen is the session's call)."""
+        """Hand an input to the session (what a number means on each screen is the session's call);
+        none starts a test while the welcome waits for staff (an ordered visit, no walk-ups)."""
+        if self.session.phase is Phase.WELCOME and self._welcome_held():
+            return
         self._drive(self.session.handle, item)
 
     def _start(self, language: str) -> None:
@@ -445,13 +465,15 @@ class KioskApp(App[int], inherit_bindings=False):
         shown = [s for s in self.screen_stack if isinstance(s, PatientScreen)]
         base, overlay = (shown + [None, None])[:2]
         key = (base_cls, base_cls.key(view))
+        if base_cls is WelcomeScreen and self._welcome_held():  # kiosk.visits: staff confirm first
+            base_cls, key = VisitReadyScreen, (VisitReadyScreen, self.visits.ready)
         if overlay is not None and (type(overlay) is not overlay_cls or key != self._screen_key):
             self.pop_screen()
             overlay = None
         if base is None:
-            self.push_screen(base_cls(view))
+            self.push_screen(self._make_screen(base_cls, view))
         elif key != self._screen_key:
-            self.switch_screen(base_cls(view))
+            self.switch_screen(self._make_screen(base_cls, view))
         else:
             base.show(view)
         self._screen_key = key
@@ -459,6 +481,68 @@ class KioskApp(App[int], inherit_bindings=False):
             overlay.show(view)
         elif overlay_cls is not None:
             self.push_screen(overlay_cls(view))
+
+    def _make_screen(self, base_cls: type[PatientScreen], view: PatientView) -> PatientScreen:
+        if base_cls is VisitReadyScreen:
+            return VisitReadyScreen(view, self.visits.ready, self.visits.walk_up)
+        return base_cls(view)
+
+    # -- visits: ordered, started by staff, walk-up (kiosk.visits) -------------------------------
+
+    def _welcome_held(self) -> bool:
+        return self.visits is not None and self.visits.holds_welcome()
+
+    def orders_changed(self, orders: Any, problems: Any = ()) -> None:
+        """The station's list of visits for this kiosk (UI thread): the welcome follows it."""
+        if self.visits is not None and self.visits.set_orders(orders, problems) \
+                and self.session.phase is Phase.WELCOME:
+            self._render()
+
+    def on_visit_ready_screen_code_entered(self, message: VisitReadyScreen.CodeEntered) -> None:
+        """Staff typed a visit's code: the station says which visit it starts (off the UI thread)."""
+        if self._start_order is None:
+            return
+        starter = self._start_order
+
+        def ask() -> None:
+            try:
+                order = starter(message.code)
+            except Exception as refused:  # noqa: BLE001 - OrderRefused or Unreachable: said to staff
+                self.call_from_thread(self._order_refused, str(refused) or type(refused).__name__)
+                return
+            self.call_from_thread(self._order_started, order)
+
+        self.run_worker(ask, thread=True, name="start an order", group="orders")
+
+    def _order_refused(self, why: str) -> None:
+        if isinstance(self.screen, VisitReadyScreen):
+            self.screen.refused(why if why.endswith(".") else f"The ward station cannot be reached ({why}).")
+
+    def _order_started(self, order: Any) -> None:
+        """The station started the visit: a session for its patient, in its language, begins."""
+        if self.session.phase is not Phase.WELCOME:
+            return
+        self._replace_session(self.visits.for_order(order))
+        self._drive(self.session.start, order.answered_by)
+
+    def on_visit_ready_screen_walk_up_chosen(self, message: VisitReadyScreen.WalkUpChosen) -> None:
+        if self.visits.choose_walk_up():
+            self._greet()
+            self._render()
+
+    def start_staff_visit(self, patient_id: str, language: str, relative: bool) -> str | None:
+        """Staff start a visit for the identifier they typed (clinician screen): why not, or None."""
+        if self.visits is None:
+            return "this kiosk cannot start visits for a patient identifier"
+        if self.session.phase is not Phase.WELCOME and not self.session.finished:
+            return "a test is in progress on this kiosk: finish it, or start a new patient, first"
+        session, why = self.visits.for_staff(patient_id, language, relative)
+        if session is None:
+            return why
+        self._replace_session(session)
+        self.close_clinician()
+        self._drive(self.session.start, session.answered_by)
+        return None
 
     # -- the clinician side -------------------------------------------------------------------
 
@@ -660,6 +744,7 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     from kiosk.questionnaire import QuestionnaireError
     from kiosk.qos_model import load_kiosk_model
     from kiosk.storage import PATIENT_ID, StorageError, new_patient_id
+    from kiosk.visits import STAFF, WALK_UP, VisitDesk
     from qos import Engine, ModelError
 
     if patient_id is not None and not PATIENT_ID.match(patient_id):
@@ -688,11 +773,14 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     voice_in = _voice_in(config, voice, statuses)
     clock = SystemClock()
 
-    def fresh(patient: str | None = None) -> Session:
+    def fresh(patient: str | None = None, language: str | None = None, answered_by: str = "patient",
+              visit: str | None = None) -> Session:
         return Session(questionnaire, clock=clock, engine=Engine(model),
-                       patient_id=patient or new_patient_id(), store=store, language=config.language,
-                       timing=config.timing, adaptation=Adaptation(policy) if policy else None,
-                       familiarisation=config.familiarisation, next_patient_after_s=config.next_patient_after_s)
+                       patient_id=patient or new_patient_id(), store=store, language=language or config.language,
+                       answered_by=answered_by, timing=config.timing,
+                       adaptation=Adaptation(policy) if policy else None, familiarisation=config.familiarisation,
+                       next_patient_after_s=config.next_patient_after_s,
+                       visit=visit or (STAFF if patient else WALK_UP))
 
     def resume(stored: StoredSession) -> Session:
         # the test goes on with the questionnaire it started with, whatever the file says now
@@ -703,11 +791,14 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
                                    next_patient_after_s=config.next_patient_after_s)
 
     guard = PinGuard(config.pin_secret, data_dir or config.data_dir)
+    visits = VisitDesk(fresh, walk_up=config.walk_up)
+    orders, start_order = _station_orders(config.station, questionnaire, lambda *found: app.call_from_thread(
+        app.orders_changed, *found))
     app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
                    voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
                    export_dir=(data_dir or config.data_dir) / "exports", export_site=site_from_config(config),
                    resume=resume, new_session=fresh, show_score=config.show_score_to_patient,
-                   sync=sync)
+                   sync=sync, visits=visits, orders=orders, start_order=start_order)
     return app, store.close
 
 
@@ -721,6 +812,21 @@ def _station_client(station: Any, store: Store, on_command: Callable[[Any], Any]
                         on_command=on_command)
     store.on_outbox = client.wake
     return client
+
+
+def _station_orders(station: Any, questionnaire: Questionnaire, on_orders: Callable[..., None]) -> tuple[Any, Any]:
+    """The watcher of this kiosk's ordered visits and the call that starts one with its code, or
+    (None, None) without a station (staff then start visits on the clinician screen)."""
+    if station is None:
+        return None, None
+    from kiosk.sync.http import Station
+    from kiosk.sync.orders import OrderWatcher, start_order
+
+    instruments, languages = [questionnaire.id], list(questionnaire.languages)
+    watcher = OrderWatcher(Station(station.url, station.token), instruments=instruments, languages=languages,
+                           on_orders=on_orders)
+    starter = Station(station.url, station.token)
+    return watcher, lambda code: start_order(starter, code, instruments=instruments, languages=languages)
 
 
 def _remotes(profiles: Path | None, wanted: bool, statuses: list[ChannelStatus],

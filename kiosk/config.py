@@ -31,6 +31,8 @@ Example ``config.yaml`` (every key optional)::
     interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
     next_patient_after_s: 90          # the end screen stays this long, then the welcome for the next patient
     show_score_to_patient: false      # the end screen shows the patient their total and band
+    walk_up: true                     # anyone may start a test at the welcome (marked walk-up); false:
+                                      # only ordered visits and visits staff start on the clinician screen
     station:                          # report to a ward station (docs/station-protocol.md)
       url: https://ward.example:8443  # without a url the kiosk talks to no station at all
       token: "…"                      # from `kiosk station add-kiosk NAME`
@@ -155,6 +157,9 @@ class Config:
     next_patient_after_s: float = 90.0
     #: the end screen shows the patient their total and band (default: only staff see them)
     show_score_to_patient: bool = False
+    #: an unordered test may be started at the welcome (stored and shown as a walk-up); false: only
+    #: a visit ordered from the station or started by staff on the clinician screen
+    walk_up: bool = True
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)
@@ -172,7 +177,7 @@ class Config:
 
 
 _PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
-_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient"}
+_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient", "walk_up"}
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}
 

@@ -18,7 +18,7 @@ import argparse
 import json
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -516,12 +516,13 @@ class _Driver:
 
 
 def run_script(script: Script, questionnaire: Questionnaire | None = None, *, store: Any = None,
-               model: str = DEFAULT_MODEL, policy: Any = None) -> ReplayResult:
+               model: str = DEFAULT_MODEL, policy: Any = None, visit: str | None = None) -> ReplayResult:
     """Run a script through a real Session and QoS engine on a simulated clock, adapting by
     ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on.
 
     ``model`` is the QoS model (a bundled name or a .roqme path, as ``qos_model:`` in the
     configuration); its timers fire on the simulated clock while nothing happens, as at the kiosk.
+    ``visit`` is the session's ``visit`` log entry (``kiosk.visits``), e.g. the order it runs.
     """
     from kiosk.adaptation import Adaptation, load_policy
     from kiosk.qos_model import load_kiosk_model
@@ -534,7 +535,7 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
         questionnaire, clock=clock, engine=Engine(model), store=store, patient_id=script.patient,
         language=script.language, answered_by=script.answered_by, timing=script.timing,
         adaptation=Adaptation(policy or load_policy(model=model)) if script.adaptation else None,
-        familiarisation=script.practice is not None,
+        familiarisation=script.practice is not None, visit=visit,
     )
     driver = _Driver(script, session, clock)
     try:
@@ -577,6 +578,24 @@ def _print_human(result: ReplayResult) -> None:
         print(f"  {name:<24} " + " ".join(f"{stats[k]:.4f}" for k in ("min", "max", "avg", "sd", "last")))
 
 
+class _NoOrder(Exception):
+    """The station did not give the ordered visit (message says why)."""
+
+
+def _take_order(code: str, config: Any, questionnaire: Questionnaire) -> Any:
+    """The ordered visit whose code staff gave, started at the configured station."""
+    if config.station is None:
+        raise _NoOrder("--order-code needs a station in the configuration (station: {url, token, kiosk_id})")
+    from kiosk.sync.http import Station, Unreachable
+    from kiosk.sync.orders import OrderRefused, start_order
+
+    try:
+        return start_order(Station(config.station.url, config.station.token), code,
+                           instruments=[questionnaire.id], languages=list(questionnaire.languages))
+    except (OrderRefused, Unreachable) as exc:
+        raise _NoOrder(f"the visit with code {code} was not started: {exc}") from None
+
+
 def main(argv: list[str]) -> int:
     """`kiosk replay FILE... [--json] [--trace OUT] [--data-dir DIR]`; exit 0, or 2 on a bad script."""
     parser = argparse.ArgumentParser(prog="kiosk replay", description="Run scripted patients through the real session core and QoS engine on a simulated clock.")
@@ -591,9 +610,14 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--station-wait", metavar="S", type=float, default=30.0,
                         help="with a station configured, how long to try delivering the stored sessions to it "
                              "before exiting (default 30; what is left goes with the next kiosk run)")
+    parser.add_argument("--order-code", metavar="CODE",
+                        help="run the script as the visit ordered for this kiosk whose code the station shows "
+                             "(one script; needs --data-dir and a station): its patient and language are the order's")
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
+    if args.order_code and (len(args.files) != 1 or not args.data_dir):
+        parser.error("--order-code takes one script and --data-dir")
     from kiosk.adaptation import PolicyError, load_policy
     from kiosk.config import ConfigError, configured_questionnaire, load_config
     from kiosk.qos_model import load_kiosk_model
@@ -625,11 +649,19 @@ def main(argv: list[str]) -> int:
             return 2
     results = []
     try:
+        order = _take_order(args.order_code, config, questionnaire) if args.order_code else None
         for file in args.files:
-            results.append(run_script(load_script(file, questionnaire), questionnaire, store=store,
-                                      model=config.qos_model, policy=policy))
+            script = load_script(file, questionnaire)
+            if order is not None:  # the ordered patient, language and answerer, never the script's own
+                script = replace(script, patient=order.patient_id, language=order.language,
+                                 answered_by=order.answered_by)
+            results.append(run_script(script, questionnaire, store=store, model=config.qos_model, policy=policy,
+                                      visit=order.visit if order is not None else None))
     except ScriptError as exc:
         print(exc, file=sys.stderr)
+        return 2
+    except _NoOrder as exc:
+        print(f"kiosk replay: {exc}", file=sys.stderr)
         return 2
     except SessionTaken as exc:  # another kiosk on this data directory took the session over
         print(f"kiosk replay: {exc}", file=sys.stderr)

@@ -34,9 +34,12 @@ class _Changed:
         self.kiosks: set[str] = set()
         self.alerts = False
         self.resync = False
+        #: results: sessions that finished (they ring), and whether any result changed at all
+        self.finished: list[str] = []
+        self.results = False
 
     def __bool__(self) -> bool:
-        return bool(self.kiosks) or self.alerts or self.resync
+        return bool(self.kiosks) or self.alerts or self.resync or self.results
 
     def take(self, message: dict[str, Any]) -> None:
         kind = message.get("type")
@@ -44,16 +47,22 @@ class _Changed:
             self.kiosks.add(message["kiosk"])
         self.alerts |= kind in ("alert", "ack")
         self.resync |= kind == "resync"
+        if kind == "result" and message.get("finished") and message.get("session"):
+            self.finished.append(message["session"])
+        self.results |= kind in ("result", "sessions", "order")  # an order's page follows its state too
 
 
 class Live:
     """Renders bus messages into page events and fans them out to the open pages."""
 
     def __init__(self, bus: Bus, render_kiosk: Callable[[str], dict[str, Any]],
-                 render_alerts: Callable[[], dict[str, Any]]) -> None:
+                 render_alerts: Callable[[], dict[str, Any]],
+                 render_results: Callable[[list[str]], dict[str, Any]] | None = None) -> None:
         self._bus = bus
         self._render_kiosk = render_kiosk
         self._render_alerts = render_alerts
+        #: the results event: the count waiting and the results that just finished (they ring)
+        self._render_results = render_results
         self._pages: set[asyncio.Queue[str]] = set()
         self._task: asyncio.Task[None] | None = None
         #: a thread of its own: rendering an alert never queues behind the kiosks' requests
@@ -91,6 +100,11 @@ class Live:
                 elif changed.alerts:
                     changed.alerts = False
                     text = sse("alerts", await self._render(self._render_alerts))
+                elif changed.results:
+                    finished, changed.finished, changed.results = changed.finished, [], False
+                    if self._render_results is None:
+                        continue
+                    text = sse("results", await self._render(self._render_results, finished))
                 else:
                     text = sse("kiosk", await self._render(self._render_kiosk, changed.kiosks.pop()))
             except Exception:  # a page must keep its feed even if one render fails

@@ -13,7 +13,6 @@ import json
 from typing import Any
 from urllib.parse import quote
 
-import sqlalchemy as sa
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
@@ -25,15 +24,12 @@ from kiosk.export import ExportError, practice_outcomes
 from kiosk.questionnaire import Questionnaire, Score
 from kiosk.review import review_state
 from kiosk.storage import StoredSession
-from station import db, exports, validation, ward
+from station import db, exports, orders, validation, ward
 from station.download import attachment
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
+from station.result_pages import ward_results
 from station.sessions import NotFound, load
-
-#: session-list size on the ward page
-RECENT = 50
-
 
 def kiosk_event(app: Starlette, name: str) -> dict[str, Any]:
     """A kiosk's tile, rendered for the live feed."""
@@ -51,19 +47,12 @@ def alerts_event(app: Starlette) -> dict[str, Any]:
                         "text": f"{a.text} — {a.kiosk_id}"} for a in pending]}
 
 
-def _session_rows(engine: Any, limit: int = RECENT) -> list[Any]:
-    with engine.connect() as connection:
-        return connection.execute(sa.select(db.sessions).where(db.sessions.c.status != "pending").order_by(
-            db.sessions.c.started_at.desc()).limit(limit)).all()
-
-
 async def ward_page(request: Request) -> Response:
     engine = request.app.state.engine
     views = await run_in_threadpool(ward.kiosk_views, engine)
     pending = await run_in_threadpool(ward.open_alerts, engine)
-    recent = await run_in_threadpool(_session_rows, engine)
-    reviews = await run_in_threadpool(validation.reviews, engine, [row.id for row in recent])
-    return render(request, "ward.html", kiosks=views, alerts=pending, sessions=recent, reviews=reviews,
+    recent = await run_in_threadpool(ward_results, engine, request.app.state.questionnaire)
+    return render(request, "ward.html", kiosks=views, alerts=pending, results=recent,
                   now=db.now(), today=db.now_iso()[:10], message=request.query_params.get("message"))
 
 
@@ -93,7 +82,7 @@ async def command(request: Request) -> Response:
         return _back(request, str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "command", "kiosk": kiosk},
                             {"type": "ack", "kiosk": kiosk})
-    return _back(request, f"Sent '{form.get('kind')}' to {kiosk}.")
+    return _back(request, ward.COMMAND_WORDS[form.get("kind", "")].format(kiosk=kiosk))
 
 
 def _fits(item: Any, option: int | None) -> bool:
@@ -170,6 +159,7 @@ async def session_page(request: Request) -> Response:
                   incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
                   reviewable=stored.status in validation.REVIEWABLE and not current.final,
                   reopened=bool(current.reopenings) and not current.final,
+                  visit=(await run_in_threadpool(orders.visit_kinds, engine, [session_id])).get(session_id),
                   message=request.query_params.get("message"))
 
 
@@ -205,6 +195,8 @@ async def sign_off(request: Request) -> Response:
         await run_in_threadpool(validation.sign_off, request.app.state.engine, session_id, request.state.user)
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
+    await run_in_threadpool(orders.signed_off, request.app.state.engine, session_id, request.state.user)
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Signed off.", to=page)
 
 

@@ -17,6 +17,9 @@ from station import auth, logins, ward
 
 templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
 templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
+#: a command as staff name it (the buttons' words), never its protocol name
+templates.env.globals["command_labels"] = {"continue": "Continue session", "person_away": "Patient away",
+                                           "person_back": "Patient back", "end": "End session"}
 
 
 class Forbidden(Exception):
@@ -50,5 +53,9 @@ async def checked_form(request: Request) -> dict[str, str]:
 
 def render(request: Request, name: str, status: int = 200, **context: Any) -> Response:
     context.setdefault("user", getattr(request.state, "user", None))
+    if context["user"] is not None and "waiting" not in context:  # the navigation's count
+        from station.results import waiting_count
+
+        context["waiting"] = waiting_count(request.app.state.engine)
     context["csrf"] = csrf_token(request)
     return templates.TemplateResponse(request, name, context, status_code=status)

@@ -25,7 +25,7 @@ from sqlalchemy.engine import Connection
 
 from kiosk.definition import canonical, canonical_json, digest, questionnaire_from
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import db
+from station import alert_rules, db, orders
 from station.checks import (
     ID_MAX,
     NEEDS_DEFINITION,
@@ -184,6 +184,8 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
             updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE))))
     if new:
         messages += _alerts(connection, kiosk_id, new, received)
+        messages += alert_rules.settle(connection, kiosk_id, new)  # staff's own doing, situations ended
+        messages += orders.on_rows(connection, kiosk_id, new)  # visits, orders, results waiting
     return seqs, messages
 
 

@@ -19,6 +19,11 @@ from station.db import alerts, audit, commands, kiosks
 #: a kiosk without a heartbeat for this long shows offline (the kiosk sends one at least every 10 s)
 OFFLINE_AFTER_S = 30.0
 COMMAND_KINDS = ("continue", "person_away", "person_back", "end")
+#: what staff read about a command they sent (never its name in the protocol)
+COMMAND_WORDS = {"continue": "Asked {kiosk} to continue the session.",
+                 "person_away": "Told {kiosk} the patient is away from it.",
+                 "person_back": "Told {kiosk} the patient is back.",
+                 "end": "Asked {kiosk} to end the session."}
 ALERT_TEXT = {"doctor_called": "Doctor called", "person_lost": "Patient left the kiosk"}
 #: the fields of a status report the ward view shows, with their types
 STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
@@ -133,7 +138,7 @@ def queue_command(engine: Engine, kiosk_id: str, session_id: str, kind: str, by:
         command_id = connection.execute(commands.insert().values(
             kiosk_id=kiosk_id, session_id=session_id, kind=kind, by=by, at=at)).inserted_primary_key[0]
         connection.execute(audit.insert().values(session_id=session_id, at=at, author=by, action="command",
-                                                 reason=f"{kind} sent to {kiosk_id}"))
+                                                 reason=COMMAND_WORDS[kind].format(kiosk=kiosk_id)))
         if kind == "continue":
             connection.execute(alerts.update().where(
                 alerts.c.session_id == session_id, alerts.c.kind == "doctor_called",

@@ -27,7 +27,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.questionnaire import Questionnaire, load_questionnaire
-from station import api, auth, logins, pages, throttle
+from station import api, api_orders, auth, logins, order_pages, pages, result_pages, signoff_pages, throttle
 from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
@@ -176,7 +176,11 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
         Route("/events", events),
         Route("/healthz", healthz),
         *pages.routes,
+        *order_pages.routes,
+        *result_pages.routes,
+        *signoff_pages.routes,
         *api.routes,
+        *api_orders.routes,
         Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),
     ]
     middleware = [
@@ -189,5 +193,6 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
-    app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app))
+    app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app),
+                          lambda finished: result_pages.results_event(app, finished))
     return app

@@ -72,6 +72,7 @@ from kiosk.export.result import (
 from kiosk.questionnaire import Code, Questionnaire
 from kiosk.review import Review, ReviewState
 from kiosk.storage import StoredSession
+from kiosk.visits import visit_of
 
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
@@ -270,9 +271,19 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
     return _labelled(resource, stored)
 
 
+#: how the visit began (kiosk.visits), as a meta tag: "order", "staff" or "walk-up"
+VISIT_SYSTEM = "urn:barthel-kiosk:visit"
+
+
 def _labelled(resource: dict[str, Any], stored: StoredSession) -> dict[str, Any]:
+    meta: dict[str, Any] = {}
     if stored.simulated:
-        resource["meta"] = {"security": [TEST_DATA]}
+        meta["security"] = [TEST_DATA]
+    visit = visit_of(stored.log)
+    if visit:
+        meta["tag"] = [{"system": VISIT_SYSTEM, "code": visit.split(" ", 1)[0], "display": visit}]
+    if meta:
+        resource["meta"] = meta
     return resource
 
 

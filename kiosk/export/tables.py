@@ -27,6 +27,7 @@ from kiosk.export.result import (
 from kiosk.questionnaire import Questionnaire
 from kiosk.review import Review
 from kiosk.storage import StoredSession
+from kiosk.visits import visit_of
 
 #: the tags that keep ids text in CSV readers; see the module docstring
 ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
@@ -43,7 +44,7 @@ ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
 CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
                "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks", "finished_at",
                "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by",
-               "simulated"]
+               "simulated", "visit"]
 
 
 def tag(kind: str, value: str) -> str:
@@ -62,7 +63,9 @@ def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str,
             "finished_at": stored.finished_at or "", "status": stored.status, "language": stored.language,
             "answered_by": stored.answered_by.value, "questionnaire": q.id,
             "questionnaire_version": questionnaire_version(q), "complete": "true" if r.complete else "false",
-            "review_state": r.review_state, "simulated": "true" if stored.simulated else "false"}
+            "review_state": r.review_state, "simulated": "true" if stored.simulated else "false",
+            # how the visit began (kiosk.visits): "order <id>", "staff", "walk-up"; blank before visits existed
+            "visit": visit_of(stored.log) or ""}
 
 
 def _writer(out: io.StringIO, columns: list[str]) -> csv.DictWriter:
@@ -113,7 +116,7 @@ def wide_columns(q: Questionnaire) -> list[str]:
     """The wide CSV's columns: the session's, then each item's option number and points."""
     return ["session", "patient", "kiosk_id", "started_at", "finished_at", "status", "language", "answered_by",
             "questionnaire", "questionnaire_version", "complete", "review_state", "signed_by", "signed_at", "simulated",
-            "total", "answered_points", "missing", "band", "band_set"] + [
+            "visit", "total", "answered_points", "missing", "band", "band_set"] + [
         f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
 
 

@@ -40,6 +40,8 @@ class ClinicianHomeScreen(ClinicianScreen):
                              id="adaptation", disabled=session.adaptation is None)
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
+                yield Button("Start a visit", id="start-visit",
+                             disabled=app.visits is None)  # type: ignore[attr-defined]
                 yield Button("Back", id="back")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             with Horizontal(id="presence-actions"):
@@ -122,7 +124,11 @@ class ClinicianHomeScreen(ClinicianScreen):
         waiting, parked = store.outbox_waiting()
         state = f"not reachable ({sync.problem})" if sync.problem else "reachable"
         text = f"Ward station {sync.station.url}: {state}; {waiting} stored changes waiting to be sent"
-        return text + (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
+        text += (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
+        visits = self.app.visits  # type: ignore[attr-defined]
+        if visits is not None and visits.problems:  # ordered visits this kiosk cannot run (kiosk.visits)
+            text += " Orders this kiosk cannot run: " + "; ".join(visits.problems) + "."
+        return text
 
     def _channels_text(self) -> str:
         lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
@@ -158,6 +164,12 @@ class ClinicianHomeScreen(ClinicianScreen):
     @on(Button.Pressed, "#new-session")
     def _new_session(self) -> None:
         self.app.start_new_session()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#start-visit")
+    def _start_visit(self) -> None:
+        from kiosk.screens.start_visit import StartVisitScreen
+
+        self.app.push_screen(StartVisitScreen())
 
     @on(Button.Pressed, "#back")
     def _back(self) -> None:

@@ -46,6 +46,8 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
     published (``None``: it stays).
     ``session_id``, ``t_offset``, ``resume_answers`` and ``resume_not_answered`` are for
     :meth:`from_stored` (continuing a stored session); other callers leave them alone.
+    ``visit`` says how the visit began (``kiosk.visits``: an order, staff, a walk-up); it is
+    logged at the start, in the start's transaction, so the result is always marked.
     """
 
     def __init__(
@@ -66,6 +68,7 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         t_offset: float = 0.0,
         resume_answers: Mapping[str, Answer] | None = None,
         resume_not_answered: tuple[str, ...] = (),
+        visit: str | None = None,
     ) -> None:
         if language not in questionnaire.languages:
             raise ValueError(f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
@@ -80,6 +83,8 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         self.timing = timing if isinstance(timing, Timing) else questionnaire.timing.with_overrides(timing)
         self.adaptation = adaptation
         self.next_patient_after_s = next_patient_after_s
+        #: how this visit began, logged as it starts ("order ID", "staff", "walk-up"; see kiosk.visits)
+        self.visit = visit
         self._language = language
         self._answered_by = AnsweredBy(answered_by)
         self._familiarisation = familiarisation and bool(questionnaire.familiarisation)
@@ -364,6 +369,8 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         state = "RESTARTED" if self._resuming else "STARTED"
         self._context(t, {"PersonDetected": True, "TestState": state})
         self._log(t, "start", f"answered by {self._answered_by.value}")
+        if self.visit and not self._resuming:
+            self._log(t, "visit", self.visit)
         if self._familiarisation:
             self._set_phase(t, Phase.FAMILIARISATION)
             self._message(t, "familiarisation")

@@ -123,6 +123,12 @@ def test_a_clinician_corrects_an_item_and_only_a_doctor_signs_off(browser, ward)
     page.goto(f"{station.url}/sessions/{session}")
     row = page.locator("#item-stairs")
     row.locator("summary").click()
+    # on the phone the open form fits the screen and every control takes a thumb (44 px and more)
+    assert page.evaluate("document.documentElement.scrollWidth") <= PHONE["width"]
+    for control in ("select[name=option]", "input[name=reason]", "button[type=submit]"):
+        box = row.locator(control).bounding_box()
+        assert box["x"] >= 0 and box["x"] + box["width"] <= PHONE["width"] and box["height"] >= 44, (control, box)
+    assert row.locator("button[type=submit]").inner_text() == "Record change"
     row.locator("select[name=option]").select_option(str(new))
     row.locator("input[name=reason]").fill("patient uses the lift; confirmed by physio")
     row.locator("button[type=submit]").click()
@@ -136,10 +142,16 @@ def test_a_clinician_corrects_an_item_and_only_a_doctor_signs_off(browser, ward)
     changed = page.locator("#item-stairs")
     assert f"was {recorded} → {new} by nurse.kim" in changed.inner_text()
     assert "kiosk recorded" in changed.inner_text()
-    page.locator("#sign-off").click()
-    page.locator("text=Signed off by").wait_for()
-    text = page.locator("main").inner_text()
-    assert "amended" in text and "dr.lopez" in text
+    total = page.locator("#total").inner_text()
+    page.locator("#sign-off").click()  # asks first: the total, the change, what it will be called
+    assert total in page.locator("#confirm-total").inner_text()
+    assert page.locator("#confirm-state").inner_text() == "amended"
+    assert f"option {recorded} → option {new}" in page.locator("#confirm-changes").inner_text()
+    page.locator("#confirm-sign-off").click()
+    page.locator("#review-words").wait_for()
+    text = page.locator("#review-words").inner_text()
+    assert text.startswith("Amended: signed off with 1 change by dr.lopez")
+    assert page.locator("h1 .badge[class*=review-]").inner_text() == "amended"  # the words and the badge agree
     trail = page.locator("table.trail").inner_text()
     assert "nurse.kim" in trail and "stairs" in trail and "sign off" in trail
     assert page.locator("details summary").count() == 0  # final: nothing left to change

@@ -137,7 +137,7 @@ def test_a_command_queued_by_staff_answers_a_waiting_long_poll_and_is_redelivere
     assert client.ack(got[0]["id"], "done").status_code == 200
     assert client.commands(wait=0) == []
     page = staff.http.get(f"/sessions/{session_id}").text
-    assert "continue by nurse.kim: done" in page
+    assert "Continue session by nurse.kim: done" in page  # the button's words, not the protocol's
 
 
 def test_status_reports_show_on_the_ward_page(ward_station):

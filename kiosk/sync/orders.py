@@ -1,0 +1,87 @@
+"""The kiosk's side of orders (protocol §4): a thread that long-polls the station for the visits
+ordered for this kiosk, and the call that starts one with the code staff typed.
+
+The thread never touches the session or the screens: it hands each new list to ``on_orders``,
+which the app runs on its own thread (``app.call_from_thread``).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Sequence
+
+from kiosk.sync.client import Backoff
+from kiosk.sync.http import Station, Unreachable
+from kiosk.visits import Order, parse_orders
+
+#: how long one long poll for orders may wait at the station
+POLL_WAIT_S = 20.0
+
+
+class OrderRefused(Exception):
+    """The station did not start the order (wrong code, too many tries, refused): one sentence for staff."""
+
+
+class OrderWatcher:
+    """Keeps ``on_orders(orders, problems)`` told of the visits waiting for this kiosk."""
+
+    def __init__(self, station: Station, *, instruments: Sequence[str], languages: Sequence[str],
+                 on_orders: Callable[[list[Order], list[str]], None], poll_wait_s: float = POLL_WAIT_S,
+                 backoff: tuple[float, float] = (0.5, 30.0)) -> None:
+        self.station = station
+        self._instruments, self._languages = list(instruments), list(languages)
+        self._on_orders = on_orders
+        self._poll_wait_s = poll_wait_s
+        self._backoff = backoff
+        self._stopping = threading.Event()
+        self._thread: threading.Thread | None = None
+        #: the last problem reaching the station (None while all is well)
+        self.problem: str | None = None
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._poll_forever, name="station orders", daemon=True)
+        self._thread.start()
+
+    def stop(self, timeout: float = 5.0) -> None:
+        self._stopping.set()
+        self.station.abort()
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+    def _poll_forever(self) -> None:
+        backoff = Backoff(*self._backoff)
+        version: str | None = None
+        while not self._stopping.is_set():
+            query = f"/api/v1/orders?wait={self._poll_wait_s:g}" + (f"&version={version}" if version else "")
+            try:
+                status, body = self.station.request("GET", query, timeout=self._poll_wait_s + 15)
+            except Unreachable as exc:
+                self.problem = str(exc)
+                self._stopping.wait(backoff.next())
+                continue
+            if status != 200 or not isinstance(body, dict):
+                self.problem = f"the station answered {status} to the orders poll"
+                self._stopping.wait(backoff.next())
+                continue
+            self.problem = None
+            backoff.reset()
+            if body.get("version") != version and not self._stopping.is_set():
+                version = str(body.get("version"))
+                self._on_orders(*parse_orders(body, self._instruments, self._languages))
+
+
+def start_order(station: Station, code: str, *, instruments: Sequence[str], languages: Sequence[str]) -> Order:
+    """Start the visit whose code staff typed, checked as :func:`kiosk.visits.parse_orders` checks
+    the list; :class:`OrderRefused` (or ``Unreachable``) with why not."""
+    status, body = station.request("POST", "/api/v1/orders/start", {"code": code})
+    error = body.get("error") if isinstance(body, dict) else None
+    if status == 404:
+        raise OrderRefused("That code is not one of this kiosk's visits: check it on the ward station.")
+    if status == 429:
+        raise OrderRefused(f"Too many wrong codes: {error or 'wait a few minutes'}.")
+    if status != 200 or not isinstance(body, dict):
+        raise OrderRefused(f"The ward station answered {status}{': ' + error if error else ''}.")
+    found, problems = parse_orders({"orders": [body.get("order")]}, instruments, languages)
+    if not found:
+        raise OrderRefused(f"The ward station's order cannot be run here: {'; '.join(problems)}.")
+    return found[0]

@@ -1,0 +1,71 @@
+"""A patient's course as a server-rendered SVG step plot per instrument: the total of each signed
+or waiting visit over calendar time, with the questionnaire's bands shaded behind.
+
+Steps, not lines: a total holds until the next visit measures it again, and a line between visits
+would invent values nobody measured. Incomplete visits have no total and are not drawn; a visit
+whose result is not yet signed off is drawn hollow. Everything is escaped.
+"""
+
+from __future__ import annotations
+
+from datetime import datetime
+from html import escape
+
+from kiosk.questionnaire import Questionnaire
+from station.results import Result
+
+WIDTH, HEIGHT = 480, 220
+LEFT, RIGHT, TOP, BOTTOM = 44, 16, 12, 34
+BAND_FILLS = ("#fde8e7", "#fff1d6", "#fff7d6", "#eaf5e4", "#dff0e6")
+
+
+def _when(result: Result) -> datetime:
+    return datetime.fromisoformat((result.finished_at or result.started_at).replace("Z", "+00:00"))
+
+
+def course_svg(q: Questionnaire, results: list[Result]) -> str:
+    """The plot of ``results`` for questionnaire ``q`` as an inline ``<svg>`` (a note when no visit
+    has a total yet)."""
+    points = [(r, _when(r)) for r in results if r.questionnaire_id == q.id and r.total is not None]
+    if not points:
+        return f'<p class="muted">No complete {escape(q.id)} total yet.</p>'
+    top = max(r.max_total for r, _ in points) or 1
+    first, last = points[0][1], points[-1][1]
+    span = max((last - first).total_seconds(), 1.0)
+    t_end = span * 1.08 if len(points) > 1 else 1.0
+    plot_w, plot_h = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
+
+    def x(when: datetime) -> float:
+        return LEFT + plot_w * ((when - first).total_seconds() / t_end if len(points) > 1 else 0.5)
+
+    def y(total: float) -> float:
+        return TOP + plot_h * (1 - total / top)
+
+    parts = [f'<svg class="course-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
+             f'aria-label="{escape(q.id)} totals over time" xmlns="http://www.w3.org/2000/svg">']
+    for index, band in enumerate(q.bands_named(None).bands):
+        y1, y2 = y(min(band.max, top) + 0.5), y(max(band.min, 0) - 0.5)
+        parts.append(f'<rect x="{LEFT}" y="{max(TOP, y1):.1f}" width="{plot_w}" '
+                     f'height="{max(0.0, min(TOP + plot_h, y2) - max(TOP, y1)):.1f}" '
+                     f'fill="{BAND_FILLS[index % len(BAND_FILLS)]}"><title>{escape(band.id)}</title></rect>')
+    for tick in (0, top // 2, top):
+        parts.append(f'<text x="{LEFT - 6}" y="{y(tick) + 4:.1f}" text-anchor="end">{tick}</text>')
+    steps: list[str] = []
+    for index, (result, when) in enumerate(points):
+        if index:
+            steps.append(f"{x(when):.1f},{y(points[index - 1][0].total or 0):.1f}")
+        steps.append(f"{x(when):.1f},{y(result.total or 0):.1f}")
+    steps.append(f"{LEFT + plot_w:.1f},{y(points[-1][0].total or 0):.1f}" if len(points) > 1 else "")
+    parts.append(f'<polyline fill="none" stroke="#1b6ac9" stroke-width="2" points="{" ".join(steps).strip()}"/>')
+    for result, when in points:
+        final = result.review in ("signed_off", "amended")
+        label = escape(f"{when:%Y-%m-%d}: {result.total}/{result.max_total}"
+                       f"{' ' + result.band if result.band else ''}, {result.review_words}")
+        parts.append(f'<circle cx="{x(when):.1f}" cy="{y(result.total or 0):.1f}" r="5" '
+                     f'fill="{"#1b6ac9" if final else "#fff"}" stroke="#1b6ac9" stroke-width="2" '
+                     f'class="visit-point"><title>{label}</title></circle>')
+    parts.append(f'<text x="{LEFT}" y="{HEIGHT - 10}">{first:%Y-%m-%d}</text>')
+    if len(points) > 1:
+        parts.append(f'<text x="{LEFT + plot_w}" y="{HEIGHT - 10}" text-anchor="end">{last:%Y-%m-%d}</text>')
+    parts.append("</svg>")
+    return "".join(parts)

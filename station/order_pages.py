@@ -1,0 +1,87 @@
+"""The staff pages of orders: order a visit (phone or desk), see its code and state, cancel it.
+
+Thin handlers as in :mod:`station.pages`: check the form (CSRF), call :mod:`station.orders`,
+publish what changed (the kiosk's long poll wakes), redirect (post/redirect/get).
+"""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Any
+from urllib.parse import quote
+
+from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
+from starlette.responses import PlainTextResponse, RedirectResponse, Response
+from starlette.routing import Route
+
+from station import orders, validation, ward
+from station.api_orders import ORDER_LANE
+from station.rendering import checked_form, render
+
+
+def _kiosk_names(engine: Any) -> list[str]:
+    return [k.name for k in ward.kiosk_views(engine) if not k.revoked]
+
+
+async def orders_page(request: Request) -> Response:
+    """The order form and the orders, open ones first (filter: ``state``, ``kiosk``)."""
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    state = request.query_params.get("state") or ""
+    kiosk = request.query_params.get("kiosk") or ""
+    states = [state] if state in orders.STATES else (list(orders.OPEN) if state == "" else None)
+    found = await run_in_threadpool(lambda: orders.listing(engine, kiosk_id=kiosk or None, states=states))
+    return render(request, "orders.html", orders=found, kiosks=await run_in_threadpool(_kiosk_names, engine),
+                  instruments=[(q.id, q.title.get("en", q.id))], languages=q.languages, state=state, kiosk=kiosk,
+                  words=orders.WORDS, form=dict(request.query_params), error=request.query_params.get("error"),
+                  message=request.query_params.get("message"))
+
+
+async def create_order(request: Request) -> Response:
+    form = await checked_form(request)
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    multi = await request.form()
+    def place() -> orders.Order:
+        order = orders.create(
+            engine, kiosk_id=form.get("kiosk", ""), patient_id=form.get("patient_id", ""),
+            instruments=[str(v) for v in multi.getlist("instrument")], language=form.get("language", ""),
+            relative=form.get("relative") == "yes", by=request.state.user, known_instruments=[q.id],
+            languages=q.languages)
+        request.app.state.bus.publish({"type": "order", "kiosk": order.kiosk_id})
+        return order
+
+    try:
+        # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
+        order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
+    except orders.OrderError as exc:
+        keep = "&".join(f"{k}={quote(form.get(k, ''))}" for k in ("kiosk", "patient_id", "language"))
+        return RedirectResponse(f"/orders?error={quote(str(exc))}&{keep}", status_code=303)
+    return RedirectResponse(f"/orders/{order.id}", status_code=303)
+
+
+async def order_page(request: Request) -> Response:
+    engine = request.app.state.engine
+    order = await run_in_threadpool(orders.get, engine, request.path_params["order_id"])
+    if order is None:
+        return PlainTextResponse(f"no order {request.path_params['order_id']}", status_code=404)
+    trail = await run_in_threadpool(validation.trail, engine, order.id)
+    return render(request, "order.html", order=order, trail=trail, message=request.query_params.get("message"))
+
+
+async def cancel_order(request: Request) -> Response:
+    form = await checked_form(request)
+    engine, order_id = request.app.state.engine, request.path_params["order_id"]
+    try:
+        order = await run_in_threadpool(orders.cancel, engine, order_id, request.state.user, form.get("reason", ""))
+    except orders.OrderError as exc:
+        return RedirectResponse(f"/orders/{quote(order_id)}?message={quote(str(exc))}", status_code=303)
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "order", "kiosk": order.kiosk_id})
+    return RedirectResponse(f"/orders/{quote(order_id)}?message={quote('Cancelled.')}", status_code=303)
+
+
+routes = [
+    Route("/orders", orders_page, methods=["GET"]),
+    Route("/orders", create_order, methods=["POST"]),
+    Route("/orders/{order_id}", order_page, methods=["GET"]),
+    Route("/orders/{order_id}/cancel", cancel_order, methods=["POST"]),
+]

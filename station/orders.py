@@ -1,0 +1,369 @@
+"""Visits ordered from the ward: who orders what for which patient on which kiosk, and the order's
+way from ``ordered`` to ``signed off``.
+
+An order names the patient by the identifier the hospital gives (pseudonymous: see
+:func:`check_patient_id`), one kiosk, the instruments (a list, so a battery fits; today the
+station's one questionnaire), the language and whether a relative answers. Its states::
+
+    ordered -> in_progress -> awaiting_validation -> signed_off
+       |            |
+       +-> cancelled <-+          (an abandoned session puts an order back to ordered)
+
+The kiosk takes an order only with the short code the station shows on the order's page, typed at
+the kiosk by staff who see the patient (:func:`start`): so a result never lands under a patient who
+is not there. The kiosk's session then says which order it is for (a ``visit`` entry of its log,
+protocol §4); :func:`on_rows` links it when that row arrives and moves the order on as the session
+finishes or is abandoned. Every step is a row of the append-only audit trail, keyed by the
+order's id (``order-…``), so an order's history reads like a session's.
+"""
+
+from __future__ import annotations
+
+import json
+import secrets
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from typing import Any
+
+import sqlalchemy as sa
+from sqlalchemy.engine import Connection, Engine
+
+from kiosk.visits import HOSPITAL_ID
+from station import db
+from station.db import audit, kiosks
+from station.sessions import LIFECYCLE
+
+#: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
+#: No spaces, dots or apostrophes, and a digit required, so "Maria Lopez", "O'Neill" or "LOPEZ"
+#: are refused: identifiers such as "NHC-0012345" or "12345678" are what a ward types. The kiosk's
+#: clinician screen checks the same rule (one definition, in kiosk.visits).
+PATIENT_ID = HOSPITAL_ID
+STATES = ("ordered", "in_progress", "awaiting_validation", "signed_off", "cancelled")
+WORDS = {"ordered": "ordered", "in_progress": "in progress", "awaiting_validation": "awaiting validation",
+         "signed_off": "signed off", "cancelled": "cancelled"}
+OPEN = ("ordered", "in_progress")
+#: digits of the confirmation code typed at the kiosk
+CODE_DIGITS = 4
+#: wrong codes a kiosk may send within the window before the station stops checking them
+MAX_CODE_FAILURES = 5
+CODE_WINDOW_S = 10 * 60
+#: who may order (every staff role) and who signs off (doctors: station.validation)
+ORDER_ROLES = ("nurse", "doctor")
+#: orders one member of staff may place within the window (a ward round is a few dozen at most:
+#: more is a script or a session left open on a stolen phone)
+MAX_ORDERS_PER_USER = 30
+ORDER_WINDOW_S = 10 * 60
+
+orders = sa.Table(
+    "orders", db.metadata,
+    sa.Column("id", sa.String(32), primary_key=True),
+    sa.Column("kiosk_id", sa.String(64), nullable=False),
+    sa.Column("patient_id", sa.String(64), nullable=False),
+    #: JSON list of questionnaire ids, in the order the kiosk gives them
+    sa.Column("instruments", sa.Text, nullable=False),
+    sa.Column("language", sa.String(8), nullable=False),
+    sa.Column("answered_by", sa.String(16), nullable=False),
+    sa.Column("code", sa.String(8), nullable=False),
+    sa.Column("state", sa.String(24), nullable=False),
+    sa.Column("ordered_by", sa.String(64), nullable=False),
+    sa.Column("ordered_at", sa.String(40), nullable=False),
+    sa.Column("session_id", sa.String(64)),
+    sa.Column("updated_at", sa.String(40), nullable=False),
+)
+
+#: how each session at the station began: "order" (with its order), "staff" (started by staff at the
+#: kiosk for a patient id they typed) or "walk-up" (whoever tapped the welcome, where allowed)
+visits = sa.Table(
+    "visits", db.metadata,
+    sa.Column("session_id", sa.String(64), primary_key=True),
+    sa.Column("kind", sa.String(16), nullable=False),
+    sa.Column("order_id", sa.String(32)),
+)
+
+code_failures = sa.Table(
+    "order_code_failures", db.metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("kiosk_id", sa.String(64), nullable=False),
+    sa.Column("at", sa.Float, nullable=False),
+)
+
+
+class OrderError(ValueError):
+    """An order or a step the station refuses (one sentence naming the field and the problem)."""
+
+
+class TooManyCodes(OrderError):
+    """The kiosk sent too many wrong codes lately."""
+
+    status = 429
+
+
+class LinkRefused(OrderError):
+    """A kiosk's session claims an order it may not (another kiosk's, another patient's): the
+    sync refuses the row (422, so the kiosk parks it) and nothing is filed under the order."""
+
+    status = 422
+
+
+@dataclass(frozen=True)
+class Order:
+    id: str
+    kiosk_id: str
+    patient_id: str
+    instruments: tuple[str, ...]
+    language: str
+    answered_by: str
+    code: str
+    state: str
+    ordered_by: str
+    ordered_at: str
+    session_id: str | None
+    updated_at: str
+
+    @classmethod
+    def of(cls, row: Any) -> Order:
+        values = dict(row._mapping)
+        values["instruments"] = tuple(json.loads(values["instruments"]))
+        return cls(**values)
+
+    @property
+    def words(self) -> str:
+        return WORDS.get(self.state, self.state)
+
+    @property
+    def relative(self) -> bool:
+        return self.answered_by == "relative"
+
+    def for_kiosk(self) -> dict[str, Any]:
+        """What the kiosk is told of the order (never the code: staff bring it from the station)."""
+        return {"id": self.id, "patient_id": self.patient_id, "instruments": list(self.instruments),
+                "language": self.language, "answered_by": self.answered_by, "ordered_by": self.ordered_by,
+                "ordered_at": self.ordered_at}
+
+
+def check_patient_id(value: str) -> str:
+    """The identifier, stripped, if it is pseudonymous (:data:`PATIENT_ID`); else OrderError."""
+    value = value.strip()
+    if not value:
+        raise OrderError("patient identifier: give the identifier the hospital uses (e.g. NHC-0012345)")
+    if not PATIENT_ID.match(value):
+        raise OrderError(f"patient identifier {value[:64]!r}: use the hospital's identifier, 2-64 letters, digits, "
+                         "'-' or '_' with at least one digit, never a name")
+    return value
+
+
+def _audit(connection: Connection, order_id: str, author: str, action: str, reason: str) -> None:
+    connection.execute(audit.insert().values(session_id=order_id, at=db.now_iso(), author=author[:64],
+                                             action=action, reason=reason[:1000]))
+
+
+def create(engine: Engine, *, kiosk_id: str, patient_id: str, instruments: Sequence[str], language: str,
+           relative: bool, by: Any, known_instruments: Sequence[str], languages: Sequence[str]) -> Order:
+    """Order a visit (a nurse or a doctor); returns it with its confirmation code."""
+    if by.role not in ORDER_ROLES:
+        raise OrderError("only nurses and doctors may order a visit")
+    patient_id = check_patient_id(patient_id)
+    chosen = [i for i in dict.fromkeys(instruments) if i]
+    if not chosen:
+        raise OrderError("instruments: choose at least one")
+    unknown = [i for i in chosen if i not in known_instruments]
+    if unknown:
+        raise OrderError(f"instruments: {', '.join(unknown)} is not one this station knows "
+                         f"({', '.join(known_instruments)})")
+    if language not in languages:
+        raise OrderError(f"language {language!r}: choose one of {', '.join(languages)}")
+    now = db.now_iso()
+    since = datetime.fromtimestamp(db.now() - ORDER_WINDOW_S, UTC).isoformat(timespec="milliseconds")
+    with engine.begin() as connection:
+        recent = connection.execute(sa.select(sa.func.count()).select_from(orders).where(
+            orders.c.ordered_by == by.name, orders.c.ordered_at > since)).scalar_one()
+        if recent >= MAX_ORDERS_PER_USER:
+            raise OrderError(f"you have ordered {recent} visits in the last {ORDER_WINDOW_S // 60} minutes: "
+                             "wait a little, or ask a colleague")
+        row = connection.execute(sa.select(kiosks.c.revoked_at).where(kiosks.c.name == kiosk_id)).first()
+        if row is None or row.revoked_at is not None:
+            raise OrderError(f"kiosk {kiosk_id!r}: no such kiosk with a valid token")
+        taken = set(connection.execute(sa.select(orders.c.code).where(
+            orders.c.kiosk_id == kiosk_id, orders.c.state.in_(OPEN))).scalars())
+        code = _new_code(taken)
+        order_id = "order-" + secrets.token_hex(6)
+        connection.execute(orders.insert().values(
+            id=order_id, kiosk_id=kiosk_id, patient_id=patient_id, instruments=json.dumps(chosen),
+            language=language, answered_by="relative" if relative else "patient", code=code, state="ordered",
+            ordered_by=by.name, ordered_at=now, updated_at=now))
+        _audit(connection, order_id, by.name, "order",
+               f"{', '.join(chosen)} for {patient_id} on {kiosk_id} ({language}"
+               f"{', a relative answers' if relative else ''})")
+        return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
+
+
+def _new_code(taken: set[str]) -> str:
+    """A code no open order of the kiosk has (the kiosk finds the order by it)."""
+    while True:
+        code = f"{secrets.randbelow(10 ** CODE_DIGITS):0{CODE_DIGITS}d}"
+        if code not in taken:
+            return code
+
+
+def get(engine: Engine, order_id: str) -> Order | None:
+    with engine.connect() as connection:
+        row = connection.execute(sa.select(orders).where(orders.c.id == order_id)).first()
+    return Order.of(row) if row else None
+
+
+def listing(engine: Engine, *, kiosk_id: str | None = None, states: Sequence[str] | None = None,
+            patient_id: str | None = None, limit: int = 200) -> list[Order]:
+    """Orders, newest first, optionally of one kiosk, in some states, of one patient."""
+    query = sa.select(orders).order_by(orders.c.ordered_at.desc()).limit(limit)
+    if kiosk_id:
+        query = query.where(orders.c.kiosk_id == kiosk_id)
+    if states:
+        query = query.where(orders.c.state.in_(list(states)))
+    if patient_id:
+        query = query.where(orders.c.patient_id == patient_id)
+    with engine.connect() as connection:
+        return [Order.of(r) for r in connection.execute(query)]
+
+
+def ready_for(connection: Connection, kiosk_id: str) -> list[Order]:
+    """The kiosk's orders waiting to be started, oldest first."""
+    return [Order.of(r) for r in connection.execute(sa.select(orders).where(
+        orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered").order_by(orders.c.ordered_at))]
+
+
+def cancel(engine: Engine, order_id: str, by: Any, reason: str) -> Order:
+    """Cancel an order not yet done (who and why go to the trail)."""
+    if by.role not in ORDER_ROLES:
+        raise OrderError("only nurses and doctors may cancel a visit")
+    with engine.begin() as connection:
+        row = connection.execute(sa.select(orders).where(orders.c.id == order_id)).first()
+        if row is None:
+            raise OrderError(f"no order {order_id}")
+        if row.state not in OPEN:
+            raise OrderError(f"the order is {WORDS[row.state]}: only an ordered or running visit can be cancelled")
+        connection.execute(orders.update().where(orders.c.id == order_id).values(
+            state="cancelled", updated_at=db.now_iso()))
+        _audit(connection, order_id, by.name, "order_cancel", reason.strip() or "cancelled")
+        return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
+
+
+def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
+    """The kiosk's staff typed ``code``: the kiosk's ordered visit with that code moves to in
+    progress and is returned; None for a wrong code, which is counted (in the caller's
+    transaction, so commit it); after :data:`MAX_CODE_FAILURES` within
+    :data:`CODE_WINDOW_S` the kiosk gets :class:`TooManyCodes` until the window passes. Another
+    kiosk's order is never found: the code is looked up among this kiosk's orders only."""
+    since = db.now() - CODE_WINDOW_S
+    failures = connection.execute(sa.select(sa.func.count()).select_from(code_failures).where(
+        code_failures.c.kiosk_id == kiosk_id, code_failures.c.at > since)).scalar_one()
+    if failures >= MAX_CODE_FAILURES:
+        raise TooManyCodes(f"too many wrong codes from this kiosk: wait {CODE_WINDOW_S // 60} minutes")
+    code = str(code).strip()
+    row = None
+    if code.isdigit() and len(code) == CODE_DIGITS:
+        row = connection.execute(sa.select(orders).where(
+            orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered",
+            orders.c.code == code).with_for_update()).first()
+    if row is None:
+        connection.execute(code_failures.delete().where(code_failures.c.at < since))
+        connection.execute(code_failures.insert().values(kiosk_id=kiosk_id, at=db.now()))
+        return None
+    connection.execute(orders.update().where(orders.c.id == row.id).values(state="in_progress",
+                                                                          updated_at=db.now_iso()))
+    _audit(connection, row.id, f"kiosk {kiosk_id}", "order_start",
+           f"staff confirmed patient {row.patient_id} at {kiosk_id} with the order's code")
+    return Order.of(connection.execute(sa.select(orders).where(orders.c.id == row.id)).one())
+
+
+def visit_of(detail: str) -> tuple[str, str | None]:
+    """The kind of visit and its order from a ``visit`` log entry's detail ("order order-…",
+    "staff", "walk-up")."""
+    kind, _, order_id = detail.partition(" ")
+    return (kind, order_id or None) if kind in ("order", "staff", "walk-up") else ("unknown", None)
+
+
+def on_rows(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[dict[str, Any]]:
+    """What the kiosk's new rows (``station.sync.Event``) mean for visits and orders, in the sync's
+    transaction: a session's ``visit`` entry records how it began and links its order (refused
+    when the order is another kiosk's or another patient's); a finished session is a result
+    waiting (its order awaits validation); an abandoned one puts its order back to ordered.
+    Returns the bus messages to publish."""
+    messages: list[dict[str, Any]] = []
+    if any(e.kind in LIFECYCLE for e in new):  # the Results lists show statuses: they follow live
+        messages.append({"type": "sessions", "kiosk": kiosk_id})
+    for event in sorted(new, key=lambda e: e.seq):
+        p = event.payload
+        if event.kind == "record_event" and p.get("kind") == "visit":
+            kind, order_id = visit_of(str(p.get("detail", "")))
+            if kind == "order":
+                _link(connection, kiosk_id, event, order_id)
+                messages.append({"type": "order", "kiosk": kiosk_id})
+            db.insert_ignore(connection, visits, [{"session_id": event.session_id, "kind": kind,
+                                                   "order_id": order_id}], ["session_id"])
+        elif event.kind == "finish_session":
+            messages.append({"type": "result", "kiosk": kiosk_id, "session": event.session_id, "finished": True})
+            _move(connection, event.session_id, "in_progress", "awaiting_validation", "order_result",
+                  f"session {event.session_id} finished on {kiosk_id}: the result waits for validation")
+        elif event.kind == "abandon":
+            if _move(connection, event.session_id, "in_progress", "ordered", "order_ready",
+                     f"session {event.session_id} ended without a result: the visit can be started again"):
+                messages.append({"type": "order", "kiosk": kiosk_id})
+        elif event.kind == "create_session":
+            linked = connection.execute(sa.select(orders.c.id, orders.c.patient_id).where(
+                orders.c.session_id == event.session_id)).first()
+            if linked is not None and linked.patient_id != p.get("patient_id"):
+                raise LinkRefused(f"seq {event.seq}: order {linked.id} is for patient {linked.patient_id}, "
+                                  f"not {p.get('patient_id')}: the result is not filed under it")
+    return messages
+
+
+def _link(connection: Connection, kiosk_id: str, event: Any, order_id: str | None) -> None:
+    row = connection.execute(sa.select(orders).where(orders.c.id == (order_id or ""))).first()
+    if row is None or row.kiosk_id != kiosk_id:
+        raise LinkRefused(f"seq {event.seq}: no order {order_id} for kiosk {kiosk_id}")
+    patient = connection.execute(sa.select(db.sessions.c.patient_id).where(
+        db.sessions.c.id == event.session_id)).scalar()
+    if patient is not None and patient != row.patient_id:
+        raise LinkRefused(f"seq {event.seq}: order {order_id} is for patient {row.patient_id}, "
+                      f"not {patient}: the result is not filed under it")
+    if row.state == "ordered":
+        raise LinkRefused(f"seq {event.seq}: order {order_id} was not started with its code at the kiosk")
+    if row.state != "in_progress":
+        return  # cancelled (or done) meanwhile: the session is kept, the order stays as it is
+    if row.session_id not in (None, event.session_id):
+        raise LinkRefused(f"seq {event.seq}: order {order_id} is running as session {row.session_id}")
+    connection.execute(orders.update().where(orders.c.id == row.id).values(session_id=event.session_id,
+                                                                          updated_at=db.now_iso()))
+    _audit(connection, row.id, f"kiosk {kiosk_id}", "order_session",
+           f"session {event.session_id} started for {row.patient_id} on {kiosk_id}")
+
+
+def _move(connection: Connection, session_id: str, source: str, target: str, action: str, reason: str) -> bool:
+    row = connection.execute(sa.select(orders.c.id, orders.c.kiosk_id).where(
+        orders.c.session_id == session_id, orders.c.state == source)).first()
+    if row is None:
+        return False
+    values: dict[str, Any] = {"state": target, "updated_at": db.now_iso()}
+    if target == "ordered":
+        values["session_id"] = None
+    connection.execute(orders.update().where(orders.c.id == row.id).values(**values))
+    _audit(connection, row.id, f"kiosk {row.kiosk_id}", action, reason)
+    return True
+
+
+def signed_off(engine: Engine, session_id: str, by: Any) -> None:
+    """The session's result was signed off: its order (if any) is done."""
+    with engine.begin() as connection:
+        _move(connection, session_id, "awaiting_validation", "signed_off", "order_signed",
+              f"result of session {session_id} signed off by {by.name}")
+
+
+def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:
+    """How each session began: (kind, order id); sessions without a ``visit`` entry are absent
+    (kiosks older than orders)."""
+    if not session_ids:
+        return {}
+    with engine.connect() as connection:
+        rows = connection.execute(sa.select(visits).where(visits.c.session_id.in_(list(session_ids))))
+        return {r.session_id: (r.kind, r.order_id) for r in rows}

@@ -1,0 +1,109 @@
+"""The clinician's pages of results: the inbox of results waiting for validation (filter by kiosk
+and review state), patient search, and one patient's course (every visit, a step plot per
+instrument). Read-only: validating a result stays on its session page (:mod:`station.pages`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import sqlalchemy as sa
+from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
+from starlette.responses import HTMLResponse, PlainTextResponse, RedirectResponse, Response
+from starlette.routing import Route
+
+from station import db, orders, results, ward
+from station.course_plot import course_svg
+from station.rendering import render, templates
+
+#: sessions in the ward page's Results list
+RECENT = 50
+
+
+async def inbox_page(request: Request) -> Response:
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    state = request.query_params.get("state", "waiting")
+    if state not in results.INBOX_STATES:
+        state = "waiting"
+    kiosk = request.query_params.get("kiosk") or ""
+    found = await run_in_threadpool(lambda: results.inbox(engine, q, state=state, kiosk_id=kiosk or None))
+    names = await run_in_threadpool(lambda: [k.name for k in ward.kiosk_views(engine)])
+    return render(request, "inbox.html", results=found, state=state, kiosk=kiosk, kiosks=names)
+
+
+async def patients_page(request: Request) -> Response:
+    """Search by patient identifier; an exact identifier goes straight to the patient's page."""
+    engine = request.app.state.engine
+    text = request.query_params.get("q", "").strip()
+    found = await run_in_threadpool(results.search, engine, text) if text else []
+    if len(found) == 1 and found[0][0].lower() == text.lower():
+        return RedirectResponse(f"/patients/{found[0][0]}", status_code=303)
+    return render(request, "patients.html", q=text, found=found)
+
+
+async def patient_page(request: Request) -> Response:
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    patient_id = request.path_params["patient_id"]
+    visits = await run_in_threadpool(results.course, engine, q, patient_id)
+    ordered = await run_in_threadpool(lambda: orders.listing(engine, patient_id=patient_id))
+    if not visits and not ordered:
+        return PlainTextResponse(f"no visit of patient {patient_id} has reached this station", status_code=404)
+    return render(request, "patient.html", patient_id=patient_id, visits=visits, orders=ordered,
+                  plots=[(q.id, q.title.get("en", q.id), course_svg(q, visits))])
+
+
+routes = [
+    Route("/inbox", inbox_page),
+    Route("/patients", patients_page),
+    Route("/patients/{patient_id}", patient_page),
+]
+
+
+# -- live: the results event and the fragments the open pages fetch when it comes ----------------
+
+def results_event(app: Any, finished: list[str]) -> dict[str, Any]:
+    """The count of results waiting, and the ones that just finished (the pages ring for them).
+    Cheap on purpose (two small queries, no session folded): it is rendered on the live feed's
+    one thread, which alerts share."""
+    engine = app.state.engine
+    rung = []
+    if finished:
+        with engine.connect() as connection:
+            columns = (db.sessions.c.id, db.sessions.c.patient_id, db.sessions.c.kiosk_id)
+            rows = connection.execute(sa.select(*columns).where(
+                db.sessions.c.id.in_(finished), db.sessions.c.status == "finished")).all()
+        rung = [{"session": r.id, "href": f"/sessions/{r.id}",
+                 "text": f"Result waiting: {r.patient_id}, kiosk {r.kiosk_id}"} for r in rows]
+    return {"count": results.waiting_count(engine), "rung": rung}
+
+
+async def inbox_rows(request: Request) -> Response:
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    state = request.query_params.get("state", "waiting")
+    kiosk = request.query_params.get("kiosk") or None
+    found = await run_in_threadpool(lambda: results.inbox(
+        engine, q, state=state if state in results.INBOX_STATES else "waiting", kiosk_id=kiosk))
+    template = templates.get_template("_result_row.html")
+    html = "".join(template.render(r=r) for r in found) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
+    return HTMLResponse(html)
+
+
+def ward_results(engine: Any, q: Any) -> list[results.Result]:
+    """The ward page's Results: the latest sessions of every status, newest first."""
+    with engine.connect() as connection:
+        ids = connection.execute(sa.select(db.sessions.c.id).where(db.sessions.c.status != "pending").order_by(
+            db.sessions.c.started_at.desc()).limit(RECENT)).all()
+    return results.results_of(engine, q, ids)
+
+
+async def ward_rows(request: Request) -> Response:
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    found = await run_in_threadpool(ward_results, engine, q)
+    return HTMLResponse(templates.get_template("_ward_results.html").render(results=found))
+
+
+routes += [
+    Route("/fragments/inbox", inbox_rows),
+    Route("/fragments/results", ward_rows),
+]

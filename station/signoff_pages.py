@@ -1,0 +1,45 @@
+"""Sign-off asks first: a confirmation step showing the total the result will have, its band, and
+every change made, with what the result will be called (signed off as recorded, or amended).
+Signing off cannot be undone by a tap, so the doctor sees what they sign before they do.
+
+GET shows the step (no change); its form POSTs to the sign-off route (:mod:`station.pages`).
+"""
+
+from __future__ import annotations
+
+from urllib.parse import quote
+
+from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
+from starlette.responses import PlainTextResponse, RedirectResponse, Response
+from starlette.routing import Route
+
+from station import validation
+from station.rendering import render
+from station.sessions import NotFound, load
+
+
+async def confirm_page(request: Request) -> Response:
+    engine, q = request.app.state.engine, request.app.state.questionnaire
+    session_id = request.path_params["session_id"]
+
+    def read() -> tuple[str, object]:
+        with engine.connect() as connection:
+            return load(connection, session_id)
+
+    try:
+        kiosk, stored = await run_in_threadpool(read)
+    except NotFound:
+        return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
+    current = await run_in_threadpool(validation.review, engine, session_id)
+    if current.final or stored.status not in validation.REVIEWABLE:  # type: ignore[attr-defined]
+        return RedirectResponse(f"/sessions/{session_id}", status_code=303)
+    if not request.state.user.is_doctor:
+        return RedirectResponse(f"/sessions/{session_id}?message={quote('Only a doctor can sign off.')}",
+                                status_code=303)
+    score = validation.corrected(stored, q, current)["score"]
+    labels = {item.id: item.text.get("en", item.id) for item in q.items}
+    return render(request, "sign_off.html", s=stored, kiosk=kiosk, review=current, score=score, labels=labels)
+
+
+routes = [Route("/sessions/{session_id}/sign-off", confirm_page, methods=["GET"])]
