@@ -153,6 +153,41 @@ class DatabaseError(RuntimeError):
     """The database cannot be opened or migrated (message says which and why)."""
 
 
+#: visits staff ordered for a kiosk (station.orders owns their states)
+orders = sa.Table(
+    "orders", metadata,
+    sa.Column("id", sa.String(32), primary_key=True),
+    sa.Column("kiosk_id", sa.String(64), nullable=False),
+    sa.Column("patient_id", sa.String(64), nullable=False),
+    #: JSON list of questionnaire ids, in the order the kiosk gives them
+    sa.Column("instruments", sa.Text, nullable=False),
+    sa.Column("language", sa.String(8), nullable=False),
+    sa.Column("answered_by", sa.String(16), nullable=False),
+    sa.Column("code", sa.String(8), nullable=False),
+    sa.Column("state", sa.String(24), nullable=False),
+    sa.Column("ordered_by", sa.String(64), nullable=False),
+    sa.Column("ordered_at", sa.String(40), nullable=False),
+    sa.Column("session_id", sa.String(64)),
+    sa.Column("updated_at", sa.String(40), nullable=False),
+)
+
+#: how each session at the station began: "order" (with its order), "staff" (started by staff at the
+#: kiosk for a patient id they typed) or "walk-up" (whoever tapped the welcome, where allowed)
+visits = sa.Table(
+    "visits", metadata,
+    sa.Column("session_id", sa.String(64), primary_key=True),
+    sa.Column("kind", sa.String(16), nullable=False),
+    sa.Column("order_id", sa.String(32)),
+)
+
+code_failures = sa.Table(
+    "order_code_failures", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("kiosk_id", sa.String(64), nullable=False),
+    sa.Column("at", sa.Float, nullable=False),
+)
+
+
 def now_iso() -> str:
     """The wall-clock time, ISO-8601 UTC, as every stored time."""
     return datetime.now(UTC).isoformat(timespec="milliseconds")

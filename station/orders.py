@@ -31,7 +31,7 @@ from sqlalchemy.engine import Connection, Engine
 
 from kiosk.visits import HOSPITAL_ID
 from station import db
-from station.db import audit, kiosks
+from station.db import audit, code_failures, kiosks, orders, visits
 from station.sessions import LIFECYCLE
 
 #: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
@@ -54,40 +54,6 @@ ORDER_ROLES = ("nurse", "doctor")
 #: more is a script or a session left open on a stolen phone)
 MAX_ORDERS_PER_USER = 30
 ORDER_WINDOW_S = 10 * 60
-
-orders = sa.Table(
-    "orders", db.metadata,
-    sa.Column("id", sa.String(32), primary_key=True),
-    sa.Column("kiosk_id", sa.String(64), nullable=False),
-    sa.Column("patient_id", sa.String(64), nullable=False),
-    #: JSON list of questionnaire ids, in the order the kiosk gives them
-    sa.Column("instruments", sa.Text, nullable=False),
-    sa.Column("language", sa.String(8), nullable=False),
-    sa.Column("answered_by", sa.String(16), nullable=False),
-    sa.Column("code", sa.String(8), nullable=False),
-    sa.Column("state", sa.String(24), nullable=False),
-    sa.Column("ordered_by", sa.String(64), nullable=False),
-    sa.Column("ordered_at", sa.String(40), nullable=False),
-    sa.Column("session_id", sa.String(64)),
-    sa.Column("updated_at", sa.String(40), nullable=False),
-)
-
-#: how each session at the station began: "order" (with its order), "staff" (started by staff at the
-#: kiosk for a patient id they typed) or "walk-up" (whoever tapped the welcome, where allowed)
-visits = sa.Table(
-    "visits", db.metadata,
-    sa.Column("session_id", sa.String(64), primary_key=True),
-    sa.Column("kind", sa.String(16), nullable=False),
-    sa.Column("order_id", sa.String(32)),
-)
-
-code_failures = sa.Table(
-    "order_code_failures", db.metadata,
-    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
-    sa.Column("kiosk_id", sa.String(64), nullable=False),
-    sa.Column("at", sa.Float, nullable=False),
-)
-
 
 class OrderError(ValueError):
     """An order or a step the station refuses (one sentence naming the field and the problem)."""
