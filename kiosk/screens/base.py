@@ -53,8 +53,6 @@ class PatientView:
     questionnaire: Questionnaire
     #: what the channels allow now (the instructions are built from it)
     ways: Ways = Ways()
-    #: a notice to show above the answers (an adaptation, "we cannot see you"), or None
-    banner: str | None = None
     #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
     voice_again: bool = False
     #: the number of answers of the question on screen, when the patient pressed a number it
@@ -98,8 +96,11 @@ def patient_notices(view: PatientView) -> str | None:
             ways = ("touch", "remote") if view.ways.remote else ("touch",)
             notices.append(ways_sentence(lang, "voice_off", ways, "_answer"))
             continue
-        notices.append(view.questionnaire.message(name, lang)
-                       or ui_text(lang, name, default=name.replace("_", " ")))
+        # the patient's words come from their language's text, or there is no notice: a policy's
+        # name ("longer_attempts") is never shown
+        words = view.questionnaire.message(name, lang) or ui_text(lang, name, default="")
+        if words:
+            notices.append(words)
     return " ".join(notices) or None
 
 
@@ -119,6 +120,8 @@ class PatientScreen(Screen):
     #: the screen asks the patient for an answer (its top bar shows the ways they can give one)
     ASKS = False
     VERTICAL_BREAKPOINTS = [(0, "-short"), (ROOMY_ROWS, "-roomy")]
+    #: the screen shows the notices banner (the end screen does not: it no longer concerns the patient)
+    NOTICES = True
 
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``."""
@@ -161,7 +164,7 @@ class PatientScreen(Screen):
         for ways in self.query("#ways").results(Label):
             ways.update(self.ways_text(view))
         for banner in self.query(AdaptationBanner):
-            banner.show(patient_notices(view))
+            banner.show(patient_notices(view) if self.NOTICES else None)
         for button in self.query(VoiceAgainButton):
             button.show(view.voice_again)
         for sign in self.query(WaitingSign):
