@@ -79,6 +79,11 @@ CLINICIAN_CHORD = "ctrl+k"
 POLL_INTERVAL = 0.1
 #: the source name the voice-out statuses carry when no speaker is wired
 VOICE_OUT_SOURCE = "espeak-ng"
+#: seconds the PIN pad waits for a touch or key before it goes back to the patient (a patient who
+#: tapped the corner five times is not left on it)
+PIN_IDLE_S = 60.0
+#: the same for the clinician screens behind the PIN (staff walked away: the patient's screen returns)
+CLINICIAN_IDLE_S = 300.0
 
 
 @dataclass
@@ -120,6 +125,8 @@ class KioskApp(App[int], inherit_bindings=False):
 
     CSS_PATH = "kiosk.tcss"
     TITLE = "Barthel kiosk"
+    #: no text selection: taps (the five on the staff corner) must not leave a highlighted word
+    ALLOW_SELECT = False
     BINDINGS = [Binding(CLINICIAN_CHORD, "clinician", "Clinician", show=False, priority=True)]
     ENABLE_COMMAND_PALETTE = False
 
@@ -183,6 +190,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self._held: Session | None = None
         #: the patient pressed a number the question on screen does not have (a hint shows)
         self._no_such_option = False
+        #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
+        self._staff_seen = 0.0
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -261,6 +270,8 @@ class KioskApp(App[int], inherit_bindings=False):
     def patient_key(self, key: str) -> bool:
         """A key pressed on a patient screen; True if it meant something to the kiosk."""
         item = self.keyboard.translate(key) if self.keyboard is not None else None
+        if item is None and key not in KIOSK_KEY_BUTTONS:  # "C" (or "shift+c") is C
+            key = key.removeprefix("shift+").lower() if len(key.removeprefix("shift+")) == 1 else key
         if item is None and key in KIOSK_KEY_BUTTONS:
             meaning = KIOSK_KEY_BUTTONS[key]
             detail = f"key {key}"
@@ -328,6 +339,7 @@ class KioskApp(App[int], inherit_bindings=False):
         """Let the session's due time-outs happen (the poll timer calls this), and move the
         waiting sign's dot on with the session's clock."""
         self._drive(self.session.poll)
+        self._staff_idle()
         if isinstance(self.screen, PatientScreen):
             for sign in self.screen.query(WaitingSign):
                 sign.tick(self.session.now())
@@ -476,8 +488,18 @@ class KioskApp(App[int], inherit_bindings=False):
             else:
                 self._release_session()
 
+        self._staff_seen = self.session.now()
         self.push_screen(PinScreen(self.pin_guard), unlocked)
         self._hold_session()
+
+    def _staff_idle(self) -> None:
+        """Back to the patient once the staff screens have had no touch or key for their idle time
+        (the session's clock: a simulated one in tests and replays)."""
+        if not self.clinician_open:
+            return
+        idle = PIN_IDLE_S if isinstance(self.screen, PinScreen) else CLINICIAN_IDLE_S
+        if self.session.now() - self._staff_seen >= idle:
+            self.close_clinician()
 
     async def on_event(self, event: events.Event) -> None:
         """Watch every press for the staff corner before the screens see it (a button under the
@@ -485,6 +507,9 @@ class KioskApp(App[int], inherit_bindings=False):
         if isinstance(event, events.MouseDown) and not self.clinician_open \
                 and self._corner.tap(event.screen_x, event.screen_y):
             self.action_clinician()
+        elif self.clinician_open and isinstance(event, (events.Key, events.MouseDown, events.MouseScrollDown,
+                                                          events.MouseScrollUp)):
+            self._staff_seen = self.session.now()
         await super().on_event(event)
 
     def quit_kiosk(self) -> None:

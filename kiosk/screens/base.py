@@ -6,11 +6,11 @@ from __future__ import annotations
 from collections.abc import Hashable
 from dataclasses import dataclass
 
-from textual import events
+from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.screen import Screen
-from textual.widgets import Label
+from textual.widgets import Button, Label
 
 from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
@@ -122,6 +122,8 @@ class PatientScreen(Screen):
     VERTICAL_BREAKPOINTS = [(0, "-short"), (ROOMY_ROWS, "-roomy")]
     #: the screen shows the notices banner (the end screen does not: it no longer concerns the patient)
     NOTICES = True
+    #: the top bar shows "Attempt 1 of 2" (not while the doctor is called: nothing is being asked)
+    SHOWS_ATTEMPT = True
 
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``."""
@@ -160,7 +162,7 @@ class PatientScreen(Screen):
             progress.update(self.progress_text(view))
         for attempt in self.query("#attempt").results(Label):
             attempt.update(ui_text(self.language, "attempt_of", number=snap.attempt, total=ATTEMPTS)
-                           if snap.attempt else "")
+                           if snap.attempt and self.SHOWS_ATTEMPT else "")
         for ways in self.query("#ways").results(Label):
             ways.update(self.ways_text(view))
         for banner in self.query(AdaptationBanner):
@@ -192,17 +194,39 @@ class PatientScreen(Screen):
         kiosk's own P, R and D, which keep working in every language."""
         key = event.key
         for command, letter in (("pause", "p"), ("repeat", "r"), ("call_doctor", "d")):
-            if key == ui_text(self.language, f"key_{command}"):
+            if key.removeprefix("shift+").lower() == ui_text(self.language, f"key_{command}"):
                 key = letter
         if self.app.patient_key(key):  # type: ignore[attr-defined]
             event.stop()
             event.prevent_default()
 
 
+def staff_nav(back: str = "Back to the patient") -> ComposeResult:
+    """The bar at the bottom of a staff screen: the way back, and Up/Down that page its scrolling
+    body (a finger on the served display has no wheel)."""
+    with Horizontal(id="staff-nav"):
+        yield Button(back, id="back", variant="primary")
+        yield Button("▲ Up", id="page-up")
+        yield Button("▼ Down", id="page-down")
+
+
 class ClinicianScreen(Screen):
-    """Base of the screens behind the PIN; the patient's screen waits underneath until they close."""
+    """Base of the screens behind the PIN; the patient's screen waits underneath until they close.
+    A screen with :func:`staff_nav` pages its ``.staff-body`` with Up and Down."""
 
     BINDINGS = [("escape", "close", "Back")]
+
+    @on(Button.Pressed, "#page-up")
+    def _page_up(self, event: Button.Pressed) -> None:
+        event.stop()
+        for body in self.query(".staff-body"):
+            body.scroll_page_up(animate=False)
+
+    @on(Button.Pressed, "#page-down")
+    def _page_down(self, event: Button.Pressed) -> None:
+        event.stop()
+        for body in self.query(".staff-body"):
+            body.scroll_page_down(animate=False)
 
     def action_close(self) -> None:
         """Go back one clinician screen (from the first one, back to the patient)."""

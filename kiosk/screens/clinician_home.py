@@ -1,15 +1,16 @@
 """The clinician's first screen: the running session (continue it, adaptation on/off, patient left or
 back), the channel states with their reasons, the interrupted tests staff may continue, and the
-list of stored sessions."""
+list of stored sessions. It scrolls (wheel, Tab, or the Up/Down buttons for a finger on the
+touch display), with "Back to the patient" always at the bottom."""
 
 from __future__ import annotations
 
 from textual import on
 from textual.app import ComposeResult
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
-from kiosk.screens.base import ClinicianScreen
+from kiosk.screens.base import ClinicianScreen, staff_nav
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
 
@@ -27,7 +28,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         """The running session, channels, stored sessions, and the way back."""
         app = self.app
         session = app.session  # type: ignore[attr-defined]
-        with Vertical(classes="clinician"):
+        with VerticalScroll(classes="clinician staff-body", id="clinician-body"):
             yield Static("Clinician", classes="heading")
             if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
                 yield Static(warning, id="pin-warning")
@@ -39,7 +40,6 @@ class ClinicianHomeScreen(ClinicianScreen):
                              id="adaptation", disabled=session.adaptation is None)
                 yield Button("New patient", id="new-session",
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
-                yield Button("Back", id="back")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost")
@@ -50,13 +50,14 @@ class ClinicianHomeScreen(ClinicianScreen):
             if app.sync is not None:  # type: ignore[attr-defined]
                 yield Static(self._station_text(), id="station")
             # continuing a test is the staff's decision: only with the same patient at the kiosk
-            yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")
+            yield Label("Interrupted tests: none.", id="interrupted-label")
             yield DataTable(id="interrupted", cursor_type="row", zebra_stripes=True)
             with Horizontal(id="interrupted-actions"):
-                yield Button("Continue this test", id="continue-test", variant="warning", disabled=True)
+                yield Button("Continue this test", id="continue-test", variant="warning")
                 yield Static("", id="continue-result")
-            yield Label("Stored sessions (Enter or click to open):")
+            yield Label("Stored sessions (tap one, or Enter, to open):")
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
+        yield from staff_nav()
 
     def on_mount(self) -> None:
         """Fill the tables, and keep the running session's line current while it runs."""
@@ -68,7 +69,13 @@ class ClinicianHomeScreen(ClinicianScreen):
                 f", {len(test.not_answered)} not answered" if test.not_answered else "")
             interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,
                                 test.interrupted_reason or "", test.id, key=test.id)
-        self.query_one("#continue-test", Button).disabled = not interrupted.row_count
+        # "Continue this test" only when there is one to continue
+        some = bool(interrupted.row_count)
+        interrupted.display = some
+        self.query_one("#interrupted-actions").display = some
+        if some:
+            self.query_one("#interrupted-label", Label).update(
+                "Interrupted tests (continue one only with that patient in front of the kiosk):")
         table = self.query_one("#sessions", DataTable)
         table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
         self._fill_sessions()
