@@ -362,6 +362,8 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         state = "RESTARTED" if self._resuming else "STARTED"
         self._context(t, {"PersonDetected": True, "TestState": state})
         self._log(t, "start", f"answered by {self._answered_by.value}")
+        if not self._voice_out_available:  # said before the start, when nothing was stored yet
+            self._log(t, "voice_out", "unavailable")
         if self._familiarisation:
             self._set_phase(t, Phase.FAMILIARISATION)
             self._message(t, "familiarisation")
