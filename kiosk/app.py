@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import sqlite3
 import sys
 from functools import partial
@@ -43,6 +44,7 @@ from kiosk.screens.clinician_home import ClinicianHomeScreen
 from kiosk.screens.doctor_called import DoctorCalledScreen
 from kiosk.screens.explanation import ExplanationScreen
 from kiosk.screens.familiarisation import FamiliarisationScreen
+from kiosk.screens.out_of_order import OutOfOrderScreen
 from kiosk.screens.paused import PausedScreen
 from kiosk.screens.pin import PinScreen
 from kiosk.screens.question import QuestionScreen
@@ -84,6 +86,9 @@ VOICE_OUT_SOURCE = "espeak-ng"
 PIN_IDLE_S = 60.0
 #: the same for the clinician screens behind the PIN (staff walked away: the patient's screen returns)
 CLINICIAN_IDLE_S = 300.0
+#: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
+#: patients again (a test's rows, its QoS trace and the WAL need room to grow)
+PROBE_BYTES = 256 * 1024
 
 
 @dataclass
@@ -192,6 +197,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self._no_such_option = False
         #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
         self._staff_seen = 0.0
+        #: why the kiosk takes no patient now (the store failed), for staff; None while it works
+        self.out_of_order: str | None = None
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -325,10 +332,15 @@ class KioskApp(App[int], inherit_bindings=False):
         self._drive(self.session.acknowledge)
 
     def forward(self, item: ChannelInput) -> None:
-        """Hand an input to the session (what a number means on each screen is the session's call)."""
-        self._drive(self.session.handle, item)
+        """Hand an input to the session (what a number means on each screen is the session's call);
+        nothing while the kiosk is out of order."""
+        if self.out_of_order is None:
+            self._drive(self.session.handle, item)
 
     def _start(self, language: str) -> None:
+        if self.out_of_order is not None:
+            return
+
         def start() -> None:
             self.session.choose_language(language)
             self.session.start()
@@ -355,7 +367,7 @@ class KioskApp(App[int], inherit_bindings=False):
             self._session_lost(str(taken))
             return
         except sqlite3.Error as failed:  # the step was rolled back: the session in memory is ahead of it
-            self._session_lost(f"the kiosk could not store its last step ({failed})")
+            self._store_failed(failed)
             return
         if self._dirty:
             self._dirty = False
@@ -452,6 +464,8 @@ class KioskApp(App[int], inherit_bindings=False):
             return
         view = self._view()
         base_cls, overlay_cls = self._screen_classes(view)
+        if self.out_of_order is not None:
+            base_cls, overlay_cls = OutOfOrderScreen, None
         shown = [s for s in self.screen_stack if isinstance(s, PatientScreen)]
         base, overlay = (shown + [None, None])[:2]
         key = (base_cls, base_cls.key(view))
@@ -581,7 +595,7 @@ class KioskApp(App[int], inherit_bindings=False):
         if self.sync is not None:
             from kiosk.sync.commands import live_status
 
-            self.sync.set_status(live_status(self.session))
+            self.sync.set_status({**live_status(self.session), "out_of_order": self.out_of_order})
 
     def station_command(self, command: Any) -> tuple[str, str | None] | None:
         """A command from the ward station (called on the client's thread): applied on the UI thread."""
@@ -638,11 +652,45 @@ class KioskApp(App[int], inherit_bindings=False):
             return  # the database is busy or failing: the next round tries again
         if why is not None:
             self._session_lost(why)
+        elif self.out_of_order is not None and self._can_write():
+            self.out_of_order = None  # space was freed (or the lock let go): the welcome is back
+            self._screen_key = None
+            self._render()
+            self._report_status()
 
-    def _session_lost(self, reason: str) -> None:
-        """This kiosk may no longer record in its session: say so plainly and start over."""
-        self.notify(f"This kiosk stopped the test of {self.session.patient_id}: {reason}. Staff can see it "
-                    "on the clinician screen.", title="Test stopped", severity="warning", timeout=60)
+    def _store_failed(self, failed: sqlite3.Error) -> None:
+        """The store refused a step (a full disk, a failing drive, a lock held too long; what it
+        refused was rolled back, what was stored stays for staff to continue). The kiosk takes no
+        patient until it can write again: the patient sees one calm out-of-order screen, staff
+        the reason on the clinician screen and the station (:meth:`keep_session` recovers)."""
+        self.out_of_order = f"the kiosk could not store its last step ({failed})"
+        self._session_lost(self.out_of_order, tell_patient=False)
+        self._report_status()
+
+    def _can_write(self) -> bool:
+        """The data directory takes :data:`PROBE_BYTES` more (written, synced and removed)."""
+        assert self.store is not None
+        probe = Path(self.store.path).parent / ".kiosk-write-probe"
+        try:
+            handle = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            try:
+                os.write(handle, bytes(PROBE_BYTES))
+                os.fsync(handle)
+            finally:
+                os.close(handle)
+            return True
+        except OSError:
+            return False
+        finally:
+            with contextlib.suppress(OSError):
+                probe.unlink()
+
+    def _session_lost(self, reason: str, *, tell_patient: bool = True) -> None:
+        """This kiosk may no longer record in its session: say so plainly (naming no one: the next
+        patient may be reading) and start over."""
+        if tell_patient:
+            self.notify(f"This test was stopped: {reason}. Staff can see it on the clinician screen.",
+                        title="Test stopped", severity="warning", timeout=60)
         if self._new_session is not None:
             self._replace_session(self._new_session())
             self._greet()

@@ -32,6 +32,7 @@ class ClinicianHomeScreen(ClinicianScreen):
             yield Static("Clinician", classes="heading")
             if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
                 yield Static(warning, id="pin-warning")
+            yield Static("", id="out-of-order-reason")
             yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
                 yield Button("Continue", id="continue", variant="primary")
@@ -99,6 +100,12 @@ class ClinicianHomeScreen(ClinicianScreen):
         app = self.app
         session = app.session  # type: ignore[attr-defined]
         self.query_one("#current", Static).update(self._session_line())
+        reason = app.out_of_order  # type: ignore[attr-defined]
+        line = self.query_one("#out-of-order-reason", Static)
+        line.display = reason is not None
+        if reason is not None:
+            line.update(f"Out of order: {reason}. The patient sees \"This kiosk is not working\"; the welcome "
+                        "comes back by itself once the data directory can be written again (free disk space).")
         self.query_one("#channel-reasons", Static).update(self._channels_text())
         # Continue is for a session halted by call-doctor or paused by the patient, not for the
         # pause that opening these screens made (leaving them resumes that one)
