@@ -219,14 +219,18 @@ class ClinicianScreen(Screen):
     @on(Button.Pressed, "#page-up")
     def _page_up(self, event: Button.Pressed) -> None:
         event.stop()
-        for body in self.query(".staff-body"):
-            body.scroll_page_up(animate=False)
+        self._page(-1)
 
     @on(Button.Pressed, "#page-down")
     def _page_down(self, event: Button.Pressed) -> None:
         event.stop()
+        self._page(1)
+
+    def _page(self, direction: int) -> None:
+        """Scroll the body by half its height: whatever is shorter than that is wholly in view
+        at some tap (a full page would step over a table straddling the fold)."""
         for body in self.query(".staff-body"):
-            body.scroll_page_down(animate=False)
+            body.scroll_relative(y=direction * max(1, body.size.height // 2), animate=False)
 
     def action_close(self) -> None:
         """Go back one clinician screen (from the first one, back to the patient)."""
