@@ -18,7 +18,7 @@ from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.session import Phase
 
 from .conftest import UI_PIN, UiKiosk
-from .helpers import drawn_text, screen_name, settle, start_in_english, until_drawn
+from .helpers import screen_name, settle, start_in_english, until_drawn
 
 OUT_OF_ORDER = "This kiosk is not working at the moment."
 

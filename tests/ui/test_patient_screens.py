@@ -18,7 +18,7 @@ from kiosk.session import Phase, Prompt
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.change_answer import ChangeAnswerButton
 
-from .helpers import deliver_from_thread, drawn_text, screen_name, settle, start_in_english, until_drawn
+from .helpers import deliver_from_thread, drawn_text, screen_name, settle, until_drawn
 
 QUESTIONNAIRE = load_questionnaire()
 #: the terminal sizes the issue tried (and the 73x18 a 1024x600 panel gets at 28 px, and 60x18)
