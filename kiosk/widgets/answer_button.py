@@ -59,6 +59,9 @@ class AnswerButton(Widget, can_focus=True):
     """
 
     BINDINGS = [Binding("enter,space", "choose", "Choose", show=False)]
+    #: a touch chooses, it does not focus: the focus outline drew a light strip over the chosen
+    #: answer's dark edge (Tab still focuses, for a keyboard)
+    FOCUS_ON_CLICK = False
 
     class Chosen(Message):
         """The patient touched (or clicked) this answer."""

@@ -198,3 +198,16 @@ async def test_the_doctor_called_screen_counts_no_attempt_and_the_next_attempt_i
         await until_drawn(pilot, "Attempt 2 of 2", "Someone has to feed me")
         asked = [e for e in kiosk.app.events[seen:] if isinstance(e, Prompt) and e.kind == "question"]
         assert asked and asked[0].key == "feeding" and asked[0].repeat  # asked again, as attempt 2
+
+
+async def test_a_touched_answer_shows_no_focus_strip(ui_kiosk):
+    """A touch chooses without focusing: the focus outline drew a light strip over the chosen
+    answer's dark left edge."""
+    kiosk = ui_kiosk(familiarisation=False)
+    async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
+        await _to_first_question(kiosk, pilot, "en")
+        await pilot.click("#answer-2")
+        await until_drawn(pilot, "C  Change my answer")
+        chosen = kiosk.app.screen.query_one("#answer-2", AnswerButton)
+        assert chosen.has_class("-chosen") and kiosk.app.focused is not chosen
+        assert chosen.styles.outline_left[0] in ("", "none")  # no outline over the edge
