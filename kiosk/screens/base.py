@@ -201,13 +201,22 @@ class PatientScreen(Screen):
             event.prevent_default()
 
 
+class PageButton(Button):
+    """Up or Down: every tap pages, also one that comes while the last tap still shows (a plain
+    Button ignores a tap during its 0.2 s pressed look, so quick taps would be lost)."""
+
+    async def _on_click(self, event: events.Click) -> None:
+        event.stop()
+        self.press()
+
+
 def staff_nav(back: str = "Back to the patient") -> ComposeResult:
     """The bar at the bottom of a staff screen: the way back, and Up/Down that page its scrolling
     body (a finger on the served display has no wheel)."""
     with Horizontal(id="staff-nav"):
         yield Button(back, id="back", variant="primary")
-        yield Button("▲ Up", id="page-up")
-        yield Button("▼ Down", id="page-down")
+        yield PageButton("▲ Up", id="page-up")
+        yield PageButton("▼ Down", id="page-down")
 
 
 class ClinicianScreen(Screen):

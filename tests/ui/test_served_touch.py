@@ -77,6 +77,23 @@ async def _twin(folder: Path, size: tuple[int, int]) -> dict:
     return where
 
 
+async def _body_shot(page, box: tuple[float, float, float, float]) -> bytes:
+    """The pixels of ``box`` on the page as drawn now."""
+    left, top, right, bottom = box
+    return await page.screenshot(clip={"x": left, "y": top, "width": right - left, "height": bottom - top})
+
+
+async def _until_changed(page, box: tuple[float, float, float, float], before: bytes) -> None:
+    """Wait (at most :data:`PATIENCE_S`) until ``box`` is drawn differently: the page scrolled (a
+    second tap before that frame would let the app skip a position)."""
+    import time
+
+    deadline = time.monotonic() + PATIENCE_S
+    while await _body_shot(page, box) == before:
+        assert time.monotonic() < deadline, "the page never scrolled on Down"
+        await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S
+
+
 def _share(shot, box: tuple[float, float, float, float], rgb: tuple[int, int, int]) -> float:
     """The share of the pixels in ``box`` (left, top, right, bottom px) that are exactly ``rgb``."""
     left, top, right, bottom = (int(v) for v in box)
@@ -168,11 +185,14 @@ async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_to
                 exported = await tap(where["fhir"])
                 await wait_until(page, since(exported, "FHIR QuestionnaireResponse written"), "the export")
                 plot = since(exported, "VoiceInteractionQuality", "1.00", "0.50")  # its key and axis
-                for _ in range(12):  # page down to the plot
+                # the scrolling body only (above the export's result line and the buttons)
+                body = pixels(where["fhir"]._replace(x=0, y=0, width=size[0], height=where["fhir"].y - 1))
+                for _ in range(12):  # page down to the plot, each page drawn before the next tap
                     if plot():
                         break
-                    before = await tap(where["down"])
-                    await wait_until(page, lambda: len(painted.data) > before, "a page further down")
+                    before = await _body_shot(page, body)
+                    await tap(where["down"])
+                    await _until_changed(page, body, before)
                 assert plot(), "the plot was never paged into view"
                 back = await tap(where["detail_back"])
                 await wait_until(page, since(back, "Stored sessions"), "back on the clinician home")
