@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import sqlite3
 import sys
 from functools import partial
@@ -45,6 +46,7 @@ from kiosk.screens.clinician_home import ClinicianHomeScreen
 from kiosk.screens.doctor_called import DoctorCalledScreen
 from kiosk.screens.explanation import ExplanationScreen
 from kiosk.screens.familiarisation import FamiliarisationScreen
+from kiosk.screens.out_of_order import OutOfOrderScreen
 from kiosk.screens.paused import PausedScreen
 from kiosk.screens.pin import PinScreen
 from kiosk.screens.question import QuestionScreen
@@ -71,7 +73,6 @@ from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.widgets.change_answer import ChangeAnswerButton
 from kiosk.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT, ChannelBoard
-from kiosk.widgets.text import ui_text
 from kiosk.widgets.waiting_sign import WaitingSign
 
 #: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
@@ -82,6 +83,14 @@ CLINICIAN_CHORD = "ctrl+k"
 POLL_INTERVAL = 0.1
 #: the source name the voice-out statuses carry when no speaker is wired
 VOICE_OUT_SOURCE = "espeak-ng"
+#: seconds the PIN pad waits for a touch or key before it goes back to the patient (a patient who
+#: tapped the corner five times is not left on it)
+PIN_IDLE_S = 60.0
+#: the same for the clinician screens behind the PIN (staff walked away: the patient's screen returns)
+CLINICIAN_IDLE_S = 300.0
+#: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
+#: patients again (a test's rows, its QoS trace and the WAL need room to grow)
+PROBE_BYTES = 256 * 1024
 
 
 @dataclass
@@ -123,6 +132,8 @@ class KioskApp(App[int], inherit_bindings=False):
 
     CSS_PATH = "kiosk.tcss"
     TITLE = "Barthel kiosk"
+    #: no text selection: taps (the five on the staff corner) must not leave a highlighted word
+    ALLOW_SELECT = False
     BINDINGS = [Binding(CLINICIAN_CHORD, "clinician", "Clinician", show=False, priority=True)]
     ENABLE_COMMAND_PALETTE = False
 
@@ -194,6 +205,10 @@ class KioskApp(App[int], inherit_bindings=False):
         self._held: Session | None = None
         #: the patient pressed a number the question on screen does not have (a hint shows)
         self._no_such_option = False
+        #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
+        self._staff_seen = 0.0
+        #: why the kiosk takes no patient now (the store failed), for staff; None while it works
+        self.out_of_order: str | None = None
         self._unsubscribe = self.session.subscribe(self._on_session_event)
         self._tell_voice_available()
 
@@ -276,6 +291,8 @@ class KioskApp(App[int], inherit_bindings=False):
     def patient_key(self, key: str) -> bool:
         """A key pressed on a patient screen; True if it meant something to the kiosk."""
         item = self.keyboard.translate(key) if self.keyboard is not None else None
+        if item is None and key not in KIOSK_KEY_BUTTONS:  # "C" (or "shift+c") is C
+            key = key.removeprefix("shift+").lower() if len(key.removeprefix("shift+")) == 1 else key
         if item is None and key in KIOSK_KEY_BUTTONS:
             meaning = KIOSK_KEY_BUTTONS[key]
             detail = f"key {key}"
@@ -334,12 +351,18 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def forward(self, item: ChannelInput) -> None:
         """Hand an input to the session (what a number means on each screen is the session's call);
-        none starts a test while the welcome waits for staff (an ordered visit, no walk-ups)."""
+        nothing while the kiosk is out of order, and none starts a test while the welcome waits for
+        staff (an ordered visit, no walk-ups)."""
+        if self.out_of_order is not None:
+            return
         if self.session.phase is Phase.WELCOME and self._welcome_held():
             return
         self._drive(self.session.handle, item)
 
     def _start(self, language: str) -> None:
+        if self.out_of_order is not None:
+            return
+
         def start() -> None:
             self.session.choose_language(language)
             self.session.start()
@@ -350,6 +373,7 @@ class KioskApp(App[int], inherit_bindings=False):
         """Let the session's due time-outs happen (the poll timer calls this), and move the
         waiting sign's dot on with the session's clock."""
         self._drive(self.session.poll)
+        self._staff_idle()
         if isinstance(self.screen, PatientScreen):
             for sign in self.screen.query(WaitingSign):
                 sign.tick(self.session.now())
@@ -365,7 +389,7 @@ class KioskApp(App[int], inherit_bindings=False):
             self._session_lost(str(taken))
             return
         except sqlite3.Error as failed:  # the step was rolled back: the session in memory is ahead of it
-            self._session_lost(f"the kiosk could not store its last step ({failed})")
+            self._store_failed(failed)
             return
         if self._dirty:
             self._dirty = False
@@ -462,6 +486,8 @@ class KioskApp(App[int], inherit_bindings=False):
             return
         view = self._view()
         base_cls, overlay_cls = self._screen_classes(view)
+        if self.out_of_order is not None:
+            base_cls, overlay_cls = OutOfOrderScreen, None
         shown = [s for s in self.screen_stack if isinstance(s, PatientScreen)]
         base, overlay = (shown + [None, None])[:2]
         key = (base_cls, base_cls.key(view))
@@ -562,8 +588,18 @@ class KioskApp(App[int], inherit_bindings=False):
             else:
                 self._release_session()
 
+        self._staff_seen = self.session.now()
         self.push_screen(PinScreen(self.pin_guard), unlocked)
         self._hold_session()
+
+    def _staff_idle(self) -> None:
+        """Back to the patient once the staff screens have had no touch or key for their idle time
+        (the session's clock: a simulated one in tests and replays)."""
+        if not self.clinician_open:
+            return
+        idle = PIN_IDLE_S if isinstance(self.screen, PinScreen) else CLINICIAN_IDLE_S
+        if self.session.now() - self._staff_seen >= idle:
+            self.close_clinician()
 
     async def on_event(self, event: events.Event) -> None:
         """Watch every press for the staff corner before the screens see it (a button under the
@@ -571,6 +607,9 @@ class KioskApp(App[int], inherit_bindings=False):
         if isinstance(event, events.MouseDown) and not self.clinician_open \
                 and self._corner.tap(event.screen_x, event.screen_y):
             self.action_clinician()
+        elif self.clinician_open and isinstance(event, (events.Key, events.MouseDown, events.MouseScrollDown,
+                                                          events.MouseScrollUp)):
+            self._staff_seen = self.session.now()
         await super().on_event(event)
 
     def quit_kiosk(self) -> None:
@@ -642,7 +681,7 @@ class KioskApp(App[int], inherit_bindings=False):
         if self.sync is not None:
             from kiosk.sync.commands import live_status
 
-            self.sync.set_status(live_status(self.session))
+            self.sync.set_status({**live_status(self.session), "out_of_order": self.out_of_order})
 
     def station_command(self, command: Any) -> tuple[str, str | None] | None:
         """A command from the ward station (called on the client's thread): applied on the UI thread."""
@@ -699,11 +738,45 @@ class KioskApp(App[int], inherit_bindings=False):
             return  # the database is busy or failing: the next round tries again
         if why is not None:
             self._session_lost(why)
+        elif self.out_of_order is not None and self._can_write():
+            self.out_of_order = None  # space was freed (or the lock let go): the welcome is back
+            self._screen_key = None
+            self._render()
+            self._report_status()
 
-    def _session_lost(self, reason: str) -> None:
-        """This kiosk may no longer record in its session: say so plainly and start over."""
-        self.notify(f"This kiosk stopped the test of {self.session.patient_id}: {reason}. Staff can see it "
-                    "on the clinician screen.", title="Test stopped", severity="warning", timeout=60)
+    def _store_failed(self, failed: sqlite3.Error) -> None:
+        """The store refused a step (a full disk, a failing drive, a lock held too long; what it
+        refused was rolled back, what was stored stays for staff to continue). The kiosk takes no
+        patient until it can write again: the patient sees one calm out-of-order screen, staff
+        the reason on the clinician screen and the station (:meth:`keep_session` recovers)."""
+        self.out_of_order = f"the kiosk could not store its last step ({failed})"
+        self._session_lost(self.out_of_order, tell_patient=False)
+        self._report_status()
+
+    def _can_write(self) -> bool:
+        """The data directory takes :data:`PROBE_BYTES` more (written, synced and removed)."""
+        assert self.store is not None
+        probe = Path(self.store.path).parent / ".kiosk-write-probe"
+        try:
+            handle = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            try:
+                os.write(handle, bytes(PROBE_BYTES))
+                os.fsync(handle)
+            finally:
+                os.close(handle)
+            return True
+        except OSError:
+            return False
+        finally:
+            with contextlib.suppress(OSError):
+                probe.unlink()
+
+    def _session_lost(self, reason: str, *, tell_patient: bool = True) -> None:
+        """This kiosk may no longer record in its session: say so plainly (naming no one: the next
+        patient may be reading) and start over."""
+        if tell_patient:
+            self.notify(f"This test was stopped: {reason}. Staff can see it on the clinician screen.",
+                        title="Test stopped", severity="warning", timeout=60)
         if self._new_session is not None:
             self._replace_session(self._new_session())
             self._greet()

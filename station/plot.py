@@ -1,27 +1,25 @@
-"""The session's QoS metrics as a server-rendered SVG step plot, with its incidents marked.
+"""The session's QoS metrics as a server-rendered SVG step plot, with its incidents and the
+kiosk's adaptations marked.
 
 A metric keeps its value until the next update, so each series is drawn as steps (a horizontal
 run, then a vertical jump), never as lines between samples, which would invent values the engine
-never published. Incidents (pause, doctor call, patient away, a question timing out, ...) are
-vertical marks with their name in a tooltip and a legend; everything is escaped.
+never published. Incidents (pause, doctor call, patient away, a question timing out, ...) and
+adaptations switching on or off (slow speech, voice answers off, longer attempts) are vertical
+marks with their words in a tooltip and a legend; everything is escaped. The colours and words
+are the kiosk's own (:mod:`kiosk.export.qos_plot`): a metric looks the same on both.
 """
 
 from __future__ import annotations
 
 from html import escape
 
+from kiosk.export.qos_plot import INCIDENT_WORDS, MARK_COLOURS, metric_colour, plot_marks
 from kiosk.storage import StoredSession
 
-WIDTH, HEIGHT = 760, 280
-LEFT, RIGHT, TOP, BOTTOM = 44, 12, 14, 46
-COLOURS = ("#1b6ac9", "#c2410c", "#15803d", "#7e22ce", "#a16207")
+WIDTH, HEIGHT = 760, 298
+LEFT, RIGHT, TOP, BOTTOM = 44, 12, 14, 64
 #: session-log kinds shown as incidents, with the words a clinician reads
-INCIDENTS = {
-    "pause": "paused", "resume": "resumed", "call_doctor": "doctor called", "doctor_called": "doctor called",
-    "clinician_continue": "continued by staff", "doctor_continued": "continued by staff",
-    "person_lost": "patient left", "person_back": "patient back", "attempt_timed_out": "no answer in time",
-    "repeat": "asked to repeat", "abandoned": "abandoned",
-}
+INCIDENTS = INCIDENT_WORDS
 
 
 def _fmt(value: float) -> str:
@@ -35,7 +33,8 @@ def qos_svg(stored: StoredSession) -> str:
         return '<p class="muted">No QoS samples were recorded for this session.</p>'
     names = sorted({name for s in samples for name in s.metrics})
     incidents = [e for e in stored.log if e.kind in INCIDENTS]
-    t_end = max([s.t for s in samples] + [e.t for e in incidents]) or 1.0
+    adaptations = [m for m in plot_marks(stored, ()) if m.kind == "adaptation"]
+    t_end = max([s.t for s in samples] + [e.t for e in incidents] + [m.t for m in adaptations]) or 1.0
     t_end *= 1.02
     values = [float(v) for s in samples for v in s.metrics.values()]
     low, high = min(0.0, *values), max(1.0, *values)
@@ -59,7 +58,13 @@ def qos_svg(stored: StoredSession) -> str:
     for incident in incidents:
         label = escape(f"{INCIDENTS[incident.kind]} at {incident.t:.0f} s {incident.detail}".strip())
         parts.append(f'<line x1="{_fmt(x(incident.t))}" x2="{_fmt(x(incident.t))}" y1="{TOP}" '
-                     f'y2="{TOP + plot_h}" class="incident incident-{escape(incident.kind)}">'
+                     f'y2="{TOP + plot_h}" style="stroke: {MARK_COLOURS["incident"]}" '
+                     f'class="incident incident-{escape(incident.kind)}">'
+                     f'<title>{label}</title></line>')
+    for mark in adaptations:
+        label = escape(f"{mark.label} at {mark.t:.0f} s")
+        parts.append(f'<line x1="{_fmt(x(mark.t))}" x2="{_fmt(x(mark.t))}" y1="{TOP}" y2="{TOP + plot_h}" '
+                     f'class="adaptation" style="stroke: {MARK_COLOURS["adaptation"]}" stroke-dasharray="4 3">'
                      f'<title>{label}</title></line>')
     for index, name in enumerate(names):
         points, last = [], None
@@ -73,12 +78,14 @@ def qos_svg(stored: StoredSession) -> str:
             last = value
         if last is not None:
             points.append(f"{_fmt(x(t_end))},{_fmt(y(last))}")
-        colour = COLOURS[index % len(COLOURS)]
+        colour = metric_colour(name, index)
         parts.append(f'<polyline fill="none" stroke="{colour}" stroke-width="2" points="{" ".join(points)}">'
                      f'<title>{escape(name)}</title></polyline>')
-        parts.append(f'<text x="{LEFT + index * 200}" y="{HEIGHT - 8}" fill="{colour}">■ {escape(name)}</text>')
-    if incidents:
-        parts.append(f'<text x="{WIDTH - RIGHT}" y="{HEIGHT - 8}" text-anchor="end" class="incident-key">'
-                     '┆ incident (hover for what)</text>')
+        parts.append(f'<text x="{LEFT + index * 200}" y="{HEIGHT - 26}" fill="{colour}">■ {escape(name)}</text>')
+    keys = ([f'<tspan fill="{MARK_COLOURS["incident"]}">┆ incident</tspan>'] if incidents else []) + (
+        [f'<tspan fill="{MARK_COLOURS["adaptation"]}">┆ adaptation</tspan>'] if adaptations else [])
+    if keys:
+        parts.append(f'<text x="{LEFT}" y="{HEIGHT - 8}" class="incident-key">'
+                     f'{"  ".join(keys)}  (hover a line for what)</text>')
     parts.append("</svg>")
     return "".join(parts)

@@ -30,6 +30,8 @@ STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
     "session_id": (str, type(None)), "patient_id": (str, type(None)), "phase": (str, type(None)),
     "question": (int, type(None)), "of": (int, type(None)), "paused": bool, "person_away": bool,
     "doctor_called": bool, "simulated": bool, "at": (str, type(None)),
+    # why the kiosk takes no patient (its store failed: a full disk); None while it works
+    "out_of_order": (str, type(None)),
 }
 
 

@@ -51,9 +51,11 @@ def to_input(button: Button, detail: str) -> ChannelInput:
 
 #: the kiosk's own keys (channel KEYBOARD) and the button each stands for: answers 1-4, pause,
 #: call doctor, repeat, and C for "Change my answer" (undo; backspace too, the key a keyboard user
-#: reaches for to take something back)
+#: reaches for to take something back). 5-9 are numbers too: under the explanation any number
+#: starts, on a question they get the gentle "Please choose 1, 2 or 3". Letters work in either
+#: case (the app looks a capital up by its small letter).
 KIOSK_KEY_BUTTONS: dict[str, Button] = {
-    "1": 1, "2": 2, "3": 3, "4": 4,
+    "1": 1, "2": 2, "3": 3, "4": 4, "5": 5, "6": 6, "7": 7, "8": 8, "9": 9,
     "p": Command.PAUSE, "d": Command.CALL_DOCTOR, "r": Command.REPEAT,
     "c": Command.UNDO, "backspace": Command.UNDO,
 }

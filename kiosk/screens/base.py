@@ -6,11 +6,11 @@ from __future__ import annotations
 from collections.abc import Hashable
 from dataclasses import dataclass
 
-from textual import events
+from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.screen import Screen
-from textual.widgets import Label
+from textual.widgets import Button, Label
 
 from kiosk.questionnaire import Questionnaire
 from kiosk.session import ATTEMPTS, Snapshot
@@ -53,8 +53,6 @@ class PatientView:
     questionnaire: Questionnaire
     #: what the channels allow now (the instructions are built from it)
     ways: Ways = Ways()
-    #: a notice to show above the answers (an adaptation, "we cannot see you"), or None
-    banner: str | None = None
     #: offer "Answer by voice again" (voice is switched off by adaptation and voice in works)
     voice_again: bool = False
     #: the number of answers of the question on screen, when the patient pressed a number it
@@ -98,8 +96,11 @@ def patient_notices(view: PatientView) -> str | None:
             ways = ("touch", "remote") if view.ways.remote else ("touch",)
             notices.append(ways_sentence(lang, "voice_off", ways, "_answer"))
             continue
-        notices.append(view.questionnaire.message(name, lang)
-                       or ui_text(lang, name, default=name.replace("_", " ")))
+        # the patient's words come from their language's text, or there is no notice: a policy's
+        # name ("longer_attempts") is never shown
+        words = view.questionnaire.message(name, lang) or ui_text(lang, name, default="")
+        if words:
+            notices.append(words)
     return " ".join(notices) or None
 
 
@@ -119,6 +120,10 @@ class PatientScreen(Screen):
     #: the screen asks the patient for an answer (its top bar shows the ways they can give one)
     ASKS = False
     VERTICAL_BREAKPOINTS = [(0, "-short"), (ROOMY_ROWS, "-roomy")]
+    #: the screen shows the notices banner (the end screen does not: it no longer concerns the patient)
+    NOTICES = True
+    #: the top bar shows "Attempt 1 of 2" (not while the doctor is called: nothing is being asked)
+    SHOWS_ATTEMPT = True
 
     def __init__(self, view: PatientView) -> None:
         """Build the screen for ``view``."""
@@ -157,11 +162,11 @@ class PatientScreen(Screen):
             progress.update(self.progress_text(view))
         for attempt in self.query("#attempt").results(Label):
             attempt.update(ui_text(self.language, "attempt_of", number=snap.attempt, total=ATTEMPTS)
-                           if snap.attempt else "")
+                           if snap.attempt and self.SHOWS_ATTEMPT else "")
         for ways in self.query("#ways").results(Label):
             ways.update(self.ways_text(view))
         for banner in self.query(AdaptationBanner):
-            banner.show(patient_notices(view))
+            banner.show(patient_notices(view) if self.NOTICES else None)
         for button in self.query(VoiceAgainButton):
             button.show(view.voice_again)
         for sign in self.query(WaitingSign):
@@ -189,17 +194,52 @@ class PatientScreen(Screen):
         kiosk's own P, R and D, which keep working in every language."""
         key = event.key
         for command, letter in (("pause", "p"), ("repeat", "r"), ("call_doctor", "d")):
-            if key == ui_text(self.language, f"key_{command}"):
+            if key.removeprefix("shift+").lower() == ui_text(self.language, f"key_{command}"):
                 key = letter
         if self.app.patient_key(key):  # type: ignore[attr-defined]
             event.stop()
             event.prevent_default()
 
 
+class PageButton(Button):
+    """Up or Down: every tap pages, also one that comes while the last tap still shows (a plain
+    Button ignores a tap during its 0.2 s pressed look, so quick taps would be lost)."""
+
+    async def _on_click(self, event: events.Click) -> None:
+        event.stop()
+        self.press()
+
+
+def staff_nav(back: str = "Back to the patient") -> ComposeResult:
+    """The bar at the bottom of a staff screen: the way back, and Up/Down that page its scrolling
+    body (a finger on the served display has no wheel)."""
+    with Horizontal(id="staff-nav"):
+        yield Button(back, id="back", variant="primary")
+        yield PageButton("▲ Up", id="page-up")
+        yield PageButton("▼ Down", id="page-down")
+
+
 class ClinicianScreen(Screen):
-    """Base of the screens behind the PIN; the patient's screen waits underneath until they close."""
+    """Base of the screens behind the PIN; the patient's screen waits underneath until they close.
+    A screen with :func:`staff_nav` pages its ``.staff-body`` with Up and Down."""
 
     BINDINGS = [("escape", "close", "Back")]
+
+    @on(Button.Pressed, "#page-up")
+    def _page_up(self, event: Button.Pressed) -> None:
+        event.stop()
+        self._page(-1)
+
+    @on(Button.Pressed, "#page-down")
+    def _page_down(self, event: Button.Pressed) -> None:
+        event.stop()
+        self._page(1)
+
+    def _page(self, direction: int) -> None:
+        """Scroll the body by half its height: whatever is shorter than that is wholly in view
+        at some tap (a full page would step over a table straddling the fold)."""
+        for body in self.query(".staff-body"):
+            body.scroll_relative(y=direction * max(1, body.size.height // 2), animate=False)
 
     def action_close(self) -> None:
         """Go back one clinician screen (from the first one, back to the patient)."""

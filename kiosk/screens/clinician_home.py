@@ -1,16 +1,17 @@
 """The clinician's first screen: the running session (continue it, adaptation on/off, patient left or
 back), the channel states with their reasons, the interrupted tests staff may continue, and the
-list of stored sessions."""
+list of stored sessions. It scrolls (wheel, Tab, or the Up/Down buttons for a finger on the
+touch display), with "Back to the patient" always at the bottom."""
 
 from __future__ import annotations
 
 from textual import on
 from textual.app import ComposeResult
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
 from kiosk.captured import questionnaire_of
-from kiosk.screens.base import ClinicianScreen
+from kiosk.screens.base import ClinicianScreen, staff_nav
 from kiosk.screens.session_detail import SessionDetailScreen
 from kiosk.session import Phase
 
@@ -28,10 +29,11 @@ class ClinicianHomeScreen(ClinicianScreen):
         """The running session, channels, stored sessions, and the way back."""
         app = self.app
         session = app.session  # type: ignore[attr-defined]
-        with Vertical(classes="clinician"):
+        with VerticalScroll(classes="clinician staff-body", id="clinician-body"):
             yield Static("Clinician", classes="heading")
             if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
                 yield Static(warning, id="pin-warning")
+            yield Static("", id="out-of-order-reason")
             yield Static(self._session_line(), id="current")
             with Horizontal(id="current-actions"):
                 yield Button("Continue", id="continue", variant="primary")
@@ -42,7 +44,6 @@ class ClinicianHomeScreen(ClinicianScreen):
                              disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
                 yield Button("Start a visit", id="start-visit",
                              disabled=app.visits is None)  # type: ignore[attr-defined]
-                yield Button("Back", id="back")
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost")
@@ -53,13 +54,14 @@ class ClinicianHomeScreen(ClinicianScreen):
             if app.sync is not None:  # type: ignore[attr-defined]
                 yield Static(self._station_text(), id="station")
             # continuing a test is the staff's decision: only with the same patient at the kiosk
-            yield Label("Interrupted tests (continue one only with that patient in front of the kiosk):")
+            yield Label("Interrupted tests: none.", id="interrupted-label")
             yield DataTable(id="interrupted", cursor_type="row", zebra_stripes=True)
             with Horizontal(id="interrupted-actions"):
-                yield Button("Continue this test", id="continue-test", variant="warning", disabled=True)
+                yield Button("Continue this test", id="continue-test", variant="warning")
                 yield Static("", id="continue-result")
-            yield Label("Stored sessions (Enter or click to open):")
+            yield Label("Stored sessions (tap one, or Enter, to open):")
             yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
+        yield from staff_nav()
 
     def on_mount(self) -> None:
         """Fill the tables, and keep the running session's line current while it runs."""
@@ -71,7 +73,13 @@ class ClinicianHomeScreen(ClinicianScreen):
                 f", {len(test.not_answered)} not answered" if test.not_answered else "")
             interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,
                                 test.interrupted_reason or "", test.id, key=test.id)
-        self.query_one("#continue-test", Button).disabled = not interrupted.row_count
+        # "Continue this test" only when there is one to continue
+        some = bool(interrupted.row_count)
+        interrupted.display = some
+        self.query_one("#interrupted-actions").display = some
+        if some:
+            self.query_one("#interrupted-label", Label).update(
+                "Interrupted tests (continue one only with that patient in front of the kiosk):")
         table = self.query_one("#sessions", DataTable)
         table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
         self._fill_sessions()
@@ -95,6 +103,12 @@ class ClinicianHomeScreen(ClinicianScreen):
         app = self.app
         session = app.session  # type: ignore[attr-defined]
         self.query_one("#current", Static).update(self._session_line())
+        reason = app.out_of_order  # type: ignore[attr-defined]
+        line = self.query_one("#out-of-order-reason", Static)
+        line.display = reason is not None
+        if reason is not None:
+            line.update(f"Out of order: {reason}. The patient sees \"This kiosk is not working\"; the welcome "
+                        "comes back by itself once the data directory can be written again (free disk space).")
         self.query_one("#channel-reasons", Static).update(self._channels_text())
         # Continue is for a session halted by call-doctor or paused by the patient, not for the
         # pause that opening these screens made (leaving them resumes that one)

@@ -14,7 +14,10 @@ from kiosk.widgets.text import ui_text
 
 class DoctorCalledScreen(PatientScreen):
     """Reassures the patient that help is coming, and offers "1  I'm fine, carry on" (the button,
-    the 1 key or the remote's 1; never by voice, so a misheard phrase cannot call help off)."""
+    the 1 key or the remote's 1; never by voice, so a misheard phrase cannot call help off). No
+    attempt count: nothing is being asked while help comes."""
+
+    SHOWS_ATTEMPT = False
 
     class CarryOn(Message):
         """The patient touched "I'm fine, carry on"."""

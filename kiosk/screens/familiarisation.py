@@ -31,12 +31,10 @@ class FamiliarisationScreen(PatientScreen):
         yield from self.compose_bars()
         practice = self.view.snapshot.practice
         if practice is None:
-            yield Static(self.view.questionnaire.message("familiarisation", self.language),
-                         classes="heading")
+            yield Static(self._intro(self.view), classes="heading", id="practice-intro")
         else:
-            # in the flow above the question (the overlay that keeps real answers still is for
-            # the question screen's thank-you line)
-            yield Static("", id="interlude", classes="interlude -inline")
+            # in the flow above the question, as on the question screen
+            yield Static("", id="interlude", classes="interlude")
             yield QuestionPanel(practice.text[self.language],
                                 [o.label_in(self.language) for o in practice.options])
         yield WaitingSign(self.language)
@@ -50,10 +48,20 @@ class FamiliarisationScreen(PatientScreen):
             bar.show_repeat(view.ways.voice_out)
         snap = view.snapshot
         feedback = view.questionnaire.message(snap.interlude, self.language) if snap.interlude else ""
-        intro = view.questionnaire.message("familiarisation", self.language) if snap.practice_number == 1 else ""
+        intro = self._intro(view) if snap.practice_number == 1 else ""
         for line in self.query("#interlude").results(Static):
             line.update(feedback or intro)
             line.display = bool(feedback or intro)
+        for heading in self.query("#practice-intro").results(Static):
+            heading.update(self._intro(view))
+
+    def _intro(self, view: PatientView) -> str:
+        """"First, a few practice questions…": the questionnaire's words, which promise a hearing
+        check, only while the kiosk can speak; without voice out the kiosk's own words, which do not
+        (the hearing check is skipped then)."""
+        if view.ways.voice_out:
+            return view.questionnaire.message("familiarisation", self.language)
+        return ui_text(self.language, "practice_intro_silent")
 
     def progress_text(self, view: PatientView) -> str:
         """"Practice 1 of 3" (of those asked on this kiosk, as the session counts them)."""

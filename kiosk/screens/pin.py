@@ -11,7 +11,7 @@ import math
 
 from textual import events, on
 from textual.app import ComposeResult
-from textual.containers import Grid, Vertical
+from textual.containers import Grid, Horizontal, Vertical
 from textual.widgets import Button, Label, Static
 
 from kiosk.pin import MAX_DIGITS, PinGuard
@@ -38,16 +38,18 @@ class PinScreen(ClinicianScreen):
         self._typed = ""
 
     def compose(self) -> ComposeResult:
-        """A title, the masked digits, the message line, the keypad and the way back."""
-        with Vertical(classes="clinician", id="pin-pad"):
-            yield Static("Clinician access", classes="heading")
-            yield Label("Enter the PIN on the keys below (or the keyboard), then OK.")
-            yield Static("", id="pin")
-            yield Label("", id="pin-error")
+        """The title, the masked digits, the message line and the way back beside the keypad, which
+        takes the height left: the whole pad and "Back to the patient" fit from 64x18 up."""
+        with Horizontal(classes="clinician", id="pin-pad"):
+            with Vertical(id="pin-side"):
+                yield Static("Clinician access", classes="heading")
+                yield Label("Enter the PIN on the keys (or the keyboard), then OK.", id="pin-help")
+                yield Static("", id="pin")
+                yield Label("", id="pin-error")
+                yield Button("Back to the patient", id="pin-back")
             with Grid(id="pin-keys"):
                 for label in _KEYS:
                     yield Button(label, id=_key_id(label), variant="primary" if label == "OK" else "default")
-            yield Button("Back to the patient", id="pin-back")
 
     def on_mount(self) -> None:
         """Say at once when the pad is still waiting after earlier failures."""

@@ -12,7 +12,7 @@ from kiosk.questionnaire import Item
 from kiosk.screens.base import PatientScreen, PatientView
 from kiosk.widgets.answer_button import AnswerButton
 from kiosk.widgets.bars import ControlBar
-from kiosk.widgets.change_answer import ChangeAnswerButton
+from kiosk.widgets.change_answer import ThanksRow
 from kiosk.widgets.confirm_panel import ConfirmPanel
 from kiosk.widgets.question_panel import QuestionPanel
 from kiosk.widgets.text import ui_text
@@ -25,7 +25,8 @@ class QuestionScreen(PatientScreen):
     Between questions the last item (before the first, the explanation) stays on screen, its answer
     marked, under a calm line such as "Thank you. Next question…", as the session's
     :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile; during
-    that thank-you gap "Change my answer" is offered. While the session asks back an unsure answer
+    that thank-you gap "Change my answer" is offered beside it. The line and the button take the
+    question text's rows (the answers keep theirs), so the chosen answer is never covered. While the session asks back an unsure answer
     ("I heard: … Is that right?") the question's panel gives way to the Yes/No panel. While an
     answer is awaited a gentle sign says so.
     """
@@ -46,46 +47,44 @@ class QuestionScreen(PatientScreen):
         return view.snapshot.language
 
     def compose(self) -> ComposeResult:
-        """Bars, the between-questions line, the question with its answers, and the controls."""
+        """Bars, the thank-you row (the between-questions line and "Change my answer", hidden
+        until a gap), the question with its answers, and the controls."""
         yield from self.compose_bars()
-        yield Static("", id="interlude", classes="interlude")
-        yield ChangeAnswerButton(self.language)
-        if (panel := self._panel(self.view)) is not None:
-            yield panel
+        yield from self._panel(self.view)
         yield WaitingSign(self.language)
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 
-    def _panel(self, view: PatientView) -> Widget | None:
-        """The question and answers of the view's item; between the explanation and item 1 the
-        explanation the patient just read stays (None if the questionnaire has none)."""
+    def _panel(self, view: PatientView) -> list[Widget]:
+        """The question and answers of the view's item, the thank-you row laid over the question
+        text; between the explanation and item 1 the row above the explanation the patient just
+        read (none if the questionnaire has no explanation)."""
         item = view.snapshot.item
         self._item_id = item.id if item else None
         self._confirming = view.snapshot.confirming
         prompt = view.snapshot.prompt
         if self._confirming is not None and prompt is not None and prompt.kind == "confirm":
-            return ConfirmPanel(prompt.text, [o.label for o in prompt.options])
+            return [ConfirmPanel(prompt.text, [o.label for o in prompt.options])]
+        thanks = ThanksRow(self.language, self._line(view), offered=view.snapshot.can_undo)
         if item is None:
             explanation = view.questionnaire.message("explanation", self.language)
-            return Static(explanation, classes="notice", id="recap") if explanation else None
+            return [thanks, Static(explanation, classes="notice", id="recap")] if explanation else [thanks]
         answer = view.snapshot.answers.get(item.id)
-        return QuestionPanel(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
-                             chosen=answer.option if answer else None)
+        return [QuestionPanel(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
+                              chosen=answer.option if answer else None, over_question=thanks)]
+
+    def _line(self, view: PatientView) -> str:
+        """The between-questions line in the patient's language ("" outside a gap)."""
+        key = view.snapshot.interlude
+        return (view.questionnaire.message(key, self.language) or ui_text(self.language, key)) if key else ""
 
     def show(self, view: PatientView) -> None:
-        """Refresh the bars and the between-questions line; swap in the next item's panel, or mark
-        the recorded answer."""
+        """Refresh the bars and the thank-you row; swap in the next item's panel, or mark the
+        recorded answer."""
         super().show(view)
         for bar in self.query(ControlBar):
             bar.show_repeat(view.ways.voice_out)
-        key = view.snapshot.interlude
-        for line in self.query("#interlude").results(Static):
-            line.update(view.questionnaire.message(key, self.language) or ui_text(self.language, key)
-                        if key else "")
-            line.display = bool(key)
-        for button in self.query(ChangeAnswerButton):
-            button.show(view.snapshot.can_undo)
-        if key or view.snapshot.can_undo:
-            self.call_after_refresh(self._place_interlude)
+        for thanks in self.query(ThanksRow):
+            thanks.show(self._line(view), view.snapshot.can_undo)
         if not self.is_mounted:  # compose has not run yet: it will draw this view
             return
         item = view.snapshot.item
@@ -94,10 +93,10 @@ class QuestionScreen(PatientScreen):
             if (item is not None and self._item_id is not None and confirming is None
                     and self._confirming is None and self._reword(view, item)):
                 return
-            for old in self.query("QuestionPanel, ConfirmPanel, #recap"):
+            for old in self.query("QuestionPanel, ConfirmPanel, #recap, ThanksRow"):
                 old.remove()
-            if (panel := self._panel(view)) is not None:
-                self.mount(panel, before=self.query_one(WaitingSign))
+            if widgets := self._panel(view):
+                self.mount_all(widgets, before=self.query_one(WaitingSign))
             return
         prompt = view.snapshot.prompt
         if confirming is not None and prompt is not None and prompt.kind == "confirm":
@@ -106,22 +105,6 @@ class QuestionScreen(PatientScreen):
         answer = view.snapshot.answers.get(item.id) if item else None
         for panel in self.query(QuestionPanel):
             panel.mark_chosen(answer.option if answer else None)
-
-    def _place_interlude(self) -> None:
-        """Lay the between-questions line exactly over the question text, so the answers below do
-        not move when it comes and goes; over the explanation recap (no answers) it simply goes
-        above it."""
-        for line in self.query("#interlude").results(Static):
-            questions = self.query("#question")
-            line.set_class(not questions, "-inline")
-            if questions:
-                question = questions.first().region
-                line.styles.offset = (0, question.y)
-                line.styles.height = max(1, question.height)
-                for button in self.query(ChangeAnswerButton):  # at the right, over the question
-                    width = len(str(button.label)) + 4
-                    button.styles.width = width
-                    button.styles.offset = (max(0, self.size.width - width - 1), question.y)
 
     def _reword(self, view: PatientView, item: Item) -> bool:
         """Put ``item`` into the panel on screen when it has as many answers (no remount); False

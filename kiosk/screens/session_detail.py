@@ -7,17 +7,42 @@ from pathlib import Path
 
 from textual import on
 from textual.app import ComposeResult
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static
 
 from kiosk.captured import questionnaire_of, site_of
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
-from kiosk.screens.base import ClinicianScreen
+from kiosk.screens.base import ClinicianScreen, staff_nav
 from kiosk.storage import StoredSession
 from kiosk.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png
 
+#: the session log's entries staff see as events, in their words
+EVENT_WORDS = {
+    "call_doctor": "Doctor called",
+    "doctor_call_cancelled": "\"I'm fine, carry on\" (the patient called the doctor off)",
+    "clinician_continue": "Continued by a clinician",
+    "pause": "Paused",
+    "resume": "Continued after a pause",
+    "person_lost": "Patient left the kiosk",
+    "person_back": "Patient back",
+    "answer_withdrawn": "Answer taken back",
+    "abandoned": "Ended by staff",
+}
+
+
+def session_events(stored: StoredSession) -> list[tuple[str, str]]:
+    """The events of ``stored`` staff read on its page: (time into the session, what happened)."""
+    rows = []
+    for entry in stored.log:
+        if (words := EVENT_WORDS.get(entry.kind)) is not None:
+            detail = f" ({entry.detail})" if entry.detail and entry.kind != "doctor_call_cancelled" else ""
+            rows.append((f"{entry.t:.0f} s", words + detail))
+    return rows
+
+
 class SessionDetailScreen(ClinicianScreen):
-    """The answers table above the metrics plot; export buttons at the bottom."""
+    """The answers table, the events, the metrics plot, scrolling; exports and the way back at the
+    bottom."""
 
     def __init__(self, stored: StoredSession) -> None:
         """Show ``stored`` (read from the store when the clinician opened it)."""
@@ -27,14 +52,6 @@ class SessionDetailScreen(ClinicianScreen):
     def compose(self) -> ComposeResult:
         """Header, answers, total line, plot and export buttons."""
         s = self.stored
-        with Vertical(classes="clinician"):
-            yield Static(f"Session {s.id}  patient {s.patient_id}  {s.status}  language {s.language}  "
-                         f"answered by {s.answered_by.value}", classes="heading")
-            yield DataTable(id="answers-table", zebra_stripes=True, cursor_type="row")
-            yield Label(self._total_line(), id="total")
-            yield Label(self._practice_line(), id="practice")
-            yield Static(metrics_key(), id="metrics-key")
-            yield MetricsPlot(plot_data(s), id="metrics-plot")
         # at the bottom, above the buttons, so an export's outcome shows at every size
         with Vertical(id="detail-bottom"):
             yield Label("", id="export-result")
@@ -42,7 +59,21 @@ class SessionDetailScreen(ClinicianScreen):
                 yield Button("FHIR", id="export-fhir", tooltip="Export a FHIR QuestionnaireResponse")
                 yield Button("CSV", id="export-csv", tooltip="Export the answers as CSV")
                 yield Button("Plot PNG", id="export-png", tooltip="Save the QoS plot as a PNG")
-                yield Button("Back", id="back")
+            yield from staff_nav("Back")
+        with VerticalScroll(classes="clinician staff-body", id="detail-body"):
+            yield Static(f"Session {s.id}  patient {s.patient_id}  {s.status}  language {s.language}  "
+                         f"answered by {s.answered_by.value}", classes="heading")
+            yield DataTable(id="answers-table", zebra_stripes=True, cursor_type="row")
+            yield Label(self._total_line(), id="total")
+            yield Label(self._practice_line(), id="practice")
+            events = session_events(s)
+            yield Label("Events:" if events else "Events: none (no doctor call, pause or patient away).",
+                        id="events-label")
+            table = DataTable(id="events", zebra_stripes=True, cursor_type="row")
+            table.display = bool(events)
+            yield table
+            yield Static(metrics_key(), id="metrics-key")
+            yield MetricsPlot(plot_data(s), id="metrics-plot")
 
     @property
     def q(self):  # -> Questionnaire
@@ -51,6 +82,10 @@ class SessionDetailScreen(ClinicianScreen):
 
     def on_mount(self) -> None:
         """One row per item, in questionnaire order, answered or not."""
+        events = self.query_one("#events", DataTable)
+        events.add_columns("when", "what")
+        for when, what in session_events(self.stored):
+            events.add_row(when, what)
         q = self.q
         table = self.query_one("#answers-table", DataTable)
         table.add_columns("#", "item", "option", "answer", "points", "attempt", "channel")

@@ -4,8 +4,6 @@ kiosk goes back to the welcome for the next patient after ``next_patient_after_s
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from textual.app import ComposeResult
 from textual.widgets import Static
 
@@ -15,11 +13,10 @@ from kiosk.widgets.text import ui_text
 
 class SummaryScreen(PatientScreen):
     """Thank-you and what to do now; if the site shows it, the total out of the maximum, the band,
-    and how many items went unanswered."""
+    and how many items went unanswered. No notices once it is over: what the kiosk adapted no
+    longer concerns the patient."""
 
-    def show(self, view: PatientView) -> None:
-        """No notices once it is over: what the kiosk adapted no longer concerns the patient."""
-        super().show(replace(view, banner=None))
+    NOTICES = False
 
     def progress_text(self, view: PatientView) -> str:
         """The title: the questions are over."""

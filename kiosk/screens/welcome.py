@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Hashable
 
-from textual import on
+from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.message import Message
@@ -26,6 +26,34 @@ def welcome_line(view: PatientView, language: str) -> str:
 def language_ways(ways: Ways) -> tuple[str, ...]:
     """How a language can be chosen now: touch; a remote's number; "start" while the kiosk listens."""
     return ("touch",) + (("remote",) if ways.remote else ()) + (("voice",) if ways.listening else ())
+
+
+class LanguageList(Vertical):
+    """The language buttons, all equally tall (an odd number of rows, so each label sits in the
+    middle) and equally labelled: names padded to the longest, so the labels line up centred."""
+
+    def on_resize(self, event: events.Resize) -> None:
+        """The display changed: share the rows out again."""
+        self.lay_out()
+
+    def lay_out(self) -> None:
+        """Give every button the same height; spare rows stay below the last."""
+        buttons = list(self.query(Button))
+        rows = self.content_region.height
+        if not buttons or rows <= 0:
+            return
+        height = max(3, (rows - len(buttons)) // len(buttons))  # one row of margin above each
+        if height % 2 == 0:
+            height -= 1
+        for button in buttons:
+            button.styles.height = height
+
+
+def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:
+    """"1  English ", "2  Español ", "3  Français": numbered like the remote, padded to one width."""
+    labels = [f"{number}  {language_name(language)}" for number, language in enumerate(languages, start=1)]
+    width = max(map(len, labels))
+    return [label.ljust(width) for label in labels]
 
 
 class WelcomeScreen(PatientScreen):
@@ -53,9 +81,9 @@ class WelcomeScreen(PatientScreen):
             for language in q.languages:
                 yield Static(welcome_line(self.view, language), classes="welcome-line",
                              id=f"welcome-{language}")
-        with Vertical(id="languages"):
-            for number, language in enumerate(q.languages, start=1):
-                yield Button(f"{number}  {language_name(language)}", id=f"language-{language}")
+        with LanguageList(id="languages"):
+            for language, label in zip(q.languages, language_labels(q.languages)):
+                yield Button(label, id=f"language-{language}")
 
     def show(self, view: PatientView) -> None:
         """Also keep the welcome lines true to the channels on now."""

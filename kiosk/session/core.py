@@ -371,6 +371,8 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         self._log(t, "start", f"answered by {self._answered_by.value}")
         if self.visit and not self._resuming:
             self._log(t, "visit", self.visit)
+        if not self._voice_out_available:  # said before the start, when nothing was stored yet
+            self._log(t, "voice_out", "unavailable")
         if self._familiarisation:
             self._set_phase(t, Phase.FAMILIARISATION)
             self._message(t, "familiarisation")

@@ -7,11 +7,51 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.message import Message
 from textual.widget import Widget
-from textual.widgets import Digits, Label
+from textual.widgets import Label
+
+#: each digit as 3x5 pixels: solid strokes, not Textual's box-drawing Digits, which read as
+#: brackets from a metre away
+_FONT = {
+    "0": ("111", "101", "101", "101", "111"), "1": ("010", "110", "010", "010", "111"),
+    "2": ("111", "001", "111", "100", "111"), "3": ("111", "001", "111", "001", "111"),
+    "4": ("101", "101", "111", "001", "001"), "5": ("111", "100", "111", "001", "111"),
+    "6": ("111", "100", "111", "101", "111"), "7": ("111", "001", "001", "001", "001"),
+    "8": ("111", "101", "111", "101", "111"), "9": ("111", "101", "111", "001", "111"),
+}
+_HALVES = {("0", "0"): " ", ("1", "0"): "▀", ("0", "1"): "▄", ("1", "1"): "█"}
+
+
+def big_number(number: int, rows: int = 5) -> str:
+    """``number`` in solid block figures, six columns a digit (two a pixel, so on a cell twice as
+    tall as wide each pixel is square): five rows high with ``rows`` >= 5, else three rows of half
+    blocks (a blank pixel row on top centres the five-pixel figure)."""
+    lines: list[str] = []
+    for digit in str(number):
+        pixels = _FONT[digit]
+        if rows >= 5:
+            drawn = ["".join("██" if p == "1" else "  " for p in row) for row in pixels]
+        else:
+            padded = ("000", *pixels)
+            drawn = ["".join(_HALVES[t, b] * 2 for t, b in zip(padded[2 * r], padded[2 * r + 1]))
+                     for r in range(3)]
+        lines = [a + (" " if a else "") + b for a, b in zip(lines, drawn)] if lines else drawn
+    return "\n".join(lines)
+
+
+class BigNumber(Widget):
+    """An answer's number in :func:`big_number` figures, five rows high when it has the rows."""
+
+    def __init__(self, number: int, *, classes: str | None = None) -> None:
+        super().__init__(classes=classes)
+        self.number = number
+
+    def render(self) -> str:
+        """The figure for the height the layout gave it."""
+        return big_number(self.number, self.size.height)
 
 
 class AnswerButton(Widget, can_focus=True):
-    """One answer option: its number in large digits (as printed on the remote) and its label.
+    """One answer option: its number in large solid figures (as printed on the remote) and its label.
     The layout around it sets its height and the class ``-big`` when the digits fit.
 
     A click or tap posts :class:`AnswerButton.Chosen`; the screen forwards it to the session as a
@@ -19,6 +59,9 @@ class AnswerButton(Widget, can_focus=True):
     """
 
     BINDINGS = [Binding("enter,space", "choose", "Choose", show=False)]
+    #: a touch chooses, it does not focus: the focus outline drew a light strip over the chosen
+    #: answer's dark edge (Tab still focuses, for a keyboard)
+    FOCUS_ON_CLICK = False
 
     class Chosen(Message):
         """The patient touched (or clicked) this answer."""
@@ -37,7 +80,7 @@ class AnswerButton(Widget, can_focus=True):
     def compose(self) -> ComposeResult:
         """The number -- in block digits when the button is tall enough, else in bold -- beside
         the answer text."""
-        yield Digits(str(self.option), classes="number")
+        yield BigNumber(self.option, classes="number")
         yield Label(str(self.option), classes="small-number")
         yield Label(self.label, classes="label")
 

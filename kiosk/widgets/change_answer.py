@@ -1,9 +1,11 @@
-"""'Change my answer': offered during the thank-you gap after an answer."""
+"""The thank-you gap after an answer: the calm line and 'Change my answer', in a row of their own."""
 
 from __future__ import annotations
 
+from textual.app import ComposeResult
+from textual.containers import Horizontal
 from textual.message import Message
-from textual.widgets import Button
+from textual.widgets import Button, Static
 
 from kiosk.widgets.text import ui_text
 
@@ -14,10 +16,10 @@ class ChangeAnswerButton(Button):
     class Requested(Message):
         """The patient touched "Change my answer"."""
 
-    def __init__(self, language: str) -> None:
-        """A hidden button with the words of ``language``."""
+    def __init__(self, language: str, *, offered: bool = False) -> None:
+        """A button with the words of ``language``, shown while ``offered``."""
         super().__init__(ui_text(language, "change_answer"), id="change-answer")
-        self.display = False
+        self.display = offered
 
     def show(self, offered: bool) -> None:
         """Show the button while an answer can still be changed."""
@@ -27,3 +29,37 @@ class ChangeAnswerButton(Button):
         """Forward the touch as a request; the session decides whether it is still possible."""
         event.stop()
         self.post_message(self.Requested())
+
+
+class ThanksRow(Horizontal):
+    """"Thank you. Next question…" with "Change my answer" at its right, shown during a gap.
+
+    Over a question it takes exactly the question text's rows (the stylesheet lays it over them),
+    so the answers below -- the chosen one marked -- neither move nor are covered; above the
+    explanation recap it is a row in the flow. It never measures anything after a refresh: where
+    it is drawn follows from the layout alone.
+    """
+
+    def __init__(self, language: str, line: str = "", *, offered: bool = False) -> None:
+        """The row in ``language`` showing ``line`` (hidden while empty and nothing is ``offered``)."""
+        super().__init__(id="gap")
+        self.language = language
+        self._line, self._offered = line, offered
+        self.display = bool(line) or offered
+
+    def compose(self) -> ComposeResult:
+        """The line, then the button."""
+        line = Static(self._line, id="interlude", classes="interlude")
+        line.display = bool(self._line)
+        yield line
+        yield ChangeAnswerButton(self.language, offered=self._offered)
+
+    def show(self, line: str, offered: bool) -> None:
+        """Show ``line`` (none: empty) and the button while ``offered``; hide the row if neither."""
+        self._line, self._offered = line, offered
+        self.display = bool(line) or offered
+        for static in self.query("#interlude").results(Static):
+            static.update(line)
+            static.display = bool(line)
+        for button in self.query(ChangeAnswerButton):
+            button.show(offered)

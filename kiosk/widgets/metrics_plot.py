@@ -2,7 +2,8 @@
 with incidents (pause, call doctor, patient away...) and adaptations marked.
 
 Drawn in the terminal with textual-plotext, and saved as a PNG with matplotlib for the record.
-Both draw the same :func:`plot_data`, so the terminal and the PNG never tell different stories.
+Both draw the same :func:`plot_data`, so the terminal and the PNG never tell different stories;
+the colours and the marks' words come from :mod:`kiosk.export.qos_plot`, as on the ward station.
 Neither puts its legend over the data: the first seconds of a session matter as much as the rest,
 so the terminal shows a coloured key line (:func:`metrics_key`) above the plot and the PNG puts
 its legend below the axes.
@@ -17,28 +18,20 @@ from typing import Any
 from rich.text import Text
 from textual_plotext import PlotextPlot
 
+from kiosk.export.qos_plot import MARK_COLOURS, METRICS, Mark, metric_colour, plot_marks
 from kiosk.storage import StoredSession
 from qos.files import open_private
 
-#: the metrics of the CLARC model, in the order they are drawn, with one colour each
-METRICS = ("Performance", "Interaction", "VoiceInteractionQuality")
-_COLOURS = {"Performance": "blue", "Interaction": "green", "VoiceInteractionQuality": "magenta"}
-#: the colours of the marks: (terminal, matplotlib)
-_MARK_COLOURS = {"incident": ("gray", "0.5"), "adaptation": ("red", "tab:red")}
-#: Rich's name for the ANSI colour plotext calls "gray" (the others share their names)
-_RICH_NAMES = {"gray": "bright_black"}
 #: log entries worth a mark on the plot (the rest -- ignored inputs, time-outs -- would crowd it)
-INCIDENTS = ("pause", "resume", "call_doctor", "clinician_continue", "person_lost", "person_back", "repeat")
+INCIDENTS = ("pause", "resume", "call_doctor", "doctor_call_cancelled", "clinician_continue", "person_lost",
+             "person_back", "repeat")
+#: label lanes the PNG may stack its marks' labels in, from the top of the axes down
+LABEL_LANES = 14
 
 
-@dataclass(frozen=True)
-class Mark:
-    """A vertical mark on the plot: an incident or an adaptation switching on or off."""
-
-    t: float
-    label: str
-    #: "incident" or "adaptation"
-    kind: str
+def _rgb(colour: str) -> tuple[int, int, int]:
+    """``"#1b6ac9"`` as (27, 106, 201): plotext takes RGB tuples."""
+    return int(colour[1:3], 16), int(colour[3:5], 16), int(colour[5:7], 16)
 
 
 @dataclass(frozen=True)
@@ -55,10 +48,7 @@ def plot_data(stored: StoredSession) -> PlotData:
     for name in METRICS:
         samples = [(s.t, s.metrics[name]) for s in stored.metrics if name in s.metrics]
         series[name] = ([t for t, _ in samples], [v for _, v in samples])
-    marks = [Mark(e.t, e.kind.replace("_", " "), "incident") for e in stored.log if e.kind in INCIDENTS]
-    marks += [Mark(a.t, f"{a.name.replace('_', ' ')} {'on' if a.active else 'off'}", "adaptation")
-              for a in stored.adaptations]
-    return PlotData(series, tuple(sorted(marks, key=lambda m: m.t)))
+    return PlotData(series, plot_marks(stored, INCIDENTS))
 
 
 def metrics_key() -> Text:
@@ -66,10 +56,10 @@ def metrics_key() -> Text:
     which is drawn inside the plot and hides the first seconds of the curves)."""
     key = Text("QoS: ", style="bold")
     for name in METRICS:
-        key.append("━ ", style=f"bold {_RICH_NAMES.get(_COLOURS[name], _COLOURS[name])}")
+        key.append("━ ", style=f"bold {metric_colour(name)}")
         key.append(f"{name}  ")
-    for kind, (colour, _) in _MARK_COLOURS.items():
-        key.append("│ ", style=f"bold {_RICH_NAMES.get(colour, colour)}")
+    for kind, colour in MARK_COLOURS.items():
+        key.append("│ ", style=f"bold {colour}")
         key.append(f"{kind}s  ")
     key.rstrip()
     return key
@@ -107,14 +97,15 @@ class MetricsPlot(PlotextPlot):
         plt.ylim(0, 1)
         for name, (times, values) in self.data.series.items():
             if times:  # no label: plotext would draw its legend box over the first seconds
-                plt.plot(*steps(times, values), color=_COLOURS[name], marker="braille")
+                plt.plot(*steps(times, values), color=_rgb(metric_colour(name)), marker="braille")
         for mark in self.data.marks:
-            plt.vline(mark.t, _MARK_COLOURS[mark.kind][0])
+            plt.vline(mark.t, _rgb(MARK_COLOURS[mark.kind]))
 
 
 def metrics_figure(data: PlotData, title: str) -> Any:
     """The plot as a matplotlib Figure (the caller closes it): the metrics as steps, the marks as
-    dashed lines, and the legend below the axes, where it cannot cover a curve."""
+    dashed lines, each mark's label in the highest lane where it overlaps no other label (measured
+    as drawn), and the legend below the axes, where it cannot cover a curve."""
     import matplotlib
 
     matplotlib.use("Agg")  # no display on a kiosk's service shell
@@ -124,25 +115,40 @@ def metrics_figure(data: PlotData, title: str) -> Any:
     figure, axes = pyplot.subplots(figsize=(10, 5), dpi=100)
     for name, (times, values) in data.series.items():
         if times:
-            axes.step(times, values, where="post", label=name, color=_COLOURS[name], linewidth=2)
-    for index, mark in enumerate(data.marks):
-        colour = _MARK_COLOURS[mark.kind][1]
-        axes.axvline(mark.t, color=colour, linestyle="--", linewidth=1)
-        axes.annotate(mark.label, (mark.t, 1.0 - 0.06 * (index % 4)), rotation=0, fontsize=8,
-                      color=colour, xytext=(3, -10), textcoords="offset points")
+            axes.step(times, values, where="post", label=name, color=metric_colour(name), linewidth=2)
     axes.set_ylim(0, 1.05)
+    for mark in data.marks:
+        axes.axvline(mark.t, color=MARK_COLOURS[mark.kind], linestyle="--", linewidth=1)
     axes.set_xlabel("session time (s)")
     axes.set_ylabel("metric")
     axes.set_title(title)
     handles, _ = axes.get_legend_handles_labels()
     kinds = {m.kind for m in data.marks}
-    handles += [Line2D([], [], color=_MARK_COLOURS[k][1], linestyle="--", linewidth=1, label=f"{k}s")
-                for k in _MARK_COLOURS if k in kinds]
+    handles += [Line2D([], [], color=MARK_COLOURS[k], linestyle="--", linewidth=1, label=f"{k}s")
+                for k in MARK_COLOURS if k in kinds]
     if handles:
         axes.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=len(handles),
                     frameon=False)
     axes.grid(alpha=0.3)
+    _label_marks(figure, axes, data.marks)
     return figure
+
+
+def _label_marks(figure: Any, axes: Any, marks: tuple[Mark, ...]) -> None:
+    """Write each mark's label beside its line, in the first lane (from the top) where its drawn
+    box meets no label already placed; marks too crowded for every lane keep only their line."""
+    renderer = figure.canvas.get_renderer()
+    placed: list[Any] = []
+    for mark in marks:
+        for lane in range(LABEL_LANES):
+            text = axes.annotate(mark.label, (mark.t, 1.0 - 0.065 * lane), xycoords=("data", "axes fraction"),
+                                 fontsize=8, color=MARK_COLOURS[mark.kind], xytext=(3, -10),
+                                 textcoords="offset points")
+            box = text.get_window_extent(renderer).expanded(1.0, 1.1)
+            if not any(box.overlaps(other) for other in placed):
+                placed.append(box)
+                break
+            text.remove()
 
 
 def save_png(data: PlotData, path: str | Path, title: str) -> Path:

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from textual import events
 from textual.app import ComposeResult
 from textual.containers import Vertical
+from textual.widget import Widget
 from textual.widgets import Static
 
 from kiosk.widgets.answer_button import AnswerButton
@@ -55,16 +56,22 @@ class QuestionPanel(Vertical):
     display is short -- two-by-two, so every answer is on screen whatever its size.
     """
 
-    def __init__(self, question: str, options: Sequence[str], *, chosen: int | None = None) -> None:
-        """Show ``question`` and the ``options`` labels (option 1 first); mark ``chosen`` if set."""
+    def __init__(self, question: str, options: Sequence[str], *, chosen: int | None = None,
+                 over_question: Widget | None = None) -> None:
+        """Show ``question`` and the ``options`` labels (option 1 first); mark ``chosen`` if set.
+        ``over_question`` (the thank-you row) is laid over the question text's rows when shown."""
         super().__init__(classes="panel")
         self.question = question
         self.options = tuple(options)
         self.chosen = chosen
+        self._over = over_question
 
     def compose(self) -> ComposeResult:
-        """The question text, then the answers taking all the height left."""
-        yield Static(self.question, id="question")
+        """The question text (with what is laid over it), then the answers taking all the height left."""
+        with Vertical(id="head"):
+            yield Static(self.question, id="question")
+            if self._over is not None:
+                yield self._over
         with AnswerList(id="answers"):
             for number, label in enumerate(self.options, start=1):
                 yield AnswerButton(number, label, id=f"answer-{number}")

@@ -42,3 +42,22 @@ def test_a_session_without_samples_says_so_instead_of_an_empty_plot():
     stored = _session("barthel1.yaml")
     empty = type(stored)(**{**stored.__dict__, "metrics": ()})
     assert "No QoS samples" in qos_svg(empty)
+
+
+def test_adaptations_are_marked_and_metrics_have_the_kiosks_colours():
+    """The station's plot marks each adaptation switching on or off, as the kiosk's plot does, and
+    draws each metric in the colour the kiosk draws it in (one palette, kiosk.export.qos_plot)."""
+    from kiosk.export.qos_plot import METRIC_COLOURS
+    from kiosk.stored import AdaptationRecord
+
+    stored = _session("barthel5.yaml")
+    adapted = type(stored)(**{**stored.__dict__, "adaptations": (
+        AdaptationRecord(12.0, "longer_attempts", True, "Interaction 0.2 < 0.3"),
+        AdaptationRecord(30.0, "voice_off", True, "VoiceInteractionQuality 0.1 < 0.2"))})
+    svg = qos_svg(adapted)
+    titles = re.findall(r'class="adaptation"[^>]*><title>([^<]+)</title>', svg)
+    assert titles == ["longer attempts on at 12 s", "voice answers off on at 30 s"]
+    for colour, name in re.findall(r'<polyline fill="none" stroke="([^"]+)"[^>]*><title>([^<]+)</title>', svg):
+        if name in METRIC_COLOURS:
+            assert colour == METRIC_COLOURS[name], name
+    assert "adaptation" in svg.split('class="incident-key">', 1)[1]

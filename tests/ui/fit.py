@@ -24,9 +24,11 @@ def problems(screen: Screen) -> list[str]:
     answers = [b for b in screen.query(AnswerButton) if _shown(b)]
     for button in answers:
         for label in button.query(".label").results(Label):
-            # a label is as tall as its wrapped text; the button clips whatever sticks out
-            if not button.region.contains_region(label.region):
-                found.append(f"answer {button.option}'s text at {label.region} is cut by its button "
+            # the label fills the button; its wrapped text must fit in it (and it in the button)
+            box = label.content_region
+            wanted = label.get_content_height(label.size, screen.size, box.width)
+            if not button.region.contains_region(label.region) or wanted > box.height:
+                found.append(f"answer {button.option}'s text ({wanted} lines) is cut by its button "
                              f"at {button.region}")
         for other in answers:
             if other.option > button.option and button.region.overlaps(other.region):

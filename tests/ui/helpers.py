@@ -107,3 +107,33 @@ async def start_with_voice_off(kiosk: UiKiosk, pilot: Pilot) -> None:
         if "voice_off" in kiosk.session.snapshot().adaptations:
             return
     raise AssertionError("voice_off never switched on")
+
+
+def drawn_text(app) -> str:
+    """The screen as the compositor draws it now, as plain text lines: what a patient would read
+    (tests wait on this, not on the session's state, before they look or snapshot)."""
+    import io
+
+    from rich.console import Console
+
+    width, height = app.size
+    console = Console(width=width, height=height, file=io.StringIO(), record=True, legacy_windows=False,
+                      force_terminal=True, color_system=None)
+    console.print(app.screen._compositor.render_update(full=True, screen_stack=app._background_screens))
+    return console.export_text()
+
+
+async def until_drawn(pilot: Pilot, *texts: str) -> str:
+    """Let the app process and draw until every one of ``texts`` is on screen; the drawn text."""
+    shown = ""
+
+    def check() -> bool:
+        nonlocal shown
+        shown = drawn_text(pilot.app)
+        return all(text in shown for text in texts)
+
+    for _ in range(TURNS):
+        await pilot.pause()
+        if check():
+            return shown
+    raise AssertionError(f"never drawn: {[t for t in texts if t not in shown]}\n{shown}")
