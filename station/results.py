@@ -120,6 +120,26 @@ def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
     return results_of(engine, q, rows)
 
 
+def instruments(engine: Engine, q: Questionnaire, visits: list[Result]) -> list[Questionnaire]:
+    """The questionnaires of a patient's course, one per instrument in order of first visit: each as
+    its latest visit captured it (a site's own questionnaire plots on its own scale and bands);
+    ``q`` (the station's) when there is no visit, or a visit captured none."""
+    latest: dict[str, str] = {}
+    for visit in visits:
+        latest[visit.questionnaire_id] = visit.session_id
+    found: list[Questionnaire] = []
+    with engine.connect() as connection:
+        for questionnaire_id, session_id in latest.items():
+            _, stored = load(connection, session_id)
+            try:
+                ran = questionnaire_of(stored, fallback=q if questionnaire_id == q.id else None)
+            except ExportError:  # nothing to plot it against: its rows still list the visit
+                continue
+            if ran.id == questionnaire_id:
+                found.append(ran)
+    return found or [q]
+
+
 def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, str]]:
     """Patients whose identifier contains ``text`` (case-insensitive): (id, visits, last visit)."""
     text = text.strip()
