@@ -58,7 +58,12 @@ class Result:
 
 
 def _signed(engine: Engine) -> Any:
-    return sa.select(audit.c.session_id).where(audit.c.action == "sign_off")
+    """Sessions whose latest sign-off or reopening is a sign-off: a result a doctor reopened to
+    amend waits for validation again, as :func:`kiosk.review.review_from_steps` says."""
+    latest = sa.select(audit.c.session_id, sa.func.max(audit.c.id).label("last")).where(
+        audit.c.action.in_(("sign_off", "amend"))).group_by(audit.c.session_id).subquery()
+    return sa.select(latest.c.session_id).join(audit, audit.c.id == latest.c.last).where(
+        audit.c.action == "sign_off")
 
 
 def waiting_count(engine: Engine) -> int:

@@ -107,3 +107,42 @@ def test_changes_that_come_back_to_the_kiosks_answer_are_signed_off_as_recorded(
         assert response_in(fhir)["status"] == "completed"
     finally:
         staff.http.close()
+
+
+def _row_state(html: str, session_id: str) -> str | None:
+    """The review badge of ``session_id``'s row in an inbox page; None when it is not listed."""
+    found = re.search(rf'data-session="{session_id}".*?class="badge review-([a-z_]+)"', html, re.S)
+    return found.group(1) if found else None
+
+
+def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_station):  # noqa: F811
+    """Reopened, a result is ``corrected`` on its page, in CSV and FHIR: the inbox lists it as
+    waiting (and counts it), not as signed; signed again it is ``amended`` everywhere."""
+    station, ward = shared_station
+    session_id, _, answers = _own_session(station, ward)
+    feeding = next(a for a in answers if a["item_id"] == "feeding")["option"]
+    staff = Staff(station.url)
+    try:
+        assert staff.post(f"/sessions/{session_id}/items/feeding", option=str(1 if feeding != 1 else 2),
+                          reason="misheard").status_code == 303
+        assert staff.post(f"/sessions/{session_id}/sign-off").status_code == 303
+        assert _row_state(staff.http.get("/inbox?state=signed").text, session_id) == "amended"
+        waiting_before = int(_badge(staff.http.get("/inbox").text, "waiting-count"))
+        reopened = staff.post(f"/sessions/{session_id}/amend", reason="physio: feeding needs help")
+        assert reopened.status_code == 303 and "Reopened" in staff.http.get(reopened.headers["location"]).text
+        assert _badge(staff.http.get(f"/sessions/{session_id}").text, "review-state") == "corrected"
+        waiting = staff.http.get("/inbox")
+        assert _row_state(waiting.text, session_id) == "corrected"
+        assert int(_badge(waiting.text, "waiting-count")) == waiting_before + 1
+        assert _row_state(staff.http.get("/inbox?state=signed").text, session_id) is None
+        assert _row_state(staff.http.get("/fragments/inbox").text, session_id) == "corrected"
+        table = staff.http.get(f"/sessions/{session_id}/export.csv")
+        assert {r["review_state"] for r in csv.DictReader(io.StringIO(table.text))} == {"corrected"}
+        fhir = staff.http.get(f"/sessions/{session_id}/export.json").json()
+        assert [e["resource"]["status"] for e in fhir["entry"]
+                if e["resource"]["resourceType"] == "Observation"] == ["preliminary"]
+        assert staff.post(f"/sessions/{session_id}/sign-off").status_code == 303
+        assert _row_state(staff.http.get("/inbox?state=signed").text, session_id) == "amended"
+        assert _row_state(staff.http.get("/inbox").text, session_id) is None
+    finally:
+        staff.http.close()
