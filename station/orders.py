@@ -359,6 +359,14 @@ def signed_off(engine: Engine, session_id: str, by: Any) -> None:
               f"result of session {session_id} signed off by {by.name}")
 
 
+def reopened(engine: Engine, session_id: str, by: Any) -> None:
+    """A doctor reopened the session's signed-off result to amend it: its order (if any) awaits
+    validation again, so the order never says "signed off" of a result that is not."""
+    with engine.begin() as connection:
+        _move(connection, session_id, "signed_off", "awaiting_validation", "order_reopened",
+              f"result of session {session_id} reopened to amend by {by.name}")
+
+
 def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:
     """How each session began: (kind, order id); sessions without a ``visit`` entry are absent
     (kiosks older than orders)."""

@@ -209,6 +209,8 @@ async def amend(request: Request) -> Response:
                                 request.state.user)
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
+    await run_in_threadpool(orders.reopened, request.app.state.engine, session_id, request.state.user)
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Reopened to amend: change the answers, then sign off again.", to=page)
 
 
