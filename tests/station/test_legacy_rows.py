@@ -29,8 +29,8 @@ def _spoil(db_url: str, session_id: str) -> None:
             for number, row in enumerate(rows[:2]):
                 payload = json.loads(row.payload)
                 payload |= {"option": 99} if number == 0 else {"item_id": "nonexistent"}
-                connection.execute(db.inbox.update().where(db.inbox.c.kiosk_id == row.kiosk_id,
-                                                           db.inbox.c.seq == row.seq).values(payload=json.dumps(payload)))
+                where = (db.inbox.c.kiosk_id == row.kiosk_id) & (db.inbox.c.seq == row.seq)
+                connection.execute(db.inbox.update().where(where).values(payload=json.dumps(payload)))
     finally:
         engine.dispose()
 
