@@ -94,6 +94,7 @@ def test_changes_that_come_back_to_the_kiosks_answer_are_signed_off_as_recorded(
             assert changed.status_code == 303, changed.text
         confirm = staff.http.get(f"/sessions/{session_id}/sign-off")
         assert _badge(confirm.text, "confirm-state") == "signed off"
+        assert _badge(confirm.text, "confirm-sign-off") == "Sign off"
         assert staff.post(f"/sessions/{session_id}/sign-off").status_code == 303
         page = staff.http.get(f"/sessions/{session_id}")
         assert _badge(page.text, "review-state") == "signed off"
