@@ -147,3 +147,25 @@ def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_statio
         assert _row_state(staff.http.get("/inbox").text, session_id) is None
     finally:
         staff.http.close()
+
+
+def test_staff_order_a_visit_of_the_sites_own_questionnaire(shared_station):  # noqa: F811
+    """A site whose kiosk runs its own questionnaire can order it: the station offers every
+    instrument a kiosk has run here, and the kiosk is sent an order it can take."""
+    station, ward = shared_station
+    _own_session(station, ward)
+    name, token = new_kiosk(ward.db_url)
+    nurse = Staff(station.url, "nurse.kim", "nurse")
+    kiosk = KioskClient(station.url, token, name)
+    try:
+        form = nurse.http.get("/orders").text
+        assert 'value="site-adl"' in form and "Site ADL" in form
+        placed = nurse.post("/orders", patient_id="NHC-0044001", kiosk=name, instrument="site-adl", language="en")
+        assert placed.status_code == 303 and placed.headers["location"].startswith("/orders/order-"), (
+            placed.headers["location"])
+        assert [o["instruments"] for o in kiosk.orders()["orders"]] == [["site-adl"]]
+        refused = nurse.post("/orders", patient_id="NHC-0044001", kiosk=name, instrument="site-adl", language="de")
+        assert refused.headers["location"].startswith("/orders?error=")
+    finally:
+        nurse.http.close()
+        kiosk.close()
