@@ -7,7 +7,6 @@ GET shows the step (no change); its form POSTs to the sign-off route (:mod:`stat
 
 from __future__ import annotations
 
-from dataclasses import replace
 from urllib.parse import quote
 
 from starlette.concurrency import run_in_threadpool
@@ -17,7 +16,7 @@ from starlette.routing import Route
 
 from kiosk.captured import questionnaire_of
 from kiosk.export import ExportError
-from kiosk.review import ReviewState, review_state
+from kiosk.review import state_once_signed
 from station import validation
 from station.rendering import render
 from station.sessions import NotFound, load
@@ -50,7 +49,7 @@ async def confirm_page(request: Request) -> Response:
     # what the result will be called once signed: the one review-state function's answer, so the
     # step never says "amended" for changes that came back to the kiosk's answers
     recorded = {a.item_id: a.option for a in stored.answers}
-    will_be = review_state(replace(current, state=ReviewState.SIGNED_OFF), recorded)
+    will_be = state_once_signed(current, recorded)
     return render(request, "sign_off.html", s=stored, kiosk=kiosk, review=current, score=score, labels=labels,
                   will_be=will_be.value)
 

@@ -92,6 +92,7 @@ def test_changes_that_come_back_to_the_kiosks_answer_are_signed_off_as_recorded(
         for option, reason in ((other, "misheard"), (feeding, "it was right after all")):
             changed = staff.post(f"/sessions/{session_id}/items/feeding", option=str(option), reason=reason)
             assert changed.status_code == 303, changed.text
+        assert _badge(staff.http.get(f"/sessions/{session_id}").text, "sign-off") == "Accept as recorded and sign off"
         confirm = staff.http.get(f"/sessions/{session_id}/sign-off")
         assert _badge(confirm.text, "confirm-state") == "signed off"
         assert _badge(confirm.text, "confirm-sign-off") == "Sign off"
