@@ -11,7 +11,7 @@ result stands, from its review and the kiosk's answers). Pure data, no I/O.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 from typing import Protocol
 
@@ -137,3 +137,10 @@ def review_state(review: Review, recorded: Mapping[str, int]) -> ReviewState:
     if review.final:
         return ReviewState.AMENDED if changed else ReviewState.SIGNED_OFF
     return ReviewState.CORRECTED if changed or review.reopenings else ReviewState.UNREVIEWED
+
+
+def state_once_signed(review: Review, recorded: Mapping[str, int]) -> ReviewState:
+    """What :func:`review_state` will say once a doctor signs ``review`` off: ``AMENDED`` when
+    the answers differ from the kiosk's, else ``SIGNED_OFF`` (what a sign-off button and its
+    confirmation announce, so they never promise another state than the badge shows after)."""
+    return review_state(replace(review, state=ReviewState.SIGNED_OFF), recorded)

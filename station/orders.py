@@ -124,6 +124,37 @@ def _audit(connection: Connection, order_id: str, author: str, action: str, reas
                                              action=action, reason=reason[:1000]))
 
 
+@dataclass(frozen=True)
+class Instrument:
+    """An instrument staff may order: its id, title (English, else any) and languages."""
+
+    id: str
+    title: str
+    languages: tuple[str, ...]
+
+
+def instruments(engine: Engine, bundled: Any) -> list[Instrument]:
+    """What staff may order: the station's bundled questionnaire, then every other one a kiosk
+    has run here (its latest stored definition), so a site running its own questionnaire can
+    order it; the kiosks still take only orders for instruments they give."""
+    found = {bundled.id: Instrument(bundled.id, bundled.title.get("en") or bundled.id, tuple(bundled.languages))}
+    with engine.connect() as connection:
+        rows = connection.execute(sa.select(db.definitions.c.questionnaire_id, db.definitions.c.body).where(
+            db.definitions.c.questionnaire_id != bundled.id).order_by(db.definitions.c.stored_at.desc())).all()
+    for row in rows:
+        if row.questionnaire_id in found:
+            continue
+        try:
+            body = json.loads(row.body)
+            title, languages = body.get("title") or {}, [str(lang) for lang in body["languages"]]
+        except (ValueError, KeyError, TypeError, AttributeError):
+            continue  # stored definitions were checked at sync; one that does not read is not offered
+        name = title.get("en") or next(iter(title.values()), row.questionnaire_id) if isinstance(title, dict) else ""
+        found[row.questionnaire_id] = Instrument(row.questionnaire_id, str(name or row.questionnaire_id),
+                                                 tuple(languages))
+    return list(found.values())
+
+
 def create(engine: Engine, *, kiosk_id: str, patient_id: str, instruments: Sequence[str], language: str,
            relative: bool, by: Any, known_instruments: Sequence[str], languages: Sequence[str]) -> Order:
     """Order a visit (a nurse or a doctor); returns it with its confirmation code."""
@@ -323,6 +354,14 @@ def signed_off(engine: Engine, session_id: str, by: Any) -> None:
     with engine.begin() as connection:
         _move(connection, session_id, "awaiting_validation", "signed_off", "order_signed",
               f"result of session {session_id} signed off by {by.name}")
+
+
+def reopened(engine: Engine, session_id: str, by: Any) -> None:
+    """A doctor reopened the session's signed-off result to amend it: its order (if any) awaits
+    validation again, so the order never says "signed off" of a result that is not."""
+    with engine.begin() as connection:
+        _move(connection, session_id, "signed_off", "awaiting_validation", "order_reopened",
+              f"result of session {session_id} reopened to amend by {by.name}")
 
 
 def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:

@@ -22,7 +22,7 @@ from starlette.routing import Route
 from kiosk.captured import questionnaire_of
 from kiosk.export import ExportError, practice_outcomes
 from kiosk.questionnaire import Questionnaire, Score
-from kiosk.review import review_state
+from kiosk.review import review_state, state_once_signed
 from kiosk.storage import StoredSession
 from station import db, exports, orders, validation, ward
 from station.download import attachment
@@ -151,8 +151,10 @@ async def session_page(request: Request) -> Response:
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
     score = _score(q, stored, current)
-    state = review_state(current, {a.item_id: a.option for a in stored.answers})
+    recorded = {a.item_id: a.option for a in stored.answers}
+    state = review_state(current, recorded)
     return render(request, "session.html", s=stored, kiosk=kiosk, review=current, state=state, trail=entries,
+                  will_be=state_once_signed(current, recorded).value,
                   q=q, items=_items(q, stored, current), score=score, practice=_practice(q, stored),
                   plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
                   unfit=[e for e in stored.log if e.kind.startswith(("unfit:", "unreadable:"))],
@@ -209,6 +211,8 @@ async def amend(request: Request) -> Response:
                                 request.state.user)
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
+    await run_in_threadpool(orders.reopened, request.app.state.engine, session_id, request.state.user)
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Reopened to amend: change the answers, then sign off again.", to=page)
 
 

@@ -49,8 +49,9 @@ async def patient_page(request: Request) -> Response:
     ordered = await run_in_threadpool(lambda: orders.listing(engine, patient_id=patient_id))
     if not visits and not ordered:
         return PlainTextResponse(f"no visit of patient {patient_id} has reached this station", status_code=404)
+    ran = await run_in_threadpool(results.instruments, engine, q, visits)
     return render(request, "patient.html", patient_id=patient_id, visits=visits, orders=ordered,
-                  plots=[(q.id, q.title.get("en", q.id), course_svg(q, visits))])
+                  plots=[(i.id, i.title.get("en", i.id), course_svg(i, visits)) for i in ran])
 
 
 routes = [

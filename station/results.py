@@ -58,7 +58,12 @@ class Result:
 
 
 def _signed(engine: Engine) -> Any:
-    return sa.select(audit.c.session_id).where(audit.c.action == "sign_off")
+    """Sessions whose latest sign-off or reopening is a sign-off: a result a doctor reopened to
+    amend waits for validation again, as :func:`kiosk.review.review_from_steps` says."""
+    latest = sa.select(audit.c.session_id, sa.func.max(audit.c.id).label("last")).where(
+        audit.c.action.in_(("sign_off", "amend"))).group_by(audit.c.session_id).subquery()
+    return sa.select(latest.c.session_id).join(audit, audit.c.id == latest.c.last).where(
+        audit.c.action == "sign_off")
 
 
 def waiting_count(engine: Engine) -> int:
@@ -118,6 +123,26 @@ def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
             sessions.c.patient_id == patient_id, sessions.c.status != "pending").order_by(
             sessions.c.started_at)).all()
     return results_of(engine, q, rows)
+
+
+def instruments(engine: Engine, q: Questionnaire, visits: list[Result]) -> list[Questionnaire]:
+    """The questionnaires of a patient's course, one per instrument in order of first visit: each as
+    its latest visit captured it (a site's own questionnaire plots on its own scale and bands);
+    ``q`` (the station's) when there is no visit, or a visit captured none."""
+    latest: dict[str, str] = {}
+    for visit in visits:
+        latest[visit.questionnaire_id] = visit.session_id
+    found: list[Questionnaire] = []
+    with engine.connect() as connection:
+        for questionnaire_id, session_id in latest.items():
+            _, stored = load(connection, session_id)
+            try:
+                ran = questionnaire_of(stored, fallback=q if questionnaire_id == q.id else None)
+            except ExportError:  # nothing to plot it against: its rows still list the visit
+                continue
+            if ran.id == questionnaire_id:
+                found.append(ran)
+    return found or [q]
 
 
 def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, str]]:

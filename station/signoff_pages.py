@@ -14,6 +14,9 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
+from kiosk.captured import questionnaire_of
+from kiosk.export import ExportError
+from kiosk.review import state_once_signed
 from station import validation
 from station.rendering import render
 from station.sessions import NotFound, load
@@ -37,9 +40,18 @@ async def confirm_page(request: Request) -> Response:
     if not request.state.user.is_doctor:
         return RedirectResponse(f"/sessions/{session_id}?message={quote('Only a doctor can sign off.')}",
                                 status_code=303)
+    try:  # the questionnaire the session ran, not the one the station bundles
+        q = questionnaire_of(stored, fallback=q)
+    except ExportError as exc:
+        return PlainTextResponse(f"session {session_id} cannot be described: {exc}", status_code=422)
     score = validation.corrected(stored, q, current)["score"]
     labels = {item.id: item.text.get("en", item.id) for item in q.items}
-    return render(request, "sign_off.html", s=stored, kiosk=kiosk, review=current, score=score, labels=labels)
+    # what the result will be called once signed: the one review-state function's answer, so the
+    # step never says "amended" for changes that came back to the kiosk's answers
+    recorded = {a.item_id: a.option for a in stored.answers}
+    will_be = state_once_signed(current, recorded)
+    return render(request, "sign_off.html", s=stored, kiosk=kiosk, review=current, score=score, labels=labels,
+                  will_be=will_be.value)
 
 
 routes = [Route("/sessions/{session_id}/sign-off", confirm_page, methods=["GET"])]

@@ -15,6 +15,7 @@ import json
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
+from urllib.parse import quote
 
 import httpx
 import pytest
@@ -172,3 +173,20 @@ def test_a_sync_body_is_stored_and_shown_or_refused_never_a_500(ward_station, bo
     for fmt in ("json", "csv"):
         export = staff.http.get(f"/sessions/{session_id}/export.{fmt}")
         assert export.status_code == 200 or (not created and export.status_code == 409), export.text[:2000]
+    # the pages that list or follow it: the ward, the inbox, its patient's course, the sign-off step
+    patient = next((e["payload"].get("patient_id") for e in payload["events"] if e["kind"] == "create_session"), None)
+    pages = ["/", "/fragments/results", "/inbox?state=all", "/fragments/inbox?state=all", "/orders",
+             f"/sessions/{session_id}/sign-off", "/exports/signed-off.json?from=2000-01-01&to=2100-12-31"]
+    if isinstance(patient, str) and patient:
+        pages += [f"/patients?q={quote(patient)}", f"/patients/{quote(patient, safe='')}"]
+    for path in pages:
+        shown = staff.http.get(path)
+        assert shown.status_code in (200, 303, 404), (path, shown.status_code, shown.text[:2000])
+    # signed off (where it can be), it still renders and exports, alone and in the period's Bundle
+    signed = staff.post(f"/sessions/{session_id}/sign-off")
+    assert signed.status_code == 303, signed.text[:2000]
+    event("signed off" if "Signed%20off." in signed.headers["location"] else "not signed off")
+    for path in [*pages, f"/sessions/{session_id}", f"/sessions/{session_id}/export.json"]:
+        shown = staff.http.get(path)
+        assert shown.status_code in (200, 303, 404) or (not created and shown.status_code == 409), (
+            path, shown.status_code, shown.text[:2000])

@@ -4,6 +4,7 @@ filed under the order (never under another patient), and every step is in the au
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
@@ -67,15 +68,27 @@ def test_an_order_goes_from_ordered_to_signed_off_on_its_own_kiosk_only(database
     assert mine.orders()["orders"] == []  # started: no longer waiting on the kiosk's welcome
     assert mine.start_order(code).status_code == 404  # a code starts one visit once
 
-    rows = record_patient(PATIENTS / "barthel1.yaml", patient="NHC-0012345", visit=f"order {order_id}")
+    identity = {"site": "north-hospital", "kiosk_id": ward.kiosk_id}
+    rows = record_patient(PATIENTS / "barthel1.yaml", patient="NHC-0012345", visit=f"order {order_id}",
+                          export=identity)
     assert mine.sync(rows).status_code == 200
     waiting, session_id = state(db_url, order_id)
     assert waiting == "awaiting_validation" and session_id == rows[0].session_id
 
     assert doctor.post(f"/sessions/{session_id}/sign-off").status_code == 303
     assert state(db_url, order_id) == ("signed_off", session_id)
+    # the ordered visit's result names the site and kiosk that recorded it, not the station's defaults
+    bundle = doctor.http.get(f"/sessions/{session_id}/export.json").json()
+    (response,) = [e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse"]
+    named = json.dumps(response["identifier"])
+    assert "north-hospital" in named and ward.kiosk_id in named
+    # reopened to amend, the order awaits validation again; signed again, it is signed off again
+    assert doctor.post(f"/sessions/{session_id}/amend", reason="new information").status_code == 303
+    assert state(db_url, order_id) == ("awaiting_validation", session_id)
+    assert doctor.post(f"/sessions/{session_id}/sign-off").status_code == 303
+    assert state(db_url, order_id) == ("signed_off", session_id)
     page = doctor.http.get(f"/orders/{order_id}").text
-    for step in ("order:", "order start", "order session", "order result", "order signed"):
+    for step in ("order:", "order start", "order session", "order result", "order signed", "order reopened"):
         assert step in page, step
     mine.close()
     other.close()

@@ -166,7 +166,9 @@ def test_a_doctor_reopens_a_signed_result_amends_it_and_signs_again(browser, war
     context, page = open_page(browser, station, "dr.lopez", "doctor", PHONE)
     page.goto(f"{station.url}/sessions/{session}")
     page.locator("#sign-off").click()
-    page.locator("text=Signed off by").wait_for()
+    assert page.locator("#confirm-state").inner_text() == "signed off"  # the step asks first
+    page.locator("#confirm-sign-off").click()
+    page.locator("#review-words").wait_for()
     assert page.locator("#review-state").inner_text() == "signed off"
     page.locator("input[name=reason]").fill("physiotherapist: needs help on stairs")
     page.locator("#amend").click()
@@ -179,7 +181,10 @@ def test_a_doctor_reopens_a_signed_result_amends_it_and_signs_again(browser, war
     row.locator("button[type=submit]").click()
     page.locator("text=Change recorded.").wait_for()
     page.locator("#sign-off").click()
-    page.locator("text=Signed off by").wait_for()
+    assert page.locator("#confirm-state").inner_text() == "amended"
+    assert "95 of 100" in page.locator("#confirm-total").inner_text()
+    page.locator("#confirm-sign-off").click()
+    page.locator("#review-words").wait_for()
     assert page.locator("#review-state").inner_text() == "amended"
     assert page.locator("#total").inner_text() == "95"
     trail = page.locator("table.trail").inner_text()
