@@ -14,7 +14,6 @@ from __future__ import annotations
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
-import station.orders  # noqa: F401 - its tables (orders, visits, code failures) join db.metadata: grant them too
 from station import db
 
 #: the only privileges the app role gets on the audit trail
