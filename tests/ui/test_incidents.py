@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 
-from textual.widgets import Input, Label, Static
+from textual.widgets import Label, Static
 
 from kiosk.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.session import AttemptTimedOut, Phase, Prompt, QuestionNotAnswered
