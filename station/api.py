@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 import json
 from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Awaitable
 from typing import Any
 
 from sqlalchemy.engine import Connection
@@ -20,6 +21,7 @@ from starlette.routing import Route
 
 from qos.files import BadFile, load_json
 from station import auth, sync, ward
+from station.bus import long_poll
 
 #: the longest long poll the station holds open (seconds)
 MAX_WAIT_S = 30.0
@@ -176,18 +178,11 @@ async def get_commands(request: Request) -> Response:
     queue = bus.subscribe()
     try:
         await run_in_threadpool(ward.seen, engine, kiosk)
-        pending = await run_in_threadpool(ward.pending_commands, engine, kiosk)
-        deadline = asyncio.get_running_loop().time() + wait
-        while not pending:
-            left = deadline - asyncio.get_running_loop().time()
-            if left <= 0:
-                break
-            try:
-                message = await asyncio.wait_for(queue.get(), timeout=left)
-            except TimeoutError:
-                break
-            if message.get("type") in ("command", "resync") and message.get("kiosk") in (kiosk, None):
-                pending = await run_in_threadpool(ward.pending_commands, engine, kiosk)
+
+        def fetch() -> Awaitable[list[dict[str, Any]]]:
+            return run_in_threadpool(ward.pending_commands, engine, kiosk)
+
+        pending = await long_poll(queue, kiosk, ("command", "resync"), wait, await fetch(), fetch, bool)
     finally:
         bus.unsubscribe(queue)
     return JSONResponse({"commands": pending})

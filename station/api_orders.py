@@ -12,6 +12,7 @@ import asyncio
 import hashlib
 import json
 from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Awaitable
 from typing import Any
 
 from sqlalchemy.engine import Connection
@@ -20,6 +21,7 @@ from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
 from station import auth, orders
+from station.bus import long_poll
 from station.api import MAX_WAIT_S, _error, _in_worker, _json, _refused, _token, _unauthorised, _Unauthorised
 
 
@@ -55,18 +57,12 @@ async def get_orders(request: Request) -> Response:
     engine, bus = request.app.state.engine, request.app.state.bus
     queue = bus.subscribe()
     try:
-        current = await loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk)
-        deadline = loop.time() + wait
-        while current["version"] == known:
-            left = deadline - loop.time()
-            if left <= 0:
-                break
-            try:
-                message = await asyncio.wait_for(queue.get(), timeout=left)
-            except TimeoutError:
-                break
-            if message.get("type") in ("order", "resync") and message.get("kiosk") in (kiosk, None):
-                current = await loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk)
+
+        def fetch() -> Awaitable[dict[str, Any]]:
+            return loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk)
+
+        current = await long_poll(queue, kiosk, ("order", "resync"), wait, await fetch(), fetch,
+                                  lambda listed: listed["version"] != known)
     finally:
         bus.unsubscribe(queue)
     return JSONResponse(current)

@@ -15,7 +15,7 @@ import contextlib
 import json
 import logging
 import threading
-from collections.abc import Iterator
+from collections.abc import Awaitable, Callable, Iterator
 from typing import Any
 
 import sqlalchemy as sa
@@ -126,3 +126,24 @@ class Bus:
             except psycopg.Error as exc:
                 log.warning("station: lost the database notification connection (%s); reconnecting", exc)
                 self._stopping.wait(1.0)
+
+
+async def long_poll(queue: asyncio.Queue[dict[str, Any]], kiosk: str, kinds: tuple[str, ...], wait: float,
+                    current: Any, fetch: Callable[[], Awaitable[Any]], answered: Callable[[Any], bool]) -> Any:
+    """The long polls' wait: from ``current`` (read after subscribing ``queue``, so nothing
+    published in between is missed), read again with ``fetch`` on every message of one of
+    ``kinds`` for ``kiosk`` (or for every kiosk), until ``answered`` says so or ``wait`` seconds
+    pass; returns what was read last."""
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + wait
+    while not answered(current):
+        left = deadline - loop.time()
+        if left <= 0:
+            break
+        try:
+            message = await asyncio.wait_for(queue.get(), timeout=left)
+        except TimeoutError:
+            break
+        if message.get("type") in kinds and message.get("kiosk") in (kiosk, None):
+            current = await fetch()
+    return current
