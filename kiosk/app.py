@@ -371,7 +371,10 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def poll_session(self) -> None:
         """Let the session's due time-outs happen (the poll timer calls this), and move the
-        waiting sign's dot on with the session's clock."""
+        waiting sign's dot on with the session's clock. Nothing while no screen is up: the timer
+        can still fire while the app is closing (as when another kiosk holds the test)."""
+        if not self.screen_stack:
+            return
         self._drive(self.session.poll)
         self._staff_idle()
         if isinstance(self.screen, PatientScreen):
