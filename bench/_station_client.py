@@ -43,15 +43,15 @@ def record_patient(script: str | Path, first_seq: int = 1, patient: str | None =
                    export: dict[str, str] | None = None, data_dir: Path | None = None,
                    visit: str | None = None) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
-    on the kiosk's real :class:`kiosk.storage.Store` with a station configured, its outbox read
+    on the kiosk's real :class:`kiosk.store.database.Store` with a station configured, its outbox read
     back and numbered from ``first_seq``; ``export`` is the kiosk's export identity, ``visit`` the
     session's ``visit`` log entry (``order ID`` for an ordered visit). The store is thrown away,
     unless ``data_dir`` names where to keep it (for the kiosk's own exports)."""
     import contextlib
     from dataclasses import replace
 
-    from kiosk.replay import load_script, run_script
-    from kiosk.storage import DB_NAME, Store
+    from kiosk.commands.replay import load_script, run_script
+    from kiosk.store.database import DB_NAME, Store
 
     loaded = load_script(script)
     if patient is not None:

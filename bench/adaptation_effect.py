@@ -1,4 +1,4 @@
-"""The effect of the longer_attempts adaptation (kiosk/adaptation.yaml) on the scripted patients.
+"""The effect of the longer_attempts adaptation (kiosk/core/adaptation.yaml) on the scripted patients.
 
 Every scripted patient in recordings/patients/ runs through the real session and QoS engine on a
 simulated clock twice: with the bundled adaptation policy, and with the same policy without its
@@ -15,9 +15,9 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from kiosk.adaptation import load_policy
-from kiosk.questionnaire import load_questionnaire
-from kiosk.replay import ScriptError, load_script, run_script
+from kiosk.core.adaptation import load_policy
+from kiosk.core.questionnaire import load_questionnaire
+from kiosk.commands.replay import ScriptError, load_script, run_script
 
 PATIENTS = Path(__file__).resolve().parents[1] / "recordings" / "patients"
 RULE = "longer_attempts"

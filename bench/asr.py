@@ -104,8 +104,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _vads import endpointer_factory  # noqa: E402
 
-from kiosk.channels import ChannelInput, Command  # noqa: E402
-from kiosk.questionnaire import load_questionnaire  # noqa: E402
+from kiosk.core.channels import ChannelInput, Command  # noqa: E402
+from kiosk.core.questionnaire import load_questionnaire  # noqa: E402
 from kiosk.speech import rooms  # noqa: E402
 from kiosk.speech.asr import PocketSphinxRecogniser  # noqa: E402
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav  # noqa: E402

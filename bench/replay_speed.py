@@ -16,9 +16,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from kiosk.questionnaire import load_questionnaire
-from kiosk.replay import load_script, run_script
-from kiosk.storage import Store
+from kiosk.core.questionnaire import load_questionnaire
+from kiosk.commands.replay import load_script, run_script
+from kiosk.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[1]
 ROUNDS = 5

@@ -4,7 +4,7 @@
 Both run as ``python -m …`` on a pseudo-terminal of 100x32, fresh data directory, no station; the
 clock stops when the welcome's "English" button is on the terminal (escape sequences stripped),
 which is what a patient waits for. Rounds alternate the two apps so machine load hits both alike;
-the medians' ratio is the figure. Also reports ``python -X importtime`` of ``kiosk.app``'s heaviest
+the medians' ratio is the figure. Also reports ``python -X importtime`` of ``kiosk.ui.app``'s heaviest
 imports. Prints JSON. Run: uv run python bench/startup.py [--rounds N]
 """
 
@@ -68,8 +68,8 @@ def time_to_marker(argv: list[str], env: dict[str, str], timeout_s: float = 60.0
 
 
 def heaviest_imports(n: int = 8) -> list[dict[str, object]]:
-    """The ``n`` largest cumulative import times (ms) under ``import kiosk.app``."""
-    err = subprocess.run([sys.executable, "-X", "importtime", "-c", "import kiosk.app"],
+    """The ``n`` largest cumulative import times (ms) under ``import kiosk.ui.app``."""
+    err = subprocess.run([sys.executable, "-X", "importtime", "-c", "import kiosk.ui.app"],
                          capture_output=True, text=True, check=True).stderr
     rows = []
     for line in err.splitlines():

@@ -30,13 +30,13 @@ from pathlib import Path
 
 from textual import events
 
-from kiosk.adaptation import Adaptation, load_policy
-from kiosk.app import KIOSK_SIZE, KioskApp
-from kiosk.clock import SimClock
-from kiosk.questionnaire import load_questionnaire
-from kiosk.records import MODEL
-from kiosk.session import Phase, Session
-from kiosk.storage import Store
+from kiosk.core.adaptation import Adaptation, load_policy
+from kiosk.ui.app import KIOSK_SIZE, KioskApp
+from kiosk.core.clock import SimClock
+from kiosk.core.questionnaire import load_questionnaire
+from kiosk.export.opening import MODEL
+from kiosk.core.session import Phase, Session
+from kiosk.store.database import Store
 from qos import Engine, load_model
 
 GOAL_SESSION_S = 3.0

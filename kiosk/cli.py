@@ -15,15 +15,15 @@ from collections.abc import Sequence
 
 #: sub-command -> (module exposing main(argv), one-line description)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "run": ("kiosk.app", "start the kiosk (the default when no sub-command is given)"),
-    "serve": ("kiosk.serve", "serve the kiosk to a browser on a touch display (localhost by default)"),
-    "replay": ("kiosk.replay", "run a scripted patient through the real session on a simulated clock"),
-    "validate": ("kiosk.validate", "check a questionnaire YAML file and list every problem"),
-    "results": ("kiosk.results", "list stored sessions, show one, or export it (FHIR JSON, CSV)"),
-    "devices": ("kiosk.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
-    "pin": ("kiosk.pin_cli", "set the clinician PIN (`kiosk pin set`; stored hashed in the configuration)"),
+    "run": ("kiosk.ui.app", "start the kiosk (the default when no sub-command is given)"),
+    "serve": ("kiosk.ui.serve.server", "serve the kiosk to a browser on a touch display (localhost by default)"),
+    "replay": ("kiosk.commands.replay", "run a scripted patient through the real session on a simulated clock"),
+    "validate": ("kiosk.commands.validate", "check a questionnaire YAML file and list every problem"),
+    "results": ("kiosk.commands.results", "list stored sessions, show one, or export it (FHIR JSON, CSV)"),
+    "devices": ("kiosk.commands.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
+    "pin": ("kiosk.commands.pin", "set the clinician PIN (`kiosk pin set`; stored hashed in the configuration)"),
     "models": ("kiosk.speech.models", "install and list speech-recognition models"),
-    "qos": ("kiosk.qos_cli", "QoS tools: replay a context trace, print a session's trace"),
+    "qos": ("kiosk.commands.qos", "QoS tools: replay a context trace, print a session's trace"),
     "station": ("station.cli", "the ward station web app (kiosks report to it; staff watch and validate)"),
 }
 

@@ -56,11 +56,11 @@ from urllib.parse import urlsplit
 
 import platformdirs
 
-from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
-from kiosk.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
-from kiosk.yamlmarks import Problem, parse_file
+from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
+from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
+from fileio.positions import Problem, parse_file
 from qos import bundled_models
-from qos.files import BadFile, open_private, read_text
+from fileio.bounded import BadFile, open_private, read_text
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
@@ -127,9 +127,9 @@ class Config:
     serve_max_sessions: int = SERVE_MAX_SESSIONS
     #: live adaptation (the clinician can still switch it off per session)
     adaptation: bool = True
-    #: an adaptation policy file (None: the bundled kiosk/adaptation.yaml)
+    #: an adaptation policy file (None: the bundled kiosk/core/adaptation.yaml)
     adaptation_policy: Path | None = None
-    #: the QoS model: a bundled model's name, or a .roqme file's absolute path (see kiosk.qos_model)
+    #: the QoS model: a bundled model's name, or a .roqme file's absolute path (see kiosk.core.qos_model)
     qos_model: str = "clarc"
     #: a questionnaire file (None: the bundled Barthel questionnaire)
     questionnaire: Path | None = None
@@ -305,7 +305,7 @@ def _read(path: Path) -> dict[str, Any]:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
         elif key == "qos_model":
-            from kiosk.qos_model import resolve_model
+            from kiosk.core.qos_model import resolve_model
 
             if not isinstance(value, str) or not value.strip():
                 raise fail((key,), "qos_model must name a bundled model (clarc, kiosk_pace) or a .roqme file")
@@ -372,7 +372,7 @@ def _station(values: Mapping[str, str], where: str) -> Station | None:
 def configured_questionnaire(config: Config) -> Questionnaire:
     """The questionnaire this kiosk uses, scoring with the configured band set.
 
-    Raises :class:`~kiosk.questionnaire.QuestionnaireError` for a bad questionnaire file and
+    Raises :class:`~kiosk.core.questionnaire.QuestionnaireError` for a bad questionnaire file and
     :class:`ConfigError` when ``bands`` names a set the questionnaire does not have.
     """
     questionnaire = load_questionnaire(config.questionnaire)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from qos import load_model
 from qos.errors import QosError
-from qos.files import open_private, write_error
+from fileio.bounded import open_private, write_error
 from qos.model import Model, type_name
 from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
 

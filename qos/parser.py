@@ -14,7 +14,7 @@ from pathlib import Path
 from lark import Token, Tree
 
 from qos.errors import ModelError
-from qos.files import BadFile, read_text
+from fileio.bounded import BadFile, read_text
 from qos.grammar import SyntaxProblem, parse_text
 from qos.model import (
     BOOLEAN, EVENTTYPE, INTENSITY_LR, NUMBER, ArrayType, ClearEvidence, Context, EnumType, Evidence, Literal, Model,

@@ -27,7 +27,7 @@ import yaml
 
 from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
 from qos.errors import ContextError, ModelError, TraceError
-from qos.files import BadFile, load_data, write_private
+from fileio.bounded import BadFile, load_data, write_private
 from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")

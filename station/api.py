@@ -19,7 +19,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
-from qos.files import BadFile, load_json
+from fileio.bounded import BadFile, load_json
 from station import auth, sync, ward
 from station.bus import long_poll
 
@@ -85,7 +85,7 @@ class _TooLarge(ValueError):
 
 async def _json(request: Request) -> Any:
     """The request's JSON body, read under the same limits as the kiosk's own files
-    (:func:`qos.files.load_json`: nesting, duplicate keys, NaN, huge numbers), at most
+    (:func:`fileio.bounded.load_json`: nesting, duplicate keys, NaN, huge numbers), at most
     :data:`MAX_BODY` bytes and never buffered beyond that: a ``ValueError`` naming what is wrong."""
     declared = request.headers.get("content-length", "")
     if declared.isdigit() and int(declared) > MAX_BODY:

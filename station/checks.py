@@ -20,12 +20,12 @@ from collections.abc import Mapping
 from datetime import datetime
 from typing import Any
 
-from kiosk.channels import Channel
-from kiosk.definition import DefinitionError, questionnaire_from
+from kiosk.core.channels import Channel
+from kiosk.core.questionnaire.definition import DefinitionError, questionnaire_from
 from kiosk.export import ExportError, ExportSite, fhir_questionnaire
-from kiosk.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
-from kiosk.session import AnsweredBy
-from kiosk.storage import PATIENT_ID
+from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
+from kiosk.core.session import AnsweredBy
+from kiosk.store.database import PATIENT_ID
 
 #: the longest id (item, session, kind, name) and time the station's columns hold
 ID_MAX, TIME_MAX = 64, 40

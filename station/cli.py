@@ -25,7 +25,7 @@ import logging
 import sys
 from pathlib import Path
 
-from qos.files import BadFile, read_text
+from fileio.bounded import BadFile, read_text
 from station import auth, db, roles, throttle
 
 ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate")

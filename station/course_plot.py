@@ -11,7 +11,7 @@ from __future__ import annotations
 from datetime import datetime
 from html import escape
 
-from kiosk.questionnaire import Questionnaire
+from kiosk.core.questionnaire import Questionnaire
 from station.results import Result
 
 WIDTH, HEIGHT = 480, 220

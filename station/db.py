@@ -94,7 +94,7 @@ sessions = sa.Table(
     sa.Column("definition_attached_later", sa.Boolean, nullable=False, server_default=sa.false()),
 )
 
-#: questionnaire definitions, stored once per content (kiosk.definition: canonical JSON, SHA-256)
+#: questionnaire definitions, stored once per content (kiosk.core.questionnaire.definition: canonical JSON, SHA-256)
 definitions = sa.Table(
     "definitions", metadata,
     sa.Column("sha256", sa.String(64), primary_key=True),

@@ -2,7 +2,7 @@
 transaction Bundles, and one result as CSV, all through the kiosk's own export code
 (:mod:`kiosk.export`), so a result reads the same from the kiosk and from the station.
 
-Each result is described with what its session captured as it started (:mod:`kiosk.captured`):
+Each result is described with what its session captured as it started (:mod:`kiosk.export.captured`):
 the questionnaire definition it ran and the identity it was recorded under (site, kiosk id, FHIR
 systems), so a hospital importing the kiosk's and the station's exports gets one result, not two;
 the station's review (:mod:`station.validation`) says where it stands. The caller's questionnaire
@@ -16,9 +16,9 @@ from datetime import date, timedelta
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
-from kiosk.captured import questionnaire_of, site_of
+from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.export import Described, bundle_of, csv_text, result
-from kiosk.questionnaire import Questionnaire
+from kiosk.core.questionnaire import Questionnaire
 from station import validation
 from station.db import audit
 from station.sessions import load

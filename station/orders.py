@@ -29,7 +29,7 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
-from kiosk.visits import HOSPITAL_ID
+from kiosk.core.visits import HOSPITAL_ID
 from station import db
 from station.db import audit, code_failures, kiosks, orders, visits
 from station.sessions import LIFECYCLE
@@ -37,7 +37,7 @@ from station.sessions import LIFECYCLE
 #: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
 #: No spaces, dots or apostrophes, and a digit required, so "Maria Lopez", "O'Neill" or "LOPEZ"
 #: are refused: identifiers such as "NHC-0012345" or "12345678" are what a ward types. The kiosk's
-#: clinician screen checks the same rule (one definition, in kiosk.visits).
+#: clinician screen checks the same rule (one definition, in kiosk.core.visits).
 PATIENT_ID = HOSPITAL_ID
 STATES = ("ordered", "in_progress", "awaiting_validation", "signed_off", "cancelled")
 WORDS = {"ordered": "ordered", "in_progress": "in progress", "awaiting_validation": "awaiting validation",

@@ -3,7 +3,7 @@
 Thin handlers: check the form (CSRF), call :mod:`station.ward` or :mod:`station.validation`,
 publish what changed, redirect back (post/redirect/get, so a reload never repeats an action).
 A session is shown and exported with the questionnaire it ran and the identity its kiosk recorded
-it under (:mod:`kiosk.captured`), never with the station's bundled file; what of a session does
+it under (:mod:`kiosk.export.captured`), never with the station's bundled file; what of a session does
 not fit its questionnaire (rows stored before they were checked) is left out, never a 500.
 """
 
@@ -19,11 +19,11 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.captured import questionnaire_of
+from kiosk.export.captured import questionnaire_of
 from kiosk.export import ExportError, practice_outcomes
-from kiosk.questionnaire import Questionnaire, Score
-from kiosk.review import review_state, state_once_signed
-from kiosk.storage import StoredSession
+from kiosk.core.questionnaire import Questionnaire, Score
+from kiosk.core.review import review_state, state_once_signed
+from kiosk.store.database import StoredSession
 from station import db, exports, orders, validation, ward
 from station.download import attachment
 from station.plot import INCIDENTS, qos_svg

@@ -14,7 +14,7 @@ from __future__ import annotations
 from html import escape
 
 from kiosk.export.qos_plot import INCIDENT_WORDS, MARK_COLOURS, metric_colour, plot_marks
-from kiosk.storage import StoredSession
+from kiosk.store.database import StoredSession
 
 WIDTH, HEIGHT = 760, 298
 LEFT, RIGHT, TOP, BOTTOM = 44, 12, 14, 64

@@ -14,10 +14,10 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 
-from kiosk.captured import questionnaire_of
+from kiosk.export.captured import questionnaire_of
 from kiosk.export import ExportError
-from kiosk.questionnaire import Questionnaire
-from kiosk.review import review_state
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.review import review_state
 from station import orders, validation
 from station.db import audit, sessions
 from station.sessions import load
@@ -59,7 +59,7 @@ class Result:
 
 def _signed(engine: Engine) -> Any:
     """Sessions whose latest sign-off or reopening is a sign-off: a result a doctor reopened to
-    amend waits for validation again, as :func:`kiosk.review.review_from_steps` says."""
+    amend waits for validation again, as :func:`kiosk.core.review.review_from_steps` says."""
     latest = sa.select(audit.c.session_id, sa.func.max(audit.c.id).label("last")).where(
         audit.c.action.in_(("sign_off", "amend"))).group_by(audit.c.session_id).subquery()
     return sa.select(latest.c.session_id).join(audit, audit.c.id == latest.c.last).where(

@@ -1,5 +1,5 @@
 """A session read back from what its kiosk sent: the inbox rows folded in ``seq`` order into the
-kiosk's own :class:`kiosk.storage.StoredSession`, so scoring, labels and exports are the session
+kiosk's own :class:`kiosk.store.database.StoredSession`, so scoring, labels and exports are the session
 core's, not a copy. A row that arrived late (alerts go first) simply takes its place in the order.
 The session carries the definition it ran and the identity its kiosk recorded it under (what the
 kiosk sent with ``create_session``), so pages and exports describe it as it was recorded. A row the
@@ -16,12 +16,12 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.captured import questionnaire_of
-from kiosk.channels import Channel
+from kiosk.export.captured import questionnaire_of
+from kiosk.core.channels import Channel
 from kiosk.export import ExportError
-from kiosk.questionnaire import Questionnaire
-from kiosk.session import Answer, AnsweredBy
-from kiosk.storage import (
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.session import Answer, AnsweredBy
+from kiosk.store.database import (
     AdaptationRecord,
     LogEntry,
     MetricSample,

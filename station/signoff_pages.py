@@ -14,9 +14,9 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.captured import questionnaire_of
+from kiosk.export.captured import questionnaire_of
 from kiosk.export import ExportError
-from kiosk.review import state_once_signed
+from kiosk.core.review import state_once_signed
 from station import validation
 from station.rendering import render
 from station.sessions import NotFound, load

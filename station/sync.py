@@ -23,8 +23,8 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.definition import canonical, canonical_json, digest, questionnaire_from
-from kiosk.questionnaire import Questionnaire, load_questionnaire
+from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
+from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from station import alert_rules, db, orders
 from station.checks import (
     ID_MAX,

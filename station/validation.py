@@ -1,8 +1,8 @@
 """Clinicians validate a session: correct an item (new option and why; the kiosk's answer is
 kept), fill an item the patient did not answer, then a doctor signs off; a doctor may reopen a
 signed result to amend it (with a reason), after which it is changed and signed off again. Every
-step is a row of the append-only audit trail, and the :class:`kiosk.review.Review` exports take
-is derived from those rows (:func:`kiosk.review.review_from_steps`), so what an export says can
+step is a row of the append-only audit trail, and the :class:`kiosk.core.review.Review` exports take
+is derived from those rows (:func:`kiosk.core.review.review_from_steps`), so what an export says can
 always be traced to who did it and why.
 """
 
@@ -14,9 +14,9 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
-from kiosk.questionnaire import Questionnaire
-from kiosk.review import Review, review_from_steps
-from kiosk.storage import StoredSession
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.review import Review, review_from_steps
+from kiosk.store.database import StoredSession
 from station import db
 from station.auth import User
 from station.db import audit

@@ -26,7 +26,7 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response, S
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
-from kiosk.questionnaire import Questionnaire, load_questionnaire
+from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from station import api, api_orders, auth, logins, order_pages, pages, result_pages, signoff_pages, throttle
 from station.bodylimit import BodyLimit
 from station.bus import Bus

@@ -12,7 +12,7 @@ from tests.prerequisites import ensure_npm_packages, require_debian
 
 @pytest.fixture(scope="session")
 def npm_packages() -> Path:
-    """tests/fhir/js/node_modules, installed by ``npm ci`` when missing or stale."""
+    """tests/kiosk/export/js/node_modules, installed by ``npm ci`` when missing or stale."""
     return ensure_npm_packages()
 
 

@@ -1,5 +1,5 @@
 """What the tests need beyond the Python packages, set up by the test run itself: the npm packages
-of tests/fhir/js (installed with ``npm ci`` when missing or older than their lock file) and the
+of tests/kiosk/export/js (installed with ``npm ci`` when missing or older than their lock file) and the
 Debian packages some tests use (checked: installing them needs root, so a missing one is one
 failure line naming the ``apt-get install`` that fixes it).
 
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-JS = Path(__file__).parent / "fhir" / "js"
+JS = Path(__file__).parent / "kiosk" / "export" / "js"
 #: the hash of the package-lock.json node_modules was last installed from
 STAMP = JS / "node_modules" / ".installed-from-lock"
 #: serialises installs between test processes sharing this checkout

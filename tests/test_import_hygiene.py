@@ -11,9 +11,9 @@ import qos
 
 #: the pure-Python parts of the kiosk (imported by module name; missing ones are an error)
 PURE_KIOSK_MODULES = [
-    "kiosk.channels", "kiosk.cli", "kiosk.clock", "kiosk.questionnaire", "kiosk.session", "kiosk.adaptation",
-    "kiosk.storage", "kiosk.replay", "kiosk.config", "kiosk.records", "kiosk.export", "kiosk.results",
-    "kiosk.validate", "kiosk.yamlmarks",
+    "kiosk.core.channels", "kiosk.cli", "kiosk.core.clock", "kiosk.core.questionnaire", "kiosk.core.session", "kiosk.core.adaptation",
+    "kiosk.store.database", "kiosk.commands.replay", "kiosk.config", "kiosk.export.opening", "kiosk.export", "kiosk.commands.results",
+    "kiosk.commands.validate", "fileio.positions",
 ]
 
 
@@ -50,5 +50,5 @@ def test_channels_never_import_textual():
     import kiosk.remote
     import kiosk.speech
 
-    loaded = _imported_after(_modules_of(kiosk.speech) + _modules_of(kiosk.remote) + ["kiosk.devices"])
+    loaded = _imported_after(_modules_of(kiosk.speech) + _modules_of(kiosk.remote) + ["kiosk.commands.devices"])
     assert "textual" not in loaded

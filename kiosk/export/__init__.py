@@ -10,7 +10,7 @@
 - :mod:`kiosk.export.tables`: CSV for researchers, long and wide, ids that stay text.
 
 Never a total for an incomplete result: a partial sum is only ever shown apart, as the points of
-the answered items. The station passes the session's :class:`kiosk.review.Review`; the kiosk on
+the answered items. The station passes the session's :class:`kiosk.core.review.Review`; the kiosk on
 its own exports results as unreviewed. Every function takes the questionnaire and the identity
 (:class:`ExportSite`) it is given, and reads no file or configuration.
 """

@@ -24,9 +24,9 @@ from urllib.parse import quote
 from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of, total_of
 from kiosk.export.provenance import fhir_provenances
 from kiosk.export.result import ExportSite, Result, questionnaire_version, results
-from kiosk.questionnaire import Questionnaire
-from kiosk.review import Review
-from kiosk.storage import StoredSession
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.review import Review
+from kiosk.store.database import StoredSession
 
 
 @dataclass(frozen=True)

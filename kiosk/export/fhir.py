@@ -26,12 +26,12 @@ Choices, each from the R4 specification:
   expected to complete it), ``stopped`` for one abandoned or signed off incomplete; ``amended``
   once a clinician's corrections changed the kiosk's answers (signed off or still in review: the
   signature and the Observation's status tell which). Where a result stands comes from one
-  function, :func:`kiosk.review.review_state`, which the CSV's ``review_state`` also states.
+  function, :func:`kiosk.core.review.review_state`, which the CSV's ``review_state`` also states.
   As SDC does, an unanswered item is left out of the response, and the ``total`` item (LOINC
   96761-2) is there only when the result is complete (its calculatedExpression gives none otherwise).
 - **Review**: a sign-off is the R4 ``questionnaireresponse-signature`` extension (a Verification
   Signature: when, and who as a Practitioner reference carrying the staff account's name as its
-  identifier in the station's staff system, :attr:`kiosk.review.Review.staff_system`). ``author``
+  identifier in the station's staff system, :attr:`kiosk.core.review.Review.staff_system`). ``author``
   ("who recorded the answers") stays the kiosk (a Device), which recorded every answer nobody
   changed; each change is a Provenance (:mod:`kiosk.export.provenance`: who, when, why, and the
   answer it replaced with that answer's author). ``authored`` is when the answers last changed
@@ -69,10 +69,10 @@ from kiosk.export.result import (
     questionnaire_version,
     result,
 )
-from kiosk.questionnaire import Code, Questionnaire
-from kiosk.review import Review, ReviewState
-from kiosk.storage import StoredSession
-from kiosk.visits import visit_of
+from kiosk.core.questionnaire import Code, Questionnaire
+from kiosk.core.review import Review, ReviewState
+from kiosk.store.database import StoredSession
+from kiosk.core.visits import visit_of
 
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
@@ -271,7 +271,7 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
     return _labelled(resource, stored)
 
 
-#: how the visit began (kiosk.visits), as a meta tag: "order", "staff" or "walk-up"
+#: how the visit began (kiosk.core.visits), as a meta tag: "order", "staff" or "walk-up"
 VISIT_SYSTEM = "urn:barthel-kiosk:visit"
 
 

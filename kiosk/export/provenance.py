@@ -27,7 +27,7 @@ from typing import Any
 
 from kiosk.export.fhir import device_reference, instant, option_coding, practitioner
 from kiosk.export.result import ExportSite, Result
-from kiosk.questionnaire import Questionnaire
+from kiosk.core.questionnaire import Questionnaire
 
 #: the answer a change replaced, as the response's Coding had it (on ``Provenance.entity``)
 REPLACED_ANSWER = "urn:barthel-kiosk:fhir:StructureDefinition:replaced-answer"

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from kiosk.stored import StoredSession
+from kiosk.store.records import StoredSession
 
 #: the metrics of the CLARC model, in the order they are drawn
 METRICS = ("Performance", "Interaction", "VoiceInteractionQuality")

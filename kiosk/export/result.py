@@ -1,5 +1,5 @@
 """What every export of a stored session states: a :class:`Result` is the session's answers after
-a clinician's corrections (:class:`kiosk.review.Review`), their score recomputed from the option
+a clinician's corrections (:class:`kiosk.core.review.Review`), their score recomputed from the option
 numbers (a stored total or stored points are never trusted), whether it is complete and whether a
 clinician signed it off; :class:`ExportSite` is who exports (site, kiosk, FHIR systems)."""
 
@@ -12,10 +12,10 @@ from pathlib import Path
 from typing import Any
 
 from kiosk.config import Config, default_kiosk_id
-from kiosk.questionnaire import Questionnaire, Score
-from kiosk.review import Review, ReviewState, review_state
-from kiosk.storage import PracticeRecord, StoredSession
-from qos.files import write_error, write_private  # the one owner-only writer; exports use it from here too
+from kiosk.core.questionnaire import Questionnaire, Score
+from kiosk.core.review import Review, ReviewState, review_state
+from kiosk.store.database import PracticeRecord, StoredSession
+from fileio.bounded import write_error, write_private  # the one owner-only writer; exports use it from here too
 
 TOTAL_LINK = "total"
 
@@ -122,7 +122,7 @@ class Result:
 
     @property
     def state(self) -> ReviewState:
-        """Where the result stands (:func:`kiosk.review.review_state`: the one answer the CSV,
+        """Where the result stands (:func:`kiosk.core.review.review_state`: the one answer the CSV,
         the FHIR response and Observation, and the station's pages all give)."""
         return review_state(self.review, {a.item_id: a.option for a in self.stored.answers})
 

@@ -24,10 +24,10 @@ from kiosk.export.result import (
     questionnaire_version,
     results,
 )
-from kiosk.questionnaire import Questionnaire
-from kiosk.review import Review
-from kiosk.storage import StoredSession
-from kiosk.visits import visit_of
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.review import Review
+from kiosk.store.database import StoredSession
+from kiosk.core.visits import visit_of
 
 #: the tags that keep ids text in CSV readers; see the module docstring
 ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
@@ -40,7 +40,7 @@ ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
 #: ``label`` "incomplete (N points from K of M items)"; its band and ``band_set``, the set that
 #: gave it: "severe" is 21-60 in Shah's set but 20-35 in the Spanish one). Every row carries the
 #: session's columns (ids tagged, see the module docstring); ``review_state`` is
-#: :func:`kiosk.review.review_state`'s (unreviewed, corrected, signed_off, amended), as in FHIR.
+#: :func:`kiosk.core.review.review_state`'s (unreviewed, corrected, signed_off, amended), as in FHIR.
 CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
                "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks", "finished_at",
                "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by",
@@ -64,7 +64,7 @@ def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str,
             "answered_by": stored.answered_by.value, "questionnaire": q.id,
             "questionnaire_version": questionnaire_version(q), "complete": "true" if r.complete else "false",
             "review_state": r.review_state, "simulated": "true" if stored.simulated else "false",
-            # how the visit began (kiosk.visits): "order <id>", "staff", "walk-up"; blank before visits existed
+            # how the visit began (kiosk.core.visits): "order <id>", "staff", "walk-up"; blank before visits existed
             "visit": visit_of(stored.log) or ""}
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from kiosk.channels import InputSource
+from kiosk.core.channels import InputSource
 from kiosk.remote.hid import HidBackend, HidRemote
 from kiosk.remote.keymap import KeyboardRemote
 from kiosk.remote.profiles import ProfileError, load_profiles
@@ -25,7 +25,7 @@ def open_sources(profiles_path: str | Path | None = None, *, backoff: Backoff | 
 
     ``profiles_path`` is the site's profile file from the config (None: built-in profiles only).
     Each source looks for its device until stopped, reporting what it finds as
-    :class:`~kiosk.channels.ChannelStatus`. Raises :class:`ProfileError` for a bad profile file.
+    :class:`~kiosk.core.channels.ChannelStatus`. Raises :class:`ProfileError` for a bad profile file.
     """
     profiles = load_profiles(profiles_path)
     sources: list[InputSource] = [SerialRemote(p, backoff=backoff) for p in profiles.serial]

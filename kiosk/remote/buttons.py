@@ -1,14 +1,14 @@
-"""The buttons a remote can have, and how a press becomes a :class:`~kiosk.channels.ChannelInput`.
+"""The buttons a remote can have, and how a press becomes a :class:`~kiosk.core.channels.ChannelInput`.
 
 A button is either an answer number (1-4, printed on the remote and on the screen's answer
-buttons) or a :class:`~kiosk.channels.Command` (repeat, pause, call doctor, volume up/down).
+buttons) or a :class:`~kiosk.core.channels.Command` (repeat, pause, call doctor, volume up/down).
 Device profiles name buttons the way a clinician would write them: ``1`` .. ``4``, ``repeat``,
 ``pause``, ``call_doctor``, ``volume_up``, ``volume_down``.
 """
 
 from __future__ import annotations
 
-from kiosk.channels import Channel, ChannelInput, Command
+from kiosk.core.channels import Channel, ChannelInput, Command
 
 #: one button of a remote: an answer option number or a command
 Button = int | Command

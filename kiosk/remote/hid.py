@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
-from kiosk.channels import ChannelState
+from kiosk.core.channels import ChannelState
 from kiosk.remote.decoders import Press, ReportDecoder
 from kiosk.remote.profiles import HidProfile, usb_id
 from kiosk.remote.reconnect import Backoff, DeviceLost, DeviceUnavailable, ReconnectingReader, Wait, wait_or_stop

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from kiosk.channels import ChannelInput
+from kiosk.core.channels import ChannelInput
 from kiosk.remote.buttons import Button, to_input
 from kiosk.remote.profiles import KeyboardProfile
 

@@ -17,7 +17,7 @@ from typing import Any
 
 from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
 from kiosk.remote.decoders import ReportMatch
-from kiosk.yamlmarks import Positions, Problem, parse_file
+from fileio.positions import Positions, Problem, parse_file
 
 #: the profiles shipped with the kiosk
 BUILTIN_PROFILES = Path(__file__).with_name("devices.yaml")

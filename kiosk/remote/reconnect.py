@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Protocol
 
-from kiosk.channels import Channel, ChannelState, ChannelStatus, Sink
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
 from kiosk.remote.buttons import to_input
 from kiosk.remote.decoders import Press
 
@@ -78,7 +78,7 @@ class Connection(Protocol):
 class ReconnectingReader:
     """Runs a remote in a daemon thread and hands presses and status changes to a sink.
 
-    Subclasses provide :meth:`connect`. Implements the :class:`~kiosk.channels.InputSource`
+    Subclasses provide :meth:`connect`. Implements the :class:`~kiosk.core.channels.InputSource`
     protocol.
     """
 

@@ -13,7 +13,7 @@ import os
 
 import serial
 
-from kiosk.channels import ChannelState
+from kiosk.core.channels import ChannelState
 from kiosk.remote.decoders import LineDecoder, Press
 from kiosk.remote.profiles import SerialProfile
 from kiosk.remote.reconnect import Backoff, DeviceLost, DeviceUnavailable, ReconnectingReader, Wait, wait_or_stop

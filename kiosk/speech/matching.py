@@ -19,7 +19,7 @@ import unicodedata
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from kiosk.channels import Command
+from kiosk.core.channels import Command
 
 LANGUAGES = ("en", "es", "fr")
 

@@ -59,7 +59,7 @@ from typing import Protocol
 
 import numpy as np
 
-from kiosk.channels import Channel, ChannelState, ChannelStatus
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 
 log = logging.getLogger(__name__)
 

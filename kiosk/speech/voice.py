@@ -1,6 +1,6 @@
 """The voice channel: microphone → endpointer → recogniser → matcher → :class:`ChannelInput`.
 
-:class:`VoiceChannel` is an :class:`~kiosk.channels.InputSource`. The app feeds it the session's
+:class:`VoiceChannel` is an :class:`~kiosk.core.channels.InputSource`. The app feeds it the session's
 events on the UI thread (:meth:`VoiceChannel.on_session_event`): each ``Prompt`` with options
 sets the grammar for that question in the prompt's language, ``ListeningChanged`` opens and
 closes the microphone gate, and while the session is paused only commands are listened for, so
@@ -35,7 +35,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from kiosk.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
+from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
 from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
 from kiosk.speech.audio import (
     AudioUnavailable, Endpointer, MicrophoneStream, PcmConsumer, Utterance, UtterancePipeline,

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, Protocol
 
-from kiosk.session import Phase, Session
+from kiosk.core.session import Phase, Session
 from kiosk.sync.client import Outcome
 
 

@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 
 from kiosk.sync.client import Backoff
 from kiosk.sync.http import Station, Unreachable
-from kiosk.visits import Order, parse_orders
+from kiosk.core.visits import Order, parse_orders
 
 #: how long one long poll for orders may wait at the station
 POLL_WAIT_S = 20.0
@@ -71,7 +71,7 @@ class OrderWatcher:
 
 
 def start_order(station: Station, code: str, *, instruments: Sequence[str], languages: Sequence[str]) -> Order:
-    """Start the visit whose code staff typed, checked as :func:`kiosk.visits.parse_orders` checks
+    """Start the visit whose code staff typed, checked as :func:`kiosk.core.visits.parse_orders` checks
     the list; :class:`OrderRefused` (or ``Unreachable``) with why not."""
     status, body = station.request("POST", "/api/v1/orders/start", {"code": code})
     error = body.get("error") if isinstance(body, dict) else None

@@ -1,6 +1,6 @@
 """The outbox table as the sync client sees it, through its own SQLite connection.
 
-The session's :class:`~kiosk.storage.Store` writes rows in the same transaction as each change;
+The session's :class:`~kiosk.store.database.Store` writes rows in the same transaction as each change;
 this side reads them in ``seq`` order (alerts first), deletes the ones the station stored, and
 parks one the station refuses (kept, with the reason, never silently dropped). Its own
 connection means the client's thread never shares the session's ``sqlite3`` connection.

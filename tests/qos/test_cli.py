@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from kiosk import qos_cli
+from kiosk.commands import qos as qos_cli
 from qos import load_trace, replay
 from qos.cli import main
 
@@ -89,8 +89,8 @@ def test_bad_arguments_exit_2(capsys):
 
 
 def test_kiosk_qos_trace_prints_a_stored_sessions_trace_that_replays_to_its_metrics(tmp_path, capsys):
-    from kiosk.replay import load_script, run_script
-    from kiosk.storage import Store
+    from kiosk.commands.replay import load_script, run_script
+    from kiosk.store.database import Store
 
     data = tmp_path / "data"
     with Store.open(data) as store:

@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from kiosk import qos_cli
+from kiosk.commands import qos as qos_cli
 from qos import Engine, load_model, load_trace, replay
 
 ROOT = Path(__file__).resolve().parents[2]

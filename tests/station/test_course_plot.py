@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 
-from kiosk.questionnaire import load_questionnaire
+from kiosk.core.questionnaire import load_questionnaire
 from station.course_plot import course_svg
 from station.results import Result
 

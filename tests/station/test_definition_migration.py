@@ -11,8 +11,8 @@ import sqlalchemy as sa
 from alembic import command
 from alembic.config import Config
 
-from kiosk.definition import canonical, digest
-from kiosk.questionnaire import load_questionnaire
+from kiosk.core.questionnaire.definition import canonical, digest
+from kiosk.core.questionnaire import load_questionnaire
 from station import auth, db
 from tests.station.conftest import PASSWORDS
 from tests.station.helpers import PATIENTS, KioskClient, Row, Staff, record_patient, response_in

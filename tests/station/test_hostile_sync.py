@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from bench._postgres import create_database
-from kiosk.definition import digest
+from kiosk.core.questionnaire.definition import digest
 from station import db
 from tests.station.conftest import make_ward, start_station
 from tests.station.helpers import PATIENTS, Staff, record_patient

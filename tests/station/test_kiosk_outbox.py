@@ -1,4 +1,4 @@
-"""The kiosk's real outbox (``kiosk.storage.Store`` with a station configured) delivered to a real
+"""The kiosk's real outbox (``kiosk.store.database.Store`` with a station configured) delivered to a real
 station: what the station reads back is what the kiosk stored, row for row. The rows come from
 the kiosk's own SQLite after real sessions ran scripted patients; they are sent the way the
 protocol says (alerts first, then the rest oldest first, in batches), by this test until the
@@ -11,8 +11,8 @@ import sqlite3
 
 import pytest
 
-from kiosk.replay import load_script, run_script
-from kiosk.storage import ALERT_EVENTS, Store
+from kiosk.commands.replay import load_script, run_script
+from kiosk.store.database import ALERT_EVENTS, Store
 from station import db
 from station.sessions import load
 from tests.station.helpers import PATIENTS, KioskClient, Row

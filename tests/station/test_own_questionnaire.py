@@ -10,7 +10,7 @@ import io
 
 import pytest
 
-from kiosk.definition import digest
+from kiosk.core.questionnaire.definition import digest
 from tests.station.conftest import new_kiosk, shared_station  # noqa: F401 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient, response_in
 

@@ -11,7 +11,7 @@ import re
 
 import pytest
 
-from kiosk.definition import digest
+from kiosk.core.questionnaire.definition import digest
 from tests.station.conftest import new_kiosk, shared_station  # noqa: F401 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient, response_in
 

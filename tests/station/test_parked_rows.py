@@ -12,9 +12,9 @@ import sqlite3
 import pytest
 import sqlalchemy as sa
 
-from kiosk.replay import load_script, run_script
-from kiosk.results import main as results_main
-from kiosk.storage import Store
+from kiosk.commands.replay import load_script, run_script
+from kiosk.commands.results import main as results_main
+from kiosk.store.database import Store
 from kiosk.sync import SyncClient
 from station import db
 from tests.station.conftest import make_ward

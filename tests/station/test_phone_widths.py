@@ -10,7 +10,7 @@ from urllib.parse import quote
 
 import pytest
 
-from kiosk.definition import digest
+from kiosk.core.questionnaire.definition import digest
 from tests.station.conftest import new_kiosk, shared_station  # noqa: F401 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 from tests.station.test_visit_e2e import PHONE, fits, login

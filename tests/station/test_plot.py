@@ -48,7 +48,7 @@ def test_adaptations_are_marked_and_metrics_have_the_kiosks_colours():
     """The station's plot marks each adaptation switching on or off, as the kiosk's plot does, and
     draws each metric in the colour the kiosk draws it in (one palette, kiosk.export.qos_plot)."""
     from kiosk.export.qos_plot import METRIC_COLOURS
-    from kiosk.stored import AdaptationRecord
+    from kiosk.store.records import AdaptationRecord
 
     stored = _session("barthel5.yaml")
     adapted = type(stored)(**{**stored.__dict__, "adaptations": (

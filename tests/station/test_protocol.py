@@ -216,7 +216,7 @@ def test_the_stations_export_names_the_result_as_its_kiosk_does(ward_station, tm
     export carries the identifiers of the kiosk's own (site, kiosk id and FHIR systems from the
     kiosk's config, sent with the session), not the station's defaults."""
     from kiosk.export import ExportSite, export_identity, fhir_response
-    from kiosk.questionnaire import load_questionnaire
+    from kiosk.core.questionnaire import load_questionnaire
 
     ward, station, client = ward_station
     site = ExportSite(site="H1", kiosk_id="ward3-bed2", patient_system="https://h1.example/pseudonyms",

@@ -10,11 +10,11 @@ from datetime import UTC, date, datetime, timedelta
 
 import pytest
 
-from kiosk.questionnaire import load_questionnaire
-from kiosk.review import ReviewState
+from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.review import ReviewState
 from station import db, exports, sync, validation
 from station.auth import User
-from tests.fhir.standard import check_fhir
+from tests.kiosk.export.standard import check_fhir
 from tests.station.helpers import PATIENTS, record_patient
 
 NURSE, DOCTOR = User("nurse.kim", "nurse"), User("dr.lopez", "doctor")

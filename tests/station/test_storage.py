@@ -10,8 +10,8 @@ from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
 
-from kiosk.questionnaire import load_questionnaire
-from kiosk.review import ReviewState
+from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.review import ReviewState
 from station import auth, db, sync, validation
 from station.auth import User
 from station.sessions import load

@@ -1,7 +1,7 @@
 """The clinician's loop end to end, with every part real: a `kiosk station` process (SQLite at a
 phone's 390x844, PostgreSQL at a desk's 1366x768), Chromium, the kiosk's own order watcher and a
 real `kiosk replay --order-code` kiosk process. Staff order a visit; the kiosk is told (its
-welcome greets the visit: see tests/sync/test_orders_kiosk.py for the screen); staff confirm the
+welcome greets the visit: see tests/kiosk/sync/test_orders_kiosk.py for the screen); staff confirm the
 patient with the order's code at the kiosk; the patient answers; the doctor's inbox rings and
 counts it; the doctor opens it, confirms the sign-off seeing the total; the patient's page shows
 the visit. Every page the test visits fits the viewport's width (no sideways scrolling)."""

@@ -34,8 +34,8 @@ def upgrade() -> None:
     if bind.execute(sa.text("SELECT COUNT(*) FROM sessions")).scalar():
         # the definition in force now: the bundled questionnaire (what the station described every
         # session with until now), marked attached later
-        from kiosk.definition import canonical, canonical_json, digest
-        from kiosk.questionnaire import load_questionnaire
+        from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
+        from kiosk.core.questionnaire import load_questionnaire
 
         definition = canonical(load_questionnaire())
         sha = digest(definition)

@@ -1,0 +1,1 @@
+"""Every file the project loads or writes: bounded, positioned reading and owner-only writing (imports nothing of ours)."""

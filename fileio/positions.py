@@ -1,0 +1,111 @@
+"""YAML with positions: parse a document and remember where every value was written.
+
+Hand-edited files (questionnaires, scripted patients, the config) must report problems as
+``file:line:col``. PyYAML's ``compose`` keeps the marks that ``safe_load`` throws away; this module
+keeps both the constructed data and a map from each path (keys and list indexes) to its mark. The
+file itself is read by ``fileio.bounded`` (size, encoding, nesting, aliases, duplicate keys, numbers),
+the one bounded reader every loader of the project shares.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from fileio.bounded import MAX_YAML_BYTES, BadFile, Problem, compose_yaml, construct_yaml, read_text
+
+__all__ = ["Positions", "Problem", "describe", "parse", "parse_file", "schema_problems"]
+
+
+class Positions:
+    """Maps a path inside a YAML document (keys and indexes) to where it was written."""
+
+    def __init__(self, root: yaml.Node) -> None:
+        self._marks: dict[tuple[Any, ...], tuple[int, int]] = {}
+        self._key_marks: dict[tuple[Any, ...], tuple[int, int]] = {}
+        self._walk(root, ())
+
+    @staticmethod
+    def _mark(node: yaml.Node) -> tuple[int, int]:
+        return node.start_mark.line + 1, node.start_mark.column + 1
+
+    def _walk(self, node: yaml.Node, path: tuple[Any, ...]) -> None:
+        self._marks[path] = self._mark(node)
+        if isinstance(node, yaml.MappingNode):
+            for key_node, value_node in node.value:
+                key = key_node.value
+                self._key_marks[path + (key,)] = self._mark(key_node)
+                self._walk(value_node, path + (key,))
+        elif isinstance(node, yaml.SequenceNode):
+            for index, child in enumerate(node.value):
+                self._walk(child, path + (index,))
+
+    def of(self, path: tuple[Any, ...], *, key: bool = False) -> tuple[int, int]:
+        """Position of the value at ``path`` (or of its key), falling back to the nearest parent."""
+        if key and path in self._key_marks:
+            return self._key_marks[path]
+        while path not in self._marks and path:
+            path = path[:-1]
+        return self._marks.get(path, (1, 1))
+
+
+def describe(path: tuple[Any, ...]) -> str:
+    """A path as people read it: ``items[2].options[0].points``."""
+    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p)) for i, p in enumerate(path))
+
+
+def parse(text: str, filename: str) -> tuple[Any, Positions | None, list[Problem]]:
+    """Parse one YAML document under the shared reader's limits (``fileio.bounded``): (data, positions,
+    problems).
+
+    A document that cannot be read (syntax, duplicate keys, nesting, alias bombs, huge or
+    non-finite numbers) or is empty gives (None, None, [that problem]).
+    """
+    try:
+        node = compose_yaml(text, filename)
+        if node is None:
+            return None, None, [Problem(filename, 1, 1, "the file is empty")]
+        data = construct_yaml(node, filename)
+    except BadFile as exc:
+        return None, None, [exc.problem]
+    return data, Positions(node), []
+
+
+def parse_file(path: str | Path, name: str | None = None) -> tuple[Any, Positions | None, list[Problem]]:
+    """Read a YAML file through the shared bounded reader and :func:`parse` it; an unreadable file
+    (missing, too big, not UTF-8, binary) is one problem. ``name`` is how messages call the file."""
+    name = str(path) if name is None else name
+    try:
+        text = read_text(path, MAX_YAML_BYTES)
+    except BadFile as exc:
+        return None, None, [Problem(name, exc.problem.line, exc.problem.column, exc.problem.message)]
+    return parse(text, name)
+
+
+def schema_problems(data: Any, schema: dict[str, Any], positions: Positions,
+                    add: Callable[..., None]) -> None:
+    """Check ``data`` against a JSON Schema, reporting each error through ``add(path, message, key=)``.
+
+    Messages are rewritten for people: unknown keys and missing keys by name, multiples of 5 as such.
+    """
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(schema)
+    for error in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
+        path = tuple(error.absolute_path)
+        where = describe(path) or "the file"
+        if error.validator == "additionalProperties":
+            for name in sorted(set(error.instance) - set(error.schema.get("properties", {}))):
+                add(path + (name,), f"unknown key {name!r}" + (f" in {describe(path)}" if path else ""), key=True)
+        elif error.validator == "required":
+            missing = error.message.split("'")[1] if "'" in error.message else error.message
+            add(path, f"{where} is missing {missing!r}")
+        elif error.validator == "minItems" and error.validator_value == 1 and error.instance == []:
+            add(path, f"{where} is empty: list at least one")
+        elif error.validator == "multipleOf":
+            add(path, f"{where}: must be a multiple of {error.validator_value}, got {error.instance!r}")
+        else:
+            add(path, f"{where}: {error.message}")

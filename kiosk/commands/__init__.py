@@ -1,0 +1,1 @@
+"""The `kiosk` sub-commands, one module each, imported only when asked for."""

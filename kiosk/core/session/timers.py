@@ -1,0 +1,127 @@
+"""The attempt clock: the session's one pending time-out and the freezes that stop it.
+
+Nothing happens on its own: a driver calls ``Session.poll`` once the clock reaches
+:meth:`AttemptClock.next_deadline`, and every operation first lets due time-outs fire (each at its
+own due time, not at the time of the call). Pause, call-doctor and person lost freeze the clock;
+once the last freeze is lifted an open attempt gets at least the largest grace any of them asked
+for.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from kiosk.core.clock import Clock
+
+
+@dataclass
+class Timer:
+    """The one pending time-out: ``due`` (clock time) while running, ``remaining`` while frozen."""
+
+    #: "open" (next attempt 1), "attempt" (window ends), "finish" (the summary), and the others
+    #: the session schedules (see ``Session._fire``)
+    kind: str
+    due: float | None
+    remaining: float = 0.0
+
+
+class AttemptClock:
+    """Session time and its single time-out. ``origin`` is the clock time of session time 0."""
+
+    def __init__(self, clock: Clock, origin: float) -> None:
+        self.clock = clock
+        self.origin = origin
+        self.timer: Timer | None = None
+        #: why the clock is stopped ("paused", "doctor", "away", ...); empty while it runs
+        self.freezes: set[str] = set()
+        self._grace = 0.0
+
+    def t(self, clock_time: float) -> float:
+        """Session time of a clock time."""
+        return clock_time - self.origin
+
+    def now(self) -> float:
+        """Session time now."""
+        return self.t(self.clock.now())
+
+    @property
+    def kind(self) -> str | None:
+        """The pending time-out's kind, or None."""
+        return self.timer.kind if self.timer is not None else None
+
+    @property
+    def frozen(self) -> bool:
+        """Whether anything stops the clock."""
+        return bool(self.freezes)
+
+    def set(self, kind: str, start_t: float, seconds: float) -> None:
+        """Replace the pending time-out by one ``seconds`` after session time ``start_t``."""
+        if self.freezes:
+            self.timer = Timer(kind, None, seconds)
+        else:
+            self.timer = Timer(kind, self.origin + start_t + seconds)
+
+    def cancel(self) -> None:
+        """Drop the pending time-out."""
+        self.timer = None
+
+    def due(self, now: float, inclusive: bool) -> Iterator[tuple[str, float]]:
+        """Take the time-outs due by clock time ``now`` in order, as (kind, session time due).
+
+        The caller acts on each before the next is looked at (acting may set another timer).
+        """
+        while self.timer is not None and self.timer.due is not None and (
+            self.timer.due < now or (inclusive and self.timer.due == now)
+        ):
+            timer, self.timer = self.timer, None
+            assert timer.due is not None
+            yield timer.kind, self.t(timer.due)
+
+    def freeze(self, reason: str) -> None:
+        """Stop the clock for ``reason`` (the first freeze keeps what was left)."""
+        if not self.freezes and self.timer is not None and self.timer.due is not None:
+            self.timer.remaining = max(0.0, self.timer.due - self.clock.now())
+            self.timer.due = None
+        self.freezes.add(reason)
+
+    def unfreeze(self, reasons: set[str], grace: float) -> bool:
+        """Lift freezes; once none is left the attempt gets at least the largest grace seen.
+
+        False if none of ``reasons`` was in force (nothing changed).
+        """
+        if not reasons & self.freezes:
+            return False
+        self.freezes -= reasons
+        self._grace = max(self._grace, grace)
+        if not self.freezes:
+            if self.timer is not None and self.timer.due is None:
+                remaining = self.timer.remaining
+                if self.timer.kind == "attempt":
+                    remaining = max(remaining, self._grace)
+                self.timer.due = self.clock.now() + remaining
+            self._grace = 0.0
+        return True
+
+    def at_least(self, seconds: float) -> None:
+        """Leave at least ``seconds`` on a running time-out (hearing a question again takes time)."""
+        if self.timer is not None and self.timer.due is not None:
+            self.timer.due = max(self.timer.due, self.clock.now() + seconds)
+
+    def attempt_remaining(self) -> float | None:
+        """Seconds left on an attempt window (frozen or running), or None if none is pending."""
+        if self.timer is None or self.timer.kind != "attempt":
+            return None
+        if self.timer.due is None:
+            return self.timer.remaining
+        return max(0.0, self.timer.due - self.clock.now())
+
+    def attempt_deadline(self) -> float | None:
+        """Session time a running attempt window ends, or None."""
+        if self.timer is not None and self.timer.kind == "attempt" and self.timer.due is not None:
+            return self.t(self.timer.due)
+        return None
+
+    def next_deadline(self) -> float | None:
+        """Clock time of the next time-out, or None if none is running."""
+        return self.timer.due if self.timer is not None else None

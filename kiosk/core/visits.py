@@ -1,0 +1,150 @@
+"""How a visit begins at the kiosk: an order from the ward station (confirmed by staff with the
+order's code), staff typing a patient identifier on the clinician screen, or a walk-up where the
+site allows it. Plain data and rules, no Textual, no network (the station side is
+``kiosk.sync.orders``).
+
+Every session says how it began in a ``visit`` entry of its log, written in the start's own
+transaction (:attr:`kiosk.core.session.Session.visit`): ``order <id>``, ``staff`` or ``walk-up``. The
+station files an ordered result under its order from that entry, and marks walk-ups as such.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+WALK_UP = "walk-up"
+STAFF = "staff"
+#: a patient identifier as a hospital gives it: 2-64 letters, digits, '-' or '_' and at least one
+#: digit, so that no name ("Maria Lopez", "LOPEZ") is ever taken for one (same rule as the station)
+HOSPITAL_ID = re.compile(r"^(?=.*[0-9])[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
+
+
+@dataclass(frozen=True)
+class Order:
+    """A visit ordered for this kiosk, as the station describes it (protocol §4)."""
+
+    id: str
+    patient_id: str
+    instruments: tuple[str, ...]
+    language: str
+    answered_by: str
+    ordered_by: str = ""
+
+    @property
+    def visit(self) -> str:
+        """The session's ``visit`` log entry for this order."""
+        return order_visit(self.id)
+
+    @property
+    def relative(self) -> bool:
+        return self.answered_by == "relative"
+
+
+def order_visit(order_id: str) -> str:
+    return f"order {order_id}"
+
+
+def check_patient_id(value: str) -> str | None:
+    """Why ``value`` is not a hospital's patient identifier (one sentence), or None."""
+    if not value:
+        return "type the patient's identifier"
+    if not HOSPITAL_ID.match(value):
+        return (f"{value[:64]!r} is not a patient identifier: 2 to 64 letters, digits, '-' or '_', "
+                "with at least one digit, never a name")
+    return None
+
+
+def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]) -> tuple[list[Order], list[str]]:
+    """The orders of a ``GET /api/v1/orders`` answer this kiosk can run, and one sentence per entry
+    it cannot (an instrument or language it does not have, a malformed entry): never half-taken."""
+    found: list[Order] = []
+    problems: list[str] = []
+    entries = body.get("orders") if isinstance(body, Mapping) else None
+    if not isinstance(entries, list):
+        return [], ["the station's answer has no 'orders' list"]
+    known_languages = set(languages)
+    for index, entry in enumerate(entries):
+        where = f"orders[{index}]"
+        if not isinstance(entry, Mapping):
+            problems.append(f"{where}: not an object")
+            continue
+        order_id, patient = entry.get("id"), entry.get("patient_id")
+        wanted = entry.get("instruments")
+        language, answered_by = entry.get("language"), entry.get("answered_by", "patient")
+        if not isinstance(order_id, str) or not order_id or not isinstance(patient, str):
+            problems.append(f"{where}: without an id or a patient identifier")
+        elif check_patient_id(patient):
+            problems.append(f"{where} ({order_id}): {check_patient_id(patient)}")
+        elif not isinstance(wanted, list) or not wanted or any(i not in instruments for i in wanted):
+            problems.append(f"{where} ({order_id}): instruments {wanted!r}: this kiosk gives {', '.join(instruments)}")
+        elif language not in known_languages:
+            problems.append(f"{where} ({order_id}): language {language!r} is not one this kiosk speaks")
+        elif answered_by not in ("patient", "relative", "caregiver"):
+            problems.append(f"{where} ({order_id}): answered_by {answered_by!r}")
+        else:
+            found.append(Order(order_id, patient, tuple(wanted), language, answered_by,
+                               str(entry.get("ordered_by") or "")))
+    return found, problems
+
+
+def visit_of(log: Iterable[Any]) -> str | None:
+    """How a stored session began, from its log entries (``kind``, ``detail``): "order <id>",
+    "staff", "walk-up", or None for a session stored before visits were recorded."""
+    return next((entry.detail for entry in log if entry.kind == "visit"), None)
+
+
+class VisitDesk:
+    """What the kiosk's welcome offers and how a visit's session is made, for the app to follow.
+
+    ``make_session(patient_id, language, answered_by, visit)`` builds a fresh session;
+    ``walk_up`` says whether anyone may start a test at the welcome (the site's config). The app
+    tells the desk the orders the station lists (:meth:`set_orders`) and asks it what to show
+    (:meth:`holds_welcome`) and which session to start.
+    """
+
+    def __init__(self, make_session: Any, *, walk_up: bool = True) -> None:
+        self._make = make_session
+        self.walk_up = walk_up
+        #: the visits ordered for this kiosk, oldest first
+        self.ready: tuple[Order, ...] = ()
+        #: the station's entries this kiosk cannot run, for the clinician screen
+        self.problems: tuple[str, ...] = ()
+        #: staff chose a walk-up although visits wait (until the next session)
+        self.walk_up_chosen = False
+
+    def set_orders(self, orders: Sequence[Order], problems: Sequence[str] = ()) -> bool:
+        """The station's current list; True when it changed what the welcome shows."""
+        changed = tuple(orders) != self.ready
+        self.ready, self.problems = tuple(orders), tuple(problems)
+        return changed
+
+    def holds_welcome(self) -> bool:
+        """The welcome is replaced by the visit screen: visits wait (and staff did not choose a
+        walk-up), or walk-ups are not allowed here. Nothing a patient presses starts a test then."""
+        return not self.walk_up or (bool(self.ready) and not self.walk_up_chosen)
+
+    def choose_walk_up(self) -> bool:
+        """Staff chose a test without an order; False where walk-ups are not allowed."""
+        self.walk_up_chosen = self.walk_up
+        return self.walk_up
+
+    def next_visit(self) -> None:
+        """A new session replaced the last one: back to offering the ordered visits."""
+        self.walk_up_chosen = False
+
+    def for_order(self, order: Order) -> Any:
+        """The session of an ordered visit: its patient, language and who answers."""
+        self.ready = tuple(o for o in self.ready if o.id != order.id)
+        return self._make(order.patient_id, order.language, order.answered_by, order.visit)
+
+    def for_staff(self, patient_id: str, language: str, relative: bool) -> tuple[Any, str | None]:
+        """The session of a visit staff start by typing the identifier: (session, None), or
+        (None, why not)."""
+        patient_id = patient_id.strip()
+        why = check_patient_id(patient_id)
+        if why:
+            return None, why
+        return self._make(patient_id, language, "relative" if relative else "patient", STAFF), None

@@ -1,0 +1,1 @@
+"""The kiosk's Textual UI: a thin app, its controller, screens, widgets and the served page."""

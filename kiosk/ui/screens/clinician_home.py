@@ -1,0 +1,208 @@
+"""The clinician's first screen: the running session (continue it, adaptation on/off, patient left or
+back), the channel states with their reasons, the interrupted tests staff may continue, and the
+list of stored sessions. It scrolls (wheel, Tab, or the Up/Down buttons for a finger on the
+touch display), with "Back to the patient" always at the bottom."""
+
+from __future__ import annotations
+
+from textual import on
+from textual.app import ComposeResult
+from textual.containers import Horizontal, VerticalScroll
+from textual.widgets import Button, DataTable, Label, Static, Switch
+
+from kiosk.export.captured import questionnaire_of
+from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.ui.screens.session_detail import SessionDetailScreen
+from kiosk.core.session import Phase
+
+#: how often the running session's line is redrawn (seconds)
+REFRESH_S = 1.0
+
+
+class ClinicianHomeScreen(ClinicianScreen):
+    """Reads the app's session and store; every action goes back through the app."""
+
+    #: the session list has the keys: arrows pick a session, Enter opens it
+    AUTO_FOCUS = "#sessions"
+
+    def compose(self) -> ComposeResult:
+        """The running session, channels, stored sessions, and the way back."""
+        app = self.app
+        session = app.session  # type: ignore[attr-defined]
+        with VerticalScroll(classes="clinician staff-body", id="clinician-body"):
+            yield Static("Clinician", classes="heading")
+            if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
+                yield Static(warning, id="pin-warning")
+            yield Static("", id="out-of-order-reason")
+            yield Static(self._session_line(), id="current")
+            with Horizontal(id="current-actions"):
+                yield Button("Continue", id="continue", variant="primary")
+                yield Label("Adaptation", id="adaptation-label")
+                yield Switch(value=session.adaptation is not None and session.adaptation.enabled,
+                             id="adaptation", disabled=session.adaptation is None)
+                yield Button("New patient", id="new-session",
+                             disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
+                yield Button("Start a visit", id="start-visit",
+                             disabled=app.visits is None)  # type: ignore[attr-defined]
+            # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
+            with Horizontal(id="presence-actions"):
+                yield Button("Patient left", id="person-lost")
+                yield Button("Patient back", id="person-back")
+                # the only way out of the locked-down kiosk, on the shorter row so it always shows
+                yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
+            yield Static(self._channels_text(), id="channel-reasons")
+            if app.sync is not None:  # type: ignore[attr-defined]
+                yield Static(self._station_text(), id="station")
+            # continuing a test is the staff's decision: only with the same patient at the kiosk
+            yield Label("Interrupted tests: none.", id="interrupted-label")
+            yield DataTable(id="interrupted", cursor_type="row", zebra_stripes=True)
+            with Horizontal(id="interrupted-actions"):
+                yield Button("Continue this test", id="continue-test", variant="warning")
+                yield Static("", id="continue-result")
+            yield Label("Stored sessions (tap one, or Enter, to open):")
+            yield DataTable(id="sessions", cursor_type="row", zebra_stripes=True)
+        yield from staff_nav()
+
+    def on_mount(self) -> None:
+        """Fill the tables, and keep the running session's line current while it runs."""
+        interrupted = self.query_one("#interrupted", DataTable)
+        interrupted.add_columns("patient", "started", "progress", "why it stopped", "session")
+        for test in self.app.interrupted_tests():  # type: ignore[attr-defined]
+            count = len(questionnaire_of(test, fallback=self.app.questionnaire).items)  # type: ignore[attr-defined]
+            progress = f"{len(test.answers)} of {count} answered" + (
+                f", {len(test.not_answered)} not answered" if test.not_answered else "")
+            interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,
+                                test.interrupted_reason or "", test.id, key=test.id)
+        # "Continue this test" only when there is one to continue
+        some = bool(interrupted.row_count)
+        interrupted.display = some
+        self.query_one("#interrupted-actions").display = some
+        if some:
+            self.query_one("#interrupted-label", Label).update(
+                "Interrupted tests (continue one only with that patient in front of the kiosk):")
+        table = self.query_one("#sessions", DataTable)
+        table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
+        self._fill_sessions()
+        self.refresh_session()
+        self.set_interval(REFRESH_S, self.refresh_session)
+
+    def _fill_sessions(self) -> None:
+        table = self.query_one("#sessions", DataTable)
+        store = self.app.store  # type: ignore[attr-defined]
+        for s in store.sessions() if store is not None else []:
+            row = (s.id, s.patient_id, s.started_at[:19], s.label, s.language, str(s.answered), str(s.not_answered))
+            if s.id in table.rows:
+                for column, value in zip(table.columns, row):
+                    table.update_cell(s.id, column, value)
+            else:
+                table.add_row(*row, key=s.id)
+
+    def refresh_session(self) -> None:
+        """Redraw what a running session changes: its line, the channels, which actions apply,
+        and the stored sessions' progress."""
+        app = self.app
+        session = app.session  # type: ignore[attr-defined]
+        self.query_one("#current", Static).update(self._session_line())
+        reason = app.out_of_order  # type: ignore[attr-defined]
+        line = self.query_one("#out-of-order-reason", Static)
+        line.display = reason is not None
+        if reason is not None:
+            line.update(f"Out of order: {reason}. The patient sees \"This kiosk is not working\"; the welcome "
+                        "comes back by itself once the data directory can be written again (free disk space).")
+        self.query_one("#channel-reasons", Static).update(self._channels_text())
+        # Continue is for a session halted by call-doctor or paused by the patient, not for the
+        # pause that opening these screens made (leaving them resumes that one)
+        paused_by_patient = session.paused and not app.held_for_clinician  # type: ignore[attr-defined]
+        self.query_one("#continue", Button).disabled = not (session.halted or paused_by_patient)
+        running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
+        present = session.snapshot().person_present
+        self.query_one("#person-lost", Button).disabled = not (running and present)
+        self.query_one("#person-back", Button).disabled = not (running and not present)
+        self._fill_sessions()
+
+    def _session_line(self) -> str:
+        session = self.app.session  # type: ignore[attr-defined]
+        state = "waiting for a clinician (doctor called)" if session.halted else (
+            "paused while you are here" if self.app.held_for_clinician  # type: ignore[attr-defined]
+            else "paused" if session.paused else session.phase.value)
+        if not session.snapshot().person_present:
+            state += ", patient away"
+        line = (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
+                f"{len(session.answers)} of {len(session.questionnaire.items)} answered.")
+        if session.metrics:
+            line += " QoS now: " + ", ".join(f"{name} {value:.2f}" for name, value in session.metrics.items())
+        return line
+
+    def _station_text(self) -> str:
+        sync, store = self.app.sync, self.app.store  # type: ignore[attr-defined]
+        waiting, parked = store.outbox_waiting()
+        state = f"not reachable ({sync.problem})" if sync.problem else "reachable"
+        text = f"Ward station {sync.station.url}: {state}; {waiting} stored changes waiting to be sent"
+        text += (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
+        visits = self.app.visits  # type: ignore[attr-defined]
+        if visits is not None and visits.problems:  # ordered visits this kiosk cannot run (kiosk.core.visits)
+            text += " Orders this kiosk cannot run: " + "; ".join(visits.problems) + "."
+        return text
+
+    def _channels_text(self) -> str:
+        lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
+        return "Channels: " + "; ".join(
+            f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
+            for line in lines)
+
+    @on(Button.Pressed, "#continue")
+    def _continue(self) -> None:
+        self.app.clinician_continue()  # type: ignore[attr-defined]
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#person-lost")
+    def _person_lost(self) -> None:
+        self.app.person_lost()  # type: ignore[attr-defined]
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#person-back")
+    def _person_back(self) -> None:
+        self.app.person_back()  # type: ignore[attr-defined]
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#continue-test")
+    def _continue_test(self) -> None:
+        table = self.query_one("#interrupted", DataTable)
+        if not table.row_count:
+            return
+        row_key, _ = table.coordinate_to_cell_key(table.cursor_coordinate)
+        refused = self.app.continue_test(str(row_key.value))  # type: ignore[attr-defined]
+        if refused:
+            self.query_one("#continue-result", Static).update(f"Not continued: {refused}")
+
+    @on(Button.Pressed, "#new-session")
+    def _new_session(self) -> None:
+        self.app.start_new_session()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#start-visit")
+    def _start_visit(self) -> None:
+        from kiosk.ui.screens.start_visit import StartVisitScreen
+
+        self.app.push_screen(StartVisitScreen())
+
+    @on(Button.Pressed, "#back")
+    def _back(self) -> None:
+        self.app.close_clinician()  # type: ignore[attr-defined]
+
+    @on(Button.Pressed, "#quit-kiosk")
+    def _quit(self) -> None:
+        self.app.quit_kiosk()  # type: ignore[attr-defined]
+
+    @on(Switch.Changed, "#adaptation")
+    def _adaptation(self, event: Switch.Changed) -> None:
+        self.app.set_adaptation(event.value)  # type: ignore[attr-defined]
+
+    @on(DataTable.RowSelected, "#sessions")
+    def _open(self, event: DataTable.RowSelected) -> None:
+        store = self.app.store  # type: ignore[attr-defined]
+        stored = store.session(str(event.row_key.value))
+        self.app.push_screen(SessionDetailScreen(stored))
+
+    def action_close(self) -> None:
+        """Escape from here goes back to the patient."""
+        self.app.close_clinician()  # type: ignore[attr-defined]

@@ -1,0 +1,120 @@
+"""A Barthel question: large text, big numbered answers, progress, attempt and controls."""
+
+from __future__ import annotations
+
+from collections.abc import Hashable
+
+from textual.app import ComposeResult
+from textual.widget import Widget
+from textual.widgets import Static
+
+from kiosk.core.questionnaire import Item
+from kiosk.ui.screens.base import PatientScreen, PatientView
+from kiosk.ui.widgets.answer_button import AnswerButton
+from kiosk.ui.widgets.bars import ControlBar
+from kiosk.ui.widgets.change_answer import ThanksRow
+from kiosk.ui.widgets.confirm_panel import ConfirmPanel
+from kiosk.ui.widgets.question_panel import QuestionPanel
+from kiosk.ui.widgets.text import ui_text
+from kiosk.ui.widgets.waiting_sign import WaitingSign
+
+
+class QuestionScreen(PatientScreen):
+    """One scored item. Touching an answer posts ``AnswerButton.Chosen``; the app forwards it.
+
+    Between questions the last item (before the first, the explanation) stays on screen, its answer
+    marked, under a calm line such as "Thank you. Next question…", as the session's
+    :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile; during
+    that thank-you gap "Change my answer" is offered beside it. The line and the button take the
+    question text's rows (the answers keep theirs), so the chosen answer is never covered. While the session asks back an unsure answer
+    ("I heard: … Is that right?") the question's panel gives way to the Yes/No panel. While an
+    answer is awaited a gentle sign says so.
+    """
+
+    ASKS = True
+
+    def __init__(self, view: PatientView) -> None:
+        """Build the screen for ``view``'s item."""
+        super().__init__(view)
+        #: the item whose panel is on screen
+        self._item_id: str | None = None
+        #: the option the Yes/No panel on screen asks about (None: the question's panel is shown)
+        self._confirming: int | None = None
+
+    @classmethod
+    def key(cls, view: PatientView) -> Hashable:
+        """One screen for all the items of a language: the next item only swaps the panel."""
+        return view.snapshot.language
+
+    def compose(self) -> ComposeResult:
+        """Bars, the thank-you row (the between-questions line and "Change my answer", hidden
+        until a gap), the question with its answers, and the controls."""
+        yield from self.compose_bars()
+        yield from self._panel(self.view)
+        yield WaitingSign(self.language)
+        yield ControlBar(self.language, repeat=self.view.ways.voice_out)
+
+    def _panel(self, view: PatientView) -> list[Widget]:
+        """The question and answers of the view's item, the thank-you row laid over the question
+        text; between the explanation and item 1 the row above the explanation the patient just
+        read (none if the questionnaire has no explanation)."""
+        item = view.snapshot.item
+        self._item_id = item.id if item else None
+        self._confirming = view.snapshot.confirming
+        prompt = view.snapshot.prompt
+        if self._confirming is not None and prompt is not None and prompt.kind == "confirm":
+            return [ConfirmPanel(prompt.text, [o.label for o in prompt.options])]
+        thanks = ThanksRow(self.language, self._line(view), offered=view.snapshot.can_undo)
+        if item is None:
+            explanation = view.questionnaire.message("explanation", self.language)
+            return [thanks, Static(explanation, classes="notice", id="recap")] if explanation else [thanks]
+        answer = view.snapshot.answers.get(item.id)
+        return [QuestionPanel(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
+                              chosen=answer.option if answer else None, over_question=thanks)]
+
+    def _line(self, view: PatientView) -> str:
+        """The between-questions line in the patient's language ("" outside a gap)."""
+        key = view.snapshot.interlude
+        return (view.questionnaire.message(key, self.language) or ui_text(self.language, key)) if key else ""
+
+    def show(self, view: PatientView) -> None:
+        """Refresh the bars and the thank-you row; swap in the next item's panel, or mark the
+        recorded answer."""
+        super().show(view)
+        for bar in self.query(ControlBar):
+            bar.show_repeat(view.ways.voice_out)
+        for thanks in self.query(ThanksRow):
+            thanks.show(self._line(view), view.snapshot.can_undo)
+        if not self.is_mounted:  # compose has not run yet: it will draw this view
+            return
+        item = view.snapshot.item
+        confirming = view.snapshot.confirming
+        if (item.id if item else None) != self._item_id or confirming != self._confirming:
+            if (item is not None and self._item_id is not None and confirming is None
+                    and self._confirming is None and self._reword(view, item)):
+                return
+            for old in self.query("QuestionPanel, ConfirmPanel, #recap, ThanksRow"):
+                old.remove()
+            if widgets := self._panel(view):
+                self.mount_all(widgets, before=self.query_one(WaitingSign))
+            return
+        prompt = view.snapshot.prompt
+        if confirming is not None and prompt is not None and prompt.kind == "confirm":
+            for confirm in self.query(ConfirmPanel):
+                confirm.ask(prompt.text)
+        answer = view.snapshot.answers.get(item.id) if item else None
+        for panel in self.query(QuestionPanel):
+            panel.mark_chosen(answer.option if answer else None)
+
+    def _reword(self, view: PatientView, item: Item) -> bool:
+        """Put ``item`` into the panel on screen when it has as many answers (no remount); False
+        when it cannot, so the caller builds a new panel."""
+        answer = view.snapshot.answers.get(item.id)
+        for panel in self.query(QuestionPanel):
+            if panel.show_item(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
+                               chosen=answer.option if answer else None):
+                self._item_id = item.id
+                if isinstance(self.focused, AnswerButton):  # it would look chosen on the new item
+                    self.set_focus(None)
+                return True
+        return False

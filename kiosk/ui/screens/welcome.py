@@ -1,0 +1,102 @@
+"""Welcome: the patient chooses a language, which starts the test."""
+
+from __future__ import annotations
+
+from collections.abc import Hashable
+
+from textual import events, on
+from textual.app import ComposeResult
+from textual.containers import Vertical
+from textual.message import Message
+from textual.widgets import Button, Static
+
+from kiosk.ui.screens.base import PatientScreen, PatientView, Ways
+from kiosk.ui.widgets.text import language_name, ui_text, ways_sentence
+
+
+def welcome_line(view: PatientView, language: str) -> str:
+    """The welcome in ``language`` itself, and how to choose with the channels on now: "Welcome.
+    Please choose your language." alone when touching is the only way (the buttons say the rest)."""
+    ways = language_ways(view.ways)
+    how = ways_sentence(language, "choose_by", ways, "_language") if len(ways) > 1 else ui_text(
+        language, "choose_language")
+    return f"{view.questionnaire.message('welcome', language)} {how}".strip()
+
+
+def language_ways(ways: Ways) -> tuple[str, ...]:
+    """How a language can be chosen now: touch; a remote's number; "start" while the kiosk listens."""
+    return ("touch",) + (("remote",) if ways.remote else ()) + (("voice",) if ways.listening else ())
+
+
+class LanguageList(Vertical):
+    """The language buttons, all equally tall (an odd number of rows, so each label sits in the
+    middle) and equally labelled: names padded to the longest, so the labels line up centred."""
+
+    def on_resize(self, event: events.Resize) -> None:
+        """The display changed: share the rows out again."""
+        self.lay_out()
+
+    def lay_out(self) -> None:
+        """Give every button the same height; spare rows stay below the last."""
+        buttons = list(self.query(Button))
+        rows = self.content_region.height
+        if not buttons or rows <= 0:
+            return
+        height = max(3, (rows - len(buttons)) // len(buttons))  # one row of margin above each
+        if height % 2 == 0:
+            height -= 1
+        for button in buttons:
+            button.styles.height = height
+
+
+def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:
+    """"1  English ", "2  Español ", "3  Français": numbered like the remote, padded to one width."""
+    labels = [f"{number}  {language_name(language)}" for number, language in enumerate(languages, start=1)]
+    width = max(map(len, labels))
+    return [label.ljust(width) for label in labels]
+
+
+class WelcomeScreen(PatientScreen):
+    """The welcome and "choose your language", each line in its own language, and one big button
+    per language (numbered like the remote)."""
+
+    class LanguageChosen(Message):
+        """The patient touched a language: start in it."""
+
+        def __init__(self, language: str) -> None:
+            self.language = language
+            """One of the questionnaire's languages."""
+            super().__init__()
+
+    @classmethod
+    def key(cls, view: PatientView) -> Hashable:
+        """Rebuilt when the language changes."""
+        return view.snapshot.language
+
+    def compose(self) -> ComposeResult:
+        """Bars, the welcome lines, the language buttons."""
+        yield from self.compose_bars()
+        q = self.view.questionnaire
+        with Vertical(id="welcome"):
+            for language in q.languages:
+                yield Static(welcome_line(self.view, language), classes="welcome-line",
+                             id=f"welcome-{language}")
+        with LanguageList(id="languages"):
+            for language, label in zip(q.languages, language_labels(q.languages)):
+                yield Button(label, id=f"language-{language}")
+
+    def show(self, view: PatientView) -> None:
+        """Also keep the welcome lines true to the channels on now."""
+        super().show(view)
+        for language in view.questionnaire.languages:
+            for line in self.query(f"#welcome-{language}").results(Static):
+                line.update(welcome_line(view, language))
+
+    def progress_text(self, view: PatientView) -> str:
+        """The title in every language: the patient has not chosen one yet."""
+        return " · ".join(dict.fromkeys(view.questionnaire.title.values()))
+
+    @on(Button.Pressed, "#languages Button")
+    def _language(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.post_message(self.LanguageChosen((event.button.id or "").removeprefix("language-")))

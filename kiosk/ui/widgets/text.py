@@ -1,0 +1,55 @@
+"""The kiosk's own screen words (buttons, titles, progress) in each language, from ``ui_text.yaml``.
+
+The questionnaire's texts (questions, options, explanations) come from the questionnaire; these are
+only the words around them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from functools import cache
+from importlib import resources
+
+import yaml
+
+#: the language whose words every other language falls back to
+FALLBACK = "en"
+
+
+@cache
+def _table() -> dict[str, dict[str, str]]:
+    text = resources.files("kiosk.ui.widgets").joinpath("ui_text.yaml").read_text(encoding="utf-8")
+    return yaml.safe_load(text)
+
+
+def ui_text(language: str, key: str, default: str | None = None, **values: object) -> str:
+    """The words for ``key`` in ``language`` (English if missing), with ``values`` filled in.
+
+    A key no language has gives ``default``; without one it is a KeyError (a typo in a screen).
+    """
+    table = _table()
+    words = table.get(language, {}).get(key) or table[FALLBACK].get(key, default)
+    if words is None:
+        raise KeyError(f"no screen text {key!r}")
+    return words.format(**values) if values else words
+
+
+def language_name(language: str) -> str:
+    """The language's own name for itself ("Español"), or its code for a language with no screen words."""
+    return _table().get(language, {}).get("language_name") or language
+
+
+def ways_sentence(language: str, sentence: str, ways: Sequence[str], suffix: str = "") -> str:
+    """A sentence listing the ways of doing something that are on now, e.g. ``answer_by`` with
+    ("touch", "remote"): "Answer by touching it on the screen or pressing its number on the
+    remote." Each way's words are ``way_<way><suffix>``; the last two are joined by ``or``."""
+    words = ui_text(language, sentence,
+                    ways=join_or(language, [ui_text(language, f"way_{way}{suffix}") for way in ways]))
+    return words[0].upper() + words[1:]
+
+
+def join_or(language: str, phrases: Sequence[str]) -> str:
+    """"a, b or c" in ``language``."""
+    if len(phrases) == 1:
+        return phrases[0]
+    return ", ".join(phrases[:-1]) + f" {ui_text(language, 'or')} {phrases[-1]}"

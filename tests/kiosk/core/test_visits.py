@@ -1,0 +1,51 @@
+"""How a visit begins (kiosk.core.visits): the identifier rule that keeps names out, the station's orders
+a kiosk can and cannot run (each refusal one sentence naming the entry), and what the welcome
+shows: ordered visits first, walk-ups only where the site allows them."""
+
+from __future__ import annotations
+
+import pytest
+
+from kiosk.core.visits import Order, VisitDesk, check_patient_id, parse_orders
+
+
+@pytest.mark.parametrize("identifier", ["NHC-0012345", "12345678", "MRN_77", "p2"])
+def test_hospital_identifiers_are_taken(identifier):
+    assert check_patient_id(identifier) is None
+
+
+@pytest.mark.parametrize("name", ["Maria Lopez", "LOPEZ", "O'Neill", "Jose.Garcia", "-123", "x" * 65, ""])
+def test_names_and_malformed_identifiers_are_refused(name):
+    why = check_patient_id(name)
+    assert why is not None and ("never a name" in why or "type the patient" in why)
+
+
+def test_orders_the_kiosk_cannot_run_are_left_out_with_why():
+    entry = {"id": "order-1", "patient_id": "NHC-1", "instruments": ["barthel"], "language": "es",
+             "answered_by": "relative", "ordered_by": "nurse.kim"}
+    body = {"orders": [entry, entry | {"id": "order-2", "instruments": ["moca"]},
+                       entry | {"id": "order-3", "language": "de"}, entry | {"id": "order-4", "patient_id": "LOPEZ"},
+                       "nonsense"]}
+    found, problems = parse_orders(body, ["barthel"], ["en", "es", "fr"])
+    assert found == [Order("order-1", "NHC-1", ("barthel",), "es", "relative", "nurse.kim")]
+    assert [p.split(":")[0] for p in problems] == ["orders[1] (order-2)", "orders[2] (order-3)",
+                                                   "orders[3] (order-4)", "orders[4]"]
+    assert "this kiosk gives barthel" in problems[0] and "'de'" in problems[1] and "never a name" in problems[2]
+    assert parse_orders({"oops": 1}, ["barthel"], ["en"]) == ([], ["the station's answer has no 'orders' list"])
+
+
+def test_the_welcome_is_held_for_ordered_visits_and_where_walk_ups_are_not_allowed():
+    made = []
+    desk = VisitDesk(lambda *args: made.append(args) or args, walk_up=True)
+    assert not desk.holds_welcome()
+    order = Order("order-1", "NHC-1", ("barthel",), "es", "relative")
+    assert desk.set_orders([order]) and desk.holds_welcome()
+    assert not desk.set_orders([order])  # nothing changed
+    assert desk.choose_walk_up() and not desk.holds_welcome()
+    desk.next_visit()
+    assert desk.holds_welcome()
+    assert desk.for_order(order) == ("NHC-1", "es", "relative", "order order-1") and desk.ready == ()
+    assert desk.for_staff("Maria Lopez", "en", False)[0] is None
+    assert desk.for_staff(" NHC-2 ", "en", True)[0] == ("NHC-2", "en", "relative", "staff")
+    closed = VisitDesk(lambda *args: args, walk_up=False)
+    assert closed.holds_welcome() and not closed.choose_walk_up() and closed.holds_welcome()

@@ -1,0 +1,129 @@
+"""A real `kiosk serve` process for browser tests, and what its page was sent to draw."""
+
+from __future__ import annotations
+
+import io
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from kiosk.ui.serve.guard import token_digest
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+#: what a test waits for at most (server start, first paint, an answer reaching the database)
+PATIENCE_S = 30.0
+#: the device key the served kiosks of the tests are set up with
+TOKEN = "test-device-key-0123456789abcdefghijklmnop"
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@dataclass
+class Served:
+    """A running `kiosk serve`: its port, database and log."""
+
+    port: int
+    database: Path
+    log: Path
+
+    def url(self, path: str = "/", host: str = "127.0.0.1") -> str:
+        return f"http://{host}:{self.port}{path}"
+
+
+@contextmanager
+def serve(tmp_path: Path, config: str = "", *, between_questions_s: float = 0.5) -> Iterator[Served]:
+    """`kiosk serve` on a free localhost port, set up with :data:`TOKEN` and ``config`` lines
+    (``between_questions_s``: the thank-you gap, long where a test looks at it)."""
+    path = tmp_path / "config.yaml"
+    path.write_text('familiarisation: false\nclinician_pin: "246813"\n'
+                    f"timing: {{attempt_window_s: 300, between_questions_s: {between_questions_s}}}\n"
+                    f'serve_token_sha256: "{token_digest(TOKEN)}"\n' + config)
+    port = free_port()
+    log = tmp_path / "serve.log"
+    with open(log, "wb") as output:  # a file, not a pipe nobody reads, which would fill and stall it
+        server = subprocess.Popen(
+            [sys.executable, "-m", "kiosk", "serve", "--port", str(port), "--data-dir", str(tmp_path / "data"),
+             "--no-voice"], env=dict(os.environ, KIOSK_CONFIG=str(path)), stdout=output, stderr=subprocess.STDOUT)
+    try:
+        deadline = time.monotonic() + PATIENCE_S
+        while True:
+            assert server.poll() is None, f"kiosk serve exited with {server.returncode}: {log.read_text()}"
+            with socket.socket() as probe:
+                if probe.connect_ex(("127.0.0.1", port)) == 0:
+                    break
+            assert time.monotonic() < deadline, f"kiosk serve did not listen on port {port}"
+            time.sleep(0.1)  # polling a real server's start-up, not standing in for logic
+        yield Served(port, tmp_path / "data" / "kiosk.sqlite3", log)
+    finally:
+        server.terminate()
+        server.wait(timeout=PATIENCE_S)
+
+
+class Painted:
+    """Everything the server sent a page's websockets to draw, so far."""
+
+    def __init__(self, page) -> None:
+        self.sockets: list = []
+        self.data = bytearray()
+        page.on("websocket", self._follow)
+
+    def _follow(self, ws) -> None:
+        self.sockets.append(ws)
+        ws.on("framereceived", lambda data: self.data.extend(data if isinstance(data, bytes) else data.encode()))
+
+    def shows(self, text: str) -> Callable[[], bool]:
+        """The server has sent the page ``text`` to draw: that screen is up in the app."""
+        return lambda: text.encode() in self.data
+
+
+async def wait_until(page, check: Callable[[], bool], what: str) -> None:
+    """Let Playwright deliver frames until ``check()`` holds, at most :data:`PATIENCE_S`."""
+    deadline = time.monotonic() + PATIENCE_S
+    while not check():
+        assert time.monotonic() < deadline, f"never saw {what}"
+        await page.wait_for_timeout(50)  # lets Playwright deliver frames; bounded by PATIENCE_S
+
+
+#: the backgrounds of what a patient taps on the page (kiosk.tcss), as RGB
+ANSWER_RGB = (0xdc, 0xe6, 0xf5)
+ACTION_RGB = (0x0b, 0x3d, 0x91)
+
+
+async def drawn(page, left: float, top: float, right: float, bottom: float, cell_h: float,
+                rgb: tuple[int, int, int]) -> bool:
+    """The page shows a button of colour ``rgb`` exactly over this box, as a patient sees it before
+    they tap: its colour just inside the top and bottom rows, not in the row above (a button drawn a
+    row off, or in a frame laid out before the screen settled, fails one of them). The mouse is
+    moved off the box first, so a hover colour from the last tap does not hide the button."""
+    from PIL import Image
+
+    await page.mouse.move(1, 1)
+    shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
+    x = int(right) - 4  # the label's right padding: never a letter there
+
+    def colour(y: float) -> tuple[int, int, int]:
+        return shot.getpixel((x, min(max(int(y), 0), shot.height - 1)))
+
+    return (colour(top + 2) == rgb and colour(bottom - 2) == rgb
+            and (top < cell_h or colour(top - cell_h / 2) != rgb))
+
+
+async def wait_until_drawn(page, box: tuple[float, float, float, float], cell_h: float,
+                           rgb: tuple[int, int, int], what: str) -> None:
+    """Wait, at most :data:`PATIENCE_S`, until :func:`drawn` holds for ``box`` (left, top, right, bottom px)."""
+    deadline = time.monotonic() + PATIENCE_S
+    while not await drawn(page, *box, cell_h, rgb):
+        assert time.monotonic() < deadline, f"never saw {what} drawn where the headless layout put it"
+        await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S
