@@ -39,8 +39,9 @@ import httpx
 CSRF = re.compile(r'name="csrf" content="([^"]+)"')
 
 
-async def poll_orders(http: httpx.AsyncClient, seen: dict[str, float], stop: asyncio.Event,
-                      listening: asyncio.Event) -> None:
+async def poll_orders(
+    http: httpx.AsyncClient, seen: dict[str, float], stop: asyncio.Event, listening: asyncio.Event
+) -> None:
     """One kiosk's order watcher: the first time each order id is listed (monotonic seconds);
     ``listening`` is set once its first answer came (the kiosk is then waiting on a long poll)."""
     version = None
@@ -60,8 +61,15 @@ async def poll_orders(http: httpx.AsyncClient, seen: dict[str, float], stop: asy
             seen.setdefault(order["id"], now)
 
 
-async def place_orders(url: str, user: str, password: str, kiosks: list[str], every_s: float,
-                       placed: dict[str, float], placed_wall: dict[str, float]) -> None:
+async def place_orders(
+    url: str,
+    user: str,
+    password: str,
+    kiosks: list[str],
+    every_s: float,
+    placed: dict[str, float],
+    placed_wall: dict[str, float],
+) -> None:
     """Staff order one visit per kiosk, ``every_s`` apart: order id -> when the form was sent
     (monotonic, and the wall clock in ``placed_wall``)."""
     async with httpx.AsyncClient(base_url=url, timeout=60) as http:
@@ -71,17 +79,32 @@ async def place_orders(url: str, user: str, password: str, kiosks: list[str], ev
         for index, kiosk in enumerate(kiosks):
             await asyncio.sleep(every_s)
             sent, wall = time.monotonic(), time.time()
-            response = await http.post("/orders", data={
-                "csrf": token, "patient_id": f"NHC-B{index:04d}", "kiosk": kiosk, "instrument": "barthel",
-                "language": "en"})
+            response = await http.post(
+                "/orders",
+                data={
+                    "csrf": token,
+                    "patient_id": f"NHC-B{index:04d}",
+                    "kiosk": kiosk,
+                    "instrument": "barthel",
+                    "language": "en",
+                },
+            )
             location = response.headers.get("location", "")
             if response.status_code == 303 and location.startswith("/orders/order-"):
                 placed[location.rsplit("/", 1)[1]] = sent
                 placed_wall[location.rsplit("/", 1)[1]] = wall
 
 
-def ward_round(url: str, kiosks: dict[str, str], users: tuple[str, ...], password: str, every_s: float,
-               placed: dict[str, float], placed_wall: dict[str, float], seen: dict[str, float]) -> None:
+def ward_round(
+    url: str,
+    kiosks: dict[str, str],
+    users: tuple[str, ...],
+    password: str,
+    every_s: float,
+    placed: dict[str, float],
+    placed_wall: dict[str, float],
+    seen: dict[str, float],
+) -> None:
     """In a thread of its own (its own event loop, as each real kiosk and phone has its own
     process): every kiosk's order long poll, and staff ordering one visit per kiosk, ``every_s``
     apart overall, split between ``users``, once every kiosk is waiting. ``seen``: order id ->
@@ -89,14 +112,20 @@ def ward_round(url: str, kiosks: dict[str, str], users: tuple[str, ...], passwor
 
     async def run() -> None:
         stop = asyncio.Event()
-        clients = {name: httpx.AsyncClient(base_url=url, headers={"Authorization": f"Bearer {token}"}, timeout=60)
-                   for name, token in kiosks.items()}
+        clients = {
+            name: httpx.AsyncClient(base_url=url, headers={"Authorization": f"Bearer {token}"}, timeout=60)
+            for name, token in kiosks.items()
+        }
         listening = {name: asyncio.Event() for name in kiosks}
         polls = [asyncio.create_task(poll_orders(clients[name], seen, stop, listening[name])) for name in kiosks]
         await asyncio.gather(*(event.wait() for event in listening.values()))
         names = list(kiosks)
-        await asyncio.gather(*(place_orders(url, user, password, names[index::len(users)], every_s * len(users),
-                                            placed, placed_wall) for index, user in enumerate(users)))
+        await asyncio.gather(
+            *(
+                place_orders(url, user, password, names[index :: len(users)], every_s * len(users), placed, placed_wall)
+                for index, user in enumerate(users)
+            )
+        )
         deadline = time.monotonic() + 15
         while time.monotonic() < deadline and not all(o in seen for o in placed):
             await asyncio.sleep(0.05)

@@ -31,17 +31,27 @@ class Row:
     at: str
 
     def event(self) -> dict[str, Any]:
-        return {"seq": self.seq, "kind": self.kind, "session_id": self.session_id, "at": self.at,
-                "payload": self.payload}
+        return {
+            "seq": self.seq,
+            "kind": self.kind,
+            "session_id": self.session_id,
+            "at": self.at,
+            "payload": self.payload,
+        }
 
     @property
     def alert(self) -> bool:
         return self.kind == "record_event" and self.payload.get("kind") in ALERT_KINDS
 
 
-def record_patient(script: str | Path, first_seq: int = 1, patient: str | None = None,
-                   export: dict[str, str] | None = None, data_dir: Path | None = None,
-                   visit: str | None = None) -> list[Row]:
+def record_patient(
+    script: str | Path,
+    first_seq: int = 1,
+    patient: str | None = None,
+    export: dict[str, str] | None = None,
+    data_dir: Path | None = None,
+    visit: str | None = None,
+) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
     on the kiosk's real :class:`kiosk.store.database.Store` with a station configured, its outbox read
     back and numbered from ``first_seq``; ``export`` is the kiosk's export identity, ``visit`` the
@@ -84,9 +94,19 @@ class KioskClient:
         return self.http.post("/api/v1/sync", json={"kiosk_id": self.kiosk_id, "events": [r.event() for r in rows]})
 
     def status(self, **fields: Any) -> httpx.Response:
-        body = {"kiosk_id": self.kiosk_id, "at": None, "session_id": None, "patient_id": None, "phase": None,
-                "question": None, "of": None, "paused": False, "person_away": False, "doctor_called": False,
-                "simulated": True} | fields
+        body = {
+            "kiosk_id": self.kiosk_id,
+            "at": None,
+            "session_id": None,
+            "patient_id": None,
+            "phase": None,
+            "question": None,
+            "of": None,
+            "paused": False,
+            "person_away": False,
+            "doctor_called": False,
+            "simulated": True,
+        } | fields
         return self.http.post("/api/v1/status", json=body)
 
     def commands(self, wait: float = 0.0) -> list[dict[str, Any]]:

@@ -77,9 +77,10 @@ class SileroEndpointer(Endpointer):
         while len(self._buffer) >= self.CONTEXT + self.WINDOW:
             chunk = self._buffer[: self.CONTEXT + self.WINDOW][None, :]
             out, self._state = self._session.run(
-                None, {"input": chunk, "state": self._state, "sr": np.array(SAMPLE_RATE, dtype=np.int64)})
+                None, {"input": chunk, "state": self._state, "sr": np.array(SAMPLE_RATE, dtype=np.int64)}
+            )
             self._probability = float(out[0][0])
-            self._buffer = self._buffer[self.WINDOW:]
+            self._buffer = self._buffer[self.WINDOW :]
         threshold = self.threshold if starting else self.threshold - 0.15
         return level_db >= self.settings.min_speech_db and self._probability >= threshold
 

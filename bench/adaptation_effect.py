@@ -15,9 +15,9 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from kiosk.commands.replay import ScriptError, load_script, run_script
 from kiosk.core.adaptation import load_policy
 from kiosk.core.questionnaire import load_questionnaire
-from kiosk.commands.replay import ScriptError, load_script, run_script
 
 PATIENTS = Path(__file__).resolve().parents[1] / "recordings" / "patients"
 RULE = "longer_attempts"
@@ -29,11 +29,14 @@ def run(path: Path, policy, questionnaire) -> dict:
         result = run_script(load_script(path, questionnaire), questionnaire, policy=policy)
     except ScriptError as error:  # a script whose declared attempts no longer fit
         return {"error": str(error)}
-    switched = [round(e.t, 1) for e in result.events
-                if type(e).__name__ == "AdaptationChanged" and e.name == RULE and e.active]
-    return {"session_s": round(result.simulated_s, 1),
-            "unanswered": len(result.session.snapshot().not_answered),
-            "longer_attempts_on_at_s": switched[0] if switched else None}
+    switched = [
+        round(e.t, 1) for e in result.events if type(e).__name__ == "AdaptationChanged" and e.name == RULE and e.active
+    ]
+    return {
+        "session_s": round(result.simulated_s, 1),
+        "unanswered": len(result.session.snapshot().not_answered),
+        "longer_attempts_on_at_s": switched[0] if switched else None,
+    }
 
 
 def main(argv: list[str]) -> int:

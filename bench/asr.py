@@ -115,14 +115,29 @@ from kiosk.speech.voice import VoiceChannel  # noqa: E402
 
 #: patients' voices (espeak-ng voice+variant, words per minute); never the kiosk's own en-us at 160
 VOICES = {
-    "dev": [("en-us+m3", 130), ("en+f2", 170), ("en-gb+klatt", 150), ("en+croak", 120),
-            ("en-us+f4", 185), ("en-gb-scotland+m7", 145), ("en+grandpa", 115), ("en-us+whisperf", 150)],
-    "held_out": [("en+m5", 140), ("en-us+f3", 160), ("en+klatt3", 125), ("en-gb-x-rp+m2", 180),
-                 ("en+f5", 110), ("en-029+m4", 155), ("en-us+aunty", 135), ("en+whisper", 165)],
+    "dev": [
+        ("en-us+m3", 130),
+        ("en+f2", 170),
+        ("en-gb+klatt", 150),
+        ("en+croak", 120),
+        ("en-us+f4", 185),
+        ("en-gb-scotland+m7", 145),
+        ("en+grandpa", 115),
+        ("en-us+whisperf", 150),
+    ],
+    "held_out": [
+        ("en+m5", 140),
+        ("en-us+f3", 160),
+        ("en+klatt3", 125),
+        ("en-gb-x-rp+m2", 180),
+        ("en+f5", 110),
+        ("en-029+m4", 155),
+        ("en-us+aunty", 135),
+        ("en+whisper", 165),
+    ],
 }
 #: other people talking in the ward, for babble (never a patient's voice)
-BABBLE_TALKERS = [("en-gb+m1", 170), ("en-us+f1", 180), ("en+m6", 160), ("en-gb-x-rp+f3", 175),
-                  ("en-us+m8", 165)]
+BABBLE_TALKERS = [("en-gb+m1", 170), ("en-us+f1", 180), ("en+m6", 160), ("en-gb-x-rp+f3", 175), ("en-us+m8", 165)]
 BABBLE_TEXT = [
     "I told her the appointment was moved to Thursday afternoon but she did not listen",
     "Could you bring the trolley round to bed twelve when you have a moment please",
@@ -149,29 +164,59 @@ class Condition:
 
 CONDITIONS = {
     "clean": Condition(),
-    "white_20": Condition("white", 20, steady=True), "white_10": Condition("white", 10, steady=True),
+    "white_20": Condition("white", 20, steady=True),
+    "white_10": Condition("white", 10, steady=True),
     "white_5": Condition("white", 5, steady=True),
-    "babble_20": Condition("babble", 20), "babble_10": Condition("babble", 10), "babble_5": Condition("babble", 5),
-    "reverb": Condition(effect="reverb"), "telephone": Condition(effect="telephone"),
-    "quiet_-20dB": Condition(effect="quiet"), "leading_silence": Condition(effect="leading_silence"),
+    "babble_20": Condition("babble", 20),
+    "babble_10": Condition("babble", 10),
+    "babble_5": Condition("babble", 5),
+    "reverb": Condition(effect="reverb"),
+    "telephone": Condition(effect="telephone"),
+    "quiet_-20dB": Condition(effect="quiet"),
+    "leading_silence": Condition(effect="leading_silence"),
 }
 QUICK_CONDITIONS = ["clean", "white_10", "babble_10", "reverb"]
 
 #: answers in a patient's own words (item, text, option)
 NATURAL_EN = [
-    ("transfers", "I need a lot of help", 2), ("transfers", "I need a little help", 3),
-    ("transfers", "I can do it by myself", 4), ("feeding", "I need some help", 2),
-    ("feeding", "I eat by myself", 3), ("mobility", "I use a wheelchair", 2),
-    ("mobility", "I walk with help", 3), ("stairs", "I need help", 2), ("bladder", "never", 3),
-    ("bowels", "sometimes", 2), ("dressing", "I can't", 1), ("toilet", "I need some help", 2),
-    ("grooming", "I need help", 1), ("bathing", "by myself", 2),
+    ("transfers", "I need a lot of help", 2),
+    ("transfers", "I need a little help", 3),
+    ("transfers", "I can do it by myself", 4),
+    ("feeding", "I need some help", 2),
+    ("feeding", "I eat by myself", 3),
+    ("mobility", "I use a wheelchair", 2),
+    ("mobility", "I walk with help", 3),
+    ("stairs", "I need help", 2),
+    ("bladder", "never", 3),
+    ("bowels", "sometimes", 2),
+    ("dressing", "I can't", 1),
+    ("toilet", "I need some help", 2),
+    ("grooming", "I need help", 1),
+    ("bathing", "by myself", 2),
 ]
 #: things patients say that are not answers (every question); "<cough>" is a cough
-NON_ANSWERS_EN = ["um", "uh", "what?", "sorry?", "<cough>", "is it time for lunch yet", "all the time",
-                  "I don't know", "the weather is nice today", "where is my coat", "hello",
-                  "my daughter is coming later", "banana split", "can you say that again slowly"]
-COMMANDS_EN = [("call the doctor", Command.CALL_DOCTOR), ("repeat", Command.REPEAT),
-               ("stop", Command.PAUSE), ("louder", Command.VOLUME_UP)]
+NON_ANSWERS_EN = [
+    "um",
+    "uh",
+    "what?",
+    "sorry?",
+    "<cough>",
+    "is it time for lunch yet",
+    "all the time",
+    "I don't know",
+    "the weather is nice today",
+    "where is my coat",
+    "hello",
+    "my daughter is coming later",
+    "banana split",
+    "can you say that again slowly",
+]
+COMMANDS_EN = [
+    ("call the doctor", Command.CALL_DOCTOR),
+    ("repeat", Command.REPEAT),
+    ("stop", Command.PAUSE),
+    ("louder", Command.VOLUME_UP),
+]
 YES_EN = ["yes", "yes that's right", "yes it is", "that's right"]
 NO_EN = ["no", "no that's wrong", "no it isn't", "no"]
 NUMBER_WORDS = ["one", "two", "three", "four"]
@@ -186,8 +231,11 @@ def patient_cases(questionnaire) -> list[tuple[str, str, object]]:
             cases.append((item.id, spoken_label(option.label_in("en")), option.number))
             cases += [(item.id, s, option.number) for s in option.synonyms_in("en")]
             n = option.number - 1
-            cases += [(item.id, NUMBER_WORDS[n], option.number), (item.id, f"number {NUMBER_WORDS[n]}", option.number),
-                      (item.id, f"the {ORDINAL_WORDS[n]} one", option.number)]
+            cases += [
+                (item.id, NUMBER_WORDS[n], option.number),
+                (item.id, f"number {NUMBER_WORDS[n]}", option.number),
+                (item.id, f"the {ORDINAL_WORDS[n]} one", option.number),
+            ]
         cases += [(item.id, text, None) for text in NON_ANSWERS_EN]
         cases += [(item.id, text, command) for text, command in COMMANDS_EN]
     cases += [(item, text, option) for item, text, option in NATURAL_EN]
@@ -219,8 +267,10 @@ class Room:
         self.rng = np.random.default_rng(seed)
         self.talkers = []
         if condition.noise == "babble":
-            self.talkers = [np.concatenate([audio.say(t, v, r) for t in BABBLE_TEXT[i:] + BABBLE_TEXT[:i]])
-                            for i, (v, r) in enumerate(BABBLE_TALKERS)]
+            self.talkers = [
+                np.concatenate([audio.say(t, v, r) for t in BABBLE_TEXT[i:] + BABBLE_TEXT[:i]])
+                for i, (v, r) in enumerate(BABBLE_TALKERS)
+            ]
 
     def _noise(self, seconds: float) -> np.ndarray:
         if self.condition.noise == "white":
@@ -244,7 +294,7 @@ class Room:
             out = self._noise(seconds) * SPEECH_LEVEL * 10 ** (-c.snr_db / 20)
         else:  # a microphone's own hiss, -75 dBFS
             out = rooms.white_noise(seconds, self.rng) * 32768 * 10 ** (-75 / 20)
-        out[before:before + len(speech)] += speech
+        out[before : before + len(speech)] += speech
         return np.clip(np.round(out), -32768, 32767).astype(np.int16)
 
 
@@ -286,8 +336,9 @@ class _Timed:
 class Patient:
     """One voice in one room, answering through a real :class:`VoiceChannel`."""
 
-    def __init__(self, voice: str, rate: int, condition: Condition, audio: Audio, vad, confirm_below: float,
-                 seed: int) -> None:
+    def __init__(
+        self, voice: str, rate: int, condition: Condition, audio: Audio, vad, confirm_below: float, seed: int
+    ) -> None:
         self.voice, self.rate, self.audio = voice, rate, audio
         self.room = Room(condition, audio, seed)
         self.inputs: list = []
@@ -305,8 +356,13 @@ class Patient:
             self.timed.append(_Timed(PocketSphinxRecogniser(language)))
             return self.timed[-1]
 
-        self.channel = VoiceChannel("en", recogniser_factory=recogniser, confirm_below=confirm_below,
-                                    on_utterance=self._heard, endpointer_factory=vad)
+        self.channel = VoiceChannel(
+            "en",
+            recogniser_factory=recogniser,
+            confirm_below=confirm_below,
+            on_utterance=self._heard,
+            endpointer_factory=vad,
+        )
         self.channel.attach(self.inputs.append)
         self.channel.listen(True)
         # Before the first question the kiosk has listened on its welcome screen ("or say
@@ -379,7 +435,7 @@ class Patient:
         return out
 
     def confirm(self, meant: bool, key: int) -> bool | None:
-        """"I heard X, is that right?": the patient says yes only if X is what they meant;
+        """ "I heard X, is that right?": the patient says yes only if X is what they meant;
         whether the kiosk heard yes (asked once more if it heard neither; None if it never did)."""
         reply = (YES_EN if meant else NO_EN)[key % 4]
         for _ in range(2):
@@ -406,18 +462,40 @@ def run_condition(name: str, voices, cases, audio: Audio, args) -> dict:
     """Every voice's sample of cases in one condition; the figures."""
     condition = CONDITIONS[name]
     questionnaire = load_questionnaire()
-    options_of = {item.id: [OptionWords(o.label_in("en"), tuple(o.synonyms_in("en"))) for o in item.options]
-                  for item in questionnaire.items}
-    tally = dict(utterances=0, answers=0, non_answers=0, commands=0, right=0, right_first=0, wrong_stored=0,
-                 non_answers_stored=0, wrong_commands=0, asked_again=0, confirmations=0, unresolved=0,
-                 asked_to_press=0, asked_to_press_right=0)
+    options_of = {
+        item.id: [OptionWords(o.label_in("en"), tuple(o.synonyms_in("en"))) for o in item.options]
+        for item in questionnaire.items
+    }
+    tally = dict(
+        utterances=0,
+        answers=0,
+        non_answers=0,
+        commands=0,
+        right=0,
+        right_first=0,
+        wrong_stored=0,
+        non_answers_stored=0,
+        wrong_commands=0,
+        asked_again=0,
+        confirmations=0,
+        unresolved=0,
+        asked_to_press=0,
+        asked_to_press_right=0,
+    )
     first_inputs: list[tuple[float, bool]] = []
     latency, cut_off, seconds, audio_seconds, mistakes = [], 0, 0.0, 0.0, []
     for v, (voice, rate) in enumerate(voices):
         rng = random.Random(f"{name}/{voice}/{rate}")
         sample = rng.sample(cases, min(args.cases, len(cases)))
-        patient = Patient(voice, rate, condition, audio, endpointer_factory(args.vad, args.silero_onnx),
-                          args.confirm_below, seed=rng.randrange(2**32))
+        patient = Patient(
+            voice,
+            rate,
+            condition,
+            audio,
+            endpointer_factory(args.vad, args.silero_onnx),
+            args.confirm_below,
+            seed=rng.randrange(2**32),
+        )
         for k, (item, text, expected) in enumerate(sample):
             outcome = patient.answer(options_of[item], text, expected, key=k + v)
             kind = "non_answers" if expected is None else "commands" if isinstance(expected, Command) else "answers"
@@ -459,7 +537,8 @@ def run_condition(name: str, voices, cases, audio: Audio, args) -> dict:
         "speech_end_to_answer_ms": {"p50": _p(latency, 0.5), "p95": _p(latency, 0.95)},
         "unconfirmed_wrong_by_confidence": {
             str(t): round(sum(1 for c, ok in first_inputs if c >= t and not ok) / max(1, n), 4)
-            for t in (0.6, 0.7, 0.8, 0.9, 0.95)},
+            for t in (0.6, 0.7, 0.8, 0.9, 0.95)
+        },
         "mistakes": mistakes[:20],
     }
 
@@ -467,15 +546,20 @@ def run_condition(name: str, voices, cases, audio: Audio, args) -> dict:
 def main(argv: list[str] | None = None) -> int:
     """Run the matrix and print its JSON."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--voices", nargs="+", default=["dev", "held_out"],
-                        help="dev, held_out, all, or VOICE:WPM (any espeak-ng voice)")
+    parser.add_argument(
+        "--voices",
+        nargs="+",
+        default=["dev", "held_out"],
+        help="dev, held_out, all, or VOICE:WPM (any espeak-ng voice)",
+    )
     parser.add_argument("--conditions", nargs="+", default=list(CONDITIONS), choices=list(CONDITIONS))
     parser.add_argument("--quick", action="store_true", help="3 dev voices, 4 conditions, 20 cases each")
     parser.add_argument("--cases", type=int, default=40, help="utterances per voice and condition")
     parser.add_argument("--vad", default="energy", choices=["energy", "webrtc", "silero"])
     parser.add_argument("--silero-onnx", help="silero-vad's ONNX model (see bench/_vads.py)")
-    parser.add_argument("--confirm-below", type=float, default=None,
-                        help="confirm answers below this confidence (default: the kiosk's)")
+    parser.add_argument(
+        "--confirm-below", type=float, default=None, help="confirm answers below this confidence (default: the kiosk's)"
+    )
     parser.add_argument("--cache", type=Path, help="keep synthesised speech here between runs")
     args = parser.parse_args(argv)
     from kiosk.speech.voice import CONFIRM_BELOW
@@ -492,17 +576,27 @@ def main(argv: list[str] | None = None) -> int:
         if named:
             splits["named"] = [(v.split(":")[0], int(v.split(":")[1])) for v in named]
     cases = patient_cases(load_questionnaire())
-    report = {"goals": {"wrong_rate_max": 0.005, "right_clean_min": 0.8, "right_snr10_min": 0.5,
-                        "cut_off_steady_snr_ge_10": 0},
-              "vad": args.vad, "confirm_below": args.confirm_below, "cases_per_voice": args.cases,
-              "voices": {s: [f"{v}:{r}" for v, r in vs] for s, vs in splits.items()}, "conditions": {}}
+    report = {
+        "goals": {
+            "wrong_rate_max": 0.005,
+            "right_clean_min": 0.8,
+            "right_snr10_min": 0.5,
+            "cut_off_steady_snr_ge_10": 0,
+        },
+        "vad": args.vad,
+        "confirm_below": args.confirm_below,
+        "cases_per_voice": args.cases,
+        "voices": {s: [f"{v}:{r}" for v, r in vs] for s, vs in splits.items()},
+        "conditions": {},
+    }
     with tempfile.TemporaryDirectory() as tmp:
         folder = args.cache or Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
         audio = Audio(folder)
         for name in args.conditions:
-            report["conditions"][name] = {split: run_condition(name, voices, cases, audio, args)
-                                          for split, voices in splits.items()}
+            report["conditions"][name] = {
+                split: run_condition(name, voices, cases, audio, args) for split, voices in splits.items()
+            }
             print(json.dumps({name: report["conditions"][name]}, default=str), file=sys.stderr, flush=True)
     json.dump(report, sys.stdout, indent=2, default=str)
     print()

@@ -43,17 +43,22 @@ def main() -> int:
     everything = [ns for session in per_session for ns in session]
     first = [ns for session in per_session[:tenth] for ns in session]
     last = [ns for session in per_session[-tenth:] for ns in session]
-    print(json.dumps({
-        "benchmark": "qos_latency",
-        "model": "clarc",
-        "sessions": SESSIONS,
-        "simulated_hours": round(last_t / 3600, 1),
-        "all": percentiles(everything),
-        "first_tenth": percentiles(first),
-        "last_tenth": percentiles(last),
-        "last_over_first_p99": round(percentiles(last)["p99_us"] / percentiles(first)["p99_us"], 2),
-        "goal": "p99 < 1000 us, last tenth no slower than the first",
-    }, indent=1))
+    print(
+        json.dumps(
+            {
+                "benchmark": "qos_latency",
+                "model": "clarc",
+                "sessions": SESSIONS,
+                "simulated_hours": round(last_t / 3600, 1),
+                "all": percentiles(everything),
+                "first_tenth": percentiles(first),
+                "last_tenth": percentiles(last),
+                "last_over_first_p99": round(percentiles(last)["p99_us"] / percentiles(first)["p99_us"], 2),
+                "goal": "p99 < 1000 us, last tenth no slower than the first",
+            },
+            indent=1,
+        )
+    )
     return 0
 
 

@@ -53,9 +53,13 @@ def with_questions(day):
 def cost(samples: list[tuple[int, int]]) -> dict[str, float]:
     """Mean and p99 of an update (+ read) in microseconds: elapsed, and CPU time of the thread (which
     leaves out the time other processes held the CPU: on a shared machine elapsed p99 is mostly that)."""
+
     def summary(values: list[int]) -> tuple[float, float]:
-        return (round(statistics.fmean(values) / 1000, 2),
-                round(statistics.quantiles(values, n=100, method="inclusive")[98] / 1000, 2))
+        return (
+            round(statistics.fmean(values) / 1000, 2),
+            round(statistics.quantiles(values, n=100, method="inclusive")[98] / 1000, 2),
+        )
+
     mean, p99 = summary([wall for wall, _ in samples])
     cpu_mean, cpu_p99 = summary([cpu for _, cpu in samples])
     return {"mean_us": mean, "p99_us": p99, "cpu_mean_us": cpu_mean, "cpu_p99_us": cpu_p99, "events": len(samples)}
@@ -121,8 +125,12 @@ def soak(model: Model, day) -> dict:
 def main() -> int:
     clarc = soak(load_model("clarc"), lambda: back_to_back(gap=300.0))
     timed = soak(parse_model(SOAK_MODEL, "soak.roqme", MODELS), lambda: with_questions(back_to_back(gap=300.0)))
-    print(json.dumps({"benchmark": "qos_soak", "simulated_hours": DAY / 3600, "clarc": clarc,
-                      "timers_and_windows": timed}, indent=1))
+    print(
+        json.dumps(
+            {"benchmark": "qos_soak", "simulated_hours": DAY / 3600, "clarc": clarc, "timers_and_windows": timed},
+            indent=1,
+        )
+    )
     return 0
 
 

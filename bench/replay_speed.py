@@ -16,8 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from kiosk.core.questionnaire import load_questionnaire
 from kiosk.commands.replay import load_script, run_script
+from kiosk.core.questionnaire import load_questionnaire
 from kiosk.store.database import Store
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,18 +48,23 @@ def main(argv: list[str]) -> int:
         if store is not None:
             store.close()
     best, median = min(walls), statistics.median(walls)
-    print(json.dumps({
-        "scripts": len(paths),
-        "rounds": ROUNDS,
-        "store": use_store,
-        "wall_s_best": round(best, 4),
-        "wall_s_median": round(median, 4),
-        "simulated_s": round(simulated, 1),
-        "speedup_simulated_per_wall": round(simulated / median, 1),
-        "wall_per_simulated": round(median / simulated, 7),
-        "goal_wall_s": 2.0,
-        "goal_met": median < 2.0,
-    }, indent=1))
+    print(
+        json.dumps(
+            {
+                "scripts": len(paths),
+                "rounds": ROUNDS,
+                "store": use_store,
+                "wall_s_best": round(best, 4),
+                "wall_s_median": round(median, 4),
+                "simulated_s": round(simulated, 1),
+                "speedup_simulated_per_wall": round(simulated / median, 1),
+                "wall_per_simulated": round(median / simulated, 7),
+                "goal_wall_s": 2.0,
+                "goal_met": median < 2.0,
+            },
+            indent=1,
+        )
+    )
     return 0
 
 

@@ -58,8 +58,9 @@ def time_to_marker(argv: list[str], env: dict[str, str], timeout_s: float = 60.0
             try:
                 seen += os.read(fd, 65536)
             except OSError:  # the child closed the terminal: it exited before the welcome
-                raise RuntimeError(f"{argv[-1]} exited before the welcome: "
-                                   f"{_ANSI.sub(b'', seen)[-400:].decode(errors='replace')}") from None
+                raise RuntimeError(
+                    f"{argv[-1]} exited before the welcome: {_ANSI.sub(b'', seen)[-400:].decode(errors='replace')}"
+                ) from None
         return time.perf_counter() - began
     finally:
         os.kill(pid, signal.SIGKILL)
@@ -69,8 +70,9 @@ def time_to_marker(argv: list[str], env: dict[str, str], timeout_s: float = 60.0
 
 def heaviest_imports(n: int = 8) -> list[dict[str, object]]:
     """The ``n`` largest cumulative import times (ms) under ``import kiosk.ui.app``."""
-    err = subprocess.run([sys.executable, "-X", "importtime", "-c", "import kiosk.ui.app"],
-                         capture_output=True, text=True, check=True).stderr
+    err = subprocess.run(
+        [sys.executable, "-X", "importtime", "-c", "import kiosk.ui.app"], capture_output=True, text=True, check=True
+    ).stderr
     rows = []
     for line in err.splitlines():
         parts = line.split("|")
@@ -90,24 +92,28 @@ def main(argv: list[str]) -> int:
         config = os.path.join(tmp, "config.yaml")
         with open(config, "w", encoding="utf-8") as f:
             f.write("{}\n")
-        env = dict(os.environ, TERM="xterm-256color", KIOSK_DATA_DIR=os.path.join(tmp, "data"),
-                   KIOSK_CONFIG=config)
+        env = dict(os.environ, TERM="xterm-256color", KIOSK_DATA_DIR=os.path.join(tmp, "data"), KIOSK_CONFIG=config)
         env.pop("KIOSK_STATION_URL", None)
         two, kiosk = [], []
         for _ in range(args.rounds):
             two.append(time_to_marker([sys.executable, baseline], env))
             kiosk.append(time_to_marker([sys.executable, "-m", "kiosk"], env))
     ratio = statistics.median(kiosk) / statistics.median(two)
-    print(json.dumps({
-        "rounds": args.rounds,
-        "two_widget_s_median": round(statistics.median(two), 3),
-        "kiosk_s_median": round(statistics.median(kiosk), 3),
-        "kiosk_s_best": round(min(kiosk), 3),
-        "ratio_median": round(ratio, 2),
-        "goal_ratio": 1.5,
-        "goal_met": ratio <= 1.5,
-        "heaviest_imports_ms": heaviest_imports(),
-    }, indent=2))
+    print(
+        json.dumps(
+            {
+                "rounds": args.rounds,
+                "two_widget_s_median": round(statistics.median(two), 3),
+                "kiosk_s_median": round(statistics.median(kiosk), 3),
+                "kiosk_s_best": round(min(kiosk), 3),
+                "ratio_median": round(ratio, 2),
+                "goal_ratio": 1.5,
+                "goal_met": ratio <= 1.5,
+                "heaviest_imports_ms": heaviest_imports(),
+            },
+            indent=2,
+        )
+    )
     return 0
 
 

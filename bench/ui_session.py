@@ -31,12 +31,12 @@ from pathlib import Path
 from textual import events
 
 from kiosk.core.adaptation import Adaptation, load_policy
-from kiosk.ui.app import KIOSK_SIZE, KioskApp
 from kiosk.core.clock import SimClock
 from kiosk.core.questionnaire import load_questionnaire
-from kiosk.export.opening import MODEL
 from kiosk.core.session import Phase, Session
+from kiosk.export.opening import MODEL
 from kiosk.store.database import Store
+from kiosk.ui.app import KIOSK_SIZE, KioskApp
 from qos import Engine, load_model
 
 GOAL_SESSION_S = 3.0
@@ -50,8 +50,14 @@ def build(data_dir: Path) -> tuple[KioskApp, SimClock, Store]:
     clock = SimClock()
     questionnaire = load_questionnaire()
     store = Store.open(data_dir)
-    session = Session(questionnaire, clock=clock, engine=Engine(load_model(MODEL)), patient_id="P-BENCH1",
-                      store=store, adaptation=Adaptation(load_policy()))
+    session = Session(
+        questionnaire,
+        clock=clock,
+        engine=Engine(load_model(MODEL)),
+        patient_id="P-BENCH1",
+        store=store,
+        adaptation=Adaptation(load_policy()),
+    )
     return KioskApp(session, clinician_pin="2468", store=store, poll_interval=3600), clock, store
 
 
@@ -132,8 +138,13 @@ async def one_session(data_dir: Path, latencies: dict[str, list[float]]) -> floa
             to_deadline(app, clock)  # the gap between questions (or the closing) is over
             if index + 1 < len(session.questionnaire.items):
                 nxt = session.questionnaire.items[index + 1]
-                await until(lambda: session.current_item == nxt and drawn(app, "QuestionScreen")
-                            and not app.screen.query(".-chosen"))
+                await until(
+                    lambda: (
+                        session.current_item == nxt
+                        and drawn(app, "QuestionScreen")
+                        and not app.screen.query(".-chosen")
+                    )
+                )
                 await painted(app)
                 latencies["next_question"].append((time.perf_counter() - start) * 1000)
         await until(lambda: drawn(app, "SummaryScreen"))
@@ -148,9 +159,13 @@ def summary(values: list[float]) -> dict[str, object]:
     """Median, 95th percentile and maximum, rounded, and whether the median meets the goal."""
     ordered = sorted(values)
     median = statistics.median(ordered)
-    return {"median": round(median, 2),
-            "p95": round(ordered[min(len(ordered) - 1, int(0.95 * len(ordered)))], 2),
-            "max": round(ordered[-1], 2), "n": len(ordered), "met": median < GOAL_MEDIAN_MS}
+    return {
+        "median": round(median, 2),
+        "p95": round(ordered[min(len(ordered) - 1, int(0.95 * len(ordered)))], 2),
+        "max": round(ordered[-1], 2),
+        "n": len(ordered),
+        "met": median < GOAL_MEDIAN_MS,
+    }
 
 
 def main(argv: list[str]) -> int:
@@ -164,17 +179,26 @@ def main(argv: list[str]) -> int:
         for round_ in range(args.rounds):
             times.append(asyncio.run(one_session(Path(tmp) / str(round_), latencies)))
     kinds = {name: summary(values) for name, values in latencies.items()}
-    print(json.dumps({
-        "terminal_size": list(KIOSK_SIZE),
-        "rounds": args.rounds,
-        "session_s": {"best": round(min(times), 3), "median": round(statistics.median(times), 3),
-                      "worst": round(max(times), 3), "goal": GOAL_SESSION_S,
-                      "met": statistics.median(times) < GOAL_SESSION_S},
-        "key_to_screen_ms": kinds,
-        "key_goal_median_ms": GOAL_MEDIAN_MS,
-        "key_goal_judged_on": list(SCREEN_CHANGES),
-        "key_goal_met": all(kinds[name]["met"] for name in SCREEN_CHANGES),
-    }, indent=2))
+    print(
+        json.dumps(
+            {
+                "terminal_size": list(KIOSK_SIZE),
+                "rounds": args.rounds,
+                "session_s": {
+                    "best": round(min(times), 3),
+                    "median": round(statistics.median(times), 3),
+                    "worst": round(max(times), 3),
+                    "goal": GOAL_SESSION_S,
+                    "met": statistics.median(times) < GOAL_SESSION_S,
+                },
+                "key_to_screen_ms": kinds,
+                "key_goal_median_ms": GOAL_MEDIAN_MS,
+                "key_goal_judged_on": list(SCREEN_CHANGES),
+                "key_goal_met": all(kinds[name]["met"] for name in SCREEN_CHANGES),
+            },
+            indent=2,
+        )
+    )
     return 0
 
 

@@ -23,7 +23,6 @@ import yaml.reader
 from yaml.composer import Composer
 
 
-
 @contextmanager
 def open_private(path: str | Path, binary: bool = False) -> Iterator[IO]:
     """Create or replace ``path`` for writing, readable by its owner only (mode 0600).
@@ -127,8 +126,13 @@ def read_text(path: str | Path, limit: int = MAX_BYTES) -> str:
     try:
         return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
-        raise BadFile(Problem(name, *_position(data, exc.start),
-                              f"not UTF-8 text (byte 0x{data[exc.start]:02x}); save the file as UTF-8")) from None
+        raise BadFile(
+            Problem(
+                name,
+                *_position(data, exc.start),
+                f"not UTF-8 text (byte 0x{data[exc.start]:02x}); save the file as UTF-8",
+            )
+        ) from None
 
 
 #: characters no text of the project may hold, even written as an escape ("\\ud800", "\\x00",
@@ -145,8 +149,13 @@ def bad_character(text: str) -> str | None:
     if found is None:
         return None
     code = ord(found.group())
-    kind = "a lone surrogate, not a character" if 0xD800 <= code <= 0xDFFF else \
-        "a non-character" if code >= 0xFFFE else "a control character"
+    kind = (
+        "a lone surrogate, not a character"
+        if 0xD800 <= code <= 0xDFFF
+        else "a non-character"
+        if code >= 0xFFFE
+        else "a control character"
+    )
     return f"holds U+{code:04X}, {kind}; remove it"
 
 
@@ -190,8 +199,11 @@ class _BoundedComposer(Composer):
                 raise self.fail(node.start_mark, f"the text {problem}")
             size, height = 1, 0
         else:
-            children = [self._sizes[id(child)] for pair in node.value
-                        for child in (pair if isinstance(node, yaml.MappingNode) else (pair,))]
+            children = [
+                self._sizes[id(child)]
+                for pair in node.value
+                for child in (pair if isinstance(node, yaml.MappingNode) else (pair,))
+            ]
             size = 1 + sum(s for s, _ in children)
             height = 1 + max((h for _, h in children), default=0)
             if isinstance(node, yaml.MappingNode):
@@ -206,8 +218,9 @@ class _BoundedComposer(Composer):
     def _check_number(self, node: yaml.ScalarNode) -> None:
         if node.tag == "tag:yaml.org,2002:int":  # decimal, 0x hex, 0o octal or 1:30 sexagesimal
             if len(node.value) > 2 * MAX_DIGITS or abs(self.construct_yaml_int(node)) >= 10**MAX_DIGITS:
-                raise self.fail(node.start_mark, f"the number {node.value[:20]}… is too large "
-                                                 f"(more than {MAX_DIGITS} digits)")
+                raise self.fail(
+                    node.start_mark, f"the number {node.value[:20]}… is too large (more than {MAX_DIGITS} digits)"
+                )
         elif node.tag == "tag:yaml.org,2002:float":
             value = self.construct_yaml_float(node)
             if not math.isfinite(value):
@@ -232,8 +245,9 @@ class _PlainComposer(_BoundedComposer, yaml.SafeLoader):
 
 #: on libyaml's parser when PyYAML has it: a few times faster (a file near the size cap in well
 #: under a second); the composing, where the limits are, stays in Python
-_FastComposer = type("_FastComposer", (_BoundedComposer, yaml.CSafeLoader), {}) \
-    if yaml.__with_libyaml__ else _PlainComposer
+_FastComposer = (
+    type("_FastComposer", (_BoundedComposer, yaml.CSafeLoader), {}) if yaml.__with_libyaml__ else _PlainComposer
+)
 
 
 def compose_yaml(text: str, name: str) -> yaml.Node | None:
@@ -242,8 +256,9 @@ def compose_yaml(text: str, name: str) -> yaml.Node | None:
     :data:`MAX_NODES` values, integers of more than :data:`MAX_DIGITS` digits, NaN or infinity, or
     a text holding a lone surrogate or control character (:func:`bad_character`), escaped or not."""
     if len(text) > MAX_YAML_BYTES:
-        raise BadFile(Problem(name, 1, 1, f"the file is larger than {MAX_YAML_BYTES // 1024} KB of YAML; "
-                                          "is it the right file?"))
+        raise BadFile(
+            Problem(name, 1, 1, f"the file is larger than {MAX_YAML_BYTES // 1024} KB of YAML; is it the right file?")
+        )
     try:
         return _compose(_FastComposer, text, name)
     except _SyntaxProblem:
@@ -258,8 +273,9 @@ def _compose(kind: type[_BoundedComposer], text: str, name: str) -> yaml.Node | 
     try:
         composer = kind(text, name)  # PyYAML's reader refuses control characters here
     except yaml.reader.ReaderError as exc:
-        raise _SyntaxProblem(Problem(name, *_position(text, exc.position),
-                                     f"character #x{exc.character:04x} is not allowed in YAML")) from None
+        raise _SyntaxProblem(
+            Problem(name, *_position(text, exc.position), f"character #x{exc.character:04x} is not allowed in YAML")
+        ) from None
     try:
         return composer.get_single_node()
     except yaml.MarkedYAMLError as exc:
@@ -267,8 +283,9 @@ def _compose(kind: type[_BoundedComposer], text: str, name: str) -> yaml.Node | 
         line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise _SyntaxProblem(Problem(name, line, column, f"YAML syntax: {exc.problem or exc.context}")) from None
     except yaml.reader.ReaderError as exc:  # met while reading on
-        raise _SyntaxProblem(Problem(name, *_position(text, exc.position),
-                                     f"character #x{exc.character:04x} is not allowed in YAML")) from None
+        raise _SyntaxProblem(
+            Problem(name, *_position(text, exc.position), f"character #x{exc.character:04x} is not allowed in YAML")
+        ) from None
     except yaml.YAMLError as exc:
         raise _SyntaxProblem(Problem(name, 1, 1, f"YAML syntax: {str(exc).splitlines()[0]}")) from None
     finally:

@@ -85,8 +85,7 @@ def parse_file(path: str | Path, name: str | None = None) -> tuple[Any, Position
     return parse(text, name)
 
 
-def schema_problems(data: Any, schema: dict[str, Any], positions: Positions,
-                    add: Callable[..., None]) -> None:
+def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add: Callable[..., None]) -> None:
     """Check ``data`` against a JSON Schema, reporting each error through ``add(path, message, key=)``.
 
     Messages are rewritten for people: unknown keys and missing keys by name, multiples of 5 as such.

@@ -56,11 +56,11 @@ from urllib.parse import urlsplit
 
 import platformdirs
 
-from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
-from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
-from fileio.positions import Problem, parse_file
-from qos import bundled_models
 from fileio.bounded import BadFile, open_private, read_text
+from fileio.positions import Problem, parse_file
+from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
+from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
+from qos import bundled_models
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
@@ -206,8 +206,10 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     station = values.get("station") or {}
     # one kiosk id for exports and the station: kiosk_id, or station.kiosk_id, never two different ones
     if station.get("kiosk_id") and values.get("kiosk_id", station["kiosk_id"]) != station["kiosk_id"]:
-        raise ConfigError(f"{path}: kiosk_id {values['kiosk_id']!r} and station.kiosk_id {station['kiosk_id']!r} "
-                          "differ: one kiosk has one id (set kiosk_id only)")
+        raise ConfigError(
+            f"{path}: kiosk_id {values['kiosk_id']!r} and station.kiosk_id {station['kiosk_id']!r} "
+            "differ: one kiosk has one id (set kiosk_id only)"
+        )
     values["kiosk_id"] = values.get("kiosk_id") or station.get("kiosk_id") or default_kiosk_id()
     station = {**station, "kiosk_id": values["kiosk_id"]} if station else station
     for var, key in (("KIOSK_STATION_URL", "url"), ("KIOSK_STATION_TOKEN", "token")):
@@ -261,10 +263,18 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "clinician_pin":
             if isinstance(value, int) and not isinstance(value, bool):
                 raise fail((key,), 'write the PIN in quotes ("012345"), or leading zeros are lost')
-            if not isinstance(value, str) or not value.isascii() or not value.isdigit() or len(value) > 12 \
-                    or (len(value) < MIN_DIGITS and value != DEFAULT_PIN):
-                raise fail((key,), f"clinician_pin must be {MIN_DIGITS} to 12 digits, in quotes "
-                                   "(better: run `kiosk pin set`, which stores it hashed)")
+            if (
+                not isinstance(value, str)
+                or not value.isascii()
+                or not value.isdigit()
+                or len(value) > 12
+                or (len(value) < MIN_DIGITS and value != DEFAULT_PIN)
+            ):
+                raise fail(
+                    (key,),
+                    f"clinician_pin must be {MIN_DIGITS} to 12 digits, in quotes "
+                    "(better: run `kiosk pin set`, which stores it hashed)",
+                )
             if "clinician_pin_hash" in data:
                 raise fail((key,), "clinician_pin and clinician_pin_hash are both set: remove clinician_pin")
         elif key == "clinician_pin_hash":
@@ -273,8 +283,7 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), problem)
         elif key == "serve_token_sha256":
             if not isinstance(value, str) or not _SHA256.fullmatch(value):
-                raise fail((key,), "serve_token_sha256 is not a key written by `kiosk serve --new-token`; "
-                                   "run it again")
+                raise fail((key,), "serve_token_sha256 is not a key written by `kiosk serve --new-token`; run it again")
         elif key == "serve_max_sessions":
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 16:
                 raise fail((key,), "serve_max_sessions must be a whole number from 1 to 16")
@@ -289,12 +298,18 @@ def _read(path: Path) -> dict[str, Any]:
                 if setting not in FHIR_KEYS:
                     raise fail((key, setting), f"unknown fhir setting {setting!r} (known: {', '.join(FHIR_KEYS)})")
                 if not isinstance(uri, str) or not _URI.fullmatch(uri):
-                    raise fail((key, setting), f"fhir {setting} must be an absolute URI without spaces or '|', "
-                                               "in ASCII, such as https://example.org/sid/patient")
+                    raise fail(
+                        (key, setting),
+                        f"fhir {setting} must be an absolute URI without spaces or '|', "
+                        "in ASCII, such as https://example.org/sid/patient",
+                    )
             value = dict(value)
         elif key == "station":
-            if not isinstance(value, dict) or set(value) - {"url", "token", "kiosk_id"} \
-                    or not all(isinstance(v, str) for v in value.values()):
+            if (
+                not isinstance(value, dict)
+                or set(value) - {"url", "token", "kiosk_id"}
+                or not all(isinstance(v, str) for v in value.values())
+            ):
                 raise fail((key,), "station must be a mapping {url: ..., token: ..., kiosk_id: ...} of strings")
             try:
                 _station(value, "station")
@@ -311,8 +326,11 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "qos_model must name a bundled model (clarc, kiosk_pace) or a .roqme file")
             value = resolve_model(value, path.parent)
             if "/" not in value and value not in bundled_models():
-                raise fail((key,), f"no bundled model named {value!r} (bundled: {', '.join(bundled_models())}); "
-                                   "give a path to a .roqme file instead")
+                raise fail(
+                    (key,),
+                    f"no bundled model named {value!r} (bundled: {', '.join(bundled_models())}); "
+                    "give a path to a .roqme file instead",
+                )
         elif key == "next_patient_after_s":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
                 raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
@@ -328,14 +346,22 @@ def _path(value: object, name: str) -> Path:
     if not isinstance(value, str) or not value:
         raise ConfigError(f"{name} must be a path")
     if any(ord(c) < 32 or ord(c) == 127 for c in value) or any(0xD800 <= ord(c) <= 0xDFFF for c in value):
-        raise ConfigError(f"{name} {value!r} holds a control character or bytes that are not UTF-8; "
-                          "write the path on one line, in UTF-8")
+        raise ConfigError(
+            f"{name} {value!r} holds a control character or bytes that are not UTF-8; "
+            "write the path on one line, in UTF-8"
+        )
     try:
         return Path(value).expanduser()
     except RuntimeError:  # no such user, or no home directory to expand ~ to
         user = value[1:].split("/", 1)[0]
-        raise ConfigError(f"{name} {value!r}: " + (f"there is no user {user!r} to expand ~{user} for" if user
-                                                   else "there is no home directory to expand ~ to")) from None
+        raise ConfigError(
+            f"{name} {value!r}: "
+            + (
+                f"there is no user {user!r} to expand ~{user} for"
+                if user
+                else "there is no home directory to expand ~ to"
+            )
+        ) from None
 
 
 def _station(values: Mapping[str, str], where: str) -> Station | None:
@@ -344,28 +370,35 @@ def _station(values: Mapping[str, str], where: str) -> Station | None:
     if not url:
         return None
     if not _STATION_URL.fullmatch(url):
-        raise ConfigError(f"{where}: url {url!r} must be an http:// or https:// address of visible ASCII "
-                          "characters (no spaces, line breaks or query) such as https://ward.example:8443",
-                          ("url",))
+        raise ConfigError(
+            f"{where}: url {url!r} must be an http:// or https:// address of visible ASCII "
+            "characters (no spaces, line breaks or query) such as https://ward.example:8443",
+            ("url",),
+        )
     try:
         port = urlsplit(url).port
     except ValueError:  # not digits, or past 65535
         port = 0
     if port == 0 or not urlsplit(url).hostname:
-        raise ConfigError(f"{where}: url {url!r} needs a host and, if it names a port, one from 1 to 65535",
-                          ("url",))
+        raise ConfigError(f"{where}: url {url!r} needs a host and, if it names a port, one from 1 to 65535", ("url",))
     token = values.get("token")
     if not token:
-        raise ConfigError(f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
-                          "the station issues it with `kiosk station add-kiosk NAME`)", ("url",))
+        raise ConfigError(
+            f"{where}: a token is needed with the url (KIOSK_STATION_TOKEN, or station.token; "
+            "the station issues it with `kiosk station add-kiosk NAME`)",
+            ("url",),
+        )
     if not _TOKEN.fullmatch(token):
-        raise ConfigError(f"{where}: the token is not one the station issues (letters, digits and -._~+/ only; "
-                          "no spaces or line breaks): copy it again from `kiosk station add-kiosk NAME`",
-                          ("token",))
+        raise ConfigError(
+            f"{where}: the token is not one the station issues (letters, digits and -._~+/ only; "
+            "no spaces or line breaks): copy it again from `kiosk station add-kiosk NAME`",
+            ("token",),
+        )
     kiosk_id = values.get("kiosk_id") or default_kiosk_id()
     if not KIOSK_ID.fullmatch(kiosk_id):
-        raise ConfigError(f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'",
-                          ("kiosk_id",))
+        raise ConfigError(
+            f"{where}: kiosk_id {kiosk_id!r} must be 1-64 letters, digits, '.', '-' or '_'", ("kiosk_id",)
+        )
     return Station(url.rstrip("/"), values["token"], kiosk_id)
 
 
@@ -378,15 +411,19 @@ def configured_questionnaire(config: Config) -> Questionnaire:
     questionnaire = load_questionnaire(config.questionnaire)
     where = f"{config.source}: " if config.source else ""
     if config.language not in questionnaire.languages:
-        raise ConfigError(f"{where}language: {config.language!r} is not a language of {questionnaire.source} "
-                          f"(it has {', '.join(questionnaire.languages)}); set language: to one of them")
+        raise ConfigError(
+            f"{where}language: {config.language!r} is not a language of {questionnaire.source} "
+            f"(it has {', '.join(questionnaire.languages)}); set language: to one of them"
+        )
     if config.bands is None:
         return questionnaire
     try:
         return questionnaire.with_band_set(config.bands)
     except KeyError:
-        raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
-                          f"(it has {', '.join(questionnaire.band_sets)})") from None
+        raise ConfigError(
+            f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
+            f"(it has {', '.join(questionnaire.band_sets)})"
+        ) from None
 
 
 def write_settings(path: Path, changes: Mapping[str, str | None]) -> None:

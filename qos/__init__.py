@@ -24,14 +24,41 @@ from qos.errors import ContextError, ModelError, QosError, TraceError
 from qos.model import Context, EnumType, Model, Observation, Property, Timer, Variable
 from qos.parser import load_model_file, parse_model
 from qos.trace import (
-    ReplaySamples, Trace, TraceEvent, TraceRecorder, dump_trace, load_trace, replay, sample_trace,
+    ReplaySamples,
+    Trace,
+    TraceEvent,
+    TraceRecorder,
+    dump_trace,
+    load_trace,
+    replay,
+    sample_trace,
 )
 
 __all__ = [
-    "Context", "ContextError", "Engine", "EnumType", "Model", "ModelError", "Observation", "Property",
-    "QosError", "ReplaySamples", "Timer", "Trace", "TraceError", "TraceEvent", "TraceRecorder", "UpdateResult",
-    "Variable", "bundled_models",
-    "dump_trace", "load_model", "load_trace", "parse_model", "replay", "sample_trace",
+    "Context",
+    "ContextError",
+    "Engine",
+    "EnumType",
+    "Model",
+    "ModelError",
+    "Observation",
+    "Property",
+    "QosError",
+    "ReplaySamples",
+    "Timer",
+    "Trace",
+    "TraceError",
+    "TraceEvent",
+    "TraceRecorder",
+    "UpdateResult",
+    "Variable",
+    "bundled_models",
+    "dump_trace",
+    "load_model",
+    "load_trace",
+    "parse_model",
+    "replay",
+    "sample_trace",
 ]
 
 
@@ -50,8 +77,10 @@ def load_model(name_or_path: str | Path) -> Model:
     if isinstance(name_or_path, Path) or text.endswith(".roqme") or "/" in text or "\\" in text:
         return load_model_file(name_or_path)
     if text not in bundled_models():
-        raise ModelError(f"no bundled model named {text!r} (bundled: {', '.join(bundled_models())}); "
-                         "give a path to a .roqme file instead")
+        raise ModelError(
+            f"no bundled model named {text!r} (bundled: {', '.join(bundled_models())}); "
+            "give a path to a .roqme file instead"
+        )
     folder = resources.files("qos") / "models"
     # bundled models may import each other (the package is installed as files, not zipped)
     return parse_model((folder / f"{text}.roqme").read_text(encoding="utf-8"), f"{text}.roqme", Path(str(folder)))

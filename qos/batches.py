@@ -23,8 +23,9 @@ def check_time(t: object) -> float:
     return float(t)
 
 
-def check_batch(model: Model, set: Mapping[str, object] | None,
-                emit: Iterable[str] | None) -> tuple[dict[str, object], list[str]]:
+def check_batch(
+    model: Model, set: Mapping[str, object] | None, emit: Iterable[str] | None
+) -> tuple[dict[str, object], list[str]]:
     """Validate a batch against the model without applying it.
 
     Returns the values to set (booleans, floats, enum literal names) and the eventtypes to emit;
@@ -68,8 +69,9 @@ def check_value(context: Context | Variable, name: str, value_type: ValueType, v
         size = value_type.size
         if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence) or len(value) > size:
             raise ContextError(f"{what} {name} is an array of at most {size} values, got {_describe(value)}")
-        return tuple(check_value(context, f"{name}[{index + 1}]", value_type.element, item)
-                     for index, item in enumerate(value))
+        return tuple(
+            check_value(context, f"{name}[{index + 1}]", value_type.element, item) for index, item in enumerate(value)
+        )
     if value_type == BOOLEAN:
         if not isinstance(value, bool):
             raise ContextError(f"{what} {name} is boolean, got {_describe(value)}")
@@ -89,6 +91,7 @@ def check_value(context: Context | Variable, name: str, value_type: ValueType, v
     if not isinstance(literal, str):
         raise ContextError(f"{what} {name} is an enum of {', '.join(value_type.literals)}; got {_describe(value)}")
     if literal not in value_type.literals:
-        raise ContextError(f"{what} {name} has no literal {literal!r} (expected one of "
-                           f"{', '.join(value_type.literals)})")
+        raise ContextError(
+            f"{what} {name} has no literal {literal!r} (expected one of {', '.join(value_type.literals)})"
+        )
     return literal

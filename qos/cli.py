@@ -11,9 +11,9 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from fileio.bounded import open_private, write_error
 from qos import load_model
 from qos.errors import QosError
-from fileio.bounded import open_private, write_error
 from qos.model import Model, type_name
 from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
 
@@ -32,37 +32,53 @@ def build_parser(prog: str, epilog: str | None = None) -> argparse.ArgumentParse
     """The argument parser of the replay tool (``prog`` names it in usage lines)."""
     parser = argparse.ArgumentParser(prog=prog, description="QoS engine tools.", epilog=epilog)
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    replay = commands.add_parser("replay", help="replay a context trace and print the metrics",
-                                 description="Replay a context trace (YAML or JSON) through its model and "
-                                             "print min/max/avg/sd/last of every property and the "
-                                             "observations fired over time.")
+    replay = commands.add_parser(
+        "replay",
+        help="replay a context trace and print the metrics",
+        description="Replay a context trace (YAML or JSON) through its model and "
+        "print min/max/avg/sd/last of every property and the "
+        "observations fired over time.",
+    )
     replay.add_argument("trace", type=Path, metavar="TRACE", help="the trace file (.yaml, .yml or .json)")
     replay.add_argument("--json", action="store_true", help="print one JSON object (trace-format.md)")
-    replay.add_argument("--sample-period", type=_positive_seconds, default=1.0, metavar="S",
-                        help="seconds between metric samples (default 1)")
+    replay.add_argument(
+        "--sample-period",
+        type=_positive_seconds,
+        default=1.0,
+        metavar="S",
+        help="seconds between metric samples (default 1)",
+    )
     replay.add_argument("--plot", type=Path, metavar="FILE.png", help="also draw the metrics over time")
-    check = commands.add_parser("check", help="check a RoQME model and say what it holds",
-                                description="Parse and check a model (a bundled name or a .roqme file): one "
-                                            "file:line:col line and exit 2 when it is malformed, otherwise what a "
-                                            "trace must provide and what the model computes and observes.")
+    check = commands.add_parser(
+        "check",
+        help="check a RoQME model and say what it holds",
+        description="Parse and check a model (a bundled name or a .roqme file): one "
+        "file:line:col line and exit 2 when it is malformed, otherwise what a "
+        "trace must provide and what the model computes and observes.",
+    )
     check.add_argument("model", metavar="MODEL", help="a bundled model name (clarc) or a .roqme file")
     return parser
 
 
 def describe_model(model: Model) -> str:
     """What a QoS engineer needs to know of a checked model, one section a kind."""
+
     def names(items) -> str:
         return ", ".join(items) or "none"
 
     primitive = [f"{c.name} ({type_name(c.type)})" for c in model.contexts.values() if not c.derived]
-    lines = [f"model {model.name}: OK", *(model.description or "").splitlines()[:1], "",
-             f"contexts a trace sets or emits: {names(primitive)}",
-             f"derived contexts: {names(c.name for c in model.contexts.values() if c.derived)}",
-             f"properties (published): {names(model.properties)}",
-             f"belief variables: {names(model.beliefvars)}",
-             f"variables and parameters: {names(model.variables)}",
-             f"timers: {names(model.timers)}",
-             f"observations: {names(model.observations)}"]
+    lines = [
+        f"model {model.name}: OK",
+        *(model.description or "").splitlines()[:1],
+        "",
+        f"contexts a trace sets or emits: {names(primitive)}",
+        f"derived contexts: {names(c.name for c in model.contexts.values() if c.derived)}",
+        f"properties (published): {names(model.properties)}",
+        f"belief variables: {names(model.beliefvars)}",
+        f"variables and parameters: {names(model.variables)}",
+        f"timers: {names(model.timers)}",
+        f"observations: {names(model.observations)}",
+    ]
     if model.imports:
         lines.append(f"imports: {names(Path(path).name for path in model.imports)}")
     return "\n".join(lines)
@@ -78,7 +94,9 @@ def format_table(result: dict) -> str:
         if table and heading:
             lines.append(heading)
         for name, stats in table.items():
-            lines.append(f"{name:<{width}}  " + "  ".join(f"{stats[key]:6.4f}" for key in ("min", "max", "avg", "sd", "last")))
+            lines.append(
+                f"{name:<{width}}  " + "  ".join(f"{stats[key]:6.4f}" for key in ("min", "max", "avg", "sd", "last"))
+            )
     lines += ["", "fired observations:" if result["fired"] else "no observation fired"]
     for entry in result["fired"]:
         lines.append(f"  t={entry['t']:>8g} s  {' '.join(entry['observations'])}")

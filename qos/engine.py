@@ -75,14 +75,16 @@ class Engine:
     1970 UTC, for ``schedule`` timers; ``params`` overrides parameters' defaults.
     """
 
-    def __init__(self, model: Model, start: float | None = 0.0, origin: float = 0.0,
-                 params: Mapping[str, object] | None = None):
+    def __init__(
+        self, model: Model, start: float | None = 0.0, origin: float = 0.0, params: Mapping[str, object] | None = None
+    ):
         self.model = model
         beliefs = {**model.properties, **model.beliefvars}
         self._beliefs = {name: PropertyBelief(prop) for name, prop in beliefs.items()}
         self._matcher = ObservationMatcher(model.observations)
-        self._values: dict[str, object] = {name: variable.initial for name, variable in model.variables.items()
-                                           if variable.initial is not None}
+        self._values: dict[str, object] = {
+            name: variable.initial for name, variable in model.variables.items() if variable.initial is not None
+        }
         for name, value in (params or {}).items():
             variable = model.variables.get(name)
             if variable is None or not variable.parameter:
@@ -94,10 +96,17 @@ class Engine:
         self._started = False
         #: beliefs that expressions read: their value is refreshed before each batch
         self._beliefs_read = sorted(set(names_in((model.streams, model.observations))) & set(beliefs))
-        self._setters = {id(action): compile_expr(action.expr) for observation in model.observations.values()
-                         for action in observation.actions if isinstance(action, SetVariable)}
-        self._outputs = {name: compile_expr(prop.transformation) for name, prop in model.properties.items()
-                         if prop.transformation is not None}
+        self._setters = {
+            id(action): compile_expr(action.expr)
+            for observation in model.observations.values()
+            for action in observation.actions
+            if isinstance(action, SetVariable)
+        }
+        self._outputs = {
+            name: compile_expr(prop.transformation)
+            for name, prop in model.properties.items()
+            if prop.transformation is not None
+        }
         self._t: float | None = None
         self._subscribers: list[Subscriber] = []
 
@@ -127,8 +136,9 @@ class Engine:
         dues += [due for stream in self._streams if (due := stream.due()) is not None]
         return min(dues, default=None)
 
-    def update(self, t: float, set: Mapping[str, object] | None = None,
-               emit: Iterable[str] | None = None) -> UpdateResult:
+    def update(
+        self, t: float, set: Mapping[str, object] | None = None, emit: Iterable[str] | None = None
+    ) -> UpdateResult:
         """Apply one batch at time t and return the metrics and fired observations.
 
         Timers and time windows due before t run first, each as its own batch. The whole batch is
@@ -169,8 +179,10 @@ class Engine:
             self._started = True
         firings = sum(clock.firings_until(t) for clock in self._timers.values())
         if firings > MAX_TIMED_BATCHES:
-            raise ContextError(f"time {t:g} s is too far ahead: the timers would fire about {firings:,.0f} times "
-                               f"before it (at most {MAX_TIMED_BATCHES:,}); advance the engine in smaller steps")
+            raise ContextError(
+                f"time {t:g} s is too far ahead: the timers would fire about {firings:,.0f} times "
+                f"before it (at most {MAX_TIMED_BATCHES:,}); advance the engine in smaller steps"
+            )
 
     def _timers_due(self, t: float) -> list[str]:
         fired = [name for name, clock in self._timers.items() if clock.due is not None and clock.due <= t]
@@ -196,8 +208,9 @@ class Engine:
         self._act(t, fired)
         metrics = self._metrics_at(t)
         outputs = {name: self._output(name, metrics[name]) for name in self._outputs}
-        result = UpdateResult(t, metrics, sorted(fired, key=observation_sort_key), values, emitted, timers,
-                              outputs, self.beliefs(t))
+        result = UpdateResult(
+            t, metrics, sorted(fired, key=observation_sort_key), values, emitted, timers, outputs, self.beliefs(t)
+        )
         for callback in list(self._subscribers):
             callback(result)
         return result
@@ -249,4 +262,5 @@ class Engine:
         def unsubscribe() -> None:
             if callback in self._subscribers:
                 self._subscribers.remove(callback)
+
         return unsubscribe

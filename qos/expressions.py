@@ -24,8 +24,16 @@ def _divide(left: float, right: float) -> float | None:
 
 
 _BINARY: dict[str, Callable[[object, object], object]] = {
-    "=": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le, ">": operator.gt,
-    ">=": operator.ge, "+": operator.add, "-": operator.sub, "*": operator.mul, "/": _divide,
+    "=": operator.eq,
+    "!=": operator.ne,
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "+": operator.add,
+    "-": operator.sub,
+    "*": operator.mul,
+    "/": _divide,
 }
 
 
@@ -34,9 +42,15 @@ def _at(array: tuple, index: float) -> object:
 
 
 _FUNCTIONS: dict[str, Callable[..., object]] = {
-    "pow": lambda x, y: x ** y, "sqrt": lambda x: math.sqrt(x) if x >= 0 else None, "exp": math.exp,
-    "abs": abs, "size": lambda a: float(len(a)), "isEmpty": lambda a: len(a) == 0,
-    "first": lambda a: a[0] if a else None, "last": lambda a: a[-1] if a else None, "at": _at,
+    "pow": lambda x, y: x**y,
+    "sqrt": lambda x: math.sqrt(x) if x >= 0 else None,
+    "exp": math.exp,
+    "abs": abs,
+    "size": lambda a: float(len(a)),
+    "isEmpty": lambda a: len(a) == 0,
+    "first": lambda a: a[0] if a else None,
+    "last": lambda a: a[-1] if a else None,
+    "at": _at,
     "includes": lambda a, v: v in a,
 }
 
@@ -67,6 +81,7 @@ def compile_expr(expr: Expr) -> Evaluator:
         def choose(values):
             decided = condition(values)
             return None if decided is None else (then(values) if decided else otherwise(values))
+
         return choose
     if isinstance(expr, Call):
         function, args = _FUNCTIONS[expr.function], [compile_expr(arg) for arg in expr.args]
@@ -79,6 +94,7 @@ def compile_expr(expr: Expr) -> Evaluator:
                 return _real(function(*given))
             except (OverflowError, ZeroDivisionError, ValueError):
                 return None
+
         return call
     assert isinstance(expr, Binary)
     left, right = compile_expr(expr.left), compile_expr(expr.right)
@@ -90,6 +106,7 @@ def compile_expr(expr: Expr) -> Evaluator:
             if a is want or b is want:
                 return want
             return None if a is None or b is None else not want
+
         return logic
     function = _BINARY[expr.op]
 
@@ -98,6 +115,7 @@ def compile_expr(expr: Expr) -> Evaluator:
         if a is None or b is None:
             return None
         return _real(function(a, b))
+
     return binary
 
 
@@ -109,7 +127,7 @@ def names_in(node: object) -> Iterator[str]:
         for item in dataclasses.fields(node):
             yield from names_in(getattr(node, item.name))
     elif isinstance(node, (tuple, list, dict)):
-        for item in (node.values() if isinstance(node, dict) else node):
+        for item in node.values() if isinstance(node, dict) else node:
             yield from names_in(item)
 
 

@@ -180,13 +180,32 @@ _DESCRIPTIONS: ContextVar[list[Token]] = ContextVar("descriptions")
 
 # The basic lexer keeps keywords reserved everywhere, so a misplaced 'reinforces' is reported as such
 # instead of being read as a context name.
-PARSER = Lark(GRAMMAR, parser="lalr", lexer="basic", propagate_positions=True,
-              lexer_callbacks={"DESCRIPTION": lambda token: _DESCRIPTIONS.get().append(token)})
+PARSER = Lark(
+    GRAMMAR,
+    parser="lalr",
+    lexer="basic",
+    propagate_positions=True,
+    lexer_callbacks={"DESCRIPTION": lambda token: _DESCRIPTIONS.get().append(token)},
+)
 
 #: seconds per time unit (RoQME's words and the short forms older models use)
-TIME_UNITS = {"ms": 0.001, "millisecond": 0.001, "milliseconds": 0.001, "s": 1.0, "sec": 1.0,
-              "second": 1.0, "seconds": 1.0, "min": 60.0, "minute": 60.0, "minutes": 60.0, "h": 3600.0,
-              "hour": 3600.0, "hours": 3600.0, "day": 86400.0, "days": 86400.0}
+TIME_UNITS = {
+    "ms": 0.001,
+    "millisecond": 0.001,
+    "milliseconds": 0.001,
+    "s": 1.0,
+    "sec": 1.0,
+    "second": 1.0,
+    "seconds": 1.0,
+    "min": 60.0,
+    "minute": 60.0,
+    "minutes": 60.0,
+    "h": 3600.0,
+    "hour": 3600.0,
+    "hours": 3600.0,
+    "day": 86400.0,
+    "days": 86400.0,
+}
 
 #: words of other event languages that RoQME does not have, with what to write instead
 UNSUPPORTED_WORDS = {
@@ -197,20 +216,53 @@ UNSUPPORTED_WORDS = {
 
 #: how an expected terminal is described in a message
 _TERMINAL_TEXT = {
-    "NAME": "a name", "NUMBER": "a number", "TIME": "a time such as 100min, 30 seconds or 2 hours",
-    "COLON": "':'", "LBRACE": "'{'", "RBRACE": "'}'", "COMMA": "','", "LPAR": "'('", "RPAR": "')'",
-    "REINFORCES": "'reinforces'", "UNDERMINES": "'undermines'", "COMPARE": "a comparison", "ADD": "'+' or '-'",
-    "MUL": "'*' or '/'", "BAR": "'|'", "AMP": "'&'", "ENUM": "'enum'", "MODEL": "'roqme'", "STRING": "a string",
-    "DEFINE": "':='", "ARROW": "'->'", "LSQB": "'['", "RSQB": "']'", "SEMICOLON": "';'",
+    "NAME": "a name",
+    "NUMBER": "a number",
+    "TIME": "a time such as 100min, 30 seconds or 2 hours",
+    "COLON": "':'",
+    "LBRACE": "'{'",
+    "RBRACE": "'}'",
+    "COMMA": "','",
+    "LPAR": "'('",
+    "RPAR": "')'",
+    "REINFORCES": "'reinforces'",
+    "UNDERMINES": "'undermines'",
+    "COMPARE": "a comparison",
+    "ADD": "'+' or '-'",
+    "MUL": "'*' or '/'",
+    "BAR": "'|'",
+    "AMP": "'&'",
+    "ENUM": "'enum'",
+    "MODEL": "'roqme'",
+    "STRING": "a string",
+    "DEFINE": "':='",
+    "ARROW": "'->'",
+    "LSQB": "'['",
+    "RSQB": "']'",
+    "SEMICOLON": "';'",
 }
 #: what a NAME means right after a keyword
 _NAME_AFTER = {
-    "roqme": "a model name", "property": "a property name", "context": "a context name",
-    "type": "a type name", "observation": "an observation name", "reinforces": "a property name",
-    "undermines": "a property name", "::": "an enum literal", "{": "an enum literal", "var": "a variable name",
-    "param": "a parameter name", "timer": "a timer name", "beliefvar": "a belief variable name",
-    "sets": "a variable name", "clears": "a property name", "starts": "a timer name", "stops": "a timer name",
-    "resumes": "a timer name", "'": "a function name", "import": "a model file name",
+    "roqme": "a model name",
+    "property": "a property name",
+    "context": "a context name",
+    "type": "a type name",
+    "observation": "an observation name",
+    "reinforces": "a property name",
+    "undermines": "a property name",
+    "::": "an enum literal",
+    "{": "an enum literal",
+    "var": "a variable name",
+    "param": "a parameter name",
+    "timer": "a timer name",
+    "beliefvar": "a belief variable name",
+    "sets": "a variable name",
+    "clears": "a property name",
+    "starts": "a timer name",
+    "stops": "a timer name",
+    "resumes": "a timer name",
+    "'": "a function name",
+    "import": "a model file name",
 }
 _DECLARATION_START = {"TYPE", "PROPERTY", "CONTEXT", "OBSERVATION", "VAR", "PARAM", "TIMER", "BELIEFVAR"}
 _ACTION_START = {"REINFORCES", "UNDERMINES", "SETS", "CLEARS", "STARTS", "STOPS", "RESUMES"}

@@ -138,6 +138,7 @@ class Property:
 
 # ---- expressions (values) and patterns (occurrences), as parsed and type-checked ----------------
 
+
 @dataclass(frozen=True)
 class Var:
     """A context's current value in an expression."""
@@ -311,6 +312,7 @@ Pattern = Union[Updated, Changed, AnyOf, AllOf, AndNot, FollowedBy, Once, While,
 
 
 # ---- actions, variables, timers ------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class Evidence:

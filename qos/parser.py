@@ -13,12 +13,29 @@ from pathlib import Path
 
 from lark import Token, Tree
 
-from qos.errors import ModelError
 from fileio.bounded import BadFile, read_text
+from qos.errors import ModelError
 from qos.grammar import SyntaxProblem, parse_text
 from qos.model import (
-    BOOLEAN, EVENTTYPE, INTENSITY_LR, NUMBER, ArrayType, ClearEvidence, Context, EnumType, Evidence, Literal, Model,
-    Observation, Property, SetVariable, Timer, TimerAction, TypeSpec, Variable, type_name,
+    BOOLEAN,
+    EVENTTYPE,
+    INTENSITY_LR,
+    NUMBER,
+    ArrayType,
+    ClearEvidence,
+    Context,
+    EnumType,
+    Evidence,
+    Literal,
+    Model,
+    Observation,
+    Property,
+    SetVariable,
+    Timer,
+    TimerAction,
+    TypeSpec,
+    Variable,
+    type_name,
 )
 from qos.terms import TermChecker, is_pattern, seconds_of
 from qos.timers import ScheduleError, parse_schedule
@@ -79,8 +96,11 @@ def _check_nesting(source: _Source, tree: Tree) -> None:
     while stack:
         node, depth, declaration = stack.pop()
         if depth > MAX_NESTING:
-            raise source.at(declaration, f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
-                                         "deep: split it with derived contexts")
+            raise source.at(
+                declaration,
+                f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
+                "deep: split it with derived contexts",
+            )
         stack.extend((child, depth + 1, declaration) for child in node.children if isinstance(child, Tree))
 
 
@@ -127,9 +147,20 @@ class _Checker(TermChecker):
             header = tree.children[0] if tree.children and tree.children[0].data == "header" else None
             where = (header.children[1].line, header.children[1].column) if header else (1, 1)
             raise source.error(*where, f"model {name} declares no property")
-        return Model(name, source.filename, self.properties, self.types, self.contexts, self.observations,
-                     self.beliefvars, self.variables, self.timers, tuple(self.streams), tuple(self.imported),
-                     description)
+        return Model(
+            name,
+            source.filename,
+            self.properties,
+            self.types,
+            self.contexts,
+            self.observations,
+            self.beliefvars,
+            self.variables,
+            self.timers,
+            tuple(self.streams),
+            tuple(self.imported),
+            description,
+        )
 
     def _declarations(self, tree: Tree, descriptions: list[Token]) -> tuple[str | None, str | None]:
         name = model_description = None
@@ -190,8 +221,9 @@ class _Checker(TermChecker):
         """The type of a declaration: a referenced type name or a data type written in place."""
         if isinstance(node, Token):
             if str(node) not in self.types:
-                raise self.error(node, f"unknown type {node} (declare it with 'type {node} : enum {{…}}' before "
-                                       f"this {what})")
+                raise self.error(
+                    node, f"unknown type {node} (declare it with 'type {node} : enum {{…}}' before this {what})"
+                )
             return self.types[str(node)]
         keyword, cardinality, *rest = node.children
         kind = node.data
@@ -239,12 +271,15 @@ class _Checker(TermChecker):
         value = self.expr(node, role)
         if not isinstance(value, Literal):
             raise self.error(node, f"{role} must be a constant")
-        if value.type != spec.type and not (isinstance(spec.type, ArrayType) and isinstance(value.type, ArrayType)
-                                             and value.type.element == spec.type.element):
+        if value.type != spec.type and not (
+            isinstance(spec.type, ArrayType)
+            and isinstance(value.type, ArrayType)
+            and value.type.element == spec.type.element
+        ):
             raise self.error(node, f"{role} is {type_name(value.type)}, but {owner} is {type_name(spec.type)}")
         if isinstance(spec.type, ArrayType) and len(value.value) > spec.type.size:
             raise self.error(node, f"{role} has {len(value.value)} values; {owner} holds at most {spec.type.size}")
-        for number in (value.value if isinstance(value.value, tuple) else (value.value,)):
+        for number in value.value if isinstance(value.value, tuple) else (value.value,):
             problem = spec.out_of_bounds(number) if isinstance(number, float) else None
             if problem:
                 raise self.error(node, f"{role}: {problem} of {owner}")
@@ -265,13 +300,17 @@ class _Checker(TermChecker):
                 value = self.pattern(definition)
             else:
                 if is_pattern(definition):
-                    raise self.error(definition, f"a pattern defines an eventtype context; {name} is "
-                                                 f"{type_name(spec.type)}: declare it eventtype, or define it by a "
-                                                 "value")
+                    raise self.error(
+                        definition,
+                        f"a pattern defines an eventtype context; {name} is "
+                        f"{type_name(spec.type)}: declare it eventtype, or define it by a "
+                        "value",
+                    )
                 value = self.expr(definition, f"the definition of {name}")
                 if value.type != spec.type:
-                    raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
-                                                 f"{type_name(spec.type)}")
+                    raise self.error(
+                        definition, f"the definition of {name} is {type_name(value.type)}, not {type_name(spec.type)}"
+                    )
         finally:
             self.defining = None
         context = Context(str(name), spec.type, spec, value, self.description)
@@ -286,11 +325,19 @@ class _Checker(TermChecker):
         try:
             value = self.expr(definition, f"the definition of {name}")
             if value.type != spec.type:
-                raise self.error(definition, f"the definition of {name} is {type_name(value.type)}, not "
-                                             f"{type_name(spec.type)}")
+                raise self.error(
+                    definition, f"the definition of {name} is {type_name(value.type)}, not {type_name(spec.type)}"
+                )
             if isinstance(value, Literal):
-                variable = Variable(str(name), spec.type, spec, self._value_of(definition, spec, str(name), "the value"),
-                                    None, False, self.description)
+                variable = Variable(
+                    str(name),
+                    spec.type,
+                    spec,
+                    self._value_of(definition, spec, str(name), "the value"),
+                    None,
+                    False,
+                    self.description,
+                )
             else:
                 variable = Variable(str(name), spec.type, spec, None, value, False, self.description)
                 self.streams.append((str(name), variable))
@@ -331,8 +378,9 @@ class _Checker(TermChecker):
             else:
                 interval, schedule = self._timer_definition(name, part.children[1])
         if "definition" not in seen:
-            raise self.error(name, f"timer {name} needs a definition: timer {name} := 1 minutes, or := "
-                                   "schedule(\"0, 9, *, *, *\")")
+            raise self.error(
+                name, f'timer {name} needs a definition: timer {name} := 1 minutes, or := schedule("0, 9, *, *, *")'
+            )
         self.timers[str(name)] = Timer(str(name), interval, schedule, offset, onetime, paused, self.description)
 
     def _timer_definition(self, name: Token, node):
@@ -344,13 +392,12 @@ class _Checker(TermChecker):
         if isinstance(node, Tree) and node.data == "call" and str(node.children[0]) == "schedule":
             args = [child for child in node.children[1:] if child is not None]
             if len(args) != 1 or not (isinstance(args[0], Tree) and args[0].data == "string"):
-                raise self.error(node, "schedule takes one string: schedule(\"minutes, hours, days, months, "
-                                       "weekdays\")")
+                raise self.error(node, 'schedule takes one string: schedule("minutes, hours, days, months, weekdays")')
             try:
                 return None, parse_schedule(str(args[0].children[0])[1:-1])
             except ScheduleError as exc:
                 raise self.error(args[0], f"bad schedule: {exc}") from None
-        raise self.error(node, f"timer {name} is defined by a time (1 minutes) or schedule(\"…\")")
+        raise self.error(node, f'timer {name} is defined by a time (1 minutes) or schedule("…")')
 
     # ---- properties and belief variables ---------------------------------------------------------
 
@@ -366,8 +413,9 @@ class _Checker(TermChecker):
             finally:
                 self.self_belief_allowed, self.defining = False, None
             if output.type != spec.type:
-                raise self.error(transformation, f"the output of {name} is {type_name(output.type)}, not "
-                                                 f"{type_name(spec.type)}")
+                raise self.error(
+                    transformation, f"the output of {name} is {type_name(output.type)}, not {type_name(spec.type)}"
+                )
         self.properties[str(name)] = self._belief(name, "property", options, output)
         self.beliefs[str(name)] = self.properties[str(name)]
 
@@ -386,8 +434,9 @@ class _Checker(TermChecker):
             if option.data == "reference":
                 reference = float(option.children[1])
                 if not 0.0 <= reference <= 1.0:
-                    raise self.error(option.children[1], f"reference {option.children[1]} of {what} {name} "
-                                                         "is outside [0, 1]")
+                    raise self.error(
+                        option.children[1], f"reference {option.children[1]} of {what} {name} is outside [0, 1]"
+                    )
             else:
                 survival = seconds_of(option.children[1])
                 if survival <= 0:
@@ -401,16 +450,17 @@ class _Checker(TermChecker):
         self._declare(name, "observation")
         description = self.description
         pattern = self.pattern(pattern_tree)
-        actions = tuple(getattr(self, f"_{action.data}")(name, action)
-                        for action in action_trees if action is not None)
+        actions = tuple(getattr(self, f"_{action.data}")(name, action) for action in action_trees if action is not None)
         self.observations[str(name)] = Observation(str(name), pattern, actions, name.line, description)
 
     def _belief_target(self, name: Token, verb: Token, target: Token) -> str:
         if str(target) not in self.beliefs:
             what = self.declared.get(str(target))
             if what:
-                raise self.error(target, f"observation {name} {verb} {target}, a {what}: only a property or a "
-                                         "beliefvar holds evidence")
+                raise self.error(
+                    target,
+                    f"observation {name} {verb} {target}, a {what}: only a property or a beliefvar holds evidence",
+                )
             raise self.error(target, f"observation {name} {verb} unknown property {target}")
         return str(target)
 
@@ -423,11 +473,13 @@ class _Checker(TermChecker):
                 word = option.children[0]
                 if str(word).lower().replace("_", "") not in INTENSITY_LR or str(word) == "default":
                     # a misspelt keyword on the next line lands here too, so say what it came after
-                    raise self.error(word, f"expected a strength ({_STRENGTHS}) after {str(previous)!r}, found "
-                                           f"{str(word)!r}")
+                    raise self.error(
+                        word, f"expected a strength ({_STRENGTHS}) after {str(previous)!r}, found {str(word)!r}"
+                    )
             if option.data in seen:
-                raise self.error(option, f"observation {name} gives {option.data.replace('evidence_', '')} twice "
-                                         f"for {target}")
+                raise self.error(
+                    option, f"observation {name} gives {option.data.replace('evidence_', '')} twice for {target}"
+                )
             seen.add(option.data)
             previous = option.children[-1]
             if option.data == "strength":

@@ -73,7 +73,18 @@ from dataclasses import dataclass
 
 from qos.expressions import Evaluator, compile_expr, variables_of
 from qos.model import (
-    AllOf, AndNot, AnyOf, Changed, FollowedBy, Observation, Once, Pattern, Range, Repeat, Updated, While,
+    AllOf,
+    AndNot,
+    AnyOf,
+    Changed,
+    FollowedBy,
+    Observation,
+    Once,
+    Pattern,
+    Range,
+    Repeat,
+    Updated,
+    While,
 )
 
 

@@ -76,6 +76,7 @@ class _Evidence:
         for fired_at, u in self._recent:
             total += 2.0 * math.atanh(u * math.exp(-self._rate * (t - fired_at)))
         return total + self._series_value(t)
+
     def _rebase(self, t: float) -> None:
         """Move the series' reference time to t, decaying its coefficients."""
         if t == self._series_t:

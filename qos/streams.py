@@ -41,7 +41,6 @@ from qos.expressions import compile_expr, variables_of
 from qos.model import EVENTTYPE, Aggregate, Context, Model, Period, Stream, Variable
 from qos.patterns import Batch, PatternRunner
 
-
 TRENDS = ("increasing", "decreasing", "stable")
 
 

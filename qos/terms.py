@@ -13,21 +13,77 @@ from lark import Token, Tree
 from qos.expressions import variables_of
 from qos.grammar import TIME_UNITS
 from qos.model import (
-    BOOLEAN, EVENTTYPE, NUMBER, Aggregate, AllOf, AndNot, AnyOf, ArrayType, Binary, Call, Changed, Conditional,
-    Context, EnumType, Expr, FollowedBy, Literal, Once, Pattern, Period, Range, Repeat, Stream, Unary, Updated,
-    ValueType, Var, While, type_name,
+    BOOLEAN,
+    EVENTTYPE,
+    NUMBER,
+    Aggregate,
+    AllOf,
+    AndNot,
+    AnyOf,
+    ArrayType,
+    Binary,
+    Call,
+    Changed,
+    Conditional,
+    Context,
+    EnumType,
+    Expr,
+    FollowedBy,
+    Literal,
+    Once,
+    Pattern,
+    Period,
+    Range,
+    Repeat,
+    Stream,
+    Unary,
+    Updated,
+    ValueType,
+    Var,
+    While,
+    type_name,
 )
 
 AGGREGATES = ("avg", "min", "max", "count", "sum", "increasing", "decreasing", "stable")
 ARITHMETIC = ("pow", "sqrt", "exp", "abs")
 COLLECTION = ("first", "last", "at", "size", "isEmpty", "includes")
 #: how many arguments each function of values takes (the array itself counts)
-_ARITY = {"pow": 2, "sqrt": 1, "exp": 1, "abs": 1, "first": 1, "last": 1, "size": 1, "isEmpty": 1, "at": 2,
-          "includes": 2}
-_PATTERN_NODES = {"followed_by", "p_or", "p_and", "once", "while_", "repeat", "range", "update", "event_when",
-                  "not_event"}
-_OPERATOR = {"followed_by": "->", "p_or": "or", "p_and": "and", "once": "once", "while_": "while",
-             "repeat": "repeat", "range": "range", "update": "update", "event_when": "eventWhen", "not_event": "not"}
+_ARITY = {
+    "pow": 2,
+    "sqrt": 1,
+    "exp": 1,
+    "abs": 1,
+    "first": 1,
+    "last": 1,
+    "size": 1,
+    "isEmpty": 1,
+    "at": 2,
+    "includes": 2,
+}
+_PATTERN_NODES = {
+    "followed_by",
+    "p_or",
+    "p_and",
+    "once",
+    "while_",
+    "repeat",
+    "range",
+    "update",
+    "event_when",
+    "not_event",
+}
+_OPERATOR = {
+    "followed_by": "->",
+    "p_or": "or",
+    "p_and": "and",
+    "once": "once",
+    "while_": "while",
+    "repeat": "repeat",
+    "range": "range",
+    "update": "update",
+    "event_when": "eventWhen",
+    "not_event": "not",
+}
 #: the name the engine gives the belief a property's output transformation reads
 SELF_BELIEF = "#belief"
 
@@ -36,7 +92,7 @@ def seconds_of(token: Token) -> float:
     """A TIME token (``100min``, ``5 minutes``) in seconds."""
     text = str(token)
     number = text.rstrip("abcdefghijklmnopqrstuvwxyz").rstrip()
-    return float(number) * TIME_UNITS[text[len(number):].strip()]
+    return float(number) * TIME_UNITS[text[len(number) :].strip()]
 
 
 def is_pattern(node) -> bool:
@@ -122,8 +178,9 @@ class TermChecker:
         if isinstance(argument, Tree) and argument.data == "var" and str(argument.children[0]) in self.contexts:
             context = self.contexts[str(argument.children[0])]
             if when_true and context.type != BOOLEAN:
-                raise self.error(argument, f"eventWhen needs a boolean, but {context.name} is "
-                                           f"{type_name(context.type)}")
+                raise self.error(
+                    argument, f"eventWhen needs a boolean, but {context.name} is {type_name(context.type)}"
+                )
             return Updated(context.name, when_true=when_true)
         expr = self.expr(argument, role=f"the argument of {keyword}")
         if when_true and expr.type != BOOLEAN:
@@ -133,8 +190,11 @@ class TermChecker:
     def _changed(self, node, expr: Expr, when_true: bool) -> Changed:
         """A change of a value, which only an update of a context (or of a stream) can bring."""
         if not any(name in self.contexts or name.startswith("#") for name in variables_of(expr)):
-            raise self.error(node, "this value reads no context, so it never changes by an update: use it as a "
-                                   "condition (X while(…)) or read a context")
+            raise self.error(
+                node,
+                "this value reads no context, so it never changes by an update: use it as a "
+                "condition (X while(…)) or read a context",
+            )
         return Changed(expr, when_true=when_true)
 
     def _count(self, token: Token, message: str) -> int:
@@ -154,8 +214,9 @@ class TermChecker:
             return self._enum_occurrence(node)
         expr = self.expr(node)
         if expr.type != BOOLEAN:
-            raise self.error(node, f"a {type_name(expr.type)} value cannot stand as a pattern: use update(…) or "
-                                   "compare it")
+            raise self.error(
+                node, f"a {type_name(expr.type)} value cannot stand as a pattern: use update(…) or compare it"
+            )
         return self._changed(node, expr, True)
 
     def _enum_occurrence(self, node: Tree) -> Pattern:
@@ -167,8 +228,11 @@ class TermChecker:
         else:
             users = [c for c in self.contexts.values() if c.type == literal.type]
             if len(users) != 1:
-                raise self.error(node, f"{qualifier}::{node.children[1]} as a pattern needs the context it is "
-                                       f"about: write CONTEXT::{node.children[1]}")
+                raise self.error(
+                    node,
+                    f"{qualifier}::{node.children[1]} as a pattern needs the context it is "
+                    f"about: write CONTEXT::{node.children[1]}",
+                )
             context = users[0]
         return While(Updated(context.name), Binary("=", Var(context.name, context.type), literal, BOOLEAN))
 
@@ -177,8 +241,11 @@ class TermChecker:
     def expr(self, node, role: str = "a value") -> Expr:
         """A checked value expression."""
         if is_pattern(node):
-            raise self.error(node, f"the pattern operator '{_OPERATOR[node.data]}' cannot be used in {role}; "
-                                   "only values and & | ! comparisons and arithmetic can")
+            raise self.error(
+                node,
+                f"the pattern operator '{_OPERATOR[node.data]}' cannot be used in {role}; "
+                "only values and & | ! comparisons and arithmetic can",
+            )
         kind = node.data
         children = node.children
         if kind == "var":
@@ -195,8 +262,11 @@ class TermChecker:
             raise self.error(node, "a string is only a value in import and schedule(…)")
         if kind == "belief":
             if not self.self_belief_allowed:
-                raise self.error(node, "'belief' is the property's own belief: use it in a property's output "
-                                       "transformation (property P : number := belief * 100)")
+                raise self.error(
+                    node,
+                    "'belief' is the property's own belief: use it in a property's output "
+                    "transformation (property P : number := belief * 100)",
+                )
             return Var(SELF_BELIEF, NUMBER)
         if kind == "enum_literal":
             return self._enum_literal(node)
@@ -258,8 +328,9 @@ class TermChecker:
         if not isinstance(enum, EnumType):
             raise self.error(type_token, f"{type_token} is not an enum type")
         if str(literal) not in enum.literals:
-            raise self.error(literal, f"{type_token} has no literal {literal} (expected one of "
-                                      f"{', '.join(enum.literals)})")
+            raise self.error(
+                literal, f"{type_token} has no literal {literal} (expected one of {', '.join(enum.literals)})"
+            )
         return Literal(str(literal), enum)
 
     def _array(self, node: Tree) -> Literal:
@@ -268,8 +339,9 @@ class TermChecker:
             if not isinstance(value, Literal) or isinstance(value.type, ArrayType):
                 raise self.error(child, "an array holds constants: numbers, booleans or enum literals")
             if value.type != values[0].type:
-                raise self.error(child, f"an array holds one type: {type_name(values[0].type)}, not "
-                                        f"{type_name(value.type)}")
+                raise self.error(
+                    child, f"an array holds one type: {type_name(values[0].type)}, not {type_name(value.type)}"
+                )
         return Literal(tuple(value.value for value in values), ArrayType(values[0].type, len(values)))
 
     def _conditional(self, node: Tree, role: str) -> Conditional:
@@ -278,8 +350,10 @@ class TermChecker:
         self._expect(condition_node, condition, BOOLEAN, "the condition of '? :'")
         then, otherwise = self.expr(then_node, role), self.expr(otherwise_node, role)
         if then.type != otherwise.type:
-            raise self.error(otherwise_node, f"both branches of '? :' need one type: {type_name(then.type)} and "
-                                             f"{type_name(otherwise.type)}")
+            raise self.error(
+                otherwise_node,
+                f"both branches of '? :' need one type: {type_name(then.type)} and {type_name(otherwise.type)}",
+            )
         return Conditional(condition, then, otherwise, then.type)
 
     def _binary(self, node: Tree, role: str) -> Binary:
@@ -308,29 +382,40 @@ class TermChecker:
         if node.data == "postfix_call":
             subject, function, arguments = node.children
             if isinstance(subject, Token) and subject.type == "BELIEF":
-                raise self.error(node, f"belief'{function} is not supported: a belief changes continuously, not "
-                                       "by updates; aggregate a context instead")
+                raise self.error(
+                    node,
+                    f"belief'{function} is not supported: a belief changes continuously, not "
+                    "by updates; aggregate a context instead",
+                )
             args = [Tree("var", [subject], node.meta)] + (
-                [child for child in arguments.children if child is not None] if arguments is not None else [])
+                [child for child in arguments.children if child is not None] if arguments is not None else []
+            )
         else:
             function, *rest = node.children
             args = [child for child in rest if child is not None]
         name = str(function)
         if name in ("update", "eventWhen"):
-            raise self.error(node, f"the pattern operator '{name}' cannot be used in a value; only values and & | ! "
-                                   "comparisons and arithmetic can")
+            raise self.error(
+                node,
+                f"the pattern operator '{name}' cannot be used in a value; only values and & | ! "
+                "comparisons and arithmetic can",
+            )
         if name in AGGREGATES:
             return self._aggregate(node, name, args)
         if name == "period":
             return self._period(node, args)
         if name == "schedule":
-            raise self.error(node, "schedule(…) defines a timer: timer T := schedule(\"…\")")
+            raise self.error(node, 'schedule(…) defines a timer: timer T := schedule("…")')
         if name not in _ARITY:
-            raise self.error(node, f"unknown function {name}(…) (functions: {', '.join(AGGREGATES + ARITHMETIC + COLLECTION)}"
-                                   ", period, update, eventWhen)")
+            raise self.error(
+                node,
+                f"unknown function {name}(…) (functions: {', '.join(AGGREGATES + ARITHMETIC + COLLECTION)}"
+                ", period, update, eventWhen)",
+            )
         if len(args) != _ARITY[name]:
-            raise self.error(node, f"{name} takes {_ARITY[name]} argument{'s' if _ARITY[name] > 1 else ''}, "
-                                   f"not {len(args)}")
+            raise self.error(
+                node, f"{name} takes {_ARITY[name]} argument{'s' if _ARITY[name] > 1 else ''}, not {len(args)}"
+            )
         values = [self.expr(arg, f"the arguments of {name}") for arg in args]
         if name in ARITHMETIC:
             for arg, value in zip(args, values):
@@ -349,11 +434,13 @@ class TermChecker:
 
     def _aggregate(self, node: Tree, name: str, args: list) -> Var:
         if not 1 <= len(args) <= 3:
-            raise self.error(node, f"{name} takes a context, then optionally a window (a count or a time) and a "
-                                   "condition")
+            raise self.error(
+                node, f"{name} takes a context, then optionally a window (a count or a time) and a condition"
+            )
         source_node = args[0]
-        source_name = str(source_node.children[0]) if isinstance(source_node, Tree) and source_node.data == "var" \
-            else None
+        source_name = (
+            str(source_node.children[0]) if isinstance(source_node, Tree) and source_node.data == "var" else None
+        )
         if source_name in self.contexts:
             source_type = self.contexts[source_name].type
         else:  # any other value: aggregate a hidden stream of its values
@@ -372,8 +459,9 @@ class TermChecker:
             elif kind == "number" and "." not in window_node.children[0] and int(window_node.children[0]) >= 1:
                 window = int(window_node.children[0])
             else:
-                raise self.error(window_node, f"the window of {name} is a whole number of updates (3) or a time "
-                                              "(5 minutes)")
+                raise self.error(
+                    window_node, f"the window of {name} is a whole number of updates (3) or a time (5 minutes)"
+                )
             if isinstance(window, float) and window <= 0:
                 raise self.error(window_node, f"the window of {name} must be longer than 0")
         where = None
@@ -392,5 +480,6 @@ class TermChecker:
         if isinstance(argument, Tree) and argument.data == "followed_by":
             first, then = self.pattern(argument.children[0]), self.pattern(argument.children[2])
             return self._stream(Period(None, first, then), NUMBER)
-        raise self.error(argument, "period needs a context (how long it kept its value) or 'a -> b' (the time "
-                                   "from a to b)")
+        raise self.error(
+            argument, "period needs a context (how long it kept its value) or 'a -> b' (the time from a to b)"
+        )

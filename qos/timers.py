@@ -27,8 +27,14 @@ from datetime import datetime, timedelta, timezone
 
 from qos.model import Schedule, Timer
 
-_FIELDS = (("minutes", 0, 59), ("hours", 0, 23), ("days", 1, 31), ("months", 1, 12), ("weekdays", 0, 6),
-           ("seconds", 0, 59))
+_FIELDS = (
+    ("minutes", 0, 59),
+    ("hours", 0, 23),
+    ("days", 1, 31),
+    ("months", 1, 12),
+    ("weekdays", 0, 6),
+    ("seconds", 0, 59),
+)
 #: how far ahead a schedule is searched (a schedule matching nothing in 8 years never fires: Feb 30)
 _HORIZON_DAYS = 8 * 366
 
@@ -76,8 +82,10 @@ def parse_schedule(text: str) -> Schedule:
     """Read an Esper ``timer:at`` schedule; raises :class:`ScheduleError` saying what is wrong."""
     fields = _split(text)
     if len(fields) not in (5, 6) or not all(fields):
-        raise ScheduleError(f"expected 5 or 6 comma-separated fields (minutes, hours, days, months, weekdays"
-                            f"[, seconds]), found {len(fields)}")
+        raise ScheduleError(
+            f"expected 5 or 6 comma-separated fields (minutes, hours, days, months, weekdays"
+            f"[, seconds]), found {len(fields)}"
+        )
     if len(fields) == 5:
         fields.append("0")
     sets = [_field(text, name, low, high) for text, (name, low, high) in zip(fields, _FIELDS)]
@@ -97,8 +105,7 @@ def _next_match(schedule: Schedule, after: float, origin: float) -> float | None
     moment = datetime.fromtimestamp(origin + after, timezone.utc).replace(microsecond=0) + timedelta(seconds=1)
     day = moment.replace(hour=0, minute=0, second=0)
     for _ in range(_HORIZON_DAYS):
-        if (day.month in schedule.months and day.day in schedule.days
-                and (day.weekday() + 1) % 7 in schedule.weekdays):
+        if day.month in schedule.months and day.day in schedule.days and (day.weekday() + 1) % 7 in schedule.weekdays:
             for hour in sorted(schedule.hours):
                 for minute in sorted(schedule.minutes):
                     for second in sorted(schedule.seconds):

@@ -25,9 +25,9 @@ from typing import Any
 
 import yaml
 
+from fileio.bounded import BadFile, load_data, write_private
 from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
 from qos.errors import ContextError, ModelError, TraceError
-from fileio.bounded import BadFile, load_data, write_private
 from qos.model import Model
 
 _EVENT_KEYS = ("t", "set", "emit")
@@ -84,8 +84,11 @@ class Trace:
     def from_events(cls, model: str, events: Iterable[Mapping[str, Any]], description: str | None = None) -> Trace:
         """A trace from recorded events (mappings with ``t`` and optional ``set``/``emit``, as a
         session records them), times whole where they are whole."""
-        return cls(model, [TraceEvent(seconds(e["t"]), dict(e.get("set", {})), list(e.get("emit", [])))
-                           for e in events], description=description)
+        return cls(
+            model,
+            [TraceEvent(seconds(e["t"]), dict(e.get("set", {})), list(e.get("emit", []))) for e in events],
+            description=description,
+        )
 
     def load_model(self) -> Model:
         """Load the trace's model (a bundled name, or a path relative to the trace's folder)."""
@@ -115,8 +118,10 @@ class Trace:
             for context in event.set:
                 first = setters.setdefault((float(event.t), context), index)
                 if first != index:
-                    raise TraceError(f"{where}: events[{first}] already sets {context} at t={event.t}; "
-                                     "one batch can set a context only once")
+                    raise TraceError(
+                        f"{where}: events[{first}] already sets {context} at t={event.t}; "
+                        "one batch can set a context only once"
+                    )
         return model
 
     def batches(self) -> list[tuple[float, dict[str, object], list[str]]]:
@@ -156,8 +161,12 @@ class Trace:
 
 
 def _flow(value: object) -> str:
-    return yaml.safe_dump(value, default_flow_style=True, sort_keys=False, width=math.inf,
-                          allow_unicode=True).strip().removesuffix("...").strip()
+    return (
+        yaml.safe_dump(value, default_flow_style=True, sort_keys=False, width=math.inf, allow_unicode=True)
+        .strip()
+        .removesuffix("...")
+        .strip()
+    )
 
 
 def dump_trace(trace: Trace, path: str | Path, header: str | None = None) -> None:
@@ -224,8 +233,9 @@ def _calendar(text: str, name: str) -> float:
     try:
         moment = datetime.fromisoformat(text.replace("Z", "+00:00"))
     except ValueError:
-        raise TraceError(f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {text!r}") \
-            from None
+        raise TraceError(
+            f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {text!r}"
+        ) from None
     return (moment if moment.tzinfo else moment.replace(tzinfo=timezone.utc)).timestamp()
 
 
@@ -302,8 +312,7 @@ class ReplaySamples:
 MAX_SAMPLES = 100_000
 
 
-def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
-                 model: Model | None = None) -> ReplaySamples:
+def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0, model: Model | None = None) -> ReplaySamples:
     """Replay a trace through a fresh engine, sampling every property.
 
     Samples are taken at t = 0, period, 2·period, … up to and including the last event's time, each
@@ -312,8 +321,12 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     anything when the trace or its model is bad, or when the period would take more than
     :data:`MAX_SAMPLES` samples.
     """
-    if isinstance(sample_period, bool) or not isinstance(sample_period, (int, float)) \
-            or not math.isfinite(sample_period) or sample_period <= 0:
+    if (
+        isinstance(sample_period, bool)
+        or not isinstance(sample_period, (int, float))
+        or not math.isfinite(sample_period)
+        or sample_period <= 0
+    ):
         raise ValueError(f"the sample period must be a positive number of seconds, not {sample_period!r}")
     if not isinstance(trace, Trace):
         trace = load_trace(trace)
@@ -323,16 +336,23 @@ def sample_trace(trace: Trace | str | Path, sample_period: float = 1.0,
     last_t = float(batches[-1][0]) if batches else 0.0
     count = math.floor(last_t / sample_period + 1e-9) + 1
     if count > MAX_SAMPLES:
-        raise TraceError(f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
-                         f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period")
+        raise TraceError(
+            f"{trace.name}: a sample period of {sample_period:g} s over the trace's {last_t:g} s "
+            f"would take {count:,} samples (at most {MAX_SAMPLES:,}); use a longer sample period"
+        )
     firings = sum(last_t / (timer.interval or 1.0) for timer in model.timers.values())
     if firings > MAX_TIMED_BATCHES:
-        raise TraceError(f"{trace.name}: the model's timers would fire about {firings:,.0f} times over the trace's "
-                         f"{last_t:g} s (at most {MAX_TIMED_BATCHES:,}); is a timer's interval too short?")
+        raise TraceError(
+            f"{trace.name}: the model's timers would fire about {firings:,.0f} times over the trace's "
+            f"{last_t:g} s (at most {MAX_TIMED_BATCHES:,}); is a timer's interval too short?"
+        )
     samples = ReplaySamples([], {name: [] for name in model.properties}, [], {name: [] for name in model.beliefvars})
     # every batch that fires, timer batches included, in the order the engine runs them
-    engine.subscribe(lambda result: samples.fired.append({"t": seconds(result.t), "observations": result.fired})
-                     if result.fired else None)
+    engine.subscribe(
+        lambda result: (
+            samples.fired.append({"t": seconds(result.t), "observations": result.fired}) if result.fired else None
+        )
+    )
 
     def sample(now: float) -> None:
         engine.advance(max(now, engine.t or 0.0))
@@ -381,8 +401,10 @@ def replay(trace: Trace | str | Path, sample_period: float = 1.0, model: Model |
 def summarise(samples: ReplaySamples) -> dict:
     """The replay result of trace-format.md from a replay's samples (and, for a model with belief
     variables, their statistics under ``beliefs``)."""
-    result: dict = {"metrics": {name: _statistics(values) for name, values in samples.series.items()},
-                    "fired": samples.fired}
+    result: dict = {
+        "metrics": {name: _statistics(values) for name, values in samples.series.items()},
+        "fired": samples.fired,
+    }
     if samples.beliefs:
         result["beliefs"] = {name: _statistics(values) for name, values in samples.beliefs.items()}
     return result

@@ -34,30 +34,52 @@ def settle(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[di
     now = db.now_iso()
     closed = 0
     seqs = [e.seq for e in new]
-    raised = connection.execute(sa.select(alerts).where(
-        alerts.c.kiosk_id == kiosk_id, alerts.c.seq.in_(seqs), alerts.c.kind == "person_lost",
-        alerts.c.ack_at.is_(None))).all()
+    raised = connection.execute(
+        sa.select(alerts).where(
+            alerts.c.kiosk_id == kiosk_id,
+            alerts.c.seq.in_(seqs),
+            alerts.c.kind == "person_lost",
+            alerts.c.ack_at.is_(None),
+        )
+    ).all()
     for alert in raised:
-        before = connection.execute(sa.select(sa.func.max(alerts.c.received_at)).where(
-            alerts.c.session_id == alert.session_id, alerts.c.kind == "person_lost",
-            alerts.c.id != alert.id)).scalar()
-        query = sa.select(commands.c.by).where(  # sent, and not refused by the kiosk
-            commands.c.session_id == alert.session_id, commands.c.kind == "person_away",
-            sa.or_(commands.c.result.is_(None), commands.c.result == "done")).order_by(commands.c.id.desc())
+        before = connection.execute(
+            sa.select(sa.func.max(alerts.c.received_at)).where(
+                alerts.c.session_id == alert.session_id, alerts.c.kind == "person_lost", alerts.c.id != alert.id
+            )
+        ).scalar()
+        query = (
+            sa.select(commands.c.by)
+            .where(  # sent, and not refused by the kiosk
+                commands.c.session_id == alert.session_id,
+                commands.c.kind == "person_away",
+                sa.or_(commands.c.result.is_(None), commands.c.result == "done"),
+            )
+            .order_by(commands.c.id.desc())
+        )
         if before is not None:
             query = query.where(commands.c.at > _iso(before))
         sender = connection.execute(query).scalar()
         if sender is not None:
-            closed += connection.execute(alerts.update().where(alerts.c.id == alert.id).values(
-                ack_by=sender, ack_at=now)).rowcount
+            closed += connection.execute(
+                alerts.update().where(alerts.c.id == alert.id).values(ack_by=sender, ack_at=now)
+            ).rowcount
     # resolved (patient back, doctor's call answered): closed with the resolution
-    closed += connection.execute(alerts.update().where(
-        alerts.c.kiosk_id == kiosk_id, alerts.c.resolved_at.is_not(None), alerts.c.ack_at.is_(None),
-        alerts.c.session_id.in_(sorted({e.session_id for e in new}))).values(ack_by="closed: situation ended",
-                                                                     ack_at=now)).rowcount
+    closed += connection.execute(
+        alerts.update()
+        .where(
+            alerts.c.kiosk_id == kiosk_id,
+            alerts.c.resolved_at.is_not(None),
+            alerts.c.ack_at.is_(None),
+            alerts.c.session_id.in_(sorted({e.session_id for e in new})),
+        )
+        .values(ack_by="closed: situation ended", ack_at=now)
+    ).rowcount
     for event in new:
         if event.kind in ENDED:
-            closed += connection.execute(alerts.update().where(
-                alerts.c.session_id == event.session_id, alerts.c.ack_at.is_(None)).values(
-                ack_by=f"closed: {ENDED[event.kind]}", ack_at=now)).rowcount
+            closed += connection.execute(
+                alerts.update()
+                .where(alerts.c.session_id == event.session_id, alerts.c.ack_at.is_(None))
+                .values(ack_by=f"closed: {ENDED[event.kind]}", ack_at=now)
+            ).rowcount
     return [{"type": "alert", "kiosk": kiosk_id}] if closed else []

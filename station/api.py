@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import asyncio
 import json
-from concurrent.futures import ThreadPoolExecutor
 from collections.abc import Awaitable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from sqlalchemy.engine import Connection
@@ -38,8 +38,9 @@ def _refused(exc: ValueError) -> JSONResponse:
     """A request refused for what it sent: 413 for a body over :data:`MAX_BODY`, 422 for a row
     that breaks a rule (the body names its ``seq`` too), else 400."""
     seq = getattr(exc, "seq", None)
-    return JSONResponse({"error": str(exc)} | ({"seq": seq} if seq is not None else {}),
-                        status_code=getattr(exc, "status", 400))
+    return JSONResponse(
+        {"error": str(exc)} | ({"seq": seq} if seq is not None else {}), status_code=getattr(exc, "status", 400)
+    )
 
 
 def _token(request: Request) -> str | None:
@@ -106,8 +107,9 @@ async def _json(request: Request) -> Any:
 
 
 def _unauthorised() -> JSONResponse:
-    return JSONResponse({"error": "unknown or revoked kiosk token"}, status_code=401,
-                        headers={"WWW-Authenticate": "Bearer"})
+    return JSONResponse(
+        {"error": "unknown or revoked kiosk token"}, status_code=401, headers={"WWW-Authenticate": "Bearer"}
+    )
 
 
 class _WrongKiosk(ValueError):
@@ -194,8 +196,9 @@ async def post_command_ack(request: Request) -> Response:
         return _unauthorised()
     try:
         body = await _json(request)
-        await run_in_threadpool(ward.ack_command, request.app.state.engine, kiosk,
-                                int(request.path_params["command_id"]), body)
+        await run_in_threadpool(
+            ward.ack_command, request.app.state.engine, kiosk, int(request.path_params["command_id"]), body
+        )
     except ward.WardError as exc:
         return _error(404 if str(exc).startswith("no command") else 400, str(exc))
     except ValueError as exc:

@@ -11,8 +11,8 @@ from __future__ import annotations
 import asyncio
 import hashlib
 import json
-from concurrent.futures import ThreadPoolExecutor
 from collections.abc import Awaitable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from sqlalchemy.engine import Connection
@@ -21,9 +21,8 @@ from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
 from station import auth, orders
+from station.api import MAX_WAIT_S, _error, _in_worker, _json, _refused, _token, _Unauthorised, _unauthorised
 from station.bus import long_poll
-from station.api import MAX_WAIT_S, _error, _in_worker, _json, _refused, _token, _unauthorised, _Unauthorised
-
 
 #: worker threads for the orders' long polls and order forms only: a waiting visit neither queues
 #: behind the kiosks' routine rows nor behind a burst of alerts (measured: bench/station.py)
@@ -61,8 +60,9 @@ async def get_orders(request: Request) -> Response:
         def fetch() -> Awaitable[dict[str, Any]]:
             return loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk)
 
-        current = await long_poll(queue, kiosk, ("order", "resync"), wait, await fetch(), fetch,
-                                  lambda listed: listed["version"] != known)
+        current = await long_poll(
+            queue, kiosk, ("order", "resync"), wait, await fetch(), fetch, lambda listed: listed["version"] != known
+        )
     finally:
         bus.unsubscribe(queue)
     return JSONResponse(current)
@@ -76,7 +76,7 @@ async def post_start(request: Request) -> Response:
     try:
         body = await _json(request)
         if not isinstance(body, dict) or not isinstance(body.get("code"), str):
-            raise ValueError("the body must be {\"code\": \"1234\"}")
+            raise ValueError('the body must be {"code": "1234"}')
     except ValueError as exc:
         return _refused(exc)
 

@@ -82,8 +82,9 @@ def set_password(engine: Engine, name: str, password: str) -> int:
     """Change a user's password and end every login of that user; returns how many ended."""
     _check_password(password)
     with engine.begin() as connection:
-        if not connection.execute(users.update().where(users.c.name == name).values(
-                password_hash=_hasher.hash(password))).rowcount:
+        if not connection.execute(
+            users.update().where(users.c.name == name).values(password_hash=_hasher.hash(password))
+        ).rowcount:
             raise AuthError(f"no user {name!r}")
         return end_sessions(connection, name)
 
@@ -135,16 +136,18 @@ def add_kiosk(engine: Engine, name: str) -> str:
         if existing is None:
             connection.execute(kiosks.insert().values(name=name, token_hash=_digest(token), created_at=db.now_iso()))
         else:
-            connection.execute(kiosks.update().where(kiosks.c.name == name).values(
-                token_hash=_digest(token), revoked_at=None))
+            connection.execute(
+                kiosks.update().where(kiosks.c.name == name).values(token_hash=_digest(token), revoked_at=None)
+            )
     return token
 
 
 def revoke_kiosk(engine: Engine, name: str) -> None:
     """Refuse the kiosk's token from now on (its data stays)."""
     with engine.begin() as connection:
-        done = connection.execute(kiosks.update().where(kiosks.c.name == name, kiosks.c.revoked_at.is_(None)).values(
-            revoked_at=db.now_iso())).rowcount
+        done = connection.execute(
+            kiosks.update().where(kiosks.c.name == name, kiosks.c.revoked_at.is_(None)).values(revoked_at=db.now_iso())
+        ).rowcount
     if not done:
         raise AuthError(f"no kiosk {name!r} with a valid token")
 
@@ -152,8 +155,9 @@ def revoke_kiosk(engine: Engine, name: str) -> None:
 def kiosk_for(engine: Engine, token: str) -> str | None:
     """The kiosk a bearer token belongs to, unless revoked."""
     with engine.connect() as connection:
-        return connection.execute(sa.select(kiosks.c.name).where(
-            kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None))).scalar()
+        return connection.execute(
+            sa.select(kiosks.c.name).where(kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None))
+        ).scalar()
 
 
 def touch_kiosk(connection: Connection, token: str, status: str | None = None) -> str | None:
@@ -162,9 +166,12 @@ def touch_kiosk(connection: Connection, token: str, status: str | None = None) -
     values: dict[str, object] = {"last_seen": db.now()}
     if status is not None:
         values["status"] = status
-    return connection.execute(kiosks.update().where(
-        kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None)).values(**values).returning(
-        kiosks.c.name)).scalar()
+    return connection.execute(
+        kiosks.update()
+        .where(kiosks.c.token_hash == _digest(token), kiosks.c.revoked_at.is_(None))
+        .values(**values)
+        .returning(kiosks.c.name)
+    ).scalar()
 
 
 def secret_key(engine: Engine) -> str:

@@ -65,8 +65,10 @@ class Bus:
             yield connection, messages
             if is_postgres(self._engine):
                 for message in messages:
-                    connection.execute(sa.text("SELECT pg_notify(:channel, :payload)"),
-                                       {"channel": CHANNEL, "payload": json.dumps(message)})
+                    connection.execute(
+                        sa.text("SELECT pg_notify(:channel, :payload)"),
+                        {"channel": CHANNEL, "payload": json.dumps(message)},
+                    )
         if not is_postgres(self._engine):
             for message in messages:
                 self._deliver(message)
@@ -78,8 +80,10 @@ class Bus:
         if is_postgres(self._engine):
             with self._engine.connect() as connection:
                 for message in messages:
-                    connection.execute(sa.text("SELECT pg_notify(:channel, :payload)"),
-                                       {"channel": CHANNEL, "payload": json.dumps(message)})
+                    connection.execute(
+                        sa.text("SELECT pg_notify(:channel, :payload)"),
+                        {"channel": CHANNEL, "payload": json.dumps(message)},
+                    )
                 connection.commit()
         else:
             for message in messages:
@@ -128,8 +132,15 @@ class Bus:
                 self._stopping.wait(1.0)
 
 
-async def long_poll(queue: asyncio.Queue[dict[str, Any]], kiosk: str, kinds: tuple[str, ...], wait: float,
-                    current: Any, fetch: Callable[[], Awaitable[Any]], answered: Callable[[Any], bool]) -> Any:
+async def long_poll(
+    queue: asyncio.Queue[dict[str, Any]],
+    kiosk: str,
+    kinds: tuple[str, ...],
+    wait: float,
+    current: Any,
+    fetch: Callable[[], Awaitable[Any]],
+    answered: Callable[[Any], bool],
+) -> Any:
     """The long polls' wait: from ``current`` (read after subscribing ``queue``, so nothing
     published in between is missed), read again with ``fetch`` on every message of one of
     ``kinds`` for ``kiosk`` (or for every kiosk), until ``answered`` says so or ``wait`` seconds

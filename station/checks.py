@@ -21,10 +21,10 @@ from datetime import datetime
 from typing import Any
 
 from kiosk.core.channels import Channel
-from kiosk.core.questionnaire.definition import DefinitionError, questionnaire_from
-from kiosk.export import ExportError, ExportSite, fhir_questionnaire
 from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
+from kiosk.core.questionnaire.definition import DefinitionError, questionnaire_from
 from kiosk.core.session import AnsweredBy
+from kiosk.export import ExportError, ExportSite, fhir_questionnaire
 from kiosk.store.database import PATIENT_ID
 
 #: the longest id (item, session, kind, name) and time the station's columns hold
@@ -74,8 +74,12 @@ def integer(value: Any, where: str, low: int, high: int) -> int:
 
 
 def number(value: Any, where: str, low: float = 0.0, high: float = T_MAX) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or not low <= value <= high:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not math.isfinite(value)
+        or not low <= value <= high
+    ):
         raise _fail(where, f"must be a number from {low:g} to {high:g}, got {value!r:.40}")
     return float(value)
 
@@ -136,10 +140,12 @@ def check_definition(definition: Any, where: str) -> Questionnaire:
     maps: list[tuple[str, Mapping[str, str]]] = [("title", q.title)]
     maps += [(f"items.{i.id}.{part}", getattr(i, part)) for i in q.items for part in ("text", "spoken")]
     maps += [(f"items.{i.id}.options.{o.number}.label", o.label) for i in q.items for o in i.options]
-    maps += [(f"familiarisation.{p.id}.{part}", getattr(p, part)) for p in q.familiarisation
-             for part in ("text", "spoken")]
-    maps += [(f"familiarisation.{p.id}.options.{o.number}.label", o.label) for p in q.familiarisation
-             for o in p.options]
+    maps += [
+        (f"familiarisation.{p.id}.{part}", getattr(p, part)) for p in q.familiarisation for part in ("text", "spoken")
+    ]
+    maps += [
+        (f"familiarisation.{p.id}.options.{o.number}.label", o.label) for p in q.familiarisation for o in p.options
+    ]
     maps += [(f"band_sets.{s.id}.{b.id}.label", b.label) for s in q.band_sets.values() for b in s.bands]
     for name, texts in maps:
         missing = [lang for lang in q.languages if lang not in texts]
@@ -176,8 +182,10 @@ def check_create(payload: Mapping[str, Any], where: str, session_id: str, q: Que
     if not isinstance(payload["patient_id"], str) or not PATIENT_ID.match(payload["patient_id"]):
         raise _fail(f"{where}.patient_id", "is not pseudonymous (2-64 letters, digits, '-' or '_')")
     if payload["questionnaire_id"] != q.id:
-        raise _fail(f"{where}.questionnaire_id", f"{payload['questionnaire_id']!r:.70} is not the id of the "
-                                                 f"session's definition ({q.id!r})")
+        raise _fail(
+            f"{where}.questionnaire_id",
+            f"{payload['questionnaire_id']!r:.70} is not the id of the session's definition ({q.id!r})",
+        )
     one_of(payload["language"], f"{where}.language", q.languages)
     one_of(payload["answered_by"], f"{where}.answered_by", tuple(a.value for a in AnsweredBy))
     iso_time(payload["started_at"], f"{where}.started_at")
@@ -215,8 +223,10 @@ def _answer(p: Mapping[str, Any], where: str, q: Questionnaire | None) -> None:
     item = _item(p, where, q)
     option = integer(p["option"], f"{where}.option", 1, len(item.options))
     if p["points"] != item.option(option).points or isinstance(p["points"], bool):
-        raise _fail(f"{where}.points", f"{p['points']!r:.20} is not what option {option} of {item.id} scores "
-                                       f"({item.option(option).points})")
+        raise _fail(
+            f"{where}.points",
+            f"{p['points']!r:.20} is not what option {option} of {item.id} scores ({item.option(option).points})",
+        )
     integer(p["attempt"], f"{where}.attempt", 1, 10)
     one_of(p["channel"], f"{where}.channel", tuple(c.value for c in Channel))
     one_of(p["answered_by"], f"{where}.answered_by", tuple(a.value for a in AnsweredBy))
@@ -228,8 +238,9 @@ def _item(p: Mapping[str, Any], where: str, q: Questionnaire | None) -> Any:
     try:
         return q.item(item_id)
     except KeyError:
-        raise _fail(f"{where}.item_id", f"{item_id!r} is not an item of {q.id} "
-                                        f"({', '.join(i.id for i in q.items)})") from None
+        raise _fail(
+            f"{where}.item_id", f"{item_id!r} is not an item of {q.id} ({', '.join(i.id for i in q.items)})"
+        ) from None
 
 
 def _practice(p: Mapping[str, Any], where: str, q: Questionnaire | None) -> None:

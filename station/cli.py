@@ -36,34 +36,49 @@ class UsageError(Exception):
 
 
 def _db_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--db", metavar="URL",
-                        help="database URL: postgresql://user@host/dbname, or sqlite:///path "
-                             "(default: station.sqlite3 in $KIOSK_STATION_DIR or the user data directory)")
+    parser.add_argument(
+        "--db",
+        metavar="URL",
+        help="database URL: postgresql://user@host/dbname, or sqlite:///path "
+        "(default: station.sqlite3 in $KIOSK_STATION_DIR or the user data directory)",
+    )
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="kiosk station", formatter_class=argparse.RawDescriptionHelpFormatter,
+        prog="kiosk station",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         description="The ward station: kiosks report to it, staff watch the ward, answer doctor calls and "
-                    "validate results.",
+        "validate results.",
         epilog="administration (each takes --db too):\n"
-               "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
-               "  kiosk station passwd NAME [--password-file F]   a new password; ends NAME's logins\n"
-               "  kiosk station remove-user NAME                  ends NAME's logins too\n"
-               "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
-               "  kiosk station revoke-kiosk NAME\n"
-               "  kiosk station migrate --db OWNER_URL --grant APP_ROLE   (PostgreSQL) migrate as the owner; the\n"
-               "      station then runs as APP_ROLE, which cannot change or switch off the audit trail")
+        "  kiosk station add-user NAME --role nurse|doctor [--password-file F]\n"
+        "  kiosk station passwd NAME [--password-file F]   a new password; ends NAME's logins\n"
+        "  kiosk station remove-user NAME                  ends NAME's logins too\n"
+        "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
+        "  kiosk station revoke-kiosk NAME\n"
+        "  kiosk station migrate --db OWNER_URL --grant APP_ROLE   (PostgreSQL) migrate as the owner; the\n"
+        "      station then runs as APP_ROLE, which cannot change or switch off the audit trail",
+    )
     _db_option(parser)
-    parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)")
+    parser.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)"
+    )
     parser.add_argument("--port", type=int, default=8443, help="port (default 8443)")
     parser.add_argument("--tls-cert", type=Path, metavar="PEM", help="TLS certificate chain (PEM)")
     parser.add_argument("--tls-key", type=Path, metavar="PEM", help="TLS private key (PEM)")
-    parser.add_argument("--trusted-proxy", action="append", default=[], metavar="ADDRESS",
-                        help="a reverse proxy (address or network) whose X-Forwarded-For names the client; "
-                             "repeat for each (default: none, the peer's own address counts)")
-    parser.add_argument("--insecure-lan", action="store_true",
-                        help="allow a non-loopback --host without TLS (only on a network you trust)")
+    parser.add_argument(
+        "--trusted-proxy",
+        action="append",
+        default=[],
+        metavar="ADDRESS",
+        help="a reverse proxy (address or network) whose X-Forwarded-For names the client; "
+        "repeat for each (default: none, the peer's own address counts)",
+    )
+    parser.add_argument(
+        "--insecure-lan",
+        action="store_true",
+        help="allow a non-loopback --host without TLS (only on a network you trust)",
+    )
     return parser
 
 
@@ -71,16 +86,22 @@ def _admin_parser(command: str) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=f"kiosk station {command}")
     _db_option(parser)
     if command == "migrate":
-        parser.add_argument("--grant", action="append", default=[], metavar="APP_ROLE",
-                            help="PostgreSQL: let this role run the station (tables read and written, the audit "
-                                 "trail only read and added to); repeat for several")
+        parser.add_argument(
+            "--grant",
+            action="append",
+            default=[],
+            metavar="APP_ROLE",
+            help="PostgreSQL: let this role run the station (tables read and written, the audit "
+            "trail only read and added to); repeat for several",
+        )
         return parser
     parser.add_argument("name", help="the user's or kiosk's name")
     if command == "add-user":
         parser.add_argument("--role", required=True, choices=auth.ROLES)
     if command in ("add-user", "passwd"):
-        parser.add_argument("--password-file", type=Path,
-                            help="read the password from this file's first line (default: ask)")
+        parser.add_argument(
+            "--password-file", type=Path, help="read the password from this file's first line (default: ask)"
+        )
     return parser
 
 
@@ -163,8 +184,10 @@ def _check_listen(args: argparse.Namespace) -> None:
     except ValueError:
         loopback = args.host == "localhost"
     if not loopback and not args.tls_cert and not args.insecure_lan:
-        raise UsageError(f"--host {args.host} would let other machines in without encryption: give --tls-cert "
-                         "and --tls-key, or --insecure-lan on a network you trust")
+        raise UsageError(
+            f"--host {args.host} would let other machines in without encryption: give --tls-cert "
+            "and --tls-key, or --insecure-lan on a network you trust"
+        )
 
 
 def _serve(argv: list[str]) -> int:
@@ -185,19 +208,25 @@ def _serve(argv: list[str]) -> int:
         print(warning, file=sys.stderr, flush=True)
     app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies)
     scheme = "https" if args.tls_cert else "http"
-    print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})",
-          flush=True)
+    print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})", flush=True)
     # failed and refused logins are logged here (station.security), one line each
     logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
-    uvicorn.run(app, host=args.host, port=args.port, log_level="warning", access_log=False,
-                # uvicorn would trust X-Forwarded-For from 127.0.0.1 by default: the station
-                # reads it itself, from --trusted-proxy only (station.throttle)
-                proxy_headers=False,
-                ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
-                ssl_keyfile=str(args.tls_key) if args.tls_key else None, timeout_graceful_shutdown=2,
-                # kiosks keep their connection between batches; closing it after 5 s idle made
-                # them retry on a half-closed socket
-                timeout_keep_alive=75)
+    uvicorn.run(
+        app,
+        host=args.host,
+        port=args.port,
+        log_level="warning",
+        access_log=False,
+        # uvicorn would trust X-Forwarded-For from 127.0.0.1 by default: the station
+        # reads it itself, from --trusted-proxy only (station.throttle)
+        proxy_headers=False,
+        ssl_certfile=str(args.tls_cert) if args.tls_cert else None,
+        ssl_keyfile=str(args.tls_key) if args.tls_key else None,
+        timeout_graceful_shutdown=2,
+        # kiosks keep their connection between batches; closing it after 5 s idle made
+        # them retry on a half-closed socket
+        timeout_keep_alive=75,
+    )
     return 0
 
 

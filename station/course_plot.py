@@ -41,13 +41,17 @@ def course_svg(q: Questionnaire, results: list[Result]) -> str:
     def y(total: float) -> float:
         return TOP + plot_h * (1 - total / top)
 
-    parts = [f'<svg class="course-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
-             f'aria-label="{escape(q.id)} totals over time" xmlns="http://www.w3.org/2000/svg">']
+    parts = [
+        f'<svg class="course-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
+        f'aria-label="{escape(q.id)} totals over time" xmlns="http://www.w3.org/2000/svg">'
+    ]
     for index, band in enumerate(q.bands_named(None).bands):
         y1, y2 = y(min(band.max, top) + 0.5), y(max(band.min, 0) - 0.5)
-        parts.append(f'<rect x="{LEFT}" y="{max(TOP, y1):.1f}" width="{plot_w}" '
-                     f'height="{max(0.0, min(TOP + plot_h, y2) - max(TOP, y1)):.1f}" '
-                     f'fill="{BAND_FILLS[index % len(BAND_FILLS)]}"><title>{escape(band.id)}</title></rect>')
+        parts.append(
+            f'<rect x="{LEFT}" y="{max(TOP, y1):.1f}" width="{plot_w}" '
+            f'height="{max(0.0, min(TOP + plot_h, y2) - max(TOP, y1)):.1f}" '
+            f'fill="{BAND_FILLS[index % len(BAND_FILLS)]}"><title>{escape(band.id)}</title></rect>'
+        )
     for tick in (0, top // 2, top):
         parts.append(f'<text x="{LEFT - 6}" y="{y(tick) + 4:.1f}" text-anchor="end">{tick}</text>')
     steps: list[str] = []
@@ -59,11 +63,15 @@ def course_svg(q: Questionnaire, results: list[Result]) -> str:
     parts.append(f'<polyline fill="none" stroke="#1b6ac9" stroke-width="2" points="{" ".join(steps).strip()}"/>')
     for result, when in points:
         final = result.review in ("signed_off", "amended")
-        label = escape(f"{when:%Y-%m-%d}: {result.total}/{result.max_total}"
-                       f"{' ' + result.band if result.band else ''}, {result.review_words}")
-        parts.append(f'<circle cx="{x(when):.1f}" cy="{y(result.total or 0):.1f}" r="5" '
-                     f'fill="{"#1b6ac9" if final else "#fff"}" stroke="#1b6ac9" stroke-width="2" '
-                     f'class="visit-point"><title>{label}</title></circle>')
+        label = escape(
+            f"{when:%Y-%m-%d}: {result.total}/{result.max_total}"
+            f"{' ' + result.band if result.band else ''}, {result.review_words}"
+        )
+        parts.append(
+            f'<circle cx="{x(when):.1f}" cy="{y(result.total or 0):.1f}" r="5" '
+            f'fill="{"#1b6ac9" if final else "#fff"}" stroke="#1b6ac9" stroke-width="2" '
+            f'class="visit-point"><title>{label}</title></circle>'
+        )
     parts.append(f'<text x="{LEFT}" y="{HEIGHT - 10}">{first:%Y-%m-%d}</text>')
     if len(points) > 1:
         parts.append(f'<text x="{LEFT + plot_w}" y="{HEIGHT - 10}" text-anchor="end">{last:%Y-%m-%d}</text>')

@@ -27,13 +27,15 @@ MIGRATIONS = Path(__file__).with_name("migrations")
 metadata = sa.MetaData()
 
 settings = sa.Table(
-    "settings", metadata,
+    "settings",
+    metadata,
     sa.Column("key", sa.String(64), primary_key=True),
     sa.Column("value", sa.Text, nullable=False),
 )
 
 users = sa.Table(
-    "users", metadata,
+    "users",
+    metadata,
     sa.Column("name", sa.String(64), primary_key=True),
     sa.Column("role", sa.String(16), nullable=False),
     sa.Column("password_hash", sa.Text, nullable=False),
@@ -41,7 +43,8 @@ users = sa.Table(
 )
 
 staff_sessions = sa.Table(
-    "staff_sessions", metadata,
+    "staff_sessions",
+    metadata,
     sa.Column("id_hash", sa.String(64), primary_key=True),
     sa.Column("user_name", sa.String(64), sa.ForeignKey("users.name", ondelete="CASCADE"), nullable=False),
     sa.Column("created_at", sa.Float, nullable=False),
@@ -49,7 +52,8 @@ staff_sessions = sa.Table(
 )
 
 login_failures = sa.Table(
-    "login_failures", metadata,
+    "login_failures",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("name", sa.String(64), nullable=False),
     sa.Column("address", sa.String(64), nullable=False),
@@ -57,7 +61,8 @@ login_failures = sa.Table(
 )
 
 kiosks = sa.Table(
-    "kiosks", metadata,
+    "kiosks",
+    metadata,
     sa.Column("name", sa.String(64), primary_key=True),
     sa.Column("token_hash", sa.String(64), nullable=False, unique=True),
     sa.Column("created_at", sa.String(40), nullable=False),
@@ -69,7 +74,8 @@ kiosks = sa.Table(
 )
 
 inbox = sa.Table(
-    "inbox", metadata,
+    "inbox",
+    metadata,
     sa.Column("kiosk_id", sa.String(64), primary_key=True),
     sa.Column("seq", sa.BigInteger, primary_key=True),
     sa.Column("kind", sa.String(64), nullable=False),
@@ -80,7 +86,8 @@ inbox = sa.Table(
 )
 
 sessions = sa.Table(
-    "sessions", metadata,
+    "sessions",
+    metadata,
     sa.Column("id", sa.String(64), primary_key=True),
     sa.Column("kiosk_id", sa.String(64), nullable=False),
     sa.Column("patient_id", sa.String(64)),
@@ -96,7 +103,8 @@ sessions = sa.Table(
 
 #: questionnaire definitions, stored once per content (kiosk.core.questionnaire.definition: canonical JSON, SHA-256)
 definitions = sa.Table(
-    "definitions", metadata,
+    "definitions",
+    metadata,
     sa.Column("sha256", sa.String(64), primary_key=True),
     sa.Column("questionnaire_id", sa.Text, nullable=False),
     sa.Column("version", sa.Text, nullable=False),
@@ -105,7 +113,8 @@ definitions = sa.Table(
 )
 
 alerts = sa.Table(
-    "alerts", metadata,
+    "alerts",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("kiosk_id", sa.String(64), nullable=False),
     sa.Column("seq", sa.BigInteger, nullable=False),
@@ -122,7 +131,8 @@ alerts = sa.Table(
 )
 
 commands = sa.Table(
-    "commands", metadata,
+    "commands",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("kiosk_id", sa.String(64), nullable=False, index=True),
     sa.Column("session_id", sa.String(64), nullable=False),
@@ -135,7 +145,8 @@ commands = sa.Table(
 )
 
 audit = sa.Table(
-    "audit", metadata,
+    "audit",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("session_id", sa.String(64), index=True),
     sa.Column("at", sa.String(40), nullable=False),
@@ -155,7 +166,8 @@ class DatabaseError(RuntimeError):
 
 #: visits staff ordered for a kiosk (station.orders owns their states)
 orders = sa.Table(
-    "orders", metadata,
+    "orders",
+    metadata,
     sa.Column("id", sa.String(32), primary_key=True),
     sa.Column("kiosk_id", sa.String(64), nullable=False),
     sa.Column("patient_id", sa.String(64), nullable=False),
@@ -174,14 +186,16 @@ orders = sa.Table(
 #: how each session at the station began: "order" (with its order), "staff" (started by staff at the
 #: kiosk for a patient id they typed) or "walk-up" (whoever tapped the welcome, where allowed)
 visits = sa.Table(
-    "visits", metadata,
+    "visits",
+    metadata,
     sa.Column("session_id", sa.String(64), primary_key=True),
     sa.Column("kind", sa.String(16), nullable=False),
     sa.Column("order_id", sa.String(32)),
 )
 
 code_failures = sa.Table(
-    "order_code_failures", metadata,
+    "order_code_failures",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("kiosk_id", sa.String(64), nullable=False),
     sa.Column("at", sa.Float, nullable=False),
@@ -227,7 +241,7 @@ def _normalise(url: str) -> str:
     """``postgresql://`` means psycopg 3 (SQLAlchemy's default driver name is psycopg2)."""
     for prefix in ("postgresql://", "postgres://"):
         if url.startswith(prefix):
-            return "postgresql+psycopg://" + url[len(prefix):]
+            return "postgresql+psycopg://" + url[len(prefix) :]
     return url
 
 
@@ -238,8 +252,9 @@ def make_engine(url: str) -> Engine:
     try:
         return _make_engine(url)
     except (sa.exc.ArgumentError, ImportError):  # not a URL, or a database the station does not run on
-        raise DatabaseError(f"--db {url!r}: not a station database URL (postgresql://user@host/dbname or "
-                            "sqlite:///path)") from None
+        raise DatabaseError(
+            f"--db {url!r}: not a station database URL (postgresql://user@host/dbname or sqlite:///path)"
+        ) from None
 
 
 def _make_engine(url: str) -> Engine:
@@ -290,11 +305,14 @@ def migrate(engine: Engine) -> None:
     except sa.exc.SQLAlchemyError as exc:
         if getattr(getattr(exc, "orig", None), "sqlstate", None) == "42501":  # insufficient privilege
             role = engine.url.username or "this role"
-            raise DatabaseError(f"the station database {engine.url.render_as_string()} needs migrating, and role "
-                                f"{role!r} may not change its schema: run 'kiosk station migrate --db OWNER_URL "
-                                f"--grant {role}' as the schema's owner first") from None
-        raise DatabaseError(f"cannot open the station database {engine.url!r}: {exc.__class__.__name__}: "
-                            f"{str(exc).splitlines()[0]}") from None
+            raise DatabaseError(
+                f"the station database {engine.url.render_as_string()} needs migrating, and role "
+                f"{role!r} may not change its schema: run 'kiosk station migrate --db OWNER_URL "
+                f"--grant {role}' as the schema's owner first"
+            ) from None
+        raise DatabaseError(
+            f"cannot open the station database {engine.url!r}: {exc.__class__.__name__}: {str(exc).splitlines()[0]}"
+        ) from None
 
 
 def open_database(url: str) -> Engine:

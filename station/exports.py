@@ -16,9 +16,9 @@ from datetime import date, timedelta
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
-from kiosk.export.captured import questionnaire_of, site_of
-from kiosk.export import Described, bundle_of, csv_text, result
 from kiosk.core.questionnaire import Questionnaire
+from kiosk.export import Described, bundle_of, csv_text, result
+from kiosk.export.captured import questionnaire_of, site_of
 from station import validation
 from station.db import audit
 from station.sessions import load
@@ -67,9 +67,15 @@ def signed_off_in(engine: Engine, first: date, last: date) -> list[str]:
     signed again is left out: the hospital keeps its earlier signed version until then."""
     start, end = first.isoformat(), (last + timedelta(days=1)).isoformat()
     with engine.connect() as connection:
-        candidates = list(dict.fromkeys(connection.execute(
-            sa.select(audit.c.session_id).where(audit.c.action == "sign_off", audit.c.at >= start,
-                                                audit.c.at < end).order_by(audit.c.id)).scalars()))
+        candidates = list(
+            dict.fromkeys(
+                connection.execute(
+                    sa.select(audit.c.session_id)
+                    .where(audit.c.action == "sign_off", audit.c.at >= start, audit.c.at < end)
+                    .order_by(audit.c.id)
+                ).scalars()
+            )
+        )
     reviews = validation.reviews(engine, candidates)
     chosen = [s for s in candidates if reviews[s].final and start <= (reviews[s].signed_at or "") < end]
     return sorted(chosen, key=lambda s: reviews[s].signed_at or "")

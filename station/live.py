@@ -55,9 +55,13 @@ class _Changed:
 class Live:
     """Renders bus messages into page events and fans them out to the open pages."""
 
-    def __init__(self, bus: Bus, render_kiosk: Callable[[str], dict[str, Any]],
-                 render_alerts: Callable[[], dict[str, Any]],
-                 render_results: Callable[[list[str]], dict[str, Any]] | None = None) -> None:
+    def __init__(
+        self,
+        bus: Bus,
+        render_kiosk: Callable[[str], dict[str, Any]],
+        render_alerts: Callable[[], dict[str, Any]],
+        render_results: Callable[[list[str]], dict[str, Any]] | None = None,
+    ) -> None:
         self._bus = bus
         self._render_kiosk = render_kiosk
         self._render_alerts = render_alerts

@@ -32,17 +32,22 @@ def start(engine: Engine, name: str) -> str:
     now = db.now()
     with engine.begin() as connection:
         connection.execute(staff_sessions.delete().where(staff_sessions.c.expires_at < now))
-        connection.execute(staff_sessions.insert().values(id_hash=_digest(session_id), user_name=name,
-                                                          created_at=now, expires_at=now + MAX_AGE_S))
+        connection.execute(
+            staff_sessions.insert().values(
+                id_hash=_digest(session_id), user_name=name, created_at=now, expires_at=now + MAX_AGE_S
+            )
+        )
     return session_id
 
 
 def user_of(engine: Engine, session_id: str) -> User | None:
     """The user of a live session; None when it was ended, expired or never existed."""
     with engine.connect() as connection:
-        row = connection.execute(sa.select(users.c.name, users.c.role).join(
-            staff_sessions, staff_sessions.c.user_name == users.c.name).where(
-            staff_sessions.c.id_hash == _digest(session_id), staff_sessions.c.expires_at > db.now())).first()
+        row = connection.execute(
+            sa.select(users.c.name, users.c.role)
+            .join(staff_sessions, staff_sessions.c.user_name == users.c.name)
+            .where(staff_sessions.c.id_hash == _digest(session_id), staff_sessions.c.expires_at > db.now())
+        ).first()
     return User(row.name, row.role) if row else None
 
 
@@ -50,4 +55,3 @@ def end(engine: Engine, session_id: str) -> None:
     """End one session (logout); ending an unknown one is not an error."""
     with engine.begin() as connection:
         connection.execute(staff_sessions.delete().where(staff_sessions.c.id_hash == _digest(session_id)))
-

@@ -33,28 +33,46 @@ async def orders_page(request: Request) -> Response:
     found = await run_in_threadpool(lambda: orders.listing(engine, kiosk_id=kiosk or None, states=states))
     offered = await run_in_threadpool(orders.instruments, engine, q)
     languages = list(dict.fromkeys(lang for i in offered for lang in i.languages))
-    return render(request, "orders.html", orders=found, kiosks=await run_in_threadpool(_kiosk_names, engine),
-                  instruments=[(i.id, i.title) for i in offered], languages=languages, state=state, kiosk=kiosk,
-                  words=orders.WORDS, form=dict(request.query_params), error=request.query_params.get("error"),
-                  message=request.query_params.get("message"))
+    return render(
+        request,
+        "orders.html",
+        orders=found,
+        kiosks=await run_in_threadpool(_kiosk_names, engine),
+        instruments=[(i.id, i.title) for i in offered],
+        languages=languages,
+        state=state,
+        kiosk=kiosk,
+        words=orders.WORDS,
+        form=dict(request.query_params),
+        error=request.query_params.get("error"),
+        message=request.query_params.get("message"),
+    )
 
 
 async def create_order(request: Request) -> Response:
     form = await checked_form(request)
     engine, q = request.app.state.engine, request.app.state.questionnaire
     multi = await request.form()
+
     def place() -> orders.Order:
         offered = {i.id: i for i in orders.instruments(engine, q)}
         chosen = [str(v) for v in multi.getlist("instrument")]
         # a language every chosen instrument has (all of them when none is known yet: create says why)
         spoken = [set(offered[i].languages) for i in chosen if i in offered]
-        languages = sorted(set.intersection(*spoken)) if spoken else sorted({x for i in offered.values()
-                                                                             for x in i.languages})
+        languages = (
+            sorted(set.intersection(*spoken)) if spoken else sorted({x for i in offered.values() for x in i.languages})
+        )
         order = orders.create(
-            engine, kiosk_id=form.get("kiosk", ""), patient_id=form.get("patient_id", ""),
-            instruments=chosen, language=form.get("language", ""),
-            relative=form.get("relative") == "yes", by=request.state.user, known_instruments=list(offered),
-            languages=languages)
+            engine,
+            kiosk_id=form.get("kiosk", ""),
+            patient_id=form.get("patient_id", ""),
+            instruments=chosen,
+            language=form.get("language", ""),
+            relative=form.get("relative") == "yes",
+            by=request.state.user,
+            known_instruments=list(offered),
+            languages=languages,
+        )
         request.app.state.bus.publish({"type": "order", "kiosk": order.kiosk_id})
         return order
 

@@ -40,8 +40,13 @@ from station.sessions import LIFECYCLE
 #: clinician screen checks the same rule (one definition, in kiosk.core.visits).
 PATIENT_ID = HOSPITAL_ID
 STATES = ("ordered", "in_progress", "awaiting_validation", "signed_off", "cancelled")
-WORDS = {"ordered": "ordered", "in_progress": "in progress", "awaiting_validation": "awaiting validation",
-         "signed_off": "signed off", "cancelled": "cancelled"}
+WORDS = {
+    "ordered": "ordered",
+    "in_progress": "in progress",
+    "awaiting_validation": "awaiting validation",
+    "signed_off": "signed off",
+    "cancelled": "cancelled",
+}
 OPEN = ("ordered", "in_progress")
 #: digits of the confirmation code typed at the kiosk
 CODE_DIGITS = 4
@@ -54,6 +59,7 @@ ORDER_ROLES = ("nurse", "doctor")
 #: more is a script or a session left open on a stolen phone)
 MAX_ORDERS_PER_USER = 30
 ORDER_WINDOW_S = 10 * 60
+
 
 class OrderError(ValueError):
     """An order or a step the station refuses (one sentence naming the field and the problem)."""
@@ -103,9 +109,15 @@ class Order:
 
     def for_kiosk(self) -> dict[str, Any]:
         """What the kiosk is told of the order (never the code: staff bring it from the station)."""
-        return {"id": self.id, "patient_id": self.patient_id, "instruments": list(self.instruments),
-                "language": self.language, "answered_by": self.answered_by, "ordered_by": self.ordered_by,
-                "ordered_at": self.ordered_at}
+        return {
+            "id": self.id,
+            "patient_id": self.patient_id,
+            "instruments": list(self.instruments),
+            "language": self.language,
+            "answered_by": self.answered_by,
+            "ordered_by": self.ordered_by,
+            "ordered_at": self.ordered_at,
+        }
 
 
 def check_patient_id(value: str) -> str:
@@ -114,14 +126,19 @@ def check_patient_id(value: str) -> str:
     if not value:
         raise OrderError("patient identifier: give the identifier the hospital uses (e.g. NHC-0012345)")
     if not PATIENT_ID.match(value):
-        raise OrderError(f"patient identifier {value[:64]!r}: use the hospital's identifier, 2-64 letters, digits, "
-                         "'-' or '_' with at least one digit, never a name")
+        raise OrderError(
+            f"patient identifier {value[:64]!r}: use the hospital's identifier, 2-64 letters, digits, "
+            "'-' or '_' with at least one digit, never a name"
+        )
     return value
 
 
 def _audit(connection: Connection, order_id: str, author: str, action: str, reason: str) -> None:
-    connection.execute(audit.insert().values(session_id=order_id, at=db.now_iso(), author=author[:64],
-                                             action=action, reason=reason[:1000]))
+    connection.execute(
+        audit.insert().values(
+            session_id=order_id, at=db.now_iso(), author=author[:64], action=action, reason=reason[:1000]
+        )
+    )
 
 
 @dataclass(frozen=True)
@@ -139,8 +156,11 @@ def instruments(engine: Engine, bundled: Any) -> list[Instrument]:
     order it; the kiosks still take only orders for instruments they give."""
     found = {bundled.id: Instrument(bundled.id, bundled.title.get("en") or bundled.id, tuple(bundled.languages))}
     with engine.connect() as connection:
-        rows = connection.execute(sa.select(db.definitions.c.questionnaire_id, db.definitions.c.body).where(
-            db.definitions.c.questionnaire_id != bundled.id).order_by(db.definitions.c.stored_at.desc())).all()
+        rows = connection.execute(
+            sa.select(db.definitions.c.questionnaire_id, db.definitions.c.body)
+            .where(db.definitions.c.questionnaire_id != bundled.id)
+            .order_by(db.definitions.c.stored_at.desc())
+        ).all()
     for row in rows:
         if row.questionnaire_id in found:
             continue
@@ -150,13 +170,24 @@ def instruments(engine: Engine, bundled: Any) -> list[Instrument]:
         except (ValueError, KeyError, TypeError, AttributeError):
             continue  # stored definitions were checked at sync; one that does not read is not offered
         name = title.get("en") or next(iter(title.values()), row.questionnaire_id) if isinstance(title, dict) else ""
-        found[row.questionnaire_id] = Instrument(row.questionnaire_id, str(name or row.questionnaire_id),
-                                                 tuple(languages))
+        found[row.questionnaire_id] = Instrument(
+            row.questionnaire_id, str(name or row.questionnaire_id), tuple(languages)
+        )
     return list(found.values())
 
 
-def create(engine: Engine, *, kiosk_id: str, patient_id: str, instruments: Sequence[str], language: str,
-           relative: bool, by: Any, known_instruments: Sequence[str], languages: Sequence[str]) -> Order:
+def create(
+    engine: Engine,
+    *,
+    kiosk_id: str,
+    patient_id: str,
+    instruments: Sequence[str],
+    language: str,
+    relative: bool,
+    by: Any,
+    known_instruments: Sequence[str],
+    languages: Sequence[str],
+) -> Order:
     """Order a visit (a nurse or a doctor); returns it with its confirmation code."""
     if by.role not in ORDER_ROLES:
         raise OrderError("only nurses and doctors may order a visit")
@@ -166,39 +197,64 @@ def create(engine: Engine, *, kiosk_id: str, patient_id: str, instruments: Seque
         raise OrderError("instruments: choose at least one")
     unknown = [i for i in chosen if i not in known_instruments]
     if unknown:
-        raise OrderError(f"instruments: {', '.join(unknown)} is not one this station knows "
-                         f"({', '.join(known_instruments)})")
+        raise OrderError(
+            f"instruments: {', '.join(unknown)} is not one this station knows ({', '.join(known_instruments)})"
+        )
     if language not in languages:
         raise OrderError(f"language {language!r}: choose one of {', '.join(languages)}")
     now = db.now_iso()
     since = datetime.fromtimestamp(db.now() - ORDER_WINDOW_S, UTC).isoformat(timespec="milliseconds")
     with engine.begin() as connection:
-        recent = connection.execute(sa.select(sa.func.count()).select_from(orders).where(
-            orders.c.ordered_by == by.name, orders.c.ordered_at > since)).scalar_one()
+        recent = connection.execute(
+            sa.select(sa.func.count())
+            .select_from(orders)
+            .where(orders.c.ordered_by == by.name, orders.c.ordered_at > since)
+        ).scalar_one()
         if recent >= MAX_ORDERS_PER_USER:
-            raise OrderError(f"you have ordered {recent} visits in the last {ORDER_WINDOW_S // 60} minutes: "
-                             "wait a little, or ask a colleague")
+            raise OrderError(
+                f"you have ordered {recent} visits in the last {ORDER_WINDOW_S // 60} minutes: "
+                "wait a little, or ask a colleague"
+            )
         row = connection.execute(sa.select(kiosks.c.revoked_at).where(kiosks.c.name == kiosk_id)).first()
         if row is None or row.revoked_at is not None:
             raise OrderError(f"kiosk {kiosk_id!r}: no such kiosk with a valid token")
-        taken = set(connection.execute(sa.select(orders.c.code).where(
-            orders.c.kiosk_id == kiosk_id, orders.c.state.in_(OPEN))).scalars())
+        taken = set(
+            connection.execute(
+                sa.select(orders.c.code).where(orders.c.kiosk_id == kiosk_id, orders.c.state.in_(OPEN))
+            ).scalars()
+        )
         code = _new_code(taken)
         order_id = "order-" + secrets.token_hex(6)
-        connection.execute(orders.insert().values(
-            id=order_id, kiosk_id=kiosk_id, patient_id=patient_id, instruments=json.dumps(chosen),
-            language=language, answered_by="relative" if relative else "patient", code=code, state="ordered",
-            ordered_by=by.name, ordered_at=now, updated_at=now))
-        _audit(connection, order_id, by.name, "order",
-               f"{', '.join(chosen)} for {patient_id} on {kiosk_id} ({language}"
-               f"{', a relative answers' if relative else ''})")
+        connection.execute(
+            orders.insert().values(
+                id=order_id,
+                kiosk_id=kiosk_id,
+                patient_id=patient_id,
+                instruments=json.dumps(chosen),
+                language=language,
+                answered_by="relative" if relative else "patient",
+                code=code,
+                state="ordered",
+                ordered_by=by.name,
+                ordered_at=now,
+                updated_at=now,
+            )
+        )
+        _audit(
+            connection,
+            order_id,
+            by.name,
+            "order",
+            f"{', '.join(chosen)} for {patient_id} on {kiosk_id} ({language}"
+            f"{', a relative answers' if relative else ''})",
+        )
         return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
 
 
 def _new_code(taken: set[str]) -> str:
     """A code no open order of the kiosk has (the kiosk finds the order by it)."""
     while True:
-        code = f"{secrets.randbelow(10 ** CODE_DIGITS):0{CODE_DIGITS}d}"
+        code = f"{secrets.randbelow(10**CODE_DIGITS):0{CODE_DIGITS}d}"
         if code not in taken:
             return code
 
@@ -209,8 +265,14 @@ def get(engine: Engine, order_id: str) -> Order | None:
     return Order.of(row) if row else None
 
 
-def listing(engine: Engine, *, kiosk_id: str | None = None, states: Sequence[str] | None = None,
-            patient_id: str | None = None, limit: int = 200) -> list[Order]:
+def listing(
+    engine: Engine,
+    *,
+    kiosk_id: str | None = None,
+    states: Sequence[str] | None = None,
+    patient_id: str | None = None,
+    limit: int = 200,
+) -> list[Order]:
     """Orders, newest first, optionally of one kiosk, in some states, of one patient."""
     query = sa.select(orders).order_by(orders.c.ordered_at.desc()).limit(limit)
     if kiosk_id:
@@ -225,8 +287,14 @@ def listing(engine: Engine, *, kiosk_id: str | None = None, states: Sequence[str
 
 def ready_for(connection: Connection, kiosk_id: str) -> list[Order]:
     """The kiosk's orders waiting to be started, oldest first."""
-    return [Order.of(r) for r in connection.execute(sa.select(orders).where(
-        orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered").order_by(orders.c.ordered_at))]
+    return [
+        Order.of(r)
+        for r in connection.execute(
+            sa.select(orders)
+            .where(orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered")
+            .order_by(orders.c.ordered_at)
+        )
+    ]
 
 
 def cancel(engine: Engine, order_id: str, by: Any, reason: str) -> Order:
@@ -239,8 +307,9 @@ def cancel(engine: Engine, order_id: str, by: Any, reason: str) -> Order:
             raise OrderError(f"no order {order_id}")
         if row.state not in OPEN:
             raise OrderError(f"the order is {WORDS[row.state]}: only an ordered or running visit can be cancelled")
-        connection.execute(orders.update().where(orders.c.id == order_id).values(
-            state="cancelled", updated_at=db.now_iso()))
+        connection.execute(
+            orders.update().where(orders.c.id == order_id).values(state="cancelled", updated_at=db.now_iso())
+        )
         _audit(connection, order_id, by.name, "order_cancel", reason.strip() or "cancelled")
         return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
 
@@ -252,24 +321,35 @@ def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
     :data:`CODE_WINDOW_S` the kiosk gets :class:`TooManyCodes` until the window passes. Another
     kiosk's order is never found: the code is looked up among this kiosk's orders only."""
     since = db.now() - CODE_WINDOW_S
-    failures = connection.execute(sa.select(sa.func.count()).select_from(code_failures).where(
-        code_failures.c.kiosk_id == kiosk_id, code_failures.c.at > since)).scalar_one()
+    failures = connection.execute(
+        sa.select(sa.func.count())
+        .select_from(code_failures)
+        .where(code_failures.c.kiosk_id == kiosk_id, code_failures.c.at > since)
+    ).scalar_one()
     if failures >= MAX_CODE_FAILURES:
         raise TooManyCodes(f"too many wrong codes from this kiosk: wait {CODE_WINDOW_S // 60} minutes")
     code = str(code).strip()
     row = None
     if code.isdigit() and len(code) == CODE_DIGITS:
-        row = connection.execute(sa.select(orders).where(
-            orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered",
-            orders.c.code == code).with_for_update()).first()
+        row = connection.execute(
+            sa.select(orders)
+            .where(orders.c.kiosk_id == kiosk_id, orders.c.state == "ordered", orders.c.code == code)
+            .with_for_update()
+        ).first()
     if row is None:
         connection.execute(code_failures.delete().where(code_failures.c.at < since))
         connection.execute(code_failures.insert().values(kiosk_id=kiosk_id, at=db.now()))
         return None
-    connection.execute(orders.update().where(orders.c.id == row.id).values(state="in_progress",
-                                                                          updated_at=db.now_iso()))
-    _audit(connection, row.id, f"kiosk {kiosk_id}", "order_start",
-           f"staff confirmed patient {row.patient_id} at {kiosk_id} with the order's code")
+    connection.execute(
+        orders.update().where(orders.c.id == row.id).values(state="in_progress", updated_at=db.now_iso())
+    )
+    _audit(
+        connection,
+        row.id,
+        f"kiosk {kiosk_id}",
+        "order_start",
+        f"staff confirmed patient {row.patient_id} at {kiosk_id} with the order's code",
+    )
     return Order.of(connection.execute(sa.select(orders).where(orders.c.id == row.id)).one())
 
 
@@ -296,22 +376,41 @@ def on_rows(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[d
             if kind == "order":
                 _link(connection, kiosk_id, event, order_id)
                 messages.append({"type": "order", "kiosk": kiosk_id})
-            db.insert_ignore(connection, visits, [{"session_id": event.session_id, "kind": kind,
-                                                   "order_id": order_id}], ["session_id"])
+            db.insert_ignore(
+                connection,
+                visits,
+                [{"session_id": event.session_id, "kind": kind, "order_id": order_id}],
+                ["session_id"],
+            )
         elif event.kind == "finish_session":
             messages.append({"type": "result", "kiosk": kiosk_id, "session": event.session_id, "finished": True})
-            _move(connection, event.session_id, "in_progress", "awaiting_validation", "order_result",
-                  f"session {event.session_id} finished on {kiosk_id}: the result waits for validation")
+            _move(
+                connection,
+                event.session_id,
+                "in_progress",
+                "awaiting_validation",
+                "order_result",
+                f"session {event.session_id} finished on {kiosk_id}: the result waits for validation",
+            )
         elif event.kind == "abandon":
-            if _move(connection, event.session_id, "in_progress", "ordered", "order_ready",
-                     f"session {event.session_id} ended without a result: the visit can be started again"):
+            if _move(
+                connection,
+                event.session_id,
+                "in_progress",
+                "ordered",
+                "order_ready",
+                f"session {event.session_id} ended without a result: the visit can be started again",
+            ):
                 messages.append({"type": "order", "kiosk": kiosk_id})
         elif event.kind == "create_session":
-            linked = connection.execute(sa.select(orders.c.id, orders.c.patient_id).where(
-                orders.c.session_id == event.session_id)).first()
+            linked = connection.execute(
+                sa.select(orders.c.id, orders.c.patient_id).where(orders.c.session_id == event.session_id)
+            ).first()
             if linked is not None and linked.patient_id != p.get("patient_id"):
-                raise LinkRefused(f"seq {event.seq}: order {linked.id} is for patient {linked.patient_id}, "
-                                  f"not {p.get('patient_id')}: the result is not filed under it")
+                raise LinkRefused(
+                    f"seq {event.seq}: order {linked.id} is for patient {linked.patient_id}, "
+                    f"not {p.get('patient_id')}: the result is not filed under it"
+                )
     return messages
 
 
@@ -319,26 +418,36 @@ def _link(connection: Connection, kiosk_id: str, event: Any, order_id: str | Non
     row = connection.execute(sa.select(orders).where(orders.c.id == (order_id or ""))).first()
     if row is None or row.kiosk_id != kiosk_id:
         raise LinkRefused(f"seq {event.seq}: no order {order_id} for kiosk {kiosk_id}")
-    patient = connection.execute(sa.select(db.sessions.c.patient_id).where(
-        db.sessions.c.id == event.session_id)).scalar()
+    patient = connection.execute(
+        sa.select(db.sessions.c.patient_id).where(db.sessions.c.id == event.session_id)
+    ).scalar()
     if patient is not None and patient != row.patient_id:
-        raise LinkRefused(f"seq {event.seq}: order {order_id} is for patient {row.patient_id}, "
-                      f"not {patient}: the result is not filed under it")
+        raise LinkRefused(
+            f"seq {event.seq}: order {order_id} is for patient {row.patient_id}, "
+            f"not {patient}: the result is not filed under it"
+        )
     if row.state == "ordered":
         raise LinkRefused(f"seq {event.seq}: order {order_id} was not started with its code at the kiosk")
     if row.state != "in_progress":
         return  # cancelled (or done) meanwhile: the session is kept, the order stays as it is
     if row.session_id not in (None, event.session_id):
         raise LinkRefused(f"seq {event.seq}: order {order_id} is running as session {row.session_id}")
-    connection.execute(orders.update().where(orders.c.id == row.id).values(session_id=event.session_id,
-                                                                          updated_at=db.now_iso()))
-    _audit(connection, row.id, f"kiosk {kiosk_id}", "order_session",
-           f"session {event.session_id} started for {row.patient_id} on {kiosk_id}")
+    connection.execute(
+        orders.update().where(orders.c.id == row.id).values(session_id=event.session_id, updated_at=db.now_iso())
+    )
+    _audit(
+        connection,
+        row.id,
+        f"kiosk {kiosk_id}",
+        "order_session",
+        f"session {event.session_id} started for {row.patient_id} on {kiosk_id}",
+    )
 
 
 def _move(connection: Connection, session_id: str, source: str, target: str, action: str, reason: str) -> bool:
-    row = connection.execute(sa.select(orders.c.id, orders.c.kiosk_id).where(
-        orders.c.session_id == session_id, orders.c.state == source)).first()
+    row = connection.execute(
+        sa.select(orders.c.id, orders.c.kiosk_id).where(orders.c.session_id == session_id, orders.c.state == source)
+    ).first()
     if row is None:
         return False
     values: dict[str, Any] = {"state": target, "updated_at": db.now_iso()}
@@ -352,16 +461,28 @@ def _move(connection: Connection, session_id: str, source: str, target: str, act
 def signed_off(engine: Engine, session_id: str, by: Any) -> None:
     """The session's result was signed off: its order (if any) is done."""
     with engine.begin() as connection:
-        _move(connection, session_id, "awaiting_validation", "signed_off", "order_signed",
-              f"result of session {session_id} signed off by {by.name}")
+        _move(
+            connection,
+            session_id,
+            "awaiting_validation",
+            "signed_off",
+            "order_signed",
+            f"result of session {session_id} signed off by {by.name}",
+        )
 
 
 def reopened(engine: Engine, session_id: str, by: Any) -> None:
     """A doctor reopened the session's signed-off result to amend it: its order (if any) awaits
     validation again, so the order never says "signed off" of a result that is not."""
     with engine.begin() as connection:
-        _move(connection, session_id, "signed_off", "awaiting_validation", "order_reopened",
-              f"result of session {session_id} reopened to amend by {by.name}")
+        _move(
+            connection,
+            session_id,
+            "signed_off",
+            "awaiting_validation",
+            "order_reopened",
+            f"result of session {session_id} reopened to amend by {by.name}",
+        )
 
 
 def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:

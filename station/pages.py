@@ -19,10 +19,10 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export.captured import questionnaire_of
-from kiosk.export import ExportError, practice_outcomes
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import review_state, state_once_signed
+from kiosk.export import ExportError, practice_outcomes
+from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import StoredSession
 from station import db, exports, orders, validation, ward
 from station.download import attachment
@@ -30,6 +30,7 @@ from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
 from station.result_pages import ward_results
 from station.sessions import NotFound, load
+
 
 def kiosk_event(app: Starlette, name: str) -> dict[str, Any]:
     """A kiosk's tile, rendered for the live feed."""
@@ -42,9 +43,20 @@ def alerts_event(app: Starlette) -> dict[str, Any]:
     """The open alerts, rendered for the live feed, with their ids (the page sounds new ones)."""
     pending = ward.open_alerts(app.state.engine)
     html = templates.get_template("_alerts.html").render(alerts=pending, csrf="__CSRF__")
-    return {"ids": [a.id for a in pending], "html": html,
-            "alerts": [{"id": a.id, "kiosk": a.kiosk_id, "kind": a.kind, "raised_at": a.raised_at,
-                        "text": f"{a.text} — {a.kiosk_id}"} for a in pending]}
+    return {
+        "ids": [a.id for a in pending],
+        "html": html,
+        "alerts": [
+            {
+                "id": a.id,
+                "kiosk": a.kiosk_id,
+                "kind": a.kind,
+                "raised_at": a.raised_at,
+                "text": f"{a.text} — {a.kiosk_id}",
+            }
+            for a in pending
+        ],
+    }
 
 
 async def ward_page(request: Request) -> Response:
@@ -52,8 +64,16 @@ async def ward_page(request: Request) -> Response:
     views = await run_in_threadpool(ward.kiosk_views, engine)
     pending = await run_in_threadpool(ward.open_alerts, engine)
     recent = await run_in_threadpool(ward_results, engine, request.app.state.questionnaire)
-    return render(request, "ward.html", kiosks=views, alerts=pending, results=recent,
-                  now=db.now(), today=db.now_iso()[:10], message=request.query_params.get("message"))
+    return render(
+        request,
+        "ward.html",
+        kiosks=views,
+        alerts=pending,
+        results=recent,
+        now=db.now(),
+        today=db.now_iso()[:10],
+        message=request.query_params.get("message"),
+    )
 
 
 def _back(request: Request, message: str | None = None, to: str = "/") -> Response:
@@ -64,8 +84,9 @@ async def acknowledge(request: Request) -> Response:
     await checked_form(request)
     engine = request.app.state.engine
     try:
-        kiosk = await run_in_threadpool(ward.acknowledge, engine, int(request.path_params["alert_id"]),
-                                        request.state.user.name)
+        kiosk = await run_in_threadpool(
+            ward.acknowledge, engine, int(request.path_params["alert_id"]), request.state.user.name
+        )
     except ward.WardError as exc:
         return _back(request, str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "ack", "kiosk": kiosk})
@@ -76,12 +97,14 @@ async def command(request: Request) -> Response:
     form = await checked_form(request)
     engine, kiosk = request.app.state.engine, request.path_params["name"]
     try:
-        await run_in_threadpool(ward.queue_command, engine, kiosk, form.get("session_id", ""), form.get("kind", ""),
-                                request.state.user.name)
+        await run_in_threadpool(
+            ward.queue_command, engine, kiosk, form.get("session_id", ""), form.get("kind", ""), request.state.user.name
+        )
     except ward.WardError as exc:
         return _back(request, str(exc))
-    await run_in_threadpool(request.app.state.bus.publish, {"type": "command", "kiosk": kiosk},
-                            {"type": "ack", "kiosk": kiosk})
+    await run_in_threadpool(
+        request.app.state.bus.publish, {"type": "command", "kiosk": kiosk}, {"type": "ack", "kiosk": kiosk}
+    )
     return _back(request, ward.COMMAND_WORDS[form.get("kind", "")].format(kiosk=kiosk))
 
 
@@ -102,8 +125,10 @@ def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[st
     answers = {a.item_id: a for a in stored.answers if a.item_id in items}
     options = review.options({a.item_id: a.option for a in stored.answers})
     # a question's attempts timing out are logged as "ITEM attempt N"
-    outcomes = sorted([(a.t, a.item_id) for a in stored.answers] + [
-        (e.t, e.detail.split(" ")[0]) for e in stored.log if e.kind == "attempt_timed_out"])
+    outcomes = sorted(
+        [(a.t, a.item_id) for a in stored.answers]
+        + [(e.t, e.detail.split(" ")[0]) for e in stored.log if e.kind == "attempt_timed_out"]
+    )
     start = next((e.t for e in stored.log if e.kind == "start"), 0.0)
     rows, previous_t = [], start
     for number, item in enumerate(q.items, 1):
@@ -116,15 +141,24 @@ def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[st
             previous_t = max([t for t, i in outcomes if i == item.id] + [previous_t])
         option = options.get(item.id) if _fits(item, options.get(item.id)) else None
         changes = [c for c in review.corrections if c.item_id == item.id]
-        rows.append({
-            "number": number, "id": item.id, "text": _in(item.text, stored.language),
-            "recorded": a, "recorded_label": _in(item.option(a.option).label, stored.language)
-            if a and _fits(item, a.option) else None,
-            "option": option, "label": _in(item.option(option).label, stored.language) if option else None,
-            "points": item.option(option).points if option else None, "taken": taken,
-            "not_answered": item.id in stored.not_answered, "changes": changes,
-            "options": [(o.number, _in(o.label, stored.language), o.points) for o in item.options],
-        })
+        rows.append(
+            {
+                "number": number,
+                "id": item.id,
+                "text": _in(item.text, stored.language),
+                "recorded": a,
+                "recorded_label": _in(item.option(a.option).label, stored.language)
+                if a and _fits(item, a.option)
+                else None,
+                "option": option,
+                "label": _in(item.option(option).label, stored.language) if option else None,
+                "points": item.option(option).points if option else None,
+                "taken": taken,
+                "not_answered": item.id in stored.not_answered,
+                "changes": changes,
+                "options": [(o.number, _in(o.label, stored.language), o.points) for o in item.options],
+            }
+        )
     return rows
 
 
@@ -153,16 +187,29 @@ async def session_page(request: Request) -> Response:
     score = _score(q, stored, current)
     recorded = {a.item_id: a.option for a in stored.answers}
     state = review_state(current, recorded)
-    return render(request, "session.html", s=stored, kiosk=kiosk, review=current, state=state, trail=entries,
-                  will_be=state_once_signed(current, recorded).value,
-                  q=q, items=_items(q, stored, current), score=score, practice=_practice(q, stored),
-                  plot=qos_svg(stored), incidents=[e for e in stored.log if e.kind in INCIDENTS],
-                  unfit=[e for e in stored.log if e.kind.startswith(("unfit:", "unreadable:"))],
-                  incident_words=INCIDENTS, commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
-                  reviewable=stored.status in validation.REVIEWABLE and not current.final,
-                  reopened=bool(current.reopenings) and not current.final,
-                  visit=(await run_in_threadpool(orders.visit_kinds, engine, [session_id])).get(session_id),
-                  message=request.query_params.get("message"))
+    return render(
+        request,
+        "session.html",
+        s=stored,
+        kiosk=kiosk,
+        review=current,
+        state=state,
+        trail=entries,
+        will_be=state_once_signed(current, recorded).value,
+        q=q,
+        items=_items(q, stored, current),
+        score=score,
+        practice=_practice(q, stored),
+        plot=qos_svg(stored),
+        incidents=[e for e in stored.log if e.kind in INCIDENTS],
+        unfit=[e for e in stored.log if e.kind.startswith(("unfit:", "unreadable:"))],
+        incident_words=INCIDENTS,
+        commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
+        reviewable=stored.status in validation.REVIEWABLE and not current.final,
+        reopened=bool(current.reopenings) and not current.final,
+        visit=(await run_in_threadpool(orders.visit_kinds, engine, [session_id])).get(session_id),
+        message=request.query_params.get("message"),
+    )
 
 
 def _load(engine: Any, session_id: str) -> tuple[str, StoredSession]:
@@ -182,8 +229,16 @@ async def change_item(request: Request) -> Response:
     try:
         _, stored = await run_in_threadpool(_load, engine, session_id)
         q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
-        await run_in_threadpool(validation.change_item, engine, q, session_id, request.path_params["item_id"],
-                                option, form.get("reason", ""), request.state.user)
+        await run_in_threadpool(
+            validation.change_item,
+            engine,
+            q,
+            session_id,
+            request.path_params["item_id"],
+            option,
+            form.get("reason", ""),
+            request.state.user,
+        )
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
     return _back(request, "Change recorded.", to=page)
@@ -207,8 +262,9 @@ async def amend(request: Request) -> Response:
     session_id = request.path_params["session_id"]
     page = f"/sessions/{session_id}"
     try:
-        await run_in_threadpool(validation.amend, request.app.state.engine, session_id, form.get("reason", ""),
-                                request.state.user)
+        await run_in_threadpool(
+            validation.amend, request.app.state.engine, session_id, form.get("reason", ""), request.state.user
+        )
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
     await run_in_threadpool(orders.reopened, request.app.state.engine, session_id, request.state.user)
@@ -228,13 +284,13 @@ async def export(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id, fmt = request.path_params["session_id"], request.path_params["fmt"]
     if fmt not in ("json", "csv"):
-        return PlainTextResponse(f"no export .{fmt[:20]}: choose export.json (FHIR) or export.csv",
-                                 status_code=404)
+        return PlainTextResponse(f"no export .{fmt[:20]}: choose export.json (FHIR) or export.csv", status_code=404)
     try:
         if fmt == "json":
             bundle = await run_in_threadpool(exports.result_bundle, engine, q, session_id)
-            return _attachment(json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json",
-                               session_id, ".fhir.json")
+            return _attachment(
+                json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json", session_id, ".fhir.json"
+            )
         body = await run_in_threadpool(exports.result_csv, engine, q, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id}", status_code=404)
@@ -255,10 +311,15 @@ async def period_export(request: Request) -> Response:
     try:
         bundle = await run_in_threadpool(exports.period_bundle, engine, q, first, last)
     except ExportError as exc:
-        return PlainTextResponse(f"the results signed off from {first} to {last} cannot be exported: {exc}",
-                                 status_code=422)
-    return _attachment(json.dumps(bundle, indent=2, ensure_ascii=False), "application/fhir+json",
-                       f"signed-off-{first}-{last}", ".fhir.json")
+        return PlainTextResponse(
+            f"the results signed off from {first} to {last} cannot be exported: {exc}", status_code=422
+        )
+    return _attachment(
+        json.dumps(bundle, indent=2, ensure_ascii=False),
+        "application/fhir+json",
+        f"signed-off-{first}-{last}",
+        ".fhir.json",
+    )
 
 
 routes = [

@@ -46,26 +46,33 @@ def qos_svg(stored: StoredSession) -> str:
     def y(v: float) -> float:
         return TOP + plot_h * (high - v) / ((high - low) or 1.0)
 
-    parts = [f'<svg class="qos-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
-             f'aria-label="QoS metrics over the session, with incidents" xmlns="http://www.w3.org/2000/svg">']
+    parts = [
+        f'<svg class="qos-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
+        f'aria-label="QoS metrics over the session, with incidents" xmlns="http://www.w3.org/2000/svg">'
+    ]
     for tick in (low, (low + high) / 2, high):
-        parts.append(f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{_fmt(y(tick))}" y2="{_fmt(y(tick))}" '
-                     'class="grid"/>')
+        parts.append(f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{_fmt(y(tick))}" y2="{_fmt(y(tick))}" class="grid"/>')
         parts.append(f'<text x="{LEFT - 6}" y="{_fmt(y(tick) + 4)}" text-anchor="end">{tick:g}</text>')
     for t_tick in range(0, int(t_end) + 1, max(60, int(t_end / 6) // 60 * 60 or 60)):
-        parts.append(f'<text x="{_fmt(x(t_tick))}" y="{HEIGHT - BOTTOM + 16}" text-anchor="middle">'
-                     f'{t_tick // 60}:{t_tick % 60:02d}</text>')
+        parts.append(
+            f'<text x="{_fmt(x(t_tick))}" y="{HEIGHT - BOTTOM + 16}" text-anchor="middle">'
+            f"{t_tick // 60}:{t_tick % 60:02d}</text>"
+        )
     for incident in incidents:
         label = escape(f"{INCIDENTS[incident.kind]} at {incident.t:.0f} s {incident.detail}".strip())
-        parts.append(f'<line x1="{_fmt(x(incident.t))}" x2="{_fmt(x(incident.t))}" y1="{TOP}" '
-                     f'y2="{TOP + plot_h}" style="stroke: {MARK_COLOURS["incident"]}" '
-                     f'class="incident incident-{escape(incident.kind)}">'
-                     f'<title>{label}</title></line>')
+        parts.append(
+            f'<line x1="{_fmt(x(incident.t))}" x2="{_fmt(x(incident.t))}" y1="{TOP}" '
+            f'y2="{TOP + plot_h}" style="stroke: {MARK_COLOURS["incident"]}" '
+            f'class="incident incident-{escape(incident.kind)}">'
+            f"<title>{label}</title></line>"
+        )
     for mark in adaptations:
         label = escape(f"{mark.label} at {mark.t:.0f} s")
-        parts.append(f'<line x1="{_fmt(x(mark.t))}" x2="{_fmt(x(mark.t))}" y1="{TOP}" y2="{TOP + plot_h}" '
-                     f'class="adaptation" style="stroke: {MARK_COLOURS["adaptation"]}" stroke-dasharray="4 3">'
-                     f'<title>{label}</title></line>')
+        parts.append(
+            f'<line x1="{_fmt(x(mark.t))}" x2="{_fmt(x(mark.t))}" y1="{TOP}" y2="{TOP + plot_h}" '
+            f'class="adaptation" style="stroke: {MARK_COLOURS["adaptation"]}" stroke-dasharray="4 3">'
+            f"<title>{label}</title></line>"
+        )
     for index, name in enumerate(names):
         points, last = [], None
         for sample in samples:
@@ -79,13 +86,17 @@ def qos_svg(stored: StoredSession) -> str:
         if last is not None:
             points.append(f"{_fmt(x(t_end))},{_fmt(y(last))}")
         colour = metric_colour(name, index)
-        parts.append(f'<polyline fill="none" stroke="{colour}" stroke-width="2" points="{" ".join(points)}">'
-                     f'<title>{escape(name)}</title></polyline>')
+        parts.append(
+            f'<polyline fill="none" stroke="{colour}" stroke-width="2" points="{" ".join(points)}">'
+            f"<title>{escape(name)}</title></polyline>"
+        )
         parts.append(f'<text x="{LEFT + index * 200}" y="{HEIGHT - 26}" fill="{colour}">■ {escape(name)}</text>')
     keys = ([f'<tspan fill="{MARK_COLOURS["incident"]}">┆ incident</tspan>'] if incidents else []) + (
-        [f'<tspan fill="{MARK_COLOURS["adaptation"]}">┆ adaptation</tspan>'] if adaptations else [])
+        [f'<tspan fill="{MARK_COLOURS["adaptation"]}">┆ adaptation</tspan>'] if adaptations else []
+    )
     if keys:
-        parts.append(f'<text x="{LEFT}" y="{HEIGHT - 8}" class="incident-key">'
-                     f'{"  ".join(keys)}  (hover a line for what)</text>')
+        parts.append(
+            f'<text x="{LEFT}" y="{HEIGHT - 8}" class="incident-key">{"  ".join(keys)}  (hover a line for what)</text>'
+        )
     parts.append("</svg>")
     return "".join(parts)

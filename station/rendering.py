@@ -18,8 +18,12 @@ from station import auth, logins, ward
 templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
 templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
 #: a command as staff name it (the buttons' words), never its protocol name
-templates.env.globals["command_labels"] = {"continue": "Continue session", "person_away": "Patient away",
-                                           "person_back": "Patient back", "end": "End session"}
+templates.env.globals["command_labels"] = {
+    "continue": "Continue session",
+    "person_away": "Patient away",
+    "person_back": "Patient back",
+    "end": "End session",
+}
 
 
 class Forbidden(Exception):

@@ -50,8 +50,14 @@ async def patient_page(request: Request) -> Response:
     if not visits and not ordered:
         return PlainTextResponse(f"no visit of patient {patient_id} has reached this station", status_code=404)
     ran = await run_in_threadpool(results.instruments, engine, q, visits)
-    return render(request, "patient.html", patient_id=patient_id, visits=visits, orders=ordered,
-                  plots=[(i.id, i.title.get("en", i.id), course_svg(i, visits)) for i in ran])
+    return render(
+        request,
+        "patient.html",
+        patient_id=patient_id,
+        visits=visits,
+        orders=ordered,
+        plots=[(i.id, i.title.get("en", i.id), course_svg(i, visits)) for i in ran],
+    )
 
 
 routes = [
@@ -63,6 +69,7 @@ routes = [
 
 # -- live: the results event and the fragments the open pages fetch when it comes ----------------
 
+
 def results_event(app: Any, finished: list[str]) -> dict[str, Any]:
     """The count of results waiting, and the ones that just finished (the pages ring for them).
     Cheap on purpose (two small queries, no session folded): it is rendered on the live feed's
@@ -72,10 +79,17 @@ def results_event(app: Any, finished: list[str]) -> dict[str, Any]:
     if finished:
         with engine.connect() as connection:
             columns = (db.sessions.c.id, db.sessions.c.patient_id, db.sessions.c.kiosk_id)
-            rows = connection.execute(sa.select(*columns).where(
-                db.sessions.c.id.in_(finished), db.sessions.c.status == "finished")).all()
-        rung = [{"session": r.id, "href": f"/sessions/{r.id}",
-                 "text": f"Result waiting: {r.patient_id}, kiosk {r.kiosk_id}"} for r in rows]
+            rows = connection.execute(
+                sa.select(*columns).where(db.sessions.c.id.in_(finished), db.sessions.c.status == "finished")
+            ).all()
+        rung = [
+            {
+                "session": r.id,
+                "href": f"/sessions/{r.id}",
+                "text": f"Result waiting: {r.patient_id}, kiosk {r.kiosk_id}",
+            }
+            for r in rows
+        ]
     return {"count": results.waiting_count(engine), "rung": rung}
 
 
@@ -83,8 +97,9 @@ async def inbox_rows(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     state = request.query_params.get("state", "waiting")
     kiosk = request.query_params.get("kiosk") or None
-    found = await run_in_threadpool(lambda: results.inbox(
-        engine, q, state=state if state in results.INBOX_STATES else "waiting", kiosk_id=kiosk))
+    found = await run_in_threadpool(
+        lambda: results.inbox(engine, q, state=state if state in results.INBOX_STATES else "waiting", kiosk_id=kiosk)
+    )
     template = templates.get_template("_result_row.html")
     html = "".join(template.render(r=r) for r in found) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
     return HTMLResponse(html)
@@ -93,8 +108,12 @@ async def inbox_rows(request: Request) -> Response:
 def ward_results(engine: Any, q: Any) -> list[results.Result]:
     """The ward page's Results: the latest sessions of every status, newest first."""
     with engine.connect() as connection:
-        ids = connection.execute(sa.select(db.sessions.c.id).where(db.sessions.c.status != "pending").order_by(
-            db.sessions.c.started_at.desc()).limit(RECENT)).all()
+        ids = connection.execute(
+            sa.select(db.sessions.c.id)
+            .where(db.sessions.c.status != "pending")
+            .order_by(db.sessions.c.started_at.desc())
+            .limit(RECENT)
+        ).all()
     return results.results_of(engine, q, ids)
 
 

@@ -14,10 +14,10 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 
-from kiosk.export.captured import questionnaire_of
-from kiosk.export import ExportError
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import review_state
+from kiosk.export import ExportError
+from kiosk.export.captured import questionnaire_of
 from station import orders, validation
 from station.db import audit, sessions
 from station.sessions import load
@@ -60,17 +60,25 @@ class Result:
 def _signed(engine: Engine) -> Any:
     """Sessions whose latest sign-off or reopening is a sign-off: a result a doctor reopened to
     amend waits for validation again, as :func:`kiosk.core.review.review_from_steps` says."""
-    latest = sa.select(audit.c.session_id, sa.func.max(audit.c.id).label("last")).where(
-        audit.c.action.in_(("sign_off", "amend"))).group_by(audit.c.session_id).subquery()
-    return sa.select(latest.c.session_id).join(audit, audit.c.id == latest.c.last).where(
-        audit.c.action == "sign_off")
+    latest = (
+        sa.select(audit.c.session_id, sa.func.max(audit.c.id).label("last"))
+        .where(audit.c.action.in_(("sign_off", "amend")))
+        .group_by(audit.c.session_id)
+        .subquery()
+    )
+    return sa.select(latest.c.session_id).join(audit, audit.c.id == latest.c.last).where(audit.c.action == "sign_off")
 
 
 def waiting_count(engine: Engine) -> int:
     """Finished results no doctor has signed off yet (the count in the navigation)."""
     with engine.connect() as connection:
-        return int(connection.execute(sa.select(sa.func.count()).select_from(sessions).where(
-            sessions.c.status == "finished", sessions.c.id.not_in(_signed(engine)))).scalar_one())
+        return int(
+            connection.execute(
+                sa.select(sa.func.count())
+                .select_from(sessions)
+                .where(sessions.c.status == "finished", sessions.c.id.not_in(_signed(engine)))
+            ).scalar_one()
+        )
 
 
 def results_of(engine: Engine, q: Questionnaire, rows: list[Any]) -> list[Result]:
@@ -87,23 +95,44 @@ def results_of(engine: Engine, q: Questionnaire, rows: list[Any]) -> list[Result
                 ran = questionnaire_of(stored, fallback=q)
             except ExportError:
                 ran = None
-            score = validation.corrected(stored, ran, review)["score"] if ran and stored.questionnaire_id == ran.id else None
+            score = (
+                validation.corrected(stored, ran, review)["score"]
+                if ran and stored.questionnaire_id == ran.id
+                else None
+            )
             state = review_state(review, {a.item_id: a.option for a in stored.answers})
             kind, order_id = kinds.get(row.id, ("", None))
-            found.append(Result(
-                row.id, kiosk, stored.patient_id, stored.questionnaire_id, stored.started_at, stored.finished_at,
-                stored.status, score.total if score and score.complete else None,
-                score.max_total if score else 0, bool(score and score.complete),
-                score.band.id if score and score.band else None, state.value, stored.simulated,
-                kind, order_id))
+            found.append(
+                Result(
+                    row.id,
+                    kiosk,
+                    stored.patient_id,
+                    stored.questionnaire_id,
+                    stored.started_at,
+                    stored.finished_at,
+                    stored.status,
+                    score.total if score and score.complete else None,
+                    score.max_total if score else 0,
+                    bool(score and score.complete),
+                    score.band.id if score and score.band else None,
+                    state.value,
+                    stored.simulated,
+                    kind,
+                    order_id,
+                )
+            )
     return found
 
 
 def inbox(engine: Engine, q: Questionnaire, *, state: str = "waiting", kiosk_id: str | None = None) -> list[Result]:
     """Finished results, newest first, in the review states of ``state`` (:data:`INBOX_STATES`),
     of one kiosk or all."""
-    query = sa.select(sessions.c.id).where(sessions.c.status == "finished").order_by(
-        sessions.c.finished_at.desc()).limit(INBOX_LIMIT)
+    query = (
+        sa.select(sessions.c.id)
+        .where(sessions.c.status == "finished")
+        .order_by(sessions.c.finished_at.desc())
+        .limit(INBOX_LIMIT)
+    )
     if kiosk_id:
         query = query.where(sessions.c.kiosk_id == kiosk_id)
     if state == "waiting":
@@ -119,9 +148,11 @@ def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
     """Every visit of one patient that reached this station, oldest first (running, abandoned
     and interrupted ones too: the course shows what happened, the plot only what was scored)."""
     with engine.connect() as connection:
-        rows = connection.execute(sa.select(sessions.c.id).where(
-            sessions.c.patient_id == patient_id, sessions.c.status != "pending").order_by(
-            sessions.c.started_at)).all()
+        rows = connection.execute(
+            sa.select(sessions.c.id)
+            .where(sessions.c.patient_id == patient_id, sessions.c.status != "pending")
+            .order_by(sessions.c.started_at)
+        ).all()
     return results_of(engine, q, rows)
 
 
@@ -151,8 +182,12 @@ def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, s
     if not text:
         return []
     pattern = "%" + text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_") + "%"
-    query = sa.select(sessions.c.patient_id, sa.func.count(), sa.func.max(sessions.c.started_at)).where(
-        sessions.c.patient_id.ilike(pattern, escape="\\"), sessions.c.status != "pending").group_by(
-        sessions.c.patient_id).order_by(sa.func.max(sessions.c.started_at).desc()).limit(limit)
+    query = (
+        sa.select(sessions.c.patient_id, sa.func.count(), sa.func.max(sessions.c.started_at))
+        .where(sessions.c.patient_id.ilike(pattern, escape="\\"), sessions.c.status != "pending")
+        .group_by(sessions.c.patient_id)
+        .order_by(sa.func.max(sessions.c.started_at).desc())
+        .limit(limit)
+    )
     with engine.connect() as connection:
         return [(p, int(n), last or "") for p, n, last in connection.execute(query)]

@@ -37,8 +37,9 @@ def grant_app_role(engine: Engine, role: str) -> None:
     try:
         _grant(engine, role)
     except sa.exc.SQLAlchemyError as exc:
-        raise RoleError(f"cannot grant role {role!r} the station's tables: {str(exc.orig or exc).splitlines()[0]}"
-                        ) from None
+        raise RoleError(
+            f"cannot grant role {role!r} the station's tables: {str(exc.orig or exc).splitlines()[0]}"
+        ) from None
 
 
 def _grant(engine: Engine, role: str) -> None:
@@ -46,19 +47,25 @@ def _grant(engine: Engine, role: str) -> None:
         if not connection.execute(sa.text("SELECT 1 FROM pg_roles WHERE rolname = :r"), {"r": role}).first():
             raise RoleError(f"no role {role!r} on this server: create it first (CREATE ROLE {role} LOGIN PASSWORD ...)")
         if connection.execute(sa.text("SELECT rolsuper FROM pg_roles WHERE rolname = :r"), {"r": role}).scalar():
-            raise RoleError(f"role {role!r} is a superuser, so it can change anything: give the station an "
-                            "ordinary role")
-        owner = connection.execute(sa.text("SELECT tableowner FROM pg_tables WHERE tablename = 'audit' "
-                                           "AND schemaname = current_schema()")).scalar()
+            raise RoleError(
+                f"role {role!r} is a superuser, so it can change anything: give the station an ordinary role"
+            )
+        owner = connection.execute(
+            sa.text("SELECT tableowner FROM pg_tables WHERE tablename = 'audit' AND schemaname = current_schema()")
+        ).scalar()
         if owner == role:
             raise RoleError(f"role {role!r} owns the tables: the app role must be another role than the owner")
-        me, superuser = connection.execute(sa.text(
-            "SELECT current_user, rolsuper FROM pg_roles WHERE rolname = current_user")).one()
+        me, superuser = connection.execute(
+            sa.text("SELECT current_user, rolsuper FROM pg_roles WHERE rolname = current_user")
+        ).one()
         if me != owner and not superuser:  # PostgreSQL would only warn, and grant nothing
-            raise RoleError(f"only the tables' owner ({owner!r}) can grant them; this is role {me!r}: give the "
-                            "owner's URL as --db")
-        who, schema = _quote(connection, role), _quote(connection, connection.execute(
-            sa.text("SELECT current_schema()")).scalar_one())
+            raise RoleError(
+                f"only the tables' owner ({owner!r}) can grant them; this is role {me!r}: give the owner's URL as --db"
+            )
+        who, schema = (
+            _quote(connection, role),
+            _quote(connection, connection.execute(sa.text("SELECT current_schema()")).scalar_one()),
+        )
         app_tables = [name for name in db.metadata.tables if name != db.audit.name]
         connection.execute(sa.text(f"GRANT USAGE ON SCHEMA {schema} TO {who}"))
         for table in [*app_tables, db.audit.name, "alembic_version"]:
@@ -81,12 +88,14 @@ def check_privileges(engine: Engine) -> None:
     with engine.connect() as connection:
         for table, privileges in needed.items():
             for privilege in privileges.split(", "):
-                if not connection.execute(sa.text("SELECT has_table_privilege(:t, :p)"),
-                                          {"t": table, "p": privilege}).scalar():
+                if not connection.execute(
+                    sa.text("SELECT has_table_privilege(:t, :p)"), {"t": table, "p": privilege}
+                ).scalar():
                     role = connection.execute(sa.text("SELECT current_user")).scalar()
                     raise db.DatabaseError(
                         f"role {role!r} may not {privilege} on table {table}: run 'kiosk station migrate --db "
-                        f"OWNER_URL --grant {role}' as the schema's owner")
+                        f"OWNER_URL --grant {role}' as the schema's owner"
+                    )
 
 
 def guard_warning(engine: Engine) -> str | None:
@@ -95,12 +104,17 @@ def guard_warning(engine: Engine) -> str | None:
     if not db.is_postgres(engine):
         return None
     with engine.connect() as connection:
-        row = connection.execute(sa.text(
-            "SELECT current_user AS me, (SELECT rolsuper FROM pg_roles WHERE rolname = current_user) AS super, "
-            "(SELECT tableowner FROM pg_tables WHERE tablename = 'audit' AND schemaname = current_schema()) "
-            "AS owner")).one()
+        row = connection.execute(
+            sa.text(
+                "SELECT current_user AS me, (SELECT rolsuper FROM pg_roles WHERE rolname = current_user) AS super, "
+                "(SELECT tableowner FROM pg_tables WHERE tablename = 'audit' AND schemaname = current_schema()) "
+                "AS owner"
+            )
+        ).one()
     if not row.super and row.owner != row.me:
         return None
-    return (f"warning: the station runs as role {row.me!r}, which "
-            f"{'is a superuser' if row.super else 'owns the audit table'} and could switch off the audit "
-            "trail's append-only guard; run it as an app role (kiosk station migrate --db OWNER_URL --grant ROLE)")
+    return (
+        f"warning: the station runs as role {row.me!r}, which "
+        f"{'is a superuser' if row.super else 'owns the audit table'} and could switch off the audit "
+        "trail's append-only guard; run it as an app role (kiosk station migrate --db OWNER_URL --grant ROLE)"
+    )

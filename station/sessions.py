@@ -16,11 +16,11 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.export.captured import questionnaire_of
 from kiosk.core.channels import Channel
-from kiosk.export import ExportError
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Answer, AnsweredBy
+from kiosk.export import ExportError
+from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import (
     AdaptationRecord,
     LogEntry,
@@ -50,8 +50,11 @@ class NotFound(KeyError):
 
 def rows_of(connection: Connection, session_id: str, kinds: Iterable[str] | None = None) -> list[Row]:
     """The session's rows in the kiosk's order."""
-    query = sa.select(inbox.c.seq, inbox.c.kind, inbox.c.payload, inbox.c.at).where(
-        inbox.c.session_id == session_id).order_by(inbox.c.seq)
+    query = (
+        sa.select(inbox.c.seq, inbox.c.kind, inbox.c.payload, inbox.c.at)
+        .where(inbox.c.session_id == session_id)
+        .order_by(inbox.c.seq)
+    )
     if kinds is not None:
         query = query.where(inbox.c.kind.in_(list(kinds)))
     return [Row(seq, kind, json.loads(payload), at) for seq, kind, payload, at in connection.execute(query)]
@@ -101,14 +104,25 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
     except ValueError:
         answered_by = AnsweredBy.PATIENT
     return StoredSession(
-        id=session_id, patient_id=status["patient_id"] or "?",
-        questionnaire_id=str(head.get("questionnaire_id", "barthel")), language=language, answered_by=answered_by,
+        id=session_id,
+        patient_id=status["patient_id"] or "?",
+        questionnaire_id=str(head.get("questionnaire_id", "barthel")),
+        language=language,
+        answered_by=answered_by,
         timing=head.get("timing", {}) if isinstance(head.get("timing"), dict) else {},
-        started_at=str(status["started_at"] or ""), status=status["status"],
-        finished_at=status["finished_at"], answers=tuple(ordered), not_answered=tuple(not_answered),
-        trace=tuple(trace), metrics=tuple(metrics), adaptations=tuple(adaptations), log=tuple(log),
-        practice=tuple(practice), simulated=head.get("simulated") is True,
-        identity=_identity(head), identity_attached_later=bool(head.get("export_attached_later")),
+        started_at=str(status["started_at"] or ""),
+        status=status["status"],
+        finished_at=status["finished_at"],
+        answers=tuple(ordered),
+        not_answered=tuple(not_answered),
+        trace=tuple(trace),
+        metrics=tuple(metrics),
+        adaptations=tuple(adaptations),
+        log=tuple(log),
+        practice=tuple(practice),
+        simulated=head.get("simulated") is True,
+        identity=_identity(head),
+        identity_attached_later=bool(head.get("export_attached_later")),
         **(interrupted if status["status"] == "interrupted" else {}),
     )
 
@@ -118,18 +132,34 @@ def _identity(head: dict[str, Any]) -> dict[str, str]:
     return {k: v for k, v in identity.items() if isinstance(v, str)} if isinstance(identity, dict) else {}
 
 
-def _apply(row: Row, head: dict[str, Any], answers: dict[str, Answer], not_answered: list[str],
-           trace: list[dict[str, Any]], metrics: list[MetricSample], adaptations: list[AdaptationRecord],
-           log: list[LogEntry], practice: list[PracticeRecord], interrupted: dict[str, Any]) -> None:
+def _apply(
+    row: Row,
+    head: dict[str, Any],
+    answers: dict[str, Answer],
+    not_answered: list[str],
+    trace: list[dict[str, Any]],
+    metrics: list[MetricSample],
+    adaptations: list[AdaptationRecord],
+    log: list[LogEntry],
+    practice: list[PracticeRecord],
+    interrupted: dict[str, Any],
+) -> None:
     """Fold one row into the session being read."""
     p = row.payload
     if row.kind == "create_session":
         head.clear()
         head.update(p)
     elif row.kind == "record_answer":
-        answers[p["item_id"]] = Answer(p["item_id"], int(p["option"]), int(p["points"]), int(p["attempt"]),
-                                       Channel(p["channel"]), AnsweredBy(p["answered_by"]), float(p["t"]),
-                                       p.get("detail", ""))
+        answers[p["item_id"]] = Answer(
+            p["item_id"],
+            int(p["option"]),
+            int(p["points"]),
+            int(p["attempt"]),
+            Channel(p["channel"]),
+            AnsweredBy(p["answered_by"]),
+            float(p["t"]),
+            p.get("detail", ""),
+        )
         if p["item_id"] in not_answered:
             not_answered.remove(p["item_id"])
     elif row.kind == "withdraw_answer":  # the patient's "Change my answer": the answer is gone
@@ -138,9 +168,17 @@ def _apply(row: Row, head: dict[str, Any], answers: dict[str, Answer], not_answe
         if p["item_id"] not in answers and p["item_id"] not in not_answered:
             not_answered.append(p["item_id"])
     elif row.kind == "record_practice":
-        practice.append(PracticeRecord(p["question_id"], p["checks"], p["outcome"], p.get("option"),
-                                       Channel(p["channel"]) if p.get("channel") else None, float(p["t"]),
-                                       p.get("detail", "")))
+        practice.append(
+            PracticeRecord(
+                p["question_id"],
+                p["checks"],
+                p["outcome"],
+                p.get("option"),
+                Channel(p["channel"]) if p.get("channel") else None,
+                float(p["t"]),
+                p.get("detail", ""),
+            )
+        )
     elif row.kind == "record_context":
         event: dict[str, Any] = {"t": float(p["t"])}
         if p.get("set"):
@@ -173,13 +211,19 @@ def _kiosk_and_rows(connection: Connection, session_id: str) -> tuple[str, list[
 def _with_definition(connection: Connection, stored: StoredSession) -> StoredSession:
     """``stored`` with the definition it runs (None if its create_session never arrived), and only
     what fits it (see :func:`fitted`)."""
-    row = connection.execute(sa.select(sessions.c.definition_sha256, sessions.c.definition_attached_later,
-                                       definitions.c.body).select_from(sessions.outerjoin(
-        definitions, definitions.c.sha256 == sessions.c.definition_sha256)).where(sessions.c.id == stored.id)).first()
+    row = connection.execute(
+        sa.select(sessions.c.definition_sha256, sessions.c.definition_attached_later, definitions.c.body)
+        .select_from(sessions.outerjoin(definitions, definitions.c.sha256 == sessions.c.definition_sha256))
+        .where(sessions.c.id == stored.id)
+    ).first()
     if row is None or row.body is None:
         return stored
-    stored = replace(stored, definition=json.loads(row.body), definition_sha256=row.definition_sha256,
-                     definition_attached_later=bool(row.definition_attached_later))
+    stored = replace(
+        stored,
+        definition=json.loads(row.body),
+        definition_sha256=row.definition_sha256,
+        definition_attached_later=bool(row.definition_attached_later),
+    )
     try:
         return fitted(stored, questionnaire_of(stored))
     except ExportError:
@@ -200,18 +244,29 @@ def fitted(stored: StoredSession, q: Questionnaire) -> StoredSession:
         return item is not None and 1 <= a.option <= len(item.options) and item.option(a.option).points == a.points
 
     answers = tuple(a for a in stored.answers if fits(a))
-    log += [LogEntry(a.t, "unfit:answer", f"{a.item_id} option {a.option} ({a.points} points)")
-            for a in stored.answers if not fits(a)]
+    log += [
+        LogEntry(a.t, "unfit:answer", f"{a.item_id} option {a.option} ({a.points} points)")
+        for a in stored.answers
+        if not fits(a)
+    ]
     practice = tuple(p for p in stored.practice if p.question_id in practice_ids)
-    log += [LogEntry(p.t, "unfit:practice", p.question_id) for p in stored.practice if p.question_id not in practice_ids]
+    log += [
+        LogEntry(p.t, "unfit:practice", p.question_id) for p in stored.practice if p.question_id not in practice_ids
+    ]
     language = stored.language
     if language not in q.languages:
         log.append(LogEntry(0.0, "unfit:language", f"{language!r}; shown in {q.languages[0]}"))
         language = q.languages[0]
     if len(log) == len(stored.log):
         return stored
-    return replace(stored, answers=answers, practice=practice, language=language, log=tuple(log),
-                   not_answered=tuple(i for i in stored.not_answered if i in items))
+    return replace(
+        stored,
+        answers=answers,
+        practice=practice,
+        language=language,
+        log=tuple(log),
+        not_answered=tuple(i for i in stored.not_answered if i in items),
+    )
 
 
 def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
@@ -219,4 +274,3 @@ def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
     if it never arrived)."""
     kiosk, rows = _kiosk_and_rows(connection, session_id)
     return kiosk, _with_definition(connection, fold(session_id, rows))
-

@@ -14,9 +14,9 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from kiosk.export.captured import questionnaire_of
-from kiosk.export import ExportError
 from kiosk.core.review import state_once_signed
+from kiosk.export import ExportError
+from kiosk.export.captured import questionnaire_of
 from station import validation
 from station.rendering import render
 from station.sessions import NotFound, load
@@ -38,8 +38,9 @@ async def confirm_page(request: Request) -> Response:
     if current.final or stored.status not in validation.REVIEWABLE:  # type: ignore[attr-defined]
         return RedirectResponse(f"/sessions/{session_id}", status_code=303)
     if not request.state.user.is_doctor:
-        return RedirectResponse(f"/sessions/{session_id}?message={quote('Only a doctor can sign off.')}",
-                                status_code=303)
+        return RedirectResponse(
+            f"/sessions/{session_id}?message={quote('Only a doctor can sign off.')}", status_code=303
+        )
     try:  # the questionnaire the session ran, not the one the station bundles
         q = questionnaire_of(stored, fallback=q)
     except ExportError as exc:
@@ -50,8 +51,16 @@ async def confirm_page(request: Request) -> Response:
     # step never says "amended" for changes that came back to the kiosk's answers
     recorded = {a.item_id: a.option for a in stored.answers}
     will_be = state_once_signed(current, recorded)
-    return render(request, "sign_off.html", s=stored, kiosk=kiosk, review=current, score=score, labels=labels,
-                  will_be=will_be.value)
+    return render(
+        request,
+        "sign_off.html",
+        s=stored,
+        kiosk=kiosk,
+        review=current,
+        score=score,
+        labels=labels,
+        will_be=will_be.value,
+    )
 
 
 routes = [Route("/sessions/{session_id}/sign-off", confirm_page, methods=["GET"])]

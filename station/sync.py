@@ -23,8 +23,8 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
-from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
+from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
 from station import alert_rules, db, orders
 from station.checks import (
     ID_MAX,
@@ -123,7 +123,7 @@ def parse(body: Any) -> list[Event]:
         if not isinstance(raw, dict):
             raise SyncError(f"{where}: not an object")
         seq, kind, session_id, payload, at = (raw.get(k) for k in ("seq", "kind", "session_id", "payload", "at"))
-        if not isinstance(seq, int) or isinstance(seq, bool) or not 0 <= seq < 2 ** 63:
+        if not isinstance(seq, int) or isinstance(seq, bool) or not 0 <= seq < 2**63:
             raise SyncError(f"{where}: 'seq' must be a non-negative integer")
         where = f"seq {seq}"
         try:
@@ -146,8 +146,10 @@ def parse(body: Any) -> list[Event]:
                 sent = payload.get("definition_sha256")
                 payload["definition_sha256"] = digest(definition)
                 if sent is not None and sent != payload["definition_sha256"]:
-                    raise RowRefused(f"{where}: create_session.definition_sha256: is not the SHA-256 of the "
-                                     "definition's canonical JSON")
+                    raise RowRefused(
+                        f"{where}: create_session.definition_sha256: is not the SHA-256 of the "
+                        "definition's canonical JSON"
+                    )
         except RowRefused as exc:
             raise Refused(str(exc), seq) from None
         events.append(Event(seq, kind, session_id, payload, at, definition))
@@ -166,22 +168,47 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
     if len(set(seqs)) != len(seqs):
         raise SyncError("a seq appears twice in one batch")
     received = db.now()
-    known = {row.seq: row for row in connection.execute(
-        sa.select(inbox.c.seq, inbox.c.kind, inbox.c.session_id, inbox.c.payload).where(
-            inbox.c.kiosk_id == kiosk_id, inbox.c.seq.in_(seqs)))}
+    known = {
+        row.seq: row
+        for row in connection.execute(
+            sa.select(inbox.c.seq, inbox.c.kind, inbox.c.session_id, inbox.c.payload).where(
+                inbox.c.kiosk_id == kiosk_id, inbox.c.seq.in_(seqs)
+            )
+        )
+    }
     for event in events:
         if event.seq in known and not _same(known[event.seq], event):
-            raise Conflict(f"seq {event.seq}: already stored with different content (was this kiosk's "
-                           "database replaced? its rows are kept apart until someone checks)", event.seq)
+            raise Conflict(
+                f"seq {event.seq}: already stored with different content (was this kiosk's "
+                "database replaced? its rows are kept apart until someone checks)",
+                event.seq,
+            )
     new = [e for e in events if e.seq not in known]
     _claim_sessions(connection, kiosk_id, new, received)
     _check_against_definitions(connection, new)
-    db.insert_ignore(connection, inbox, [{"kiosk_id": kiosk_id, "seq": e.seq, "kind": e.kind,
-                                          "session_id": e.session_id, "payload": json.dumps(e.payload), "at": e.at,
-                                          "received_at": received} for e in new], ["kiosk_id", "seq"])
+    db.insert_ignore(
+        connection,
+        inbox,
+        [
+            {
+                "kiosk_id": kiosk_id,
+                "seq": e.seq,
+                "kind": e.kind,
+                "session_id": e.session_id,
+                "payload": json.dumps(e.payload),
+                "at": e.at,
+                "received_at": received,
+            }
+            for e in new
+        ],
+        ["kiosk_id", "seq"],
+    )
     for session_id in {e.session_id for e in new if e.kind in LIFECYCLE}:
-        connection.execute(sessions.update().where(sessions.c.id == session_id).values(
-            updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE))))
+        connection.execute(
+            sessions.update()
+            .where(sessions.c.id == session_id)
+            .values(updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE)))
+        )
     if new:
         messages += _alerts(connection, kiosk_id, new, received)
         messages += alert_rules.settle(connection, kiosk_id, new)  # staff's own doing, situations ended
@@ -207,9 +234,20 @@ def _rebuilt(body: str) -> Questionnaire:
 
 
 def _store_definition(connection: Connection, definition: dict[str, Any], sha: str) -> None:
-    db.insert_ignore(connection, definitions, [{
-        "sha256": sha, "questionnaire_id": str(definition.get("id", "")), "version": str(definition.get("version", "")),
-        "body": canonical_json(definition), "stored_at": db.now_iso()}], ["sha256"])
+    db.insert_ignore(
+        connection,
+        definitions,
+        [
+            {
+                "sha256": sha,
+                "questionnaire_id": str(definition.get("id", "")),
+                "version": str(definition.get("version", "")),
+                "body": canonical_json(definition),
+                "stored_at": db.now_iso(),
+            }
+        ],
+        ["sha256"],
+    )
 
 
 def _check_against_definitions(connection: Connection, new: Sequence[Event]) -> None:
@@ -229,8 +267,9 @@ def _check_against_definitions(connection: Connection, new: Sequence[Event]) -> 
                 later = event.definition is None and "definition_sha256" not in event.payload
                 if event.definition is not None:
                     sha = event.payload["definition_sha256"]
-                    known = connection.execute(sa.select(definitions.c.sha256).where(
-                        definitions.c.sha256 == sha)).scalar()
+                    known = connection.execute(
+                        sa.select(definitions.c.sha256).where(definitions.c.sha256 == sha)
+                    ).scalar()
                     if sha not in cache and known is None:  # stored ones were checked as they came
                         cache[sha] = check_definition(event.definition, f"{where}.definition")
                         _store_definition(connection, event.definition, sha)
@@ -239,18 +278,27 @@ def _check_against_definitions(connection: Connection, new: Sequence[Event]) -> 
                     _store_definition(connection, definition, sha)
                 else:
                     sha = event.payload["definition_sha256"]
-                    if connection.execute(sa.select(definitions.c.sha256).where(definitions.c.sha256 == sha)).scalar() \
-                            is None:
-                        raise RowRefused(f"{where}.definition_sha256: this station has no definition {sha[:12]}; "
-                                         "send the definition with the session")
+                    if (
+                        connection.execute(sa.select(definitions.c.sha256).where(definitions.c.sha256 == sha)).scalar()
+                        is None
+                    ):
+                        raise RowRefused(
+                            f"{where}.definition_sha256: this station has no definition {sha[:12]}; "
+                            "send the definition with the session"
+                        )
                 check_create(event.payload, where, event.session_id, _questionnaire(connection, sha, cache))
-                connection.execute(sessions.update().where(sessions.c.id == event.session_id).values(
-                    definition_sha256=sha, definition_attached_later=later))
+                connection.execute(
+                    sessions.update()
+                    .where(sessions.c.id == event.session_id)
+                    .values(definition_sha256=sha, definition_attached_later=later)
+                )
                 running[event.session_id] = sha
             sha = running[event.session_id]
             if event.kind in NEEDS_DEFINITION and sha is None:
-                raise RowRefused(f"{where}: session {event.session_id} has no questionnaire at this station "
-                                 "(its create_session has not arrived)")
+                raise RowRefused(
+                    f"{where}: session {event.session_id} has no questionnaire at this station "
+                    "(its create_session has not arrived)"
+                )
             check_row(event.kind, event.payload, where, _questionnaire(connection, sha, cache) if sha else None)
         except RowRefused as exc:
             raise Refused(str(exc), event.seq) from None
@@ -267,8 +315,12 @@ def _claim_sessions(connection: Connection, kiosk_id: str, new: Sequence[Event],
         if owner is not None and owner != kiosk_id:
             seq = next(e.seq for e in new if e.session_id == session_id)
             raise Conflict(f"seq {seq}: session {session_id} belongs to kiosk {owner}, not {kiosk_id}", seq)
-    db.insert_ignore(connection, sessions, [{"id": s, "kiosk_id": kiosk_id, "status": "pending", "updated_at": received}
-                                   for s in ids if s not in owners], ["id"])
+    db.insert_ignore(
+        connection,
+        sessions,
+        [{"id": s, "kiosk_id": kiosk_id, "status": "pending", "updated_at": received} for s in ids if s not in owners],
+        ["id"],
+    )
 
 
 def _alerts(connection: Connection, kiosk_id: str, new: Sequence[Event], received: float) -> list[dict[str, Any]]:
@@ -280,14 +332,33 @@ def _alerts(connection: Connection, kiosk_id: str, new: Sequence[Event], receive
             continue
         log_kind = event.payload.get("kind")
         if log_kind in RAISES:
-            db.insert_ignore(connection, alerts, [{"kiosk_id": kiosk_id, "seq": event.seq, "session_id": event.session_id,
-                                          "kind": RAISES[log_kind], "raised_at": event.at, "received_at": received}],
-                    ["kiosk_id", "seq"])
+            db.insert_ignore(
+                connection,
+                alerts,
+                [
+                    {
+                        "kiosk_id": kiosk_id,
+                        "seq": event.seq,
+                        "session_id": event.session_id,
+                        "kind": RAISES[log_kind],
+                        "raised_at": event.at,
+                        "received_at": received,
+                    }
+                ],
+                ["kiosk_id", "seq"],
+            )
             messages.append({"type": "alert", "kiosk": kiosk_id})
         elif log_kind in ENDS:
-            open_alert = connection.execute(sa.select(alerts.c.id).where(
-                alerts.c.session_id == event.session_id, alerts.c.kind == ENDS[log_kind],
-                alerts.c.resolved_at.is_(None), alerts.c.seq < event.seq).order_by(alerts.c.seq.desc())).scalar()
+            open_alert = connection.execute(
+                sa.select(alerts.c.id)
+                .where(
+                    alerts.c.session_id == event.session_id,
+                    alerts.c.kind == ENDS[log_kind],
+                    alerts.c.resolved_at.is_(None),
+                    alerts.c.seq < event.seq,
+                )
+                .order_by(alerts.c.seq.desc())
+            ).scalar()
             if open_alert is not None:
                 connection.execute(alerts.update().where(alerts.c.id == open_alert).values(resolved_at=event.at))
                 messages.append({"type": "alert", "kiosk": kiosk_id})

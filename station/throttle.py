@@ -96,13 +96,21 @@ def admit(engine: Engine, name: str, address: str) -> tuple[float, int]:
     with engine.begin() as connection:
         _lock(connection, address)
         connection.execute(login_failures.delete().where(login_failures.c.at < now - WINDOW_S))
-        pair_count, pair_last = connection.execute(sa.select(sa.func.count(), sa.func.max(login_failures.c.at)).where(
-            login_failures.c.name == name, login_failures.c.address == address)).one()
-        names, address_last = connection.execute(sa.select(sa.func.count(sa.distinct(login_failures.c.name)),
-                                                           sa.func.max(login_failures.c.at)).where(
-            login_failures.c.address == address)).one()
-        wait = max(0.0, pair_last + pause_after(pair_count) - now if pair_count else 0.0,
-                   address_last + pause_after(names, FREE_NAMES) - now if names else 0.0)
+        pair_count, pair_last = connection.execute(
+            sa.select(sa.func.count(), sa.func.max(login_failures.c.at)).where(
+                login_failures.c.name == name, login_failures.c.address == address
+            )
+        ).one()
+        names, address_last = connection.execute(
+            sa.select(sa.func.count(sa.distinct(login_failures.c.name)), sa.func.max(login_failures.c.at)).where(
+                login_failures.c.address == address
+            )
+        ).one()
+        wait = max(
+            0.0,
+            pair_last + pause_after(pair_count) - now if pair_count else 0.0,
+            address_last + pause_after(names, FREE_NAMES) - now if names else 0.0,
+        )
         if wait > 0:
             return wait, pair_count
         connection.execute(login_failures.insert().values(name=name, address=address, at=now))
@@ -111,15 +119,20 @@ def admit(engine: Engine, name: str, address: str) -> tuple[float, int]:
 
 def log_failure(name: str, address: str, count: int) -> None:
     """Note a wrong name or password (``count``: the pair's failures in the window)."""
-    log.warning("login failed: name %r from %s (wrong name or password; %d failure(s) in the last hour)",
-                name[:64], address[:64], count)
+    log.warning(
+        "login failed: name %r from %s (wrong name or password; %d failure(s) in the last hour)",
+        name[:64],
+        address[:64],
+        count,
+    )
 
 
 def record_success(connection: Connection, name: str, address: str) -> None:
     """The right password from this address: its failures for this name (this try's included)
     are forgiven."""
-    connection.execute(login_failures.delete().where(
-        login_failures.c.name == name[:64], login_failures.c.address == address[:64]))
+    connection.execute(
+        login_failures.delete().where(login_failures.c.name == name[:64], login_failures.c.address == address[:64])
+    )
 
 
 def log_refused(name: str, address: str, wait: float) -> None:

@@ -88,8 +88,9 @@ def reviews(engine: Engine, session_ids: list[str]) -> dict[str, Review]:
     return {session_id: review_of(found) for session_id, found in entries.items()}
 
 
-def change_item(engine: Engine, q: Questionnaire, session_id: str, item_id: str, option: int, reason: str,
-                by: User) -> None:
+def change_item(
+    engine: Engine, q: Questionnaire, session_id: str, item_id: str, option: int, reason: str, by: User
+) -> None:
     """Correct an answered item or fill an unanswered one (nurse or doctor), before sign-off."""
     reason = reason.strip()
     if not reason:
@@ -106,9 +107,18 @@ def change_item(engine: Engine, q: Questionnaire, session_id: str, item_id: str,
         previous = current.options({a.item_id: a.option for a in stored.answers}).get(item_id)
         if previous == option:
             raise ValidationError(f"{item_id} already has option {option}")
-        connection.execute(audit.insert().values(
-            session_id=session_id, at=db.now_iso(), author=by.name, action="fill" if previous is None else "correct",
-            item_id=item_id, option=option, previous_option=previous, reason=reason[:1000]))
+        connection.execute(
+            audit.insert().values(
+                session_id=session_id,
+                at=db.now_iso(),
+                author=by.name,
+                action="fill" if previous is None else "correct",
+                item_id=item_id,
+                option=option,
+                previous_option=previous,
+                reason=reason[:1000],
+            )
+        )
 
 
 def sign_off(engine: Engine, session_id: str, by: User) -> None:
@@ -118,8 +128,9 @@ def sign_off(engine: Engine, session_id: str, by: User) -> None:
     with engine.begin() as connection:
         stored, entries = _locked(connection, session_id)
         _check_open(stored, review_of(entries))
-        connection.execute(audit.insert().values(session_id=session_id, at=db.now_iso(), author=by.name,
-                                                 action="sign_off", reason=""))
+        connection.execute(
+            audit.insert().values(session_id=session_id, at=db.now_iso(), author=by.name, action="sign_off", reason="")
+        )
 
 
 def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
@@ -129,22 +140,28 @@ def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
         raise ValidationError("only a doctor can amend a signed-off result")
     reason = reason.strip()
     if not reason:
-        raise ValidationError("say why: amending a signed-off result needs a reason (e.g. 'new information "
-                              "from the physiotherapist')")
+        raise ValidationError(
+            "say why: amending a signed-off result needs a reason (e.g. 'new information from the physiotherapist')"
+        )
     with engine.begin() as connection:
         _, entries = _locked(connection, session_id)
         if not review_of(entries).final:
             raise ValidationError("the result is not signed off: change it directly, no need to amend")
-        connection.execute(audit.insert().values(session_id=session_id, at=db.now_iso(), author=by.name,
-                                                 action="amend", reason=reason[:1000]))
+        connection.execute(
+            audit.insert().values(
+                session_id=session_id, at=db.now_iso(), author=by.name, action="amend", reason=reason[:1000]
+            )
+        )
 
 
 def _check_open(stored: StoredSession, current: Review) -> None:
     if stored.status not in REVIEWABLE:
         raise ValidationError(f"the session is {stored.status}: it can be validated once it is over")
     if current.final:
-        raise ValidationError(f"signed off by {current.signed_by} at {current.signed_at}: the result is final "
-                              "(a doctor can amend it, giving a reason)")
+        raise ValidationError(
+            f"signed off by {current.signed_by} at {current.signed_at}: the result is final "
+            "(a doctor can amend it, giving a reason)"
+        )
 
 
 def corrected(stored: StoredSession, q: Questionnaire, current: Review) -> dict[str, Any]:

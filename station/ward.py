@@ -20,16 +20,25 @@ from station.db import alerts, audit, commands, kiosks
 OFFLINE_AFTER_S = 30.0
 COMMAND_KINDS = ("continue", "person_away", "person_back", "end")
 #: what staff read about a command they sent (never its name in the protocol)
-COMMAND_WORDS = {"continue": "Asked {kiosk} to continue the session.",
-                 "person_away": "Told {kiosk} the patient is away from it.",
-                 "person_back": "Told {kiosk} the patient is back.",
-                 "end": "Asked {kiosk} to end the session."}
+COMMAND_WORDS = {
+    "continue": "Asked {kiosk} to continue the session.",
+    "person_away": "Told {kiosk} the patient is away from it.",
+    "person_back": "Told {kiosk} the patient is back.",
+    "end": "Asked {kiosk} to end the session.",
+}
 ALERT_TEXT = {"doctor_called": "Doctor called", "person_lost": "Patient left the kiosk"}
 #: the fields of a status report the ward view shows, with their types
 STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
-    "session_id": (str, type(None)), "patient_id": (str, type(None)), "phase": (str, type(None)),
-    "question": (int, type(None)), "of": (int, type(None)), "paused": bool, "person_away": bool,
-    "doctor_called": bool, "simulated": bool, "at": (str, type(None)),
+    "session_id": (str, type(None)),
+    "patient_id": (str, type(None)),
+    "phase": (str, type(None)),
+    "question": (int, type(None)),
+    "of": (int, type(None)),
+    "paused": bool,
+    "person_away": bool,
+    "doctor_called": bool,
+    "simulated": bool,
+    "at": (str, type(None)),
     # why the kiosk takes no patient (its store failed: a full disk); None while it works
     "out_of_order": (str, type(None)),
 }
@@ -108,8 +117,16 @@ def kiosk_views(engine: Engine, name: str | None = None) -> list[KioskView]:
     with engine.connect() as connection:
         rows = connection.execute(query).all()
     pending = open_alerts(engine, name)
-    return [KioskView(r.name, r.last_seen, r.revoked_at is not None, json.loads(r.status) if r.status else {},
-                      tuple(a for a in pending if a.kiosk_id == r.name)) for r in rows]
+    return [
+        KioskView(
+            r.name,
+            r.last_seen,
+            r.revoked_at is not None,
+            json.loads(r.status) if r.status else {},
+            tuple(a for a in pending if a.kiosk_id == r.name),
+        )
+        for r in rows
+    ]
 
 
 def acknowledge(engine: Engine, alert_id: int, by: str) -> str:
@@ -121,10 +138,18 @@ def acknowledge(engine: Engine, alert_id: int, by: str) -> str:
             raise WardError(f"no alert {alert_id}")
         if row.ack_at is not None:
             return row.kiosk_id  # two nurses pressed at once: the first one is recorded
-        connection.execute(alerts.update().where(alerts.c.id == alert_id, alerts.c.ack_at.is_(None)).values(
-            ack_by=by, ack_at=at))
-        connection.execute(audit.insert().values(session_id=row.session_id, at=at, author=by, action="acknowledge",
-                                                 reason=f"{ALERT_TEXT.get(row.kind, row.kind)} on {row.kiosk_id}"))
+        connection.execute(
+            alerts.update().where(alerts.c.id == alert_id, alerts.c.ack_at.is_(None)).values(ack_by=by, ack_at=at)
+        )
+        connection.execute(
+            audit.insert().values(
+                session_id=row.session_id,
+                at=at,
+                author=by,
+                action="acknowledge",
+                reason=f"{ALERT_TEXT.get(row.kind, row.kind)} on {row.kiosk_id}",
+            )
+        )
     return row.kiosk_id
 
 
@@ -137,42 +162,63 @@ def queue_command(engine: Engine, kiosk_id: str, session_id: str, kind: str, by:
     with engine.begin() as connection:
         if connection.execute(sa.select(kiosks.c.name).where(kiosks.c.name == kiosk_id)).first() is None:
             raise WardError(f"no kiosk {kiosk_id!r}")
-        command_id = connection.execute(commands.insert().values(
-            kiosk_id=kiosk_id, session_id=session_id, kind=kind, by=by, at=at)).inserted_primary_key[0]
-        connection.execute(audit.insert().values(session_id=session_id, at=at, author=by, action="command",
-                                                 reason=COMMAND_WORDS[kind].format(kiosk=kiosk_id)))
+        command_id = connection.execute(
+            commands.insert().values(kiosk_id=kiosk_id, session_id=session_id, kind=kind, by=by, at=at)
+        ).inserted_primary_key[0]
+        connection.execute(
+            audit.insert().values(
+                session_id=session_id,
+                at=at,
+                author=by,
+                action="command",
+                reason=COMMAND_WORDS[kind].format(kiosk=kiosk_id),
+            )
+        )
         if kind == "continue":
-            connection.execute(alerts.update().where(
-                alerts.c.session_id == session_id, alerts.c.kind == "doctor_called",
-                alerts.c.ack_at.is_(None)).values(ack_by=by, ack_at=at))
+            connection.execute(
+                alerts.update()
+                .where(alerts.c.session_id == session_id, alerts.c.kind == "doctor_called", alerts.c.ack_at.is_(None))
+                .values(ack_by=by, ack_at=at)
+            )
     return int(command_id)
 
 
 def pending_commands(engine: Engine, kiosk_id: str) -> list[dict[str, Any]]:
     """Commands the kiosk has not acknowledged (re-delivered until it does)."""
     with engine.connect() as connection:
-        rows = connection.execute(sa.select(commands).where(
-            commands.c.kiosk_id == kiosk_id, commands.c.acked_at.is_(None)).order_by(commands.c.id)).all()
+        rows = connection.execute(
+            sa.select(commands)
+            .where(commands.c.kiosk_id == kiosk_id, commands.c.acked_at.is_(None))
+            .order_by(commands.c.id)
+        ).all()
     return [{"id": r.id, "kind": r.kind, "session_id": r.session_id, "by": r.by, "at": r.at} for r in rows]
 
 
 def ack_command(engine: Engine, kiosk_id: str, command_id: int, body: Any) -> None:
     """The kiosk's answer to a command: ``done``, or ``refused`` with a reason."""
     if not isinstance(body, dict) or body.get("result") not in ("done", "refused"):
-        raise WardError("the body must be {\"result\": \"done\"} or {\"result\": \"refused\", \"reason\": \"...\"}")
+        raise WardError('the body must be {"result": "done"} or {"result": "refused", "reason": "..."}')
     reason = body.get("reason")
     with engine.begin() as connection:
-        done = connection.execute(commands.update().where(
-            commands.c.id == command_id, commands.c.kiosk_id == kiosk_id, commands.c.acked_at.is_(None)).values(
-            acked_at=db.now_iso(), result=body["result"], reason=str(reason)[:500] if reason else None)).rowcount
-        if not done and connection.execute(sa.select(commands.c.id).where(
-                commands.c.id == command_id, commands.c.kiosk_id == kiosk_id)).first() is None:
+        done = connection.execute(
+            commands.update()
+            .where(commands.c.id == command_id, commands.c.kiosk_id == kiosk_id, commands.c.acked_at.is_(None))
+            .values(acked_at=db.now_iso(), result=body["result"], reason=str(reason)[:500] if reason else None)
+        ).rowcount
+        if (
+            not done
+            and connection.execute(
+                sa.select(commands.c.id).where(commands.c.id == command_id, commands.c.kiosk_id == kiosk_id)
+            ).first()
+            is None
+        ):
             raise WardError(f"no command {command_id} for this kiosk")
 
 
 def recent_commands(engine: Engine, session_id: str) -> list[dict[str, Any]]:
     """The session's commands and what the kiosk answered, newest first."""
     with engine.connect() as connection:
-        rows = connection.execute(sa.select(commands).where(commands.c.session_id == session_id).order_by(
-            commands.c.id.desc())).all()
+        rows = connection.execute(
+            sa.select(commands).where(commands.c.session_id == session_id).order_by(commands.c.id.desc())
+        ).all()
     return [dict(r._mapping) for r in rows]

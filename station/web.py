@@ -56,14 +56,16 @@ class SecurityHeaders:
             if message["type"] == "http.response.start":
                 message.setdefault("headers", [])
                 present = {k.decode().lower() for k, _ in message["headers"]}
-                message["headers"] += [(k.encode(), v.encode()) for k, v in SECURITY_HEADERS.items()
-                                       if k not in present]
+                message["headers"] += [
+                    (k.encode(), v.encode()) for k, v in SECURITY_HEADERS.items() if k not in present
+                ]
             await send(message)
 
         await self.app(scope, receive, send_with_headers if scope["type"] == "http" else send)
 
 
 # -- login ---------------------------------------------------------------------------------------
+
 
 async def login_page(request: Request) -> Response:
     return render(request, "login.html", next=request.query_params.get("next", "/"))
@@ -76,8 +78,11 @@ async def login_post(request: Request) -> Response:
         return render(request, "login.html", status=403, error=str(exc), next="/")
     engine = request.app.state.engine
     name, password = form.get("name", "").strip(), form.get("password", "")
-    address = throttle.client_address(request.client.host if request.client else None,
-                                      request.headers.getlist("x-forwarded-for"), request.app.state.trusted_proxies)
+    address = throttle.client_address(
+        request.client.host if request.client else None,
+        request.headers.getlist("x-forwarded-for"),
+        request.app.state.trusted_proxies,
+    )
     target = form.get("next", "/")
     if not target.startswith("/") or target.startswith("//"):
         target = "/"
@@ -85,9 +90,14 @@ async def login_post(request: Request) -> Response:
     if wait > 0:
         throttle.log_refused(name, address, wait)
         seconds = math.ceil(wait)
-        response = render(request, "login.html", status=429, next=target,
-                          error=f"Too many failed logins for this name from your address: try again in {seconds} "
-                                "seconds, or ask an administrator.")
+        response = render(
+            request,
+            "login.html",
+            status=429,
+            next=target,
+            error=f"Too many failed logins for this name from your address: try again in {seconds} "
+            "seconds, or ask an administrator.",
+        )
         response.headers["retry-after"] = str(seconds)
         return response
     found = await run_in_threadpool(auth.login, engine, name, password, address)
@@ -116,8 +126,7 @@ async def events(request: Request) -> Response:
     if current_user(request) is None:
         return PlainTextResponse("log in first", status_code=401)
     live: Live = request.app.state.live
-    return StreamingResponse(live.stream(), media_type="text/event-stream",
-                             headers={"x-accel-buffering": "no"})
+    return StreamingResponse(live.stream(), media_type="text/event-stream", headers={"x-accel-buffering": "no"})
 
 
 class LoginRequired:
@@ -151,8 +160,12 @@ async def healthz(request: Request) -> Response:
     return PlainTextResponse("ok")
 
 
-def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https: bool = False,
-               trusted_proxies: tuple[throttle.Network, ...] = ()) -> Starlette:
+def create_app(
+    engine: Engine,
+    questionnaire: Questionnaire | None = None,
+    https: bool = False,
+    trusted_proxies: tuple[throttle.Network, ...] = (),
+) -> Starlette:
     """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
     from ``trusted_proxies``."""
     bus = Bus(engine)
@@ -186,13 +199,23 @@ def create_app(engine: Engine, questionnaire: Questionnaire | None = None, https
     middleware = [
         Middleware(SecurityHeaders),
         Middleware(BodyLimit),
-        Middleware(SessionMiddleware, secret_key=auth.secret_key(engine), session_cookie="station_session",
-                   max_age=logins.MAX_AGE_S, same_site="strict", https_only=https),
+        Middleware(
+            SessionMiddleware,
+            secret_key=auth.secret_key(engine),
+            session_cookie="station_session",
+            max_age=logins.MAX_AGE_S,
+            same_site="strict",
+            https_only=https,
+        ),
         Middleware(LoginRequired),
     ]
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
-    app.state.live = Live(bus, lambda name: pages.kiosk_event(app, name), lambda: pages.alerts_event(app),
-                          lambda finished: result_pages.results_event(app, finished))
+    app.state.live = Live(
+        bus,
+        lambda name: pages.kiosk_event(app, name),
+        lambda: pages.alerts_event(app),
+        lambda finished: result_pages.results_event(app, finished),
+    )
     return app

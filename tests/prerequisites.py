@@ -47,10 +47,13 @@ def ensure_npm_packages(js: Path = JS) -> Path:
             if not _up_to_date(js):
                 npm = shutil.which("npm")
                 if npm is None:
-                    pytest.fail(f"npm is not installed (the FHIR checkers in {js} need it): "
-                                "sudo apt-get install npm", pytrace=False)
-                done = subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=js, capture_output=True,
-                                      text=True, check=False)
+                    pytest.fail(
+                        f"npm is not installed (the FHIR checkers in {js} need it): sudo apt-get install npm",
+                        pytrace=False,
+                    )
+                done = subprocess.run(
+                    [npm, "ci", "--no-audit", "--no-fund"], cwd=js, capture_output=True, text=True, check=False
+                )
                 if done.returncode != 0:
                     last = (done.stderr.strip() or done.stdout.strip()).splitlines()[-1:] or ["(no output)"]
                     pytest.fail(f"`npm ci` in {js} failed with exit {done.returncode}: {last[0]}", pytrace=False)

@@ -11,16 +11,30 @@ import qos
 
 #: the pure-Python parts of the kiosk (imported by module name; missing ones are an error)
 PURE_KIOSK_MODULES = [
-    "kiosk.core.channels", "kiosk.cli", "kiosk.core.clock", "kiosk.core.questionnaire", "kiosk.core.session", "kiosk.core.adaptation",
-    "kiosk.store.database", "kiosk.commands.replay", "kiosk.config", "kiosk.export.opening", "kiosk.export", "kiosk.commands.results",
-    "kiosk.commands.validate", "fileio.positions",
+    "kiosk.core.channels",
+    "kiosk.cli",
+    "kiosk.core.clock",
+    "kiosk.core.questionnaire",
+    "kiosk.core.session",
+    "kiosk.core.adaptation",
+    "kiosk.store.database",
+    "kiosk.commands.replay",
+    "kiosk.config",
+    "kiosk.export.opening",
+    "kiosk.export",
+    "kiosk.commands.results",
+    "kiosk.commands.validate",
+    "fileio.positions",
 ]
 
 
 def _modules_of(package) -> list[str]:
     names = [package.__name__]
-    names += [m.name for m in pkgutil.walk_packages(package.__path__, package.__name__ + ".")
-              if not m.name.endswith("__main__")]
+    names += [
+        m.name
+        for m in pkgutil.walk_packages(package.__path__, package.__name__ + ".")
+        if not m.name.endswith("__main__")
+    ]
     return names
 
 

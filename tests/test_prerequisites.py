@@ -15,9 +15,17 @@ from tests.prerequisites import STAMP, ensure_npm_packages, require_debian
 def _package(folder, version: str):
     folder.mkdir()
     (folder / "package.json").write_text(json.dumps({"name": "p", "version": version, "private": True}))
-    (folder / "package-lock.json").write_text(json.dumps(
-        {"name": "p", "version": version, "lockfileVersion": 3, "requires": True,
-         "packages": {"": {"name": "p", "version": version}}}))
+    (folder / "package-lock.json").write_text(
+        json.dumps(
+            {
+                "name": "p",
+                "version": version,
+                "lockfileVersion": 3,
+                "requires": True,
+                "packages": {"": {"name": "p", "version": version}},
+            }
+        )
+    )
     return folder
 
 
@@ -42,7 +50,10 @@ def test_npm_ci_runs_when_the_lock_is_new_or_changed_and_not_otherwise(tmp_path,
 def test_a_missing_debian_package_is_one_line_naming_it(tmp_path):
     with pytest.raises(pytest.fail.Exception) as failed:
         require_debian("espeak-ng", command="no-such-command-here")
-    assert str(failed.value) == "no-such-command-here is not installed: sudo apt-get install espeak-ng (.ci/run installs it)"
+    assert (
+        str(failed.value)
+        == "no-such-command-here is not installed: sudo apt-get install espeak-ng (.ci/run installs it)"
+    )
     with pytest.raises(pytest.fail.Exception):
         require_debian("chromium", path=str(tmp_path / "chromium"))
     require_debian("coreutils", command="ls")  # present: nothing happens

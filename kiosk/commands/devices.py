@@ -15,17 +15,29 @@ import serial.tools.list_ports
 from kiosk.config import ConfigError, load_config
 from kiosk.remote.buttons import button_name
 from kiosk.remote.hid import HidapiBackend, HidDeviceInfo
-from kiosk.remote.profiles import (BUILTIN_PROFILES, HidProfile, KeyboardProfile, Profile, ProfileError,
-                                   SerialProfile, load_profiles)
+from kiosk.remote.profiles import (
+    BUILTIN_PROFILES,
+    HidProfile,
+    KeyboardProfile,
+    Profile,
+    ProfileError,
+    SerialProfile,
+    load_profiles,
+)
 from kiosk.remote.serial import matching_ports
 
 
 def main(argv: list[str]) -> int:
     """Print the devices report; exit status 2 if the profile file is unusable."""
-    parser = argparse.ArgumentParser(prog="kiosk devices", description="List remotes (HID, serial) and audio inputs, and what the kiosk would use.")
-    parser.add_argument("--profiles", metavar="PATH",
-                        help="the site's device profile file, adding to or overriding the built-in ones "
-                             "(default: remote_profiles from the kiosk's config)")
+    parser = argparse.ArgumentParser(
+        prog="kiosk devices", description="List remotes (HID, serial) and audio inputs, and what the kiosk would use."
+    )
+    parser.add_argument(
+        "--profiles",
+        metavar="PATH",
+        help="the site's device profile file, adding to or overriding the built-in ones "
+        "(default: remote_profiles from the kiosk's config)",
+    )
     args = parser.parse_args(argv)
     try:
         if args.profiles is None:
@@ -36,8 +48,10 @@ def main(argv: list[str]) -> int:
         return 2
 
     hid_devices, hid_problem = _hid_devices()
-    ports = sorted({p.device for p in serial.tools.list_ports.comports()}
-                   | {port for p in profiles.serial for port in matching_ports(p.port)})
+    ports = sorted(
+        {p.device for p in serial.tools.list_ports.comports()}
+        | {port for p in profiles.serial for port in matching_ports(p.port)}
+    )
 
     sources = f"built-in {BUILTIN_PROFILES.name}" + (f" + {args.profiles}" if args.profiles else "")
     print(f"Remote profiles ({sources}):")

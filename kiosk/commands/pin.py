@@ -38,8 +38,11 @@ def main(argv: list[str]) -> int:
     """Set the PIN; exit 0, or 2 with one line when the PIN or the file is refused."""
     parser = argparse.ArgumentParser(prog="kiosk pin", description="Set the clinician PIN (stored hashed).")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    setter = commands.add_parser("set", help="choose a new clinician PIN",
-                                 description="Ask for a new PIN and store its hash in the configuration.")
+    setter = commands.add_parser(
+        "set",
+        help="choose a new clinician PIN",
+        description="Ask for a new PIN and store its hash in the configuration.",
+    )
     setter.add_argument("--config", type=Path, help="configuration file (default: $KIOSK_CONFIG or the user's)")
     args = parser.parse_args(argv)
     path = _config_path(args.config)

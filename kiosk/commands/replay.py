@@ -24,8 +24,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from fileio.bounded import BadFile
+from fileio.positions import Problem, describe, parse_file, schema_problems
 from kiosk.core.channels import Channel, ChannelInput, Command
 from kiosk.core.clock import SimClock
+from kiosk.core.qos_model import DEFAULT_MODEL
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, QuestionnaireError, load_questionnaire
 from kiosk.core.session import (
     AnswerRecorded,
@@ -39,9 +42,6 @@ from kiosk.core.session import (
     SessionEvent,
 )
 from kiosk.store.lease import SessionTaken
-from kiosk.core.qos_model import DEFAULT_MODEL
-from fileio.positions import Problem, describe, parse_file, schema_problems
-from fileio.bounded import BadFile
 from qos.errors import QosError
 from qos.trace import seconds
 
@@ -52,8 +52,12 @@ ANY = 0
 UNSURE_CONFIDENCE = 0.5
 
 #: incidents that are commands a patient gives through a channel
-_COMMANDS = {"pause": Command.PAUSE, "resume": Command.RESUME, "call_doctor": Command.CALL_DOCTOR,
-             "repeat": Command.REPEAT}
+_COMMANDS = {
+    "pause": Command.PAUSE,
+    "resume": Command.RESUME,
+    "call_doctor": Command.CALL_DOCTOR,
+    "repeat": Command.REPEAT,
+}
 
 
 class ScriptError(ValueError):
@@ -153,13 +157,16 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
     except ValueError as exc:
         add(("timing",), str(exc))
     if len(data["questions"]) != len(questionnaire.items):
-        add(("questions",), f"the script has {len(data['questions'])} questions; "
-                            f"the questionnaire has {len(questionnaire.items)}")
+        add(
+            ("questions",),
+            f"the script has {len(data['questions'])} questions; the questionnaire has {len(questionnaire.items)}",
+        )
     if problems:
         raise _script_error(problems)
 
-    def answer_step(p: tuple[Any, ...], entry: dict[str, Any], question: Item | PracticeQuestion,
-                    kind: str, attempt: int | None) -> Step | None:
+    def answer_step(
+        p: tuple[Any, ...], entry: dict[str, Any], question: Item | PracticeQuestion, kind: str, attempt: int | None
+    ) -> Step | None:
         if "option" in entry and "say" in entry:
             add(p, f"{describe(p)} gives both 'option' and 'say'; give one")
             return None
@@ -185,8 +192,16 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
         if entry.get("unsure") and channel is not Channel.VOICE:
             add(p + ("unsure",), f"only a voice answer can be unsure, not a {channel.value} one")
             return None
-        return Step(kind, attempt, float(entry.get("after", 0)), channel, option, entry.get("say"),
-                    bool(entry.get("unsure")), where(p))
+        return Step(
+            kind,
+            attempt,
+            float(entry.get("after", 0)),
+            channel,
+            option,
+            entry.get("say"),
+            bool(entry.get("unsure")),
+            where(p),
+        )
 
     def corrections(p: tuple[Any, ...], entry: dict[str, Any], item: Item, attempt: int) -> list[Step]:
         """The steps after an answer: Yes/No to an unsure one, an undo, the answer that follows."""
@@ -205,15 +220,32 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
                 if isinstance(option, str):
                     add(p + ("confirm", "say"), option)
                     return steps
-            steps.append(Step("confirm", None, float(reply.get("after", 0)), channel, option, reply.get("say"),
-                              where=where(p + ("confirm",))))
+            steps.append(
+                Step(
+                    "confirm",
+                    None,
+                    float(reply.get("after", 0)),
+                    channel,
+                    option,
+                    reply.get("say"),
+                    where=where(p + ("confirm",)),
+                )
+            )
             declined = option == 2
         if "undo" in entry:
             if declined:
                 add(p + ("undo",), "a declined answer was never stored: there is nothing to undo", key=True)
             undo = entry["undo"]
-            steps.append(Step("undo", None, float(undo.get("after", 0)), Channel(undo.get("channel", "touch")),
-                              say=undo.get("say"), where=where(p + ("undo",))))
+            steps.append(
+                Step(
+                    "undo",
+                    None,
+                    float(undo.get("after", 0)),
+                    Channel(undo.get("channel", "touch")),
+                    say=undo.get("say"),
+                    where=where(p + ("undo",)),
+                )
+            )
         if "then" in entry:
             if not (declined or "undo" in entry):
                 add(p + ("then",), "'then' is the answer after a No (confirm) or an undo", key=True)
@@ -228,8 +260,11 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
         steps = []
         entries = data["familiarisation"]
         if len(entries) != len(questionnaire.familiarisation):
-            add(("familiarisation",), f"the script answers {len(entries)} practice questions; "
-                                      f"the questionnaire has {len(questionnaire.familiarisation)}")
+            add(
+                ("familiarisation",),
+                f"the script answers {len(entries)} practice questions; "
+                f"the questionnaire has {len(questionnaire.familiarisation)}",
+            )
         for i, (entry, pq) in enumerate(zip(entries, questionnaire.familiarisation)):
             step = answer_step(("familiarisation", i), entry, pq, "practice", 1)
             if step:
@@ -263,10 +298,17 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
     if problems:
         raise _script_error(problems)
     return Script(
-        source=name, patient=data["patient"], description=data.get("description", ""), language=language,
-        answered_by=data.get("answered_by", "patient"), adaptation=data.get("adaptation", True),
-        start_at=float(data.get("start_at", 0)), acknowledge_after=float(data.get("acknowledge_after", 0)),
-        timing=dict(data.get("timing", {})), practice=practice, questions=tuple(questions),
+        source=name,
+        patient=data["patient"],
+        description=data.get("description", ""),
+        language=language,
+        answered_by=data.get("answered_by", "patient"),
+        adaptation=data.get("adaptation", True),
+        start_at=float(data.get("start_at", 0)),
+        acknowledge_after=float(data.get("acknowledge_after", 0)),
+        timing=dict(data.get("timing", {})),
+        practice=practice,
+        questions=tuple(questions),
     )
 
 
@@ -286,8 +328,7 @@ def _match(question: Item | PracticeQuestion, language: str, utterance: str) -> 
     """The option an utterance selects, with the speech helper's matcher; a message if none."""
     from kiosk.speech.matching import Matcher, OptionWords
 
-    matcher = Matcher([OptionWords(o.label_in(language), o.synonyms_in(language)) for o in question.options],
-                      language)
+    matcher = Matcher([OptionWords(o.label_in(language), o.synonyms_in(language)) for o in question.options], language)
     match = matcher.match(utterance)
     if match.option is None:
         return f"on {question.id!r}, {match.reason or repr(utterance) + ' is a command, not an answer'}"
@@ -320,17 +361,28 @@ class ReplayResult:
             "patient": self.script.patient,
             "language": self.script.language,
             "answered_by": self.script.answered_by,
-            "score": {"total": score.total, "complete": score.complete, "max_total": score.max_total,
-                      "band": score.band.id if score.band else None},
+            "score": {
+                "total": score.total,
+                "complete": score.complete,
+                "max_total": score.max_total,
+                "band": score.band.id if score.band else None,
+            },
             "answers": [
-                {"item": a.item_id, "option": a.option, "points": a.points, "attempt": a.attempt,
-                 "channel": a.channel.value, "t": _num(a.t)}
+                {
+                    "item": a.item_id,
+                    "option": a.option,
+                    "points": a.points,
+                    "attempt": a.attempt,
+                    "channel": a.channel.value,
+                    "t": _num(a.t),
+                }
                 for a in sorted(self.session.answers.values(), key=lambda a: a.t)
             ],
             "not_answered": list(self.session.snapshot().not_answered),
             "adaptations": [
                 {"t": _num(e.t), "name": e.name, "active": e.active, "reason": e.reason}
-                for e in self.events if type(e).__name__ == "AdaptationChanged"
+                for e in self.events
+                if type(e).__name__ == "AdaptationChanged"
             ],
             "qos": self.qos,
             "simulated_s": _num(self.simulated_s),
@@ -382,7 +434,7 @@ class _Driver:
         elif isinstance(event, AttemptTimedOut) and not event.practice:
             index = event.number - 1
             question = self.script.questions[index]
-            pending = question.steps[self.next_step[index]:]
+            pending = question.steps[self.next_step[index] :]
             if pending and pending[0].attempt == ANY:  # too slow for this attempt: again on the next
                 self.waiting[index] = False
                 self.armed_in[index] = None
@@ -390,20 +442,29 @@ class _Driver:
                 self.errors.append(
                     f"{pending[0].where}: the answer declared on attempt {event.attempt} "
                     f"({pending[0].after:g} s after it opened) never happened: attempt {event.attempt} "
-                    f"timed out at t={_num(event.t)} s under the session's rules")
+                    f"timed out at t={_num(event.t)} s under the session's rules"
+                )
         elif isinstance(event, (AnswerRecorded, QuestionNotAnswered)):
             index = event.number - 1
             question = self.script.questions[index]
-            pending = question.steps[self.next_step[index]:]
-            if isinstance(event, QuestionNotAnswered) and question.attempt == ANY and pending \
-                    and pending[0].kind == "answer":
+            pending = question.steps[self.next_step[index] :]
+            if (
+                isinstance(event, QuestionNotAnswered)
+                and question.attempt == ANY
+                and pending
+                and pending[0].kind == "answer"
+            ):
                 self.next_step[index] = len(question.steps)  # never fast enough: not answered
             elif pending and not (isinstance(event, AnswerRecorded) and pending[0].kind == "undo"):
-                self.errors.append(f"{pending[0].where}: the declared {pending[0].kind} never happened: "
-                                   f"question {event.number} ({question.item.id}) ended at t={_num(event.t)} s")
+                self.errors.append(
+                    f"{pending[0].where}: the declared {pending[0].kind} never happened: "
+                    f"question {event.number} ({question.item.id}) ended at t={_num(event.t)} s"
+                )
             elif isinstance(event, QuestionNotAnswered) and question.attempt not in (None, ANY):
-                self.errors.append(f"{question.where}: declared answered on attempt {question.attempt} "
-                                   f"but the question was not answered")
+                self.errors.append(
+                    f"{question.where}: declared answered on attempt {question.attempt} "
+                    f"but the question was not answered"
+                )
 
     def _try_arm(self, index: int) -> None:
         question = self.script.questions[index]
@@ -447,8 +508,10 @@ class _Driver:
             undo = ChannelInput(step.channel, command=Command.UNDO, detail=step.say or "script")
             self.session.handle(undo)
             if any(isinstance(e, InputIgnored) and e.input is undo for e in self.events):
-                self.errors.append(f"{step.where}: the undo came too late: the answer could no longer be changed "
-                                   f"at t={_num(self.session.now())} s")
+                self.errors.append(
+                    f"{step.where}: the undo came too late: the answer could no longer be changed "
+                    f"at t={_num(self.session.now())} s"
+                )
         elif step.kind in _COMMANDS:
             assert step.channel is not None
             self.session.handle(ChannelInput(step.channel, command=_COMMANDS[step.kind], detail="script"))
@@ -465,21 +528,35 @@ class _Driver:
         if index is not None and check:
             item = self.session.current_item
             attempt = self.session.current_attempt
-            if (attempt is None if step.attempt == ANY else attempt != step.attempt) \
-                    or item is None or item.number != index + 1:
-                state = (f"question {item.number} attempt {self.session.current_attempt}" if item
-                         else f"phase {self.session.phase.value}")
-                self.errors.append(f"{step.where}: the answer declared on attempt {step.attempt} came when the "
-                                   f"session was at {state}")
+            if (
+                (attempt is None if step.attempt == ANY else attempt != step.attempt)
+                or item is None
+                or item.number != index + 1
+            ):
+                state = (
+                    f"question {item.number} attempt {self.session.current_attempt}"
+                    if item
+                    else f"phase {self.session.phase.value}"
+                )
+                self.errors.append(
+                    f"{step.where}: the answer declared on attempt {step.attempt} came when the session was at {state}"
+                )
                 return
-        given = ChannelInput(step.channel, option=step.option, detail=step.say or "script",
-                             confidence=UNSURE_CONFIDENCE if step.unsure else None, needs_confirmation=step.unsure)
+        given = ChannelInput(
+            step.channel,
+            option=step.option,
+            detail=step.say or "script",
+            confidence=UNSURE_CONFIDENCE if step.unsure else None,
+            needs_confirmation=step.unsure,
+        )
         self.session.handle(given)
         ignored = [e for e in self.events if isinstance(e, InputIgnored) and e.input is given]
         if ignored:
             what = "practice answer" if index is None else f"answer declared on attempt {step.attempt}"
-            self.errors.append(f"{step.where}: the session ignored the {what} ({ignored[0].reason.value}) "
-                               f"at t={_num(self.session.now())} s")
+            self.errors.append(
+                f"{step.where}: the session ignored the {what} ({ignored[0].reason.value}) "
+                f"at t={_num(self.session.now())} s"
+            )
 
     # the loop
 
@@ -501,8 +578,10 @@ class _Driver:
                 self.clock.set(max(deadline, self.clock.now()))
                 self.session.poll()
             else:
-                raise ScriptError(f"{self.script.source}: the script ends while the session waits "
-                                  f"({self._waiting_for()}) at t={_num(self.session.now())} s")
+                raise ScriptError(
+                    f"{self.script.source}: the script ends while the session waits "
+                    f"({self._waiting_for()}) at t={_num(self.session.now())} s"
+                )
         raise ScriptError(f"{self.script.source}: the replay did not finish")
 
     def _waiting_for(self) -> str:
@@ -516,8 +595,15 @@ class _Driver:
         return f"phase {s.phase.value}"
 
 
-def run_script(script: Script, questionnaire: Questionnaire | None = None, *, store: Any = None,
-               model: str = DEFAULT_MODEL, policy: Any = None, visit: str | None = None) -> ReplayResult:
+def run_script(
+    script: Script,
+    questionnaire: Questionnaire | None = None,
+    *,
+    store: Any = None,
+    model: str = DEFAULT_MODEL,
+    policy: Any = None,
+    visit: str | None = None,
+) -> ReplayResult:
     """Run a script through a real Session and QoS engine on a simulated clock, adapting by
     ``policy`` (default: the bundled adaptation policy) when the script turns adaptation on.
 
@@ -533,10 +619,17 @@ def run_script(script: Script, questionnaire: Questionnaire | None = None, *, st
     reference, model = model, load_kiosk_model(model)
     clock = SimClock()
     session = Session(
-        questionnaire, clock=clock, engine=Engine(model), store=store, patient_id=script.patient,
-        language=script.language, answered_by=script.answered_by, timing=script.timing,
+        questionnaire,
+        clock=clock,
+        engine=Engine(model),
+        store=store,
+        patient_id=script.patient,
+        language=script.language,
+        answered_by=script.answered_by,
+        timing=script.timing,
         adaptation=Adaptation(policy or load_policy(model=model)) if script.adaptation else None,
-        familiarisation=script.practice is not None, visit=visit,
+        familiarisation=script.practice is not None,
+        visit=visit,
     )
     driver = _Driver(script, session, clock)
     try:
@@ -567,8 +660,10 @@ def _print_human(result: ReplayResult) -> None:
     print(f"{data['script']}: patient {data['patient']} ({data['language']}, answered by {data['answered_by']})")
     print(f"score {score['total']}/{score['max_total']} {status}{band}; simulated {data['simulated_s']} s")
     for answer in data["answers"]:
-        print(f"  {answer['item']:<10} option {answer['option']}  {answer['points']:>2} points  "
-              f"attempt {answer['attempt']}  {answer['channel']:<8} t={answer['t']}")
+        print(
+            f"  {answer['item']:<10} option {answer['option']}  {answer['points']:>2} points  "
+            f"attempt {answer['attempt']}  {answer['channel']:<8} t={answer['t']}"
+        )
     for item in data["not_answered"]:
         print(f"  {item:<10} not answered")
     for adaptation in data["adaptations"]:
@@ -591,36 +686,57 @@ def _take_order(code: str, config: Any, questionnaire: Questionnaire) -> Any:
     from kiosk.sync.orders import OrderRefused, start_order
 
     try:
-        return start_order(Station(config.station.url, config.station.token), code,
-                           instruments=[questionnaire.id], languages=list(questionnaire.languages))
+        return start_order(
+            Station(config.station.url, config.station.token),
+            code,
+            instruments=[questionnaire.id],
+            languages=list(questionnaire.languages),
+        )
     except (OrderRefused, Unreachable) as exc:
         raise _NoOrder(f"the visit with code {code} was not started: {exc}") from None
 
 
 def main(argv: list[str]) -> int:
     """`kiosk replay FILE... [--json] [--trace OUT] [--data-dir DIR]`; exit 0, or 2 on a bad script."""
-    parser = argparse.ArgumentParser(prog="kiosk replay", description="Run scripted patients through the real session core and QoS engine on a simulated clock.")
+    parser = argparse.ArgumentParser(
+        prog="kiosk replay",
+        description="Run scripted patients through the real session core and QoS engine on a simulated clock.",
+    )
     parser.add_argument("files", nargs="+", metavar="FILE", help="scripted patient YAML file(s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object per script")
     parser.add_argument("--trace", metavar="OUT", help="write the context trace (one script only)")
-    parser.add_argument("--data-dir", metavar="DIR",
-                        help="also store the replayed sessions in this data directory (see `kiosk results`)")
-    parser.add_argument("--config", metavar="FILE",
-                        help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
-                             "band set, adaptation policy and QoS model are the ones replayed, as at the kiosk")
-    parser.add_argument("--station-wait", metavar="S", type=float, default=30.0,
-                        help="with a station configured, how long to try delivering the stored sessions to it "
-                             "before exiting (default 30; what is left goes with the next kiosk run)")
-    parser.add_argument("--order-code", metavar="CODE",
-                        help="run the script as the visit ordered for this kiosk whose code the station shows "
-                             "(one script; needs --data-dir and a station): its patient and language are the order's")
+    parser.add_argument(
+        "--data-dir",
+        metavar="DIR",
+        help="also store the replayed sessions in this data directory (see `kiosk results`)",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="FILE",
+        help="configuration file (default: $KIOSK_CONFIG or the user's): its questionnaire, "
+        "band set, adaptation policy and QoS model are the ones replayed, as at the kiosk",
+    )
+    parser.add_argument(
+        "--station-wait",
+        metavar="S",
+        type=float,
+        default=30.0,
+        help="with a station configured, how long to try delivering the stored sessions to it "
+        "before exiting (default 30; what is left goes with the next kiosk run)",
+    )
+    parser.add_argument(
+        "--order-code",
+        metavar="CODE",
+        help="run the script as the visit ordered for this kiosk whose code the station shows "
+        "(one script; needs --data-dir and a station): its patient and language are the order's",
+    )
     args = parser.parse_args(argv)
     if args.trace and len(args.files) != 1:
         parser.error("--trace takes one script")
     if args.order_code and (len(args.files) != 1 or not args.data_dir):
         parser.error("--order-code takes one script and --data-dir")
-    from kiosk.core.adaptation import PolicyError, load_policy
     from kiosk.config import ConfigError, configured_questionnaire, load_config
+    from kiosk.core.adaptation import PolicyError, load_policy
     from kiosk.core.qos_model import load_kiosk_model
 
     try:
@@ -642,9 +758,13 @@ def main(argv: list[str]) -> int:
             from kiosk.export import export_identity, site_from_config
             from kiosk.export.opening import in_force_of
 
-            store = Store.open(args.data_dir, simulated=True, outbox=config.station is not None,
-                               export=export_identity(site_from_config(config)),
-                               in_force=lambda: in_force_of(config))
+            store = Store.open(
+                args.data_dir,
+                simulated=True,
+                outbox=config.station is not None,
+                export=export_identity(site_from_config(config)),
+                in_force=lambda: in_force_of(config),
+            )
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
@@ -654,10 +774,19 @@ def main(argv: list[str]) -> int:
         for file in args.files:
             script = load_script(file, questionnaire)
             if order is not None:  # the ordered patient, language and answerer, never the script's own
-                script = replace(script, patient=order.patient_id, language=order.language,
-                                 answered_by=order.answered_by)
-            results.append(run_script(script, questionnaire, store=store, model=config.qos_model, policy=policy,
-                                      visit=order.visit if order is not None else None))
+                script = replace(
+                    script, patient=order.patient_id, language=order.language, answered_by=order.answered_by
+                )
+            results.append(
+                run_script(
+                    script,
+                    questionnaire,
+                    store=store,
+                    model=config.qos_model,
+                    policy=policy,
+                    visit=order.visit if order is not None else None,
+                )
+            )
     except ScriptError as exc:
         print(exc, file=sys.stderr)
         return 2
@@ -677,8 +806,8 @@ def main(argv: list[str]) -> int:
         if unsent:
             print(f"kiosk replay: {unsent}", file=sys.stderr)
     if args.trace:
-        from qos import dump_trace
         from fileio.bounded import write_error
+        from qos import dump_trace
 
         try:
             dump_trace(results[0].trace, args.trace, header=f"context trace of {results[0].script.source}")

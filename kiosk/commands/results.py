@@ -20,8 +20,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, wide_csv_of
 from kiosk.config import ConfigError, configured_questionnaire, load_config
+from kiosk.core.questionnaire import QuestionnaireError
 from kiosk.export import (
     ID_TAGS,
     ExportError,
@@ -34,7 +34,7 @@ from kiosk.export import (
     write_export,
     write_json,
 )
-from kiosk.core.questionnaire import QuestionnaireError
+from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, wide_csv_of
 from kiosk.export.opening import in_force_of, open_store
 from kiosk.store.database import StorageError, StoredSession
 
@@ -42,19 +42,34 @@ from kiosk.store.database import StorageError, StoredSession
 def _show(stored: StoredSession) -> None:
     q = questionnaire_of(stored)
     score = rescore(q, stored)
-    status = stored.status + (f" ({stored.interrupted_reason})" if stored.interrupted_reason else "") + (
-        ", simulated (a scripted patient, kiosk replay)" if stored.simulated else "")
-    print(f"session {stored.id}  patient {stored.patient_id}  {status}  language {stored.language}  "
-          f"answered by {stored.answered_by.value}")
+    status = (
+        stored.status
+        + (f" ({stored.interrupted_reason})" if stored.interrupted_reason else "")
+        + (", simulated (a scripted patient, kiosk replay)" if stored.simulated else "")
+    )
+    print(
+        f"session {stored.id}  patient {stored.patient_id}  {status}  language {stored.language}  "
+        f"answered by {stored.answered_by.value}"
+    )
     print(f"started {stored.started_at}" + (f"  finished {stored.finished_at}" if stored.finished_at else ""))
-    later = [what for what, flag in (("questionnaire", stored.definition_attached_later),
-                                     ("site and kiosk", stored.identity_attached_later)) if flag]
-    print(f"questionnaire {q.id} {q.version} ({stored.definition_sha256[:12]}), recorded at "
-          f"{stored.identity.get('site', '?')}/{stored.identity.get('kiosk_id', '?')}"
-          + (f"; {' and '.join(later)} attached later (stored before kiosks captured them)" if later else ""))
+    later = [
+        what
+        for what, flag in (
+            ("questionnaire", stored.definition_attached_later),
+            ("site and kiosk", stored.identity_attached_later),
+        )
+        if flag
+    ]
+    print(
+        f"questionnaire {q.id} {q.version} ({stored.definition_sha256[:12]}), recorded at "
+        f"{stored.identity.get('site', '?')}/{stored.identity.get('kiosk_id', '?')}"
+        + (f"; {' and '.join(later)} attached later (stored before kiosks captured them)" if later else "")
+    )
     outcomes = practice_outcomes(q, stored)
-    print("practice: " + ("; ".join(str(o) for o in outcomes) if outcomes
-                          else "none (no practice questions in this session)"))
+    print(
+        "practice: "
+        + ("; ".join(str(o) for o in outcomes) if outcomes else "none (no practice questions in this session)")
+    )
     answers = {a.item_id: a for a in stored.answers}
     for item in q.items:
         a = answers.get(item.id)
@@ -63,11 +78,12 @@ def _show(stored: StoredSession) -> None:
             print(f"  {item.number:>2} {item.id:<10} {outcome}")
         else:
             label = item.option(a.option).label_in(stored.language)
-            print(f"  {item.number:>2} {item.id:<10} option {a.option} {a.points:>3} points  attempt {a.attempt}  "
-                  f"{a.channel.value:<8} {label}")
+            print(
+                f"  {item.number:>2} {item.id:<10} option {a.option} {a.points:>3} points  attempt {a.attempt}  "
+                f"{a.channel.value:<8} {label}"
+            )
     source = q.bands_named(score.band_set).source
-    band = (f"{score.band.label['en']} (bands: {score.band_set}, {source})" if score.band
-            else "no band (incomplete)")
+    band = f"{score.band.label['en']} (bands: {score.band_set}, {source})" if score.band else "no band (incomplete)"
     completeness = "complete" if score.complete else f"incomplete, missing {', '.join(score.missing)}"
     print(f"total {score.total}/{score.max_total} ({completeness}); {band}")
     for record in stored.adaptations:
@@ -79,12 +95,22 @@ def _show(stored: StoredSession) -> None:
 
 def main(argv: list[str]) -> int:
     """List, show or export stored sessions; returns the exit status."""
-    parser = argparse.ArgumentParser(prog="kiosk results", description="List stored sessions, show some, or export them as FHIR R4 JSON or CSV (totals recomputed from the answers).")
-    parser.add_argument("sessions", nargs="*", metavar="SESSION",
-                        help="session id or unique prefix (default: list sessions; exports cover all)")
+    parser = argparse.ArgumentParser(
+        prog="kiosk results",
+        description="List stored sessions, show some, or export them as FHIR R4 JSON or CSV (totals recomputed from the answers).",
+    )
+    parser.add_argument(
+        "sessions",
+        nargs="*",
+        metavar="SESSION",
+        help="session id or unique prefix (default: list sessions; exports cover all)",
+    )
     parser.add_argument("--fhir", metavar="FILE", help="write the sessions as one FHIR R4 transaction Bundle")
-    parser.add_argument("--fhir-questionnaire", metavar="FILE",
-                        help="write the FHIR R4 Questionnaire (with --language: that language's; else a Bundle of all)")
+    parser.add_argument(
+        "--fhir-questionnaire",
+        metavar="FILE",
+        help="write the FHIR R4 Questionnaire (with --language: that language's; else a Bundle of all)",
+    )
     parser.add_argument("--language", choices=("en", "es", "fr"), help="language of --fhir-questionnaire")
     parser.add_argument("--csv", metavar="FILE", help="write the sessions as CSV, rows per item")
     parser.add_argument("--csv-wide", metavar="FILE", help="write the sessions as CSV, one row per session")
@@ -100,13 +126,20 @@ def main(argv: list[str]) -> int:
         # and an export of no session; stored sessions are described by what they captured
         if args.fhir_questionnaire:
             q = configured_questionnaire(config)
-            write_json(args.fhir_questionnaire, fhir_questionnaire(q, args.language, site) if args.language
-                       else questionnaire_bundle(q, site))
+            write_json(
+                args.fhir_questionnaire,
+                fhir_questionnaire(q, args.language, site) if args.language else questionnaire_bundle(q, site),
+            )
         with open_store(args.data_dir, in_force=lambda: in_force_of(config), export=export_identity(site)) as store:
             refs = [ref.removeprefix(ID_TAGS["session"]) for ref in args.sessions]
             exporting = args.fhir or args.csv or args.csv_wide
-            chosen = ([store.session(ref) for ref in refs] if refs
-                      else [store.session(s.id) for s in store.sessions()] if exporting else [])
+            chosen = (
+                [store.session(ref) for ref in refs]
+                if refs
+                else [store.session(s.id) for s in store.sessions()]
+                if exporting
+                else []
+            )
             empty = None if chosen or not exporting else (configured_questionnaire(config), site)
             if args.fhir:
                 write_json(args.fhir, bundle_of(chosen, empty=empty))
@@ -119,12 +152,17 @@ def main(argv: list[str]) -> int:
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
                 for s in summaries:
-                    print(f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.label:<9} {s.language}  "
-                          f"{s.answered} answered, {s.not_answered} not answered")
+                    print(
+                        f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.label:<9} {s.language}  "
+                        f"{s.answered} answered, {s.not_answered} not answered"
+                    )
                 waiting, parked = store.outbox_waiting()
                 if waiting or parked:
-                    print(f"outbox: {waiting} stored changes waiting for the ward station, {parked} refused by it "
-                          "(parked, kept for an engineer)", file=sys.stderr)
+                    print(
+                        f"outbox: {waiting} stored changes waiting for the ward station, {parked} refused by it "
+                        "(parked, kept for an engineer)",
+                        file=sys.stderr,
+                    )
             for stored in chosen if refs else ():
                 _show(stored)
     except (ConfigError, StorageError, QuestionnaireError, ExportError) as exc:

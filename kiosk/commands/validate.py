@@ -15,8 +15,11 @@ from kiosk.core.questionnaire import check_questionnaire
 
 def main(argv: list[str]) -> int:
     """Validate questionnaire files; returns the exit status."""
-    parser = argparse.ArgumentParser(prog="kiosk validate", description="List every problem of questionnaire files, one per line as file:line:col: problem; "
-                                     "exit 1 if any, 2 if a file cannot be read as YAML.")
+    parser = argparse.ArgumentParser(
+        prog="kiosk validate",
+        description="List every problem of questionnaire files, one per line as file:line:col: problem; "
+        "exit 1 if any, 2 if a file cannot be read as YAML.",
+    )
     parser.add_argument("files", nargs="+", metavar="FILE", help="questionnaire YAML file(s)")
     args = parser.parse_args(argv)
     status = 0

@@ -72,8 +72,9 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
     session runs), so a misspelt metric is an error instead of a rule that never fires.
     """
     if path is None:
-        data, positions, problems = parse_file(str(resources.files("kiosk.core").joinpath("adaptation.yaml")),
-                                               "adaptation.yaml")
+        data, positions, problems = parse_file(
+            str(resources.files("kiosk.core").joinpath("adaptation.yaml")), "adaptation.yaml"
+        )
         name = "adaptation.yaml"
     else:
         name = str(path)
@@ -104,14 +105,19 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
         if any(rule.name == raw["name"] for rule in rules):
             raise fail(p + ("name",), f"a second rule for {raw['name']!r} (one rule per adaptation)")
         if raw["metric"] not in properties:
-            raise fail(p + ("metric",), f"unknown metric {raw['metric']!r} (the model's properties: "
-                                        f"{', '.join(properties)})")
+            raise fail(
+                p + ("metric",), f"unknown metric {raw['metric']!r} (the model's properties: {', '.join(properties)})"
+            )
         if raw["count_on"] not in ("answers", "updates"):
             raise fail(p + ("count_on",), "count_on is 'answers' or 'updates'")
         # speech_rate: a factor on the normal rate; below half the kiosk's words would come with
         # pauses of seconds between them (0 would stop it speaking at all)
-        for key, low, top in (("below", 0, 1), ("recover_above", 0, 1), ("speech_rate", 0.5, 2),
-                              ("attempt_factor", 1, 4)):
+        for key, low, top in (
+            ("below", 0, 1),
+            ("recover_above", 0, 1),
+            ("speech_rate", 0.5, 2),
+            ("attempt_factor", 1, 4),
+        ):
             value = raw.get(key, 1.0)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not low <= value <= top:
                 raise fail(p + (key,), f"{key} must be a number between {low} and {top}")
@@ -119,9 +125,18 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
             raise fail(p + ("count",), "count must be a whole number of at least 1")
         if raw["recover_above"] < raw["below"]:
             raise fail(p + ("recover_above",), "recover_above must not be below 'below' (that is the hysteresis)")
-        rules.append(Rule(raw["name"], str(raw["metric"]), float(raw["below"]), raw["count"], raw["count_on"],
-                          float(raw["recover_above"]), float(raw.get("speech_rate", 1.0)),
-                          float(raw.get("attempt_factor", 1.0))))
+        rules.append(
+            Rule(
+                raw["name"],
+                str(raw["metric"]),
+                float(raw["below"]),
+                raw["count"],
+                raw["count_on"],
+                float(raw["recover_above"]),
+                float(raw.get("speech_rate", 1.0)),
+                float(raw.get("attempt_factor", 1.0)),
+            )
+        )
     return Policy(tuple(rules))
 
 
@@ -150,8 +165,9 @@ class Adaptation:
     @property
     def attempt_factor(self) -> float:
         """Factor on the attempt window (above 1 while longer_attempts is on)."""
-        factors = [r.attempt_factor for r in self.policy.rules
-                   if r.name in self._active and r.name == "longer_attempts"]
+        factors = [
+            r.attempt_factor for r in self.policy.rules if r.name in self._active and r.name == "longer_attempts"
+        ]
         return max(factors, default=1.0)
 
     def observe(self, metrics: Mapping[str, float], answered: bool) -> list[AdaptationChange]:
@@ -167,8 +183,11 @@ class Adaptation:
                 if value > rule.recover_above:
                     self._active.discard(rule.name)
                     self._low[rule.name] = 0
-                    changes.append(AdaptationChange(rule.name, False,
-                                                    f"{rule.metric} recovered to {value:.2f} (> {rule.recover_above:g})"))
+                    changes.append(
+                        AdaptationChange(
+                            rule.name, False, f"{rule.metric} recovered to {value:.2f} (> {rule.recover_above:g})"
+                        )
+                    )
                 continue
             if rule.count_on == "answers" and not answered:
                 continue
@@ -176,9 +195,13 @@ class Adaptation:
             if self._low[rule.name] >= rule.count:
                 self._active.add(rule.name)
                 readings = "answers" if rule.count_on == "answers" else "updates"
-                changes.append(AdaptationChange(rule.name, True,
-                                                f"{rule.metric} {value:.2f} < {rule.below:g} for "
-                                                f"{self._low[rule.name]} {readings} in a row"))
+                changes.append(
+                    AdaptationChange(
+                        rule.name,
+                        True,
+                        f"{rule.metric} {value:.2f} < {rule.below:g} for {self._low[rule.name]} {readings} in a row",
+                    )
+                )
         return changes
 
     def hold(self, name: str, held: bool, reason: str) -> list[AdaptationChange]:
@@ -216,7 +239,9 @@ class Adaptation:
         self.enabled = enabled
         if enabled:
             return []
-        lifted = [AdaptationChange(name, False, "adaptation turned off by the clinician") for name in sorted(self._active)]
+        lifted = [
+            AdaptationChange(name, False, "adaptation turned off by the clinician") for name in sorted(self._active)
+        ]
         self._active.clear()
         self._low = {name: 0 for name in self._low}
         return lifted

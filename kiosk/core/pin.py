@@ -231,8 +231,9 @@ class PinGuard:
         if self._dir is None:
             return
         self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
-        line = json.dumps({"at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(self._now())),
-                           "event": event, "detail": detail})
+        line = json.dumps(
+            {"at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(self._now())), "event": event, "detail": detail}
+        )
         descriptor = os.open(self._dir / LOG_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
         with os.fdopen(descriptor, "a", encoding="utf-8") as handle:
             handle.write(line + "\n")

@@ -58,6 +58,8 @@ def load_kiosk_model(name_or_path: str | Path = DEFAULT_MODEL) -> Model:
             check_batch(model, values, emitted)
         except ContextError as exc:
             what = ", ".join(f"{name} = {value}" for name, value in values.items()) or f"the event {emitted[0]}"
-            raise ModelError(f"{model.source}:1:1: the kiosk cannot run this model: it publishes {what}, "
-                             f"and {exc} (import \"clarc.roqme\" to declare the kiosk's contexts)") from None
+            raise ModelError(
+                f"{model.source}:1:1: the kiosk cannot run this model: it publishes {what}, "
+                f'and {exc} (import "clarc.roqme" to declare the kiosk\'s contexts)'
+            ) from None
     return model

@@ -113,8 +113,11 @@ def review_from_steps(steps: Iterable[Step], staff_system: str = STAFF_SYSTEM) -
     sign: Step | None = None
     for step in steps:
         if step.action in ("correct", "fill"):
-            corrections.append(Correction(step.item_id or "", step.option or 0, step.previous_option, step.reason,
-                                          step.author, step.at))
+            corrections.append(
+                Correction(
+                    step.item_id or "", step.option or 0, step.previous_option, step.reason, step.author, step.at
+                )
+            )
         elif step.action == "sign_off":
             sign = step
         elif step.action == "amend" and sign is not None:

@@ -52,8 +52,10 @@ def check_patient_id(value: str) -> str | None:
     if not value:
         return "type the patient's identifier"
     if not HOSPITAL_ID.match(value):
-        return (f"{value[:64]!r} is not a patient identifier: 2 to 64 letters, digits, '-' or '_', "
-                "with at least one digit, never a name")
+        return (
+            f"{value[:64]!r} is not a patient identifier: 2 to 64 letters, digits, '-' or '_', "
+            "with at least one digit, never a name"
+        )
     return None
 
 
@@ -85,8 +87,9 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
         elif answered_by not in ("patient", "relative", "caregiver"):
             problems.append(f"{where} ({order_id}): answered_by {answered_by!r}")
         else:
-            found.append(Order(order_id, patient, tuple(wanted), language, answered_by,
-                               str(entry.get("ordered_by") or "")))
+            found.append(
+                Order(order_id, patient, tuple(wanted), language, answered_by, str(entry.get("ordered_by") or ""))
+            )
     return found, problems
 
 

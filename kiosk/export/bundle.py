@@ -21,11 +21,11 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import quote
 
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.review import Review
 from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of, total_of
 from kiosk.export.provenance import fhir_provenances
 from kiosk.export.result import ExportSite, Result, questionnaire_version, results
-from kiosk.core.questionnaire import Questionnaire
-from kiosk.core.review import Review
 from kiosk.store.database import StoredSession
 
 
@@ -49,15 +49,19 @@ def _query(**params: str) -> str:
 
 def _entry(resource: dict[str, Any], full_url: str, condition: str, update: bool) -> dict[str, Any]:
     kind = resource["resourceType"]
-    request = ({"method": "PUT", "url": f"{kind}?{condition}"} if update
-               else {"method": "POST", "url": kind, "ifNoneExist": condition})
+    request = (
+        {"method": "PUT", "url": f"{kind}?{condition}"}
+        if update
+        else {"method": "POST", "url": kind, "ifNoneExist": condition}
+    )
     return {"fullUrl": full_url, "resource": {k: v for k, v in resource.items() if k != "id"}, "request": request}
 
 
 def _questionnaire_entry(q: Questionnaire, site: ExportSite, language: str) -> dict[str, Any]:
     url, version = questionnaire_canonical(q, site, language), questionnaire_version(q)
-    return _entry(fhir_questionnaire(q, language, site), _full_url(url, version), _query(url=url, version=version),
-                  update=False)
+    return _entry(
+        fhir_questionnaire(q, language, site), _full_url(url, version), _query(url=url, version=version), update=False
+    )
 
 
 def _result_entries(d: Described, device_url: str) -> list[dict[str, Any]]:
@@ -66,19 +70,31 @@ def _result_entries(d: Described, device_url: str) -> list[dict[str, Any]]:
     response["author"] = response["author"] | {"reference": device_url}
     value = site.result_id(r.stored.id)
     response_url = _full_url(site.identifier_system, value)
-    entries = [_entry(response, response_url, _query(identifier=f"{site.identifier_system}|{value}"),
-                      update=r.final)]
-    total = total_of(q, r, site, {"reference": response_url, "type": "QuestionnaireResponse",
-                                  "identifier": response["identifier"]})
+    entries = [_entry(response, response_url, _query(identifier=f"{site.identifier_system}|{value}"), update=r.final)]
+    total = total_of(
+        q, r, site, {"reference": response_url, "type": "QuestionnaireResponse", "identifier": response["identifier"]}
+    )
     if total is not None:
         total["device"] |= {"reference": device_url}
-        entries.append(_entry(total, _full_url(site.identifier_system, value + "/total"),
-                              _query(identifier=f"{site.identifier_system}|{value}/total"), update=r.final))
+        entries.append(
+            _entry(
+                total,
+                _full_url(site.identifier_system, value + "/total"),
+                _query(identifier=f"{site.identifier_system}|{value}/total"),
+                update=r.final,
+            )
+        )
     device = response["author"]
-    for provenance in fhir_provenances(q, r, site, {"reference": response_url, "type": "QuestionnaireResponse"},
-                                       device):
-        entries.append({"fullUrl": f"urn:uuid:{provenance['id']}", "resource": provenance,
-                        "request": {"method": "PUT", "url": f"Provenance/{provenance['id']}"}})
+    for provenance in fhir_provenances(
+        q, r, site, {"reference": response_url, "type": "QuestionnaireResponse"}, device
+    ):
+        entries.append(
+            {
+                "fullUrl": f"urn:uuid:{provenance['id']}",
+                "resource": provenance,
+                "request": {"method": "PUT", "url": f"Provenance/{provenance['id']}"},
+            }
+        )
     return entries
 
 
@@ -94,16 +110,21 @@ def bundle_of(described: Sequence[Described]) -> dict[str, Any]:
         questionnaires.setdefault(entry["fullUrl"], entry)
         device_url = _full_url(site.device_system, site.kiosk_id)
         if device_url not in devices:
-            devices[device_url] = _entry(fhir_device(site), device_url,
-                                         _query(identifier=f"{site.device_system}|{site.kiosk_id}"), update=False)
+            devices[device_url] = _entry(
+                fhir_device(site), device_url, _query(identifier=f"{site.device_system}|{site.kiosk_id}"), update=False
+            )
         results_ += _result_entries(d, device_url)
     entries = [*questionnaires.values(), *devices.values(), *results_]
     # FHIR JSON has no empty arrays: a Bundle of nothing has no entry at all
     return {"resourceType": "Bundle", "type": "transaction"} | ({"entry": entries} if entries else {})
 
 
-def transaction_bundle(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
-                       site: ExportSite | None = None) -> dict[str, Any]:
+def transaction_bundle(
+    q: Questionnaire,
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review] | None = None,
+    site: ExportSite | None = None,
+) -> dict[str, Any]:
     """Sessions answered on ``q`` under one identity ``site``, with their reviews (same order;
     None: unreviewed), as one R4 transaction Bundle (:func:`bundle_of`)."""
     site = site or ExportSite()
@@ -113,5 +134,8 @@ def transaction_bundle(q: Questionnaire, sessions: Sequence[StoredSession], revi
 def questionnaire_bundle(q: Questionnaire, site: ExportSite | None = None) -> dict[str, Any]:
     """The questionnaire in every language as a transaction Bundle of conditional creates."""
     site = site or ExportSite()
-    return {"resourceType": "Bundle", "type": "transaction",
-            "entry": [_questionnaire_entry(q, site, language) for language in q.languages]}
+    return {
+        "resourceType": "Bundle",
+        "type": "transaction",
+        "entry": [_questionnaire_entry(q, site, language) for language in q.languages],
+    }

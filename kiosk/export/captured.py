@@ -18,7 +18,9 @@ from functools import lru_cache
 from typing import Any
 
 from kiosk.config import default_kiosk_id
+from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.questionnaire.definition import DefinitionError, canonical_json, questionnaire_from
+from kiosk.core.review import Review
 from kiosk.export import (
     ExportError,
     ExportSite,
@@ -27,8 +29,6 @@ from kiosk.export import (
     transaction_bundle,
     wide_csv_text,
 )
-from kiosk.core.questionnaire import Questionnaire
-from kiosk.core.review import Review
 from kiosk.store.records import StoredSession
 
 __all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of"]
@@ -59,8 +59,9 @@ def site_of(stored: StoredSession, kiosk_id: str | None = None) -> ExportSite:
     return site_from_identity(identity, identity.get("kiosk_id") or kiosk_id or default_kiosk_id())
 
 
-def _groups(sessions: Sequence[StoredSession], reviews: Sequence[Review | None] | None,
-            kiosk_id: str | None) -> list[tuple[Questionnaire, ExportSite, list[StoredSession], list[Review | None]]]:
+def _groups(
+    sessions: Sequence[StoredSession], reviews: Sequence[Review | None] | None, kiosk_id: str | None
+) -> list[tuple[Questionnaire, ExportSite, list[StoredSession], list[Review | None]]]:
     """Sessions grouped by (definition, identity), in order of first appearance."""
     if reviews is not None and len(reviews) != len(sessions):
         raise ExportError(f"{len(sessions)} sessions but {len(reviews)} reviews: give one review per session")
@@ -79,8 +80,13 @@ def _groups(sessions: Sequence[StoredSession], reviews: Sequence[Review | None] 
 Empty = tuple[Questionnaire, ExportSite]
 
 
-def bundle_of(sessions: Sequence[StoredSession], reviews: Sequence[Review | None] | None = None,
-              kiosk_id: str | None = None, *, empty: Empty | None = None) -> dict[str, Any]:
+def bundle_of(
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review | None] | None = None,
+    kiosk_id: str | None = None,
+    *,
+    empty: Empty | None = None,
+) -> dict[str, Any]:
     """One FHIR transaction Bundle of ``sessions``, each described by its own definition and
     identity (:func:`kiosk.export.transaction_bundle` per group; an entry several groups share,
     such as the kiosk's Device, appears once)."""
@@ -130,8 +136,14 @@ def _merge_csv(texts: list[str]) -> str:
     return out.getvalue()
 
 
-def csv_of(sessions: Sequence[StoredSession], reviews: Sequence[Review | None] | None = None,
-           kiosk_id: str | None = None, *, bom: bool = False, empty: Empty | None = None) -> str:
+def csv_of(
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review | None] | None = None,
+    kiosk_id: str | None = None,
+    *,
+    bom: bool = False,
+    empty: Empty | None = None,
+) -> str:
     """The long CSV (:func:`kiosk.export.csv_text`) of ``sessions``, each with its own definition
     and identity."""
     groups = _groups(sessions, reviews, kiosk_id)
@@ -139,11 +151,18 @@ def csv_of(sessions: Sequence[StoredSession], reviews: Sequence[Review | None] |
         q, site = _empty(empty, kiosk_id)
         return csv_text(q, [], None, site, bom=bom)
     return ("\ufeff" if bom else "") + _merge_csv(
-        [csv_text(q, group, _reviews(found), site) for q, site, group, found in groups])
+        [csv_text(q, group, _reviews(found), site) for q, site, group, found in groups]
+    )
 
 
-def wide_csv_of(sessions: Sequence[StoredSession], reviews: Sequence[Review | None] | None = None,
-                kiosk_id: str | None = None, *, bom: bool = False, empty: Empty | None = None) -> str:
+def wide_csv_of(
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review | None] | None = None,
+    kiosk_id: str | None = None,
+    *,
+    bom: bool = False,
+    empty: Empty | None = None,
+) -> str:
     """The wide CSV (:func:`kiosk.export.wide_csv_text`) of ``sessions``: one row each, under the
     columns of every definition among them."""
     groups = _groups(sessions, reviews, kiosk_id)
@@ -151,5 +170,5 @@ def wide_csv_of(sessions: Sequence[StoredSession], reviews: Sequence[Review | No
         q, site = _empty(empty, kiosk_id)
         return wide_csv_text(q, [], None, site, bom=bom)
     return ("\ufeff" if bom else "") + _merge_csv(
-        [wide_csv_text(q, group, _reviews(found), site) for q, site, group, found in groups])
-
+        [wide_csv_text(q, group, _reviews(found), site) for q, site, group, found in groups]
+    )

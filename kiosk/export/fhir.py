@@ -61,6 +61,9 @@ from collections.abc import Mapping
 from datetime import datetime, timezone
 from typing import Any
 
+from kiosk.core.questionnaire import Code, Questionnaire
+from kiosk.core.review import Review, ReviewState
+from kiosk.core.visits import visit_of
 from kiosk.export.result import (
     TOTAL_LINK,
     ExportError,
@@ -69,10 +72,7 @@ from kiosk.export.result import (
     questionnaire_version,
     result,
 )
-from kiosk.core.questionnaire import Code, Questionnaire
-from kiosk.core.review import Review, ReviewState
 from kiosk.store.database import StoredSession
-from kiosk.core.visits import visit_of
 
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
@@ -80,13 +80,18 @@ TRANSLATION = "http://hl7.org/fhir/StructureDefinition/translation"
 SIGNATURE = "http://hl7.org/fhir/StructureDefinition/questionnaireresponse-signature"
 CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
 #: ASTM E1762-95 "Verification Signature": the signer checked the content is complete and correct
-VERIFICATION = {"system": "urn:iso-astm:E1762-95:2013", "code": "1.2.840.10065.1.12.1.5",
-                "display": "Verification Signature"}
+VERIFICATION = {
+    "system": "urn:iso-astm:E1762-95:2013",
+    "code": "1.2.840.10065.1.12.1.5",
+    "display": "Verification Signature",
+}
 #: the security label of test data: a scripted patient's session (``kiosk replay``) is no patient's result
-TEST_DATA = {"system": "http://terminology.hl7.org/CodeSystem/v3-ActReason", "code": "HTEST",
-             "display": "test health data"}
-SURVEY = {"system": "http://terminology.hl7.org/CodeSystem/observation-category", "code": "survey",
-          "display": "Survey"}
+TEST_DATA = {
+    "system": "http://terminology.hl7.org/CodeSystem/v3-ActReason",
+    "code": "HTEST",
+    "display": "test health data",
+}
+SURVEY = {"system": "http://terminology.hl7.org/CodeSystem/observation-category", "code": "survey", "display": "Survey"}
 TOTAL_TEXT = {"en": "Total score", "es": "Puntuación total", "fr": "Score total"}
 #: the words the kiosk used beside a code (see the module docstring): ``clinical``, ``patient``, ``spoken``
 WORDING = "urn:barthel-kiosk:fhir:StructureDefinition:wording"
@@ -111,9 +116,11 @@ def questionnaire_canonical(q: Questionnaire, site: ExportSite, language: str) -
 def _text(key: str, texts: Mapping[str, str], language: str) -> dict[str, Any]:
     """``{key: text in language, _key: the other languages}`` (FHIR translation extension; no
     ``_key`` for a text in one language only, as FHIR JSON has no empty arrays)."""
-    others = [{"url": TRANSLATION, "extension": [{"url": "lang", "valueCode": lang},
-                                                 {"url": "content", "valueString": text}]}
-              for lang, text in texts.items() if lang != language]
+    others = [
+        {"url": TRANSLATION, "extension": [{"url": "lang", "valueCode": lang}, {"url": "content", "valueString": text}]}
+        for lang, text in texts.items()
+        if lang != language
+    ]
     return {key: texts[language]} | ({f"_{key}": {"extension": others}} if others else {})
 
 
@@ -132,8 +139,13 @@ def option_coding(q: Questionnaire, item_id: str, number: int, language: str) ->
     return {"system": code.system, "code": code.code} | _text("display", option.label, language)
 
 
-def wording(language: str, *, clinical: Mapping[str, str], patient: Mapping[str, str] | None = None,
-            spoken: Mapping[str, str] | None = None) -> dict[str, Any]:
+def wording(
+    language: str,
+    *,
+    clinical: Mapping[str, str],
+    patient: Mapping[str, str] | None = None,
+    spoken: Mapping[str, str] | None = None,
+) -> dict[str, Any]:
     """The :data:`WORDING` extension: the words in ``language`` (patient's wording defaults to
     the clinical one, as on the kiosk's screen; ``spoken`` only where given)."""
     parts = [("clinical", clinical[language]), ("patient", (patient or {}).get(language) or clinical[language])]
@@ -145,8 +157,7 @@ def wording(language: str, *, clinical: Mapping[str, str], patient: Mapping[str,
 def _total_expression(q: Questionnaire) -> str:
     """The total as FHIRPath: the sum of the answers' weights, and nothing while an item is unanswered."""
     answered = f"%resource.item.where(linkId != '{TOTAL_LINK}' and answer.exists())"
-    return (f"iif({answered}.count() = {len(q.items)}, "
-            f"{answered}.answer.value.weight().sum(), {{}})")
+    return f"iif({answered}.count() = {len(q.items)}, {answered}.answer.value.weight().sum(), {{}})"
 
 
 def _computable_name(title: str) -> str:
@@ -164,33 +175,48 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
     for item in q.items:
         entry: dict[str, Any] = {
             "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
-            "linkId": item.id, **_text("text", item.text, language), "type": "choice", "required": True}
+            "linkId": item.id,
+            **_text("text", item.text, language),
+            "type": "choice",
+            "required": True,
+        }
         if item.code:
             entry["code"] = [_coding(item.code)]
         entry["answerOption"] = [
-            {"extension": [{"url": ITEM_WEIGHT, "valueDecimal": option.points},
-                           {"url": ORDINAL_VALUE, "valueDecimal": option.points},
-                           wording(language, clinical=option.label, patient=option.patient)],
-             "valueCoding": option_coding(q, item.id, option.number, language)}
+            {
+                "extension": [
+                    {"url": ITEM_WEIGHT, "valueDecimal": option.points},
+                    {"url": ORDINAL_VALUE, "valueDecimal": option.points},
+                    wording(language, clinical=option.label, patient=option.patient),
+                ],
+                "valueCoding": option_coding(q, item.id, option.number, language),
+            }
             for option in item.options
         ]
         items.append(entry)
     total: dict[str, Any] = {
-        "extension": [{"url": CALCULATED, "valueExpression": {"language": "text/fhirpath",
-                                                               "expression": _total_expression(q)}}],
+        "extension": [
+            {"url": CALCULATED, "valueExpression": {"language": "text/fhirpath", "expression": _total_expression(q)}}
+        ],
         "linkId": TOTAL_LINK,
         **_text("text", {lang: TOTAL_TEXT.get(lang, TOTAL_TEXT["en"]) for lang in q.languages}, language),
-        "type": "integer", "readOnly": True,
+        "type": "integer",
+        "readOnly": True,
     }
     if q.total_code:
         total["code"] = [_coding(q.total_code)]
     items.append(total)
     resource: dict[str, Any] = {
-        "resourceType": "Questionnaire", "id": f"{q.id}-{language}", "language": language,
-        "url": questionnaire_canonical(q, site, language), "version": questionnaire_version(q),
+        "resourceType": "Questionnaire",
+        "id": f"{q.id}-{language}",
+        "language": language,
+        "url": questionnaire_canonical(q, site, language),
+        "version": questionnaire_version(q),
         "name": _computable_name(q.title["en"]) + language.upper(),
         **_text("title", q.title, language),
-        "status": "active", "subjectType": ["Patient"], "item": items,
+        "status": "active",
+        "subjectType": ["Patient"],
+        "item": items,
     }
     if q.code:
         resource["code"] = [_coding(q.code)]
@@ -206,14 +232,21 @@ def response_status(r: Result) -> str:
 
 def device_reference(site: ExportSite) -> dict[str, Any]:
     """The kiosk as a logical Device reference (its kiosk id in the site's device system)."""
-    return {"type": "Device", "identifier": {"system": site.device_system, "value": site.kiosk_id},
-            "display": f"Barthel kiosk {site.kiosk_id}"}
+    return {
+        "type": "Device",
+        "identifier": {"system": site.device_system, "value": site.kiosk_id},
+        "display": f"Barthel kiosk {site.kiosk_id}",
+    }
 
 
 def fhir_device(site: ExportSite) -> dict[str, Any]:
     """The kiosk as an R4 Device resource."""
-    return {"resourceType": "Device", "identifier": [{"system": site.device_system, "value": site.kiosk_id}],
-            "status": "active", "deviceName": [{"name": f"Barthel kiosk {site.kiosk_id}", "type": "user-friendly-name"}]}
+    return {
+        "resourceType": "Device",
+        "identifier": [{"system": site.device_system, "value": site.kiosk_id}],
+        "status": "active",
+        "deviceName": [{"name": f"Barthel kiosk {site.kiosk_id}", "type": "user-friendly-name"}],
+    }
 
 
 def _patient(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
@@ -231,8 +264,9 @@ def _authored(r: Result) -> str:
     return instant(max(changes, key=instant) if changes else r.stored.finished_at or r.stored.started_at)
 
 
-def fhir_response(q: Questionnaire, stored: StoredSession, review: Review | None = None,
-                  site: ExportSite | None = None) -> dict[str, Any]:
+def fhir_response(
+    q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
+) -> dict[str, Any]:
     """A stored session (with its clinician's review, if any) as an R4 QuestionnaireResponse."""
     return response_of(q, result(q, stored, review), site or ExportSite())
 
@@ -247,21 +281,38 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
             continue  # unanswered: left out, as SDC does
         option = item.option(r.options[item.id])
         entry: dict[str, Any] = {"id": item.id} if item.id in changed else {}  # a Provenance's targetElement
-        entry |= {"extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
-                  "linkId": item.id, "text": item.text[language],
-                  "answer": [{"extension": [wording(language, clinical=option.label, patient=option.patient)],
-                              "valueCoding": option_coding(q, item.id, option.number, language)}]}
+        entry |= {
+            "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+            "linkId": item.id,
+            "text": item.text[language],
+            "answer": [
+                {
+                    "extension": [wording(language, clinical=option.label, patient=option.patient)],
+                    "valueCoding": option_coding(q, item.id, option.number, language),
+                }
+            ],
+        }
         items.append(entry)
     if r.complete:
-        items.append({"linkId": TOTAL_LINK, "text": TOTAL_TEXT.get(language, TOTAL_TEXT["en"]),
-                      "answer": [{"valueInteger": r.score.total}]})
+        items.append(
+            {
+                "linkId": TOTAL_LINK,
+                "text": TOTAL_TEXT.get(language, TOTAL_TEXT["en"]),
+                "answer": [{"valueInteger": r.score.total}],
+            }
+        )
     resource: dict[str, Any] = {
-        "resourceType": "QuestionnaireResponse", "id": stored.id, "language": language,
+        "resourceType": "QuestionnaireResponse",
+        "id": stored.id,
+        "language": language,
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
         "questionnaire": f"{questionnaire_canonical(q, site, language)}|{questionnaire_version(q)}",
-        "status": response_status(r), "subject": _patient(site, stored), "authored": _authored(r),
+        "status": response_status(r),
+        "subject": _patient(site, stored),
+        "authored": _authored(r),
         "author": device_reference(site),
-        "source": _patient(site, stored) if stored.answered_by.value == "patient"
+        "source": _patient(site, stored)
+        if stored.answered_by.value == "patient"
         else {"type": "RelatedPerson", "display": stored.answered_by.value},
     }
     if items:  # FHIR JSON has no empty arrays
@@ -290,8 +341,14 @@ def _labelled(resource: dict[str, Any], stored: StoredSession) -> dict[str, Any]
 def _signature(review: Review) -> dict[str, Any]:
     if not review.signed_by or not review.signed_at:
         raise ExportError(f"a review in state {ReviewState(review.state).value} needs who signed it off and when")
-    return {"url": SIGNATURE, "valueSignature": {"type": [VERIFICATION], "when": instant(review.signed_at),
-                                                 "who": practitioner(review.signed_by, review.staff_system)}}
+    return {
+        "url": SIGNATURE,
+        "valueSignature": {
+            "type": [VERIFICATION],
+            "when": instant(review.signed_at),
+            "who": practitioner(review.signed_by, review.staff_system),
+        },
+    }
 
 
 def observation_status(r: Result) -> str:
@@ -299,13 +356,16 @@ def observation_status(r: Result) -> str:
     return {ReviewState.AMENDED: "amended", ReviewState.SIGNED_OFF: "final"}.get(r.state, "preliminary")
 
 
-def fhir_total(q: Questionnaire, stored: StoredSession, review: Review | None = None,
-               site: ExportSite | None = None) -> dict[str, Any] | None:
+def fhir_total(
+    q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
+) -> dict[str, Any] | None:
     """The total as an R4 Observation (LOINC 96761-2) derived from the response; None when the
     result is incomplete, so a partial sum is never charted as a Barthel total."""
     site = site or ExportSite()
-    response = {"type": "QuestionnaireResponse",
-                "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)}}
+    response = {
+        "type": "QuestionnaireResponse",
+        "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
+    }
     return total_of(q, result(q, stored, review), site, response)
 
 
@@ -316,27 +376,51 @@ def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, 
         return None
     stored, language = r.stored, r.stored.language
     observation: dict[str, Any] = {
-        "resourceType": "Observation", "language": language,
+        "resourceType": "Observation",
+        "language": language,
         "identifier": [{"system": site.identifier_system, "value": site.result_id(stored.id) + "/total"}],
-        "status": observation_status(r), "category": [{"coding": [SURVEY]}],
-        "code": {"coding": [_coding(q.total_code)], "text": f"{q.title[language]}: {TOTAL_TEXT.get(language, 'Total')}"},
-        "subject": _patient(site, stored), "effectiveDateTime": instant(stored.finished_at or stored.started_at),
-        "device": device_reference(site), "derivedFrom": [response],
-        "valueQuantity": {"value": r.score.total, "unit": "{score}", "system": "http://unitsofmeasure.org",
-                          "code": "{score}"},
+        "status": observation_status(r),
+        "category": [{"coding": [SURVEY]}],
+        "code": {
+            "coding": [_coding(q.total_code)],
+            "text": f"{q.title[language]}: {TOTAL_TEXT.get(language, 'Total')}",
+        },
+        "subject": _patient(site, stored),
+        "effectiveDateTime": instant(stored.finished_at or stored.started_at),
+        "device": device_reference(site),
+        "derivedFrom": [response],
+        "valueQuantity": {
+            "value": r.score.total,
+            "unit": "{score}",
+            "system": "http://unitsofmeasure.org",
+            "code": "{score}",
+        },
     }
     band_set = q.bands_named(r.score.band_set)
     if r.score.band is not None:
-        observation["interpretation"] = [{
-            "coding": [{"system": f"urn:barthel-kiosk:band-set:{band_set.id}", "code": r.score.band.id,
-                        "display": r.score.band.label["en"]}],
-            "text": f"{r.score.band.label[language]} ({band_set.id}: {band_set.source})"}]
+        observation["interpretation"] = [
+            {
+                "coding": [
+                    {
+                        "system": f"urn:barthel-kiosk:band-set:{band_set.id}",
+                        "code": r.score.band.id,
+                        "display": r.score.band.label["en"],
+                    }
+                ],
+                "text": f"{r.score.band.label[language]} ({band_set.id}: {band_set.source})",
+            }
+        ]
     if r.final:
         observation["issued"] = instant(r.review.signed_at or "")
         observation["performer"] = [practitioner(r.review.signed_by or "", r.review.staff_system)]
-    notes = [{"authorString": c.author, "time": instant(c.at),
-              "text": f"{c.item_id}: option {c.previous_option or 'none'} -> {c.option} ({c.reason})"}
-             for c in r.review.corrections]
+    notes = [
+        {
+            "authorString": c.author,
+            "time": instant(c.at),
+            "text": f"{c.item_id}: option {c.previous_option or 'none'} -> {c.option} ({c.reason})",
+        }
+        for c in r.review.corrections
+    ]
     if notes:
         observation["note"] = notes
     return _labelled(observation, stored)

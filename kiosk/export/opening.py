@@ -13,11 +13,11 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
-from kiosk.core.adaptation import MODEL
 from kiosk.config import Config, ConfigError, configured_questionnaire, load_config
+from kiosk.core.adaptation import MODEL
 from kiosk.core.questionnaire.definition import canonical
-from kiosk.store.migrations import InForce
 from kiosk.store.database import StorageError, Store, StoredSession
+from kiosk.store.migrations import InForce
 
 __all__ = ["MODEL", "in_force_of", "open_store", "session_trace", "trace_main"]
 
@@ -28,8 +28,11 @@ def in_force_of(config: Config) -> InForce:
     site, kiosk and FHIR systems, dated now."""
     from kiosk.export import export_identity, site_from_config
 
-    return InForce(canonical(configured_questionnaire(config)), export_identity(site_from_config(config)),
-                   datetime.now(timezone.utc).isoformat().replace("+00:00", "Z"))
+    return InForce(
+        canonical(configured_questionnaire(config)),
+        export_identity(site_from_config(config)),
+        datetime.now(timezone.utc).isoformat().replace("+00:00", "Z"),
+    )
 
 
 def open_store(data_dir: str | None, **options: Any) -> Store:
@@ -45,14 +48,16 @@ def session_trace(stored: StoredSession, model: str = MODEL):  # -> qos.Trace
     """A stored session's context trace as a ``qos.Trace`` of ``model`` (the kiosk's ``qos_model``)."""
     from qos import Trace
 
-    return Trace.from_events(model, stored.trace, description=f"session {stored.id} (patient {stored.patient_id}, "
-                                                             f"started {stored.started_at})")
+    return Trace.from_events(
+        model,
+        stored.trace,
+        description=f"session {stored.id} (patient {stored.patient_id}, started {stored.started_at})",
+    )
 
 
 def trace_main(argv: list[str]) -> int:
     """`kiosk qos trace SESSION [--json] [-o FILE] [--data-dir DIR]`; exit 2 on an unknown session."""
-    parser = argparse.ArgumentParser(prog="kiosk qos trace",
-                                     description="print a stored session's QoS context trace")
+    parser = argparse.ArgumentParser(prog="kiosk qos trace", description="print a stored session's QoS context trace")
     parser.add_argument("session", help="session id (or a unique prefix of it)")
     parser.add_argument("--json", action="store_true", help="JSON instead of YAML")
     parser.add_argument("-o", "--output", metavar="FILE", help="write to FILE (owner-only) instead of stdout")

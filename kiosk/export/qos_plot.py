@@ -21,15 +21,25 @@ OTHER_COLOURS = ("#c2410c", "#a16207", "#0e7490")
 MARK_COLOURS = {"incident": "#6b7280", "adaptation": "#b91c1c"}
 #: session-log kinds shown as incidents, with the words a clinician reads
 INCIDENT_WORDS = {
-    "pause": "paused", "resume": "resumed", "call_doctor": "doctor called", "doctor_called": "doctor called",
-    "doctor_call_cancelled": "\"I'm fine, carry on\"",
-    "clinician_continue": "continued by staff", "doctor_continued": "continued by staff",
-    "person_lost": "patient left", "person_back": "patient back", "attempt_timed_out": "no answer in time",
-    "repeat": "asked to repeat", "abandoned": "abandoned",
+    "pause": "paused",
+    "resume": "resumed",
+    "call_doctor": "doctor called",
+    "doctor_called": "doctor called",
+    "doctor_call_cancelled": '"I\'m fine, carry on"',
+    "clinician_continue": "continued by staff",
+    "doctor_continued": "continued by staff",
+    "person_lost": "patient left",
+    "person_back": "patient back",
+    "attempt_timed_out": "no answer in time",
+    "repeat": "asked to repeat",
+    "abandoned": "abandoned",
 }
 #: adaptations in a clinician's words (a policy may name others: shown with spaces)
-ADAPTATION_WORDS = {"voice_off": "voice answers off", "slow_speech": "slow speech",
-                    "longer_attempts": "longer attempts"}
+ADAPTATION_WORDS = {
+    "voice_off": "voice answers off",
+    "slow_speech": "slow speech",
+    "longer_attempts": "longer attempts",
+}
 
 
 def metric_colour(name: str, index: int = 0) -> str:
@@ -52,8 +62,11 @@ def plot_marks(stored: StoredSession, incidents: tuple[str, ...] | None = None) 
     default all of :data:`INCIDENT_WORDS`) and every adaptation switching on or off -- except
     slow speech while voice out was off (the kiosk said nothing, so nothing was slowed)."""
     kinds = INCIDENT_WORDS.keys() if incidents is None else incidents
-    marks = [Mark(e.t, INCIDENT_WORDS.get(e.kind, e.kind.replace("_", " ")), "incident")
-             for e in stored.log if e.kind in kinds]
+    marks = [
+        Mark(e.t, INCIDENT_WORDS.get(e.kind, e.kind.replace("_", " ")), "incident")
+        for e in stored.log
+        if e.kind in kinds
+    ]
     voice_out = [(e.t, e.detail == "available") for e in stored.log if e.kind == "voice_out"]
     for change in stored.adaptations:
         if change.name == "slow_speech" and not _voice_out_at(voice_out, change.t):

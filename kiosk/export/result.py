@@ -11,11 +11,11 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from fileio.bounded import write_error, write_private  # the one owner-only writer; exports use it from here too
 from kiosk.config import Config, default_kiosk_id
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import Review, ReviewState, review_state
 from kiosk.store.database import PracticeRecord, StoredSession
-from fileio.bounded import write_error, write_private  # the one owner-only writer; exports use it from here too
 
 TOTAL_LINK = "total"
 
@@ -47,9 +47,11 @@ class ExportSite:
     device_system: str = ""
 
     def __post_init__(self) -> None:
-        defaults = {"patient_system": f"urn:barthel-kiosk:{self.site}:patient",
-                    "identifier_system": "urn:barthel-kiosk:result",
-                    "device_system": f"urn:barthel-kiosk:{self.site}:kiosk"}
+        defaults = {
+            "patient_system": f"urn:barthel-kiosk:{self.site}:patient",
+            "identifier_system": "urn:barthel-kiosk:result",
+            "device_system": f"urn:barthel-kiosk:{self.site}:kiosk",
+        }
         for name, value in defaults.items():
             if not getattr(self, name):
                 object.__setattr__(self, name, value)
@@ -92,8 +94,10 @@ def rescore(q: Questionnaire, stored: StoredSession) -> Score:
         except KeyError as exc:
             raise ExportError(f"session {stored.id}: {exc.args[0]}") from None
         if option.points != answer.points:
-            raise ExportError(f"session {stored.id}: {answer.item_id} option {answer.option} is worth "
-                              f"{option.points} points in {q.id}, but {answer.points} were stored")
+            raise ExportError(
+                f"session {stored.id}: {answer.item_id} option {answer.option} is worth "
+                f"{option.points} points in {q.id}, but {answer.points} were stored"
+            )
         assert option.points is not None
         points[answer.item_id] = option.points
     return q.score(points)
@@ -155,8 +159,10 @@ def result(q: Questionnaire, stored: StoredSession, review: Review | None = None
     """A stored session with its review applied (ExportError if either does not fit ``q``)."""
     review = review or Review.unreviewed()
     if stored.questionnaire_id != q.id:
-        raise ExportError(f"session {stored.id} was answered on questionnaire {stored.questionnaire_id!r}, "
-                          f"not on {q.id!r} ({q.source}): export it with that questionnaire")
+        raise ExportError(
+            f"session {stored.id} was answered on questionnaire {stored.questionnaire_id!r}, "
+            f"not on {q.id!r} ({q.source}): export it with that questionnaire"
+        )
     rescore(q, stored)  # the stored answers must fit the questionnaire before anything is said about them
     options = review.options({a.item_id: a.option for a in stored.answers})
     points = {}
@@ -170,8 +176,9 @@ def result(q: Questionnaire, stored: StoredSession, review: Review | None = None
     return Result(stored, review, options, q.score(points))
 
 
-def results(q: Questionnaire, sessions: Sequence[StoredSession],
-            reviews: Sequence[Review | None] | None = None) -> list[Result]:
+def results(
+    q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review | None] | None = None
+) -> list[Result]:
     """Each session with its review (``reviews`` in the same order; None: all unreviewed)."""
     if reviews is not None and len(reviews) != len(sessions):
         raise ExportError(f"{len(sessions)} sessions but {len(reviews)} reviews: give one review per session")
@@ -207,9 +214,11 @@ def practice_outcome(q: Questionnaire, record: PracticeRecord, language: str) ->
     what = PRACTICE_CHECKS.get(record.checks, record.checks)
     if record.outcome == "wrong":
         question = next((p for p in q.familiarisation if p.id == record.question_id), None)
-        chosen = (question.option(record.option).label_in(language)
-                  if question is not None and record.option is not None
-                  and 1 <= record.option <= len(question.options) else f"option {record.option}")
+        chosen = (
+            question.option(record.option).label_in(language)
+            if question is not None and record.option is not None and 1 <= record.option <= len(question.options)
+            else f"option {record.option}"
+        )
         return PracticeOutcome(what, "wrong", f"chose {chosen}")
     if record.outcome == "skipped":
         return PracticeOutcome(what, "skipped", record.detail)

@@ -16,6 +16,9 @@ import io
 from collections.abc import Sequence
 from typing import Any
 
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.review import Review
+from kiosk.core.visits import visit_of
 from kiosk.export.result import (
     TOTAL_LINK,
     ExportSite,
@@ -24,10 +27,7 @@ from kiosk.export.result import (
     questionnaire_version,
     results,
 )
-from kiosk.core.questionnaire import Questionnaire
-from kiosk.core.review import Review
 from kiosk.store.database import StoredSession
-from kiosk.core.visits import visit_of
 
 #: the tags that keep ids text in CSV readers; see the module docstring
 ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
@@ -41,10 +41,33 @@ ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
 #: gave it: "severe" is 21-60 in Shah's set but 20-35 in the Spanish one). Every row carries the
 #: session's columns (ids tagged, see the module docstring); ``review_state`` is
 #: :func:`kiosk.core.review.review_state`'s (unreviewed, corrected, signed_off, amended), as in FHIR.
-CSV_COLUMNS = ["session", "patient", "started_at", "status", "language", "item", "option", "label", "points",
-               "attempt", "channel", "answered_by", "t", "band_set", "kind", "checks", "finished_at",
-               "questionnaire_version", "complete", "review_state", "kiosk_id", "recorded_option", "corrected_by",
-               "simulated", "visit"]
+CSV_COLUMNS = [
+    "session",
+    "patient",
+    "started_at",
+    "status",
+    "language",
+    "item",
+    "option",
+    "label",
+    "points",
+    "attempt",
+    "channel",
+    "answered_by",
+    "t",
+    "band_set",
+    "kind",
+    "checks",
+    "finished_at",
+    "questionnaire_version",
+    "complete",
+    "review_state",
+    "kiosk_id",
+    "recorded_option",
+    "corrected_by",
+    "simulated",
+    "visit",
+]
 
 
 def tag(kind: str, value: str) -> str:
@@ -58,14 +81,23 @@ def _band(q: Questionnaire, r: Result) -> str:
 
 def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, str]:
     stored = r.stored
-    return {"session": tag("session", stored.id), "patient": tag("patient", stored.patient_id),
-            "kiosk_id": tag("kiosk_id", site.kiosk_id), "started_at": stored.started_at,
-            "finished_at": stored.finished_at or "", "status": stored.status, "language": stored.language,
-            "answered_by": stored.answered_by.value, "questionnaire": q.id,
-            "questionnaire_version": questionnaire_version(q), "complete": "true" if r.complete else "false",
-            "review_state": r.review_state, "simulated": "true" if stored.simulated else "false",
-            # how the visit began (kiosk.core.visits): "order <id>", "staff", "walk-up"; blank before visits existed
-            "visit": visit_of(stored.log) or ""}
+    return {
+        "session": tag("session", stored.id),
+        "patient": tag("patient", stored.patient_id),
+        "kiosk_id": tag("kiosk_id", site.kiosk_id),
+        "started_at": stored.started_at,
+        "finished_at": stored.finished_at or "",
+        "status": stored.status,
+        "language": stored.language,
+        "answered_by": stored.answered_by.value,
+        "questionnaire": q.id,
+        "questionnaire_version": questionnaire_version(q),
+        "complete": "true" if r.complete else "false",
+        "review_state": r.review_state,
+        "simulated": "true" if stored.simulated else "false",
+        # how the visit began (kiosk.core.visits): "order <id>", "staff", "walk-up"; blank before visits existed
+        "visit": visit_of(stored.log) or "",
+    }
 
 
 def _writer(out: io.StringIO, columns: list[str]) -> csv.DictWriter:
@@ -74,8 +106,14 @@ def _writer(out: io.StringIO, columns: list[str]) -> csv.DictWriter:
     return writer
 
 
-def csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
-             site: ExportSite | None = None, *, bom: bool = False) -> str:
+def csv_text(
+    q: Questionnaire,
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review] | None = None,
+    site: ExportSite | None = None,
+    *,
+    bom: bool = False,
+) -> str:
     """The long CSV (see :data:`CSV_COLUMNS`) of sessions with their reviews (None: unreviewed)."""
     site = site or ExportSite()
     out = io.StringIO()
@@ -84,9 +122,18 @@ def csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Seque
         stored = r.stored
         common = _session_columns(q, r, site)
         for record, outcome in zip(stored.practice, practice_outcomes(q, stored)):
-            writer.writerow(common | {"item": record.question_id, "option": record.option or "", "label": outcome.result,
-                                      "channel": record.channel.value if record.channel else "",
-                                      "t": f"{record.t:g}", "kind": "practice", "checks": record.checks})
+            writer.writerow(
+                common
+                | {
+                    "item": record.question_id,
+                    "option": record.option or "",
+                    "label": outcome.result,
+                    "channel": record.channel.value if record.channel else "",
+                    "t": f"{record.t:g}",
+                    "kind": "practice",
+                    "checks": record.checks,
+                }
+            )
         answers = {a.item_id: a for a in stored.answers}
         corrections = {c.item_id: c for c in r.review.corrections}
         for item in q.items:
@@ -95,33 +142,76 @@ def csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Seque
             if number is None:
                 writer.writerow(row | {"label": "not answered"})
                 continue
-            row |= {"option": number, "label": item.option(number).label_in(stored.language),
-                    "points": item.option(number).points}
+            row |= {
+                "option": number,
+                "label": item.option(number).label_in(stored.language),
+                "points": item.option(number).points,
+            }
             a = answers.get(item.id)
             if a is not None and a.option == number:
-                row |= {"attempt": a.attempt, "channel": a.channel.value, "answered_by": a.answered_by.value,
-                        "t": f"{a.t:g}"}
+                row |= {
+                    "attempt": a.attempt,
+                    "channel": a.channel.value,
+                    "answered_by": a.answered_by.value,
+                    "t": f"{a.t:g}",
+                }
             elif item.id in corrections:
                 row |= {"recorded_option": a.option if a else "", "corrected_by": corrections[item.id].author}
             writer.writerow(row)
         score = r.score
-        label = _band(q, r) if score.complete else (
-            f"incomplete ({score.total} points from {len(score.answered)} of {len(q.items)} items)")
-        writer.writerow(common | {"item": TOTAL_LINK, "label": label, "points": score.total if score.complete else "",
-                                  "band_set": score.band_set, "kind": "total"})
+        label = (
+            _band(q, r)
+            if score.complete
+            else (f"incomplete ({score.total} points from {len(score.answered)} of {len(q.items)} items)")
+        )
+        writer.writerow(
+            common
+            | {
+                "item": TOTAL_LINK,
+                "label": label,
+                "points": score.total if score.complete else "",
+                "band_set": score.band_set,
+                "kind": "total",
+            }
+        )
     return ("\ufeff" if bom else "") + out.getvalue()
 
 
 def wide_columns(q: Questionnaire) -> list[str]:
     """The wide CSV's columns: the session's, then each item's option number and points."""
-    return ["session", "patient", "kiosk_id", "started_at", "finished_at", "status", "language", "answered_by",
-            "questionnaire", "questionnaire_version", "complete", "review_state", "signed_by", "signed_at", "simulated",
-            "visit", "total", "answered_points", "missing", "band", "band_set"] + [
-        f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
+    return [
+        "session",
+        "patient",
+        "kiosk_id",
+        "started_at",
+        "finished_at",
+        "status",
+        "language",
+        "answered_by",
+        "questionnaire",
+        "questionnaire_version",
+        "complete",
+        "review_state",
+        "signed_by",
+        "signed_at",
+        "simulated",
+        "visit",
+        "total",
+        "answered_points",
+        "missing",
+        "band",
+        "band_set",
+    ] + [f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
 
 
-def wide_csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: Sequence[Review] | None = None,
-                  site: ExportSite | None = None, *, bom: bool = False) -> str:
+def wide_csv_text(
+    q: Questionnaire,
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review] | None = None,
+    site: ExportSite | None = None,
+    *,
+    bom: bool = False,
+) -> str:
     """One row per session (see :func:`wide_columns`): ``total`` only when complete, the points of
     the answered items apart in ``answered_points`` and the unanswered items in ``missing``."""
     site = site or ExportSite()
@@ -129,13 +219,17 @@ def wide_csv_text(q: Questionnaire, sessions: Sequence[StoredSession], reviews: 
     writer = _writer(out, wide_columns(q))
     for r in results(q, sessions, reviews):
         row: dict[str, Any] = _session_columns(q, r, site) | {
-            "signed_by": r.review.signed_by or "", "signed_at": r.review.signed_at or "",
-            "total": r.score.total if r.complete else "", "answered_points": r.answered_points,
-            "missing": " ".join(r.score.missing), "band": _band(q, r), "band_set": r.score.band_set}
+            "signed_by": r.review.signed_by or "",
+            "signed_at": r.review.signed_at or "",
+            "total": r.score.total if r.complete else "",
+            "answered_points": r.answered_points,
+            "missing": " ".join(r.score.missing),
+            "band": _band(q, r),
+            "band_set": r.score.band_set,
+        }
         for item in q.items:
             number = r.options.get(item.id)
             if number is not None:
                 row |= {f"{item.id}_option": number, f"{item.id}_points": item.option(number).points}
         writer.writerow(row)
     return ("\ufeff" if bom else "") + out.getvalue()
-

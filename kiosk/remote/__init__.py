@@ -19,8 +19,9 @@ from kiosk.remote.serial import SerialRemote
 __all__ = ["KeyboardRemote", "ProfileError", "keyboard_remote", "open_sources"]
 
 
-def open_sources(profiles_path: str | Path | None = None, *, backoff: Backoff | None = None,
-                 hid_backend: HidBackend | None = None) -> list[InputSource]:
+def open_sources(
+    profiles_path: str | Path | None = None, *, backoff: Backoff | None = None, hid_backend: HidBackend | None = None
+) -> list[InputSource]:
     """One not-yet-started source per enabled serial and HID profile.
 
     ``profiles_path`` is the site's profile file from the config (None: built-in profiles only).

@@ -55,9 +55,20 @@ def to_input(button: Button, detail: str) -> ChannelInput:
 #: starts, on a question they get the gentle "Please choose 1, 2 or 3". Letters work in either
 #: case (the app looks a capital up by its small letter).
 KIOSK_KEY_BUTTONS: dict[str, Button] = {
-    "1": 1, "2": 2, "3": 3, "4": 4, "5": 5, "6": 6, "7": 7, "8": 8, "9": 9,
-    "p": Command.PAUSE, "d": Command.CALL_DOCTOR, "r": Command.REPEAT,
-    "c": Command.UNDO, "backspace": Command.UNDO,
+    "1": 1,
+    "2": 2,
+    "3": 3,
+    "4": 4,
+    "5": 5,
+    "6": 6,
+    "7": 7,
+    "8": 8,
+    "9": 9,
+    "p": Command.PAUSE,
+    "d": Command.CALL_DOCTOR,
+    "r": Command.REPEAT,
+    "c": Command.UNDO,
+    "backspace": Command.UNDO,
 }
 
 #: keys the kiosk itself binds; a keyboard-emulating remote must not claim them, or one key press

@@ -111,16 +111,16 @@ class HidapiBackend:
 class HidConnection:
     """An open HID remote: reads reports and decodes them into presses."""
 
-    def __init__(self, info: HidDeviceInfo, device: HidDevice, profile: HidProfile,
-                 clock: Callable[[], float]) -> None:
+    def __init__(self, info: HidDeviceInfo, device: HidDevice, profile: HidProfile, clock: Callable[[], float]) -> None:
         self.label = f"hid {info.usb_id}"
         self._usb_id = info.usb_id
         name = f" {info.product}" if info.product else ""
         self.description = f"connected to{name} {info.usb_id} (profile {profile.name})"
         self._device = device
         self._clock = clock
-        self._decoder = ReportDecoder(profile.buttons, report_id=profile.report_id,
-                                      debounce=profile.debounce_ms / 1000, label=self.label)
+        self._decoder = ReportDecoder(
+            profile.buttons, report_id=profile.report_id, debounce=profile.debounce_ms / 1000, label=self.label
+        )
 
     def read(self) -> list[Press]:
         """Read one report (or time out); raise DeviceLost if the device failed."""
@@ -144,9 +144,15 @@ class HidRemote(ReconnectingReader):
     ``clock`` (seconds, monotonic) times the debounce; ``backend`` defaults to hidapi.
     """
 
-    def __init__(self, profile: HidProfile, *, backend: HidBackend | None = None,
-                 backoff: Backoff | None = None, wait: Wait = wait_or_stop,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        profile: HidProfile,
+        *,
+        backend: HidBackend | None = None,
+        backoff: Backoff | None = None,
+        wait: Wait = wait_or_stop,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
         super().__init__(f"hid {profile.usb_id}", backoff=backoff, wait=wait)
         self.profile = profile
         self._backend = backend or HidapiBackend()

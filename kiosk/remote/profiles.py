@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fileio.positions import Positions, Problem, parse_file
 from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
 from kiosk.remote.decoders import ReportMatch
-from fileio.positions import Positions, Problem, parse_file
 
 #: the profiles shipped with the kiosk
 BUILTIN_PROFILES = Path(__file__).with_name("devices.yaml")
@@ -27,8 +27,7 @@ KINDS = ("serial", "hid", "keyboard")
 #: every field each kind of profile may have (a misspelt field is an error, not silently ignored)
 _FIELDS = {
     "serial": {"name", "kind", "enabled", "description", "port", "baud", "max_line", "lines"},
-    "hid": {"name", "kind", "enabled", "description", "vendor_id", "product_id", "report_id",
-            "debounce_ms", "buttons"},
+    "hid": {"name", "kind", "enabled", "description", "vendor_id", "product_id", "report_id", "debounce_ms", "buttons"},
     "keyboard": {"name", "kind", "enabled", "description", "keys"},
 }
 
@@ -145,8 +144,9 @@ def _read_file(path: Path) -> list[_Fields]:
     assert positions is not None
     if not isinstance(document, dict) or set(document) != {"profiles"}:
         line, column = positions.of(())
-        raise ProfileError(str(Problem(str(path), line, column,
-                                       "expected a mapping with one key, 'profiles', holding a list")))
+        raise ProfileError(
+            str(Problem(str(path), line, column, "expected a mapping with one key, 'profiles', holding a list"))
+        )
     entries = document["profiles"] or []
     if not isinstance(entries, list):
         line, column = positions.of(("profiles",))
@@ -312,8 +312,7 @@ def _build_hid(fields: _Fields, common: dict[str, Any]) -> HidProfile:
         button = fields.button("buttons", key, sub)
         if button in buttons:
             raise fields.fail("buttons", "names the same button twice", sub)
-        if not isinstance(spec, dict) or not {"byte"} <= set(spec) <= {"byte", "mask", "value"} \
-                or len(spec) != 2:
+        if not isinstance(spec, dict) or not {"byte"} <= set(spec) <= {"byte", "mask", "value"} or len(spec) != 2:
             raise fields.fail("buttons", "must be {byte: N, mask: M} or {byte: N, value: V}", sub)
         byte = fields.check_int("buttons", spec["byte"], 0, 63, (*sub, "byte"))
         kind = "mask" if "mask" in spec else "value"
@@ -339,8 +338,11 @@ def _build_keyboard(fields: _Fields, common: dict[str, Any]) -> KeyboardProfile:
         if not isinstance(key, str) or not key.strip():
             raise fields.fail("keys", "each key must be a Textual key name such as 'f13' or 'pageup'", sub)
         if key.lower() in KIOSK_KEYS:
-            raise fields.fail("keys", f"key {key!r} is one of the kiosk's own keys "
-                              f"({', '.join(sorted(KIOSK_KEYS))}); pick another", sub)
+            raise fields.fail(
+                "keys",
+                f"key {key!r} is one of the kiosk's own keys ({', '.join(sorted(KIOSK_KEYS))}); pick another",
+                sub,
+            )
         keys[key] = fields.button("keys", value, sub)
     return KeyboardProfile(keys=keys, **common)
 
@@ -354,6 +356,9 @@ def _check_keyboard_clashes(profiles: tuple[Profile, ...], fields: dict[str, _Fi
         for key, button in profile.keys.items():
             if key in owner and owner[key][1] != button:
                 other, theirs = owner[key]
-                raise fields[profile.name].fail("keys", f"means {button_name(button)!r} here but "
-                                                f"{button_name(theirs)!r} in enabled profile {other.name!r}", (key,))
+                raise fields[profile.name].fail(
+                    "keys",
+                    f"means {button_name(button)!r} here but {button_name(theirs)!r} in enabled profile {other.name!r}",
+                    (key,),
+                )
             owner[key] = (profile, button)

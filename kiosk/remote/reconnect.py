@@ -117,8 +117,11 @@ class ReconnectingReader:
                 self._report(sink, ChannelState.LOST if was_connected else missing.state, missing.reason)
             except Exception as error:  # drivers also fail in undocumented ways: log it, retry
                 log.exception("%s: unexpected error while connecting", self.name)
-                self._report(sink, ChannelState.LOST if was_connected else ChannelState.CONNECTING,
-                             f"cannot open the remote: {error}")
+                self._report(
+                    sink,
+                    ChannelState.LOST if was_connected else ChannelState.CONNECTING,
+                    f"cannot open the remote: {error}",
+                )
             else:
                 was_connected = True
                 if self._read_until_lost(sink, connection):

@@ -60,8 +60,7 @@ class SerialConnection:
 class SerialRemote(ReconnectingReader):
     """A serial remote from a :class:`SerialProfile`, reconnecting by itself."""
 
-    def __init__(self, profile: SerialProfile, *, backoff: Backoff | None = None,
-                 wait: Wait = wait_or_stop) -> None:
+    def __init__(self, profile: SerialProfile, *, backoff: Backoff | None = None, wait: Wait = wait_or_stop) -> None:
         super().__init__(f"serial {profile.port}", backoff=backoff, wait=wait)
         self.profile = profile
 

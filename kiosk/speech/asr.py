@@ -116,9 +116,14 @@ class Recogniser(Protocol):
     name: str
     language: str
 
-    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (),
-                    taken_as_heard: bool = False) -> Grammar:
+    def set_grammar(
+        self,
+        phrases: Sequence[str],
+        meaning: Callable[[str], Hashable] | None = None,
+        lead_ins: Sequence[str] = (),
+        fillers: Sequence[str] = (),
+        taken_as_heard: bool = False,
+    ) -> Grammar:
         """Listen only for these phrases (each maybe after one lead-in, or one of the fillers)
         from the next utterance on; returns what was kept.
 
@@ -191,10 +196,15 @@ PS_CONFUSABLE_WORDS: tuple[frozenset[str], ...] = (frozenset({"first", "third"})
 #: words of the welcome the wheel's English dictionary lacks, as a patient would say them
 #: (CMU phones): the language names and "start" in Spanish and French
 PS_EXTRA_WORDS = {
-    "español": "EH S P AA N Y OW L", "espanol": "EH S P AA N Y OW L",
-    "français": "F R AA N S EY", "francais": "F R AA N S EY",
-    "français(2)": "F R AA N S EH", "français(3)": "F R AO S EH", "français(4)": "F AA S EH",
-    "empezar": "EH M P EY S AA R", "commencer": "K AO M AA N S EY",
+    "español": "EH S P AA N Y OW L",
+    "espanol": "EH S P AA N Y OW L",
+    "français": "F R AA N S EY",
+    "francais": "F R AA N S EY",
+    "français(2)": "F R AA N S EH",
+    "français(3)": "F R AO S EH",
+    "français(4)": "F AA S EH",
+    "empezar": "EH M P EY S AA R",
+    "commencer": "K AO M AA N S EY",
 }
 
 #: how British and other accents say words the wheel's US dictionary spells one way only, added
@@ -218,8 +228,10 @@ class PocketSphinxRecogniser:
 
     def __init__(self, language: str = "en") -> None:
         if language != "en":
-            raise NoModelForLanguage(f"no speech model for language {language!r}: pocketsphinx only "
-                                 f"ships English; install one with `kiosk models install {language}`")
+            raise NoModelForLanguage(
+                f"no speech model for language {language!r}: pocketsphinx only "
+                f"ships English; install one with `kiosk models install {language}`"
+            )
         try:
             from pocketsphinx import Decoder
         except ImportError as exc:
@@ -252,9 +264,14 @@ class PocketSphinxRecogniser:
         self._settled = False
         self._pcm = bytearray()
 
-    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (),
-                    taken_as_heard: bool = False) -> Grammar:
+    def set_grammar(
+        self,
+        phrases: Sequence[str],
+        meaning: Callable[[str], Hashable] | None = None,
+        lead_ins: Sequence[str] = (),
+        fillers: Sequence[str] = (),
+        taken_as_heard: bool = False,
+    ) -> Grammar:
         """Compile the phrases the dictionary knows to JSGF and make it the active search.
 
         ``meaning`` groups phrases that select the same thing: "the first one" is only
@@ -263,8 +280,9 @@ class PocketSphinxRecogniser:
         another option when heard as it came in (see :meth:`finish`).
         """
         self._taken_as_heard = taken_as_heard
-        grammar = build_grammar(phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name,
-                                lead_ins, fillers, meaning)
+        grammar = build_grammar(
+            phrases, lambda w: self._decoder.lookup_word(w) is not None, self.name, lead_ins, fillers, meaning
+        )
         for phrase in (*grammar.phrases, *grammar.lead_ins, *grammar.fillers):
             for word in phrase.split():
                 self._add_accents(word)
@@ -289,7 +307,7 @@ class PocketSphinxRecogniser:
             return
         self._accented.add(word)
         known: list[str] = []
-        while (phones := self._decoder.lookup_word(word if not known else f"{word}({len(known) + 1})")):
+        while phones := self._decoder.lookup_word(word if not known else f"{word}({len(known) + 1})"):
             known.append(phones)
         wanted = [*PS_ACCENT_WORDS.get(word, ()), *(v for p in known for v in accent_variants(p))]
         for phones in dict.fromkeys(wanted):
@@ -345,8 +363,11 @@ class PocketSphinxRecogniser:
             # acted on without asking back: heard with the talk turned down and as it came in,
             # one reply must not be two different options, each taken (see _gate_talk)
             other, other_core = self._score(pcm, cleaned)
-            if other.confidence >= PS_OTHER_HEARING_MIN and other_core in answers \
-                    and self._meaning(other_core) != self._meaning(core):
+            if (
+                other.confidence >= PS_OTHER_HEARING_MIN
+                and other_core in answers
+                and self._meaning(other_core) != self._meaning(core)
+            ):
                 log.debug("pocketsphinx: %r, but %r with the talk left in", result.text, other.text)
                 return Recognition(result.text, 0.0)
         return result
@@ -363,8 +384,8 @@ class PocketSphinxRecogniser:
         # tail excepted), the yardstick PS_FIT_MIDPOINT was set on
         counted = voiced
         if cleaned and voiced.any():
-            counted = _voiced_frames(pcm)[:len(voiced)]
-            counted[len(voiced) - PS_TRAILING_FRAMES:] = False
+            counted = _voiced_frames(pcm)[: len(voiced)]
+            counted[len(voiced) - PS_TRAILING_FRAMES :] = False
             if not counted.any():
                 counted = voiced
         # Decode the utterance once more: live cepstral mean normalisation only settles on a
@@ -382,7 +403,7 @@ class PocketSphinxRecogniser:
             return Recognition(hyp.hypstr, 0.0), core  # stopped inside a phrase: not something said
         in_words = np.zeros(len(voiced), dtype=bool)
         for seg in words:
-            in_words[seg.start_frame:seg.end_frame + 1] = True
+            in_words[seg.start_frame : seg.end_frame + 1] = True
         # in a room that talks, coverage counts only what stands out of the room (see _above_room)
         speech = voiced if cleaned else voiced & _above_room(pcm, len(voiced))
         speech = speech if speech.any() else voiced
@@ -395,8 +416,14 @@ class PocketSphinxRecogniser:
         confusable = core in self._confusable
         if confusable and len(core.split()) == 1:
             acoustic = 0.0
-        log.debug("pocketsphinx: %r coverage %.2f fit %.2f (confidence %.2f) confusable %s",
-                  hyp.hypstr, coverage, fit, acoustic, confusable)
+        log.debug(
+            "pocketsphinx: %r coverage %.2f fit %.2f (confidence %.2f) confusable %s",
+            hyp.hypstr,
+            coverage,
+            fit,
+            acoustic,
+            confusable,
+        )
         return Recognition(hyp.hypstr, min(coverage, acoustic), fit=fit, confusable=confusable), core
 
     def _free_cost(self, pcm: bytes, voiced: np.ndarray) -> float:
@@ -438,10 +465,10 @@ def _fixed_tail(pcm: bytes, voiced: np.ndarray) -> tuple[bytes, np.ndarray]:
     """
     step = _FRAME_BYTES
     end = (int(np.flatnonzero(voiced)[-1]) + 1) * step
-    tail = pcm[end:end + PS_TRAILING_FRAMES * step] or b"\0" * step
-    tail = (tail * (PS_TRAILING_FRAMES * step // len(tail) + 1))[:PS_TRAILING_FRAMES * step]
+    tail = pcm[end : end + PS_TRAILING_FRAMES * step] or b"\0" * step
+    tail = (tail * (PS_TRAILING_FRAMES * step // len(tail) + 1))[: PS_TRAILING_FRAMES * step]
     out = pcm[:end] + tail
-    return out, np.concatenate([voiced[:end // step], np.zeros(PS_TRAILING_FRAMES, dtype=bool)])
+    return out, np.concatenate([voiced[: end // step], np.zeros(PS_TRAILING_FRAMES, dtype=bool)])
 
 
 def _above_room(pcm: bytes, frames: int) -> np.ndarray:
@@ -455,7 +482,7 @@ def _above_room(pcm: bytes, frames: int) -> np.ndarray:
     """
     level = _frame_levels(pcm)[:frames]
     out = np.ones(frames, dtype=bool)
-    out[:len(level)] = _stands_out(level)
+    out[: len(level)] = _stands_out(level)
     return out
 
 
@@ -503,13 +530,13 @@ def _gate_talk(pcm: bytes) -> bytes:
     # a 5 ms ramp at each edge, so the gate does not click (a click is a consonant to the model)
     gain = np.convolve(gain, np.ones(80) / 80, mode="same")
     samples = np.frombuffer(pcm, dtype="<i2").astype(np.float64)
-    samples[:len(gain)] *= gain
+    samples[: len(gain)] *= gain
     return np.clip(np.round(samples), -32768, 32767).astype("<i2").tobytes()
 
 
 def _frame_levels(pcm: bytes) -> np.ndarray:
     """Level (dBFS) of each whole 10 ms frame."""
-    power = frame_powers(np.frombuffer(pcm, dtype="<i2")) / 32768.0 ** 2
+    power = frame_powers(np.frombuffer(pcm, dtype="<i2")) / 32768.0**2
     return 10 * np.log10(np.maximum(power, 1e-10))
 
 
@@ -570,16 +597,22 @@ class VoskRecogniser:
         #: phrases that are a whole answer once heard (partial results say so)
         self._final: frozenset[str] = frozenset()
 
-    def set_grammar(self, phrases: Sequence[str], meaning: Callable[[str], Hashable] | None = None,
-                    lead_ins: Sequence[str] = (), fillers: Sequence[str] = (),
-                    taken_as_heard: bool = False) -> Grammar:
+    def set_grammar(
+        self,
+        phrases: Sequence[str],
+        meaning: Callable[[str], Hashable] | None = None,
+        lead_ins: Sequence[str] = (),
+        fillers: Sequence[str] = (),
+        taken_as_heard: bool = False,
+    ) -> Grammar:
         """Make a recogniser limited to the phrases the model knows (plus "[unk]").
 
         ``meaning`` is not needed: Vosk's own word confidences tell confusable words apart.
         ``taken_as_heard`` changes nothing: Vosk hears each utterance one way.
         """
-        grammar = build_grammar(phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name,
-                                lead_ins, fillers, meaning)
+        grammar = build_grammar(
+            phrases, lambda w: self._model.vosk_model_find_word(w) >= 0, self.name, lead_ins, fillers, meaning
+        )
         if not grammar.phrases:
             raise ValueError("a grammar needs at least one phrase the recogniser knows")
         self._recogniser = self._vosk.KaldiRecognizer(self._model, SAMPLE_RATE, to_vosk(grammar))

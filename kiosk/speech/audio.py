@@ -94,11 +94,7 @@ def list_input_devices() -> list[InputDevice]:
         sd.check_input_settings(device=index, channels=1, dtype="int16", samplerate=SAMPLE_RATE)
 
     default_index = sd.default.device[0]
-    return [
-        describe_input(info, default_index, check)
-        for info in sd.query_devices()
-        if info["max_input_channels"] > 0
-    ]
+    return [describe_input(info, default_index, check) for info in sd.query_devices() if info["max_input_channels"] > 0]
 
 
 def default_input_device() -> InputDevice:
@@ -272,8 +268,9 @@ class Endpointer:
         self._start_ceiling_db = -90.0
         self._loud: list[float] = []
 
-    def is_voiced(self, level_db: float, margin_db: float | None = None,
-                  ceiling_margin_db: float | None = None) -> bool:
+    def is_voiced(
+        self, level_db: float, margin_db: float | None = None, ceiling_margin_db: float | None = None
+    ) -> bool:
         """Whether a frame at ``level_db`` stands ``margin_db`` out of the current noise floor and
         ``ceiling_margin_db`` above its ceiling (the start margins by default) as speech."""
         margin = self.settings.margin_db if margin_db is None else margin_db
@@ -327,7 +324,7 @@ class Endpointer:
                     # the room as the patient began, and the run that started it (the last levels
                     # learned, all above min_speech_db), which is speech
                     self.room_at_start_db, self._start_ceiling_db = self.room_db, self.ceiling_db
-                    run = list(self._levels)[-self._voiced_run:]
+                    run = list(self._levels)[-self._voiced_run :]
                     self._loud = [v for v in run if v >= self._start_ceiling_db]
                     return "start"
             else:
@@ -488,7 +485,7 @@ class UtterancePipeline:
         whole = len(data) - len(data) % step
         self._pending = data[whole:]
         for offset in range(0, whole, step):
-            self._frame(data[offset:offset + step])
+            self._frame(data[offset : offset + step])
 
     def _frame(self, chunk: bytes) -> None:
         self._samples += FRAME_SAMPLES
@@ -560,7 +557,7 @@ def feed_samples(samples: np.ndarray, pipeline: PcmConsumer, chunk_ms: int = 100
     pcm = samples.astype("<i2", copy=False).tobytes()
     step = 2 * SAMPLE_RATE * chunk_ms // 1000
     for offset in range(0, len(pcm), step):
-        pipeline.feed(pcm[offset:offset + step])
+        pipeline.feed(pcm[offset : offset + step])
 
 
 class MicrophoneStream:
@@ -584,8 +581,12 @@ class MicrophoneStream:
         device = self.device if self.device is not None else default_input_device().index
         try:
             self._stream = sd.RawInputStream(
-                samplerate=SAMPLE_RATE, channels=1, dtype="int16", blocksize=FRAME_SAMPLES,
-                device=device, callback=self._on_audio,
+                samplerate=SAMPLE_RATE,
+                channels=1,
+                dtype="int16",
+                blocksize=FRAME_SAMPLES,
+                device=device,
+                callback=self._on_audio,
             )
             self._stream.start()
         except Exception as exc:  # PortAudio errors: busy device, unplugged, refused format

@@ -61,23 +61,23 @@ def reduce_steady_noise(pcm: bytes) -> bytes:
         return pcm
     noise = power[energy <= np.quantile(energy, QUIET_SHARE)].mean(axis=0)
     noise_energy = float(noise.sum())
-    squared = window ** 2
+    squared = window**2
     # the noise's level in dBFS (Parseval: a frame's spectral power over FRAME times the
     # window's power is its mean square)
-    level = 10 * np.log10(max(noise_energy / (FRAME * float(squared.sum())), 1e-12) / 32768 ** 2)
+    level = 10 * np.log10(max(noise_energy / (FRAME * float(squared.sum())), 1e-12) / 32768**2)
     if level < QUIET_ROOM_DBFS:
         return pcm  # a quiet room: taking its hiss out only cost confidence (55 → 47 of 80 taken)
     if np.quantile(energy, 0.9) < noise_energy * 10 ** (SPEECH_ABOVE_NOISE_DB / 10):
         # nothing stands out of the noise: no words to clean, and subtracting the noise from
         # itself leaves warbling tones that the recogniser took for "needs help"
         return pcm
-    gain = np.sqrt(np.maximum(1.0 - OVER_SUBTRACTION * noise / np.maximum(power, 1e-12), FLOOR ** 2))
+    gain = np.sqrt(np.maximum(1.0 - OVER_SUBTRACTION * noise / np.maximum(power, 1e-12), FLOOR**2))
     frames = np.fft.irfft(spectra * gain, n=FRAME, axis=1) * window
     out = np.zeros(len(samples))
     weight = np.zeros(len(samples))
     for i in range(count):  # overlap-add (about 1250 frames for a 10 s utterance)
-        out[i * HOP:i * HOP + FRAME] += frames[i]
-        weight[i * HOP:i * HOP + FRAME] += squared
+        out[i * HOP : i * HOP + FRAME] += frames[i]
+        weight[i * HOP : i * HOP + FRAME] += squared
     # the few samples at the end that no whole frame covers are kept as they were
     out = np.where(weight > 1e-3, out / np.maximum(weight, 1e-3), samples)
     return np.clip(np.round(out), -32768, 32767).astype("<i2").tobytes()

@@ -42,14 +42,19 @@ class Grammar:
     def core(self, text: str) -> str:
         """``text`` without a lead-in, when what follows is an answer phrase; else ``text``."""
         for lead in sorted(self.lead_ins, key=len, reverse=True):
-            if text.startswith(lead + " ") and text[len(lead) + 1:] in self.answers:
-                return text[len(lead) + 1:]
+            if text.startswith(lead + " ") and text[len(lead) + 1 :] in self.answers:
+                return text[len(lead) + 1 :]
         return text
 
 
-def build_grammar(phrases: Sequence[str], known: Callable[[str], bool], recogniser: str,
-                  lead_ins: Sequence[str] = (), fillers: Sequence[str] = (),
-                  meaning: Callable[[str], Hashable] | None = None) -> Grammar:
+def build_grammar(
+    phrases: Sequence[str],
+    known: Callable[[str], bool],
+    recogniser: str,
+    lead_ins: Sequence[str] = (),
+    fillers: Sequence[str] = (),
+    meaning: Callable[[str], Hashable] | None = None,
+) -> Grammar:
     """Keep the phrases whose every word ``known`` accepts; log and list the others. Lead-ins
     and fillers with an unknown word, or that are also phrases, are left out silently; lead-ins
     go only before the phrases whose ``meaning`` is an option number."""
@@ -60,8 +65,9 @@ def build_grammar(phrases: Sequence[str], known: Callable[[str], bool], recognis
     return Grammar(tuple(kept), tuple(dropped), tuple(extra) if answers else (), tuple(noise), tuple(answers))
 
 
-def _known(phrases: Sequence[str], known: Callable[[str], bool], recogniser: str,
-           dropped: list[tuple[str, str]]) -> list[str]:
+def _known(
+    phrases: Sequence[str], known: Callable[[str], bool], recogniser: str, dropped: list[tuple[str, str]]
+) -> list[str]:
     kept: list[str] = []
     for phrase in phrases:
         words = recogniser_words(phrase)
@@ -80,8 +86,9 @@ def _known(phrases: Sequence[str], known: Callable[[str], bool], recogniser: str
     return kept
 
 
-def confusable_phrases(phrases: Sequence[str], meaning: Callable[[str], Hashable],
-                       confusable: Sequence[frozenset[str]]) -> frozenset[str]:
+def confusable_phrases(
+    phrases: Sequence[str], meaning: Callable[[str], Hashable], confusable: Sequence[frozenset[str]]
+) -> frozenset[str]:
     """The phrases a recogniser cannot be trusted on: they hold a word of one of the
     ``confusable`` sets, and a phrase of another meaning holds another word of that set.
 
@@ -93,8 +100,7 @@ def confusable_phrases(phrases: Sequence[str], meaning: Callable[[str], Hashable
     for phrase in phrases:
         for group in confusable:
             mine = words[phrase] & group
-            if mine and any(meaning(other) != meaning(phrase) and words[other] & (group - mine)
-                            for other in phrases):
+            if mine and any(meaning(other) != meaning(phrase) and words[other] & (group - mine) for other in phrases):
                 out.add(phrase)
     return frozenset(out)
 
@@ -109,9 +115,12 @@ def final_phrases(phrases: Sequence[str], meaning: Callable[[str], Hashable]) ->
     """
     words = {p: p.split() for p in phrases}
     return frozenset(
-        p for p in phrases
-        if not any(len(words[o]) > len(words[p]) and words[o][:len(words[p])] == words[p]
-                   and meaning(o) != meaning(p) for o in phrases)
+        p
+        for p in phrases
+        if not any(
+            len(words[o]) > len(words[p]) and words[o][: len(words[p])] == words[p] and meaning(o) != meaning(p)
+            for o in phrases
+        )
     )
 
 

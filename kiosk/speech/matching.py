@@ -32,25 +32,71 @@ COMMAND_MIN_CONFIDENCE = 0.8
 
 #: cardinal words per language, 1..10; the first form of each is the one put in grammars first
 CARDINALS: dict[str, list[tuple[str, ...]]] = {
-    "en": [("one",), ("two",), ("three",), ("four",), ("five",), ("six",), ("seven",),
-           ("eight",), ("nine",), ("ten",)],
-    "es": [("uno", "una", "un"), ("dos",), ("tres",), ("cuatro",), ("cinco",), ("seis",),
-           ("siete",), ("ocho",), ("nueve",), ("diez",)],
-    "fr": [("un", "une"), ("deux",), ("trois",), ("quatre",), ("cinq",), ("six",), ("sept",),
-           ("huit",), ("neuf",), ("dix",)],
+    "en": [("one",), ("two",), ("three",), ("four",), ("five",), ("six",), ("seven",), ("eight",), ("nine",), ("ten",)],
+    "es": [
+        ("uno", "una", "un"),
+        ("dos",),
+        ("tres",),
+        ("cuatro",),
+        ("cinco",),
+        ("seis",),
+        ("siete",),
+        ("ocho",),
+        ("nueve",),
+        ("diez",),
+    ],
+    "fr": [
+        ("un", "une"),
+        ("deux",),
+        ("trois",),
+        ("quatre",),
+        ("cinq",),
+        ("six",),
+        ("sept",),
+        ("huit",),
+        ("neuf",),
+        ("dix",),
+    ],
 }
 
 #: ordinal words per language, 1st..10th
 ORDINALS: dict[str, list[tuple[str, ...]]] = {
-    "en": [("first",), ("second",), ("third",), ("fourth",), ("fifth",), ("sixth",),
-           ("seventh",), ("eighth",), ("ninth",), ("tenth",)],
-    "es": [("primero", "primera", "primer"), ("segundo", "segunda"),
-           ("tercero", "tercera", "tercer"), ("cuarto", "cuarta"), ("quinto", "quinta"),
-           ("sexto", "sexta"), ("séptimo", "séptima"), ("octavo", "octava"),
-           ("noveno", "novena"), ("décimo", "décima")],
-    "fr": [("premier", "première"), ("deuxième", "second", "seconde"), ("troisième",),
-           ("quatrième",), ("cinquième",), ("sixième",), ("septième",), ("huitième",),
-           ("neuvième",), ("dixième",)],
+    "en": [
+        ("first",),
+        ("second",),
+        ("third",),
+        ("fourth",),
+        ("fifth",),
+        ("sixth",),
+        ("seventh",),
+        ("eighth",),
+        ("ninth",),
+        ("tenth",),
+    ],
+    "es": [
+        ("primero", "primera", "primer"),
+        ("segundo", "segunda"),
+        ("tercero", "tercera", "tercer"),
+        ("cuarto", "cuarta"),
+        ("quinto", "quinta"),
+        ("sexto", "sexta"),
+        ("séptimo", "séptima"),
+        ("octavo", "octava"),
+        ("noveno", "novena"),
+        ("décimo", "décima"),
+    ],
+    "fr": [
+        ("premier", "première"),
+        ("deuxième", "second", "seconde"),
+        ("troisième",),
+        ("quatrième",),
+        ("cinquième",),
+        ("sixième",),
+        ("septième",),
+        ("huitième",),
+        ("neuvième",),
+        ("dixième",),
+    ],
 }
 
 #: how a number is said around the number word: "{n}" is a cardinal, "{o}" an ordinal
@@ -75,8 +121,16 @@ COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
         Command.RESUME: ("continue", "resume", "go on"),
         # whole phrases only: the single words caught "start" ("doctor", on the welcome) and
         # "my daughter is coming later"; a false call takes a nurse from another patient
-        Command.CALL_DOCTOR: ("call the doctor", "call a doctor", "call the nurse", "call a nurse",
-                              "get the doctor", "get the nurse", "i need a doctor", "i need a nurse"),
+        Command.CALL_DOCTOR: (
+            "call the doctor",
+            "call a doctor",
+            "call the nurse",
+            "call a nurse",
+            "get the doctor",
+            "get the nurse",
+            "i need a doctor",
+            "i need a nurse",
+        ),
         Command.VOLUME_UP: ("louder", "speak up", "volume up"),
         Command.VOLUME_DOWN: ("quieter", "softer", "volume down"),
         # not "that's not what i said": in background talk it caught 33 of 528 non-answers
@@ -86,23 +140,47 @@ COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
         Command.REPEAT: ("repite", "repita", "repetir", "otra vez", "cómo"),
         Command.PAUSE: ("pausa", "espera", "espere"),
         Command.RESUME: ("continuar", "continúa", "continúe", "sigue", "siga", "seguir"),
-        Command.CALL_DOCTOR: ("llama al médico", "llame al médico", "llame a la enfermera",
-                              "llama a la enfermera", "necesito un médico", "necesito una enfermera"),
+        Command.CALL_DOCTOR: (
+            "llama al médico",
+            "llame al médico",
+            "llame a la enfermera",
+            "llama a la enfermera",
+            "necesito un médico",
+            "necesito una enfermera",
+        ),
         Command.VOLUME_UP: ("más alto", "sube el volumen", "suba el volumen"),
         Command.VOLUME_DOWN: ("más bajo", "baja el volumen", "baje el volumen"),
-        Command.UNDO: ("no eso está mal", "eso está mal", "cambiar mi respuesta", "cambia mi respuesta",
-                       "me he equivocado", "no es eso"),
+        Command.UNDO: (
+            "no eso está mal",
+            "eso está mal",
+            "cambiar mi respuesta",
+            "cambia mi respuesta",
+            "me he equivocado",
+            "no es eso",
+        ),
     },
     "fr": {
         Command.REPEAT: ("répète", "répétez", "répéter", "encore", "pardon", "comment"),
         Command.PAUSE: ("pause", "attendez", "attends"),
         Command.RESUME: ("continue", "continuez", "continuer", "reprenez", "reprendre"),
-        Command.CALL_DOCTOR: ("appelez le médecin", "appelle le médecin", "appelez l'infirmière",
-                              "appelle l'infirmière", "j'ai besoin d'un médecin", "j'ai besoin d'une infirmière"),
+        Command.CALL_DOCTOR: (
+            "appelez le médecin",
+            "appelle le médecin",
+            "appelez l'infirmière",
+            "appelle l'infirmière",
+            "j'ai besoin d'un médecin",
+            "j'ai besoin d'une infirmière",
+        ),
         Command.VOLUME_UP: ("plus fort", "montez le son", "monte le son"),
         Command.VOLUME_DOWN: ("moins fort", "plus bas", "baissez le son", "baisse le son"),
-        Command.UNDO: ("non c'est faux", "c'est faux", "changer ma réponse", "je me suis trompé",
-                       "je me suis trompée", "ce n'est pas ça"),
+        Command.UNDO: (
+            "non c'est faux",
+            "c'est faux",
+            "changer ma réponse",
+            "je me suis trompé",
+            "je me suis trompée",
+            "ce n'est pas ça",
+        ),
     },
 }
 
@@ -124,15 +202,22 @@ def undo_commands(language: str) -> dict[Command, tuple[str, ...]]:
     that's wrong", "change my answer") and calling the doctor."""
     return {command: COMMAND_PHRASES[language][command] for command in (Command.UNDO, Command.CALL_DOCTOR)}
 
+
 #: natural ways to say yes / no, added to an option whose label is one of the first words (a
 #: confirmation: "I heard: Independent. Is that right?"); a no option also takes the UNDO phrases
 YES_NO: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "en": (("yes", "yeah", "yes that's right", "that's right", "yes it is", "correct", "yes please"),
-           ("no", "nope", "no it isn't", "it isn't", "wrong", "no no")),
-    "es": (("sí", "si", "sí es correcto", "es correcto", "correcto", "eso es", "sí eso es", "claro"),
-           ("no", "no es correcto", "incorrecto", "no no")),
-    "fr": (("oui", "oui c'est ça", "c'est ça", "c'est juste", "exact", "exactement", "correct"),
-           ("non", "non non", "pas du tout", "ce n'est pas juste")),
+    "en": (
+        ("yes", "yeah", "yes that's right", "that's right", "yes it is", "correct", "yes please"),
+        ("no", "nope", "no it isn't", "it isn't", "wrong", "no no"),
+    ),
+    "es": (
+        ("sí", "si", "sí es correcto", "es correcto", "correcto", "eso es", "sí eso es", "claro"),
+        ("no", "no es correcto", "incorrecto", "no no"),
+    ),
+    "fr": (
+        ("oui", "oui c'est ça", "c'est ça", "c'est juste", "exact", "exactement", "correct"),
+        ("non", "non non", "pas du tout", "ce n'est pas juste"),
+    ),
 }
 
 #: the kiosk's languages by name, in any of its languages: a welcome option naming a language
@@ -145,8 +230,7 @@ LANGUAGE_NAMES: dict[str, tuple[str, ...]] = {
 #: ways to say "start": taken by a Start option, and in each language by the option naming it
 START_WORDS: dict[str, tuple[str, ...]] = {
     "en": ("start", "begin", "let's start", "let's begin", "start please", "i'm ready"),
-    "es": ("empezar", "empiece", "empieza", "comenzar", "comience", "vamos a empezar", "estoy listo",
-           "estoy lista"),
+    "es": ("empezar", "empiece", "empieza", "comenzar", "comience", "vamos a empezar", "estoy listo", "estoy lista"),
     "fr": ("commencer", "commencez", "commence", "on commence", "démarrer", "je suis prêt", "je suis prête"),
 }
 
@@ -161,13 +245,38 @@ LEAD_INS: dict[str, tuple[str, ...]] = {
 #: what patients say that is not an answer: these are in the grammar so that "um", "what?" or
 #: "I don't know" have somewhere to go other than the nearest answer; they match nothing
 FILLERS: dict[str, tuple[str, ...]] = {
-    "en": ("um", "uh", "hmm", "what", "sorry", "what did you say", "i don't know", "hello", "is it",
-           "all the time", "what time is it", "thank you", "i see", "let me think", "where am i",
-           "how long"),
-    "es": ("eh", "em", "qué", "perdón", "no sé", "hola", "vale", "gracias", "a ver", "todo el tiempo",
-           "qué hora es"),
-    "fr": ("euh", "hein", "quoi", "pardon", "je ne sais pas", "bonjour", "d'accord", "merci", "voyons",
-           "tout le temps", "quelle heure est il"),
+    "en": (
+        "um",
+        "uh",
+        "hmm",
+        "what",
+        "sorry",
+        "what did you say",
+        "i don't know",
+        "hello",
+        "is it",
+        "all the time",
+        "what time is it",
+        "thank you",
+        "i see",
+        "let me think",
+        "where am i",
+        "how long",
+    ),
+    "es": ("eh", "em", "qué", "perdón", "no sé", "hola", "vale", "gracias", "a ver", "todo el tiempo", "qué hora es"),
+    "fr": (
+        "euh",
+        "hein",
+        "quoi",
+        "pardon",
+        "je ne sais pas",
+        "bonjour",
+        "d'accord",
+        "merci",
+        "voyons",
+        "tout le temps",
+        "quelle heure est il",
+    ),
 }
 
 #: what recognisers emit for sounds outside their grammar
@@ -219,7 +328,7 @@ def _tokens(phrase: str) -> tuple[str, ...]:
 def _find(needle: tuple[str, ...], haystack: tuple[str, ...]) -> int:
     """Start of ``needle`` as a run of whole words in ``haystack``, or -1."""
     n = len(needle)
-    return next((i for i in range(len(haystack) - n + 1) if haystack[i:i + n] == needle), -1)
+    return next((i for i in range(len(haystack) - n + 1) if haystack[i : i + n] == needle), -1)
 
 
 def _is_word(label: str, which: int, language: str) -> bool:
@@ -274,16 +383,18 @@ class Matcher:
         #: "Is that right?": Yes and No are said as words, never as numbers or after "I need" (the
         #: keys and the remote give 1 and 2 without the recogniser). With "number one" / "option
         #: one" in its grammar, "no, that's wrong" was heard as Yes on other voices in noise.
-        self.yes_no = (len(self.options) == 2 and _is_word(self.options[0].label, 0, language)
-                       and no_option == 2)
+        self.yes_no = len(self.options) == 2 and _is_word(self.options[0].label, 0, language) and no_option == 2
         #: every command phrase in play (a yes/no question's UNDO phrases mean "no")
         self._command_phrases = dict(COMMAND_PHRASES[language] if commands is None else commands)
         #: a short list of commands (before the test, in the thank-you gap): no "I need ..." either
         #: ("begin" was heard as "i need two", Español, on the welcome)
         self._few_commands = commands is not None
         #: the commands listened for: RESUME only while paused; UNDO on a yes/no question means "no"
-        self.commands = {c: p for c, p in self._command_phrases.items()
-                         if (paused or c not in PAUSED_ONLY) and not (c is Command.UNDO and no_option)}
+        self.commands = {
+            c: p
+            for c, p in self._command_phrases.items()
+            if (paused or c not in PAUSED_ONLY) and not (c is Command.UNDO and no_option)
+        }
         #: phrase tokens → what it selects; options first, so a clash is detected, not hidden
         self._targets: dict[tuple[str, ...], set[int | Command]] = {}
         for number, option in enumerate(self.options, start=1):
@@ -301,10 +412,12 @@ class Matcher:
                 for word in words:
                     self._numbers[normalise(word)] = number
         self._numbers.update({str(n): n for n in range(1, len(self.options) + 1)})
-        self._all_numbers = {normalise(word): number
-                             for table in (CARDINALS, ORDINALS)
-                             for number, words in enumerate(table[language], start=1)
-                             for word in words}
+        self._all_numbers = {
+            normalise(word): number
+            for table in (CARDINALS, ORDINALS)
+            for number, words in enumerate(table[language], start=1)
+            for word in words
+        }
 
     def phrases(self) -> list[str]:
         """Every phrase this matcher understands, as written (accents kept), without repeats.
@@ -343,8 +456,8 @@ class Matcher:
 
     def _number(self, tokens: tuple[str, ...]) -> int | None:
         leads = sorted(map(_tokens, LEAD_INS[self.language]), key=len, reverse=True)
-        lead = next((lead for lead in leads if tokens[:len(lead)] == lead), ())
-        tokens = tokens[len(lead):] if len(tokens) > len(lead) else tokens
+        lead = next((lead for lead in leads if tokens[: len(lead)] == lead), ())
+        tokens = tokens[len(lead) :] if len(tokens) > len(lead) else tokens
         rest = [t for t in tokens if t not in NUMBER_FILLERS[self.language]]
         if self.language == "en" and len(rest) == 2 and rest[1] == "one" and rest[0] in self._numbers:
             rest = rest[:1]  # "the second one"
@@ -357,8 +470,9 @@ class Matcher:
     def match(self, utterance: str, confidence: float | None = None) -> Match:
         """Match one recognised utterance; ``confidence`` is the recogniser's, if it has one."""
         if confidence is not None and confidence < self.min_confidence:
-            return Match(reason=f"unsure recognition of {utterance!r} "
-                                f"(confidence {confidence:.2f} < {self.min_confidence:.2f})")
+            return Match(
+                reason=f"unsure recognition of {utterance!r} (confidence {confidence:.2f} < {self.min_confidence:.2f})"
+            )
         tokens = tuple(t for t in normalise(utterance).split() if t not in UNKNOWN_TOKENS)
         if not tokens:
             return Match(reason="nothing recognisable was said")
@@ -373,9 +487,11 @@ class Matcher:
             if start >= 0:
                 spans.append((start, start + len(phrase), targets))
         # a phrase heard inside a longer one ("help" in "minor help") does not count on its own
-        spans = [s for s in spans
-                 if not any(o is not s and o[0] <= s[0] and s[1] <= o[1] and o[1] - o[0] > s[1] - s[0]
-                            for o in spans)]
+        spans = [
+            s
+            for s in spans
+            if not any(o is not s and o[0] <= s[0] and s[1] <= o[1] and o[1] - o[0] > s[1] - s[0] for o in spans)
+        ]
         found: set[int | Command] = set().union(*(t for *_, t in spans)) if spans else set()
         if not found:
             return Match(reason=f"{utterance!r} is not an answer or a command here")
@@ -385,7 +501,9 @@ class Matcher:
         (target,) = found
         if isinstance(target, Command):
             if confidence is not None and confidence < max(self.min_confidence, COMMAND_MIN_CONFIDENCE):
-                return Match(reason=f"unsure recognition of the command {utterance!r} "
-                                    f"(confidence {confidence:.2f} < {COMMAND_MIN_CONFIDENCE:.2f})")
+                return Match(
+                    reason=f"unsure recognition of the command {utterance!r} "
+                    f"(confidence {confidence:.2f} < {COMMAND_MIN_CONFIDENCE:.2f})"
+                )
             return Match(command=target)
         return Match(option=target)

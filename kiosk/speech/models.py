@@ -39,9 +39,11 @@ OFFICIAL_MODELS = {
 OFFICIAL_INDEX = "https://alphacephei.com/vosk/models/model-list.json"
 DOWNLOAD_TIMEOUT_S = 60
 #: what works without a network, said whenever a download or the index cannot be reached
-OFFLINE_ROUTES = ("; without a network, copy the model zip to this machine and run "
-                  "`kiosk models install {language} --url file:///path/to/model.zip --sha256 HEX`, "
-                  "or unpack it and set KIOSK_VOSK_MODEL=/path/to/the/model/folder")
+OFFLINE_ROUTES = (
+    "; without a network, copy the model zip to this machine and run "
+    "`kiosk models install {language} --url file:///path/to/model.zip --sha256 HEX`, "
+    "or unpack it and set KIOSK_VOSK_MODEL=/path/to/the/model/folder"
+)
 
 
 class ModelError(Exception):
@@ -107,8 +109,10 @@ def _download(url: str, into: Path) -> tuple[Path, str, str]:
                 out.write(chunk)
     except (urllib.error.URLError, OSError) as exc:
         os.unlink(name)
-        raise ModelError(f"cannot download {url}: {getattr(exc, 'reason', exc)}"
-                         + ("" if url.startswith("file:") else OFFLINE_ROUTES)) from None
+        raise ModelError(
+            f"cannot download {url}: {getattr(exc, 'reason', exc)}"
+            + ("" if url.startswith("file:") else OFFLINE_ROUTES)
+        ) from None
     return Path(name), sha256.hexdigest(), md5.hexdigest()
 
 
@@ -118,8 +122,9 @@ def _official_md5(url: str, index_url: str) -> str:
         with urllib.request.urlopen(index_url, timeout=DOWNLOAD_TIMEOUT_S) as response:
             index = json.load(response)
     except (urllib.error.URLError, OSError, ValueError) as exc:
-        raise ModelError(f"cannot read the model index {index_url}: {getattr(exc, 'reason', exc)}"
-                         + OFFLINE_ROUTES) from None
+        raise ModelError(
+            f"cannot read the model index {index_url}: {getattr(exc, 'reason', exc)}" + OFFLINE_ROUTES
+        ) from None
     for entry in index if isinstance(index, list) else []:
         if isinstance(entry, dict) and entry.get("name") == name and entry.get("md5"):
             return str(entry["md5"]).lower()
@@ -151,8 +156,7 @@ def _unpack(archive: Path, into: Path) -> Path:
     return model
 
 
-def install(language: str, url: str | None = None, sha256: str | None = None,
-            index_url: str = OFFICIAL_INDEX) -> Path:
+def install(language: str, url: str | None = None, sha256: str | None = None, index_url: str = OFFICIAL_INDEX) -> Path:
     """Download, verify and install a model for ``language``; returns where it now lives.
 
     Without ``url`` the official model is fetched and checked against the official MD5; with
@@ -160,8 +164,10 @@ def install(language: str, url: str | None = None, sha256: str | None = None,
     """
     if url is None:
         if language not in OFFICIAL_MODELS:
-            raise ModelError(f"no official model known for language {language!r} "
-                             f"(known: {', '.join(OFFICIAL_MODELS)}); give --url and --sha256")
+            raise ModelError(
+                f"no official model known for language {language!r} "
+                f"(known: {', '.join(OFFICIAL_MODELS)}); give --url and --sha256"
+            )
         url = OFFICIAL_MODELS[language]
         expected, algorithm = (sha256, "sha256") if sha256 else (_official_md5(url, index_url), "md5")
     elif not sha256:
@@ -177,8 +183,9 @@ def install(language: str, url: str | None = None, sha256: str | None = None,
     try:
         got = got_sha256 if algorithm == "sha256" else got_md5
         if got != expected:
-            raise ModelError(f"checksum mismatch for {url}: expected {algorithm} {expected}, got {got}; "
-                             "nothing was installed")
+            raise ModelError(
+                f"checksum mismatch for {url}: expected {algorithm} {expected}, got {got}; nothing was installed"
+            )
         model = _unpack(archive, parent)
         unpacked = model if model.parent == parent else model.parent
         target = parent / language

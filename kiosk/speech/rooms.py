@@ -57,7 +57,7 @@ def babble(talkers: Sequence[np.ndarray], seconds: float, rng: np.random.Generat
         x = x / np.sqrt(max(active_power(speech), 1e-9))
         start = int(rng.integers(0, len(x)))
         mix += np.resize(np.roll(x, -start), n)
-    power = float((mix ** 2).mean())
+    power = float((mix**2).mean())
     return mix / np.sqrt(power) if power > 0 else mix
 
 
@@ -103,5 +103,5 @@ def cough(rng: np.random.Generator, level_db: float = -20.0) -> np.ndarray:
     freqs = np.fft.rfftfreq(n, 1 / SAMPLE_RATE)
     spectrum[(freqs < 200) | (freqs > 3000)] = 0
     burst = np.fft.irfft(spectrum, n) * np.minimum(1.0, t / 0.01) * np.exp(-t / 0.12)
-    burst *= 32768 * 10 ** (level_db / 20) / max(np.sqrt((burst ** 2).mean()), 1e-9)
+    burst *= 32768 * 10 ** (level_db / 20) / max(np.sqrt((burst**2).mean()), 1e-9)
     return _to_int16(burst)

@@ -101,8 +101,11 @@ class Delivery:
         out, done = [], 0
         for m in _BOUNDARY.finditer(text):
             ms = self.comma_break_ms if m.group(1) == "," else self.sentence_break_ms
-            out += [html.escape(text[done:m.end(1)], quote=False),
-                    f'<break time="{ms}ms"/>' if ms else "", m.group(2)]
+            out += [
+                html.escape(text[done : m.end(1)], quote=False),
+                f'<break time="{ms}ms"/>' if ms else "",
+                m.group(2),
+            ]
             done = m.end()
         return f"<speak>{''.join(out)}{html.escape(text[done:], quote=False)}</speak>"
 
@@ -128,14 +131,16 @@ class Synthesiser:
         self._command = shutil.which("espeak-ng")
         if self._command is None:
             raise TtsUnavailable("espeak-ng is not installed")
-        listing = subprocess.run([self._command, "--voices"], capture_output=True, text=True,
-                                 timeout=SYNTH_TIMEOUT_S).stdout
+        listing = subprocess.run(
+            [self._command, "--voices"], capture_output=True, text=True, timeout=SYNTH_TIMEOUT_S
+        ).stdout
         # columns: Pty Language Age/Gender VoiceName File Other; File is the voice id
         available = {line.split()[4].lower() for line in listing.splitlines()[1:] if len(line.split()) > 4}
         self.languages = tuple(lang for lang, voice in VOICES.items() if voice in available)
 
-    def synthesise(self, text: str, language: str, path: str | Path,
-                   rate: int = DEFAULT_RATE, volume: float = DEFAULT_VOLUME) -> Path:
+    def synthesise(
+        self, text: str, language: str, path: str | Path, rate: int = DEFAULT_RATE, volume: float = DEFAULT_VOLUME
+    ) -> Path:
         """Speak ``text`` in ``language`` into the WAV file ``path`` at the requested ``rate``
         (words per minute, see :func:`delivery`)."""
         if language not in self.languages:
@@ -153,7 +158,9 @@ class Synthesiser:
     def _run(self, text: str, voice: str, rate: int, amplitude: str, path: str | Path, markup: str) -> Path:
         subprocess.run(
             [self._command, "-v", voice, "-s", str(rate), "-a", amplitude, "-m", "-w", str(path), "--", markup],
-            check=True, capture_output=True, timeout=SYNTH_TIMEOUT_S,
+            check=True,
+            capture_output=True,
+            timeout=SYNTH_TIMEOUT_S,
         )
         if not _has_audio(path):
             raise TtsUnavailable(f"espeak-ng produced no audio for {text[:40]!r}")
@@ -300,8 +307,7 @@ class Speaker:
         self.volume = max(MIN_VOLUME, self.volume - VOLUME_STEP)
         return self.volume
 
-    def save_to_file(self, text: str, language: str, path: str | Path,
-                     timeout: float = SYNTH_TIMEOUT_S) -> Path:
+    def save_to_file(self, text: str, language: str, path: str | Path, timeout: float = SYNTH_TIMEOUT_S) -> Path:
         """Synthesise ``text`` to a WAV file on the worker (works without an audio output)."""
         done = threading.Event()
         job = _Job(text, language, Path(path), done)
@@ -331,8 +337,11 @@ class Speaker:
                 log.warning("voice out failed for %r: %s", job.text[:40], exc)
                 if job.path is None:  # the patient did not hear it: the UI must say so
                     self._lost = True
-                    self.on_status(ChannelStatus(Channel.VOICE, ChannelState.LOST, source=self.source,
-                                                 reason=f"voice out failed: {exc}"))
+                    self.on_status(
+                        ChannelStatus(
+                            Channel.VOICE, ChannelState.LOST, source=self.source, reason=f"voice out failed: {exc}"
+                        )
+                    )
                 job.error = exc if isinstance(exc, TtsUnavailable) else TtsUnavailable(str(exc))
             finally:
                 if job.done is not None:
@@ -347,8 +356,11 @@ class Speaker:
         except TtsUnavailable as exc:
             self.reason, state = str(exc), ChannelState.OFF
         self._ready.set()
-        self.on_status(ChannelStatus(Channel.VOICE, state, source=self.source,
-                                     reason=self.reason and f"voice out off: {self.reason}"))
+        self.on_status(
+            ChannelStatus(
+                Channel.VOICE, state, source=self.source, reason=self.reason and f"voice out off: {self.reason}"
+            )
+        )
         # synthesis to files still works without an audio output
         return synth
 

@@ -38,10 +38,20 @@ from typing import Any
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
 from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
 from kiosk.speech.audio import (
-    AudioUnavailable, Endpointer, MicrophoneStream, PcmConsumer, Utterance, UtterancePipeline,
+    AudioUnavailable,
+    Endpointer,
+    MicrophoneStream,
+    PcmConsumer,
+    Utterance,
+    UtterancePipeline,
 )
 from kiosk.speech.matching import (
-    DEFAULT_MIN_CONFIDENCE, Match, Matcher, OptionWords, undo_commands, welcome_commands,
+    DEFAULT_MIN_CONFIDENCE,
+    Match,
+    Matcher,
+    OptionWords,
+    undo_commands,
+    welcome_commands,
 )
 
 log = logging.getLogger(__name__)
@@ -239,12 +249,24 @@ class VoiceChannel:
         """A session ``Prompt``: a question's options become the grammar (messages change nothing)."""
         if prompt.options:
             scored = any(getattr(o, "points", None) is not None for o in prompt.options)
-            self.set_question(option_words(prompt.options), prompt.language, scored=scored,
-                              welcome=getattr(prompt, "kind", "") in ("welcome", "message"),
-                              key=getattr(prompt, "key", None), confirming=getattr(prompt, "kind", "") == "confirm")
+            self.set_question(
+                option_words(prompt.options),
+                prompt.language,
+                scored=scored,
+                welcome=getattr(prompt, "kind", "") in ("welcome", "message"),
+                key=getattr(prompt, "key", None),
+                confirming=getattr(prompt, "kind", "") == "confirm",
+            )
 
-    def set_question(self, options: Sequence[OptionWords], language: str, scored: bool = False,
-                     welcome: bool = False, key: str | None = None, confirming: bool = False) -> None:
+    def set_question(
+        self,
+        options: Sequence[OptionWords],
+        language: str,
+        scored: bool = False,
+        welcome: bool = False,
+        key: str | None = None,
+        confirming: bool = False,
+    ) -> None:
         """Listen for this question's answers (and the commands) in ``language``; answers to a
         ``scored`` question are confirmed unless heard with confidence (see :data:`CONFIRM_BELOW`).
         ``confirming``: the options reply to "Is that right?"; one spoken in a room nearly as
@@ -359,8 +381,7 @@ class VoiceChannel:
         """(Lock held.) Make ``recogniser`` the one the audio reaches, with the current grammar."""
         self._recogniser = recogniser
         if self._pipeline is None:
-            self._pipeline = UtterancePipeline(recogniser, self._on_utterance,
-                                               endpointer=self._endpointer_factory())
+            self._pipeline = UtterancePipeline(recogniser, self._on_utterance, endpointer=self._endpointer_factory())
         else:
             self._pipeline.muted = True  # drop an utterance the old recogniser was hearing
             self._pipeline.recogniser = recogniser
@@ -377,21 +398,24 @@ class VoiceChannel:
             commands = welcome_commands(self.language)
         elif self._undo_only and not self._paused:
             commands = undo_commands(self.language)
-        self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused,
-                                commands=commands)
+        self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused, commands=commands)
         phrases = self._matcher.phrases()
         if self._scored and not self._paused and self._declined:
             phrases = [p for p in phrases if self._matcher.meaning(p) not in self._declined]
         # a scored question's answers are all asked back unless the channel takes sure ones as heard
         asked_back = self._scored and self.confirm_below > 1
-        self._recogniser.set_grammar(phrases, self._matcher.meaning, self._matcher.lead_ins(),
-                                     self._matcher.fillers(), taken_as_heard=not asked_back)
+        self._recogniser.set_grammar(
+            phrases,
+            self._matcher.meaning,
+            self._matcher.lead_ins(),
+            self._matcher.fillers(),
+            taken_as_heard=not asked_back,
+        )
         self._gate()
 
     def _gate(self) -> None:
         if self._pipeline is not None:
-            wanted = (self._listening or self._paused) and self._matcher is not None \
-                and self._recogniser is not None
+            wanted = (self._listening or self._paused) and self._matcher is not None and self._recogniser is not None
             self._pipeline.muted = self._speaking or not wanted
 
     def _on_utterance(self, utterance: Utterance) -> None:
@@ -419,17 +443,23 @@ class VoiceChannel:
             confirm = True
         self._unsure = None
         if self._sink is not None:
-            self._sink(ChannelInput(Channel.VOICE, option=match.option, command=match.command,
-                                    detail=result.text, confidence=round(result.confidence, 3),
-                                    needs_confirmation=confirm))
+            self._sink(
+                ChannelInput(
+                    Channel.VOICE,
+                    option=match.option,
+                    command=match.command,
+                    detail=result.text,
+                    confidence=round(result.confidence, 3),
+                    needs_confirmation=confirm,
+                )
+            )
 
     def _too_loud(self, utterance: Utterance) -> bool:
         """Whether the room was nearly as loud as the voice (see :data:`REPLY_MIN_ABOVE_ROOM_DB`)."""
         above = utterance.above_room_db
         if above is None or above >= self.reply_min_above_room_db:
             return False
-        log.info("voice: %r spoken %.1f dB above the room, too little to take as said",
-                 utterance.result.text, above)
+        log.info("voice: %r spoken %.1f dB above the room, too little to take as said", utterance.result.text, above)
         return True
 
     def _heard_twice(self, result: Any) -> Match | None:
@@ -449,5 +479,4 @@ class VoiceChannel:
         if self._sink is not None:
             if state is ChannelState.OFF:
                 reason = f"voice answers off: {reason}"
-            self._sink(ChannelStatus(Channel.VOICE, state, source=self.name, reason=reason,
-                                     reason_key=reason_key))
+            self._sink(ChannelStatus(Channel.VOICE, state, source=self.name, reason=reason, reason_key=reason_key))

@@ -35,8 +35,9 @@ class Custody:
         return row[0] if row else None
 
     def _holder(self, session_id: str) -> tuple[Owner, float] | None:
-        row = self._db.execute("SELECT host, pid, token, renewed_at FROM leases WHERE session_id = ?",
-                               (session_id,)).fetchone()
+        row = self._db.execute(
+            "SELECT host, pid, token, renewed_at FROM leases WHERE session_id = ?", (session_id,)
+        ).fetchone()
         return (Owner(row[0], int(row[1]), row[2]), float(row[3])) if row else None
 
     def _check_held(self, session_id: str) -> None:
@@ -52,10 +53,11 @@ class Custody:
         if holder is not None and holder[0].token == self.owner.token:
             return None
         if holder is not None:
-            return (f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
-                    "one kiosk at a time records a test")
-        row = self._db.execute("SELECT status, interrupted_reason FROM sessions WHERE id = ?",
-                               (session_id,)).fetchone()
+            return (
+                f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
+                "one kiosk at a time records a test"
+            )
+        row = self._db.execute("SELECT status, interrupted_reason FROM sessions WHERE id = ?", (session_id,)).fetchone()
         if row is None:
             return f"session {session_id} is not stored"
         why = f" ({row[1]})" if row[0] == "interrupted" and row[1] else ""
@@ -65,12 +67,19 @@ class Custody:
         """Inside a write transaction: take the session's lease unless a live kiosk holds it."""
         holder = self._holder(session_id)
         now = self._wall()
-        if holder is not None and holder[0].token != self.owner.token \
-                and lapsed(holder[0], holder[1], now, self.lease_ttl_s, self.owner) is None:
-            raise SessionTaken(f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
-                               "one kiosk at a time records a test")
-        self._db.execute("INSERT OR REPLACE INTO leases VALUES (?, ?, ?, ?, ?, ?)",
-                         (session_id, self.owner.host, self.owner.pid, self.owner.token, now, now))
+        if (
+            holder is not None
+            and holder[0].token != self.owner.token
+            and lapsed(holder[0], holder[1], now, self.lease_ttl_s, self.owner) is None
+        ):
+            raise SessionTaken(
+                f"session {session_id} is open on another kiosk, {holder[0].describe()}: "
+                "one kiosk at a time records a test"
+            )
+        self._db.execute(
+            "INSERT OR REPLACE INTO leases VALUES (?, ?, ?, ?, ?, ?)",
+            (session_id, self.owner.host, self.owner.pid, self.owner.token, now, now),
+        )
         self._held.add(session_id)
 
     def _my_sessions(self) -> list[str]:
@@ -80,8 +89,11 @@ class Custody:
         """Whether another running kiosk process holds the session (say another browser tab of
         `kiosk serve` on this data directory)."""
         holder = self._holder(session_id)
-        return holder is not None and holder[0].token != self.owner.token \
+        return (
+            holder is not None
+            and holder[0].token != self.owner.token
             and lapsed(holder[0], holder[1], self._wall(), self.lease_ttl_s, self.owner) is None
+        )
 
     def holds(self, session_id: str) -> bool:
         """Whether this kiosk holds the session now."""
@@ -110,8 +122,11 @@ class Custody:
                 self.release(session_id)
 
     def _interrupt(self, session_id: str, reason: str) -> None:
-        self._write("UPDATE sessions SET status = 'interrupted', interrupted_at = ?, interrupted_reason = ?"
-                    " WHERE id = ? AND status = 'running'", (self._iso_now(), reason, session_id))
+        self._write(
+            "UPDATE sessions SET status = 'interrupted', interrupted_at = ?, interrupted_reason = ?"
+            " WHERE id = ? AND status = 'running'",
+            (self._iso_now(), reason, session_id),
+        )
         self._queue("mark_interrupted", session_id, {"reason": reason})
 
     def _stale(self) -> list[tuple[str, str]]:
@@ -119,13 +134,21 @@ class Custody:
         now = self._wall()
         stale = []
         for session_id, started_at, simulated, host, pid, token, renewed_at in self._db.execute(
-                "SELECT s.id, s.started_at, s.simulated, l.host, l.pid, l.token, l.renewed_at FROM sessions s"
-                " LEFT JOIN leases l ON l.session_id = s.id WHERE s.status = 'running'").fetchall():
-            why = "no kiosk held it" if host is None else lapsed(Owner(host, int(pid), token), float(renewed_at),
-                                                                 now, self.lease_ttl_s, self.owner)
+            "SELECT s.id, s.started_at, s.simulated, l.host, l.pid, l.token, l.renewed_at FROM sessions s"
+            " LEFT JOIN leases l ON l.session_id = s.id WHERE s.status = 'running'"
+        ).fetchall():
+            why = (
+                "no kiosk held it"
+                if host is None
+                else lapsed(Owner(host, int(pid), token), float(renewed_at), now, self.lease_ttl_s, self.owner)
+            )
             # a simulated session's start is on the replay's simulated clock: its age means nothing
-            if why is None and not simulated and self.interrupt_after_s is not None \
-                    and _age_s(started_at, now) > self.interrupt_after_s:
+            if (
+                why is None
+                and not simulated
+                and self.interrupt_after_s is not None
+                and _age_s(started_at, now) > self.interrupt_after_s
+            ):
                 why = f"not finished within {self.interrupt_after_s / 60:g} minutes"
             if why is not None:
                 stale.append((session_id, why))
@@ -152,8 +175,9 @@ class Custody:
         self.interrupt_stale()
         with self.transaction():
             self._db.execute("BEGIN IMMEDIATE")
-            status, simulated = self._db.execute("SELECT status, simulated FROM sessions WHERE id = ?",
-                                                 (session_id,)).fetchone()
+            status, simulated = self._db.execute(
+                "SELECT status, simulated FROM sessions WHERE id = ?", (session_id,)
+            ).fetchone()
             if simulated:
                 raise ValueError(f"session {session_id} is a simulated (replayed) session: it cannot be continued")
             if status == "running":
@@ -161,8 +185,10 @@ class Custody:
             elif status != "interrupted":
                 raise ValueError(f"session {session_id} is {status}: only an interrupted test can be continued")
             self._take(session_id)
-            self._db.execute("UPDATE sessions SET status = 'running', interrupted_at = NULL, interrupted_reason = NULL"
-                             " WHERE id = ?", (session_id,))
+            self._db.execute(
+                "UPDATE sessions SET status = 'running', interrupted_at = NULL, interrupted_reason = NULL WHERE id = ?",
+                (session_id,),
+            )
             self._queue("continue_session", session_id, {})
         return self.session(session_id)
 

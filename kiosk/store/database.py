@@ -46,6 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from kiosk.core.channels import Channel
+from kiosk.core.session import Answer, AnsweredBy
 from kiosk.store.custody import Custody
 from kiosk.store.lease import LEASE_TTL_S, Owner, SessionTaken
 from kiosk.store.migrations import (
@@ -55,7 +56,6 @@ from kiosk.store.migrations import (
     migrate,
     store_definition,
 )
-from kiosk.core.session import Answer, AnsweredBy
 from kiosk.store.records import (
     AdaptationRecord,
     LogEntry,
@@ -66,8 +66,18 @@ from kiosk.store.records import (
 )
 
 __all__ = [
-    "DB_NAME", "PATIENT_ID", "AdaptationRecord", "LogEntry", "MetricSample", "PracticeRecord", "SessionSummary",
-    "SessionTaken", "StorageError", "Store", "StoredSession", "new_patient_id",
+    "DB_NAME",
+    "PATIENT_ID",
+    "AdaptationRecord",
+    "LogEntry",
+    "MetricSample",
+    "PracticeRecord",
+    "SessionSummary",
+    "SessionTaken",
+    "StorageError",
+    "Store",
+    "StoredSession",
+    "new_patient_id",
 ]
 
 DB_NAME = "kiosk.sqlite3"
@@ -77,8 +87,12 @@ PATIENT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{1,63}(?!\n)$")
 #: how long a write waits for another kiosk's transaction on the same file before giving up
 BUSY_TIMEOUT_S = 10.0
 #: session-log kinds that are alerts for the ward, with the name the station protocol gives them
-ALERT_EVENTS = {"call_doctor": "doctor_called", "clinician_continue": "doctor_continued",
-                "person_lost": "person_lost", "person_back": "person_back"}
+ALERT_EVENTS = {
+    "call_doctor": "doctor_called",
+    "clinician_continue": "doctor_continued",
+    "person_lost": "person_lost",
+    "person_back": "person_back",
+}
 
 
 class StorageError(RuntimeError):
@@ -111,24 +125,37 @@ def _secure_file(path: Path) -> None:
         os.chmod(path, 0o600)
 
 
-
 def _damaged(path: Path, exc: BaseException | str) -> StorageError:
     """The one message for a database that is not one, or is corrupt: which file, what to do."""
     return StorageError(
         f"{path} is damaged ({exc}); nothing was changed. Stop the kiosk, keep a copy of {path.name} "
         f"(and {path.name}-wal, -shm if present) for the engineers, then move them out of {path.parent} "
-        "and restore a backup, or start with an empty database")
+        "and restore a backup, or start with an empty database"
+    )
 
 
 #: the tables every database of this schema has (a dropped one is damage, found at open)
-_TABLES = ("patients", "sessions", "answers", "not_answered", "practice", "contexts", "metric_samples",
-           "adaptations", "events", "leases", "outbox", "definitions")
+_TABLES = (
+    "patients",
+    "sessions",
+    "answers",
+    "not_answered",
+    "practice",
+    "contexts",
+    "metric_samples",
+    "adaptations",
+    "events",
+    "leases",
+    "outbox",
+    "definitions",
+)
 
 
 def _reading(method: Callable[..., Any]) -> Callable[..., Any]:
     """A reading method whose rows this code cannot read (a value no kiosk writes, such as an
     unknown channel, or SQL that fails on an edited file) raises one StorageError naming the
     database, instead of a traceback from deep inside. KeyError (no such session) passes."""
+
     @functools.wraps(method)
     def read(self: Store, *args: Any) -> Any:
         try:
@@ -136,8 +163,11 @@ def _reading(method: Callable[..., Any]) -> Callable[..., Any]:
         except (sqlite3.Error, ValueError, TypeError) as exc:
             if isinstance(exc, sqlite3.OperationalError) and "locked" in str(exc):  # busy, not damaged
                 raise StorageError(f"{self.path} is busy (another kiosk is writing); try again") from None
-            raise StorageError(f"{self.path} holds what this kiosk cannot read ({exc}); nothing was changed. "
-                               "Keep a copy for the engineers and restore a backup") from None
+            raise StorageError(
+                f"{self.path} holds what this kiosk cannot read ({exc}); nothing was changed. "
+                "Keep a copy for the engineers and restore a backup"
+            ) from None
+
     return read
 
 
@@ -161,10 +191,20 @@ class Store(Custody):
     questionnaire and ``export``).
     """
 
-    def __init__(self, connection: sqlite3.Connection, path: Path, *, owner: Owner | None = None,
-                 simulated: bool = False, outbox: bool = False, interrupt_after_s: float | None = None,
-                 lease_ttl_s: float = LEASE_TTL_S, wall: Callable[[], float] = time.time,
-                 export: Mapping[str, str] | None = None, in_force: Callable[[], InForce] | None = None) -> None:
+    def __init__(
+        self,
+        connection: sqlite3.Connection,
+        path: Path,
+        *,
+        owner: Owner | None = None,
+        simulated: bool = False,
+        outbox: bool = False,
+        interrupt_after_s: float | None = None,
+        lease_ttl_s: float = LEASE_TTL_S,
+        wall: Callable[[], float] = time.time,
+        export: Mapping[str, str] | None = None,
+        in_force: Callable[[], InForce] | None = None,
+    ) -> None:
         self._db = connection
         #: how this kiosk's exports name things (site, kiosk, FHIR systems), sent to the station with
         #: each new session so that the station's exports of it carry the same identifiers
@@ -194,14 +234,16 @@ class Store(Custody):
         become an empty database) a missing directory or database is a StorageError. ``options``
         are the constructor's keywords."""
         if any(not c.isprintable() for c in str(data_dir)):
-            raise StorageError(f"the data directory {str(data_dir)!r} holds a control character or bytes that "
-                               "are not UTF-8")
+            raise StorageError(
+                f"the data directory {str(data_dir)!r} holds a control character or bytes that are not UTF-8"
+            )
         try:
             directory = Path(data_dir).expanduser()
         except RuntimeError:  # ~user for a user this machine does not have
             raise StorageError(f"no data directory {data_dir} (no such user to expand ~ for)") from None
-        in_force = options.setdefault("in_force", bundled_in_force(options.get("export") or {},
-                                                                options.get("wall", time.time)))
+        in_force = options.setdefault(
+            "in_force", bundled_in_force(options.get("export") or {}, options.get("wall", time.time))
+        )
         path = directory / DB_NAME
         if not create:
             if not directory.is_dir():
@@ -320,13 +362,16 @@ class Store(Custody):
         alert = kind == "record_event" and payload.get("kind") in ALERT_EVENTS
         if alert:
             payload = {**payload, "kind": ALERT_EVENTS[payload["kind"]]}
-        self._db.execute("INSERT INTO outbox (kind, session_id, payload, at, alert) VALUES (?, ?, ?, ?, ?)",
-                         (kind, session_id, json.dumps(payload, ensure_ascii=False), self._iso_now(), int(alert)))
+        self._db.execute(
+            "INSERT INTO outbox (kind, session_id, payload, at, alert) VALUES (?, ?, ?, ?, ?)",
+            (kind, session_id, json.dumps(payload, ensure_ascii=False), self._iso_now(), int(alert)),
+        )
         self._queued = (True, self._queued[1] or alert)
 
     def _next_seq(self, table: str, session_id: str) -> int:
-        row = self._db.execute(f"SELECT COALESCE(MAX(seq), -1) + 1 FROM {table} WHERE session_id = ?",
-                               (session_id,)).fetchone()
+        row = self._db.execute(
+            f"SELECT COALESCE(MAX(seq), -1) + 1 FROM {table} WHERE session_id = ?", (session_id,)
+        ).fetchone()
         return int(row[0])
 
     def _iso_now(self) -> str:
@@ -334,15 +379,25 @@ class Store(Custody):
 
     # -- writing (kiosk.core.session.SessionStore) ----------------------------------------------------
 
-    def create_session(self, *, session_id: str, patient_id: str, questionnaire_id: str, language: str,
-                       answered_by: str, started_at: str, timing: Mapping[str, float],
-                       definition: Mapping[str, Any] | None = None) -> None:
+    def create_session(
+        self,
+        *,
+        session_id: str,
+        patient_id: str,
+        questionnaire_id: str,
+        language: str,
+        answered_by: str,
+        started_at: str,
+        timing: Mapping[str, float],
+        definition: Mapping[str, Any] | None = None,
+    ) -> None:
         """Record a new running session (and its patient, the first time), held by this kiosk, with
         the definition it runs (:func:`kiosk.core.questionnaire.definition.canonical`; None: the one in force, marked
         attached later) and this store's identity."""
         if not PATIENT_ID.match(patient_id):
-            raise ValueError(f"patient id {patient_id!r} is not a pseudonymous id "
-                             "(2-64 letters, digits, '-' or '_'; never a name)")
+            raise ValueError(
+                f"patient id {patient_id!r} is not a pseudonymous id (2-64 letters, digits, '-' or '_'; never a name)"
+            )
         later = definition is None
         if definition is None:
             definition = self._in_force().definition
@@ -353,88 +408,210 @@ class Store(Custody):
                 "INSERT INTO sessions (id, patient_id, questionnaire_id, language, answered_by, timing, started_at,"
                 " status, simulated, definition, definition_attached_later, identity)"
                 " VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?)",
-                (session_id, patient_id, questionnaire_id, language, answered_by, json.dumps(dict(timing)), started_at,
-                 int(self.simulated), sha, int(later), json.dumps(self.export, sort_keys=True)),
+                (
+                    session_id,
+                    patient_id,
+                    questionnaire_id,
+                    language,
+                    answered_by,
+                    json.dumps(dict(timing)),
+                    started_at,
+                    int(self.simulated),
+                    sha,
+                    int(later),
+                    json.dumps(self.export, sort_keys=True),
+                ),
             )
             self._take(session_id)
-            self._queue("create_session", session_id, {
-                "session_id": session_id, "patient_id": patient_id, "questionnaire_id": questionnaire_id,
-                "language": language, "answered_by": answered_by, "started_at": started_at, "timing": dict(timing),
-                "simulated": self.simulated, **({"export": self.export} if self.export else {}),
-                "definition": dict(definition),
-                "definition_sha256": sha, **({"definition_attached_later": True} if later else {})})
+            self._queue(
+                "create_session",
+                session_id,
+                {
+                    "session_id": session_id,
+                    "patient_id": patient_id,
+                    "questionnaire_id": questionnaire_id,
+                    "language": language,
+                    "answered_by": answered_by,
+                    "started_at": started_at,
+                    "timing": dict(timing),
+                    "simulated": self.simulated,
+                    **({"export": self.export} if self.export else {}),
+                    "definition": dict(definition),
+                    "definition_sha256": sha,
+                    **({"definition_attached_later": True} if later else {}),
+                },
+            )
 
-    def record_answer(self, session_id: str, *, item_id: str, option: int, points: int, attempt: int,
-                      channel: str, answered_by: str, t: float, at: str, detail: str = "") -> None:
+    def record_answer(
+        self,
+        session_id: str,
+        *,
+        item_id: str,
+        option: int,
+        points: int,
+        attempt: int,
+        channel: str,
+        answered_by: str,
+        t: float,
+        at: str,
+        detail: str = "",
+    ) -> None:
         """Store one answer."""
-        self._record("record_answer", session_id, {
-            "item_id": item_id, "option": option, "points": points, "attempt": attempt, "channel": channel,
-            "answered_by": answered_by, "t": t, "at": at, "detail": detail},
+        self._record(
+            "record_answer",
+            session_id,
+            {
+                "item_id": item_id,
+                "option": option,
+                "points": points,
+                "attempt": attempt,
+                "channel": channel,
+                "answered_by": answered_by,
+                "t": t,
+                "at": at,
+                "detail": detail,
+            },
             "INSERT INTO answers VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-            (session_id, item_id, option, points, attempt, channel, answered_by, t, at, detail))
+            (session_id, item_id, option, points, attempt, channel, answered_by, t, at, detail),
+        )
 
     def withdraw_answer(self, session_id: str, *, item_id: str, t: float, at: str, reason: str) -> None:
         """Take back a committed answer (the patient's "Change my answer"): its row is deleted and
         the session log keeps what it was (an ``answer_withdrawn`` event, detail JSON), in one commit."""
-        row = self._db.execute("SELECT option, points, attempt, channel, answered_by, t, at, detail FROM answers"
-                               " WHERE session_id = ? AND item_id = ?", (session_id, item_id)).fetchone()
+        row = self._db.execute(
+            "SELECT option, points, attempt, channel, answered_by, t, at, detail FROM answers"
+            " WHERE session_id = ? AND item_id = ?",
+            (session_id, item_id),
+        ).fetchone()
         if row is None:
             raise KeyError(f"session {session_id} has no answer to {item_id!r} to withdraw")
         withdrawn = dict(zip(("option", "points", "attempt", "channel", "answered_by", "t", "at", "detail"), row))
         with self.transaction():
-            self._record("withdraw_answer", session_id, {"item_id": item_id, "t": t, "at": at, "reason": reason},
-                         "DELETE FROM answers WHERE session_id = ? AND item_id = ?", (session_id, item_id))
-            self.record_event(session_id, t=t, kind="answer_withdrawn", detail=json.dumps(
-                {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False))
+            self._record(
+                "withdraw_answer",
+                session_id,
+                {"item_id": item_id, "t": t, "at": at, "reason": reason},
+                "DELETE FROM answers WHERE session_id = ? AND item_id = ?",
+                (session_id, item_id),
+            )
+            self.record_event(
+                session_id,
+                t=t,
+                kind="answer_withdrawn",
+                detail=json.dumps(
+                    {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False
+                ),
+            )
 
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None:
         """Store that both attempts of a question timed out."""
-        self._record("record_not_answered", session_id, {"item_id": item_id, "t": t, "at": at},
-                     "INSERT INTO not_answered VALUES (?, ?, ?, ?)", (session_id, item_id, t, at))
+        self._record(
+            "record_not_answered",
+            session_id,
+            {"item_id": item_id, "t": t, "at": at},
+            "INSERT INTO not_answered VALUES (?, ?, ?, ?)",
+            (session_id, item_id, t, at),
+        )
 
-    def record_practice(self, session_id: str, *, question_id: str, checks: str, outcome: str, option: int | None,
-                        channel: str | None, t: float, at: str, detail: str = "") -> None:
+    def record_practice(
+        self,
+        session_id: str,
+        *,
+        question_id: str,
+        checks: str,
+        outcome: str,
+        option: int | None,
+        channel: str | None,
+        t: float,
+        at: str,
+        detail: str = "",
+    ) -> None:
         """Store a practice question's outcome ("right", "wrong", "not_answered" or "skipped")."""
-        self._record("record_practice", session_id, {
-            "question_id": question_id, "checks": checks, "outcome": outcome, "option": option, "channel": channel,
-            "t": t, "at": at, "detail": detail},
+        self._record(
+            "record_practice",
+            session_id,
+            {
+                "question_id": question_id,
+                "checks": checks,
+                "outcome": outcome,
+                "option": option,
+                "channel": channel,
+                "t": t,
+                "at": at,
+                "detail": detail,
+            },
             "INSERT INTO practice VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-            (session_id, self._next_seq("practice", session_id), question_id, checks, outcome, option, channel, t,
-             at, detail))
+            (
+                session_id,
+                self._next_seq("practice", session_id),
+                question_id,
+                checks,
+                outcome,
+                option,
+                channel,
+                t,
+                at,
+                detail,
+            ),
+        )
 
     def record_context(self, session_id: str, *, t: float, set: Mapping[str, Any], emit: list[str]) -> None:
         """Store one batch of the session's QoS context trace."""
-        self._record("record_context", session_id, {"t": t, "set": dict(set), "emit": list(emit)},
-                     "INSERT INTO contexts VALUES (?, ?, ?, ?, ?)",
-                     (session_id, self._next_seq("contexts", session_id), t, json.dumps(dict(set)),
-                      json.dumps(list(emit))))
+        self._record(
+            "record_context",
+            session_id,
+            {"t": t, "set": dict(set), "emit": list(emit)},
+            "INSERT INTO contexts VALUES (?, ?, ?, ?, ?)",
+            (session_id, self._next_seq("contexts", session_id), t, json.dumps(dict(set)), json.dumps(list(emit))),
+        )
 
     def record_metrics(self, session_id: str, *, t: float, metrics: Mapping[str, float], fired: list[str]) -> None:
         """Store the QoS metrics after one update."""
-        self._record("record_metrics", session_id, {"t": t, "metrics": dict(metrics), "fired": list(fired)},
-                     "INSERT INTO metric_samples VALUES (?, ?, ?, ?, ?)",
-                     (session_id, self._next_seq("metric_samples", session_id), t, json.dumps(dict(metrics)),
-                      json.dumps(list(fired))))
+        self._record(
+            "record_metrics",
+            session_id,
+            {"t": t, "metrics": dict(metrics), "fired": list(fired)},
+            "INSERT INTO metric_samples VALUES (?, ?, ?, ?, ?)",
+            (
+                session_id,
+                self._next_seq("metric_samples", session_id),
+                t,
+                json.dumps(dict(metrics)),
+                json.dumps(list(fired)),
+            ),
+        )
 
     def record_adaptation(self, session_id: str, *, t: float, name: str, active: bool, reason: str) -> None:
         """Store an adaptation switched on or off."""
-        self._record("record_adaptation", session_id, {"t": t, "name": name, "active": active, "reason": reason},
-                     "INSERT INTO adaptations VALUES (?, ?, ?, ?, ?, ?)",
-                     (session_id, self._next_seq("adaptations", session_id), t, name, int(active), reason))
+        self._record(
+            "record_adaptation",
+            session_id,
+            {"t": t, "name": name, "active": active, "reason": reason},
+            "INSERT INTO adaptations VALUES (?, ?, ?, ?, ?, ?)",
+            (session_id, self._next_seq("adaptations", session_id), t, name, int(active), reason),
+        )
 
     def record_event(self, session_id: str, *, t: float, kind: str, detail: str = "") -> None:
         """Store a line of the session log (a call for the doctor, a patient leaving: alerts first)."""
-        self._record("record_event", session_id, {"t": t, "kind": kind, "detail": detail},
-                     "INSERT INTO events VALUES (?, ?, ?, ?, ?)",
-                     (session_id, self._next_seq("events", session_id), t, kind, detail))
+        self._record(
+            "record_event",
+            session_id,
+            {"t": t, "kind": kind, "detail": detail},
+            "INSERT INTO events VALUES (?, ?, ?, ?, ?)",
+            (session_id, self._next_seq("events", session_id), t, kind, detail),
+        )
 
-    def finish_session(self, session_id: str, *, finished_at: str, total: int, complete: bool,
-                       band: str | None) -> None:
+    def finish_session(
+        self, session_id: str, *, finished_at: str, total: int, complete: bool, band: str | None
+    ) -> None:
         """Mark a session finished (the total is kept for listing; results recompute it)."""
-        self._record("finish_session", session_id,
-                     {"finished_at": finished_at, "total": total, "complete": complete, "band": band},
-                     "UPDATE sessions SET status = 'finished', finished_at = ?, total = ?, complete = ?, band = ?"
-                     " WHERE id = ?", (finished_at, total, int(complete), band, session_id))
+        self._record(
+            "finish_session",
+            session_id,
+            {"finished_at": finished_at, "total": total, "complete": complete, "band": band},
+            "UPDATE sessions SET status = 'finished', finished_at = ?, total = ?, complete = ?, band = ? WHERE id = ?",
+            (finished_at, total, int(complete), band, session_id),
+        )
 
     def abandon(self, session_id: str) -> None:
         """Mark an unfinished session as not to be continued (its answers stay): this kiosk's
@@ -443,8 +620,11 @@ class Store(Custody):
             status = self._status(session_id)
             if status not in ("running", "interrupted"):
                 return
-            self._write("UPDATE sessions SET status = 'abandoned' WHERE id = ?", (session_id,),
-                        session=session_id if status == "running" else None)
+            self._write(
+                "UPDATE sessions SET status = 'abandoned' WHERE id = ?",
+                (session_id,),
+                session=session_id if status == "running" else None,
+            )
             self._db.execute("DELETE FROM leases WHERE session_id = ?", (session_id,))
             self._queue("abandon", session_id, {})
 
@@ -457,35 +637,40 @@ class Store(Custody):
             "SELECT s.id, s.patient_id, s.started_at, s.finished_at, s.status, s.language,"
             " (SELECT COUNT(*) FROM answers a WHERE a.session_id = s.id),"
             " (SELECT COUNT(*) FROM not_answered n WHERE n.session_id = s.id), s.simulated, s.interrupted_reason"
-            " FROM sessions s ORDER BY s.started_at DESC, s.rowid DESC").fetchall()
+            " FROM sessions s ORDER BY s.started_at DESC, s.rowid DESC"
+        ).fetchall()
         return [SessionSummary(*row[:8], simulated=bool(row[8]), interrupted_reason=row[9]) for row in rows]
 
     def unfinished_sessions(self) -> list[StoredSession]:
         """The tests staff may continue, newest first: interrupted (their kiosk stopped, or they grew
         too old: see :meth:`interrupt_stale`, run first), never simulated ones."""
         self.interrupt_stale()
-        ids = [r[0] for r in self._db.execute(
-            "SELECT id FROM sessions WHERE status = 'interrupted' AND simulated = 0"
-            " ORDER BY started_at DESC, rowid DESC")]
+        ids = [
+            r[0]
+            for r in self._db.execute(
+                "SELECT id FROM sessions WHERE status = 'interrupted' AND simulated = 0"
+                " ORDER BY started_at DESC, rowid DESC"
+            )
+        ]
         return [self.session(i) for i in ids]
 
     @_reading
     def outbox_waiting(self) -> tuple[int, int]:
         """Outbox rows waiting for the station, and rows it refused (parked, kept for an engineer)."""
-        waiting, parked = self._db.execute(
-            "SELECT COUNT(*) - COUNT(parked), COUNT(parked) FROM outbox").fetchone()
+        waiting, parked = self._db.execute("SELECT COUNT(*) - COUNT(parked), COUNT(parked) FROM outbox").fetchone()
         return int(waiting), int(parked)
 
     @_reading
     def resolve(self, ref: str) -> str:
         """A session id from a full id or a unique prefix; KeyError naming the problem otherwise."""
-        rows = [r[0] for r in self._db.execute("SELECT id FROM sessions WHERE substr(id, 1, ?) = ?",
-                                               (len(ref), ref))]
+        rows = [r[0] for r in self._db.execute("SELECT id FROM sessions WHERE substr(id, 1, ?) = ?", (len(ref), ref))]
         if ref in rows:
             return ref
         if len(rows) == 1:
             return rows[0]
-        raise KeyError(f"no session {ref!r}" if not rows else f"{ref!r} matches {len(rows)} sessions; give more of the id")
+        raise KeyError(
+            f"no session {ref!r}" if not rows else f"{ref!r} matches {len(rows)} sessions; give more of the id"
+        )
 
     @_reading
     def session(self, ref: str) -> StoredSession:
@@ -496,41 +681,81 @@ class Store(Custody):
             " simulated, interrupted_reason, interrupted_at, s.definition, d.body, definition_attached_later,"
             " identity, identity_attached_later"
             " FROM sessions s LEFT JOIN definitions d ON d.sha256 = s.definition WHERE s.id = ?",
-            (session_id,)).fetchone()
+            (session_id,),
+        ).fetchone()
         answers = tuple(
             Answer(item_id, option, points, attempt, Channel(channel), AnsweredBy(by), t, detail)
             for item_id, option, points, attempt, channel, by, t, detail in self._db.execute(
                 "SELECT item_id, option, points, attempt, channel, answered_by, t, detail FROM answers"
-                " WHERE session_id = ? ORDER BY t, rowid", (session_id,))
+                " WHERE session_id = ? ORDER BY t, rowid",
+                (session_id,),
+            )
         )
-        not_answered = tuple(r[0] for r in self._db.execute(
-            "SELECT item_id FROM not_answered WHERE session_id = ? ORDER BY t, rowid", (session_id,)))
+        not_answered = tuple(
+            r[0]
+            for r in self._db.execute(
+                "SELECT item_id FROM not_answered WHERE session_id = ? ORDER BY t, rowid", (session_id,)
+            )
+        )
         trace = []
         for t, sets, emits in self._db.execute(
-                "SELECT t, sets, emits FROM contexts WHERE session_id = ? ORDER BY seq", (session_id,)):
+            "SELECT t, sets, emits FROM contexts WHERE session_id = ? ORDER BY seq", (session_id,)
+        ):
             event: dict[str, Any] = {"t": t}
             if json.loads(sets):
                 event["set"] = json.loads(sets)
             if json.loads(emits):
                 event["emit"] = json.loads(emits)
             trace.append(event)
-        metrics = tuple(MetricSample(t, json.loads(m), tuple(json.loads(f))) for t, m, f in self._db.execute(
-            "SELECT t, metrics, fired FROM metric_samples WHERE session_id = ? ORDER BY seq", (session_id,)))
-        adaptations = tuple(AdaptationRecord(t, n, bool(a), r) for t, n, a, r in self._db.execute(
-            "SELECT t, name, active, reason FROM adaptations WHERE session_id = ? ORDER BY seq", (session_id,)))
-        log = tuple(LogEntry(*r) for r in self._db.execute(
-            "SELECT t, kind, detail FROM events WHERE session_id = ? ORDER BY seq", (session_id,)))
+        metrics = tuple(
+            MetricSample(t, json.loads(m), tuple(json.loads(f)))
+            for t, m, f in self._db.execute(
+                "SELECT t, metrics, fired FROM metric_samples WHERE session_id = ? ORDER BY seq", (session_id,)
+            )
+        )
+        adaptations = tuple(
+            AdaptationRecord(t, n, bool(a), r)
+            for t, n, a, r in self._db.execute(
+                "SELECT t, name, active, reason FROM adaptations WHERE session_id = ? ORDER BY seq", (session_id,)
+            )
+        )
+        log = tuple(
+            LogEntry(*r)
+            for r in self._db.execute(
+                "SELECT t, kind, detail FROM events WHERE session_id = ? ORDER BY seq", (session_id,)
+            )
+        )
         practice = tuple(
             PracticeRecord(q, c, o, opt, Channel(ch) if ch else None, t, d)
             for q, c, o, opt, ch, t, d in self._db.execute(
                 "SELECT question_id, checks, outcome, option, channel, t, detail FROM practice"
-                " WHERE session_id = ? ORDER BY seq", (session_id,)))
+                " WHERE session_id = ? ORDER BY seq",
+                (session_id,),
+            )
+        )
         return StoredSession(
-            id=row[0], patient_id=row[1], questionnaire_id=row[2], language=row[3], answered_by=AnsweredBy(row[4]),
-            timing=json.loads(row[5]), started_at=row[6], status=row[7], finished_at=row[8], answers=answers,
-            not_answered=not_answered, trace=tuple(trace), metrics=metrics, adaptations=adaptations, log=log,
-            practice=practice, simulated=bool(row[9]), interrupted_reason=row[10], interrupted_at=row[11],
-            definition=json.loads(row[13]) if row[13] else None, definition_sha256=row[12] or "",
-            definition_attached_later=bool(row[14]), identity=json.loads(row[15]) if row[15] else {},
+            id=row[0],
+            patient_id=row[1],
+            questionnaire_id=row[2],
+            language=row[3],
+            answered_by=AnsweredBy(row[4]),
+            timing=json.loads(row[5]),
+            started_at=row[6],
+            status=row[7],
+            finished_at=row[8],
+            answers=answers,
+            not_answered=not_answered,
+            trace=tuple(trace),
+            metrics=metrics,
+            adaptations=adaptations,
+            log=log,
+            practice=practice,
+            simulated=bool(row[9]),
+            interrupted_reason=row[10],
+            interrupted_at=row[11],
+            definition=json.loads(row[13]) if row[13] else None,
+            definition_sha256=row[12] or "",
+            definition_attached_later=bool(row[14]),
+            identity=json.loads(row[15]) if row[15] else {},
             identity_attached_later=bool(row[16]),
         )

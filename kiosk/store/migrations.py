@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from typing import Any
 
-from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
 from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
 
 V1 = """
 CREATE TABLE IF NOT EXISTS patients (
@@ -198,18 +198,21 @@ class InForce:
 
 def bundled_in_force(export: Mapping[str, str], wall: Callable[[], float]) -> Callable[[], InForce]:
     """The default :class:`InForce`: the bundled questionnaire (loaded only when asked) and ``export``."""
+
     def now() -> InForce:
         at = datetime.fromtimestamp(wall(), timezone.utc).isoformat().replace("+00:00", "Z")
         return InForce(canonical(load_questionnaire()), dict(export), at)
+
     return now
 
 
 def store_definition(db: sqlite3.Connection, definition: Mapping[str, Any], at: str) -> str:
     """Store a definition once (by its content address) in the current transaction; returns its SHA-256."""
     sha = digest(definition)
-    db.execute("INSERT OR IGNORE INTO definitions (sha256, questionnaire_id, version, body, stored_at)"
-               " VALUES (?, ?, ?, ?, ?)", (sha, str(definition.get("id", "")), str(definition.get("version", "")),
-                                           canonical_json(definition), at))
+    db.execute(
+        "INSERT OR IGNORE INTO definitions (sha256, questionnaire_id, version, body, stored_at) VALUES (?, ?, ?, ?, ?)",
+        (sha, str(definition.get("id", "")), str(definition.get("version", "")), canonical_json(definition), at),
+    )
     return sha
 
 
@@ -222,8 +225,10 @@ def attach_in_force(db: sqlite3.Connection, in_force: InForce) -> None:
         return
     sha = store_definition(db, in_force.definition, in_force.at)
     db.execute("UPDATE sessions SET definition = ?, definition_attached_later = 1 WHERE definition IS NULL", (sha,))
-    db.execute("UPDATE sessions SET identity = ?, identity_attached_later = 1 WHERE identity IS NULL",
-               (json.dumps(dict(in_force.identity), sort_keys=True),))
+    db.execute(
+        "UPDATE sessions SET identity = ?, identity_attached_later = 1 WHERE identity IS NULL",
+        (json.dumps(dict(in_force.identity), sort_keys=True),),
+    )
     for seq, payload in db.execute("SELECT seq, payload FROM outbox WHERE kind = 'create_session'").fetchall():
         body = json.loads(payload)
         if "definition" in body:
@@ -245,9 +250,11 @@ def version(db: sqlite3.Connection) -> int:
 
 def _refuse_newer(found: int, name: str) -> None:
     if found > LATEST:
-        raise SchemaError(f"{name} has schema version {found}, newer than this kiosk understands (up to "
-                          f"{LATEST}): it was written by a newer kiosk. Run that version, or update this one; "
-                          "nothing was changed")
+        raise SchemaError(
+            f"{name} has schema version {found}, newer than this kiosk understands (up to "
+            f"{LATEST}): it was written by a newer kiosk. Run that version, or update this one; "
+            "nothing was changed"
+        )
 
 
 def migrate(db: sqlite3.Connection, name: str, in_force: Callable[[], InForce] | None = None) -> int:
@@ -272,19 +279,25 @@ def migrate(db: sqlite3.Connection, name: str, in_force: Callable[[], InForce] |
                         db.execute(statement)
             if found < 3 and db.execute("SELECT 1 FROM sessions WHERE definition IS NULL LIMIT 1").fetchone():
                 if in_force is None:
-                    raise SchemaError(f"{name}: upgrading to schema version {LATEST} needs the questionnaire and "
-                                      "identity in force to attach to the sessions stored before; nothing was changed")
+                    raise SchemaError(
+                        f"{name}: upgrading to schema version {LATEST} needs the questionnaire and "
+                        "identity in force to attach to the sessions stored before; nothing was changed"
+                    )
                 try:
                     now = in_force()
                 except ValueError as exc:  # the configuration or questionnaire file in force is unusable
-                    raise SchemaError(f"{name}: upgrading to schema version {LATEST} attaches the questionnaire "
-                                      f"in force to the sessions stored before, but it cannot be read ({exc}); "
-                                      "nothing was changed") from None
+                    raise SchemaError(
+                        f"{name}: upgrading to schema version {LATEST} attaches the questionnaire "
+                        f"in force to the sessions stored before, but it cannot be read ({exc}); "
+                        "nothing was changed"
+                    ) from None
                 attach_in_force(db, now)
             problems = db.execute("PRAGMA foreign_key_check").fetchall()
             if problems:
-                raise SchemaError(f"{name}: upgrading to schema version {LATEST} found rows pointing nowhere "
-                                  f"({problems[0]}); nothing was changed")
+                raise SchemaError(
+                    f"{name}: upgrading to schema version {LATEST} found rows pointing nowhere "
+                    f"({problems[0]}); nothing was changed"
+                )
             db.execute(f"PRAGMA user_version = {LATEST}")
             db.execute("COMMIT")
         except BaseException:

@@ -9,6 +9,7 @@ from typing import Any
 from kiosk.core.channels import Channel
 from kiosk.core.session import Answer, AnsweredBy
 
+
 @dataclass(frozen=True)
 class SessionSummary:
     """One line of the session list (``status``: running, finished, abandoned or interrupted)."""
@@ -115,5 +116,3 @@ class StoredSession:
     identity: Mapping[str, str] = field(default_factory=dict)
     #: the identity was attached when the database was upgraded, from the configuration then
     identity_attached_later: bool = False
-
-

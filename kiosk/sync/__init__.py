@@ -29,6 +29,8 @@ def deliver_pending(db_path: Path, station: Any, within_s: float = EXIT_DELIVERY
         client.stop()
     if not left:
         return None
-    return (f"the station at {station.url} did not take {left} stored change{'s' if left != 1 else ''} "
-            f"within {within_s:g} s ({client.problem or 'no reason given'}); they are kept in {db_path} and go "
-            "with the next `kiosk run` or `kiosk replay` on this data directory")
+    return (
+        f"the station at {station.url} did not take {left} stored change{'s' if left != 1 else ''} "
+        f"within {within_s:g} s ({client.problem or 'no reason given'}); they are kept in {db_path} and go "
+        "with the next `kiosk run` or `kiosk replay` on this data directory"
+    )

@@ -53,7 +53,7 @@ class Backoff:
 
     def next(self) -> float:
         """How long to wait after one more failure."""
-        delay = min(self.most, self.first * 2 ** self._failures)
+        delay = min(self.most, self.first * 2**self._failures)
         self._failures += 1
         return delay * random.uniform(0.75, 1.0)
 
@@ -71,10 +71,18 @@ class SyncClient:
     ``backoff`` is (first, most) in seconds.
     """
 
-    def __init__(self, db_path: Path, *, url: str, token: str, kiosk_id: str,
-                 on_command: Callable[[Mapping[str, Any]], Outcome | None] | None = None,
-                 backoff: tuple[float, float] = (0.5, 60.0), heartbeat_s: float = HEARTBEAT_S,
-                 poll_wait_s: float = POLL_WAIT_S) -> None:
+    def __init__(
+        self,
+        db_path: Path,
+        *,
+        url: str,
+        token: str,
+        kiosk_id: str,
+        on_command: Callable[[Mapping[str, Any]], Outcome | None] | None = None,
+        backoff: tuple[float, float] = (0.5, 60.0),
+        heartbeat_s: float = HEARTBEAT_S,
+        poll_wait_s: float = POLL_WAIT_S,
+    ) -> None:
         self.station = Station(url, token)
         self.kiosk_id = kiosk_id
         self.outbox = Outbox(db_path)
@@ -168,8 +176,9 @@ class SyncClient:
         rows = self.outbox.pending(self._batch, alerts_only=True) or self.outbox.pending(self._batch)
         if not rows:
             return False
-        status, body = self.station.request("POST", "/api/v1/sync",
-                                            {"kiosk_id": self.kiosk_id, "events": [r.event() for r in rows]})
+        status, body = self.station.request(
+            "POST", "/api/v1/sync", {"kiosk_id": self.kiosk_id, "events": [r.event() for r in rows]}
+        )
         if status == 200:
             sent = {r.seq for r in rows}
             stored = body.get("stored") if isinstance(body, dict) else None
@@ -195,8 +204,11 @@ class SyncClient:
         with self._lock:
             status, self._status_changed = dict(self._status), False
         try:
-            code, body = self.station.request("POST", "/api/v1/status", {
-                **status, "kiosk_id": self.kiosk_id, "at": datetime.now(timezone.utc).isoformat()})
+            code, body = self.station.request(
+                "POST",
+                "/api/v1/status",
+                {**status, "kiosk_id": self.kiosk_id, "at": datetime.now(timezone.utc).isoformat()},
+            )
         except Unreachable:
             with self._lock:
                 self._status_changed = True  # send it again once the station answers
@@ -213,8 +225,9 @@ class SyncClient:
         backoff = Backoff(*self._backoff)
         while not self._stopping.is_set():
             try:
-                status, body = self.station.request("GET", f"/api/v1/commands?wait={self._poll_wait_s:g}",
-                                                    timeout=self._poll_wait_s + 15)
+                status, body = self.station.request(
+                    "GET", f"/api/v1/commands?wait={self._poll_wait_s:g}", timeout=self._poll_wait_s + 15
+                )
                 if status != 200 or not isinstance(body, dict):
                     raise Refused(f"the station answered {status} to the command poll{_reason(body)}")
             except (Unreachable, Refused):

@@ -30,17 +30,28 @@ def live_status(session: Session) -> dict[str, Any]:
     """The kiosk as the ward view shows it (the client adds ``kiosk_id`` and ``at``)."""
     snap = session.snapshot()
     started = session.phase is not Phase.WELCOME
-    return {"session_id": session.id if started else None, "patient_id": session.patient_id if started else None,
-            "phase": snap.phase.value, "question": snap.number, "of": snap.count, "paused": snap.paused,
-            "person_away": not snap.person_present, "doctor_called": snap.halted, "simulated": False}
+    return {
+        "session_id": session.id if started else None,
+        "patient_id": session.patient_id if started else None,
+        "phase": snap.phase.value,
+        "question": snap.number,
+        "of": snap.count,
+        "paused": snap.paused,
+        "person_away": not snap.person_present,
+        "doctor_called": snap.halted,
+        "simulated": False,
+    }
 
 
 def apply_command(kiosk: Kiosk, command: Mapping[str, Any]) -> Outcome | None:
     """Carry out a station command on the running session: ("done", None) or ("refused", why);
     None when another kiosk process on this data directory runs that session (it answers)."""
     kind, session = command.get("kind"), kiosk.session
-    if command.get("session_id") != session.id and kiosk.store is not None \
-            and kiosk.store.held_elsewhere(str(command.get("session_id"))):
+    if (
+        command.get("session_id") != session.id
+        and kiosk.store is not None
+        and kiosk.store.held_elsewhere(str(command.get("session_id")))
+    ):
         return None
     if session.phase is Phase.WELCOME or command.get("session_id") != session.id:
         return "refused", f"session {command.get('session_id')} is not the one running on this kiosk"

@@ -10,9 +10,9 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable, Sequence
 
+from kiosk.core.visits import Order, parse_orders
 from kiosk.sync.client import Backoff
 from kiosk.sync.http import Station, Unreachable
-from kiosk.core.visits import Order, parse_orders
 
 #: how long one long poll for orders may wait at the station
 POLL_WAIT_S = 20.0
@@ -25,9 +25,16 @@ class OrderRefused(Exception):
 class OrderWatcher:
     """Keeps ``on_orders(orders, problems)`` told of the visits waiting for this kiosk."""
 
-    def __init__(self, station: Station, *, instruments: Sequence[str], languages: Sequence[str],
-                 on_orders: Callable[[list[Order], list[str]], None], poll_wait_s: float = POLL_WAIT_S,
-                 backoff: tuple[float, float] = (0.5, 30.0)) -> None:
+    def __init__(
+        self,
+        station: Station,
+        *,
+        instruments: Sequence[str],
+        languages: Sequence[str],
+        on_orders: Callable[[list[Order], list[str]], None],
+        poll_wait_s: float = POLL_WAIT_S,
+        backoff: tuple[float, float] = (0.5, 30.0),
+    ) -> None:
         self.station = station
         self._instruments, self._languages = list(instruments), list(languages)
         self._on_orders = on_orders

@@ -31,8 +31,13 @@ class Row:
 
     def event(self) -> dict[str, Any]:
         """The row as the protocol's ``events`` entry."""
-        return {"seq": self.seq, "kind": self.kind, "session_id": self.session_id, "payload": self.payload,
-                "at": self.at}
+        return {
+            "seq": self.seq,
+            "kind": self.kind,
+            "session_id": self.session_id,
+            "payload": self.payload,
+            "at": self.at,
+        }
 
 
 class Outbox:
@@ -50,10 +55,13 @@ class Outbox:
     def pending(self, limit: int, alerts_only: bool = False) -> list[Row]:
         """Up to ``limit`` rows not yet delivered nor parked, in ``seq`` order."""
         where = "parked IS NULL" + (" AND alert = 1" if alerts_only else "")
-        rows = self._db.execute(f"SELECT seq, kind, session_id, payload, at, alert FROM outbox WHERE {where}"
-                                " ORDER BY seq LIMIT ?", (limit,)).fetchall()
-        return [Row(seq, kind, session_id, json.loads(payload), at, bool(alert))
-                for seq, kind, session_id, payload, at, alert in rows]
+        rows = self._db.execute(
+            f"SELECT seq, kind, session_id, payload, at, alert FROM outbox WHERE {where} ORDER BY seq LIMIT ?", (limit,)
+        ).fetchall()
+        return [
+            Row(seq, kind, session_id, json.loads(payload), at, bool(alert))
+            for seq, kind, session_id, payload, at, alert in rows
+        ]
 
     def count(self) -> int:
         """Rows waiting for the station (parked ones excluded)."""
@@ -76,5 +84,7 @@ class Outbox:
 
     def parked(self) -> list[tuple[int, str]]:
         """The rows kept aside, with why."""
-        return [(int(s), str(r)) for s, r in self._db.execute(
-            "SELECT seq, parked FROM outbox WHERE parked IS NOT NULL ORDER BY seq")]
+        return [
+            (int(s), str(r))
+            for s, r in self._db.execute("SELECT seq, parked FROM outbox WHERE parked IS NOT NULL ORDER BY seq")
+        ]

@@ -23,9 +23,9 @@ import contextlib
 import os
 import sqlite3
 import sys
-from functools import partial
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -35,24 +35,8 @@ from textual.binding import Binding
 from textual.message import Message
 
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
-from kiosk.export import ExportSite, export_identity, site_from_config
-from kiosk.export.captured import questionnaire_of
-from kiosk.export.opening import in_force_of
 from kiosk.core.pin import CornerTaps, PinGuard
 from kiosk.core.questionnaire import Questionnaire
-from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
-from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView, Ways, spoken_with_ways
-from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
-from kiosk.ui.screens.doctor_called import DoctorCalledScreen
-from kiosk.ui.screens.explanation import ExplanationScreen
-from kiosk.ui.screens.familiarisation import FamiliarisationScreen
-from kiosk.ui.screens.out_of_order import OutOfOrderScreen
-from kiosk.ui.screens.paused import PausedScreen
-from kiosk.ui.screens.pin import PinScreen
-from kiosk.ui.screens.question import QuestionScreen
-from kiosk.ui.screens.summary import SummaryScreen
-from kiosk.ui.screens.visit_ready import VisitReadyScreen
-from kiosk.ui.screens.welcome import WelcomeScreen
 from kiosk.core.session import (
     AnswerRecorded,
     DoctorCalled,
@@ -67,8 +51,24 @@ from kiosk.core.session import (
     SessionEvent,
     VolumeChanged,
 )
-from kiosk.store.lease import LEASE_TTL_S, SessionTaken
+from kiosk.export import ExportSite, export_identity, site_from_config
+from kiosk.export.captured import questionnaire_of
+from kiosk.export.opening import in_force_of
+from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
 from kiosk.store.database import Store, StoredSession
+from kiosk.store.lease import LEASE_TTL_S, SessionTaken
+from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView, Ways, spoken_with_ways
+from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
+from kiosk.ui.screens.doctor_called import DoctorCalledScreen
+from kiosk.ui.screens.explanation import ExplanationScreen
+from kiosk.ui.screens.familiarisation import FamiliarisationScreen
+from kiosk.ui.screens.out_of_order import OutOfOrderScreen
+from kiosk.ui.screens.paused import PausedScreen
+from kiosk.ui.screens.pin import PinScreen
+from kiosk.ui.screens.question import QuestionScreen
+from kiosk.ui.screens.summary import SummaryScreen
+from kiosk.ui.screens.visit_ready import VisitReadyScreen
+from kiosk.ui.screens.welcome import WelcomeScreen
 from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.ui.widgets.change_answer import ChangeAnswerButton
@@ -191,8 +191,7 @@ class KioskApp(App[int], inherit_bindings=False):
         if speaker is not None:  # its worker thread reports through these (it starts on mount)
             speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
         else:
-            self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE,
-                                            "voice out turned off"))
+            self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE, "voice out turned off"))
         for status in statuses:
             self.board.update(status)
         #: every session event the app received, in order (the clinician screens and tests read it)
@@ -220,8 +219,9 @@ class KioskApp(App[int], inherit_bindings=False):
             self.speaker.start()
         for source in self._input_sources():
             # loading a speech model or probing a device can take a while: never on the UI thread
-            self.run_worker(partial(source.start, self.channel_sink), thread=True,
-                            name=f"start {source.name}", group="channels")
+            self.run_worker(
+                partial(source.start, self.channel_sink), thread=True, name=f"start {source.name}", group="channels"
+            )
         self.set_interval(self.poll_interval, self.poll_session)
         if self.store is not None:
             self.set_interval(LEASE_TTL_S / 3, self.keep_session)
@@ -296,8 +296,11 @@ class KioskApp(App[int], inherit_bindings=False):
         if item is None and key in KIOSK_KEY_BUTTONS:
             meaning = KIOSK_KEY_BUTTONS[key]
             detail = f"key {key}"
-            item = (ChannelInput(Channel.KEYBOARD, command=meaning, detail=detail) if isinstance(meaning, Command)
-                    else ChannelInput(Channel.KEYBOARD, option=meaning, detail=detail))
+            item = (
+                ChannelInput(Channel.KEYBOARD, command=meaning, detail=detail)
+                if isinstance(meaning, Command)
+                else ChannelInput(Channel.KEYBOARD, option=meaning, detail=detail)
+            )
         if item is None:
             return False
         self.forward(item)
@@ -338,7 +341,7 @@ class KioskApp(App[int], inherit_bindings=False):
             self._drive(self.session.welcome)
 
     def on_change_answer_button_requested(self, message: ChangeAnswerButton.Requested) -> None:
-        """"Change my answer" is the undo command, by touch; the session decides if it still can."""
+        """ "Change my answer" is the undo command, by touch; the session decides if it still can."""
         self.forward(ChannelInput(Channel.TOUCH, command=Command.UNDO, detail="screen"))
 
     def on_doctor_called_screen_carry_on(self, message: DoctorCalledScreen.CarryOn) -> None:
@@ -455,15 +458,24 @@ class KioskApp(App[int], inherit_bindings=False):
         voice_in = self.board.state(VOICE_IN)[0] is ChannelState.ON
         # the session lifts voice_off when voice in goes; checked here too so the button never
         # promises listening that cannot happen (and not over Continue while paused)
-        voice_again = ("voice_off" in snap.adaptations and not (snap.paused or snap.halted) and voice_in)
-        ways = Ways(remote=self.board.state(REMOTE)[0] is ChannelState.ON,
-                    voice=voice_in and "voice_off" not in snap.adaptations,
-                    listening=voice_in and self.board.listening,
-                    voice_out=self.board.state(VOICE_OUT)[0] is ChannelState.ON)
+        voice_again = "voice_off" in snap.adaptations and not (snap.paused or snap.halted) and voice_in
+        ways = Ways(
+            remote=self.board.state(REMOTE)[0] is ChannelState.ON,
+            voice=voice_in and "voice_off" not in snap.adaptations,
+            listening=voice_in and self.board.listening,
+            voice_out=self.board.state(VOICE_OUT)[0] is ChannelState.ON,
+        )
         question = snap.item or snap.practice
         hint = len(question.options) if self._no_such_option and question is not None else None
-        return PatientView(snap, self.questionnaire, ways, voice_again=voice_again, hint_options=hint,
-                           now=self.session.now(), show_score=self.show_score)
+        return PatientView(
+            snap,
+            self.questionnaire,
+            ways,
+            voice_again=voice_again,
+            hint_options=hint,
+            now=self.session.now(),
+            show_score=self.show_score,
+        )
 
     @staticmethod
     def _screen_classes(view: PatientView) -> tuple[type[PatientScreen], type[PatientScreen] | None]:
@@ -523,8 +535,7 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def orders_changed(self, orders: Any, problems: Any = ()) -> None:
         """The station's list of visits for this kiosk (UI thread): the welcome follows it."""
-        if self.visits is not None and self.visits.set_orders(orders, problems) \
-                and self.session.phase is Phase.WELCOME:
+        if self.visits is not None and self.visits.set_orders(orders, problems) and self.session.phase is Phase.WELCOME:
             self._render()
 
     def on_visit_ready_screen_code_entered(self, message: VisitReadyScreen.CodeEntered) -> None:
@@ -607,11 +618,15 @@ class KioskApp(App[int], inherit_bindings=False):
     async def on_event(self, event: events.Event) -> None:
         """Watch every press for the staff corner before the screens see it (a button under the
         corner must not hide the taps)."""
-        if isinstance(event, events.MouseDown) and not self.clinician_open \
-                and self._corner.tap(event.screen_x, event.screen_y):
+        if (
+            isinstance(event, events.MouseDown)
+            and not self.clinician_open
+            and self._corner.tap(event.screen_x, event.screen_y)
+        ):
             self.action_clinician()
-        elif self.clinician_open and isinstance(event, (events.Key, events.MouseDown, events.MouseScrollDown,
-                                                          events.MouseScrollUp)):
+        elif self.clinician_open and isinstance(
+            event, (events.Key, events.MouseDown, events.MouseScrollDown, events.MouseScrollUp)
+        ):
             self._staff_seen = self.session.now()
         await super().on_event(event)
 
@@ -637,7 +652,8 @@ class KioskApp(App[int], inherit_bindings=False):
         unseen underneath (one already paused or halted stays as it is)."""
         session = self.session
         if session.phase in (Phase.FAMILIARISATION, Phase.EXPLANATION, Phase.QUESTIONS) and not (
-                session.paused or session.halted):
+            session.paused or session.halted
+        ):
             self._drive(session.pause)
             self._held = session if session.paused else None
 
@@ -778,8 +794,12 @@ class KioskApp(App[int], inherit_bindings=False):
         """This kiosk may no longer record in its session: say so plainly (naming no one: the next
         patient may be reading) and start over."""
         if tell_patient:
-            self.notify(f"This test was stopped: {reason}. Staff can see it on the clinician screen.",
-                        title="Test stopped", severity="warning", timeout=60)
+            self.notify(
+                f"This test was stopped: {reason}. Staff can see it on the clinician screen.",
+                title="Test stopped",
+                severity="warning",
+                timeout=60,
+            )
         if self._new_session is not None:
             self._replace_session(self._new_session())
             self._greet()
@@ -810,31 +830,43 @@ class SetupError(Exception):
     """The kiosk cannot start: a bad configuration, questionnaire, data directory or profile file."""
 
 
-def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, patient_id: str | None = None,
-              voice: bool = True, remote: bool = True) -> tuple[KioskApp, Callable[[], None]]:
+def build_app(
+    *,
+    config_path: Path | None = None,
+    data_dir: Path | None = None,
+    patient_id: str | None = None,
+    voice: bool = True,
+    remote: bool = True,
+) -> tuple[KioskApp, Callable[[], None]]:
     """The kiosk as configured, with whatever channels this machine has, and a function that
     closes what it opened. Raises :class:`SetupError` (one sentence) for a user's mistake."""
+    from kiosk.config import ConfigError, configured_questionnaire, load_config
     from kiosk.core.adaptation import Adaptation, PolicyError, load_policy
     from kiosk.core.clock import SystemClock
-    from kiosk.config import ConfigError, configured_questionnaire, load_config
-    from kiosk.core.questionnaire import QuestionnaireError
     from kiosk.core.qos_model import load_kiosk_model
-    from kiosk.store.database import PATIENT_ID, StorageError, new_patient_id
+    from kiosk.core.questionnaire import QuestionnaireError
     from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
+    from kiosk.store.database import PATIENT_ID, StorageError, new_patient_id
     from qos import Engine, ModelError
 
     if patient_id is not None and not PATIENT_ID.match(patient_id):
-        raise SetupError(f"--patient {patient_id!r} is not a pseudonymous id: use letters, digits, '-' "
-                         "and '_' only (2 to 64 characters), never a name")
+        raise SetupError(
+            f"--patient {patient_id!r} is not a pseudonymous id: use letters, digits, '-' "
+            "and '_' only (2 to 64 characters), never a name"
+        )
 
     try:
         config = load_config(config_path)
         questionnaire = configured_questionnaire(config)
         model = load_kiosk_model(config.qos_model)
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
-        store = Store.open(data_dir or config.data_dir, interrupt_after_s=config.interrupt_after_minutes * 60,
-                           outbox=config.station is not None, export=export_identity(site_from_config(config)),
-                           in_force=lambda: in_force_of(config))
+        store = Store.open(
+            data_dir or config.data_dir,
+            interrupt_after_s=config.interrupt_after_minutes * 60,
+            outbox=config.station is not None,
+            export=export_identity(site_from_config(config)),
+            in_force=lambda: in_force_of(config),
+        )
         sync = _station_client(config.station, store, lambda command: app.station_command(command))
         # what a kiosk that stopped left running is interrupted now: for staff, never a patient
         store.interrupt_stale()
@@ -849,32 +881,61 @@ def build_app(*, config_path: Path | None = None, data_dir: Path | None = None, 
     voice_in = _voice_in(config, voice, statuses)
     clock = SystemClock()
 
-    def fresh(patient: str | None = None, language: str | None = None, answered_by: str = "patient",
-              visit: str | None = None) -> Session:
-        return Session(questionnaire, clock=clock, engine=Engine(model),
-                       patient_id=patient or new_patient_id(), store=store, language=language or config.language,
-                       answered_by=answered_by, timing=config.timing,
-                       adaptation=Adaptation(policy) if policy else None, familiarisation=config.familiarisation,
-                       next_patient_after_s=config.next_patient_after_s,
-                       visit=visit or (STAFF if patient else WALK_UP))
+    def fresh(
+        patient: str | None = None, language: str | None = None, answered_by: str = "patient", visit: str | None = None
+    ) -> Session:
+        return Session(
+            questionnaire,
+            clock=clock,
+            engine=Engine(model),
+            patient_id=patient or new_patient_id(),
+            store=store,
+            language=language or config.language,
+            answered_by=answered_by,
+            timing=config.timing,
+            adaptation=Adaptation(policy) if policy else None,
+            familiarisation=config.familiarisation,
+            next_patient_after_s=config.next_patient_after_s,
+            visit=visit or (STAFF if patient else WALK_UP),
+        )
 
     def resume(stored: StoredSession) -> Session:
         # the test goes on with the questionnaire it started with, whatever the file says now
-        return Session.from_stored(questionnaire_of(stored, fallback=questionnaire), stored, clock=clock,
-                                   engine=Engine(model),
-                                   store=store, timing=config.timing,
-                                   adaptation=Adaptation(policy) if policy else None,
-                                   next_patient_after_s=config.next_patient_after_s)
+        return Session.from_stored(
+            questionnaire_of(stored, fallback=questionnaire),
+            stored,
+            clock=clock,
+            engine=Engine(model),
+            store=store,
+            timing=config.timing,
+            adaptation=Adaptation(policy) if policy else None,
+            next_patient_after_s=config.next_patient_after_s,
+        )
 
     guard = PinGuard(config.pin_secret, data_dir or config.data_dir)
     visits = VisitDesk(fresh, walk_up=config.walk_up)
-    orders, start_order = _station_orders(config.station, questionnaire, lambda *found: app.call_from_thread(
-        app.orders_changed, *found))
-    app = KioskApp(fresh(patient_id), clinician_pin=guard, store=store, speaker=speaker,
-                   voice=voice_in, sources=sources, keyboard=keyboard, statuses=statuses,
-                   export_dir=(data_dir or config.data_dir) / "exports", export_site=site_from_config(config),
-                   resume=resume, new_session=fresh, show_score=config.show_score_to_patient,
-                   sync=sync, visits=visits, orders=orders, start_order=start_order)
+    orders, start_order = _station_orders(
+        config.station, questionnaire, lambda *found: app.call_from_thread(app.orders_changed, *found)
+    )
+    app = KioskApp(
+        fresh(patient_id),
+        clinician_pin=guard,
+        store=store,
+        speaker=speaker,
+        voice=voice_in,
+        sources=sources,
+        keyboard=keyboard,
+        statuses=statuses,
+        export_dir=(data_dir or config.data_dir) / "exports",
+        export_site=site_from_config(config),
+        resume=resume,
+        new_session=fresh,
+        show_score=config.show_score_to_patient,
+        sync=sync,
+        visits=visits,
+        orders=orders,
+        start_order=start_order,
+    )
     return app, store.close
 
 
@@ -884,8 +945,9 @@ def _station_client(station: Any, store: Store, on_command: Callable[[Any], Any]
         return None
     from kiosk.sync import SyncClient
 
-    client = SyncClient(store.path, url=station.url, token=station.token, kiosk_id=station.kiosk_id,
-                        on_command=on_command)
+    client = SyncClient(
+        store.path, url=station.url, token=station.token, kiosk_id=station.kiosk_id, on_command=on_command
+    )
     store.on_outbox = client.wake
     return client
 
@@ -899,14 +961,16 @@ def _station_orders(station: Any, questionnaire: Questionnaire, on_orders: Calla
     from kiosk.sync.orders import OrderWatcher, start_order
 
     instruments, languages = [questionnaire.id], list(questionnaire.languages)
-    watcher = OrderWatcher(Station(station.url, station.token), instruments=instruments, languages=languages,
-                           on_orders=on_orders)
+    watcher = OrderWatcher(
+        Station(station.url, station.token), instruments=instruments, languages=languages, on_orders=on_orders
+    )
     starter = Station(station.url, station.token)
     return watcher, lambda code: start_order(starter, code, instruments=instruments, languages=languages)
 
 
-def _remotes(profiles: Path | None, wanted: bool, statuses: list[ChannelStatus],
-             store: Store) -> tuple[Any, list[InputSource]]:
+def _remotes(
+    profiles: Path | None, wanted: bool, statuses: list[ChannelStatus], store: Store
+) -> tuple[Any, list[InputSource]]:
     """The keyboard-remote key map and the serial/HID sources, or the reason there are none."""
     if not wanted:
         statuses.append(ChannelStatus(Channel.REMOTE, ChannelState.OFF, "remote", "turned off (--no-remote)"))
@@ -941,8 +1005,13 @@ def main(argv: list[str]) -> int:
     """`kiosk run`: build the session and channels from the configuration and run the app."""
     args = run_parser().parse_args(argv)
     try:
-        app, close = build_app(config_path=args.config, data_dir=args.data_dir, patient_id=args.patient,
-                               voice=not args.no_voice, remote=not args.no_remote)
+        app, close = build_app(
+            config_path=args.config,
+            data_dir=args.data_dir,
+            patient_id=args.patient,
+            voice=not args.no_voice,
+            remote=not args.no_remote,
+        )
     except SetupError as error:
         print(f"kiosk run: {error}", file=sys.stderr)
         return 2

@@ -40,16 +40,13 @@ def _session_events(questions: list[str]) -> list[TraceEvent]:
         incidents = items[:-2] if items[-1] in CHANNELS else items[:-1]
         for incident in incidents:
             if incident == "PR":
-                events += [TraceEvent(now, {"TestState": "PAUSED"}),
-                           TraceEvent(now + 20, {"TestState": "RESTARTED"})]
+                events += [TraceEvent(now, {"TestState": "PAUSED"}), TraceEvent(now + 20, {"TestState": "RESTARTED"})]
                 now += 30
             elif incident == "CDR":
-                events += [TraceEvent(now, emit=["CallingDoctor"]),
-                           TraceEvent(now + 20, {"TestState": "RESTARTED"})]
+                events += [TraceEvent(now, emit=["CallingDoctor"]), TraceEvent(now + 20, {"TestState": "RESTARTED"})]
                 now += 30
             elif incident == "NPD":
-                events += [TraceEvent(now, {"PersonDetected": False}),
-                           TraceEvent(now + 5, {"PersonDetected": True})]
+                events += [TraceEvent(now, {"PersonDetected": False}), TraceEvent(now + 5, {"PersonDetected": True})]
                 now += 10
             else:
                 raise ValueError(f"unknown incident {incident!r} in {question!r}")
@@ -59,12 +56,16 @@ def _session_events(questions: list[str]) -> list[TraceEvent]:
             events.append(TraceEvent(now, {"FirstAttemptAnswered": True, "UserInteraction": channel}))
             ended = now
         elif outcome == "2nd":
-            events += [TraceEvent(now, {"FirstAttemptAnswered": False}),
-                       TraceEvent(now + 25, {"SecondAttemptAnswered": True, "UserInteraction": channel})]
+            events += [
+                TraceEvent(now, {"FirstAttemptAnswered": False}),
+                TraceEvent(now + 25, {"SecondAttemptAnswered": True, "UserInteraction": channel}),
+            ]
             ended = now + 25
         elif outcome == "QNA":
-            events += [TraceEvent(now, {"FirstAttemptAnswered": False}),
-                       TraceEvent(now + 30, {"SecondAttemptAnswered": False})]
+            events += [
+                TraceEvent(now, {"FirstAttemptAnswered": False}),
+                TraceEvent(now + 30, {"SecondAttemptAnswered": False}),
+            ]
             ended = now + 30
         else:
             raise ValueError(f"unknown outcome in {question!r}")
@@ -98,11 +99,17 @@ def render_all(data: dict | None = None) -> dict[str, str]:
     files = {}
     for number in range(1, 7):
         questions = data["sessions"][f"B{number}"]
-        trace = Trace("clarc", _session_events(questions),
-                      f"Barthel #{number} of the CLARC test-bench (paper Table 2), timed by the §6 convention")
+        trace = Trace(
+            "clarc",
+            _session_events(questions),
+            f"Barthel #{number} of the CLARC test-bench (paper Table 2), timed by the §6 convention",
+        )
         files[f"barthel{number}.yaml"] = trace.to_yaml(HEADER.format(what=f"sessions.B{number}"))
-    table4 = Trace("clarc", [_timeline_event(entry) for entry in data["barthel4_timeline"]],
-                   "Barthel #4 of the CLARC test-bench with the paper's own times (Table 4)")
+    table4 = Trace(
+        "clarc",
+        [_timeline_event(entry) for entry in data["barthel4_timeline"]],
+        "Barthel #4 of the CLARC test-bench with the paper's own times (Table 4)",
+    )
     files["barthel4_table4.yaml"] = table4.to_yaml(HEADER.format(what="barthel4_timeline"))
     return files
 

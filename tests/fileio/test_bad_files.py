@@ -13,11 +13,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from kiosk.core.adaptation import load_policy
+from kiosk.commands.replay import load_script, run_script
 from kiosk.config import load_config
+from kiosk.core.adaptation import load_policy
 from kiosk.core.questionnaire import bundled_path, check_questionnaire_file, load_questionnaire
 from kiosk.remote.profiles import load_profiles
-from kiosk.commands.replay import load_script, run_script
 from qos import load_model
 from qos.trace import load_trace, sample_trace
 
@@ -46,25 +46,47 @@ def _trace(path: Path) -> None:
 #: loader name -> (a real file of its kind, the file name it is written under, the loader)
 LOADERS: dict[str, tuple[bytes, str, Callable[[Path], object]]] = {
     "questionnaire": (bundled_path().read_bytes(), "q.yaml", _questionnaire),
-    "config": (b'language: es\nclinician_pin: "482193"\ntiming: {attempt_window_s: 30}\nadaptation: true\n',
-               "config.yaml", lambda p: load_config(p, environ={})),
+    "config": (
+        b'language: es\nclinician_pin: "482193"\ntiming: {attempt_window_s: 30}\nadaptation: true\n',
+        "config.yaml",
+        lambda p: load_config(p, environ={}),
+    ),
     "policy": ((ROOT / "kiosk/core/adaptation.yaml").read_bytes(), "policy.yaml", load_policy),
     "profiles": ((ROOT / "kiosk/remote/devices.yaml").read_bytes(), "site.yaml", load_profiles),
     "script": ((ROOT / "recordings/patients/barthel6.yaml").read_bytes(), "patient.yaml", _script),
     "trace (YAML)": ((ROOT / "recordings/testbench/barthel6.yaml").read_bytes(), "trace.yaml", _trace),
-    "trace (JSON)": (b'{"model": "clarc", "events": [{"t": 0, "set": {"PersonDetected": true}}, '
-                     b'{"t": 12.5, "set": {"TestState": "STARTED", "FirstAttemptAnswered": false}}]}', "trace.json", _trace),
+    "trace (JSON)": (
+        b'{"model": "clarc", "events": [{"t": 0, "set": {"PersonDetected": true}}, '
+        b'{"t": 12.5, "set": {"TestState": "STARTED", "FirstAttemptAnswered": false}}]}',
+        "trace.json",
+        _trace,
+    ),
     "model": ((ROOT / "qos/models/clarc.roqme").read_bytes(), "m.roqme", load_model),
 }
 
-BOMB = b"".join(b"l%d: &l%d [%s]\n" % (i, i, b",".join([b"*l%d" % (i - 1)] * 9) if i else b'"lol"')
-                for i in range(10))
+BOMB = b"".join(b"l%d: &l%d [%s]\n" % (i, i, b",".join([b"*l%d" % (i - 1)] * 9) if i else b'"lol"') for i in range(10))
 
 
 def _corrupt(good: bytes, data: st.DataObject) -> bytes:
     """One generated corruption of a good file."""
-    kind = data.draw(st.sampled_from(["random", "truncate", "nul", "latin1", "utf16", "deep", "deep_block",
-                                      "bomb", "duplicate", "huge", "nan", "replace"]))
+    kind = data.draw(
+        st.sampled_from(
+            [
+                "random",
+                "truncate",
+                "nul",
+                "latin1",
+                "utf16",
+                "deep",
+                "deep_block",
+                "bomb",
+                "duplicate",
+                "huge",
+                "nan",
+                "replace",
+            ]
+        )
+    )
     at = data.draw(st.integers(0, len(good)))
     number = re.compile(rb"(?<![\w.])\d+(?:\.\d+)?(?![\w.])")
     numbers = list(number.finditer(good))
@@ -86,21 +108,28 @@ def _corrupt(good: bytes, data: st.DataObject) -> bytes:
     if kind == "bomb":
         return BOMB + good
     if kind == "duplicate":
-        first_line = good.split(b"\n")[next(i for i, line in enumerate(good.split(b"\n"))
-                                            if line and not line.startswith(b"#"))]
+        first_line = good.split(b"\n")[
+            next(i for i, line in enumerate(good.split(b"\n")) if line and not line.startswith(b"#"))
+        ]
         return good + b"\n" + first_line + b"\n"
     if kind in ("huge", "nan") and numbers:
         target = numbers[data.draw(st.integers(0, len(numbers) - 1))]
-        replacement = (b"9" * data.draw(st.integers(16, 50_000)) if kind == "huge"
-                       else data.draw(st.sampled_from([b".nan", b"NaN", b".inf", b"-.inf", b"Infinity", b"1e999"])))
-        return good[:target.start()] + replacement + good[target.end():]
+        replacement = (
+            b"9" * data.draw(st.integers(16, 50_000))
+            if kind == "huge"
+            else data.draw(st.sampled_from([b".nan", b"NaN", b".inf", b"-.inf", b"Infinity", b"1e999"]))
+        )
+        return good[: target.start()] + replacement + good[target.end() :]
     chunk = data.draw(st.binary(min_size=1, max_size=40))
-    return good[:at] + chunk + good[at + len(chunk):]
+    return good[:at] + chunk + good[at + len(chunk) :]
 
 
 @pytest.mark.parametrize("loader", list(LOADERS))
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
-                                                                 HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(
+    max_examples=40,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 @given(data=st.data())
 def test_a_bad_file_is_one_line_naming_it_or_loads(tmp_path, loader, data):
     good, name, load = LOADERS[loader]
@@ -111,8 +140,9 @@ def test_a_bad_file_is_one_line_naming_it_or_loads(tmp_path, loader, data):
     except ValueError as error:  # every loader's error is a ValueError with the position first
         message = str(error)
         assert "\n" not in message, message
-        assert re.match(rf"{re.escape(str(path.name))}:\d+:\d+: \S|{re.escape(str(path))}(:\d+:\d+)?: \S",
-                        message), message
+        assert re.match(rf"{re.escape(str(path.name))}:\d+:\d+: \S|{re.escape(str(path))}(:\d+:\d+)?: \S", message), (
+            message
+        )
 
 
 @pytest.mark.parametrize("loader", list(LOADERS))

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.core.clock import SimClock, SystemClock
 from kiosk.config import DEFAULT_PIN, Config, ConfigError, load_config
+from kiosk.core.clock import SimClock, SystemClock
 
 
 def test_defaults_without_a_file(tmp_path, monkeypatch):
@@ -20,30 +20,39 @@ def test_defaults_without_a_file(tmp_path, monkeypatch):
 
 def test_file_and_environment(tmp_path):
     path = tmp_path / "config.yaml"
-    path.write_text('data_dir: data\nlanguage: es\nclinician_pin: "042042"\nadaptation: false\n'
-                    "timing: {attempt_window_s: 45}\nvosk_model: /opt/vosk\n")
+    path.write_text(
+        'data_dir: data\nlanguage: es\nclinician_pin: "042042"\nadaptation: false\n'
+        "timing: {attempt_window_s: 45}\nvosk_model: /opt/vosk\n"
+    )
     config = load_config(environ={"KIOSK_CONFIG": str(path)})
     assert config.data_dir == tmp_path / "data"  # relative to the config file
     assert (config.language, config.clinician_pin, config.adaptation) == ("es", "042042", False)
     assert config.timing == {"attempt_window_s": 45} and config.vosk_model == Path("/opt/vosk")
     assert not config.default_pin
-    env = {"KIOSK_CONFIG": str(path), "KIOSK_DATA_DIR": str(tmp_path / "elsewhere"), "KIOSK_VOSK_MODEL": "/m",
-           "KIOSK_LANGUAGE": "fr"}
+    env = {
+        "KIOSK_CONFIG": str(path),
+        "KIOSK_DATA_DIR": str(tmp_path / "elsewhere"),
+        "KIOSK_VOSK_MODEL": "/m",
+        "KIOSK_LANGUAGE": "fr",
+    }
     config = load_config(environ=env)
     assert (config.data_dir, config.vosk_model, config.language) == (tmp_path / "elsewhere", Path("/m"), "fr")
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("colour: red\n", ":1:1: unknown setting 'colour'"),
-    ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("012345")'),
-    ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 6 to 12 digits"),
-    ("adaptation: maybe\n", ":1:1: adaptation must be true or false"),
-    ("timing: {attempt_window_s: -3}\n", ":1:1: timing setting 'attempt_window_s' must be a number"),
-    ("timing: {window: 3}\n", ":1:1: unknown timing setting 'window'"),
-    ("data_dir: [1]\n", ":1:1: data_dir must be a path"),
-    ("language: en\nlanguage: es\n", ":2:1: duplicate key 'language'"),
-    ("language: [\n", ":2:1: YAML syntax"),
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("colour: red\n", ":1:1: unknown setting 'colour'"),
+        ("language: en\nclinician_pin: 1234\n", ':2:1: write the PIN in quotes ("012345")'),
+        ('clinician_pin: "12"\n', ":1:1: clinician_pin must be 6 to 12 digits"),
+        ("adaptation: maybe\n", ":1:1: adaptation must be true or false"),
+        ("timing: {attempt_window_s: -3}\n", ":1:1: timing setting 'attempt_window_s' must be a number"),
+        ("timing: {window: 3}\n", ":1:1: unknown timing setting 'window'"),
+        ("data_dir: [1]\n", ":1:1: data_dir must be a path"),
+        ("language: en\nlanguage: es\n", ":2:1: duplicate key 'language'"),
+        ("language: [\n", ":2:1: YAML syntax"),
+    ],
+)
 def test_a_bad_config_is_one_message_naming_file_line_and_column(tmp_path, text, message):
     path = tmp_path / "config.yaml"
     path.write_text(text)
@@ -105,50 +114,63 @@ def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypa
     monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
     assert load_config(environ={}).station is None  # no station: the kiosk works alone
     path = tmp_path / "config.yaml"
-    path.write_text("station: {url: 'https://ward.example:8443/', token: abc, kiosk_id: ward3-bed2}\n"
-                    "interrupt_after_minutes: 45\n")
+    path.write_text(
+        "station: {url: 'https://ward.example:8443/', token: abc, kiosk_id: ward3-bed2}\ninterrupt_after_minutes: 45\n"
+    )
     config = load_config(path, environ={})
     assert config.station is not None
     assert (config.station.url, config.station.token, config.station.kiosk_id) == (
-        "https://ward.example:8443", "abc", "ward3-bed2")
+        "https://ward.example:8443",
+        "abc",
+        "ward3-bed2",
+    )
     assert config.interrupt_after_minutes == 45
     env = {"KIOSK_STATION_URL": "http://127.0.0.1:9000", "KIOSK_STATION_TOKEN": "xyz"}
     config = load_config(path, environ=env)
     assert (config.station.url, config.station.token, config.station.kiosk_id) == (
-        "http://127.0.0.1:9000", "xyz", "ward3-bed2")
+        "http://127.0.0.1:9000",
+        "xyz",
+        "ward3-bed2",
+    )
     only_env = load_config(environ=env).station
     assert only_env is not None and only_env.kiosk_id  # the host name by default
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("station: {url: 'ftp://x', token: a}\n", ":1:16: station: url 'ftp://x' must be an http:// or https://"),
-    ("station: {url: 'http://x:1'}\n", ":1:16: station: a token is needed with the url"),
-    ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:50: station: kiosk_id 'bed 2' must be"),
-    ("station: {url: 'http://x:1', tokn: a}\n", ":1:1: station must be a mapping"),
-    ("interrupt_after_minutes: 0\n", ":1:1: interrupt_after_minutes must be a number of minutes"),
-    # ports out of range, no host, control characters in the url, the token or an id (real
-    # processes: tests/kiosk/test_hostile_config.py)
-    ("station: {url: 'http://127.0.0.1:99999', token: a}\n", ":1:16: station: url 'http://127.0.0.1:99999' needs"),
-    ("station: {url: 'http://127.0.0.1:0', token: a}\n", ":1:16: station: url 'http://127.0.0.1:0' needs a host"),
-    ("station: {url: 'http://127.0.0.1:-1', token: a}\n", ":1:16: station: url 'http://127.0.0.1:-1' needs"),
-    ("station: {url: 'https://:8443', token: a}\n", ":1:16: station: url 'https://:8443' needs a host"),
-    ("station: {url: 'http://x:8443x', token: a}\n", ":1:16: station: url 'http://x:8443x' needs a host"),
-    ('station: {url: "http://x:1\\r\\nX-Evil: 1", token: a}\n', ":1:16: station: url 'http://x:1\\r\\nX-Evil: 1' must"),
-    ('station: {url: "http://x:1\\n", token: a}\n', ":1:16: station: url 'http://x:1\\n' must be an http://"),
-    ('station: {url: "http://wärd:1", token: a}\n', ":1:16: station: url 'http://wärd:1' must be an http://"),
-    ('station:\n  url: "http://x:1"\n  token: "ab\\ncd"\n', ":3:10: station: the token is not one the station"),
-    ('station: {url: "http://x:1", token: "ab cd"}\n', ":1:37: station: the token is not one the station issues"),
-    ('station: {url: "http://x:1", token: "ab\\u0085"}\n', ":1:37: station: the token is not one the station"),
-    ('station: {url: "http://x:1", token: a, kiosk_id: "bed2\\n"}\n', ":1:50: station: kiosk_id 'bed2\\n' must be"),
-    ('kiosk_id: "ward3\\n"\n', ":1:1: kiosk_id must be 1-64 letters"),
-    ('site: "north\\n"\n', ":1:1: site must be 1-64 letters"),
-    ('fhir: {patient_system: "https://h.example/p\\n"}\n', ":1:8: fhir patient_system must be an absolute URI"),
-    ("data_dir: ~nosuchuser/x\n", ":1:1: data_dir '~nosuchuser/x': there is no user 'nosuchuser' to expand"),
-    ("questionnaire: ~nosuchuser\n", ":1:1: questionnaire '~nosuchuser': there is no user 'nosuchuser'"),
-    ('vosk_model: "/opt/vosk\\nmodel"\n', ":1:1: vosk_model '/opt/vosk\\nmodel' holds a control character"),
-    ('data_dir: "/tmp/a\\0b"\n', ":1:11: the text holds U+0000, a control character"),
-    ('language: "\\ud800"\n', ":1:11: the text holds U+D800, a lone surrogate"),
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("station: {url: 'ftp://x', token: a}\n", ":1:16: station: url 'ftp://x' must be an http:// or https://"),
+        ("station: {url: 'http://x:1'}\n", ":1:16: station: a token is needed with the url"),
+        ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:50: station: kiosk_id 'bed 2' must be"),
+        ("station: {url: 'http://x:1', tokn: a}\n", ":1:1: station must be a mapping"),
+        ("interrupt_after_minutes: 0\n", ":1:1: interrupt_after_minutes must be a number of minutes"),
+        # ports out of range, no host, control characters in the url, the token or an id (real
+        # processes: tests/kiosk/test_hostile_config.py)
+        ("station: {url: 'http://127.0.0.1:99999', token: a}\n", ":1:16: station: url 'http://127.0.0.1:99999' needs"),
+        ("station: {url: 'http://127.0.0.1:0', token: a}\n", ":1:16: station: url 'http://127.0.0.1:0' needs a host"),
+        ("station: {url: 'http://127.0.0.1:-1', token: a}\n", ":1:16: station: url 'http://127.0.0.1:-1' needs"),
+        ("station: {url: 'https://:8443', token: a}\n", ":1:16: station: url 'https://:8443' needs a host"),
+        ("station: {url: 'http://x:8443x', token: a}\n", ":1:16: station: url 'http://x:8443x' needs a host"),
+        (
+            'station: {url: "http://x:1\\r\\nX-Evil: 1", token: a}\n',
+            ":1:16: station: url 'http://x:1\\r\\nX-Evil: 1' must",
+        ),
+        ('station: {url: "http://x:1\\n", token: a}\n', ":1:16: station: url 'http://x:1\\n' must be an http://"),
+        ('station: {url: "http://wärd:1", token: a}\n', ":1:16: station: url 'http://wärd:1' must be an http://"),
+        ('station:\n  url: "http://x:1"\n  token: "ab\\ncd"\n', ":3:10: station: the token is not one the station"),
+        ('station: {url: "http://x:1", token: "ab cd"}\n', ":1:37: station: the token is not one the station issues"),
+        ('station: {url: "http://x:1", token: "ab\\u0085"}\n', ":1:37: station: the token is not one the station"),
+        ('station: {url: "http://x:1", token: a, kiosk_id: "bed2\\n"}\n', ":1:50: station: kiosk_id 'bed2\\n' must be"),
+        ('kiosk_id: "ward3\\n"\n', ":1:1: kiosk_id must be 1-64 letters"),
+        ('site: "north\\n"\n', ":1:1: site must be 1-64 letters"),
+        ('fhir: {patient_system: "https://h.example/p\\n"}\n', ":1:8: fhir patient_system must be an absolute URI"),
+        ("data_dir: ~nosuchuser/x\n", ":1:1: data_dir '~nosuchuser/x': there is no user 'nosuchuser' to expand"),
+        ("questionnaire: ~nosuchuser\n", ":1:1: questionnaire '~nosuchuser': there is no user 'nosuchuser'"),
+        ('vosk_model: "/opt/vosk\\nmodel"\n', ":1:1: vosk_model '/opt/vosk\\nmodel' holds a control character"),
+        ('data_dir: "/tmp/a\\0b"\n', ":1:11: the text holds U+0000, a control character"),
+        ('language: "\\ud800"\n', ":1:11: the text holds U+D800, a lone surrogate"),
+    ],
+)
 def test_bad_station_settings_say_where(tmp_path, text, message):
     path = tmp_path / "config.yaml"
     path.write_text(text)

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from qos import Engine, parse_model
 
-HEAD = ("roqme M\nproperty P\ncontext B : boolean\ncontext C : boolean\ncontext N : number\n"
-        "context E : eventtype\ncontext S : enum {ON, OFF}\n")
+HEAD = (
+    "roqme M\nproperty P\ncontext B : boolean\ncontext C : boolean\ncontext N : number\n"
+    "context E : eventtype\ncontext S : enum {ON, OFF}\n"
+)
 
 
 def engine_for(body: str, head: str = HEAD, **options) -> Engine:

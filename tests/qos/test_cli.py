@@ -57,13 +57,22 @@ def test_plot_replaces_a_world_readable_png_with_an_owner_only_one(tmp_path):
     assert target.stat().st_mode & 0o777 == 0o600 and target.read_bytes()[:4] == b"\x89PNG"
 
 
-@pytest.mark.parametrize(("trace", "model", "message"), [
-    ("model: clarc\nevents:\n  - {t: 1, set: {Mood: happy}}\n", None,
-     "python -m qos replay: {dir}/t.yaml: events[0]: context 'Mood' is not in model CLARC"),
-    ("model: broken.roqme\nevents: []\n", "roqme B\nproperty P survival 10\n",
-     "python -m qos replay: broken.roqme:2:21: expected a time such as 100min, 30 seconds or 2 hours after 'survival', "
-     "found '10'"),
-])
+@pytest.mark.parametrize(
+    ("trace", "model", "message"),
+    [
+        (
+            "model: clarc\nevents:\n  - {t: 1, set: {Mood: happy}}\n",
+            None,
+            "python -m qos replay: {dir}/t.yaml: events[0]: context 'Mood' is not in model CLARC",
+        ),
+        (
+            "model: broken.roqme\nevents: []\n",
+            "roqme B\nproperty P survival 10\n",
+            "python -m qos replay: broken.roqme:2:21: expected a time such as 100min, 30 seconds or 2 hours after 'survival', "
+            "found '10'",
+        ),
+    ],
+)
 def test_bad_trace_or_model_exits_2_with_one_line(tmp_path, trace, model, message):
     (tmp_path / "t.yaml").write_text(trace, encoding="utf-8")
     if model:
@@ -77,8 +86,11 @@ def test_a_sample_period_too_small_for_the_trace_is_one_line_not_an_endless_repl
     # TABLE4 lasts 1000 s: 1e-7 s would be 10 billion samples (before the cap: an endless replay)
     assert main(["replay", str(TABLE4), "--sample-period", "1e-7"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"python -m qos replay: {TABLE4}: a sample period of 1e-07 s over the trace's ") and \
-        "(at most 100,000); use a longer sample period\n" in err and err.count("\n") == 1
+    assert (
+        err.startswith(f"python -m qos replay: {TABLE4}: a sample period of 1e-07 s over the trace's ")
+        and "(at most 100,000); use a longer sample period\n" in err
+        and err.count("\n") == 1
+    )
 
 
 def test_bad_arguments_exit_2(capsys):
@@ -109,8 +121,9 @@ def test_kiosk_qos_trace_prints_a_stored_sessions_trace_that_replays_to_its_metr
 @pytest.mark.parametrize("command", [["-m", "qos"], ["-m", "kiosk", "qos"]])
 def test_a_reader_closing_the_pipe_early_is_not_an_error(command):
     """`… | head -c 0`: the reader is gone before anything is written; no traceback, exit 0."""
-    child = subprocess.Popen([sys.executable, *command, "replay", str(TABLE4)],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+    child = subprocess.Popen(
+        [sys.executable, *command, "replay", str(TABLE4)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT
+    )
     child.stdout.close()
     assert child.wait(timeout=60) == 0
     assert child.stderr.read() == b""
@@ -122,8 +135,9 @@ def test_check_says_what_a_model_holds_or_where_it_is_wrong(tmp_path, capsys):
     assert out.startswith("model KioskPace: OK\n")
     assert "derived contexts: Answered, AnswerTime, SlowStreak, Slowing, AnswersPerFiveMinutes" in out
     assert "timers: Silence" in out and "imports: clarc.roqme" in out
-    (tmp_path / "bad.roqme").write_text("roqme X\nproperty P\ncontext A : boolean\nobservation O : A reinforces Q\n",
-                                        encoding="utf-8")
+    (tmp_path / "bad.roqme").write_text(
+        "roqme X\nproperty P\ncontext A : boolean\nobservation O : A reinforces Q\n", encoding="utf-8"
+    )
     done = run("-m", "kiosk", "qos", "check", str(tmp_path / "bad.roqme"))
     assert (done.returncode, done.stdout) == (2, "")
     assert done.stderr == "kiosk qos check: bad.roqme:4:30: observation O reinforces unknown property Q\n"

@@ -75,28 +75,40 @@ def test_long_runs_keep_a_bounded_state():
 
 
 def test_reference_is_clamped_and_no_survival_means_no_decay():
-    model = parse_model("roqme M\nproperty Hi reference 1\nproperty Lo reference 0\ncontext B : boolean\n"
-                        "observation O1 : B undermines Hi veryhigh\nobservation O2 : B reinforces Lo veryhigh\n")
+    model = parse_model(
+        "roqme M\nproperty Hi reference 1\nproperty Lo reference 0\ncontext B : boolean\n"
+        "observation O1 : B undermines Hi veryhigh\nobservation O2 : B reinforces Lo veryhigh\n"
+    )
     engine = Engine(model)
     assert engine.metrics(0) == {"Hi": 0.99, "Lo": 0.01}
     after = engine.update(0, set={"B": True}).metrics
     assert after["Hi"] == pytest.approx(0.99 * 0.1 / (0.99 * 0.1 + 0.01 * 1))  # odds 99 × LR 0.1
-    assert engine.metrics(10 ** 9) == after
+    assert engine.metrics(10**9) == after
 
 
 BAD_BATCHES = [
     (dict(set={"Nope": True}), "context 'Nope' is not in model CLARC"),
     (dict(set={"PersonDetected": "yes"}), "context PersonDetected is boolean, got 'yes' (str)"),
     (dict(set={"PersonDetected": 1}), "context PersonDetected is boolean, got 1 (int)"),
-    (dict(set={"TestState": "STOPPED"}),
-     "context TestState has no literal 'STOPPED' (expected one of IDLE, STARTED, PAUSED, RESTARTED, REPEATING, FINISHED)"),
-    (dict(set={"TestState": "UserInteraction::PAUSED"}), "context TestState is of type TestState, got 'UserInteraction::PAUSED'"),
-    (dict(set={"TestState": 3}),
-     "context TestState is an enum of IDLE, STARTED, PAUSED, RESTARTED, REPEATING, FINISHED; got 3 (int)"),
+    (
+        dict(set={"TestState": "STOPPED"}),
+        "context TestState has no literal 'STOPPED' (expected one of IDLE, STARTED, PAUSED, RESTARTED, REPEATING, FINISHED)",
+    ),
+    (
+        dict(set={"TestState": "UserInteraction::PAUSED"}),
+        "context TestState is of type TestState, got 'UserInteraction::PAUSED'",
+    ),
+    (
+        dict(set={"TestState": 3}),
+        "context TestState is an enum of IDLE, STARTED, PAUSED, RESTARTED, REPEATING, FINISHED; got 3 (int)",
+    ),
     (dict(set={"CallingDoctor": True}), "context CallingDoctor is an eventtype: emit it, do not set it"),
     (dict(emit=["PersonDetected"]), "context PersonDetected is boolean, not an eventtype: set it, do not emit it"),
     (dict(emit="CallingDoctor"), "'emit' must be a list of eventtype names, not 'CallingDoctor' (str)"),
-    (dict(set=[("PersonDetected", True)]), "'set' must map context names to values, not [('PersonDetected', True)] (list)"),
+    (
+        dict(set=[("PersonDetected", True)]),
+        "'set' must map context names to values, not [('PersonDetected', True)] (list)",
+    ),
 ]
 
 
@@ -109,8 +121,13 @@ def test_a_bad_batch_is_rejected_whole_and_changes_nothing(batch, message):
     engine.subscribe(seen.append)
     # the valid part of the batch is not applied either
     with pytest.raises(ContextError) as caught:
-        engine.update(6, set={"FirstAttemptAnswered": True, **batch.get("set", {})}
-                      if isinstance(batch.get("set", {}), dict) else batch["set"], emit=batch.get("emit"))
+        engine.update(
+            6,
+            set={"FirstAttemptAnswered": True, **batch.get("set", {})}
+            if isinstance(batch.get("set", {}), dict)
+            else batch["set"],
+            emit=batch.get("emit"),
+        )
     assert str(caught.value) == message
     assert isinstance(caught.value, ValueError)
     assert (engine.t, engine.contexts, engine.metrics(5)) == before and seen == []
@@ -151,14 +168,19 @@ def test_engines_of_one_model_are_independent():
 def _clarc_batches():
     from hypothesis import strategies as st
 
-    values = {name: (st.booleans() if context.kind == "boolean" else st.sampled_from(context.literals))
-              for name, context in CLARC.contexts.items() if context.kind != "eventtype"}
-    batch = st.tuples(st.floats(0, 60), st.dictionaries(st.sampled_from(sorted(values)), st.none(), max_size=4),
-                      st.booleans())
+    values = {
+        name: (st.booleans() if context.kind == "boolean" else st.sampled_from(context.literals))
+        for name, context in CLARC.contexts.items()
+        if context.kind != "eventtype"
+    }
+    batch = st.tuples(
+        st.floats(0, 60), st.dictionaries(st.sampled_from(sorted(values)), st.none(), max_size=4), st.booleans()
+    )
     return st.lists(batch, max_size=25).flatmap(
-        lambda batches: st.tuples(*[st.fixed_dictionaries({name: values[name] for name in chosen})
-                                    for _, chosen, _ in batches]).map(
-            lambda sets: [(gap, chosen, doctor) for (gap, _, doctor), chosen in zip(batches, sets)]))
+        lambda batches: st.tuples(
+            *[st.fixed_dictionaries({name: values[name] for name in chosen}) for _, chosen, _ in batches]
+        ).map(lambda sets: [(gap, chosen, doctor) for (gap, _, doctor), chosen in zip(batches, sets)])
+    )
 
 
 def test_any_valid_session_keeps_metrics_in_range_and_replays_identically():

@@ -42,11 +42,15 @@ def test_the_replay_reports_belief_variables_apart_from_the_published_properties
 
 
 def test_the_example_replays_identically_from_python_and_from_the_shell():
-    done = subprocess.run([sys.executable, "-m", "qos", "replay", str(SLOW_PATIENT), "--json"],
-                          capture_output=True, text=True, cwd=ROOT)
+    done = subprocess.run(
+        [sys.executable, "-m", "qos", "replay", str(SLOW_PATIENT), "--json"], capture_output=True, text=True, cwd=ROOT
+    )
     assert done.returncode == 0 and done.stderr == ""
-    assert json.loads(done.stdout) == json.loads(json.dumps(replay(SLOW_PATIENT))) == \
-        json.loads(json.dumps(replay(SLOW_PATIENT)))
+    assert (
+        json.loads(done.stdout)
+        == json.loads(json.dumps(replay(SLOW_PATIENT)))
+        == json.loads(json.dumps(replay(SLOW_PATIENT)))
+    )
 
 
 def test_silence_and_slow_answers_lower_the_metrics_they_should():

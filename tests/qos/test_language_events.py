@@ -33,14 +33,20 @@ def test_roqme_precedence_postfix_operators_take_the_whole_sequence():
     # RoQME: `E -> B while(C)` is `(E -> B) while(C)`: C must hold when the sequence completes... and at E
     batches = [(0, {"C": False}, ["E"]), (1, {"B": True, "C": True}), (2, {}, ["E"]), (3, {"B": True})]
     assert times(run("observation O : E -> B while(C) reinforces P\n", batches)) == [3]
-    assert times(run("observation O : once E -> B reinforces P\n",
-                     [(0, {}, ["E"]), (1, {"B": True}), (2, {}, ["E"]), (3, {"B": True})])) == [1]
+    assert times(
+        run(
+            "observation O : once E -> B reinforces P\n",
+            [(0, {}, ["E"]), (1, {"B": True}), (2, {}, ["E"]), (3, {"B": True})],
+        )
+    ) == [1]
 
 
 def test_an_action_block_runs_every_action_with_its_own_strength_and_survival():
-    body = ("property Q survival 100 minutes\nbeliefvar F reference 0.2\n"
-            "observation O : B { reinforces P high survival 1 minutes; undermines Q medium; reinforces F veryhigh }\n"
-            "observation Clear : E clears P\n")
+    body = (
+        "property Q survival 100 minutes\nbeliefvar F reference 0.2\n"
+        "observation O : B { reinforces P high survival 1 minutes; undermines Q medium; reinforces F veryhigh }\n"
+        "observation Clear : E clears P\n"
+    )
     engine = engine_for(body)
     result = engine.update(0, set={"B": True})
     assert result.metrics["P"] == pytest.approx(1 / 1.3)  # LR 0.3
@@ -53,9 +59,12 @@ def test_an_action_block_runs_every_action_with_its_own_strength_and_survival():
 
 
 def test_time_words_and_medium_strength():
-    model = parse_model("roqme M\nproperty A survival 2 hours\nproperty B survival 1 day\nproperty C survival 90 seconds\n"
-                        "property D survival 250 milliseconds\nproperty E survival 3 minute\ncontext X : eventtype\n"
-                        "observation O : X reinforces A medium\n", "m.roqme")
+    model = parse_model(
+        "roqme M\nproperty A survival 2 hours\nproperty B survival 1 day\nproperty C survival 90 seconds\n"
+        "property D survival 250 milliseconds\nproperty E survival 3 minute\ncontext X : eventtype\n"
+        "observation O : X reinforces A medium\n",
+        "m.roqme",
+    )
     assert [model.properties[name].survival for name in "ABCDE"] == [7200, 86400, 90, 0.25, 180]
     assert model.observations["O"].likelihood_ratio == 0.5
 
@@ -71,9 +80,11 @@ def test_an_interval_timer_fires_on_the_engines_clock_before_a_later_update():
 
 
 def test_onetime_offset_and_paused_timers_with_starts_stops_resumes():
-    body = ("timer Idle := 60 seconds onetime paused\ntimer Late := 10 seconds offset 5 seconds onetime\n"
-            "observation Ask : E starts Idle\nobservation Hold : B stops Idle\nobservation Go : C resumes Idle\n"
-            "observation O : Idle reinforces P\nobservation L : Late reinforces P\n")
+    body = (
+        "timer Idle := 60 seconds onetime paused\ntimer Late := 10 seconds offset 5 seconds onetime\n"
+        "observation Ask : E starts Idle\nobservation Hold : B stops Idle\nobservation Go : C resumes Idle\n"
+        "observation O : Idle reinforces P\nobservation L : Late reinforces P\n"
+    )
     fired = run(body, [(100, {}, ["E"]), (130, {"B": True}), (200, {"C": True}), (300, {}, ["E"])], until=1000)
     assert times(fired, "L") == [15]  # 10 s + the 5 s offset, once
     # started at 100, stopped at 130 with 30 s left, resumed at 200: due at 230; restarted at 300: 360
@@ -88,8 +99,10 @@ def test_a_timer_due_at_an_update_joins_its_batch():
 
 def test_a_scheduled_timer_fires_at_calendar_times_from_the_origin():
     origin = datetime(2026, 11, 23, 8, 0, tzinfo=timezone.utc).timestamp()  # a Monday
-    body = 'timer Morning := schedule("30, 9, *, *, [1, 2]")\ntimer Often := schedule("*/20, *, *, *, *")\n' \
-           "observation O : Morning reinforces P\nobservation F : Often reinforces P\n"
+    body = (
+        'timer Morning := schedule("30, 9, *, *, [1, 2]")\ntimer Often := schedule("*/20, *, *, *, *")\n'
+        "observation O : Morning reinforces P\nobservation F : Often reinforces P\n"
+    )
     fired = run(body, [], until=2 * 86400, origin=origin)
     assert times(fired, "O") == [5400, 5400 + 86400]  # 09:30 on Monday and Tuesday
     assert times(fired, "F")[:3] == [1200, 2400, 3600]
@@ -105,9 +118,11 @@ def test_timers_are_patterns_not_values():
 
 
 def test_descriptions_are_attached_to_what_they_precede():
-    model = parse_model("/** The kiosk's pace.\n *  Second line. */\nroqme M\n/** how well it goes */\nproperty P\n"
-                        "/* an ordinary comment */\ncontext B : boolean\n/** slow */ observation O : B reinforces P\n",
-                        "m.roqme")
+    model = parse_model(
+        "/** The kiosk's pace.\n *  Second line. */\nroqme M\n/** how well it goes */\nproperty P\n"
+        "/* an ordinary comment */\ncontext B : boolean\n/** slow */ observation O : B reinforces P\n",
+        "m.roqme",
+    )
     assert model.description == "The kiosk's pace.\nSecond line."
     assert (model.properties["P"].description, model.contexts["B"].description) == ("how well it goes", None)
     assert model.observations["O"].description == "slow"
@@ -115,8 +130,9 @@ def test_descriptions_are_attached_to_what_they_precede():
 
 def test_import_merges_another_model_and_reports_errors_in_that_file(tmp_path):
     (tmp_path / "base.roqme").write_text("roqme Base\nproperty P\ncontext B : boolean\n", encoding="utf-8")
-    (tmp_path / "top.roqme").write_text('roqme Top\nimport "base.roqme"\nobservation O : B reinforces P\n',
-                                        encoding="utf-8")
+    (tmp_path / "top.roqme").write_text(
+        'roqme Top\nimport "base.roqme"\nobservation O : B reinforces P\n', encoding="utf-8"
+    )
     model = load_model(tmp_path / "top.roqme")
     assert (model.name, list(model.properties), list(model.observations)) == ("Top", ["P"], ["O"])
     (tmp_path / "base.roqme").write_text("roqme Base\nproperty P\ncontext B : bool\n", encoding="utf-8")
@@ -139,16 +155,19 @@ def test_a_jump_that_would_fire_a_timer_too_often_is_refused_before_anything_run
     with pytest.raises(ContextError, match="time 1e\\+07 s is too far ahead: the timers would fire about"):
         engine.update(1e7, set={"B": True})
     assert engine.t is None
-    (tmp_path / "m.roqme").write_text("roqme M\nproperty P\ntimer T := 1 milliseconds\nobservation O : T reinforces P\n",
-                                      encoding="utf-8")
+    (tmp_path / "m.roqme").write_text(
+        "roqme M\nproperty P\ntimer T := 1 milliseconds\nobservation O : T reinforces P\n", encoding="utf-8"
+    )
     (tmp_path / "t.yaml").write_text("model: m.roqme\nevents:\n  - {t: 5000, set: {}}\n", encoding="utf-8")
     with pytest.raises(TraceError, match="the model's timers would fire about 5,000,000 times over the trace's 5000 s"):
         replay(tmp_path / "t.yaml")
 
 
 def test_postfix_forms_of_update_event_when_and_period():
-    body = ("observation O : N'update reinforces P\nobservation Q : B'eventWhen reinforces P\n"
-            "observation R : N'period > 1 reinforces P\n")
+    body = (
+        "observation O : N'update reinforces P\nobservation Q : B'eventWhen reinforces P\n"
+        "observation R : N'period > 1 reinforces P\n"
+    )
     fired = run(body, [(0, {"N": 1}), (1, {"B": True}), (5, {"N": 2}), (6, {"N": 2})])
     assert (times(fired, "O"), times(fired, "Q"), times(fired, "R")) == ([0, 5, 6], [1], [5])
     with pytest.raises(ModelError, match=r"m\.roqme:8:17: the pattern operator 'update' cannot be used in a value"):
@@ -159,13 +178,16 @@ def test_timers_start_with_the_session_so_a_recorded_trace_replays_them_exactly(
     from qos import Engine, TraceRecorder, dump_trace
 
     model_path = tmp_path / "m.roqme"
-    model_path.write_text(HEAD + "timer T := 10 seconds\nobservation O : T reinforces P\nobservation Q : B reinforces P\n",
-                          encoding="utf-8")
+    model_path.write_text(
+        HEAD + "timer T := 10 seconds\nobservation O : T reinforces P\nobservation Q : B reinforces P\n",
+        encoding="utf-8",
+    )
     live = Engine(load_model(model_path))
     recorder = TraceRecorder(live, "m.roqme")
     live_fired = []
-    live.subscribe(lambda result: live_fired.append({"t": result.t, "observations": result.fired})
-                   if result.fired else None)
+    live.subscribe(
+        lambda result: live_fired.append({"t": result.t, "observations": result.fired}) if result.fired else None
+    )
     live.update(3.5, set={"B": True})  # the patient starts a few seconds into the session
     live.update(27, set={"B": True})
     assert [entry["t"] for entry in live_fired] == [3.5, 10, 20, 27]
@@ -175,8 +197,9 @@ def test_timers_start_with_the_session_so_a_recorded_trace_replays_them_exactly(
 
 
 def test_a_traces_origin_places_scheduled_timers_on_the_calendar(tmp_path):
-    (tmp_path / "m.roqme").write_text(HEAD + 'timer Nine := schedule("0, 9, *, *, *")\nobservation O : Nine reinforces P\n',
-                                      encoding="utf-8")
+    (tmp_path / "m.roqme").write_text(
+        HEAD + 'timer Nine := schedule("0, 9, *, *, *")\nobservation O : Nine reinforces P\n', encoding="utf-8"
+    )
     trace = "model: m.roqme\norigin: {origin}\nevents:\n  - {{t: 7200, set: {{B: true}}}}\n"
     (tmp_path / "t.yaml").write_text(trace.format(origin="2026-11-23T08:00:00Z"), encoding="utf-8")
     assert replay(tmp_path / "t.yaml")["fired"] == [{"t": 3600, "observations": ["O"]}]  # 09:00

@@ -6,8 +6,10 @@ import pytest
 
 from qos import Engine, parse_model
 
-HEAD = ("roqme M\nproperty P\ncontext B : boolean\ncontext C : boolean\ncontext N : number\n"
-        "context E : eventtype\ncontext S : enum {ON, OFF, IDLE}\n")
+HEAD = (
+    "roqme M\nproperty P\ncontext B : boolean\ncontext C : boolean\ncontext N : number\n"
+    "context E : eventtype\ncontext S : enum {ON, OFF, IDLE}\n"
+)
 
 
 def fires(pattern: str, batches: list[dict]) -> list[int]:
@@ -115,21 +117,30 @@ def test_an_observation_fires_at_most_once_per_batch_and_each_call_is_a_batch():
 
 
 def test_enum_literals_of_named_types():
-    model = parse_model("roqme M\nproperty P\ntype Level : enum {LOW, HIGH}\ncontext L : Level\n"
-                        "observation O : eventWhen(L = Level::HIGH) reinforces P\n")
+    model = parse_model(
+        "roqme M\nproperty P\ntype Level : enum {LOW, HIGH}\ncontext L : Level\n"
+        "observation O : eventWhen(L = Level::HIGH) reinforces P\n"
+    )
     engine = Engine(model)
     assert model.contexts["L"].literals == ("LOW", "HIGH")
     assert engine.update(1, set={"L": "LOW"}).fired == []
     assert engine.update(2, set={"L": "Level::HIGH"}).fired == ["O"]
 
 
-@pytest.mark.parametrize(("batches", "expected"), [
-    ([{"FirstAttemptAnswered": False}, {"FirstAttemptAnswered": False}], [["O6", "O11"], ["O6", "O11"]]),
-    ([{"PersonDetected": True}, {"PersonDetected": False}, {"PersonDetected": False}],
-     [["O2", "O8"], ["O6", "O11"], []]),
-    ([{"TestState": "PAUSED"}, {"TestState": "RESTARTED"}, {"TestState": "RESTARTED"}],
-     [["O4", "O11"], ["O3", "O12"], []]),
-])
+@pytest.mark.parametrize(
+    ("batches", "expected"),
+    [
+        ([{"FirstAttemptAnswered": False}, {"FirstAttemptAnswered": False}], [["O6", "O11"], ["O6", "O11"]]),
+        (
+            [{"PersonDetected": True}, {"PersonDetected": False}, {"PersonDetected": False}],
+            [["O2", "O8"], ["O6", "O11"], []],
+        ),
+        (
+            [{"TestState": "PAUSED"}, {"TestState": "RESTARTED"}, {"TestState": "RESTARTED"}],
+            [["O4", "O11"], ["O3", "O12"], []],
+        ),
+    ],
+)
 def test_clarc_reads_updated_to_per_update_and_becomes_per_change(batches, expected):
     from qos import load_model
 

@@ -21,9 +21,12 @@ PROPERTIES = ("Performance", "Interaction", "VoiceInteractionQuality")
 
 def differences(result: dict, session: str) -> dict[str, dict[str, float]]:
     """property -> statistic -> ours minus the paper's (Table 3)."""
-    return {prop: {key: result["metrics"][prop][key] - expected
-                   for key, expected in PAPER["statistics"][session][prop].items()}
-            for prop in PROPERTIES}
+    return {
+        prop: {
+            key: result["metrics"][prop][key] - expected for key, expected in PAPER["statistics"][session][prop].items()
+        }
+        for prop in PROPERTIES
+    }
 
 
 def test_committed_traces_are_what_make_traces_writes():

@@ -79,9 +79,13 @@ def start_station(db_url: str, log: Path, port: int | None = None, args: tuple[s
     port = port or free_port()
     env = os.environ | {"PYTHONUNBUFFERED": "1"}
     with open(log, "ab") as out:
-        process = subprocess.Popen([sys.executable, "-m", "kiosk", "station", "--db", db_url, "--port", str(port),
-                                    *args],
-                                   stdout=out, stderr=subprocess.STDOUT, cwd=ROOT, env=env)
+        process = subprocess.Popen(
+            [sys.executable, "-m", "kiosk", "station", "--db", db_url, "--port", str(port), *args],
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            cwd=ROOT,
+            env=env,
+        )
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + PATIENCE_S
     while True:
@@ -164,7 +168,16 @@ def browser(chromium: str) -> Iterator:
     with sync_playwright() as playwright:
         chromium = playwright.chromium.launch(
             executable_path=chromium,
-            args=["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync"])
+            args=[
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-quic",
+                "--no-first-run",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+            ],
+        )
         yield chromium
         chromium.close()

@@ -19,8 +19,9 @@ class Staff:
     def __init__(self, url: str, name: str = "dr.lopez", role: str = "doctor") -> None:
         self.http = httpx.Client(base_url=url, timeout=30)
         page = self.http.get("/login")
-        response = self.http.post("/login", data={"csrf": self.csrf(page.text), "name": name,
-                                                  "password": PASSWORDS[role], "next": "/"})
+        response = self.http.post(
+            "/login", data={"csrf": self.csrf(page.text), "name": name, "password": PASSWORDS[role], "next": "/"}
+        )
         assert response.status_code == 303, response.text
 
     @staticmethod

@@ -22,16 +22,26 @@ pytestmark = pytest.mark.slow
 
 
 def kiosk_station(*args: str, env: dict | None = None, stdin: str | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "kiosk", "station", *args], cwd=ROOT, capture_output=True,
-                          text=True, env=os.environ | (env or {}), input=stdin, timeout=PATIENCE_S * 2)
+    return subprocess.run(
+        [sys.executable, "-m", "kiosk", "station", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=os.environ | (env or {}),
+        input=stdin,
+        timeout=PATIENCE_S * 2,
+    )
 
 
-@pytest.mark.parametrize("argv, words", [
-    (["--host", "0.0.0.0"], "without encryption"),
-    (["--host", "192.168.1.20", "--tls-cert", "cert.pem"], "both --tls-cert and --tls-key"),
-    (["--port", "70000"], "--port 70000"),
-    (["--db", "postgresql://nobody@127.0.0.1:1/none"], "cannot open the station database"),
-])
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["--host", "0.0.0.0"], "without encryption"),
+        (["--host", "192.168.1.20", "--tls-cert", "cert.pem"], "both --tls-cert and --tls-key"),
+        (["--port", "70000"], "--port 70000"),
+        (["--db", "postgresql://nobody@127.0.0.1:1/none"], "cannot open the station database"),
+    ],
+)
 def test_mistakes_are_one_line_and_exit_2(argv, words, tmp_path):
     done = kiosk_station(*argv, env={"KIOSK_STATION_DIR": str(tmp_path / "data")})
     assert done.returncode == 2
@@ -44,8 +54,10 @@ def test_admin_commands_keep_the_default_database_private(tmp_path):
     password = tmp_path / "pw"
     password.write_text("a-doctor-password\n")
     env = {"KIOSK_STATION_DIR": str(home)}
-    assert kiosk_station("add-user", "dr.lopez", "--role", "doctor", "--password-file", str(password),
-                         env=env).returncode == 0
+    assert (
+        kiosk_station("add-user", "dr.lopez", "--role", "doctor", "--password-file", str(password), env=env).returncode
+        == 0
+    )
     added = kiosk_station("add-kiosk", "ward3-bed2", env=env)
     assert added.returncode == 0
     token = added.stdout.strip().splitlines()[-1]
@@ -69,13 +81,50 @@ def test_admin_commands_keep_the_default_database_private(tmp_path):
 @pytest.mark.skipif(shutil.which("openssl") is None, reason="openssl makes the test certificate")
 def test_tls_options_serve_https_on_a_lan_address(tmp_path):
     cert, key = tmp_path / "cert.pem", tmp_path / "key.pem"
-    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1", "-subj", "/CN=127.0.0.1",
-                    "-addext", "subjectAltName=IP:127.0.0.1", "-keyout", str(key), "-out", str(cert)],
-                   check=True, capture_output=True)
+    subprocess.run(
+        [
+            "openssl",
+            "req",
+            "-x509",
+            "-newkey",
+            "rsa:2048",
+            "-nodes",
+            "-days",
+            "1",
+            "-subj",
+            "/CN=127.0.0.1",
+            "-addext",
+            "subjectAltName=IP:127.0.0.1",
+            "-keyout",
+            str(key),
+            "-out",
+            str(cert),
+        ],
+        check=True,
+        capture_output=True,
+    )
     port = free_port()
-    process = subprocess.Popen([sys.executable, "-m", "kiosk", "station", "--db", db.sqlite_url(tmp_path / "d"),
-                                "--host", "127.0.0.1", "--port", str(port), "--tls-cert", str(cert),
-                                "--tls-key", str(key)], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "kiosk",
+            "station",
+            "--db",
+            db.sqlite_url(tmp_path / "d"),
+            "--host",
+            "127.0.0.1",
+            "--port",
+            str(port),
+            "--tls-cert",
+            str(cert),
+            "--tls-key",
+            str(key),
+        ],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+    )
     try:
         context = ssl.create_default_context(cafile=str(cert))
         banner = process.stdout.readline().decode()

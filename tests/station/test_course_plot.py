@@ -11,9 +11,23 @@ from station.results import Result
 
 
 def visit(day: int, total: int | None, review: str = "signed_off") -> Result:
-    return Result(f"s{day}", "bed1", "NHC-1", "barthel", f"2026-0{day}-01T10:00:00+00:00",
-                  f"2026-0{day}-01T10:20:00+00:00", "finished", total, 100, total is not None,
-                  "moderate" if total else None, review, False, "order", None)
+    return Result(
+        f"s{day}",
+        "bed1",
+        "NHC-1",
+        "barthel",
+        f"2026-0{day}-01T10:00:00+00:00",
+        f"2026-0{day}-01T10:20:00+00:00",
+        "finished",
+        total,
+        100,
+        total is not None,
+        "moderate" if total else None,
+        review,
+        False,
+        "order",
+        None,
+    )
 
 
 def test_totals_are_steps_and_unsigned_results_hollow():

@@ -11,8 +11,8 @@ import sqlalchemy as sa
 from alembic import command
 from alembic.config import Config
 
-from kiosk.core.questionnaire.definition import canonical, digest
 from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.questionnaire.definition import canonical, digest
 from station import auth, db
 from tests.station.conftest import PASSWORDS
 from tests.station.helpers import PATIENTS, KioskClient, Row, Staff, record_patient, response_in
@@ -22,6 +22,7 @@ def rows_answer(rows: list, **changes) -> dict:
     """The session's feeding answer with some fields changed (replacing it, as a later row does)."""
     answer = next(r.payload for r in rows if r.kind == "record_answer" and r.payload["item_id"] == "feeding")
     return answer | changes
+
 
 pytestmark = pytest.mark.slow
 
@@ -43,26 +44,37 @@ def test_old_sessions_get_the_bundled_definition_marked_attached_later(engine_na
     rows = record_patient(PATIENTS / "barthel4.yaml")
     session_id = rows[0].session_id
     # and odd rows a station stored before it checked them: option 99, an unknown item, a time as text
-    rows = rows + [Row(900 + n, kind, session_id, payload, 0.0, "2026-01-01T00:20:00Z") for n, (kind, payload) in
-                   enumerate([("record_answer", rows_answer(rows, option=99, points=99)),
-                              ("record_answer", rows_answer(rows, item_id="swimming")),
-                              ("record_event", {"t": "soon", "kind": "note", "detail": "odd"})])]
+    rows = rows + [
+        Row(900 + n, kind, session_id, payload, 0.0, "2026-01-01T00:20:00Z")
+        for n, (kind, payload) in enumerate(
+            [
+                ("record_answer", rows_answer(rows, option=99, points=99)),
+                ("record_answer", rows_answer(rows, item_id="swimming")),
+                ("record_event", {"t": "soon", "kind": "note", "detail": "odd"}),
+            ]
+        )
+    ]
     with engine.begin() as connection:  # what a station before 0003 stored: no definition anywhere
-        connection.execute(sa.text("INSERT INTO sessions (id, kiosk_id, patient_id, started_at, status, updated_at)"
-                                   " VALUES (:id, 'old-kiosk', :patient, :started, 'finished', 0)"),
-                           {"id": session_id, "patient": rows[0].payload["patient_id"],
-                            "started": rows[0].payload["started_at"]})
+        connection.execute(
+            sa.text(
+                "INSERT INTO sessions (id, kiosk_id, patient_id, started_at, status, updated_at)"
+                " VALUES (:id, 'old-kiosk', :patient, :started, 'finished', 0)"
+            ),
+            {"id": session_id, "patient": rows[0].payload["patient_id"], "started": rows[0].payload["started_at"]},
+        )
         for row in rows:
             payload = {k: v for k, v in row.payload.items() if not k.startswith("definition")}
-            connection.execute(sa.text("INSERT INTO inbox VALUES ('old-kiosk', :seq, :kind, :session, :payload, :at, 0)"),
-                               {"seq": row.seq, "kind": row.kind, "session": session_id,
-                                "payload": json.dumps(payload), "at": row.at})
+            connection.execute(
+                sa.text("INSERT INTO inbox VALUES ('old-kiosk', :seq, :kind, :session, :payload, :at, 0)"),
+                {"seq": row.seq, "kind": row.kind, "session": session_id, "payload": json.dumps(payload), "at": row.at},
+            )
     engine.dispose()
     engine = db.open_database(url)  # upgrades to head
     bundled = canonical(load_questionnaire())
     with engine.connect() as connection:
-        found = connection.execute(sa.select(db.sessions.c.definition_sha256, db.sessions.c.definition_attached_later)
-                                   ).one()
+        found = connection.execute(
+            sa.select(db.sessions.c.definition_sha256, db.sessions.c.definition_attached_later)
+        ).one()
         bodies = connection.execute(sa.select(db.definitions.c.sha256, db.definitions.c.body)).all()
     assert tuple(found) == (digest(bundled), True)
     assert [(sha, json.loads(body)) for sha, body in bodies] == [(digest(bundled), bundled)]

@@ -58,9 +58,15 @@ def test_a_hostile_session_id_downloads_under_a_safe_name(shared_station):
     recorded = record_patient(PATIENTS / "barthel1.yaml")
     try:
         for number, session_id in enumerate(HOSTILE):
-            rows = [replace(r, seq=r.seq + 1000 * number, session_id=session_id,
-                            payload={k: session_id if k == "session_id" else v for k, v in r.payload.items()})
-                    for r in recorded]
+            rows = [
+                replace(
+                    r,
+                    seq=r.seq + 1000 * number,
+                    session_id=session_id,
+                    payload={k: session_id if k == "session_id" else v for k, v in r.payload.items()},
+                )
+                for r in recorded
+            ]
             response = kiosk.sync(rows)
             assert response.status_code == 200, response.text
             for fmt, suffix in (("csv", ".csv"), ("json", ".fhir.json")):

@@ -50,8 +50,12 @@ def deliver(client: KioskClient, rows, batch: int, stop_after: float = PATIENCE_
 def _check_exactly_once(db_url: str, kiosk_id: str, rows) -> None:
     engine = db.make_engine(db_url)
     with engine.connect() as connection:
-        seqs = [s for (s,) in connection.execute(sa.select(db.inbox.c.seq).where(db.inbox.c.kiosk_id == kiosk_id)
-                                                 .order_by(db.inbox.c.seq))]
+        seqs = [
+            s
+            for (s,) in connection.execute(
+                sa.select(db.inbox.c.seq).where(db.inbox.c.kiosk_id == kiosk_id).order_by(db.inbox.c.seq)
+            )
+        ]
         assert seqs == [r.seq for r in rows]  # none lost, none twice (the key also forbids twice)
         by_session: dict[str, list] = {}
         for row in rows:
@@ -63,8 +67,7 @@ def _check_exactly_once(db_url: str, kiosk_id: str, rows) -> None:
             assert stored.status == "finished"
             assert len(stored.trace) == sum(r.kind == "record_context" for r in own)
         alerts = connection.execute(sa.select(sa.func.count()).select_from(db.alerts)).scalar_one()
-        assert alerts == sum(r.alert and r.payload["kind"] in ("doctor_called", "person_lost")
-                             for r in rows)
+        assert alerts == sum(r.alert and r.payload["kind"] in ("doctor_called", "person_lost") for r in rows)
     engine.dispose()
 
 

@@ -72,9 +72,15 @@ def test_a_huge_login_body_is_refused_without_growing_the_station(shared_station
     pid = station.process.pid
     before = rss(pid)
     chunks = 700 if framing == "content-length" else 60
-    head = (b"POST /login HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/x-www-form-urlencoded\r\n"
-            + (b"Content-Length: %d\r\n" % (chunks * len(CHUNK)) if framing == "content-length"
-               else b"Transfer-Encoding: chunked\r\n") + b"\r\n")
+    head = (
+        b"POST /login HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/x-www-form-urlencoded\r\n"
+        + (
+            b"Content-Length: %d\r\n" % (chunks * len(CHUNK))
+            if framing == "content-length"
+            else b"Transfer-Encoding: chunked\r\n"
+        )
+        + b"\r\n"
+    )
     answer = _send_until_refused(_open(station.url), head, chunks, framed=framing == "chunked")
     status_line, _, rest = answer.partition(b"\r\n")
     assert status_line.startswith(b"HTTP/1.1 413"), answer[:300]

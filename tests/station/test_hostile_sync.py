@@ -35,12 +35,25 @@ BASE = record_patient(PATIENTS / "barthel4.yaml")
 SEQ = itertools.count(1)
 
 LONG = "ẞ" * 70
-TEXTS = st.one_of(st.sampled_from(["", "x" * 65, "x" * 5000, "اختبار", "e\u0301", "\ud800", "\x00", LONG, "🙂" * 30]),
-                  st.text(max_size=80))
-TIMES = st.sampled_from(["yesterday", "2026-13-45T99:99:99Z", "2026-01-01T00:00:02.000000000000000+00:00:00Z",
-                         "1026-01-01T00:00:00Z", "2026-01-01", "", "2026-01-01T00:00:00+05:30", 12])
-VALUES = st.one_of(st.none(), st.booleans(), st.integers(-5, 120), st.sampled_from([99, 2.5, 1e308, "2", [], {}]),
-                   TEXTS)
+TEXTS = st.one_of(
+    st.sampled_from(["", "x" * 65, "x" * 5000, "اختبار", "e\u0301", "\ud800", "\x00", LONG, "🙂" * 30]),
+    st.text(max_size=80),
+)
+TIMES = st.sampled_from(
+    [
+        "yesterday",
+        "2026-13-45T99:99:99Z",
+        "2026-01-01T00:00:02.000000000000000+00:00:00Z",
+        "1026-01-01T00:00:00Z",
+        "2026-01-01",
+        "",
+        "2026-01-01T00:00:00+05:30",
+        12,
+    ]
+)
+VALUES = st.one_of(
+    st.none(), st.booleans(), st.integers(-5, 120), st.sampled_from([99, 2.5, 1e308, "2", [], {}]), TEXTS
+)
 
 #: (where, strategy of the new value); "answer.*" is a record_answer's field, "create.*" create_session's
 FIELDS = {
@@ -50,8 +63,16 @@ FIELDS = {
     "create.started_at": TIMES,
     "create.patient_id": st.sampled_from(["P-1", "Ann Smith", "P-" + "9" * 70, "P-ÄÖÜ"]),
     "create.timing": st.sampled_from([{}, {"attempt_window_s": -1}, {"nope": 1}, "fast"]),
-    "create.export": st.sampled_from([{"site": "other site"}, {"kiosk_id": "k/1"}, {"patient_system": "no uri"},
-                                      {"site": "x" * 300}, "nope", {"site": "north", "kiosk_id": "k1"}]),
+    "create.export": st.sampled_from(
+        [
+            {"site": "other site"},
+            {"kiosk_id": "k/1"},
+            {"patient_system": "no uri"},
+            {"site": "x" * 300},
+            "nope",
+            {"site": "north", "kiosk_id": "k1"},
+        ]
+    ),
     "answer.option": st.sampled_from([0, 1, 2, 3, 4, 99, -1, "2", None, 2.5, True]),
     "answer.points": VALUES,
     "answer.item_id": st.sampled_from(["feeding", "nonexistent", "", "x" * 100, "bathing", "total"]),
@@ -73,8 +94,9 @@ FIELDS = {
 }
 #: whole-definition changes: a site's own questionnaire (consistent, so it must be stored and shown),
 #: an old kiosk that sends none, and definitions that do not fit
-DEFINITIONS = st.sampled_from(["own questionnaire", "none sent", "language dropped", "wrong hash", "no items",
-                               "German added", "as recorded"])
+DEFINITIONS = st.sampled_from(
+    ["own questionnaire", "none sent", "language dropped", "wrong hash", "no items", "German added", "as recorded"]
+)
 
 
 def _retarget(rows: list, session_id: str) -> list:
@@ -112,8 +134,14 @@ def _definition(create: dict, how: str) -> None:
 
 def _mutate(rows: list, field: str, value, pick: int) -> None:
     part, name = field.split(".")
-    kinds = {"create": "create_session", "answer": "record_answer", "event": "record_event",
-             "finish": "finish_session", "context": "record_context", "metrics": "record_metrics"}
+    kinds = {
+        "create": "create_session",
+        "answer": "record_answer",
+        "event": "record_event",
+        "finish": "finish_session",
+        "context": "record_context",
+        "metrics": "record_metrics",
+    }
     targets = rows if part == "row" else [r for r in rows if r["kind"] == kinds[part]]
     if not targets:  # an earlier change renamed the only row of that kind
         return
@@ -153,19 +181,28 @@ def ward_station(request, tmp_path_factory) -> Iterator[tuple[str, str, Staff]]:
         assert "Traceback" not in (base / "station.log").read_text(), (base / "station.log").read_text()
 
 
-@settings(max_examples=40, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture, HealthCheck.data_too_large])
+@settings(
+    max_examples=40,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture, HealthCheck.data_too_large],
+)
 @given(body=bodies())
 def test_a_sync_body_is_stored_and_shown_or_refused_never_a_500(ward_station, body):
     url, token, staff = ward_station
     session_id, payload = body
-    answer = httpx.post(url + "/api/v1/sync", content=json.dumps(payload), timeout=60,  # ASCII: lone surrogates too
-                        headers={"Authorization": f"Bearer {token}", "content-type": "application/json"})
+    answer = httpx.post(
+        url + "/api/v1/sync",
+        content=json.dumps(payload),
+        timeout=60,  # ASCII: lone surrogates too
+        headers={"Authorization": f"Bearer {token}", "content-type": "application/json"},
+    )
     assert answer.status_code == 200 or 400 <= answer.status_code < 500, answer.text
     event(f"answered {answer.status_code}")
     if answer.status_code != 200:
         assert answer.json()["error"].startswith(  # it names the row, or what of the body is wrong
-            ("seq ", "events[", "the body", "the request body", "a seq", "at most")), answer.text
+            ("seq ", "events[", "the body", "the request body", "a seq", "at most")
+        ), answer.text
         return
     created = any(e["kind"] == "create_session" for e in payload["events"])
     page = staff.http.get(f"/sessions/{session_id}")
@@ -175,8 +212,15 @@ def test_a_sync_body_is_stored_and_shown_or_refused_never_a_500(ward_station, bo
         assert export.status_code == 200 or (not created and export.status_code == 409), export.text[:2000]
     # the pages that list or follow it: the ward, the inbox, its patient's course, the sign-off step
     patient = next((e["payload"].get("patient_id") for e in payload["events"] if e["kind"] == "create_session"), None)
-    pages = ["/", "/fragments/results", "/inbox?state=all", "/fragments/inbox?state=all", "/orders",
-             f"/sessions/{session_id}/sign-off", "/exports/signed-off.json?from=2000-01-01&to=2100-12-31"]
+    pages = [
+        "/",
+        "/fragments/results",
+        "/inbox?state=all",
+        "/fragments/inbox?state=all",
+        "/orders",
+        f"/sessions/{session_id}/sign-off",
+        "/exports/signed-off.json?from=2000-01-01&to=2100-12-31",
+    ]
     if isinstance(patient, str) and patient:
         pages += [f"/patients?q={quote(patient)}", f"/patients/{quote(patient, safe='')}"]
     for path in pages:
@@ -189,4 +233,7 @@ def test_a_sync_body_is_stored_and_shown_or_refused_never_a_500(ward_station, bo
     for path in [*pages, f"/sessions/{session_id}", f"/sessions/{session_id}/export.json"]:
         shown = staff.http.get(path)
         assert shown.status_code in (200, 303, 404) or (not created and shown.status_code == 409), (
-            path, shown.status_code, shown.text[:2000])
+            path,
+            shown.status_code,
+            shown.text[:2000],
+        )

@@ -22,8 +22,12 @@ pytestmark = pytest.mark.slow
 
 def outbox_rows(path) -> list[Row]:
     with sqlite3.connect(path) as connection:
-        return [Row(seq, kind, session_id, json.loads(payload), 0.0, at) for seq, kind, session_id, payload, at, alert
-                in connection.execute("SELECT seq, kind, session_id, payload, at, alert FROM outbox ORDER BY seq")]
+        return [
+            Row(seq, kind, session_id, json.loads(payload), 0.0, at)
+            for seq, kind, session_id, payload, at, alert in connection.execute(
+                "SELECT seq, kind, session_id, payload, at, alert FROM outbox ORDER BY seq"
+            )
+        ]
 
 
 def test_the_station_reads_back_what_the_kiosk_stored(shared_station, tmp_path):
@@ -33,8 +37,10 @@ def test_the_station_reads_back_what_the_kiosk_stored(shared_station, tmp_path):
     name, token = new_kiosk(ward.db_url)
     kiosk_dir = tmp_path / "kiosk"
     with Store.open(kiosk_dir, outbox=True) as store:
-        ids = [run_script(load_script(PATIENTS / script), store=store).session.id
-               for script in ("barthel5.yaml", "barthel6.yaml", "relative_french.yaml")]
+        ids = [
+            run_script(load_script(PATIENTS / script), store=store).session.id
+            for script in ("barthel5.yaml", "barthel6.yaml", "relative_french.yaml")
+        ]
         kiosk_copies = {session_id: store.session(session_id) for session_id in ids}
     rows = outbox_rows(store.path)
     assert rows and {r.session_id for r in rows} == set(ids)
@@ -45,7 +51,7 @@ def test_the_station_reads_back_what_the_kiosk_stored(shared_station, tmp_path):
         assert client.sync([alert]).status_code == 200
     rest = [r for r in rows if not r.alert]
     for start in range(0, len(rest), 100):
-        response = client.sync(rest[start:start + 100])
+        response = client.sync(rest[start : start + 100])
         assert response.status_code == 200, response.text
     client.close()
 
@@ -57,13 +63,16 @@ def test_the_station_reads_back_what_the_kiosk_stored(shared_station, tmp_path):
             assert kiosk == name
             assert station_copy.patient_id == kiosk_copy.patient_id
             assert station_copy.status == kiosk_copy.status == "finished"
-            assert sorted(station_copy.answers, key=lambda a: a.item_id) == sorted(kiosk_copy.answers,
-                                                                                   key=lambda a: a.item_id)
+            assert sorted(station_copy.answers, key=lambda a: a.item_id) == sorted(
+                kiosk_copy.answers, key=lambda a: a.item_id
+            )
             assert station_copy.not_answered == kiosk_copy.not_answered
             assert station_copy.trace == kiosk_copy.trace
-            assert [(m.t, dict(m.metrics)) for m in station_copy.metrics] == [(m.t, dict(m.metrics))
-                                                                              for m in kiosk_copy.metrics]
+            assert [(m.t, dict(m.metrics)) for m in station_copy.metrics] == [
+                (m.t, dict(m.metrics)) for m in kiosk_copy.metrics
+            ]
             assert station_copy.practice == kiosk_copy.practice
-            assert [(e.t, e.kind) for e in station_copy.log] == [(e.t, renamed.get(e.kind, e.kind))
-                                                                for e in kiosk_copy.log]
+            assert [(e.t, e.kind) for e in station_copy.log] == [
+                (e.t, renamed.get(e.kind, e.kind)) for e in kiosk_copy.log
+            ]
     engine.dispose()

@@ -24,8 +24,11 @@ def _spoil(db_url: str, session_id: str) -> None:
     engine = db.make_engine(db_url)
     try:
         with engine.begin() as connection:
-            rows = connection.execute(sa.select(db.inbox.c.kiosk_id, db.inbox.c.seq, db.inbox.c.payload).where(
-                db.inbox.c.session_id == session_id, db.inbox.c.kind == "record_answer")).all()
+            rows = connection.execute(
+                sa.select(db.inbox.c.kiosk_id, db.inbox.c.seq, db.inbox.c.payload).where(
+                    db.inbox.c.session_id == session_id, db.inbox.c.kind == "record_answer"
+                )
+            ).all()
             for number, row in enumerate(rows[:2]):
                 payload = json.loads(row.payload)
                 payload |= {"option": 99} if number == 0 else {"item_id": "nonexistent"}
@@ -37,8 +40,11 @@ def _spoil(db_url: str, session_id: str) -> None:
 
 @pytest.mark.parametrize("database", ["sqlite", "postgres"])
 def test_a_session_with_rows_stored_before_checks_is_shown_everywhere(database, request, station_factory, tmp_path):
-    db_url = db.sqlite_url(tmp_path / "data") if database == "sqlite" else create_database(
-        request.getfixturevalue("postgres"), "l_" + uuid.uuid4().hex[:12])
+    db_url = (
+        db.sqlite_url(tmp_path / "data")
+        if database == "sqlite"
+        else create_database(request.getfixturevalue("postgres"), "l_" + uuid.uuid4().hex[:12])
+    )
     ward = make_ward(db_url)
     station = station_factory(db_url)
     rows = record_patient(PATIENTS / "barthel1.yaml", patient="NHC-0099001")
@@ -51,15 +57,28 @@ def test_a_session_with_rows_stored_before_checks_is_shown_everywhere(database, 
     _spoil(db_url, session_id)
     staff = Staff(station.url)
     try:
-        for path in ("/", "/fragments/results", "/inbox", "/inbox?state=all", "/fragments/inbox",
-                     "/patients/NHC-0099001", f"/sessions/{session_id}", f"/sessions/{session_id}/sign-off",
-                     f"/sessions/{session_id}/export.json", f"/sessions/{session_id}/export.csv"):
+        for path in (
+            "/",
+            "/fragments/results",
+            "/inbox",
+            "/inbox?state=all",
+            "/fragments/inbox",
+            "/patients/NHC-0099001",
+            f"/sessions/{session_id}",
+            f"/sessions/{session_id}/sign-off",
+            f"/sessions/{session_id}/export.json",
+            f"/sessions/{session_id}/export.csv",
+        ):
             shown = staff.http.get(path)
             assert shown.status_code == 200, (path, shown.status_code, shown.text[:500])
         signed = staff.post(f"/sessions/{session_id}/sign-off")
         assert signed.status_code == 303 and "Signed%20off." in signed.headers["location"], signed.headers
-        for path in (f"/sessions/{session_id}", "/inbox?state=signed", f"/sessions/{session_id}/export.json",
-                     "/exports/signed-off.json?from=2000-01-01&to=2100-12-31"):
+        for path in (
+            f"/sessions/{session_id}",
+            "/inbox?state=signed",
+            f"/sessions/{session_id}/export.json",
+            "/exports/signed-off.json?from=2000-01-01&to=2100-12-31",
+        ):
             shown = staff.http.get(path)
             assert shown.status_code == 200, (path, shown.status_code, shown.text[:500])
     finally:

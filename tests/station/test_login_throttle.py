@@ -43,14 +43,14 @@ class Browser:
     """A login form user from one source address (``local``), optionally with forged headers."""
 
     def __init__(self, url: str, local: str = "127.0.0.1") -> None:
-        self.http = httpx.Client(base_url=url, timeout=PATIENCE_S,
-                                 transport=httpx.HTTPTransport(local_address=local))
+        self.http = httpx.Client(base_url=url, timeout=PATIENCE_S, transport=httpx.HTTPTransport(local_address=local))
         self.token = Staff.csrf(self.http.get("/login").text)
 
     def login(self, name: str, password: str, forwarded: str | None = None) -> httpx.Response:
         headers = {"x-forwarded-for": forwarded} if forwarded else {}
-        return self.http.post("/login", data={"csrf": self.token, "name": name, "password": password, "next": "/"},
-                              headers=headers)
+        return self.http.post(
+            "/login", data={"csrf": self.token, "name": name, "password": password, "next": "/"}, headers=headers
+        )
 
 
 def hammer(browser: Browser, name: str, forwarded, stop: threading.Event, paused: threading.Event) -> list[int]:
@@ -69,8 +69,9 @@ def hammer(browser: Browser, name: str, forwarded, stop: threading.Event, paused
     return statuses
 
 
-def attack_while_doctor_logs_in(station_url: str, attacker: Browser, forwarded, doctor: Browser,
-                                doctor_forwarded: str | None = None) -> tuple[list[int], float]:
+def attack_while_doctor_logs_in(
+    station_url: str, attacker: Browser, forwarded, doctor: Browser, doctor_forwarded: str | None = None
+) -> tuple[list[int], float]:
     stop, paused, statuses = threading.Event(), threading.Event(), []
     started = time.monotonic()
     thread = threading.Thread(target=lambda: statuses.extend(hammer(attacker, "dr.lopez", forwarded, stop, paused)))
@@ -99,7 +100,8 @@ def test_forged_forwarded_for_from_an_untrusted_peer_does_not_bypass_the_limit(d
     station = station_factory(db_url)
     attacker, doctor = Browser(station.url, "127.0.0.1"), Browser(station.url, "127.0.0.2")
     statuses, elapsed = attack_while_doctor_logs_in(
-        station.url, attacker, lambda attempt: f"198.51.100.{attempt % 250}, 10.0.0.{attempt % 250}", doctor)
+        station.url, attacker, lambda attempt: f"198.51.100.{attempt % 250}, 10.0.0.{attempt % 250}", doctor
+    )
     checked = statuses.count(401)
     assert set(statuses) <= {401, 429} and len(statuses) >= throttle.FREE_FAILURES + 1
     assert throttle.FREE_FAILURES <= checked <= most_checked(elapsed), (checked, len(statuses), elapsed)
@@ -133,8 +135,12 @@ def test_behind_a_named_proxy_each_client_address_is_throttled_alone(station_fac
     proxy = Browser(station.url, "127.0.0.1")
     # the client forges the left part; the proxy (and a second trusted hop) append what they saw
     statuses, elapsed = attack_while_doctor_logs_in(
-        station.url, proxy, lambda attempt: f"192.0.2.{attempt % 250}, 203.0.113.9, 10.9.1.1",
-        Browser(station.url, "127.0.0.1"), doctor_forwarded="198.51.100.7")
+        station.url,
+        proxy,
+        lambda attempt: f"192.0.2.{attempt % 250}, 203.0.113.9, 10.9.1.1",
+        Browser(station.url, "127.0.0.1"),
+        doctor_forwarded="198.51.100.7",
+    )
     assert throttle.FREE_FAILURES <= statuses.count(401) <= most_checked(elapsed)
     # a peer that is not a named proxy is its own address, whatever it forwards
     outsider = Browser(station.url, "127.0.0.2")
@@ -148,15 +154,18 @@ def test_behind_a_named_proxy_each_client_address_is_throttled_alone(station_fac
     assert proxy.login("nurse.kim", PASSWORDS["nurse"], "203.0.113.78").status_code == 303
 
 
-@pytest.mark.parametrize("peer, forwarded, trusted, expected", [
-    ("127.0.0.1", ["198.51.100.1"], [], "127.0.0.1"),
-    ("10.0.0.5", ["198.51.100.1"], ["10.0.0.0/8"], "198.51.100.1"),
-    ("10.0.0.5", ["6.6.6.6, 198.51.100.1, 10.0.0.9"], ["10.0.0.0/8"], "198.51.100.1"),
-    ("10.0.0.5", ["6.6.6.6", "198.51.100.1"], ["10.0.0.0/8"], "198.51.100.1"),
-    ("10.0.0.5", ["not-an-address"], ["10.0.0.0/8"], "10.0.0.5"),
-    ("10.0.0.5", [], ["10.0.0.0/8"], "10.0.0.5"),
-    ("::1", [" 2001:db8::7 "], ["::1"], "2001:db8::7"),
-])
+@pytest.mark.parametrize(
+    "peer, forwarded, trusted, expected",
+    [
+        ("127.0.0.1", ["198.51.100.1"], [], "127.0.0.1"),
+        ("10.0.0.5", ["198.51.100.1"], ["10.0.0.0/8"], "198.51.100.1"),
+        ("10.0.0.5", ["6.6.6.6, 198.51.100.1, 10.0.0.9"], ["10.0.0.0/8"], "198.51.100.1"),
+        ("10.0.0.5", ["6.6.6.6", "198.51.100.1"], ["10.0.0.0/8"], "198.51.100.1"),
+        ("10.0.0.5", ["not-an-address"], ["10.0.0.0/8"], "10.0.0.5"),
+        ("10.0.0.5", [], ["10.0.0.0/8"], "10.0.0.5"),
+        ("::1", [" 2001:db8::7 "], ["::1"], "2001:db8::7"),
+    ],
+)
 def test_client_address(peer, forwarded, trusted, expected):
     assert throttle.client_address(peer, forwarded, [ipaddress.ip_network(t) for t in trusted]) == expected
 

@@ -31,8 +31,9 @@ def state(db_url: str, order_id: str) -> tuple[str, str | None]:
     engine = db.make_engine(db_url)
     try:
         with engine.connect() as connection:
-            row = connection.execute(sa.select(orders_table.c.state, orders_table.c.session_id).where(
-                orders_table.c.id == order_id)).one()
+            row = connection.execute(
+                sa.select(orders_table.c.state, orders_table.c.session_id).where(orders_table.c.id == order_id)
+            ).one()
     finally:
         engine.dispose()
     return row.state, row.session_id
@@ -69,8 +70,7 @@ def test_an_order_goes_from_ordered_to_signed_off_on_its_own_kiosk_only(database
     assert mine.start_order(code).status_code == 404  # a code starts one visit once
 
     identity = {"site": "north-hospital", "kiosk_id": ward.kiosk_id}
-    rows = record_patient(PATIENTS / "barthel1.yaml", patient="NHC-0012345", visit=f"order {order_id}",
-                          export=identity)
+    rows = record_patient(PATIENTS / "barthel1.yaml", patient="NHC-0012345", visit=f"order {order_id}", export=identity)
     assert mine.sync(rows).status_code == 200
     waiting, session_id = state(db_url, order_id)
     assert waiting == "awaiting_validation" and session_id == rows[0].session_id
@@ -131,8 +131,9 @@ def test_guessing_codes_is_stopped_and_staff_forms_need_their_token(shared_stati
     answers = [kiosk.start_order(f"{n:04d}").status_code for n in range(9000, 9006)]
     assert answers == [404] * 5 + [429]
     nurse = Staff(station.url, "nurse.kim", "nurse")
-    forged = nurse.http.post("/orders", data={"patient_id": "NHC-1", "kiosk": name, "instrument": "barthel",
-                                             "language": "en"})
+    forged = nurse.http.post(
+        "/orders", data={"patient_id": "NHC-1", "kiosk": name, "instrument": "barthel", "language": "en"}
+    )
     assert forged.status_code == 403
     assert kiosk.orders()["orders"] == []
     kiosk.close()
@@ -144,12 +145,15 @@ def test_staff_order_at_most_thirty_visits_in_ten_minutes_and_a_nurse_never_sign
     nurse = Staff(station.url, "nurse.kim", "nurse")
     answers = [order(nurse, ward.kiosk_id, patient=f"NHC-{n:04d}").headers["location"] for n in range(31)]
     assert all(a.startswith("/orders/order-") for a in answers[:30])
-    assert answers[30].startswith("/orders?error=") and "30 visits in the last 10 minutes" in nurse.http.get(
-        answers[30]).text
+    assert (
+        answers[30].startswith("/orders?error=")
+        and "30 visits in the last 10 minutes" in nurse.http.get(answers[30]).text
+    )
     assert len(KioskClient(station.url, ward.token, ward.kiosk_id).orders()["orders"]) == 30
     rows = record_patient(PATIENTS / "barthel1.yaml")
     assert KioskClient(station.url, ward.token, ward.kiosk_id).sync(rows).status_code == 200
     asked = nurse.http.get(f"/sessions/{rows[0].session_id}/sign-off")
     assert asked.status_code == 303 and "Only%20a%20doctor" in asked.headers["location"]
     assert "only a doctor can sign off" in nurse.post(f"/sessions/{rows[0].session_id}/sign-off").headers[
-        "location"].replace("%20", " ")
+        "location"
+    ].replace("%20", " ")

@@ -22,8 +22,7 @@ OWN_TEXT = "Can you eat a meal on your own? (site wording)"
 def test_a_sites_own_questionnaire_is_shown_and_exported_with_its_own_definition(shared_station):  # noqa: F811
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)
-    rows = [r for r in record_patient(PATIENTS / "barthel1.yaml")
-            if r.payload.get("item_id", KEPT[0]) in KEPT]
+    rows = [r for r in record_patient(PATIENTS / "barthel1.yaml") if r.payload.get("item_id", KEPT[0]) in KEPT]
     create = rows[0].payload
     definition = create["definition"]
     definition["id"], definition["version"] = "site-adl", "3"

@@ -17,8 +17,10 @@ from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient, 
 
 pytestmark = pytest.mark.slow
 KEPT = ("feeding", "bathing", "grooming")
-SITE_BANDS = [{"id": "needs-support", "min": 0, "max": 9, "label": {"en": "Needs support"}},
-              {"id": "manages", "min": 10, "max": 40, "label": {"en": "Manages"}}]
+SITE_BANDS = [
+    {"id": "needs-support", "min": 0, "max": 9, "label": {"en": "Needs support"}},
+    {"id": "manages", "min": 10, "max": 40, "label": {"en": "Manages"}},
+]
 OWN_LABEL = "Eats alone (site wording)"
 
 
@@ -100,7 +102,7 @@ def test_changes_that_come_back_to_the_kiosks_answer_are_signed_off_as_recorded(
         page = staff.http.get(f"/sessions/{session_id}")
         assert _badge(page.text, "review-state") == "signed off"
         signed = staff.http.get("/inbox?state=signed")
-        assert re.search(rf'{patient_id}.*?signed off', signed.text, re.S), signed.text
+        assert re.search(rf"{patient_id}.*?signed off", signed.text, re.S), signed.text
         table = staff.http.get(f"/sessions/{session_id}/export.csv")
         assert {r["review_state"] for r in csv.DictReader(io.StringIO(table.text))} == {"signed_off"}
         fhir = staff.http.get(f"/sessions/{session_id}/export.json").json()
@@ -125,8 +127,12 @@ def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_statio
     feeding = next(a for a in answers if a["item_id"] == "feeding")["option"]
     staff = Staff(station.url)
     try:
-        assert staff.post(f"/sessions/{session_id}/items/feeding", option=str(1 if feeding != 1 else 2),
-                          reason="misheard").status_code == 303
+        assert (
+            staff.post(
+                f"/sessions/{session_id}/items/feeding", option=str(1 if feeding != 1 else 2), reason="misheard"
+            ).status_code
+            == 303
+        )
         assert staff.post(f"/sessions/{session_id}/sign-off").status_code == 303
         assert _row_state(staff.http.get("/inbox?state=signed").text, session_id) == "amended"
         waiting_before = int(_badge(staff.http.get("/inbox").text, "waiting-count"))
@@ -141,8 +147,9 @@ def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_statio
         table = staff.http.get(f"/sessions/{session_id}/export.csv")
         assert {r["review_state"] for r in csv.DictReader(io.StringIO(table.text))} == {"corrected"}
         fhir = staff.http.get(f"/sessions/{session_id}/export.json").json()
-        assert [e["resource"]["status"] for e in fhir["entry"]
-                if e["resource"]["resourceType"] == "Observation"] == ["preliminary"]
+        assert [e["resource"]["status"] for e in fhir["entry"] if e["resource"]["resourceType"] == "Observation"] == [
+            "preliminary"
+        ]
         assert staff.post(f"/sessions/{session_id}/sign-off").status_code == 303
         assert _row_state(staff.http.get("/inbox?state=signed").text, session_id) == "amended"
         assert _row_state(staff.http.get("/inbox").text, session_id) is None
@@ -162,8 +169,9 @@ def test_staff_order_a_visit_of_the_sites_own_questionnaire(shared_station):  # 
         form = nurse.http.get("/orders").text
         assert 'value="site-adl"' in form and "Site ADL" in form
         placed = nurse.post("/orders", patient_id="NHC-0044001", kiosk=name, instrument="site-adl", language="en")
-        assert placed.status_code == 303 and placed.headers["location"].startswith("/orders/order-"), (
-            placed.headers["location"])
+        assert placed.status_code == 303 and placed.headers["location"].startswith("/orders/order-"), placed.headers[
+            "location"
+        ]
         assert [o["instruments"] for o in kiosk.orders()["orders"]] == [["site-adl"]]
         refused = nurse.post("/orders", patient_id="NHC-0044001", kiosk=name, instrument="site-adl", language="de")
         assert refused.headers["location"].startswith("/orders?error=")

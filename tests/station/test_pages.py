@@ -82,8 +82,9 @@ def test_an_alert_sounds_and_notifies_until_acknowledged(browser, ward, viewport
     page.wait_for_selector("body[data-sounding='0']", state="attached")
     engine = db.make_engine(ward.db_url)
     with engine.connect() as connection:
-        row = connection.execute(sa.select(db.alerts.c.ack_by, db.alerts.c.ack_at).where(
-            db.alerts.c.kiosk_id == ward.kiosk_id)).one()
+        row = connection.execute(
+            sa.select(db.alerts.c.ack_by, db.alerts.c.ack_at).where(db.alerts.c.kiosk_id == ward.kiosk_id)
+        ).one()
     engine.dispose()
     assert row.ack_by == "nurse.kim" and row.ack_at
     context.close()
@@ -96,8 +97,9 @@ def test_continue_after_a_doctor_call_reaches_the_kiosk(browser, ward):
     kiosk.sync([r for r in rows if r.seq <= call.seq])
     context, page = open_page(browser, station, "nurse.kim", "nurse", PHONE)
     page.wait_for_selector("body[data-live='1']", state="attached")
-    kiosk.status(session_id=call.session_id, patient_id="TB-0005", phase="questions", question=4, of=10,
-                 doctor_called=True)
+    kiosk.status(
+        session_id=call.session_id, patient_id="TB-0005", phase="questions", question=4, of=10, doctor_called=True
+    )
     tile = page.locator(f"#kiosk-{ward.kiosk_id}")
     tile.locator("text=doctor called").wait_for()
     got: list = []
@@ -194,6 +196,9 @@ def test_a_doctor_reopens_a_signed_result_amends_it_and_signs_again(browser, war
     with page.expect_download() as download:
         page.locator("form.period-export button").click()
     bundle = json.loads(download.value.path().read_text(encoding="utf-8"))
-    assert any(e["resource"]["identifier"]["value"].endswith(session) for e in bundle["entry"]
-               if e["resource"]["resourceType"] == "QuestionnaireResponse")
+    assert any(
+        e["resource"]["identifier"]["value"].endswith(session)
+        for e in bundle["entry"]
+        if e["resource"]["resourceType"] == "QuestionnaireResponse"
+    )
     context.close()

@@ -26,20 +26,35 @@ pytestmark = pytest.mark.slow
 def _hostile(store: Store, session_id: str) -> list[int]:
     """Two rows the station must refuse, queued among the session's own (as a buggy kiosk would)."""
     seqs = []
-    for payload, at in (({"item_id": "feeding", "option": 99, "points": 10, "attempt": 1, "channel": "touch",
-                          "answered_by": "patient", "t": 1.0, "at": "2026-01-01T00:00:01Z"}, "2026-01-01T00:00:01Z"),
-                        ({"t": 2.0, "kind": "note", "detail": ""}, "2026-01-01T00:00:02.000000000000000+00:00:00Z")):
+    for payload, at in (
+        (
+            {
+                "item_id": "feeding",
+                "option": 99,
+                "points": 10,
+                "attempt": 1,
+                "channel": "touch",
+                "answered_by": "patient",
+                "t": 1.0,
+                "at": "2026-01-01T00:00:01Z",
+            },
+            "2026-01-01T00:00:01Z",
+        ),
+        ({"t": 2.0, "kind": "note", "detail": ""}, "2026-01-01T00:00:02.000000000000000+00:00:00Z"),
+    ):
         kind = "record_answer" if "item_id" in payload else "record_event"
         cursor = store._db.execute(  # noqa: SLF001 - a row no real session writes
             "INSERT INTO outbox (kind, session_id, payload, at) VALUES (?, ?, ?, ?)",
-            (kind, session_id, json.dumps(payload), at))
+            (kind, session_id, json.dumps(payload), at),
+        )
         seqs.append(cursor.lastrowid)
     return seqs
 
 
 @pytest.mark.parametrize("engine", ["sqlite", "postgresql"])
-def test_refused_rows_are_parked_and_every_other_row_is_delivered(engine, request, tmp_path, station_factory,
-                                                                   monkeypatch, capsys):
+def test_refused_rows_are_parked_and_every_other_row_is_delivered(
+    engine, request, tmp_path, station_factory, monkeypatch, capsys
+):
     db_url = request.getfixturevalue("sqlite_url" if engine == "sqlite" else "pg_url")
     ward = make_ward(db_url)
     station = station_factory(db_url)
@@ -50,8 +65,9 @@ def test_refused_rows_are_parked_and_every_other_row_is_delivered(engine, reques
         second = run_script(load_script(PATIENTS / "barthel6.yaml"), store=store).session.id
         queued = store.outbox_waiting()[0]
     assert len(bad) == 2 and queued > 50
-    client = SyncClient(kiosk_dir / "kiosk.sqlite3", url=station.url, token=ward.token, kiosk_id=ward.kiosk_id,
-                        backoff=(0.02, 0.2))
+    client = SyncClient(
+        kiosk_dir / "kiosk.sqlite3", url=station.url, token=ward.token, kiosk_id=ward.kiosk_id, backoff=(0.02, 0.2)
+    )
     try:
         assert client.deliver_all(within_s=120) == 0  # nothing waits behind the refused rows
     finally:

@@ -58,9 +58,18 @@ def test_no_station_page_scrolls_sideways_on_a_phone(browser, shared_station):  
     context, page = login(browser, station.url, "dr.lopez", "doctor", PHONE)
     try:
         fits(page, PHONE)
-        for path in ("/inbox", "/inbox?state=all", f"/patients?q={PATIENT[:6]}", f"/patients/{quote(PATIENT)}",
-                     f"/sessions/{session_id}", f"/sessions/{session_id}/sign-off", "/orders", "/orders?state=",
-                     "/orders?state=cancelled", order_path):
+        for path in (
+            "/inbox",
+            "/inbox?state=all",
+            f"/patients?q={PATIENT[:6]}",
+            f"/patients/{quote(PATIENT)}",
+            f"/sessions/{session_id}",
+            f"/sessions/{session_id}/sign-off",
+            "/orders",
+            "/orders?state=",
+            "/orders?state=cancelled",
+            order_path,
+        ):
             page.goto(station.url + path)
             page.wait_for_selector("main")
             fits(page, PHONE)

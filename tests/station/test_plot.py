@@ -51,9 +51,15 @@ def test_adaptations_are_marked_and_metrics_have_the_kiosks_colours():
     from kiosk.store.records import AdaptationRecord
 
     stored = _session("barthel5.yaml")
-    adapted = type(stored)(**{**stored.__dict__, "adaptations": (
-        AdaptationRecord(12.0, "longer_attempts", True, "Interaction 0.2 < 0.3"),
-        AdaptationRecord(30.0, "voice_off", True, "VoiceInteractionQuality 0.1 < 0.2"))})
+    adapted = type(stored)(
+        **{
+            **stored.__dict__,
+            "adaptations": (
+                AdaptationRecord(12.0, "longer_attempts", True, "Interaction 0.2 < 0.3"),
+                AdaptationRecord(30.0, "voice_off", True, "VoiceInteractionQuality 0.1 < 0.2"),
+            ),
+        }
+    )
     svg = qos_svg(adapted)
     titles = re.findall(r'class="adaptation"[^>]*><title>([^<]+)</title>', svg)
     assert titles == ["longer attempts on at 12 s", "voice answers off on at 30 s"]

@@ -63,8 +63,12 @@ def test_the_app_role_runs_the_station_and_cannot_touch_the_audit_guard(roles, s
     assert done.returncode == 0 and f"role {app}:" in done.stdout, done.stderr
     password = tmp_path / "pw"
     password.write_text(PASSWORDS["doctor"] + "\n")
-    assert kiosk_station("add-user", "dr.lopez", "--role", "doctor", "--password-file", str(password),
-                         "--db", app_url).returncode == 0
+    assert (
+        kiosk_station(
+            "add-user", "dr.lopez", "--role", "doctor", "--password-file", str(password), "--db", app_url
+        ).returncode
+        == 0
+    )
     added = kiosk_station("add-kiosk", "ward3-bed2", "--db", app_url)
     assert added.returncode == 0, added.stderr
     token = added.stdout.strip().splitlines()[-1]
@@ -88,8 +92,13 @@ def test_the_app_role_runs_the_station_and_cannot_touch_the_audit_guard(roles, s
     (command,) = kiosk.commands()
     assert kiosk.ack(command["id"]).status_code == 200
     assert doctor.post("/logout").status_code == 303
-    assert doctor.http.post("/login", data={"csrf": Staff.csrf(doctor.http.get("/login").text), "name": "dr.lopez",
-                                            "password": "wrong-password"}).status_code == 401
+    assert (
+        doctor.http.post(
+            "/login",
+            data={"csrf": Staff.csrf(doctor.http.get("/login").text), "name": "dr.lopez", "password": "wrong-password"},
+        ).status_code
+        == 401
+    )
     kiosk.close()
     assert kiosk_station("remove-user", "dr.lopez", "--db", app_url).returncode == 0
 
@@ -102,19 +111,25 @@ def test_the_app_role_runs_the_station_and_cannot_touch_the_audit_guard(roles, s
                 connection.execute(statement)
     with psycopg.connect(app_url, autocommit=True) as connection:
         connection.execute("GRANT UPDATE, DELETE, TRUNCATE ON audit TO PUBLIC")  # a warning, nothing granted
-        assert connection.execute("SELECT has_table_privilege('audit', 'UPDATE') OR has_table_privilege('audit', "
-                                  "'DELETE') OR has_table_privilege('audit', 'TRUNCATE')").fetchone() == (False,)
+        assert connection.execute(
+            "SELECT has_table_privilege('audit', 'UPDATE') OR has_table_privilege('audit', "
+            "'DELETE') OR has_table_privilege('audit', 'TRUNCATE')"
+        ).fetchone() == (False,)
     with psycopg.connect(owner_url) as connection:
         assert connection.execute("SELECT * FROM audit ORDER BY id").fetchall() == trail
-        enabled = dict(connection.execute("SELECT tgname, tgenabled FROM pg_trigger WHERE tgrelid = 'audit'::regclass "
-                                          "AND NOT tgisinternal").fetchall())
+        enabled = dict(
+            connection.execute(
+                "SELECT tgname, tgenabled FROM pg_trigger WHERE tgrelid = 'audit'::regclass AND NOT tgisinternal"
+            ).fetchall()
+        )
     assert enabled == {"audit_no_change": "O", "audit_no_truncate": "O"}
 
 
 def test_running_as_the_owner_warns_and_grant_mistakes_are_one_line(roles, station_factory, tmp_path):
     owner_url, app_url, app = roles
-    assert "--grant is for PostgreSQL" in one_line(kiosk_station("migrate", "--db", db.sqlite_url(tmp_path / "d"),
-                                                                 "--grant", app))
+    assert "--grant is for PostgreSQL" in one_line(
+        kiosk_station("migrate", "--db", db.sqlite_url(tmp_path / "d"), "--grant", app)
+    )
     assert "no role 'nobody_here'" in one_line(kiosk_station("migrate", "--db", owner_url, "--grant", "nobody_here"))
     owner = owner_url.rsplit("@", 1)[0].rsplit("/", 1)[1]
     assert "owns the tables" in one_line(kiosk_station("migrate", "--db", owner_url, "--grant", owner))

@@ -51,8 +51,9 @@ def test_a_replayed_session_arrives_whole_and_a_retry_stores_nothing_twice(ward_
     assert again.json()["stored"] == [r.seq for r in rows]
     engine = db.make_engine(ward.db_url)
     with engine.connect() as connection:
-        count = connection.execute(sa.select(sa.func.count()).select_from(db.inbox).where(
-            db.inbox.c.kiosk_id == ward.kiosk_id)).scalar_one()
+        count = connection.execute(
+            sa.select(sa.func.count()).select_from(db.inbox).where(db.inbox.c.kiosk_id == ward.kiosk_id)
+        ).scalar_one()
     engine.dispose()
     assert count == len(rows)
     stored = _stored(ward.db_url, rows[0].session_id)
@@ -82,8 +83,9 @@ def test_rows_that_would_store_a_wrong_answer_are_refused_and_named(ward_station
     rows = record_patient(PATIENTS / "barthel1.yaml")
     assert client.sync(rows[:5]).status_code == 200
     changed = rows[4]
-    tampered = type(changed)(changed.seq, changed.kind, changed.session_id, changed.payload | {"t": 9999.0},
-                             changed.t, changed.at)
+    tampered = type(changed)(
+        changed.seq, changed.kind, changed.session_id, changed.payload | {"t": 9999.0}, changed.t, changed.at
+    )
     refused = client.sync([tampered])
     assert refused.status_code == 409 and f"seq {changed.seq}" in refused.json()["error"]
     named = record_patient(PATIENTS / "barthel1.yaml", first_seq=100)
@@ -106,15 +108,23 @@ def test_an_unknown_or_revoked_token_gets_401_and_nothing_is_stored(ward_station
     stranger = KioskClient(station.url, "not-a-token", ward.kiosk_id)
     assert stranger.sync(rows[:3]).status_code == 401
     stranger.close()
-    done = subprocess.run([sys.executable, "-m", "kiosk", "station", "revoke-kiosk", ward.kiosk_id, "--db", ward.db_url],
-                          cwd=ROOT, capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "kiosk", "station", "revoke-kiosk", ward.kiosk_id, "--db", ward.db_url],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     assert client.sync(rows[:3]).status_code == 401
     assert client.status().status_code == 401
     engine = db.make_engine(ward.db_url)
     with engine.connect() as connection:
-        assert connection.execute(sa.select(sa.func.count()).select_from(db.inbox).where(
-            db.inbox.c.kiosk_id == ward.kiosk_id)).scalar_one() == 0
+        assert (
+            connection.execute(
+                sa.select(sa.func.count()).select_from(db.inbox).where(db.inbox.c.kiosk_id == ward.kiosk_id)
+            ).scalar_one()
+            == 0
+        )
     engine.dispose()
 
 
@@ -142,8 +152,12 @@ def test_a_command_queued_by_staff_answers_a_waiting_long_poll_and_is_redelivere
 
 def test_status_reports_show_on_the_ward_page(ward_station):
     ward, station, client = ward_station
-    assert client.status(session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3, of=10,
-                         paused=True).status_code == 200
+    assert (
+        client.status(
+            session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3, of=10, paused=True
+        ).status_code
+        == 200
+    )
     page = Staff(station.url).http.get("/").text
     assert "P-7K3QX9" in page and "3 of 10" in page and "paused" in page and "online" in page
     bad = client.http.post("/api/v1/status", content=json.dumps({"question": "three"}))
@@ -165,10 +179,12 @@ def test_page_posts_need_the_csrf_token_and_logins_are_rate_limited(ward_station
     auth.add_user(engine, "dr.target", "doctor", "the-right-password")
     engine.dispose()
     started = time.monotonic()
-    statuses = [anonymous.post("/login", data={"csrf": token, "name": "dr.target", "password": f"wrong{i}"}).status_code
-                for i in range(8)]
+    statuses = [
+        anonymous.post("/login", data={"csrf": token, "name": "dr.target", "password": f"wrong{i}"}).status_code
+        for i in range(8)
+    ]
     # the pause grows from the 4th failure (station.throttle; tests/station/test_login_throttle.py)
-    assert statuses[:throttle.FREE_FAILURES] == [401] * throttle.FREE_FAILURES and 429 in statuses
+    assert statuses[: throttle.FREE_FAILURES] == [401] * throttle.FREE_FAILURES and 429 in statuses
     assert statuses.count(401) <= most_checked(time.monotonic() - started)
     assert anonymous.get("/", follow_redirects=False).status_code == 303
 
@@ -178,23 +194,25 @@ def test_a_kiosk_silent_for_more_than_30_s_shows_offline_with_when_it_was_last_s
     client.status(session_id="abc124", patient_id="P-7K3QX8", phase="questions", question=5, of=10)
     engine = db.make_engine(ward.db_url)
     with engine.begin() as connection:  # as if its last heartbeat came two minutes ago
-        connection.execute(db.kiosks.update().where(db.kiosks.c.name == ward.kiosk_id).values(
-            last_seen=db.now() - 120))
+        connection.execute(db.kiosks.update().where(db.kiosks.c.name == ward.kiosk_id).values(last_seen=db.now() - 120))
     engine.dispose()
     page = Staff(station.url).http.get("/").text
-    tile = page[page.index(f'id="kiosk-{ward.kiosk_id}"'):]
-    tile = tile[:tile.index("</article>")]
+    tile = page[page.index(f'id="kiosk-{ward.kiosk_id}"') :]
+    tile = tile[: tile.index("</article>")]
     assert "offline" in tile and "last seen" in tile and "12" in tile  # "120 s ago" (or a little more)
 
 
-@pytest.mark.parametrize("body,status,words", [
-    (b"[" * 100_000 + b"]" * 100_000, 400, "nested more than"),
-    (b'{"kiosk_id": "a", "kiosk_id": "b", "events": []}', 400, "duplicate key"),
-    (b'{"events": [{"seq": NaN}]}', 400, "not a finite number"),
-    (b'{"events": [{"seq": 1' + b"0" * 5000 + b'}]}', 400, "too large"),
-    (b'{"events": "\xff\xfe"}', 400, "not UTF-8"),
-    (b'{"events": [' + b'"x",' * 1_500_000 + b'"x"]}', 413, "larger than"),
-])
+@pytest.mark.parametrize(
+    "body,status,words",
+    [
+        (b"[" * 100_000 + b"]" * 100_000, 400, "nested more than"),
+        (b'{"kiosk_id": "a", "kiosk_id": "b", "events": []}', 400, "duplicate key"),
+        (b'{"events": [{"seq": NaN}]}', 400, "not a finite number"),
+        (b'{"events": [{"seq": 1' + b"0" * 5000 + b"}]}", 400, "too large"),
+        (b'{"events": "\xff\xfe"}', 400, "not UTF-8"),
+        (b'{"events": [' + b'"x",' * 1_500_000 + b'"x"]}', 413, "larger than"),
+    ],
+)
 def test_a_bad_body_gets_one_clear_message_and_nothing_is_stored(ward_station, body, status, words):
     """Bytes from a broken or hostile kiosk: deep nesting (which crashed json.loads with a
     RecursionError, a 500), duplicate keys, NaN, a 5000-digit number, bad UTF-8, a body over the
@@ -204,8 +222,10 @@ def test_a_bad_body_gets_one_clear_message_and_nothing_is_stored(ward_station, b
         response = client.http.post(path, content=body)
         assert response.status_code == status, (path, response.text[:200])
         assert words in response.json()["error"]
-    assert client.status(session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3,
-                         of=10).status_code == 200
+    assert (
+        client.status(session_id="abc123", patient_id="P-7K3QX9", phase="questions", question=3, of=10).status_code
+        == 200
+    )
     # without a kiosk key the body is not even read
     anonymous = httpx.post(f"{station.url}/api/v1/sync", content=body, timeout=30)
     assert anonymous.status_code == 401 and "token" in anonymous.json()["error"]
@@ -215,14 +235,18 @@ def test_the_stations_export_names_the_result_as_its_kiosk_does(ward_station, tm
     """A hospital importing from both the kiosk and the station gets one result: the station's FHIR
     export carries the identifiers of the kiosk's own (site, kiosk id and FHIR systems from the
     kiosk's config, sent with the session), not the station's defaults."""
-    from kiosk.export import ExportSite, export_identity, fhir_response
     from kiosk.core.questionnaire import load_questionnaire
+    from kiosk.export import ExportSite, export_identity, fhir_response
 
     ward, station, client = ward_station
-    site = ExportSite(site="H1", kiosk_id="ward3-bed2", patient_system="https://h1.example/pseudonyms",
-                      identifier_system="https://h1.example/barthel-results",
-                      questionnaire_url="https://h1.example/Questionnaire/barthel",
-                      device_system="https://h1.example/devices")
+    site = ExportSite(
+        site="H1",
+        kiosk_id="ward3-bed2",
+        patient_system="https://h1.example/pseudonyms",
+        identifier_system="https://h1.example/barthel-results",
+        questionnaire_url="https://h1.example/Questionnaire/barthel",
+        device_system="https://h1.example/devices",
+    )
     rows = record_patient(PATIENTS / "barthel5.yaml", export=export_identity(site))
     assert rows[0].kind == "create_session" and rows[0].payload["export"]["site"] == "H1"
     client.sync(rows)
@@ -233,8 +257,10 @@ def test_the_stations_export_names_the_result_as_its_kiosk_does(ward_station, tm
     own = fhir_response(load_questionnaire(), stored, None, site)  # what the kiosk itself exports
     for key in ("identifier", "questionnaire", "subject"):
         assert exported[key] == own[key], key
-    assert exported["identifier"] == {"system": "https://h1.example/barthel-results",
-                                      "value": f"H1/ward3-bed2/{session_id}"}
+    assert exported["identifier"] == {
+        "system": "https://h1.example/barthel-results",
+        "value": f"H1/ward3-bed2/{session_id}",
+    }
 
 
 def test_an_incomplete_session_shows_no_total(ward_station):

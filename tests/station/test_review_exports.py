@@ -40,8 +40,11 @@ def _states(table: str) -> set[str]:
 
 
 def _responses(bundle: dict) -> dict[str, dict]:
-    return {e["resource"]["identifier"]["value"].rsplit("/", 1)[1]: e for e in bundle.get("entry", [])
-            if e["resource"]["resourceType"] == "QuestionnaireResponse"}
+    return {
+        e["resource"]["identifier"]["value"].rsplit("/", 1)[1]: e
+        for e in bundle.get("entry", [])
+        if e["resource"]["resourceType"] == "QuestionnaireResponse"
+    }
 
 
 def test_amending_keeps_every_step_and_the_period_export_follows_the_sign_offs(engine):
@@ -52,7 +55,9 @@ def test_amending_keeps_every_step_and_the_period_export_follows_the_sign_offs(e
     validation.change_item(engine, q, unsigned, "feeding", 1, "checked at lunch", NURSE)
     assert set(_responses(exports.period_bundle(engine, q, today, today))) == {signed}
     assert exports.period_bundle(engine, q, today - timedelta(days=3), today - timedelta(days=1)) == {
-        "resourceType": "Bundle", "type": "transaction"}  # nothing signed then: no entry at all
+        "resourceType": "Bundle",
+        "type": "transaction",
+    }  # nothing signed then: no entry at all
 
     with pytest.raises(validation.ValidationError, match="only a doctor"):
         validation.amend(engine, signed, "more news", NURSE)
@@ -86,4 +91,3 @@ def test_a_period_is_read_from_days_or_refused_in_words():
         exports.period("yesterday", "2026-11-30")
     with pytest.raises(exports.PeriodError, match="to=2026-10-01 is before from=2026-11-01"):
         exports.period("2026-11-01", "2026-10-01")
-

@@ -6,8 +6,8 @@ SQLite and PostgreSQL, the real command line, HTTP as a browser would send it.""
 from __future__ import annotations
 
 import httpx
-import sqlalchemy as sa
 import pytest
+import sqlalchemy as sa
 
 from station import auth, db, logins
 from tests.station.conftest import PASSWORDS, make_ward
@@ -62,8 +62,12 @@ def test_logout_password_change_and_removal_end_logins(db_url, station_factory, 
     with pytest.raises(AssertionError):
         Staff(station.url, "nurse.kim", "nurse")  # the old password is refused
     new_login = httpx.Client(base_url=station.url, timeout=30)
-    form = {"csrf": Staff.csrf(new_login.get("/login").text), "name": "nurse.kim",
-            "password": "a-new-nurse-password", "next": "/"}
+    form = {
+        "csrf": Staff.csrf(new_login.get("/login").text),
+        "name": "nurse.kim",
+        "password": "a-new-nurse-password",
+        "next": "/",
+    }
     assert new_login.post("/login", data=form).status_code == 303
 
     done = kiosk_station("remove-user", "dr.lopez", "--db", ward.db_url)
@@ -76,8 +80,10 @@ def test_admin_mistakes_are_one_line(db_url, tmp_path):
     make_ward(db_url)
     password = tmp_path / "pw"
     password.write_text("long-enough-password\n")
-    for argv, words in ((["passwd", "nobody", "--password-file", str(password)], "no user 'nobody'"),
-                        (["remove-user", "nobody"], "no user 'nobody'")):
+    for argv, words in (
+        (["passwd", "nobody", "--password-file", str(password)], "no user 'nobody'"),
+        (["remove-user", "nobody"], "no user 'nobody'"),
+    ):
         done = kiosk_station(*argv, "--db", db_url)
         assert done.returncode == 2 and words in done.stderr and "Traceback" not in done.stderr
         assert len(done.stderr.strip().splitlines()) == 1

@@ -47,8 +47,9 @@ def test_migrations_reach_the_newest_revision_and_running_them_again_changes_not
 def test_the_audit_trail_refuses_update_and_delete_in_the_database_itself(engine):
     rows = _ingest(engine, "barthel1.yaml")
     q = load_questionnaire()
-    validation.change_item(engine, q, rows[0].session_id, "feeding", 1, "patient needs help cutting food",
-                           User("nurse.kim", "nurse"))
+    validation.change_item(
+        engine, q, rows[0].session_id, "feeding", 1, "patient needs help cutting food", User("nurse.kim", "nurse")
+    )
     for statement in (db.audit.update().values(reason="nothing happened"), db.audit.delete()):
         with pytest.raises(sa.exc.DatabaseError, match="append-only"):
             with engine.begin() as connection:
@@ -72,7 +73,12 @@ def test_corrections_keep_the_recorded_answer_and_only_a_doctor_signs_off(engine
     review = validation.review(engine, session_id)
     assert review.state is ReviewState.AMENDED and review.signed_by == "dr.lopez"
     (change,) = review.corrections
-    assert (change.item_id, change.option, change.previous_option, change.author) == ("stairs", new, recorded, "nurse.kim")
+    assert (change.item_id, change.option, change.previous_option, change.author) == (
+        "stairs",
+        new,
+        recorded,
+        "nurse.kim",
+    )
     with pytest.raises(validation.ValidationError, match="final"):
         validation.change_item(engine, q, session_id, "stairs", recorded, "changed my mind", doctor)
     actions = [e.action for e in validation.trail(engine, session_id)]
@@ -127,10 +133,20 @@ def test_a_withdrawn_answer_is_gone_and_the_session_follows_interruption_and_con
     item = first.payload["item_id"]
     seq = rows[-1].seq
     extra = [  # the patient changed that answer, the kiosk died, staff continued the test elsewhere
-        {"seq": seq + 1, "kind": "withdraw_answer", "session_id": session_id, "at": first.at,
-         "payload": {"item_id": item, "t": first.t + 1, "at": first.at, "reason": "patient: change my answer"}},
-        {"seq": seq + 2, "kind": "mark_interrupted", "session_id": session_id, "at": first.at,
-         "payload": {"reason": "the kiosk stopped"}},
+        {
+            "seq": seq + 1,
+            "kind": "withdraw_answer",
+            "session_id": session_id,
+            "at": first.at,
+            "payload": {"item_id": item, "t": first.t + 1, "at": first.at, "reason": "patient: change my answer"},
+        },
+        {
+            "seq": seq + 2,
+            "kind": "mark_interrupted",
+            "session_id": session_id,
+            "at": first.at,
+            "payload": {"reason": "the kiosk stopped"},
+        },
     ]
     events = [r.event() for r in rows if r.kind != "finish_session"] + extra
     with engine.begin() as connection:
@@ -139,8 +155,13 @@ def test_a_withdrawn_answer_is_gone_and_the_session_follows_interruption_and_con
     assert item not in {a.item_id for a in stored.answers}
     assert stored.status == "interrupted" and stored.interrupted_reason == "the kiosk stopped"
     again = {"seq": seq + 3, "kind": "continue_session", "session_id": session_id, "at": first.at, "payload": {}}
-    answer = {"seq": seq + 4, "kind": "record_answer", "session_id": session_id, "at": first.at,
-              "payload": first.payload | {"option": 1, "points": load_questionnaire().item(item).option(1).points}}
+    answer = {
+        "seq": seq + 4,
+        "kind": "record_answer",
+        "session_id": session_id,
+        "at": first.at,
+        "payload": first.payload | {"option": 1, "points": load_questionnaire().item(item).option(1).points},
+    }
     with engine.begin() as connection:
         sync.intake(connection, "bed1", sync.parse({"events": [again, answer]}))
         stored = load(connection, session_id)[1]

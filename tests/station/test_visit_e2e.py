@@ -47,10 +47,12 @@ def fits(page, viewport) -> None:
     assert width <= viewport["width"], f"{page.url} is {width} px wide on a {viewport['width']} px screen"
 
 
-@pytest.mark.parametrize(("viewport", "database"), [(PHONE, "sqlite"), (DESKTOP, "postgres")],
-                         ids=["phone-sqlite", "desktop-postgres"])
-def test_order_greet_confirm_answer_ring_sign_off_course(browser, request, station_factory, tmp_path, viewport,
-                                                         database):
+@pytest.mark.parametrize(
+    ("viewport", "database"), [(PHONE, "sqlite"), (DESKTOP, "postgres")], ids=["phone-sqlite", "desktop-postgres"]
+)
+def test_order_greet_confirm_answer_ring_sign_off_course(
+    browser, request, station_factory, tmp_path, viewport, database
+):
     db_url = request.getfixturevalue("sqlite_url" if database == "sqlite" else "pg_url")
     ward = make_ward(db_url)
     station = station_factory(db_url)
@@ -73,8 +75,13 @@ def test_order_greet_confirm_answer_ring_sign_off_course(browser, request, stati
         if found:
             arrived.set()
 
-    watcher = OrderWatcher(StationHttp(station.url, ward.token), instruments=["barthel"],
-                           languages=["en", "es", "fr"], on_orders=on_orders, poll_wait_s=20)
+    watcher = OrderWatcher(
+        StationHttp(station.url, ward.token),
+        instruments=["barthel"],
+        languages=["en", "es", "fr"],
+        on_orders=on_orders,
+        poll_wait_s=20,
+    )
     watcher.start()
 
     # a nurse orders the visit on her phone (or the doctor at the desk)
@@ -97,9 +104,25 @@ def test_order_greet_confirm_answer_ring_sign_off_course(browser, request, stati
     # at the kiosk staff type the code; the scripted patient answers; the kiosk delivers
     config = tmp_path / "kiosk.yaml"
     config.write_text(f"station: {{url: '{station.url}', token: '{ward.token}', kiosk_id: {ward.kiosk_id}}}\n")
-    kiosk = subprocess.run([sys.executable, "-m", "kiosk", "replay", str(ROOT / "recordings/patients/barthel1.yaml"),
-                            "--data-dir", str(tmp_path / "kiosk"), "--config", str(config), "--order-code", code],
-                           capture_output=True, text=True, cwd=ROOT, timeout=300)
+    kiosk = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "kiosk",
+            "replay",
+            str(ROOT / "recordings/patients/barthel1.yaml"),
+            "--data-dir",
+            str(tmp_path / "kiosk"),
+            "--config",
+            str(config),
+            "--order-code",
+            code,
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+    )
     assert kiosk.returncode == 0, kiosk.stderr
     assert "patient NHC-0042" in kiosk.stdout
 

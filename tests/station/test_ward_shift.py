@@ -41,8 +41,11 @@ def event(seq: int, session_id: str, kind: str, t: float) -> Row:
 def alert_rows(db_url: str, kiosk: str) -> list:
     engine = db.make_engine(db_url)
     with engine.connect() as connection:
-        rows = connection.execute(sa.select(db.alerts.c.kind, db.alerts.c.ack_by).where(
-            db.alerts.c.kiosk_id == kiosk).order_by(db.alerts.c.id)).all()
+        rows = connection.execute(
+            sa.select(db.alerts.c.kind, db.alerts.c.ack_by)
+            .where(db.alerts.c.kiosk_id == kiosk)
+            .order_by(db.alerts.c.id)
+        ).all()
     engine.dispose()
     return [tuple(r) for r in rows]
 

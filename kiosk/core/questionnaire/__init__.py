@@ -207,8 +207,10 @@ class Timing:
             if name not in known:
                 raise ValueError(f"unknown timing setting {name!r} (known: {', '.join(sorted(known))})")
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_TIMING_S:
-                raise ValueError(f"timing setting {name!r} must be a number of seconds from 0 to "
-                                 f"{MAX_TIMING_S:g} (a day), got {value!r}")
+                raise ValueError(
+                    f"timing setting {name!r} must be a number of seconds from 0 to "
+                    f"{MAX_TIMING_S:g} (a day), got {value!r}"
+                )
             changes[name] = float(value)
         for name in ("attempt_window_s", "confirm_window_s"):
             if changes.get(name, getattr(self, name)) <= 0:
@@ -395,17 +397,21 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
     Runs even when the schema found problems, so every error is reported in one go; parts with
     the wrong shape (already reported by the schema) are skipped.
     """
+
     def dicts(value: Any) -> list[tuple[int, dict[str, Any]]]:
         return [(i, v) for i, v in enumerate(value) if isinstance(v, dict)] if isinstance(value, list) else []
 
-    languages = [x for x in data.get("languages", []) if isinstance(x, str)] if isinstance(
-        data.get("languages"), list) else []
+    languages = (
+        [x for x in data.get("languages", []) if isinstance(x, str)] if isinstance(data.get("languages"), list) else []
+    )
     if len(set(languages)) != len(languages):
         add(("languages",), "a language is listed twice in 'languages'")
     for i, lang in enumerate(languages):
         if lang not in SCREEN_LANGUAGES:
-            add(("languages", i), f"language {lang!r}: the kiosk's screens have text in "
-                                  f"{', '.join(SCREEN_LANGUAGES)} only")
+            add(
+                ("languages", i),
+                f"language {lang!r}: the kiosk's screens have text in {', '.join(SCREEN_LANGUAGES)} only",
+            )
 
     def texts(path: tuple[Any, ...], value: Any) -> None:
         if not isinstance(value, dict):
@@ -415,14 +421,15 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                 add(path, f"{describe(path)} has no {lang!r} translation")
         for lang, text in value.items():
             if languages and lang not in languages:
-                add(path + (lang,), f"{describe(path)} has a {lang!r} text but {lang!r} is not in 'languages'",
-                    key=True)
+                add(
+                    path + (lang,), f"{describe(path)} has a {lang!r} text but {lang!r} is not in 'languages'", key=True
+                )
             if isinstance(text, str) and text and not text.strip():  # "" is the schema's to report
                 add(path + (lang,), f"{describe(path)} in {lang!r} is blank: write the words")
 
     texts(("title",), data.get("title"))
     messages = data.get("messages")
-    for name, value in (messages.items() if isinstance(messages, dict) else ()):
+    for name, value in messages.items() if isinstance(messages, dict) else ():
         texts(("messages", name), value)
 
     def options(path: tuple[Any, ...], value: Any, scored: bool) -> None:
@@ -432,7 +439,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             texts(path + (i, "label"), option.get("label"))
             texts(path + (i, "patient"), option.get("patient"))
             synonyms = option.get("synonyms")
-            for lang, words in (synonyms.items() if isinstance(synonyms, dict) else ()):
+            for lang, words in synonyms.items() if isinstance(synonyms, dict) else ():
                 if languages and lang not in languages:
                     add(path + (i, "synonyms", lang), f"synonyms in {lang!r}, which is not in 'languages'", key=True)
                 for n, word in enumerate(words if isinstance(words, list) else ()):
@@ -464,26 +471,37 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             texts(path + ("patient",), entry.get("patient"))
             texts(path + ("spoken",), entry.get("spoken"))
             spoken = entry.get("spoken")
-            for lang, said in (spoken.items() if isinstance(spoken, dict) else ()):
+            for lang, said in spoken.items() if isinstance(spoken, dict) else ():
                 for mark in re.findall(r"\{[^}]*\}", said) if isinstance(said, str) else ():
                     if mark != "{ways}":
-                        add(path + ("spoken", lang), f"{mark} would be said aloud: the only mark a spoken "
-                                                     "text may hold is {ways} (how to answer)")
+                        add(
+                            path + ("spoken", lang),
+                            f"{mark} would be said aloud: the only mark a spoken "
+                            "text may hold is {ways} (how to answer)",
+                        )
             options(path + ("options",), entry.get("options"), scored=section == "items")
             expected, opts = entry.get("expected"), entry.get("options")
-            if section == "familiarisation" and isinstance(expected, int) and isinstance(opts, list) \
-                    and expected > len(opts):
+            if (
+                section == "familiarisation"
+                and isinstance(expected, int)
+                and isinstance(opts, list)
+                and expected > len(opts)
+            ):
                 add(path + ("expected",), f"expected option {expected} but there are only {len(opts)} options")
 
     _check_bands(data, dicts, texts, add)
 
 
-def _check_displays(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
-                    add: Callable[..., None]) -> None:
+def _check_displays(
+    data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]], add: Callable[..., None]
+) -> None:
     """One code, one display: a code system gives a code one display, so two places of the
     file giving one code two displays is a mistake (an export would say both)."""
     first: dict[tuple[Any, Any], tuple[str, tuple[Any, ...]]] = {}
-    places: list[tuple[tuple[Any, ...], Any]] = [(("code",), data.get("code")), (("total_code",), data.get("total_code"))]
+    places: list[tuple[tuple[Any, ...], Any]] = [
+        (("code",), data.get("code")),
+        (("total_code",), data.get("total_code")),
+    ]
     for i, item in dicts(data.get("items")):
         places.append((("items", i, "code"), item.get("code")))
         places += [(("items", i, "options", j, "code"), option.get("code")) for j, option in dicts(item.get("options"))]
@@ -492,8 +510,11 @@ def _check_displays(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int,
             continue
         key = (code.get("system"), code.get("code"))
         if key in first and first[key][0] != code["display"]:
-            add(path + ("display",), f"code {key[1]!r} has the display {code['display']!r} here but "
-                                     f"{first[key][0]!r} at {describe(first[key][1])}: one code, one display")
+            add(
+                path + ("display",),
+                f"code {key[1]!r} has the display {code['display']!r} here but "
+                f"{first[key][0]!r} at {describe(first[key][1])}: one code, one display",
+            )
         first.setdefault(key, (code["display"], path))
 
 
@@ -512,8 +533,12 @@ def _reachable_totals(items: list[tuple[int, dict[str, Any]]]) -> set[int] | Non
     return totals
 
 
-def _check_bands(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
-                 texts: Callable[[tuple[Any, ...], Any], None], add: Callable[..., None]) -> None:
+def _check_bands(
+    data: dict[str, Any],
+    dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
+    texts: Callable[[tuple[Any, ...], Any], None],
+    add: Callable[..., None],
+) -> None:
     """Each band set: labels translated, unique band ids, no two bands sharing a total, every total
     a patient can reach in a band, and the last band ending at the highest possible total; the
     default names one of the sets.
@@ -539,23 +564,33 @@ def _check_bands(data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, di
             if band.get("id") in band_ids:
                 add(path + (i, "id"), f"band set {name!r}: duplicate band id {band['id']!r}")
             band_ids.add(band.get("id"))
-        if reachable is None or not bands or not all(isinstance(b.get("min"), int) and isinstance(b.get("max"), int)
-                                                     for _, b in bands):
+        if (
+            reachable is None
+            or not bands
+            or not all(isinstance(b.get("min"), int) and isinstance(b.get("max"), int) for _, b in bands)
+        ):
             continue
         for i, band in bands:
             if band["min"] > band["max"]:
-                add(path + (i,), f"band set {name!r}: band {band.get('id')!r} has min {band['min']} "
-                                 f"above max {band['max']}")
+                add(
+                    path + (i,),
+                    f"band set {name!r}: band {band.get('id')!r} has min {band['min']} above max {band['max']}",
+                )
         ordered = sorted(bands, key=lambda ib: (ib[1]["min"], ib[1]["max"]))
         below = -1  # the highest total covered so far
         previous: dict[str, Any] | None = None
         for i, band in ordered:
             if previous is not None and band["min"] <= below:
-                add(path + (i, "min"), f"band set {name!r}: bands {previous.get('id')!r} and {band.get('id')!r} "
-                                       f"overlap ({band['min']} to {min(below, band['max'])} are in both)")
+                add(
+                    path + (i, "min"),
+                    f"band set {name!r}: bands {previous.get('id')!r} and {band.get('id')!r} "
+                    f"overlap ({band['min']} to {min(below, band['max'])} are in both)",
+                )
             elif missed := sorted(t for t in reachable if below < t < band["min"]):
-                add(path + (i, "min"), f"band set {name!r}: bands leave a gap before {band['min']} "
-                                       f"(a total of {missed[0]} is in no band)")
+                add(
+                    path + (i, "min"),
+                    f"band set {name!r}: bands leave a gap before {band['min']} (a total of {missed[0]} is in no band)",
+                )
             if band["max"] > below:
                 below, previous = band["max"], band
         if below != max(reachable):
@@ -580,19 +615,37 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         )
 
     items = tuple(
-        Item(id=v["id"], number=n, text=dict(v["text"]), spoken=dict(v["spoken"]),
-             options=opts(v["options"]), code=code(v.get("code")), patient=dict(v.get("patient", {})))
+        Item(
+            id=v["id"],
+            number=n,
+            text=dict(v["text"]),
+            spoken=dict(v["spoken"]),
+            options=opts(v["options"]),
+            code=code(v.get("code")),
+            patient=dict(v.get("patient", {})),
+        )
         for n, v in enumerate(data["items"], start=1)
     )
     practice = tuple(
-        PracticeQuestion(id=v["id"], checks=v["checks"], text=dict(v["text"]), spoken=dict(v["spoken"]),
-                         options=opts(v["options"]), expected=v["expected"])
+        PracticeQuestion(
+            id=v["id"],
+            checks=v["checks"],
+            text=dict(v["text"]),
+            spoken=dict(v["spoken"]),
+            options=opts(v["options"]),
+            expected=v["expected"],
+        )
         for v in data.get("familiarisation", [])
     )
     band_sets = {
-        name: BandSet(id=name, source=v.get("source", ""),
-                      bands=tuple(Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]))
-                                  for b in sorted(v["ranges"], key=lambda b: b["min"])))
+        name: BandSet(
+            id=name,
+            source=v.get("source", ""),
+            bands=tuple(
+                Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]))
+                for b in sorted(v["ranges"], key=lambda b: b["min"])
+            ),
+        )
         for name, v in data["bands"]["sets"].items()
     }
     return Questionnaire(
@@ -611,4 +664,3 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         source=source,
         digest=hashlib.sha256(json.dumps(data, sort_keys=True, ensure_ascii=False).encode()).hexdigest(),
     )
-

@@ -50,27 +50,61 @@ def _code(code: Code | None) -> dict[str, str] | None:
 
 
 def _option(o: Option) -> dict[str, Any]:
-    return {"number": o.number, "label": dict(o.label), "synonyms": {k: list(v) for k, v in o.synonyms.items()},
-            "points": o.points, "patient": dict(o.patient), "code": _code(o.code)}
+    return {
+        "number": o.number,
+        "label": dict(o.label),
+        "synonyms": {k: list(v) for k, v in o.synonyms.items()},
+        "points": o.points,
+        "patient": dict(o.patient),
+        "code": _code(o.code),
+    }
 
 
 def canonical(q: Questionnaire) -> dict[str, Any]:
     """Everything ``q`` says, as plain JSON values (``source``, a file path, is not part of it)."""
     return {
-        "format": FORMAT, "id": q.id, "version": q.version, "digest": q.digest, "title": dict(q.title),
+        "format": FORMAT,
+        "id": q.id,
+        "version": q.version,
+        "digest": q.digest,
+        "title": dict(q.title),
         "languages": list(q.languages),
-        "items": [{"id": i.id, "number": i.number, "text": dict(i.text), "spoken": dict(i.spoken),
-                   "patient": dict(i.patient), "code": _code(i.code), "options": [_option(o) for o in i.options]}
-                  for i in q.items],
-        "band_sets": [{"id": s.id, "source": s.source,
-                       "bands": [{"id": b.id, "min": b.min, "max": b.max, "label": dict(b.label)} for b in s.bands]}
-                      for s in q.band_sets.values()],
+        "items": [
+            {
+                "id": i.id,
+                "number": i.number,
+                "text": dict(i.text),
+                "spoken": dict(i.spoken),
+                "patient": dict(i.patient),
+                "code": _code(i.code),
+                "options": [_option(o) for o in i.options],
+            }
+            for i in q.items
+        ],
+        "band_sets": [
+            {
+                "id": s.id,
+                "source": s.source,
+                "bands": [{"id": b.id, "min": b.min, "max": b.max, "label": dict(b.label)} for b in s.bands],
+            }
+            for s in q.band_sets.values()
+        ],
         "band_set": q.band_set,
         "messages": {name: dict(texts) for name, texts in q.messages.items()},
-        "familiarisation": [{"id": p.id, "checks": p.checks, "text": dict(p.text), "spoken": dict(p.spoken),
-                             "expected": p.expected, "options": [_option(o) for o in p.options]}
-                            for p in q.familiarisation],
-        "timing": asdict(q.timing), "code": _code(q.code), "total_code": _code(q.total_code),
+        "familiarisation": [
+            {
+                "id": p.id,
+                "checks": p.checks,
+                "text": dict(p.text),
+                "spoken": dict(p.spoken),
+                "expected": p.expected,
+                "options": [_option(o) for o in p.options],
+            }
+            for p in q.familiarisation
+        ],
+        "timing": asdict(q.timing),
+        "code": _code(q.code),
+        "total_code": _code(q.total_code),
     }
 
 
@@ -92,8 +126,9 @@ def questionnaire_from(definition: Mapping[str, Any], source: str = "") -> Quest
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         if isinstance(exc, DefinitionError):
             raise
-        raise DefinitionError(f"the captured definition does not describe a questionnaire "
-                              f"({type(exc).__name__}: {exc})") from None
+        raise DefinitionError(
+            f"the captured definition does not describe a questionnaire ({type(exc).__name__}: {exc})"
+        ) from None
 
 
 def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
@@ -113,10 +148,17 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
         return Code(str(value["system"]), str(value["code"]), str(value.get("display", ""))) if value else None
 
     def options(values: list[Mapping[str, Any]]) -> tuple[Option, ...]:
-        built = tuple(Option(number=int(v["number"]), label=texts(v["label"]),
-                             synonyms={lang: tuple(words) for lang, words in texts_of_lists(v["synonyms"]).items()},
-                             points=v["points"], patient=texts(v["patient"]), code=code(v["code"]))
-                      for v in values)
+        built = tuple(
+            Option(
+                number=int(v["number"]),
+                label=texts(v["label"]),
+                synonyms={lang: tuple(words) for lang, words in texts_of_lists(v["synonyms"]).items()},
+                points=v["points"],
+                patient=texts(v["patient"]),
+                code=code(v["code"]),
+            )
+            for v in values
+        )
         if [o.number for o in built] != list(range(1, len(built) + 1)):
             raise DefinitionError("options must be numbered 1, 2, 3... in order")
         return built
@@ -125,22 +167,56 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
         order = [lang for lang in languages if lang in value] + [lang for lang in value if lang not in languages]
         return {lang: list(value[lang]) for lang in order}
 
-    items = tuple(Item(id=str(v["id"]), number=int(v["number"]), text=texts(v["text"]), spoken=texts(v["spoken"]),
-                       options=options(v["options"]), code=code(v["code"]), patient=texts(v["patient"]))
-                  for v in d["items"])
+    items = tuple(
+        Item(
+            id=str(v["id"]),
+            number=int(v["number"]),
+            text=texts(v["text"]),
+            spoken=texts(v["spoken"]),
+            options=options(v["options"]),
+            code=code(v["code"]),
+            patient=texts(v["patient"]),
+        )
+        for v in d["items"]
+    )
     if not items or any(not item.options or any(o.points is None for o in item.options) for item in items):
         raise DefinitionError("every item of a captured definition needs scored options")
-    band_sets = {str(s["id"]): BandSet(id=str(s["id"]), source=str(s["source"]), bands=tuple(
-        Band(id=str(b["id"]), min=int(b["min"]), max=int(b["max"]), label=texts(b["label"])) for b in s["bands"]))
-        for s in d["band_sets"]}
+    band_sets = {
+        str(s["id"]): BandSet(
+            id=str(s["id"]),
+            source=str(s["source"]),
+            bands=tuple(
+                Band(id=str(b["id"]), min=int(b["min"]), max=int(b["max"]), label=texts(b["label"])) for b in s["bands"]
+            ),
+        )
+        for s in d["band_sets"]
+    }
     if d["band_set"] not in band_sets:
         raise DefinitionError(f"the band set in use, {d['band_set']!r}, is not one of the captured band sets")
-    practice = tuple(PracticeQuestion(id=str(v["id"]), checks=str(v["checks"]), text=texts(v["text"]),
-                                      spoken=texts(v["spoken"]), options=options(v["options"]),
-                                      expected=int(v["expected"])) for v in d["familiarisation"])
+    practice = tuple(
+        PracticeQuestion(
+            id=str(v["id"]),
+            checks=str(v["checks"]),
+            text=texts(v["text"]),
+            spoken=texts(v["spoken"]),
+            options=options(v["options"]),
+            expected=int(v["expected"]),
+        )
+        for v in d["familiarisation"]
+    )
     return Questionnaire(
-        id=str(d["id"]), version=str(d["version"]), title=texts(d["title"]), languages=languages, items=items,
-        band_sets=band_sets, band_set=str(d["band_set"]),
+        id=str(d["id"]),
+        version=str(d["version"]),
+        title=texts(d["title"]),
+        languages=languages,
+        items=items,
+        band_sets=band_sets,
+        band_set=str(d["band_set"]),
         messages={str(name): texts(value) for name, value in d["messages"].items()},
-        familiarisation=practice, timing=Timing(**{k: float(v) for k, v in d["timing"].items()}),
-        code=code(d["code"]), total_code=code(d["total_code"]), source=source, digest=str(d["digest"]))
+        familiarisation=practice,
+        timing=Timing(**{k: float(v) for k, v in d["timing"].items()}),
+        code=code(d["code"]),
+        total_code=code(d["total_code"]),
+        source=source,
+        digest=str(d["digest"]),
+    )

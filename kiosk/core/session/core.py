@@ -12,8 +12,8 @@ from typing import Any
 
 from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.clock import Clock
-from kiosk.core.questionnaire.definition import canonical
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
+from kiosk.core.questionnaire.definition import canonical
 from kiosk.core.session.corrections import Corrections
 from kiosk.core.session.events import (
     AnsweredBy,
@@ -127,8 +127,16 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
     # -- construction from a stored, unfinished session -----------------------------------------
 
     @classmethod
-    def from_stored(cls, questionnaire: Questionnaire, stored: Any, *, clock: Clock, engine: QosEngine | None,
-                    store: SessionStore | None, **kwargs: Any) -> Session:
+    def from_stored(
+        cls,
+        questionnaire: Questionnaire,
+        stored: Any,
+        *,
+        clock: Clock,
+        engine: QosEngine | None,
+        store: SessionStore | None,
+        **kwargs: Any,
+    ) -> Session:
         """A session continuing a stored unfinished one (``kiosk.store.database.StoredSession``).
 
         The QoS engine is brought back to where it was by replaying the stored context trace;
@@ -145,12 +153,20 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         if engine is not None and last_timed > last:
             engine.advance(last_timed)
         session = cls(
-            questionnaire, clock=clock, engine=engine, store=store, patient_id=stored.patient_id,
-            language=stored.language, answered_by=stored.answered_by, session_id=stored.id,
+            questionnaire,
+            clock=clock,
+            engine=engine,
+            store=store,
+            patient_id=stored.patient_id,
+            language=stored.language,
+            answered_by=stored.answered_by,
+            session_id=stored.id,
             # the crash took some time: resumed batches come a second after the stored ones
             t_offset=max(last, last_timed) + 1.0,
             resume_answers={a.item_id: a for a in stored.answers},
-            resume_not_answered=tuple(stored.not_answered), familiarisation=False, **kwargs,
+            resume_not_answered=tuple(stored.not_answered),
+            familiarisation=False,
+            **kwargs,
         )
         session.trace = [dict(e) for e in stored.trace]
         if session.adaptation is not None:
@@ -241,14 +257,26 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
             practice = self.questionnaire.familiarisation[self._open.index]
         item = self.current_item
         return Snapshot(
-            phase=self._phase, language=self._language, item=item,
-            number=item.number if item else None, count=len(self.questionnaire.items),
-            practice=practice, attempt=self.current_attempt, remaining=self.remaining(),
-            paused=self.paused, halted=self.halted, person_present=self._person_present,
-            listening=self._listening, adaptations=self._active_adaptations(),
-            speech_rate=self._speech_rate(), answers=dict(self._answers),
-            not_answered=tuple(self._not_answered), score=self._score, prompt=self._prompt,
-            interlude=self._interlude(), **self._practice_progress(),
+            phase=self._phase,
+            language=self._language,
+            item=item,
+            number=item.number if item else None,
+            count=len(self.questionnaire.items),
+            practice=practice,
+            attempt=self.current_attempt,
+            remaining=self.remaining(),
+            paused=self.paused,
+            halted=self.halted,
+            person_present=self._person_present,
+            listening=self._listening,
+            adaptations=self._active_adaptations(),
+            speech_rate=self._speech_rate(),
+            answers=dict(self._answers),
+            not_answered=tuple(self._not_answered),
+            score=self._score,
+            prompt=self._prompt,
+            interlude=self._interlude(),
+            **self._practice_progress(),
             confirming=self._open.unconfirmed.option if self._open and self._open.unconfirmed else None,
             can_undo=self._can_undo() and not self._timers.frozen,
         )
@@ -352,16 +380,19 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
 
     def _start(self, t: float, answered_by: AnsweredBy | str | None) -> None:
         if self._phase is not Phase.WELCOME:
-            self._ignore(t, None, IgnoreReason.FINISHED if self.finished else IgnoreReason.NO_OPEN_ATTEMPT,
-                         "start")
+            self._ignore(t, None, IgnoreReason.FINISHED if self.finished else IgnoreReason.NO_OPEN_ATTEMPT, "start")
             return
         if answered_by is not None:
             self._answered_by = AnsweredBy(answered_by)
         if self.store is not None and not self._resuming:
             self.store.create_session(
-                session_id=self.id, patient_id=self.patient_id, questionnaire_id=self.questionnaire.id,
-                language=self._language, answered_by=self._answered_by.value,
-                started_at=self.clock.wall().isoformat(), timing=vars(self.timing),
+                session_id=self.id,
+                patient_id=self.patient_id,
+                questionnaire_id=self.questionnaire.id,
+                language=self._language,
+                answered_by=self._answered_by.value,
+                started_at=self.clock.wall().isoformat(),
+                timing=vars(self.timing),
                 definition=canonical(self.questionnaire),  # what describes this session from now on
             )
             self._stored = True
@@ -413,10 +444,17 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         lang = self._language
         text = self.questionnaire.message("welcome", lang)
         options = tuple(
-            PromptOption(number, OWN_NAME.get(language, language),
-                         (*LANGUAGE_NAMES.get(lang, {}).get(language, ()),
-                          *(START_WORDS.get(lang, ()) if language == lang else ())), None)
-            for number, language in enumerate(self.questionnaire.languages, start=1))
+            PromptOption(
+                number,
+                OWN_NAME.get(language, language),
+                (
+                    *LANGUAGE_NAMES.get(lang, {}).get(language, ()),
+                    *(START_WORDS.get(lang, ()) if language == lang else ()),
+                ),
+                None,
+            )
+            for number, language in enumerate(self.questionnaire.languages, start=1)
+        )
         return Prompt(t, "welcome", "welcome", text, text, lang, options, speech_rate=self._speech_rate())
 
     def _acknowledge(self, t: float) -> None:

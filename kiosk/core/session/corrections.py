@@ -74,9 +74,14 @@ class Corrections:
     def _can_undo(self: Session) -> bool:
         """The thank-you gap after a stored answer is running (and nothing stops the clock)."""
         open_ = self._open
-        return (self._phase is Phase.QUESTIONS and open_ is not None and not open_.practice
-                and open_.outcome == "answered" and self._timers.kind in ("open", "finish")
-                and self.questionnaire.items[open_.index].id in self._answers)
+        return (
+            self._phase is Phase.QUESTIONS
+            and open_ is not None
+            and not open_.practice
+            and open_.outcome == "answered"
+            and self._timers.kind in ("open", "finish")
+            and self.questionnaire.items[open_.index].id in self._answers
+        )
 
     def _ask_confirmation(self: Session, t: float, event: ChannelInput) -> None:
         open_ = self._open
@@ -86,10 +91,16 @@ class Corrections:
         open_.unconfirmed = Unconfirmed(event.option, event.channel, event.detail, event.confidence, remaining)
         self._timers.set("confirm", t, self.timing.confirm_window_s)
         confidence = f", confidence {event.confidence:.2f}" if event.confidence is not None else ""
-        self._log(t, "confirmation_asked",
-                  f"{item.id} option {event.option} ({event.channel.value} {event.detail!r}{confidence})")
-        self._emit(ConfirmationAsked(t, item.id, item.number, event.option, open_.attempt, event.channel,
-                                     t + self.timing.confirm_window_s))
+        self._log(
+            t,
+            "confirmation_asked",
+            f"{item.id} option {event.option} ({event.channel.value} {event.detail!r}{confidence})",
+        )
+        self._emit(
+            ConfirmationAsked(
+                t, item.id, item.number, event.option, open_.attempt, event.channel, t + self.timing.confirm_window_s
+            )
+        )
         self._prompt_question(t, repeat=False)
         self._update_listening(t)
 
@@ -110,8 +121,7 @@ class Corrections:
             return
         open_.unconfirmed = None
         item = self.questionnaire.items[open_.index]
-        self._log(t, "answer_confirmed", f"{item.id} option {pending.option} by {event.channel.value} "
-                                         f"{event.detail!r}")
+        self._log(t, "answer_confirmed", f"{item.id} option {pending.option} by {event.channel.value} {event.detail!r}")
         self._record_answer(t, pending.option, pending.channel, f"{pending.detail} (confirmed)")
 
     def _not_confirmed(self: Session, t: float, why: str) -> None:
@@ -131,8 +141,7 @@ class Corrections:
 
     def _undo(self: Session, t: float, event: ChannelInput) -> None:
         """Take back the answer waiting for confirmation, or the last one stored during its gap."""
-        reason = (IgnoreReason.DOCTOR_CALLED if self.halted else IgnoreReason.PAUSED if self.paused
-                  else None)
+        reason = IgnoreReason.DOCTOR_CALLED if self.halted else IgnoreReason.PAUSED if self.paused else None
         open_ = self._open
         if reason is None and open_ is not None and open_.unconfirmed is not None:
             self._not_confirmed(t, "undone")
@@ -146,15 +155,31 @@ class Corrections:
         item = self.questionnaire.items[open_.index]
         answer = self._answers.pop(item.id)
         if self.store is not None and self._stored:
-            self.store.withdraw_answer(self.id, item_id=item.id, t=t, at=self._wall(t),
-                                       reason=f"undo by {event.channel.value} {event.detail!r}")
+            self.store.withdraw_answer(
+                self.id,
+                item_id=item.id,
+                t=t,
+                at=self._wall(t),
+                reason=f"undo by {event.channel.value} {event.detail!r}",
+            )
         self._context(t, {"TestState": "REPEATING"})
         open_.outcome = None
         open_.correcting = True
         window = self._attempt_window()
         self._timers.set("attempt", t, window)
-        self._emit(AnswerWithdrawn(t, item.id, item.number, answer.option, answer.points, answer.attempt,
-                                   answer.channel, event.channel, t + window))
+        self._emit(
+            AnswerWithdrawn(
+                t,
+                item.id,
+                item.number,
+                answer.option,
+                answer.points,
+                answer.attempt,
+                answer.channel,
+                event.channel,
+                t + window,
+            )
+        )
         self._prompt_question(t, repeat=True)
         self._update_listening(t)
 
@@ -165,8 +190,11 @@ class Corrections:
         lang = self._language
         item = self.questionnaire.items[open_.index]
         heard = item.option(open_.unconfirmed.option).label_in(lang)
-        template = ((open_.unconfirmed.press and self.questionnaire.message("confirm_answer_press", lang))
-                    or self.questionnaire.message("confirm_answer", lang) or "{answer}?")
+        template = (
+            (open_.unconfirmed.press and self.questionnaire.message("confirm_answer_press", lang))
+            or self.questionnaire.message("confirm_answer", lang)
+            or "{answer}?"
+        )
         text = template.replace("{answer}", heard)
         words: Mapping[int, tuple[str, tuple[str, ...]]] = CONFIRM_WORDS.get(lang, CONFIRM_WORDS["en"])
         options = tuple(PromptOption(number, label, synonyms, None) for number, (label, synonyms) in words.items())

@@ -330,4 +330,3 @@ class Finished(SessionEvent):
     """The questionnaire is over; the score is recomputed from the recorded answers."""
 
     score: Score
-

@@ -120,8 +120,9 @@ class Incidents:
 
     def _pause(self: Session, t: float, channel: Channel | None, event: ChannelInput | None = None) -> None:
         if not self._started():
-            self._ignore(t, event, IgnoreReason.NOT_STARTED if self._phase is Phase.WELCOME else IgnoreReason.FINISHED,
-                         "pause")
+            self._ignore(
+                t, event, IgnoreReason.NOT_STARTED if self._phase is Phase.WELCOME else IgnoreReason.FINISHED, "pause"
+            )
             return
         if self.halted:
             self._ignore(t, event, IgnoreReason.DOCTOR_CALLED, "pause")
@@ -149,8 +150,12 @@ class Incidents:
 
     def _call_doctor(self: Session, t: float, channel: Channel | None, event: ChannelInput | None = None) -> None:
         if not self._started():
-            self._ignore(t, event, IgnoreReason.NOT_STARTED if self._phase is Phase.WELCOME else IgnoreReason.FINISHED,
-                         "call_doctor")
+            self._ignore(
+                t,
+                event,
+                IgnoreReason.NOT_STARTED if self._phase is Phase.WELCOME else IgnoreReason.FINISHED,
+                "call_doctor",
+            )
             return
         if self.halted:
             self._ignore(t, event, IgnoreReason.ALREADY_CALLED, "call_doctor")

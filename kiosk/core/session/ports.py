@@ -29,20 +29,52 @@ class QosEngine(Protocol):
 class SessionStore(Protocol):
     """What the session needs of ``kiosk.store.database.Store`` (each call commits before returning)."""
 
-    def create_session(self, *, session_id: str, patient_id: str, questionnaire_id: str, language: str,
-                       answered_by: str, started_at: str, timing: Mapping[str, float],
-                       definition: Mapping[str, Any] | None = None) -> None: ...
-    def record_answer(self, session_id: str, *, item_id: str, option: int, points: int, attempt: int,
-                      channel: str, answered_by: str, t: float, at: str, detail: str = "") -> None: ...
+    def create_session(
+        self,
+        *,
+        session_id: str,
+        patient_id: str,
+        questionnaire_id: str,
+        language: str,
+        answered_by: str,
+        started_at: str,
+        timing: Mapping[str, float],
+        definition: Mapping[str, Any] | None = None,
+    ) -> None: ...
+    def record_answer(
+        self,
+        session_id: str,
+        *,
+        item_id: str,
+        option: int,
+        points: int,
+        attempt: int,
+        channel: str,
+        answered_by: str,
+        t: float,
+        at: str,
+        detail: str = "",
+    ) -> None: ...
     def withdraw_answer(self, session_id: str, *, item_id: str, t: float, at: str, reason: str) -> None: ...
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None: ...
-    def record_practice(self, session_id: str, *, question_id: str, checks: str, outcome: str, option: int | None,
-                        channel: str | None, t: float, at: str, detail: str = "") -> None: ...
+    def record_practice(
+        self,
+        session_id: str,
+        *,
+        question_id: str,
+        checks: str,
+        outcome: str,
+        option: int | None,
+        channel: str | None,
+        t: float,
+        at: str,
+        detail: str = "",
+    ) -> None: ...
     def record_context(self, session_id: str, *, t: float, set: Mapping[str, Any], emit: list[str]) -> None: ...
     def record_metrics(self, session_id: str, *, t: float, metrics: Mapping[str, float], fired: list[str]) -> None: ...
     def record_adaptation(self, session_id: str, *, t: float, name: str, active: bool, reason: str) -> None: ...
     def record_event(self, session_id: str, *, t: float, kind: str, detail: str = "") -> None: ...
-    def finish_session(self, session_id: str, *, finished_at: str, total: int, complete: bool,
-                       band: str | None) -> None: ...
+    def finish_session(
+        self, session_id: str, *, finished_at: str, total: int, complete: bool, band: str | None
+    ) -> None: ...
     def transaction(self) -> AbstractContextManager[None]: ...
-

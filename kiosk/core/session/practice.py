@@ -61,9 +61,12 @@ class Practice:
         if self._open is None or not self._open.practice:
             return {}
         current = self._open.index
-        asked = [i for i, question in enumerate(self.questionnaire.familiarisation)
-                 if question.id not in self._practice_unasked
-                 and (i <= current or self._practice_skip_reason(question) is None)]
+        asked = [
+            i
+            for i, question in enumerate(self.questionnaire.familiarisation)
+            if question.id not in self._practice_unasked
+            and (i <= current or self._practice_skip_reason(question) is None)
+        ]
         return {"practice_number": asked.index(current) + 1, "practice_count": len(asked)}
 
     def _next_practice(self: Session, t: float) -> None:
@@ -104,8 +107,14 @@ class Practice:
         assert self._open is not None and event.option is not None
         question = self.questionnaire.familiarisation[self._open.index]
         correct = event.option == question.expected
-        self._record_practice(t, question, "right" if correct else "wrong", option=event.option,
-                              channel=event.channel, detail=event.detail)
+        self._record_practice(
+            t,
+            question,
+            "right" if correct else "wrong",
+            option=event.option,
+            channel=event.channel,
+            detail=event.detail,
+        )
         self._emit(PracticeAnswered(t, question.id, event.option, correct, event.channel))
         self._open.feedback = "practice_right" if correct else "practice_wrong"
         self._message(t, self._open.feedback)
@@ -121,11 +130,27 @@ class Practice:
         self._emit(PracticeAnswered(t, question.id, None, False, None))
         self._next_practice(t)
 
-    def _record_practice(self: Session, t: float, question: PracticeQuestion, outcome: str, *,
-                         option: int | None = None, channel: Channel | None = None, detail: str = "") -> None:
+    def _record_practice(
+        self: Session,
+        t: float,
+        question: PracticeQuestion,
+        outcome: str,
+        *,
+        option: int | None = None,
+        channel: Channel | None = None,
+        detail: str = "",
+    ) -> None:
         """Store a practice question's outcome ("right", "wrong", "not_answered" or "skipped") for
         the clinician; practice never reaches the QoS engine."""
         if self.store is not None and self._stored:
-            self.store.record_practice(self.id, question_id=question.id, checks=question.checks, outcome=outcome,
-                                       option=option, channel=channel.value if channel else None, t=t,
-                                       at=self._wall(t), detail=detail)
+            self.store.record_practice(
+                self.id,
+                question_id=question.id,
+                checks=question.checks,
+                outcome=outcome,
+                option=option,
+                channel=channel.value if channel else None,
+                t=t,
+                at=self._wall(t),
+                detail=detail,
+            )

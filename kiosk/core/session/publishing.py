@@ -169,8 +169,16 @@ class Publisher:
                     self._log(result.t, "qos_timers", ", ".join(result.timers))
             if self.store is not None:
                 self.store.record_metrics(self.id, t=result.t, metrics=self.metrics, fired=list(fired))
-            self._emit(MetricsUpdated(result.t, dict(self.metrics), fired, contexts,
-                                      tuple(mine.emit) if mine is not None else (), tuple(result.timers)))
+            self._emit(
+                MetricsUpdated(
+                    result.t,
+                    dict(self.metrics),
+                    fired,
+                    contexts,
+                    tuple(mine.emit) if mine is not None else (),
+                    tuple(result.timers),
+                )
+            )
             if self.adaptation is not None:
                 for change in self.adaptation.observe(self.metrics, answered=_is_answer(contexts)):
                     self._apply_adaptation(result.t, change)
@@ -182,8 +190,9 @@ class Publisher:
     def _message(self: Session, t: float, name: str) -> None:
         text = self.questionnaire.message(name, self._language)
         if text:
-            self._publish_prompt(Prompt(t, "message", name, text, text, self._language,
-                                        speech_rate=self._speech_rate()))
+            self._publish_prompt(
+                Prompt(t, "message", name, text, text, self._language, speech_rate=self._speech_rate())
+            )
 
     def _prompt_question(self: Session, t: float, repeat: bool) -> None:
         """Ask the open question (or, while an answer waits for confirmation, "Is that right?")."""
@@ -193,14 +202,26 @@ class Publisher:
             return
         lang = self._language
         question = self._question()
-        options = tuple(PromptOption(o.number, o.label_in(lang), o.synonyms_in(lang), o.points)
-                        for o in question.options)
+        options = tuple(
+            PromptOption(o.number, o.label_in(lang), o.synonyms_in(lang), o.points) for o in question.options
+        )
         spoken = question.spoken[lang]
         if repeat and self.questionnaire.message("repeat", lang):
             spoken = f"{self.questionnaire.message('repeat', lang)} {spoken}"
-        self._publish_prompt(Prompt(t, "practice" if self._open.practice else "question", question.id,
-                                    question.text[lang], spoken, lang, options, repeat, self._open.attempt,
-                                    self._speech_rate()))
+        self._publish_prompt(
+            Prompt(
+                t,
+                "practice" if self._open.practice else "question",
+                question.id,
+                question.text[lang],
+                spoken,
+                lang,
+                options,
+                repeat,
+                self._open.attempt,
+                self._speech_rate(),
+            )
+        )
 
     def _publish_prompt(self: Session, prompt: Prompt) -> None:
         self._prompt = prompt
@@ -210,8 +231,12 @@ class Publisher:
         # on the welcome once it was shown (say a language), under the explanation (say "I'm
         # ready"), while an attempt is open, and in the thank-you gap after an answer, when it can
         # be taken back ("No, that's wrong")
-        wanted = ((self._phase is Phase.WELCOME and self._greeted) or self._phase is Phase.EXPLANATION
-                  or self.current_attempt is not None or self._can_undo())
+        wanted = (
+            (self._phase is Phase.WELCOME and self._greeted)
+            or self._phase is Phase.EXPLANATION
+            or self.current_attempt is not None
+            or self._can_undo()
+        )
         listening = wanted and not self._timers.frozen and "voice_off" not in self._active_adaptations()
         if listening != self._listening:
             self._listening = listening

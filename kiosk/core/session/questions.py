@@ -167,8 +167,15 @@ class QuestionFlow:
         answer = Answer(item.id, option.number, option.points, attempt, channel, self._answered_by, t, detail)
         if self.store is not None:  # committed before anything else learns of it (crash safety)
             self.store.record_answer(
-                self.id, item_id=item.id, option=option.number, points=option.points, attempt=attempt,
-                channel=channel.value, answered_by=self._answered_by.value, t=t, at=self._wall(t),
+                self.id,
+                item_id=item.id,
+                option=option.number,
+                points=option.points,
+                attempt=attempt,
+                channel=channel.value,
+                answered_by=self._answered_by.value,
+                t=t,
+                at=self._wall(t),
                 detail=detail,
             )
         self._answers[item.id] = answer
@@ -177,8 +184,11 @@ class QuestionFlow:
             contexts["FirstAttemptAnswered" if attempt == 1 else "SecondAttemptAnswered"] = True
         contexts["UserInteraction"] = USER_INTERACTION[channel]
         self._context(t, contexts)
-        self._emit(AnswerRecorded(t, item.id, item.number, option.number, option.points, attempt,
-                                  channel, self._answered_by, detail))
+        self._emit(
+            AnswerRecorded(
+                t, item.id, item.number, option.number, option.points, attempt, channel, self._answered_by, detail
+            )
+        )
         self._schedule_next_item(t, self.timing.between_questions_s)
         self._update_listening(t)  # on through the thank-you gap: "No, that's wrong" takes it back
 
@@ -245,8 +255,13 @@ class QuestionFlow:
         score = self.score()
         self._score = score
         if self.store is not None:
-            self.store.finish_session(self.id, finished_at=self._wall(t), total=score.total,
-                                      complete=score.complete, band=score.band.id if score.band else None)
+            self.store.finish_session(
+                self.id,
+                finished_at=self._wall(t),
+                total=score.total,
+                complete=score.complete,
+                band=score.band.id if score.band else None,
+            )
         self._set_phase(t, Phase.SUMMARY)
         self._message(t, "finished")
         self._update_listening(t)

@@ -65,4 +65,3 @@ class Snapshot:
     confirming: int | None = None
     #: "Change my answer" can be offered: the thank-you gap after an answer is running
     can_undo: bool = False
-

@@ -71,8 +71,10 @@ class AttemptClock:
 
         The caller acts on each before the next is looked at (acting may set another timer).
         """
-        while self.timer is not None and self.timer.due is not None and (
-            self.timer.due < now or (inclusive and self.timer.due == now)
+        while (
+            self.timer is not None
+            and self.timer.due is not None
+            and (self.timer.due < now or (inclusive and self.timer.due == now))
         ):
             timer, self.timer = self.timer, None
             assert timer.due is not None

@@ -43,7 +43,6 @@ START_LABEL: Mapping[str, str] = {"en": "Start", "es": "Empezar", "fr": "Commenc
 #: what a patient says to start, in each language
 START_WORDS: Mapping[str, tuple[str, ...]] = {
     "en": ("start", "begin", "let's start", "start please", "ready", "I'm ready"),
-    "es": ("empezar", "empiece", "empecemos", "comenzar", "comience", "listo", "lista", "estoy listo",
-           "estoy lista"),
+    "es": ("empezar", "empiece", "empecemos", "comenzar", "comience", "listo", "lista", "estoy listo", "estoy lista"),
     "fr": ("commencer", "commencez", "commençons", "démarrer", "je suis prêt", "je suis prête", "prêt", "prête"),
 }

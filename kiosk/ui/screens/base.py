@@ -161,8 +161,11 @@ class PatientScreen(Screen):
         for progress in self.query("#progress").results(Label):
             progress.update(self.progress_text(view))
         for attempt in self.query("#attempt").results(Label):
-            attempt.update(ui_text(self.language, "attempt_of", number=snap.attempt, total=ATTEMPTS)
-                           if snap.attempt and self.SHOWS_ATTEMPT else "")
+            attempt.update(
+                ui_text(self.language, "attempt_of", number=snap.attempt, total=ATTEMPTS)
+                if snap.attempt and self.SHOWS_ATTEMPT
+                else ""
+            )
         for ways in self.query("#ways").results(Label):
             ways.update(self.ways_text(view))
         for banner in self.query(AdaptationBanner):

@@ -10,10 +10,10 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
+from kiosk.core.session import Phase
 from kiosk.export.captured import questionnaire_of
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
 from kiosk.ui.screens.session_detail import SessionDetailScreen
-from kiosk.core.session import Phase
 
 #: how often the running session's line is redrawn (seconds)
 REFRESH_S = 1.0
@@ -38,12 +38,13 @@ class ClinicianHomeScreen(ClinicianScreen):
             with Horizontal(id="current-actions"):
                 yield Button("Continue", id="continue", variant="primary")
                 yield Label("Adaptation", id="adaptation-label")
-                yield Switch(value=session.adaptation is not None and session.adaptation.enabled,
-                             id="adaptation", disabled=session.adaptation is None)
-                yield Button("New patient", id="new-session",
-                             disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
-                yield Button("Start a visit", id="start-visit",
-                             disabled=app.visits is None)  # type: ignore[attr-defined]
+                yield Switch(
+                    value=session.adaptation is not None and session.adaptation.enabled,
+                    id="adaptation",
+                    disabled=session.adaptation is None,
+                )
+                yield Button("New patient", id="new-session", disabled=not app.can_start_new_session)  # type: ignore[attr-defined]
+                yield Button("Start a visit", id="start-visit", disabled=app.visits is None)  # type: ignore[attr-defined]
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost")
@@ -70,16 +71,24 @@ class ClinicianHomeScreen(ClinicianScreen):
         for test in self.app.interrupted_tests():  # type: ignore[attr-defined]
             count = len(questionnaire_of(test, fallback=self.app.questionnaire).items)  # type: ignore[attr-defined]
             progress = f"{len(test.answers)} of {count} answered" + (
-                f", {len(test.not_answered)} not answered" if test.not_answered else "")
-            interrupted.add_row(test.patient_id, test.started_at[:16].replace("T", " "), progress,
-                                test.interrupted_reason or "", test.id, key=test.id)
+                f", {len(test.not_answered)} not answered" if test.not_answered else ""
+            )
+            interrupted.add_row(
+                test.patient_id,
+                test.started_at[:16].replace("T", " "),
+                progress,
+                test.interrupted_reason or "",
+                test.id,
+                key=test.id,
+            )
         # "Continue this test" only when there is one to continue
         some = bool(interrupted.row_count)
         interrupted.display = some
         self.query_one("#interrupted-actions").display = some
         if some:
             self.query_one("#interrupted-label", Label).update(
-                "Interrupted tests (continue one only with that patient in front of the kiosk):")
+                "Interrupted tests (continue one only with that patient in front of the kiosk):"
+            )
         table = self.query_one("#sessions", DataTable)
         table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
         self._fill_sessions()
@@ -107,8 +116,10 @@ class ClinicianHomeScreen(ClinicianScreen):
         line = self.query_one("#out-of-order-reason", Static)
         line.display = reason is not None
         if reason is not None:
-            line.update(f"Out of order: {reason}. The patient sees \"This kiosk is not working\"; the welcome "
-                        "comes back by itself once the data directory can be written again (free disk space).")
+            line.update(
+                f'Out of order: {reason}. The patient sees "This kiosk is not working"; the welcome '
+                "comes back by itself once the data directory can be written again (free disk space)."
+            )
         self.query_one("#channel-reasons", Static).update(self._channels_text())
         # Continue is for a session halted by call-doctor or paused by the patient, not for the
         # pause that opening these screens made (leaving them resumes that one)
@@ -122,13 +133,23 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def _session_line(self) -> str:
         session = self.app.session  # type: ignore[attr-defined]
-        state = "waiting for a clinician (doctor called)" if session.halted else (
-            "paused while you are here" if self.app.held_for_clinician  # type: ignore[attr-defined]
-            else "paused" if session.paused else session.phase.value)
+        state = (
+            "waiting for a clinician (doctor called)"
+            if session.halted
+            else (
+                "paused while you are here"
+                if self.app.held_for_clinician  # type: ignore[attr-defined]
+                else "paused"
+                if session.paused
+                else session.phase.value
+            )
+        )
         if not session.snapshot().person_present:
             state += ", patient away"
-        line = (f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
-                f"{len(session.answers)} of {len(session.questionnaire.items)} answered.")
+        line = (
+            f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
+            f"{len(session.answers)} of {len(session.questionnaire.items)} answered."
+        )
         if session.metrics:
             line += " QoS now: " + ", ".join(f"{name} {value:.2f}" for name, value in session.metrics.items())
         return line
@@ -148,7 +169,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
         return "Channels: " + "; ".join(
             f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
-            for line in lines)
+            for line in lines
+        )
 
     @on(Button.Pressed, "#continue")
     def _continue(self) -> None:

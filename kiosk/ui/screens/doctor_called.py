@@ -26,8 +26,10 @@ class DoctorCalledScreen(PatientScreen):
         """Bars, the title, the reassurance and the way back to the test."""
         yield from self.compose_bars()
         yield Static(ui_text(self.language, "doctor_title"), classes="heading", id="doctor-title")
-        yield Static(self.view.questionnaire.message("doctor_called", self.language)
-                     or ui_text(self.language, "doctor_text"), classes="notice")
+        yield Static(
+            self.view.questionnaire.message("doctor_called", self.language) or ui_text(self.language, "doctor_text"),
+            classes="notice",
+        )
         yield Button(ui_text(self.language, "doctor_cancel"), id="doctor-cancel", classes="big-action")
 
     @on(Button.Pressed, "#doctor-cancel")

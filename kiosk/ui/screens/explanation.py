@@ -13,7 +13,7 @@ from kiosk.ui.widgets.text import ui_text, ways_sentence
 
 
 def how_to_answer(view: PatientView) -> str:
-    """"Answer by touching it on the screen or ..." and how to start, from the channels on now."""
+    """ "Answer by touching it on the screen or ..." and how to start, from the channels on now."""
     lang, ways = view.snapshot.language, view.ways.answering()
     return f"{ways_sentence(lang, 'answer_by', ways)} {ways_sentence(lang, 'start_by', ways, '_start')}"
 
@@ -29,8 +29,7 @@ class ExplanationScreen(PatientScreen):
     def compose(self) -> ComposeResult:
         """Bars, the explanation, how to answer, Start, and the controls."""
         yield from self.compose_bars()
-        yield Static(self.view.questionnaire.message("explanation", self.language), classes="heading",
-                     id="explanation")
+        yield Static(self.view.questionnaire.message("explanation", self.language), classes="heading", id="explanation")
         yield Static(how_to_answer(self.view), classes="notice", id="how-to-answer")
         yield Button(ui_text(self.language, "start"), id="understood", classes="big-action")
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)

@@ -35,8 +35,7 @@ class FamiliarisationScreen(PatientScreen):
         else:
             # in the flow above the question, as on the question screen
             yield Static("", id="interlude", classes="interlude")
-            yield QuestionPanel(practice.text[self.language],
-                                [o.label_in(self.language) for o in practice.options])
+            yield QuestionPanel(practice.text[self.language], [o.label_in(self.language) for o in practice.options])
         yield WaitingSign(self.language)
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 
@@ -56,7 +55,7 @@ class FamiliarisationScreen(PatientScreen):
             heading.update(self._intro(view))
 
     def _intro(self, view: PatientView) -> str:
-        """"First, a few practice questions…": the questionnaire's words, which promise a hearing
+        """ "First, a few practice questions…": the questionnaire's words, which promise a hearing
         check, only while the kiosk can speak; without voice out the kiosk's own words, which do not
         (the hearing check is skipped then)."""
         if view.ways.voice_out:
@@ -64,7 +63,7 @@ class FamiliarisationScreen(PatientScreen):
         return ui_text(self.language, "practice_intro_silent")
 
     def progress_text(self, view: PatientView) -> str:
-        """"Practice 1 of 3" (of those asked on this kiosk, as the session counts them)."""
+        """ "Practice 1 of 3" (of those asked on this kiosk, as the session counts them)."""
         snap = view.snapshot
         if snap.practice_number is None:
             return super().progress_text(view)

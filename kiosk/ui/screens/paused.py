@@ -11,10 +11,12 @@ from kiosk.ui.widgets.text import ui_text, ways_sentence
 
 
 def how_to_continue(view: PatientView) -> str:
-    """"We are waiting for you. When you are ready, touch Continue ..." from the channels on now."""
+    """ "We are waiting for you. When you are ready, touch Continue ..." from the channels on now."""
     lang = view.snapshot.language
-    return (f"{view.questionnaire.message('paused', lang) or ui_text(lang, 'paused_text')} "
-            f"{ways_sentence(lang, 'continue_by', view.ways.answering(), '_continue')}")
+    return (
+        f"{view.questionnaire.message('paused', lang) or ui_text(lang, 'paused_text')} "
+        f"{ways_sentence(lang, 'continue_by', view.ways.answering(), '_continue')}"
+    )
 
 
 class PausedScreen(PatientScreen):

@@ -69,8 +69,14 @@ class QuestionScreen(PatientScreen):
             explanation = view.questionnaire.message("explanation", self.language)
             return [thanks, Static(explanation, classes="notice", id="recap")] if explanation else [thanks]
         answer = view.snapshot.answers.get(item.id)
-        return [QuestionPanel(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
-                              chosen=answer.option if answer else None, over_question=thanks)]
+        return [
+            QuestionPanel(
+                item.patient_text_in(self.language),
+                [o.patient_label_in(self.language) for o in item.options],
+                chosen=answer.option if answer else None,
+                over_question=thanks,
+            )
+        ]
 
     def _line(self, view: PatientView) -> str:
         """The between-questions line in the patient's language ("" outside a gap)."""
@@ -90,8 +96,13 @@ class QuestionScreen(PatientScreen):
         item = view.snapshot.item
         confirming = view.snapshot.confirming
         if (item.id if item else None) != self._item_id or confirming != self._confirming:
-            if (item is not None and self._item_id is not None and confirming is None
-                    and self._confirming is None and self._reword(view, item)):
+            if (
+                item is not None
+                and self._item_id is not None
+                and confirming is None
+                and self._confirming is None
+                and self._reword(view, item)
+            ):
                 return
             for old in self.query("QuestionPanel, ConfirmPanel, #recap, ThanksRow"):
                 old.remove()
@@ -111,8 +122,11 @@ class QuestionScreen(PatientScreen):
         when it cannot, so the caller builds a new panel."""
         answer = view.snapshot.answers.get(item.id)
         for panel in self.query(QuestionPanel):
-            if panel.show_item(item.patient_text_in(self.language), [o.patient_label_in(self.language) for o in item.options],
-                               chosen=answer.option if answer else None):
+            if panel.show_item(
+                item.patient_text_in(self.language),
+                [o.patient_label_in(self.language) for o in item.options],
+                chosen=answer.option if answer else None,
+            ):
                 self._item_id = item.id
                 if isinstance(self.focused, AnswerButton):  # it would look chosen on the new item
                     self.set_focus(None)

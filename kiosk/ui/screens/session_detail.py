@@ -10,16 +10,16 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static
 
-from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
-from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.store.database import StoredSession
+from kiosk.ui.screens.base import ClinicianScreen, staff_nav
 from kiosk.ui.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png
 
 #: the session log's entries staff see as events, in their words
 EVENT_WORDS = {
     "call_doctor": "Doctor called",
-    "doctor_call_cancelled": "\"I'm fine, carry on\" (the patient called the doctor off)",
+    "doctor_call_cancelled": '"I\'m fine, carry on" (the patient called the doctor off)',
     "clinician_continue": "Continued by a clinician",
     "pause": "Paused",
     "resume": "Continued after a pause",
@@ -61,14 +61,18 @@ class SessionDetailScreen(ClinicianScreen):
                 yield Button("Plot PNG", id="export-png", tooltip="Save the QoS plot as a PNG")
             yield from staff_nav("Back")
         with VerticalScroll(classes="clinician staff-body", id="detail-body"):
-            yield Static(f"Session {s.id}  patient {s.patient_id}  {s.status}  language {s.language}  "
-                         f"answered by {s.answered_by.value}", classes="heading")
+            yield Static(
+                f"Session {s.id}  patient {s.patient_id}  {s.status}  language {s.language}  "
+                f"answered by {s.answered_by.value}",
+                classes="heading",
+            )
             yield DataTable(id="answers-table", zebra_stripes=True, cursor_type="row")
             yield Label(self._total_line(), id="total")
             yield Label(self._practice_line(), id="practice")
             events = session_events(s)
-            yield Label("Events:" if events else "Events: none (no doctor call, pause or patient away).",
-                        id="events-label")
+            yield Label(
+                "Events:" if events else "Events: none (no doctor call, pause or patient away).", id="events-label"
+            )
             table = DataTable(id="events", zebra_stripes=True, cursor_type="row")
             table.display = bool(events)
             yield table
@@ -96,9 +100,15 @@ class SessionDetailScreen(ClinicianScreen):
                 outcome = "not answered" if item.id in self.stored.not_answered else "-"
                 table.add_row(str(item.number), item.id, "", outcome, "", "", "")
             else:
-                table.add_row(str(item.number), item.id, str(a.option),
-                              item.option(a.option).label_in(self.stored.language), str(a.points),
-                              str(a.attempt), a.channel.value)
+                table.add_row(
+                    str(item.number),
+                    item.id,
+                    str(a.option),
+                    item.option(a.option).label_in(self.stored.language),
+                    str(a.points),
+                    str(a.attempt),
+                    a.channel.value,
+                )
 
     def _total_line(self) -> str:
         q = self.q
@@ -107,8 +117,10 @@ class SessionDetailScreen(ClinicianScreen):
         except ExportError as error:
             return f"Cannot score: {error}"
         if not score.complete:  # a partial sum is no Barthel total: never shown as one
-            return (f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
-                    f"(the answered ones add up to {score.total})")
+            return (
+                f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
+                f"(the answered ones add up to {score.total})"
+            )
         band = score.band.label["en"] if score.band else "no band"
         return f"Total {score.total} of {score.max_total} (complete); {band}"
 
@@ -162,8 +174,11 @@ class SessionDetailScreen(ClinicianScreen):
     @on(Button.Pressed, "#export-png")
     def _png(self) -> None:
         try:
-            path = save_png(plot_data(self.stored), self._export_path(".metrics.png"),
-                            f"Session {self.stored.id}, patient {self.stored.patient_id}")
+            path = save_png(
+                plot_data(self.stored),
+                self._export_path(".metrics.png"),
+                f"Session {self.stored.id}, patient {self.stored.patient_id}",
+            )
         except OSError as error:
             self._done(f"Saving the plot failed: {error}")
             return

@@ -48,8 +48,11 @@ class StartVisitScreen(ClinicianScreen):
                     yield pad_key(Button(label, id=_key_id(label)))
             with Horizontal(id="visit-languages"):
                 for language in app.questionnaire.languages:  # type: ignore[attr-defined]
-                    yield Button(language_name(language), id=f"visit-lang-{language}",
-                                 variant="primary" if language == self._language else "default")
+                    yield Button(
+                        language_name(language),
+                        id=f"visit-lang-{language}",
+                        variant="primary" if language == self._language else "default",
+                    )
                 yield Label("A relative answers")
                 yield Switch(value=False, id="visit-relative")
             with Horizontal():

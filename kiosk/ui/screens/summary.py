@@ -26,8 +26,10 @@ class SummaryScreen(PatientScreen):
         """Bars, thanks, the total and band."""
         yield from self.compose_bars()
         yield Static(ui_text(self.language, "summary_title"), classes="heading")
-        yield Static(self.view.questionnaire.message("finished", self.language)
-                     or ui_text(self.language, "summary_text"), classes="notice")
+        yield Static(
+            self.view.questionnaire.message("finished", self.language) or ui_text(self.language, "summary_text"),
+            classes="notice",
+        )
         score = self.view.snapshot.score
         if score is not None and self.view.show_score:  # a site's choice; staff always see it
             if score.missing:  # a partial sum is no total: the patient is not shown one

@@ -14,8 +14,8 @@ from textual.containers import Grid, Vertical
 from textual.message import Message
 from textual.widgets import Button, Label, Static
 
-from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.core.visits import Order
+from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.widgets.text import language_name
 
 _KEYS = ("1", "2", "3", "4", "5", "6", "7", "8", "9", "⌫", "0", "OK")

@@ -18,8 +18,11 @@ def welcome_line(view: PatientView, language: str) -> str:
     """The welcome in ``language`` itself, and how to choose with the channels on now: "Welcome.
     Please choose your language." alone when touching is the only way (the buttons say the rest)."""
     ways = language_ways(view.ways)
-    how = ways_sentence(language, "choose_by", ways, "_language") if len(ways) > 1 else ui_text(
-        language, "choose_language")
+    how = (
+        ways_sentence(language, "choose_by", ways, "_language")
+        if len(ways) > 1
+        else ui_text(language, "choose_language")
+    )
     return f"{view.questionnaire.message('welcome', language)} {how}".strip()
 
 
@@ -50,7 +53,7 @@ class LanguageList(Vertical):
 
 
 def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:
-    """"1  English ", "2  Español ", "3  Français": numbered like the remote, padded to one width."""
+    """ "1  English ", "2  Español ", "3  Français": numbered like the remote, padded to one width."""
     labels = [f"{number}  {language_name(language)}" for number, language in enumerate(languages, start=1)]
     width = max(map(len, labels))
     return [label.ljust(width) for label in labels]
@@ -79,8 +82,7 @@ class WelcomeScreen(PatientScreen):
         q = self.view.questionnaire
         with Vertical(id="welcome"):
             for language in q.languages:
-                yield Static(welcome_line(self.view, language), classes="welcome-line",
-                             id=f"welcome-{language}")
+                yield Static(welcome_line(self.view, language), classes="welcome-line", id=f"welcome-{language}")
         with LanguageList(id="languages"):
             for language, label in zip(q.languages, language_labels(q.languages)):
                 yield Button(label, id=f"language-{language}")

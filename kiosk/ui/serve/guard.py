@@ -53,26 +53,35 @@ def token_digest(token: str) -> str:
 
 def _page(status: int, title: str, text: str, retry_s: int | None = None) -> web.Response:
     refresh = f'<meta http-equiv="refresh" content="{retry_s}">' if retry_s else ""
-    body = (f'<!doctype html><html lang="en"><head><meta charset="utf-8">{refresh}<title>{html.escape(title)}'
-            '</title><style>body{font:2rem/1.4 sans-serif;margin:3rem;background:#fdfbf5;color:#111}'
-            'h1{font-size:2.6rem}</style></head>'
-            f'<body><h1>{html.escape(title)}</h1><p>{html.escape(text)}</p></body></html>')
+    body = (
+        f'<!doctype html><html lang="en"><head><meta charset="utf-8">{refresh}<title>{html.escape(title)}'
+        "</title><style>body{font:2rem/1.4 sans-serif;margin:3rem;background:#fdfbf5;color:#111}"
+        "h1{font-size:2.6rem}</style></head>"
+        f"<body><h1>{html.escape(title)}</h1><p>{html.escape(text)}</p></body></html>"
+    )
     return web.Response(status=status, text=body, content_type="text/html")
 
 
 def refused_page() -> web.Response:
     """The page for a browser without the device key."""
-    return _page(403, "This screen is not set up as a kiosk",
-                 "The kiosk only opens on a screen that staff have set up. Staff: on the kiosk computer run "
-                 "`kiosk serve --new-token` and open the address it prints once in this browser.")
+    return _page(
+        403,
+        "This screen is not set up as a kiosk",
+        "The kiosk only opens on a screen that staff have set up. Staff: on the kiosk computer run "
+        "`kiosk serve --new-token` and open the address it prints once in this browser.",
+    )
 
 
 def busy_page(limit: int) -> web.Response:
     """The page when every kiosk place is taken."""
     screens = "one screen" if limit == 1 else f"{limit} screens"
-    return _page(503, "The kiosk is in use",
-                 f"The kiosk is already open on {screens}. Close one of them, or wait: this page tries "
-                 f"again every {BUSY_RETRY_S} seconds.", retry_s=BUSY_RETRY_S)
+    return _page(
+        503,
+        "The kiosk is in use",
+        f"The kiosk is already open on {screens}. Close one of them, or wait: this page tries "
+        f"again every {BUSY_RETRY_S} seconds.",
+        retry_s=BUSY_RETRY_S,
+    )
 
 
 class KioskServer(Server):
@@ -82,8 +91,18 @@ class KioskServer(Server):
     origins are those hosts with ``scheme``. ``token_sha256`` is the device key's digest.
     """
 
-    def __init__(self, command: str, *, host: str, port: int, hosts: set[str], token_sha256: str,
-                 max_sessions: int, ssl_context: ssl.SSLContext | None = None, title: str = "Barthel kiosk") -> None:
+    def __init__(
+        self,
+        command: str,
+        *,
+        host: str,
+        port: int,
+        hosts: set[str],
+        token_sha256: str,
+        max_sessions: int,
+        ssl_context: ssl.SSLContext | None = None,
+        title: str = "Barthel kiosk",
+    ) -> None:
         # the kiosk's own page (kiosk/ui/serve/web: offline font, large text that fits the display) over
         # textual-serve's static files
         super().__init__(command, host=host, port=port, title=title, templates_path=PAGE_DIR)
@@ -131,8 +150,15 @@ class KioskServer(Server):
             return refused_page()
         rest = request.rel_url.with_query({k: v for k, v in request.query.items() if k != "token"})
         response = web.HTTPSeeOther(location=str(rest))
-        response.set_cookie(COOKIE, request.query["token"], max_age=COOKIE_MAX_AGE_S, path="/", httponly=True,
-                            samesite="Strict", secure=self.ssl_context is not None)
+        response.set_cookie(
+            COOKIE,
+            request.query["token"],
+            max_age=COOKIE_MAX_AGE_S,
+            path="/",
+            httponly=True,
+            samesite="Strict",
+            secure=self.ssl_context is not None,
+        )
         return response
 
     @staticmethod
@@ -184,11 +210,18 @@ class KioskServer(Server):
     async def _connection(self, request: web.Request) -> web.WebSocketResponse:
         websocket = web.WebSocketResponse(heartbeat=15)
         await websocket.prepare(request)
-        service = AppService(self.command, write_bytes=websocket.send_bytes, write_str=websocket.send_str,
-                             close=websocket.close, download_manager=self.download_manager, debug=self.debug)
+        service = AppService(
+            self.command,
+            write_bytes=websocket.send_bytes,
+            write_str=websocket.send_str,
+            close=websocket.close,
+            download_manager=self.download_manager,
+            debug=self.debug,
+        )
         try:
-            await service.start(to_int(request.query.get("width", "80"), 80),
-                                to_int(request.query.get("height", "24"), 24))
+            await service.start(
+                to_int(request.query.get("width", "80"), 80), to_int(request.query.get("height", "24"), 24)
+            )
             await self._process_messages(websocket, service)
         except asyncio.CancelledError:
             pass
@@ -216,5 +249,11 @@ class KioskServer(Server):
         self.debug = debug
         self.initialize_logging()
         # no access log: its request lines would write the device key of a first visit into the log
-        web.run_app(self._make_app(), host=self.host, port=self.port, ssl_context=self.ssl_context,
-                    access_log=None, print=lambda *args: None)
+        web.run_app(
+            self._make_app(),
+            host=self.host,
+            port=self.port,
+            ssl_context=self.ssl_context,
+            access_log=None,
+            print=lambda *args: None,
+        )

@@ -76,8 +76,10 @@ def served_hosts(host: str, port: int, public_url: str | None, tls: bool) -> set
     elif is_loopback(host):
         names = list(_LOOPBACK_NAMES)
     elif host in ("0.0.0.0", "::", ""):
-        raise ValueError(f"listening on every address ({host or 'all'}) needs --public-url, the address the "
-                         "kiosk's browser opens (Host and Origin are checked against it)")
+        raise ValueError(
+            f"listening on every address ({host or 'all'}) needs --public-url, the address the "
+            "kiosk's browser opens (Host and Origin are checked against it)"
+        )
     else:
         names = [host if ":" not in host else f"[{host}]"]
     hosts = {f"{name}:{port}" for name in names}
@@ -93,18 +95,28 @@ def _parser() -> argparse.ArgumentParser:
         "device key set up by --new-token. Options not listed here are passed to `kiosk run` (for example "
         "--data-dir, --config).",
     )
-    parser.add_argument("--host", default=LOCALHOST,
-                        help="address to listen on (default %(default)s: this machine only)")
+    parser.add_argument(
+        "--host", default=LOCALHOST, help="address to listen on (default %(default)s: this machine only)"
+    )
     parser.add_argument("--port", type=int, default=8000, help="TCP port (default %(default)s)")
-    parser.add_argument("--new-token", action="store_true",
-                        help="make a new device key, keep its digest in the configuration, print the address "
-                             "to open once in the kiosk's browser, and exit (the old key stops working)")
+    parser.add_argument(
+        "--new-token",
+        action="store_true",
+        help="make a new device key, keep its digest in the configuration, print the address "
+        "to open once in the kiosk's browser, and exit (the old key stops working)",
+    )
     parser.add_argument("--tls-cert", type=Path, metavar="PEM", help="serve over HTTPS with this certificate")
     parser.add_argument("--tls-key", type=Path, metavar="PEM", help="the certificate's private key")
-    parser.add_argument("--public-url", metavar="URL",
-                        help="the address browsers open when it is not --host:--port (e.g. behind a name)")
-    parser.add_argument("--insecure-network", action="store_true",
-                        help="allow a network address without TLS (patient data in clear on the network)")
+    parser.add_argument(
+        "--public-url",
+        metavar="URL",
+        help="the address browsers open when it is not --host:--port (e.g. behind a name)",
+    )
+    parser.add_argument(
+        "--insecure-network",
+        action="store_true",
+        help="allow a network address without TLS (patient data in clear on the network)",
+    )
     return parser
 
 
@@ -118,8 +130,9 @@ def _new_token(run_args: list[str], host: str, port: int, tls: bool) -> int:
     from kiosk.config import ConfigError, default_config_path, write_settings
     from kiosk.ui.serve.guard import token_digest
 
-    path = _config_path(run_args) or (Path(os.environ["KIOSK_CONFIG"]) if os.environ.get("KIOSK_CONFIG")
-                                      else default_config_path())
+    path = _config_path(run_args) or (
+        Path(os.environ["KIOSK_CONFIG"]) if os.environ.get("KIOSK_CONFIG") else default_config_path()
+    )
     token = secrets.token_urlsafe(32)
     try:
         write_settings(path, {"serve_token_sha256": token_digest(token)})
@@ -127,10 +140,12 @@ def _new_token(run_args: list[str], host: str, port: int, tls: bool) -> int:
         print(f"kiosk serve: {error}", file=sys.stderr)
         return 2
     name = "127.0.0.1" if is_loopback(host) else host
-    print(f"A new device key is set (its digest is in {path}). Open this address once in the kiosk's browser;\n"
-          f"it keeps the key in a cookie and drops it from the address:\n\n"
-          f"  {'https' if tls else 'http'}://{name}:{port}/?token={token}&fontsize=28\n\n"
-          "Anyone with this address can use the kiosk: do not write it down.")
+    print(
+        f"A new device key is set (its digest is in {path}). Open this address once in the kiosk's browser;\n"
+        f"it keeps the key in a cookie and drops it from the address:\n\n"
+        f"  {'https' if tls else 'http'}://{name}:{port}/?token={token}&fontsize=28\n\n"
+        "Anyone with this address can use the kiosk: do not write it down."
+    )
     return 0
 
 
@@ -158,9 +173,11 @@ def main(argv: list[str]) -> int:
         return 2
     tls = args.tls_cert is not None or args.tls_key is not None
     if not is_loopback(args.host) and not tls and not args.insecure_network:
-        print(f"kiosk serve: refusing to serve on {args.host} without TLS: patient data would cross the network "
-              "in clear. Give --tls-cert and --tls-key, or --insecure-network if that is really meant.",
-              file=sys.stderr)
+        print(
+            f"kiosk serve: refusing to serve on {args.host} without TLS: patient data would cross the network "
+            "in clear. Give --tls-cert and --tls-key, or --insecure-network if that is really meant.",
+            file=sys.stderr,
+        )
         return 2
     if args.new_token:
         return _new_token(run_args, args.host, args.port, tls)
@@ -177,23 +194,34 @@ def main(argv: list[str]) -> int:
         print(f"kiosk serve: {error}", file=sys.stderr)
         return 2
     if config.serve_token_sha256 is None:
-        print("kiosk serve: no device key is set up, so no browser could open the kiosk: run "
-              "`kiosk serve --new-token` (with the same --config) and open the address it prints once "
-              "in the kiosk's browser", file=sys.stderr)
+        print(
+            "kiosk serve: no device key is set up, so no browser could open the kiosk: run "
+            "`kiosk serve --new-token` (with the same --config) and open the address it prints once "
+            "in the kiosk's browser",
+            file=sys.stderr,
+        )
         return 2
     if not is_loopback(args.host):
-        print(f"kiosk serve: warning: listening on {args.host}, so other machines can reach the "
-              "kiosk (they still need its device key)", file=sys.stderr)
+        print(
+            f"kiosk serve: warning: listening on {args.host}, so other machines can reach the "
+            "kiosk (they still need its device key)",
+            file=sys.stderr,
+        )
     if (warning := PinGuard(config.pin_secret).warning) is not None:
         print(f"kiosk serve: warning: {warning}", file=sys.stderr)
 
-    server = KioskServer(build_command(run_args), host=args.host, port=args.port, hosts=hosts,
-                         token_sha256=config.serve_token_sha256, max_sessions=config.serve_max_sessions,
-                         ssl_context=context)
+    server = KioskServer(
+        build_command(run_args),
+        host=args.host,
+        port=args.port,
+        hosts=hosts,
+        token_sha256=config.serve_token_sha256,
+        max_sessions=config.serve_max_sessions,
+        ssl_context=context,
+    )
     try:
         server.serve()
     except OSError as error:  # port in use, address not on this machine
-        print(f"kiosk serve: cannot listen on {args.host}:{args.port}: {error.strerror or error}",
-              file=sys.stderr)
+        print(f"kiosk serve: cannot listen on {args.host}:{args.port}: {error.strerror or error}", file=sys.stderr)
         return 1
     return 0

@@ -37,7 +37,7 @@ class AdaptationBanner(Static):
 
 
 class VoiceAgainButton(Button):
-    """"Answer by voice again": shown with the voice-off notice, so the patient can undo it (the
+    """ "Answer by voice again": shown with the voice-off notice, so the patient can undo it (the
     session decides; touch answers alone never give the voice evidence that would lift it)."""
 
     class Requested(Message):
@@ -99,6 +99,10 @@ class ControlBar(Horizontal):
     def on_button_pressed(self, event: Button.Pressed) -> None:
         """Turn a touched control into the command it stands for."""
         event.stop()
-        command = {"pause": Command.PAUSE, "resume": Command.RESUME, "repeat": Command.REPEAT,
-                   "call-doctor": Command.CALL_DOCTOR}[event.button.id or ""]
+        command = {
+            "pause": Command.PAUSE,
+            "resume": Command.RESUME,
+            "repeat": Command.REPEAT,
+            "call-doctor": Command.CALL_DOCTOR,
+        }[event.button.id or ""]
         self.post_message(self.Commanded(command))

@@ -32,7 +32,7 @@ class ChangeAnswerButton(Button):
 
 
 class ThanksRow(Horizontal):
-    """"Thank you. Next question…" with "Change my answer" at its right, shown during a gap.
+    """ "Thank you. Next question…" with "Change my answer" at its right, shown during a gap.
 
     Over a question it takes exactly the question text's rows (the stylesheet lays it over them),
     so the answers below -- the chosen one marked -- neither move nor are covered; above the

@@ -71,6 +71,5 @@ class ChannelBoard:
                 word = ui_text(language, "speaking")
             elif state is ChannelState.ON and name == VOICE_IN and self.listening:
                 word = ui_text(language, "listening")
-            lines.append(ChannelLine(ui_text(language, f"channel_{name}"), word,
-                                     state is ChannelState.ON, reason))
+            lines.append(ChannelLine(ui_text(language, f"channel_{name}"), word, state is ChannelState.ON, reason))
         return tuple(lines)

@@ -18,13 +18,21 @@ from typing import Any
 from rich.text import Text
 from textual_plotext import PlotextPlot
 
+from fileio.bounded import open_private
 from kiosk.export.qos_plot import MARK_COLOURS, METRICS, Mark, metric_colour, plot_marks
 from kiosk.store.database import StoredSession
-from fileio.bounded import open_private
 
 #: log entries worth a mark on the plot (the rest -- ignored inputs, time-outs -- would crowd it)
-INCIDENTS = ("pause", "resume", "call_doctor", "doctor_call_cancelled", "clinician_continue", "person_lost",
-             "person_back", "repeat")
+INCIDENTS = (
+    "pause",
+    "resume",
+    "call_doctor",
+    "doctor_call_cancelled",
+    "clinician_continue",
+    "person_lost",
+    "person_back",
+    "repeat",
+)
 #: label lanes the PNG may stack its marks' labels in, from the top of the axes down
 LABEL_LANES = 14
 
@@ -124,11 +132,13 @@ def metrics_figure(data: PlotData, title: str) -> Any:
     axes.set_title(title)
     handles, _ = axes.get_legend_handles_labels()
     kinds = {m.kind for m in data.marks}
-    handles += [Line2D([], [], color=MARK_COLOURS[k], linestyle="--", linewidth=1, label=f"{k}s")
-                for k in MARK_COLOURS if k in kinds]
+    handles += [
+        Line2D([], [], color=MARK_COLOURS[k], linestyle="--", linewidth=1, label=f"{k}s")
+        for k in MARK_COLOURS
+        if k in kinds
+    ]
     if handles:
-        axes.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=len(handles),
-                    frameon=False)
+        axes.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=len(handles), frameon=False)
     axes.grid(alpha=0.3)
     _label_marks(figure, axes, data.marks)
     return figure
@@ -141,9 +151,15 @@ def _label_marks(figure: Any, axes: Any, marks: tuple[Mark, ...]) -> None:
     placed: list[Any] = []
     for mark in marks:
         for lane in range(LABEL_LANES):
-            text = axes.annotate(mark.label, (mark.t, 1.0 - 0.065 * lane), xycoords=("data", "axes fraction"),
-                                 fontsize=8, color=MARK_COLOURS[mark.kind], xytext=(3, -10),
-                                 textcoords="offset points")
+            text = axes.annotate(
+                mark.label,
+                (mark.t, 1.0 - 0.065 * lane),
+                xycoords=("data", "axes fraction"),
+                fontsize=8,
+                color=MARK_COLOURS[mark.kind],
+                xytext=(3, -10),
+                textcoords="offset points",
+            )
             box = text.get_window_extent(renderer).expanded(1.0, 1.1)
             if not any(box.overlaps(other) for other in placed):
                 placed.append(box)

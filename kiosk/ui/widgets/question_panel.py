@@ -56,8 +56,9 @@ class QuestionPanel(Vertical):
     display is short -- two-by-two, so every answer is on screen whatever its size.
     """
 
-    def __init__(self, question: str, options: Sequence[str], *, chosen: int | None = None,
-                 over_question: Widget | None = None) -> None:
+    def __init__(
+        self, question: str, options: Sequence[str], *, chosen: int | None = None, over_question: Widget | None = None
+    ) -> None:
         """Show ``question`` and the ``options`` labels (option 1 first); mark ``chosen`` if set.
         ``over_question`` (the thank-you row) is laid over the question text's rows when shown."""
         super().__init__(classes="panel")

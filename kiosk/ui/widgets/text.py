@@ -43,13 +43,14 @@ def ways_sentence(language: str, sentence: str, ways: Sequence[str], suffix: str
     """A sentence listing the ways of doing something that are on now, e.g. ``answer_by`` with
     ("touch", "remote"): "Answer by touching it on the screen or pressing its number on the
     remote." Each way's words are ``way_<way><suffix>``; the last two are joined by ``or``."""
-    words = ui_text(language, sentence,
-                    ways=join_or(language, [ui_text(language, f"way_{way}{suffix}") for way in ways]))
+    words = ui_text(
+        language, sentence, ways=join_or(language, [ui_text(language, f"way_{way}{suffix}") for way in ways])
+    )
     return words[0].upper() + words[1:]
 
 
 def join_or(language: str, phrases: Sequence[str]) -> str:
-    """"a, b or c" in ``language``."""
+    """ "a, b or c" in ``language``."""
     if len(phrases) == 1:
         return phrases[0]
     return ", ".join(phrases[:-1]) + f" {ui_text(language, 'or')} {phrases[-1]}"

@@ -23,10 +23,8 @@ _SQLITE_TRIGGERS = [
 _POSTGRES_TRIGGERS = [
     "CREATE FUNCTION audit_append_only() RETURNS trigger LANGUAGE plpgsql AS "
     "$$ BEGIN RAISE EXCEPTION 'the audit trail is append-only'; END $$",
-    "CREATE TRIGGER audit_no_change BEFORE UPDATE OR DELETE ON audit "
-    "FOR EACH ROW EXECUTE FUNCTION audit_append_only()",
-    "CREATE TRIGGER audit_no_truncate BEFORE TRUNCATE ON audit "
-    "FOR EACH STATEMENT EXECUTE FUNCTION audit_append_only()",
+    "CREATE TRIGGER audit_no_change BEFORE UPDATE OR DELETE ON audit FOR EACH ROW EXECUTE FUNCTION audit_append_only()",
+    "CREATE TRIGGER audit_no_truncate BEFORE TRUNCATE ON audit FOR EACH STATEMENT EXECUTE FUNCTION audit_append_only()",
 ]
 
 
@@ -132,6 +130,5 @@ def downgrade() -> None:
         op.execute("DROP TRIGGER audit_no_truncate ON audit")
         op.execute("DROP TRIGGER audit_no_change ON audit")
         op.execute("DROP FUNCTION audit_append_only()")
-    for table in ("audit", "commands", "alerts", "sessions", "inbox", "kiosks", "login_failures", "users",
-                  "settings"):
+    for table in ("audit", "commands", "alerts", "sessions", "inbox", "kiosks", "login_failures", "users", "settings"):
         op.drop_table(table)

@@ -28,23 +28,33 @@ def upgrade() -> None:
     )
     with op.batch_alter_table("sessions") as batch:
         batch.add_column(sa.Column("definition_sha256", sa.String(64), nullable=True))
-        batch.add_column(sa.Column("definition_attached_later", sa.Boolean, nullable=False,
-                                   server_default=sa.false()))
+        batch.add_column(sa.Column("definition_attached_later", sa.Boolean, nullable=False, server_default=sa.false()))
     bind = op.get_bind()
     if bind.execute(sa.text("SELECT COUNT(*) FROM sessions")).scalar():
         # the definition in force now: the bundled questionnaire (what the station described every
         # session with until now), marked attached later
-        from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
         from kiosk.core.questionnaire import load_questionnaire
+        from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
 
         definition = canonical(load_questionnaire())
         sha = digest(definition)
-        bind.execute(sa.text("INSERT INTO definitions (sha256, questionnaire_id, version, body, stored_at)"
-                             " VALUES (:sha, :id, :version, :body, :at)"),
-                     {"sha": sha, "id": definition["id"], "version": definition["version"],
-                      "body": canonical_json(definition), "at": datetime.now(UTC).isoformat(timespec="milliseconds")})
-        bind.execute(sa.text("UPDATE sessions SET definition_sha256 = :sha, definition_attached_later = :later"),
-                     {"sha": sha, "later": True})
+        bind.execute(
+            sa.text(
+                "INSERT INTO definitions (sha256, questionnaire_id, version, body, stored_at)"
+                " VALUES (:sha, :id, :version, :body, :at)"
+            ),
+            {
+                "sha": sha,
+                "id": definition["id"],
+                "version": definition["version"],
+                "body": canonical_json(definition),
+                "at": datetime.now(UTC).isoformat(timespec="milliseconds"),
+            },
+        )
+        bind.execute(
+            sa.text("UPDATE sessions SET definition_sha256 = :sha, definition_attached_later = :later"),
+            {"sha": sha, "later": True},
+        )
 
 
 def downgrade() -> None:

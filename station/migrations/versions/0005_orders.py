@@ -29,8 +29,9 @@ def upgrade() -> None:
         sa.Column("ordered_at", sa.String(40), nullable=False),
         sa.Column("session_id", sa.String(64)),
         sa.Column("updated_at", sa.String(40), nullable=False),
-        sa.CheckConstraint("state IN ('ordered', 'in_progress', 'awaiting_validation', 'signed_off', 'cancelled')",
-                           name="orders_state"),
+        sa.CheckConstraint(
+            "state IN ('ordered', 'in_progress', 'awaiting_validation', 'signed_off', 'cancelled')", name="orders_state"
+        ),
     )
     op.create_index("orders_kiosk_state", "orders", ["kiosk_id", "state"])
     op.create_index("orders_patient", "orders", ["patient_id"])

@@ -20,8 +20,14 @@ BOMB = "".join(f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 9) if i else 'lol'}]\n
 
 
 def kiosk(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "kiosk", *args], capture_output=True, text=True, cwd=cwd,
-                          timeout=HANG_S, env={"PATH": "/usr/bin:/bin", "HOME": str(cwd)})
+    return subprocess.run(
+        [sys.executable, "-m", "kiosk", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=HANG_S,
+        env={"PATH": "/usr/bin:/bin", "HOME": str(cwd)},
+    )
 
 
 def one_line(done: subprocess.CompletedProcess, where: str) -> str:
@@ -53,18 +59,22 @@ def write(tmp_path: Path, name: str, content: str | bytes) -> Path:
     return path
 
 
-@pytest.mark.parametrize(("name", "content", "where"), [
-    ("bomb.yaml", BOMB, "bomb.yaml:7:5: aliases expand the file to more than 200,000 values"),
-    ("deep.yaml", "items:\n" + "  " * 1 + "- " + "[" * 5000 + "]" * 5000 + "\n", "deep.yaml:2:"),
-    ("nul.yaml", b"id: barthel\x00\n", "nul.yaml:1:12: a NUL byte"),
-    ("latin.yaml", "title: {en: Índice}\n".encode("latin-1"), "latin.yaml:1:"),
-    ("de.yaml", german_only(), "de.yaml:"),
-])
+@pytest.mark.parametrize(
+    ("name", "content", "where"),
+    [
+        ("bomb.yaml", BOMB, "bomb.yaml:7:5: aliases expand the file to more than 200,000 values"),
+        ("deep.yaml", "items:\n" + "  " * 1 + "- " + "[" * 5000 + "]" * 5000 + "\n", "deep.yaml:2:"),
+        ("nul.yaml", b"id: barthel\x00\n", "nul.yaml:1:12: a NUL byte"),
+        ("latin.yaml", "title: {en: Índice}\n".encode("latin-1"), "latin.yaml:1:"),
+        ("de.yaml", german_only(), "de.yaml:"),
+    ],
+)
 def test_kiosk_run_and_validate_refuse_the_same_questionnaires(tmp_path, name, content, where):
     questionnaire = write(tmp_path, name, content)
     config = write(tmp_path, "config.yaml", f"questionnaire: {questionnaire}\n")
-    run = kiosk("run", "--config", str(config), "--data-dir", str(tmp_path / "data"), "--no-voice", "--no-remote",
-                cwd=tmp_path)
+    run = kiosk(
+        "run", "--config", str(config), "--data-dir", str(tmp_path / "data"), "--no-voice", "--no-remote", cwd=tmp_path
+    )
     assert one_line(run, f"kiosk run: {questionnaire}:").count(where) == 1
     validated = kiosk("validate", str(questionnaire), cwd=tmp_path)
     assert validated.returncode in (1, 2) and where in validated.stdout, validated.stdout
@@ -78,27 +88,39 @@ def test_an_empty_item_list_is_reported_as_such(tmp_path):
     path = write(tmp_path, "empty.yaml", yaml.safe_dump(data, allow_unicode=True, sort_keys=False))
     done = kiosk("validate", str(path), cwd=tmp_path)
     assert done.returncode == 1 and done.stdout.strip().splitlines() == [
-        f"{path}:{done.stdout.split(':')[1]}:{done.stdout.split(':')[2]}: items is empty: list at least one"]
+        f"{path}:{done.stdout.split(':')[1]}:{done.stdout.split(':')[2]}: items is empty: list at least one"
+    ]
 
 
-@pytest.mark.parametrize(("content", "where"), [
-    ('{"model": "clarc", "events": [{"t": ' + "9" * 5000 + ', "set": {"PersonDetected": true}}]}',
-     "trace.json:1:37: the number 9999"),
-    ('{"model": "clarc", "events": [{"t": NaN, "set": {"PersonDetected": true}}]}', "trace.json:1:37: NaN"),
-    ('{"model": "clarc", "model": "clarc", "events": []}', "trace.json:1:20: duplicate key 'model'"),
-    ('{"model": "clarc", "events": [{"t": 0, "set": {"PersonDetected": true}}, '
-     '{"t": 10000000, "set": {"PersonDetected": false}}]}', "would take 10,000,001 samples"),
-])
+@pytest.mark.parametrize(
+    ("content", "where"),
+    [
+        (
+            '{"model": "clarc", "events": [{"t": ' + "9" * 5000 + ', "set": {"PersonDetected": true}}]}',
+            "trace.json:1:37: the number 9999",
+        ),
+        ('{"model": "clarc", "events": [{"t": NaN, "set": {"PersonDetected": true}}]}', "trace.json:1:37: NaN"),
+        ('{"model": "clarc", "model": "clarc", "events": []}', "trace.json:1:20: duplicate key 'model'"),
+        (
+            '{"model": "clarc", "events": [{"t": 0, "set": {"PersonDetected": true}}, '
+            '{"t": 10000000, "set": {"PersonDetected": false}}]}',
+            "would take 10,000,001 samples",
+        ),
+    ],
+)
 def test_kiosk_qos_replay_refuses_bad_traces(tmp_path, content, where):
     trace = write(tmp_path, "trace.json", content)
     one_line(kiosk("qos", "replay", str(trace), cwd=tmp_path), where)
 
 
-@pytest.mark.parametrize(("change", "where"), [
-    (("start_at: 10", "start_at: 99999999999999"), "patient.yaml:10:11: start_at: 99999999999999 is greater"),
-    (("start_at: 10", "start_at: .nan"), "patient.yaml:10:11: '.nan' is not a finite number"),
-    (("start_at: 10", "start_at: 10\nstart_at: 11"), "patient.yaml:11:1: duplicate key 'start_at'"),
-])
+@pytest.mark.parametrize(
+    ("change", "where"),
+    [
+        (("start_at: 10", "start_at: 99999999999999"), "patient.yaml:10:11: start_at: 99999999999999 is greater"),
+        (("start_at: 10", "start_at: .nan"), "patient.yaml:10:11: '.nan' is not a finite number"),
+        (("start_at: 10", "start_at: 10\nstart_at: 11"), "patient.yaml:11:1: duplicate key 'start_at'"),
+    ],
+)
 def test_kiosk_replay_refuses_bad_scripts(tmp_path, change, where):
     text = (ROOT / "recordings/patients/barthel6.yaml").read_text(encoding="utf-8")
     assert change[0] in text
@@ -109,8 +131,19 @@ def test_kiosk_replay_refuses_bad_scripts(tmp_path, change, where):
 def test_a_policy_that_is_not_utf8_stops_kiosk_run_with_one_line(tmp_path):
     policy = write(tmp_path, "policy.yaml", "rules: []\n# réglée\n".encode("latin-1"))
     config = write(tmp_path, "config.yaml", f"adaptation_policy: {policy}\n")
-    one_line(kiosk("run", "--config", str(config), "--data-dir", str(tmp_path / "data"), "--no-voice",
-                   "--no-remote", cwd=tmp_path), f"{policy}:2:4: not UTF-8 text (byte 0xe9)")
+    one_line(
+        kiosk(
+            "run",
+            "--config",
+            str(config),
+            "--data-dir",
+            str(tmp_path / "data"),
+            "--no-voice",
+            "--no-remote",
+            cwd=tmp_path,
+        ),
+        f"{policy}:2:4: not UTF-8 text (byte 0xe9)",
+    )
 
 
 def test_duplicate_keys_in_site_remote_profiles_are_refused(tmp_path):

@@ -79,7 +79,10 @@ def test_spanish_voice_patient_answers_through_the_speech_matcher():
     assert result.session.language == "es"
     # "la tres" on the selecting check is answer number 3, as asked
     assert [(e.question_id, e.option, e.correct) for e in result.events if type(e).__name__ == "PracticeAnswered"] == [
-        ("practice_hear", 2, True), ("practice_read", 1, True), ("practice_select", 3, True)]
+        ("practice_hear", 2, True),
+        ("practice_read", 1, True),
+        ("practice_select", 3, True),
+    ]
 
 
 def test_adaptation_switches_voice_off_but_never_changes_the_qos_trace():
@@ -93,38 +96,74 @@ def test_adaptation_switches_voice_off_but_never_changes_the_qos_trace():
 
 def test_a_voice_answer_after_voice_off_cannot_happen_and_the_script_says_where(tmp_path):
     text = (ROOT / "recordings/patients/voice_dropout.yaml").read_text()
-    text = text.replace("{item: stairs, attempt: 1, channel: remote, option: 2, after: 5}",
-                        '{item: stairs, attempt: 1, channel: voice, say: "independent", after: 5}')
+    text = text.replace(
+        "{item: stairs, attempt: 1, channel: remote, option: 2, after: 5}",
+        '{item: stairs, attempt: 1, channel: voice, say: "independent", after: 5}',
+    )
     path = write(tmp_path, text)
-    with pytest.raises(ScriptError, match=r"patient\.yaml:21:5: the session ignored the answer declared on "
-                                          r"attempt 1 \(voice_off\)"):
+    with pytest.raises(
+        ScriptError,
+        match=r"patient\.yaml:21:5: the session ignored the answer declared on "
+        r"attempt 1 \(voice_off\)",
+    ):
         run_script(load_script(path))
 
 
-@pytest.mark.parametrize(("change", "message"), [
-    (("patient: P-T1", "patient: P-T1\ncolour: red"), r":2:1: unknown key 'colour'"),
-    (("{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
-      "{attempt: 3, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2"),
-     r":5:15: questions\[0\]\.attempt: 3 is not one of \[1, 2, 'none', 'any'\]"),
-    (("option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2", "say: hello, after: 4}\n"
-      "  - {attempt: 1, channel: touch, option: 2"), r":5:\d+: 'say' needs channel voice, not touch"),
-    (("channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
-      "channel: voice, say: purple elephants, after: 4}\n  - {attempt: 1, channel: touch, option: 2"),
-     r":5:\d+: on 'feeding', 'purple elephants' is not an answer"),
-    (("  - {attempt: 1, channel: touch, option: 3, after: 4}\n", ""), r":5:3: the script has 9 questions; the questionnaire has 10"),
-    (("{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
-      "{attempt: 1, channel: touch, option: 5, after: 4}\n  - {attempt: 1, channel: touch, option: 2"),
-     r":5:\d+: 'feeding' has 3 options, not 5"),
-    (("{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
-      "{item: bathing, attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2"),
-     r":5:\d+: question 1 of the questionnaire is 'feeding', not 'bathing'"),
-    (("{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
-      "{attempt: none, channel: touch}\n  - {attempt: 1, channel: touch, option: 2"),
-     r":5:\d+: questions\[0\] is not answered \(attempt: none\) but gives 'channel'"),
-    (("questions:\n", "questions: [\n"), r":5:3: YAML syntax: expected the node content, but found '-'"),
-    (("start_at: 2", "start_at: 2\nstart_at: 3"), r":3:1: duplicate key 'start_at'"),
-    (("attempt_window_s: 20", "attempt_window_s: 0"), r":3:\d+: timing\.attempt_window_s: 0 is less than or equal"),
-])
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("patient: P-T1", "patient: P-T1\ncolour: red"), r":2:1: unknown key 'colour'"),
+        (
+            (
+                "{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+                "{attempt: 3, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+            ),
+            r":5:15: questions\[0\]\.attempt: 3 is not one of \[1, 2, 'none', 'any'\]",
+        ),
+        (
+            (
+                "option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+                "say: hello, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+            ),
+            r":5:\d+: 'say' needs channel voice, not touch",
+        ),
+        (
+            (
+                "channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+                "channel: voice, say: purple elephants, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+            ),
+            r":5:\d+: on 'feeding', 'purple elephants' is not an answer",
+        ),
+        (
+            ("  - {attempt: 1, channel: touch, option: 3, after: 4}\n", ""),
+            r":5:3: the script has 9 questions; the questionnaire has 10",
+        ),
+        (
+            (
+                "{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+                "{attempt: 1, channel: touch, option: 5, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+            ),
+            r":5:\d+: 'feeding' has 3 options, not 5",
+        ),
+        (
+            (
+                "{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+                "{item: bathing, attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+            ),
+            r":5:\d+: question 1 of the questionnaire is 'feeding', not 'bathing'",
+        ),
+        (
+            (
+                "{attempt: 1, channel: touch, option: 3, after: 4}\n  - {attempt: 1, channel: touch, option: 2",
+                "{attempt: none, channel: touch}\n  - {attempt: 1, channel: touch, option: 2",
+            ),
+            r":5:\d+: questions\[0\] is not answered \(attempt: none\) but gives 'channel'",
+        ),
+        (("questions:\n", "questions: [\n"), r":5:3: YAML syntax: expected the node content, but found '-'"),
+        (("start_at: 2", "start_at: 2\nstart_at: 3"), r":3:1: duplicate key 'start_at'"),
+        (("attempt_window_s: 20", "attempt_window_s: 0"), r":3:\d+: timing\.attempt_window_s: 0 is less than or equal"),
+    ],
+)
 def test_a_bad_script_is_one_message_with_file_line_and_column_and_exit_2(tmp_path, capsys, change, message):
     old, new = change
     assert old in GOOD
@@ -146,12 +185,16 @@ def test_an_answer_declared_on_attempt_one_after_its_window_is_an_error(tmp_path
 
 
 def test_a_script_that_never_continues_after_calling_the_doctor_is_an_error(tmp_path, capsys):
-    text = GOOD.replace("  - {attempt: 1, channel: touch, option: 3, after: 4}\n",
-                        "  - attempt: none\n    incidents:\n"
-                        "      - {do: call_doctor, after: 3}\n", 1)
+    text = GOOD.replace(
+        "  - {attempt: 1, channel: touch, option: 3, after: 4}\n",
+        "  - attempt: none\n    incidents:\n      - {do: call_doctor, after: 3}\n",
+        1,
+    )
     assert main([str(write(tmp_path, text))]) == 2
-    assert "the script ends while the session waits (doctor called, no clinician continue) at t=7 s" in \
-        capsys.readouterr().err
+    assert (
+        "the script ends while the session waits (doctor called, no clinician continue) at t=7 s"
+        in capsys.readouterr().err
+    )
 
 
 def test_a_missing_script_is_a_clear_error(tmp_path, capsys):
@@ -176,7 +219,8 @@ def test_replays_can_be_stored_for_kiosk_results(tmp_path, capsys):
         (summary,) = store.sessions()
         assert (summary.patient_id, summary.status, summary.answered) == ("TB-0002", "finished", 10)
         assert [(a.item_id, a.option) for a in store.session(summary.id).answers] == [
-            (a["item"], a["option"]) for a in printed["answers"]]
+            (a["item"], a["option"]) for a in printed["answers"]
+        ]
 
 
 def test_a_failed_stored_replay_is_abandoned_not_left_for_the_kiosk_to_resume(tmp_path, capsys):

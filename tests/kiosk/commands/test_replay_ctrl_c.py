@@ -20,8 +20,10 @@ PATIENTS = sorted((ROOT / "recordings/patients").glob("*.yaml"))
 PATIENCE_S = 120.0
 #: `python -m kiosk ARGS` with Ctrl-C doing what it does from a terminal: a shell that started the
 #: tests in the background hands its children SIGINT ignored, and Python would keep it so
-AS_FROM_A_TERMINAL = ("import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
-                      "os.execv(sys.executable, [sys.executable, '-m', 'kiosk', *sys.argv[1:]])")
+AS_FROM_A_TERMINAL = (
+    "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+    "os.execv(sys.executable, [sys.executable, '-m', 'kiosk', *sys.argv[1:]])"
+)
 
 
 def _unused_port() -> int:
@@ -48,9 +50,25 @@ def test_ctrl_c_in_kiosk_replay_is_one_line_exit_130_and_nothing_half_stored(tmp
     data = tmp_path / "data"
     scripts = [str(p) for p in PATIENTS] * 3
     child = subprocess.Popen(
-        [sys.executable, "-c", AS_FROM_A_TERMINAL, "replay", *scripts, "--data-dir", str(data), "--config", str(config),
-         "--station-wait", "600"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True, cwd=ROOT)
+        [
+            sys.executable,
+            "-c",
+            AS_FROM_A_TERMINAL,
+            "replay",
+            *scripts,
+            "--data-dir",
+            str(data),
+            "--config",
+            str(config),
+            "--station-wait",
+            "600",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        text=True,
+        cwd=ROOT,
+    )
     try:
         pause = threading.Event()
         waited = 0.0

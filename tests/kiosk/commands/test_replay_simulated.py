@@ -43,9 +43,22 @@ def test_a_killed_replay_leaves_a_simulated_session_the_kiosk_never_offers(tmp_p
     data = tmp_path / "data"
     config = tmp_path / "config.yaml"
     config.write_text(f"data_dir: {data}\n")
-    child = subprocess.Popen([sys.executable, "-c", KILLED_REPLAY, str(ROOT / "recordings/patients/barthel2.yaml"),
-                              "--data-dir", str(data), "--config", str(config)],
-                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, cwd=ROOT)
+    child = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            KILLED_REPLAY,
+            str(ROOT / "recordings/patients/barthel2.yaml"),
+            "--data-dir",
+            str(data),
+            "--config",
+            str(config),
+        ],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
     try:
         assert child.stdout.readline().strip() == "HALFWAY"
         os.kill(child.pid, signal.SIGKILL)

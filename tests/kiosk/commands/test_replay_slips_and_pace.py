@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from kiosk.commands.replay import ScriptError, load_script, main, run_script
 from kiosk.core.adaptation import load_policy
 from kiosk.core.channels import Channel
-from kiosk.commands.replay import ScriptError, load_script, main, run_script
 from kiosk.core.session import AnswerNotConfirmed, AnswerWithdrawn, ConfirmationAsked
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -22,10 +22,11 @@ def test_a_scripted_patient_can_confirm_decline_and_undo():
     result = run_script(load_script(SLIPS))
     kinds = [type(e) for e in result.events]
     assert kinds.count(ConfirmationAsked) == 4
-    assert [(e.item_id, e.why) for e in result.events if isinstance(e, AnswerNotConfirmed)] == [
-        ("bathing", "declined")]
+    assert [(e.item_id, e.why) for e in result.events if isinstance(e, AnswerNotConfirmed)] == [("bathing", "declined")]
     assert [(e.item_id, e.option, e.by) for e in result.events if isinstance(e, AnswerWithdrawn)] == [
-        ("grooming", 1, Channel.TOUCH), ("transfers", 2, Channel.VOICE)]
+        ("grooming", 1, Channel.TOUCH),
+        ("transfers", 2, Channel.VOICE),
+    ]
     answers = result.session.answers
     assert (answers["feeding"].option, answers["feeding"].channel) == (3, Channel.VOICE)
     assert (answers["bathing"].option, answers["grooming"].option, answers["transfers"].option) == (2, 2, 3)
@@ -39,16 +40,24 @@ def write(tmp_path: Path, text: str) -> Path:
     return path
 
 
-@pytest.mark.parametrize(("old", "new", "message"), [
-    ("say: \"independent\"\n    after: 6\n    unsure: true", "say: \"independent\"\n    after: 6",
-     r"only an unsure answer \(unsure: true\) is asked back"),
-    ("    confirm: {say: \"yes\", after: 3}\n", "", r"is unsure: say what the patient replies"),
-    ("    then: {channel: voice, say: \"independent\", after: 4}\n", "", r"say what the patient answers next"),
-    ("confirm: {say: \"yes\", after: 3}", "confirm: {say: \"maybe\", after: 3}", r"'maybe' is not a yes or a no"),
-    ("{item: mobility, attempt: 1, channel: touch, option: 4, after: 6}",
-     "{item: mobility, attempt: 1, channel: touch, option: 4, after: 6, unsure: true}",
-     r"only a voice answer can be unsure"),
-])
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            'say: "independent"\n    after: 6\n    unsure: true',
+            'say: "independent"\n    after: 6',
+            r"only an unsure answer \(unsure: true\) is asked back",
+        ),
+        ('    confirm: {say: "yes", after: 3}\n', "", r"is unsure: say what the patient replies"),
+        ('    then: {channel: voice, say: "independent", after: 4}\n', "", r"say what the patient answers next"),
+        ('confirm: {say: "yes", after: 3}', 'confirm: {say: "maybe", after: 3}', r"'maybe' is not a yes or a no"),
+        (
+            "{item: mobility, attempt: 1, channel: touch, option: 4, after: 6}",
+            "{item: mobility, attempt: 1, channel: touch, option: 4, after: 6, unsure: true}",
+            r"only a voice answer can be unsure",
+        ),
+    ],
+)
 def test_a_bad_slip_is_one_message_with_file_line_and_column(tmp_path, capsys, old, new, message):
     text = SLIPS.read_text()
     assert old in text

@@ -13,8 +13,13 @@ from qos import Engine, load_model
 QUESTIONNAIRE = load_questionnaire()
 MODEL = load_model("clarc")
 #: the test-bench timing: easy round numbers to reason about
-TIMING = {"attempt_window_s": 30, "between_questions_s": 15, "resume_grace_s": 10,
-          "person_back_grace_s": 5, "closing_s": 5}
+TIMING = {
+    "attempt_window_s": 30,
+    "between_questions_s": 15,
+    "resume_grace_s": 10,
+    "person_back_grace_s": 5,
+    "closing_s": 5,
+}
 
 
 @dataclass
@@ -51,12 +56,21 @@ class Rig:
         self.session.handle(ChannelInput(channel, command=command))
 
 
-def make_rig(*, familiarisation: bool = False, timing: dict | None = None, language: str = "en",
-             engine: bool = True, **kwargs) -> Rig:
+def make_rig(
+    *, familiarisation: bool = False, timing: dict | None = None, language: str = "en", engine: bool = True, **kwargs
+) -> Rig:
     """A fresh session at clock 0 with the real QoS engine."""
     clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=Engine(MODEL) if engine else None, patient_id="T-0001",
-                      language=language, timing=timing or TIMING, familiarisation=familiarisation, **kwargs)
+    session = Session(
+        QUESTIONNAIRE,
+        clock=clock,
+        engine=Engine(MODEL) if engine else None,
+        patient_id="T-0001",
+        language=language,
+        timing=timing or TIMING,
+        familiarisation=familiarisation,
+        **kwargs,
+    )
     rig = Rig(session, clock)
     session.subscribe(rig.events.append)
     return rig
@@ -76,8 +90,15 @@ def at_first_question(store, engine=None, patient_id: str = "P-TEST01") -> Rig:
     """A stored session (the real engine unless ``engine`` is given) started and explained, with
     its first question open."""
     clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=engine or Engine(MODEL), store=store,
-                      patient_id=patient_id, timing=TIMING, familiarisation=False)
+    session = Session(
+        QUESTIONNAIRE,
+        clock=clock,
+        engine=engine or Engine(MODEL),
+        store=store,
+        patient_id=patient_id,
+        timing=TIMING,
+        familiarisation=False,
+    )
     rig = Rig(session, clock)
     session.subscribe(rig.events.append)
     session.start()

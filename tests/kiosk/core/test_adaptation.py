@@ -19,7 +19,10 @@ VOICE_OFF = {"VoiceInteractionQuality": 0.1, "Interaction": 0.9}
 def test_the_bundled_policy():
     rules = {r.name: r for r in load_policy().rules}
     assert (rules["voice_off"].metric, rules["voice_off"].below, rules["voice_off"].count) == (
-        "VoiceInteractionQuality", 0.2, 3)
+        "VoiceInteractionQuality",
+        0.2,
+        3,
+    )
     assert rules["slow_speech"].speech_rate < 1
 
 
@@ -72,25 +75,51 @@ def test_disabled_adaptation_does_nothing_and_turning_it_off_lifts_everything():
     assert not adaptation.active
 
 
-@pytest.mark.parametrize(("text", "at", "message"), [
-    ("rules:\n  - {name: voice_off, metric: VoiceInteractionQuality, below: 0.2, count: 3, count_on: answers,"
-     " recover_above: 0.4, colour: red}\n", "colour: red", "unknown key 'colour' in a rule"),
-    ("rules:\n  - {name: shout, metric: Interaction, below: 0.2, count: 3, count_on: answers, recover_above: 0.4}\n",
-     "shout", "unknown adaptation 'shout'"),
-    ("rules:\n  - {name: voice_off, metric: Interaction, below: 0.5, count: 3, count_on: answers, recover_above: 0.4}\n",
-     "0.4}", "recover_above must not be below 'below'"),
-    ("rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 0, count_on: answers, recover_above: 0.4}\n",
-     "0, count_on", "count must be a whole number of at least 1"),
-    ("rules:\n  - {name: voice_off, metric: VoiceInteractionQualty, below: 0.2, count: 3, count_on: answers,"
-     " recover_above: 0.4}\n", "VoiceInteractionQualty", "unknown metric 'VoiceInteractionQualty' (the model's "
-     "properties: Interaction, Performance, VoiceInteractionQuality)"),
-    ("rules:\n  - {name: voice_off, metric: Interaction, below: 1.5, count: 3, count_on: answers, recover_above: 1.8}\n",
-     "1.5", "below must be a number between 0 and 1"),
-    ("rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 3, count_on: answers, recover_above: 1.5}\n",
-     "1.5", "recover_above must be a number between 0 and 1"),
-    ("rules: [\n", None, ":2:1: YAML syntax"),
-    ("policy: []\n", None, ":1:1: an adaptation policy is a mapping with one key, 'rules'"),
-])
+@pytest.mark.parametrize(
+    ("text", "at", "message"),
+    [
+        (
+            "rules:\n  - {name: voice_off, metric: VoiceInteractionQuality, below: 0.2, count: 3, count_on: answers,"
+            " recover_above: 0.4, colour: red}\n",
+            "colour: red",
+            "unknown key 'colour' in a rule",
+        ),
+        (
+            "rules:\n  - {name: shout, metric: Interaction, below: 0.2, count: 3, count_on: answers, recover_above: 0.4}\n",
+            "shout",
+            "unknown adaptation 'shout'",
+        ),
+        (
+            "rules:\n  - {name: voice_off, metric: Interaction, below: 0.5, count: 3, count_on: answers, recover_above: 0.4}\n",
+            "0.4}",
+            "recover_above must not be below 'below'",
+        ),
+        (
+            "rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 0, count_on: answers, recover_above: 0.4}\n",
+            "0, count_on",
+            "count must be a whole number of at least 1",
+        ),
+        (
+            "rules:\n  - {name: voice_off, metric: VoiceInteractionQualty, below: 0.2, count: 3, count_on: answers,"
+            " recover_above: 0.4}\n",
+            "VoiceInteractionQualty",
+            "unknown metric 'VoiceInteractionQualty' (the model's "
+            "properties: Interaction, Performance, VoiceInteractionQuality)",
+        ),
+        (
+            "rules:\n  - {name: voice_off, metric: Interaction, below: 1.5, count: 3, count_on: answers, recover_above: 1.8}\n",
+            "1.5",
+            "below must be a number between 0 and 1",
+        ),
+        (
+            "rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 3, count_on: answers, recover_above: 1.5}\n",
+            "1.5",
+            "recover_above must be a number between 0 and 1",
+        ),
+        ("rules: [\n", None, ":2:1: YAML syntax"),
+        ("policy: []\n", None, ":1:1: an adaptation policy is a mapping with one key, 'rules'"),
+    ],
+)
 def test_a_bad_policy_file_is_one_positioned_message(tmp_path, text, at, message):
     path = tmp_path / "policy.yaml"
     path.write_text(text)
@@ -148,7 +177,7 @@ def test_low_interaction_slows_speech_and_repeats_the_question():
     rig.run_until(400)  # nobody answers: time-outs drag Interaction down
     slow = [e for e in rig.of(AdaptationChanged) if e.name == "slow_speech"]
     assert slow and slow[0].active
-    after = rig.events[rig.events.index(slow[0]):]
+    after = rig.events[rig.events.index(slow[0]) :]
     later = [p for p in after if isinstance(p, Prompt) and p.kind == "question"]
     assert later and all(p.speech_rate == 0.85 for p in later)
 
@@ -166,8 +195,10 @@ def test_the_metric_is_checked_against_the_model_given(tmp_path):
     from qos import parse_model
 
     path = tmp_path / "policy.yaml"
-    path.write_text("rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 3, count_on: answers,"
-                    " recover_above: 0.4}\n")
+    path.write_text(
+        "rules:\n  - {name: voice_off, metric: Interaction, below: 0.2, count: 3, count_on: answers,"
+        " recover_above: 0.4}\n"
+    )
     assert load_policy(path).rules[0].metric == "Interaction"
     other = parse_model("roqme Other\nproperty Calm reference 0.5\n", "other.roqme")
     with pytest.raises(PolicyError, match=r":2:31: unknown metric 'Interaction' \(the model's properties: Calm\)"):
@@ -177,8 +208,15 @@ def test_the_metric_is_checked_against_the_model_given(tmp_path):
 def _resumed(store: Store, rig) -> Session:
     """The kiosk restarted after a crash: the stored session continues with a fresh policy state."""
     stored = store.session(rig.session.id)
-    return Session.from_stored(QUESTIONNAIRE, stored, clock=SimClock(start=900), engine=Engine(MODEL), store=store,
-                               timing=TIMING, adaptation=Adaptation(load_policy()))
+    return Session.from_stored(
+        QUESTIONNAIRE,
+        stored,
+        clock=SimClock(start=900),
+        engine=Engine(MODEL),
+        store=store,
+        timing=TIMING,
+        adaptation=Adaptation(load_policy()),
+    )
 
 
 def test_a_resumed_session_keeps_voice_off_in_force(tmp_path):

@@ -74,11 +74,11 @@ def test_yes_stores_the_answer_on_the_attempt_it_was_given_in(tmp_path):
     recorded = rig.of(AnswerRecorded)[-1]
     assert (recorded.item_id, recorded.option, recorded.attempt, recorded.channel) == ("feeding", 2, 2, Channel.VOICE)
     stored = store.session(rig.session.id)
-    assert [(a.item_id, a.option, a.attempt, a.channel) for a in stored.answers] == [
-        ("feeding", 2, 2, Channel.VOICE)]
+    assert [(a.item_id, a.option, a.attempt, a.channel) for a in stored.answers] == [("feeding", 2, 2, Channel.VOICE)]
     # the answer counts on the attempt it was confirmed in, with the channel that gave it
     assert contexts_after(rig, 60) == [
-        {"t": 64, "set": {"SecondAttemptAnswered": True, "UserInteraction": "VOICE_RECOGNITION"}}]
+        {"t": 64, "set": {"SecondAttemptAnswered": True, "UserInteraction": "VOICE_RECOGNITION"}}
+    ]
     assert ("answer_confirmed", "feeding option 2 by touch 'screen'") in [(e.kind, e.detail) for e in stored.log]
     assert rig.session.snapshot().can_undo
 
@@ -97,10 +97,10 @@ def test_no_asks_the_question_again_in_the_same_attempt(tmp_path):
     assert rig.session.listening
     rig.at(63)
     rig.answer(3)
-    assert [(a.option, a.attempt, a.channel) for a in store.session(rig.session.id).answers] == [
-        (3, 1, Channel.TOUCH)]
+    assert [(a.option, a.attempt, a.channel) for a in store.session(rig.session.id).answers] == [(3, 1, Channel.TOUCH)]
     assert contexts_after(rig, 26) == [
-        {"t": 63, "set": {"FirstAttemptAnswered": True, "UserInteraction": "TOUCH_SCREEN"}}]
+        {"t": 63, "set": {"FirstAttemptAnswered": True, "UserInteraction": "TOUCH_SCREEN"}}
+    ]
 
 
 def test_a_confirmation_without_reply_never_stores_the_answer(tmp_path):
@@ -130,8 +130,11 @@ def test_an_unsure_yes_does_not_confirm_an_unsure_answer(tmp_path):
     assert rig.of(InputIgnored)[-1].reason is IgnoreReason.UNSURE_REPLY
     prompt = rig.of(Prompt)[-1]
     assert (prompt.kind, prompt.repeat) == ("confirm", True)
-    assert prompt.text == ("I could not hear you clearly. I heard: Independent. Is that right? "
-                           "Please press Yes or No.") == prompt.spoken
+    assert (
+        prompt.text
+        == ("I could not hear you clearly. I heard: Independent. Is that right? Please press Yes or No.")
+        == prompt.spoken
+    )
     assert rig.session.snapshot().confirming == 3
     assert store.session(rig.session.id).answers == ()
     # the 10 s window would have ended at 40: pressing takes longer than saying yes
@@ -147,8 +150,10 @@ def test_the_plea_to_press_is_in_the_patients_language_and_a_spoken_no_still_dec
     rig.at(30)
     rig.session.handle(unsure(3, "autonome"))
     rig.session.handle(ChannelInput(Channel.VOICE, option=1, detail="oui", confidence=0.9, needs_confirmation=True))
-    assert rig.of(Prompt)[-1].text == ("Je ne vous ai pas bien entendu. J'ai compris : Autonome. Est-ce bien cela ? "
-                                       "Appuyez sur Oui ou Non, s'il vous plaît.")
+    assert rig.of(Prompt)[-1].text == (
+        "Je ne vous ai pas bien entendu. J'ai compris : Autonome. Est-ce bien cela ? "
+        "Appuyez sur Oui ou Non, s'il vous plaît."
+    )
     rig.session.handle(ChannelInput(Channel.VOICE, option=2, detail="non", confidence=0.9, needs_confirmation=True))
     assert rig.of(AnswerNotConfirmed)[-1].why == "declined"
     assert rig.session.snapshot().confirming is None and store.session(rig.session.id).answers == ()
@@ -187,7 +192,11 @@ def test_undo_takes_back_the_last_answer_whatever_channel_gave_it(tmp_path):
     rig.session.handle(ChannelInput(Channel.VOICE, command=Command.UNDO, detail="no that's wrong"))
     withdrawn = rig.of(AnswerWithdrawn)[-1]
     assert (withdrawn.item_id, withdrawn.option, withdrawn.channel, withdrawn.by) == (
-        "feeding", 1, Channel.REMOTE, Channel.VOICE)
+        "feeding",
+        1,
+        Channel.REMOTE,
+        Channel.VOICE,
+    )
     stored = store.session(rig.session.id)
     assert stored.answers == () and "feeding" not in rig.session.answers
     [entry] = [e for e in stored.log if e.kind == "answer_withdrawn"]
@@ -258,8 +267,9 @@ def test_the_last_answer_can_be_changed_before_the_summary_and_a_restart_asks_it
     # the kiosk stops here: the withdrawn answer is not in the store, so stairs is asked again
     stored = store.session(rig.session.id)
     assert "stairs" not in {a.item_id for a in stored.answers}
-    again = Session.from_stored(QUESTIONNAIRE, stored, clock=SimClock(), engine=Engine(MODEL), store=store,
-                                timing=TIMING)
+    again = Session.from_stored(
+        QUESTIONNAIRE, stored, clock=SimClock(), engine=Engine(MODEL), store=store, timing=TIMING
+    )
     again.start()
     again.acknowledge()
     again.clock.advance(TIMING["between_questions_s"])

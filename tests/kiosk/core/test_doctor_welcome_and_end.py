@@ -39,7 +39,9 @@ def test_im_fine_carry_on_ends_a_doctor_call_and_is_recorded(tmp_path):
     log = [(e.kind, e.detail) for e in store.session(rig.session.id).log]
     assert ("call_doctor", "keyboard") in log and ("doctor_call_cancelled", "remote") in log
     assert [e for e in rig.session.trace if e["t"] >= 30] == [
-        {"t": 30, "emit": ["CallingDoctor"]}, {"t": 34, "set": {"TestState": "RESTARTED"}}]
+        {"t": 30, "emit": ["CallingDoctor"]},
+        {"t": 34, "set": {"TestState": "RESTARTED"}},
+    ]
     rig.session.cancel_doctor_call(Channel.TOUCH)
     assert rig.of(InputIgnored)[-1].reason is IgnoreReason.NOT_HALTED
 

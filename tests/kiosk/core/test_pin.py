@@ -59,8 +59,8 @@ def test_failures_grow_the_delay_then_lock_and_a_restart_does_not_reset_them(tmp
         verdict = guard.attempt("000000")
         assert not verdict.ok and not verdict.early
         waits.append(verdict.wait_s)
-    assert waits[:FREE_FAILURES - 1] == [0.0] * (FREE_FAILURES - 1)
-    delays = waits[FREE_FAILURES - 1:]
+    assert waits[: FREE_FAILURES - 1] == [0.0] * (FREE_FAILURES - 1)
+    delays = waits[FREE_FAILURES - 1 :]
     assert delays[0] > 0 and all(b >= a for a, b in zip(delays, delays[1:])) and delays[1] > delays[0]
     assert verdict.locked and waits[-1] >= 3600
 
@@ -95,8 +95,15 @@ print(sum(not v.early for v in verdicts), flush=True)
 
 def test_two_kiosk_processes_on_one_data_directory_share_one_failure_count(tmp_path):
     secret, tries = hash_pin("482193"), 2 * FREE_FAILURES + 2
-    guessers = [subprocess.Popen([sys.executable, "-c", GUESSER, str(tmp_path), secret, str(tries)],
-                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    guessers = [
+        subprocess.Popen(
+            [sys.executable, "-c", GUESSER, str(tmp_path), secret, str(tries)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(2)
+    ]
     try:
         # both have read the count (0) before either guesses: a count kept per process stays there
         assert [g.stdout.readline().split() for g in guessers] == [["ready", "0"]] * 2
@@ -136,8 +143,12 @@ def test_kiosk_pin_set_writes_the_hash_owner_only_and_keeps_the_rest(tmp_path):
     config = tmp_path / "config.yaml"
     config.write_text('language: es\n# the ward kiosk\nclinician_pin: "1234"\n')
     config.chmod(0o644)
-    done = subprocess.run([sys.executable, "-m", "kiosk", "pin", "set", "--config", str(config)],
-                          input="482193\n", capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "kiosk", "pin", "set", "--config", str(config)],
+        input="482193\n",
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     text = config.read_text()
     assert "482193" not in text and "# the ward kiosk" in text and "clinician_pin:" not in text
@@ -145,8 +156,12 @@ def test_kiosk_pin_set_writes_the_hash_owner_only_and_keeps_the_rest(tmp_path):
     loaded = load_config(config, environ={})
     assert loaded.language == "es" and PinGuard(loaded.pin_secret).attempt("482193").ok
 
-    refused = subprocess.run([sys.executable, "-m", "kiosk", "pin", "set", "--config", str(config)],
-                             input="2468\n", capture_output=True, text=True)
+    refused = subprocess.run(
+        [sys.executable, "-m", "kiosk", "pin", "set", "--config", str(config)],
+        input="2468\n",
+        capture_output=True,
+        text=True,
+    )
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and "6 to 12 digits" in refused.stderr
     assert config.read_text() == text
 

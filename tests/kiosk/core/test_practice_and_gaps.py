@@ -14,14 +14,15 @@ from kiosk.core.session import (
     Session,
 )
 from kiosk.store.database import Store
+from qos import Engine
 
 from .helpers import MODEL, QUESTIONNAIRE, TIMING, make_rig, started
-from qos import Engine
 
 
 def _practice(store: Store, session_id: str) -> list[tuple]:
-    return [(p.question_id, p.checks, p.outcome, p.option, p.channel, p.detail)
-            for p in store.session(session_id).practice]
+    return [
+        (p.question_id, p.checks, p.outcome, p.option, p.channel, p.detail) for p in store.session(session_id).practice
+    ]
 
 
 def test_without_voice_out_the_hearing_check_is_skipped_logged_and_stored(tmp_path):
@@ -34,7 +35,8 @@ def test_without_voice_out_the_hearing_check_is_skipped_logged_and_stored(tmp_pa
     assert snap.phase is Phase.FAMILIARISATION
     assert snap.practice.id == "practice_read" and (snap.practice_number, snap.practice_count) == (1, 2)
     assert [(e.question_id, e.checks, e.reason) for e in rig.of(PracticeSkipped)] == [
-        ("practice_hear", "hear", "no voice out")]
+        ("practice_hear", "hear", "no voice out")
+    ]
     assert "practice_hear" not in {p.key for p in rig.of(Prompt)}  # never shown nor spoken
     assert [e.item_id for e in rig.of(AttemptOpened)] == ["practice_read"]
     rig.at(7)
@@ -75,7 +77,10 @@ def test_with_voice_out_every_practice_outcome_is_stored(tmp_path):
     rig.run_until(rig.session.now() + TIMING["between_questions_s"])
     assert rig.session.phase is Phase.EXPLANATION
     assert [(p.question_id, p.option, p.correct) for p in rig.of(PracticeAnswered)] == [
-        ("practice_hear", 1, False), ("practice_read", None, False), ("practice_select", 2, False)]
+        ("practice_hear", 1, False),
+        ("practice_read", None, False),
+        ("practice_select", 2, False),
+    ]
     assert _practice(store, rig.session.id) == [
         ("practice_hear", "hear", "wrong", 1, Channel.VOICE, ""),
         ("practice_read", "read", "not_answered", None, None, ""),
@@ -164,8 +169,9 @@ def test_a_continued_session_waits_for_its_next_question_not_its_first(tmp_path)
     first.run_until(25)
     first.answer(3)
     stored = store.session(first.session.id)  # the kiosk stopped here
-    again = Session.from_stored(QUESTIONNAIRE, stored, clock=first.clock, engine=Engine(MODEL), store=store,
-                                timing=TIMING)
+    again = Session.from_stored(
+        QUESTIONNAIRE, stored, clock=first.clock, engine=Engine(MODEL), store=store, timing=TIMING
+    )
     again.start()
     again.acknowledge()
     assert again.snapshot().interlude == "next_question"

@@ -5,8 +5,8 @@ whose timers fire on the session's clock while nothing happens; the stored trace
 from __future__ import annotations
 
 import json
-import re
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -37,8 +37,9 @@ def environment(tmp_path: Path, config: str) -> dict[str, str]:
 def test_kiosk_replay_of_a_slow_patient_fires_the_inactivity_timer_at_its_time(tmp_path):
     env = environment(tmp_path, "qos_model: kiosk_pace.roqme\n")
     data, trace_file = tmp_path / "data", tmp_path / "trace.yaml"
-    printed = json.loads(kiosk("replay", str(SCRIPT), "--json", "--data-dir", str(data), "--trace", str(trace_file),
-                               env=env).stdout)
+    printed = json.loads(
+        kiosk("replay", str(SCRIPT), "--json", "--data-dir", str(data), "--trace", str(trace_file), env=env).stdout
+    )
     trace = load_trace(trace_file)
     assert trace.model == "kiosk_pace"
     # question 8 is asked, the patient walks away: a minute later the Silence timer fires
@@ -83,16 +84,22 @@ def test_qos_model_paths_are_relative_to_the_configuration(tmp_path):
         load_config(tmp_path / "config.yaml", environ={})
 
 
-@pytest.mark.parametrize(("model", "message"), [
-    ("roqme Broken\ncontext PersonDetected : boolean\nproperty Performance reference 0.5 survival\n",
-     r"broken\.roqme:3:\d+: "),
-    # well formed, but it lacks contexts the kiosk publishes: refused before any patient
-    ("roqme Lonely\ncontext PersonDetected : boolean\nproperty Performance reference 0.5\n",
-     r"broken\.roqme:1:1: the kiosk cannot run this model: it publishes TestState = STARTED"),
-    # declares QuestionAsked, but not as the event the kiosk emits
-    ('import "clarc.roqme"\ncontext QuestionAsked : boolean\n',
-     r"broken\.roqme:1:1: .*the event QuestionAsked"),
-])
+@pytest.mark.parametrize(
+    ("model", "message"),
+    [
+        (
+            "roqme Broken\ncontext PersonDetected : boolean\nproperty Performance reference 0.5 survival\n",
+            r"broken\.roqme:3:\d+: ",
+        ),
+        # well formed, but it lacks contexts the kiosk publishes: refused before any patient
+        (
+            "roqme Lonely\ncontext PersonDetected : boolean\nproperty Performance reference 0.5\n",
+            r"broken\.roqme:1:1: the kiosk cannot run this model: it publishes TestState = STARTED",
+        ),
+        # declares QuestionAsked, but not as the event the kiosk emits
+        ('import "clarc.roqme"\ncontext QuestionAsked : boolean\n', r"broken\.roqme:1:1: .*the event QuestionAsked"),
+    ],
+)
 def test_a_model_the_kiosk_cannot_run_is_refused_at_start(tmp_path, model, message):
     (tmp_path / "clarc.roqme").write_text((ROOT / "qos/models/clarc.roqme").read_text())
     (tmp_path / "broken.roqme").write_text(model)
@@ -109,7 +116,8 @@ def test_the_adaptation_policy_is_checked_against_the_configured_model(tmp_path)
     # Fatigue is a belief variable of kiosk_pace, not a published property: no rule may watch it
     (tmp_path / "policy.yaml").write_text(
         "rules:\n  - {name: slow_speech, metric: Fatigue, below: 0.3, count: 2, count_on: updates, "
-        "recover_above: 0.5}\n")
+        "recover_above: 0.5}\n"
+    )
     env = environment(tmp_path, "qos_model: kiosk_pace\nadaptation_policy: policy.yaml\n")
     done = kiosk("replay", str(SCRIPT), env=env, code=2)
     assert "policy.yaml:2:33: unknown metric 'Fatigue'" in done.stderr

@@ -27,8 +27,15 @@ rules:
 
 def pace_rig(**kwargs) -> Rig:
     clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=Engine(PACE), patient_id="T-PACE1", timing=TIMING,
-                      familiarisation=False, **kwargs)
+    session = Session(
+        QUESTIONNAIRE,
+        clock=clock,
+        engine=Engine(PACE),
+        patient_id="T-PACE1",
+        timing=TIMING,
+        familiarisation=False,
+        **kwargs,
+    )
     rig = Rig(session, clock)
     session.subscribe(rig.events.append)
     return rig
@@ -71,8 +78,13 @@ def test_the_inactivity_timer_fires_through_poll_while_nothing_happens(tmp_path)
     rig.session.poll()  # no input at all: only time passing
 
     (silence,) = rig.of(MetricsUpdated)[metrics_before:]
-    assert (silence.t, silence.timers, silence.fired, dict(silence.set), silence.emit) == \
-        (due, ("Silence",), ("Silent",), {}, ())
+    assert (silence.t, silence.timers, silence.fired, dict(silence.set), silence.emit) == (
+        due,
+        ("Silence",),
+        ("Silent",),
+        {},
+        (),
+    )
     assert silence.metrics["Interaction"] < rig.of(MetricsUpdated)[metrics_before - 1].metrics["Interaction"]
     assert rig.session.metrics == dict(silence.metrics)
     assert len(rig.session.trace) == published, "a timer is the model's own: nothing is added to the trace"
@@ -131,8 +143,9 @@ def test_a_continued_session_does_not_run_the_models_timers_again(tmp_path):
     stored = store.session(rig.session.id)
     assert stored.metrics[-1].fired == ("Silent",) and stored.trace[-1]["t"] < stored.metrics[-1].t
 
-    again = Session.from_stored(QUESTIONNAIRE, stored, clock=SimClock(), engine=Engine(PACE), store=store,
-                                timing=TIMING)
+    again = Session.from_stored(
+        QUESTIONNAIRE, stored, clock=SimClock(), engine=Engine(PACE), store=store, timing=TIMING
+    )
     again.clock.advance(2 * SILENCE_S)  # the continued session waits on the welcome screen a while
     again.poll()
     again.start()

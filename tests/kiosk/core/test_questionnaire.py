@@ -7,6 +7,7 @@ import json
 import jsonschema
 import pytest
 
+from kiosk.commands.validate import main as validate_main
 from kiosk.core.questionnaire import (
     QuestionnaireError,
     Timing,
@@ -14,15 +15,24 @@ from kiosk.core.questionnaire import (
     check_questionnaire_file,
     load_questionnaire,
 )
-from kiosk.commands.validate import main as validate_main
 
 Q = load_questionnaire()
 TEXT = bundled_path().read_text(encoding="utf-8")
 
 
 def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
-    assert [i.id for i in Q.items] == ["feeding", "bathing", "grooming", "dressing", "bowels", "bladder",
-                                       "toilet", "transfers", "mobility", "stairs"]
+    assert [i.id for i in Q.items] == [
+        "feeding",
+        "bathing",
+        "grooming",
+        "dressing",
+        "bowels",
+        "bladder",
+        "toilet",
+        "transfers",
+        "mobility",
+        "stairs",
+    ]
     assert Q.languages == ("en", "es", "fr")
     assert sorted(len(i.options) for i in Q.items) == [2, 2, 3, 3, 3, 3, 3, 3, 4, 4]
     for item in Q.items:
@@ -74,15 +84,36 @@ def test_scoring_edge_cases():
         Q.score({"bathing": True})
 
 
-@pytest.mark.parametrize(("total", "band"), [(20, "total"), (21, "severe"), (60, "severe"), (61, "moderate"),
-                                             (90, "moderate"), (95, "slight"), (100, "independent")])
+@pytest.mark.parametrize(
+    ("total", "band"),
+    [
+        (20, "total"),
+        (21, "severe"),
+        (60, "severe"),
+        (61, "moderate"),
+        (90, "moderate"),
+        (95, "slight"),
+        (100, "independent"),
+    ],
+)
 def test_bands_follow_shah(total, band):
     assert Q.band_for(total).id == band
 
 
-@pytest.mark.parametrize(("total", "band"), [(0, "total"), (15, "total"), (20, "severe"), (35, "severe"),
-                                             (40, "moderate"), (55, "moderate"), (60, "mild"), (95, "mild"),
-                                             (100, "independent")])
+@pytest.mark.parametrize(
+    ("total", "band"),
+    [
+        (0, "total"),
+        (15, "total"),
+        (20, "severe"),
+        (35, "severe"),
+        (40, "moderate"),
+        (55, "moderate"),
+        (60, "mild"),
+        (95, "mild"),
+        (100, "independent"),
+    ],
+)
 def test_the_spanish_band_set_follows_its_published_cut_offs(total, band):
     assert Q.band_for(total, "spanish").id == band
     assert Q.with_band_set("spanish").band_for(total).id == band
@@ -96,8 +127,13 @@ def test_shah_is_the_default_and_the_spanish_set_says_its_source_is_unconfirmed(
 
 
 def test_scoring_with_another_band_set():
-    points = {i.id: i.max_points for i in Q.items} | {"feeding": 0, "bathing": 0, "grooming": 0, "stairs": 0,
-                                                      "transfers": 5}
+    points = {i.id: i.max_points for i in Q.items} | {
+        "feeding": 0,
+        "bathing": 0,
+        "grooming": 0,
+        "stairs": 0,
+        "transfers": 5,
+    }
     shah, spanish = Q.score(points), Q.score(points, "spanish")
     assert shah.total == spanish.total == 60
     assert (shah.band.id, shah.band_set) == ("severe", "shah")
@@ -155,38 +191,48 @@ def broken(tmp_path, old: str, new: str, count: int = 1):
 def test_duplicate_ids(tmp_path):
     path, text = broken(tmp_path, "  - id: bathing", "  - id: feeding")
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{position(text, 'feeding', 1)}: duplicate id 'feeding' (also used at items[0])"]
+        f"{path}:{position(text, 'feeding', 1)}: duplicate id 'feeding' (also used at items[0])"
+    ]
 
 
 def test_missing_translation(tmp_path):
-    path, text = broken(tmp_path, "      fr: Comment faites-vous pour vous habiller, y compris les boutons, les "
-                                  "fermetures et les lacets ?\n", "")
+    path, text = broken(
+        tmp_path,
+        "      fr: Comment faites-vous pour vous habiller, y compris les boutons, les fermetures et les lacets ?\n",
+        "",
+    )
     spoken = text.index("spoken:", text.index("id: dressing"))
     line = text.count("\n", 0, spoken) + 1
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{line + 1}:7: items[3].spoken has no 'fr' translation"]
+        f"{path}:{line + 1}:7: items[3].spoken has no 'fr' translation"
+    ]
 
 
 def test_option_without_points(tmp_path):
-    path, text = broken(tmp_path, "      - points: 0\n        label: {en: \"Unable\"",
-                        "      - label: {en: \"Unable\"")
+    path, text = broken(tmp_path, '      - points: 0\n        label: {en: "Unable"', '      - label: {en: "Unable"')
     where = position(text, 'label: {en: "Unable"')
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{where}: items[0].options[0] is missing 'points'"]
+        f"{path}:{where}: items[0].options[0] is missing 'points'"
+    ]
 
 
 def test_points_not_a_multiple_of_five(tmp_path):
-    path, text = broken(tmp_path, "      - points: 15\n        label: {en: \"Independent\"",
-                        "      - points: 12\n        label: {en: \"Independent\"")
+    path, text = broken(
+        tmp_path,
+        '      - points: 15\n        label: {en: "Independent"',
+        '      - points: 12\n        label: {en: "Independent"',
+    )
     # one mistake, one message: bands are not judged against totals only the wrong points reach
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{position(text, ' 12') + 1}: items[7].options[3].points: must be a multiple of 5, got 12"]
+        f"{path}:{position(text, ' 12') + 1}: items[7].options[3].points: must be a multiple of 5, got 12"
+    ]
 
 
 def test_unknown_keys(tmp_path):
     path, text = broken(tmp_path, "  - id: grooming\n", "  - id: grooming\n    colour: blue\n")
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{position(text, 'colour')}: unknown key 'colour' in items[2]"]
+        f"{path}:{position(text, 'colour')}: unknown key 'colour' in items[2]"
+    ]
 
 
 def test_yaml_syntax(tmp_path):
@@ -197,15 +243,17 @@ def test_yaml_syntax(tmp_path):
 
 def test_duplicate_keys_are_not_silently_merged(tmp_path):
     path, text = broken(tmp_path, "id: barthel\n", "id: barthel\nid: barthel2\n")
-    assert [str(p) for p in check_questionnaire_file(path)] == [f"{path}:{position(text, 'id: barthel2')}: "
-                                                                "duplicate key 'id'"]
+    assert [str(p) for p in check_questionnaire_file(path)] == [
+        f"{path}:{position(text, 'id: barthel2')}: duplicate key 'id'"
+    ]
 
 
 def test_bands_with_a_gap(tmp_path):
     path, text = broken(tmp_path, "          min: 61", "          min: 70")
     assert [str(p) for p in check_questionnaire_file(path)] == [
         f"{path}:{position(text, ' 70') + 1}: band set 'shah': bands leave a gap before 70 "
-        "(a total of 65 is in no band)"]
+        "(a total of 65 is in no band)"
+    ]
 
 
 def test_a_gap_no_total_can_fall_in_is_not_a_gap(tmp_path):
@@ -218,25 +266,29 @@ def test_overlapping_bands(tmp_path):
     path, text = broken(tmp_path, "          min: 40\n", "          min: 30\n")
     assert [str(p) for p in check_questionnaire_file(path)] == [
         f"{path}:{position(text, ' 30') + 1}: band set 'spanish': bands 'severe' and 'moderate' overlap "
-        "(30 to 35 are in both)"]
+        "(30 to 35 are in both)"
+    ]
 
 
 def test_bands_that_stop_short_of_the_highest_total(tmp_path):
-    path, text = broken(tmp_path, "          min: 100\n          max: 100\n",
-                        "          min: 96\n          max: 99\n", count=2)
+    path, text = broken(
+        tmp_path, "          min: 100\n          max: 100\n", "          min: 96\n          max: 99\n", count=2
+    )
     where = {name: position(text, "- id: total", nth) for nth, name in enumerate(("shah", "spanish"))}
     assert [str(p) for p in check_questionnaire_file(path)] == [
         f"{path}:{where['shah']}: band set 'shah': bands end at 99 but the highest possible total is 100",
         f"{path}:{position(text, ' 96') + 1}: band set 'shah': bands 'slight' and 'independent' overlap "
         "(96 to 99 are in both)",
-        f"{path}:{where['spanish']}: band set 'spanish': bands end at 99 but the highest possible total is 100"]
+        f"{path}:{where['spanish']}: band set 'spanish': bands end at 99 but the highest possible total is 100",
+    ]
 
 
 def test_the_default_band_set_must_exist(tmp_path):
     path, text = broken(tmp_path, "  default: shah", "  default: barthel")
     assert [str(p) for p in check_questionnaire_file(path)] == [
         f"{path}:{position(text, 'default: barthel') + 9}: the default band set 'barthel' is not one of the sets "
-        "(shah, spanish)"]
+        "(shah, spanish)"
+    ]
 
 
 def test_bands_in_the_old_single_set_shape_are_refused_by_name(tmp_path):
@@ -246,10 +298,15 @@ def test_bands_in_the_old_single_set_shape_are_refused_by_name(tmp_path):
 
 
 def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path, capsys):
-    text = (TEXT.replace("  - id: bathing", "  - id: feeding")
-            .replace("  - id: grooming\n", "  - id: grooming\n    colour: blue\n")
-            .replace("      - points: 5\n        label: {en: \"Occasional accident\"",
-                     "      - points: 6\n        label: {en: \"Occasional accident\"", 1))
+    text = (
+        TEXT.replace("  - id: bathing", "  - id: feeding")
+        .replace("  - id: grooming\n", "  - id: grooming\n    colour: blue\n")
+        .replace(
+            '      - points: 5\n        label: {en: "Occasional accident"',
+            '      - points: 6\n        label: {en: "Occasional accident"',
+            1,
+        )
+    )
     path = tmp_path / "bad.yaml"
     path.write_text(text)
     assert validate_main([str(path)]) == 1
@@ -264,7 +321,9 @@ def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path
 
 def test_validate_accepts_the_bundled_file_and_reports_unreadable_ones(tmp_path, capsys):
     assert validate_main([str(bundled_path())]) == 0
-    assert validate_main([str(tmp_path / "missing.yaml")]) == 2  # not a questionnaire at all, as opposed to one with problems (1)
+    assert (
+        validate_main([str(tmp_path / "missing.yaml")]) == 2
+    )  # not a questionnaire at all, as opposed to one with problems (1)
     assert "missing.yaml:1:1: cannot read the file" in capsys.readouterr().out
 
 
@@ -274,13 +333,16 @@ def test_loading_a_missing_file_is_a_questionnaire_error(tmp_path):
 
 
 def test_a_patient_wording_needs_every_language_and_only_text(tmp_path):
-    path, text = broken(tmp_path, 'patient: {en: "Sometimes", es: "A veces", fr: "Parfois"}',
-                        'patient: {en: "Sometimes", es: "A veces"}')
+    path, text = broken(
+        tmp_path,
+        'patient: {en: "Sometimes", es: "A veces", fr: "Parfois"}',
+        'patient: {en: "Sometimes", es: "A veces"}',
+    )
     where = position(text, '{en: "Sometimes", es: "A veces"}')
     assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{where}: items[4].options[1].patient has no 'fr' translation"]
-    path, text = broken(tmp_path, '    patient:\n      en: "How do you manage eating?"',
-                        '    patient:\n      en: ""')
+        f"{path}:{where}: items[4].options[1].patient has no 'fr' translation"
+    ]
+    path, text = broken(tmp_path, '    patient:\n      en: "How do you manage eating?"', '    patient:\n      en: ""')
     problems = [p.message for p in check_questionnaire_file(path)]
     assert len(problems) == 1 and "items[0].patient.en" in problems[0]
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import pytest
 
 from kiosk.core.channels import Channel, ChannelInput, Command
-from kiosk.store.database import Store
 from kiosk.core.session import (
     AnswerRecorded,
     AttemptOpened,
@@ -26,6 +25,7 @@ from kiosk.core.session import (
     Resumed,
     VolumeChanged,
 )
+from kiosk.store.database import Store
 
 from .helpers import QUESTIONNAIRE, TIMING, make_rig, started
 
@@ -59,7 +59,8 @@ def test_the_first_answer_of_an_attempt_wins_and_a_simultaneous_one_is_ignored()
     assert rig.session.answers["feeding"].option == 1
     # exactly one QoS batch for that instant, with the winning channel
     assert [e for e in rig.session.trace if e["t"] == 30] == [
-        {"t": 30, "set": {"FirstAttemptAnswered": True, "UserInteraction": "REMOTE_CONTROL"}}]
+        {"t": 30, "set": {"FirstAttemptAnswered": True, "UserInteraction": "REMOTE_CONTROL"}}
+    ]
 
 
 def test_an_answer_exactly_at_the_deadline_is_accepted_one_later_goes_to_attempt_two():
@@ -74,9 +75,10 @@ def test_an_answer_exactly_at_the_deadline_is_accepted_one_later_goes_to_attempt
     assert [(e.attempt, e.t) for e in rig.of(AttemptTimedOut)] == [(1, 55)]
     rig.answer(2)
     assert rig.of(AnswerRecorded)[0].attempt == 2
-    assert rig.session.trace[1:] == [{"t": 55, "set": {"FirstAttemptAnswered": False}},
-                                     {"t": 55.5, "set": {"SecondAttemptAnswered": True,
-                                                         "UserInteraction": "TOUCH_SCREEN"}}]
+    assert rig.session.trace[1:] == [
+        {"t": 55, "set": {"FirstAttemptAnswered": False}},
+        {"t": 55.5, "set": {"SecondAttemptAnswered": True, "UserInteraction": "TOUCH_SCREEN"}},
+    ]
 
 
 def test_two_time_outs_make_the_question_not_answered_and_the_next_opens_after_the_gap():
@@ -116,7 +118,10 @@ def test_pause_freezes_the_attempt_clock_and_resume_leaves_the_grace_period():
     rig.run_until(525)
     assert rig.of(AttemptTimedOut)[-1].t == 525
     assert [e["set"]["TestState"] for e in rig.session.trace if "TestState" in e.get("set", {})] == [
-        "STARTED", "PAUSED", "RESTARTED"]
+        "STARTED",
+        "PAUSED",
+        "RESTARTED",
+    ]
 
 
 def test_pause_at_the_deadline_comes_before_the_time_out_and_resume_gives_the_grace():
@@ -146,8 +151,10 @@ def test_call_doctor_halts_until_a_clinician_continues():
     assert not rig.of(AnswerRecorded) and not rig.of(AttemptTimedOut)
     rig.session.clinician_continue()
     assert rig.of(DoctorContinued)[-1].deadline == 1015  # 15 s were left
-    assert rig.session.trace[1:] == [{"t": 40, "emit": ["CallingDoctor"]},
-                                     {"t": 1000, "set": {"TestState": "RESTARTED"}}]
+    assert rig.session.trace[1:] == [
+        {"t": 40, "emit": ["CallingDoctor"]},
+        {"t": 1000, "set": {"TestState": "RESTARTED"}},
+    ]
 
 
 def test_clinician_continue_after_doctor_called_at_the_deadline_leaves_the_grace():
@@ -170,8 +177,10 @@ def test_person_lost_freezes_and_person_back_leaves_at_least_five_seconds():
     assert rig.session.remaining() == 5  # 2 s were left; the grace is 5 s
     rig.run_until(305)
     assert rig.of(AttemptTimedOut)[-1].t == 305
-    assert rig.session.trace[1:3] == [{"t": 53, "set": {"PersonDetected": False}},
-                                      {"t": 300, "set": {"PersonDetected": True}}]
+    assert rig.session.trace[1:3] == [
+        {"t": 53, "set": {"PersonDetected": False}},
+        {"t": 300, "set": {"PersonDetected": True}},
+    ]
 
 
 def test_repeat_publishes_repeating_and_started_once_the_prompt_is_delivered():
@@ -183,8 +192,10 @@ def test_repeat_publishes_repeating_and_started_once_the_prompt_is_delivered():
     assert rig.session.remaining() == 10  # hearing it again leaves at least the grace period
     rig.at(52)
     rig.session.prompt_delivered()
-    assert rig.session.trace[1:] == [{"t": 50, "set": {"TestState": "REPEATING"}},
-                                     {"t": 52, "set": {"TestState": "STARTED"}}]
+    assert rig.session.trace[1:] == [
+        {"t": 50, "set": {"TestState": "REPEATING"}},
+        {"t": 52, "set": {"TestState": "STARTED"}},
+    ]
 
 
 def test_without_a_delivery_report_started_rides_with_the_next_batch():
@@ -193,8 +204,10 @@ def test_without_a_delivery_report_started_rides_with_the_next_batch():
     rig.session.repeat()
     rig.at(54)
     rig.answer(3, Channel.VOICE)
-    assert rig.session.trace[-1] == {"t": 54, "set": {"TestState": "STARTED", "FirstAttemptAnswered": True,
-                                                      "UserInteraction": "VOICE_RECOGNITION"}}
+    assert rig.session.trace[-1] == {
+        "t": 54,
+        "set": {"TestState": "STARTED", "FirstAttemptAnswered": True, "UserInteraction": "VOICE_RECOGNITION"},
+    }
 
 
 def test_keyboard_answers_count_as_the_touch_panel():
@@ -241,7 +254,12 @@ def test_listening_follows_open_attempts_and_freezes():
     # the explanation at 10 listens for "I'm ready" until acknowledged at once; the answer at 40
     # leaves it on through the thank-you gap, in which "No, that's wrong" takes it back
     assert [(e.t, e.listening) for e in rig.of(ListeningChanged)] == [
-        (10, True), (10, False), (25, True), (30, False), (40, True)]
+        (10, True),
+        (10, False),
+        (25, True),
+        (30, False),
+        (40, True),
+    ]
 
 
 def test_the_thank_you_gap_listens_until_the_next_question_or_the_end():
@@ -273,7 +291,10 @@ def test_familiarisation_answers_are_checked_but_never_sent_to_qos():
     rig.answer(3, Channel.REMOTE)  # "choose answer number 3"
     rig.run_until(40 + TIMING["between_questions_s"])
     assert [(p.question_id, p.correct) for p in rig.of(PracticeAnswered)] == [
-        ("practice_hear", True), ("practice_read", False), ("practice_select", True)]
+        ("practice_hear", True),
+        ("practice_read", False),
+        ("practice_select", True),
+    ]
     assert rig.session.phase is Phase.EXPLANATION
     assert rig.session.trace == [{"t": 5, "set": {"PersonDetected": True, "TestState": "STARTED"}}]
     assert not rig.session.answers
@@ -289,7 +310,10 @@ def test_inputs_outside_an_open_attempt_are_ignored_with_a_reason():
     rig.run_until(25)
     rig.answer(4)  # feeding has 3 options
     assert [e.reason for e in rig.of(InputIgnored)] == [
-        IgnoreReason.NOT_STARTED, IgnoreReason.NO_OPEN_ATTEMPT, IgnoreReason.NO_SUCH_OPTION]
+        IgnoreReason.NOT_STARTED,
+        IgnoreReason.NO_OPEN_ATTEMPT,
+        IgnoreReason.NO_SUCH_OPTION,
+    ]
 
 
 def test_volume_commands_become_events():

@@ -21,9 +21,21 @@ actions = st.one_of(
     st.tuples(st.just("wait"), st.floats(min_value=0, max_value=45, allow_nan=False)),
     st.tuples(st.just("answer"), st.tuples(channels, st.integers(min_value=1, max_value=4))),
     st.tuples(st.just("command"), st.tuples(channels, st.sampled_from(list(Command)))),
-    st.tuples(st.just("call"), st.sampled_from(["person_lost", "person_back", "clinician_continue",
-                                                 "prompt_delivered", "acknowledge", "skip_familiarisation",
-                                                 "start", "request_voice"])),
+    st.tuples(
+        st.just("call"),
+        st.sampled_from(
+            [
+                "person_lost",
+                "person_back",
+                "clinician_continue",
+                "prompt_delivered",
+                "acknowledge",
+                "skip_familiarisation",
+                "start",
+                "request_voice",
+            ]
+        ),
+    ),
     st.tuples(st.just("language"), st.sampled_from(["en", "es", "fr", "de"])),
     # a speaker or microphone that comes and goes (the app's channel statuses)
     st.tuples(st.just("voice_out"), st.booleans()),
@@ -51,8 +63,7 @@ def step(rig, action) -> None:
     snap = rig.session.snapshot()
     # a gap's line only between questions (or a practice answer's kind word); "Practice k of n"
     # always makes sense
-    assert snap.interlude is None or (snap.phase in (Phase.QUESTIONS, Phase.FAMILIARISATION)
-                                      and snap.attempt is None)
+    assert snap.interlude is None or (snap.phase in (Phase.QUESTIONS, Phase.FAMILIARISATION) and snap.attempt is None)
     assert (snap.practice_number is None) == (snap.practice is None)
     assert snap.practice_number is None or 1 <= snap.practice_number <= snap.practice_count
     if not getattr(rig, "voice_out", True):  # nothing to hear: no hearing check on screen
@@ -92,4 +103,5 @@ def test_any_input_sequence_keeps_the_session_consistent_and_it_can_always_finis
     engine = Engine(MODEL)
     replayed = [(float(t), engine.update(t, set=v, emit=em)) for t, v, em in trace.batches()]
     assert [(t, r.metrics, tuple(r.fired)) for t, r in replayed] == [
-        (u.t, dict(u.metrics), u.fired) for u in rig.of(MetricsUpdated)]
+        (u.t, dict(u.metrics), u.fired) for u in rig.of(MetricsUpdated)
+    ]

@@ -127,7 +127,10 @@ def test_voice_in_lost_while_voice_off_is_in_force_lifts_it_silently_and_truthfu
     assert _voice_messages(rig) == ["voice_off"]  # no "I can hear you again"
     stored = store.session(rig.session.id)
     assert [(a.name, a.active, a.reason) for a in stored.adaptations if a.name == "voice_off"][-1] == (
-        "voice_off", False, "voice in is unavailable")
+        "voice_off",
+        False,
+        "voice in is unavailable",
+    )
     assert [e.detail for e in stored.log if e.kind == "voice_in"] == ["unavailable"]
     # voice in back: voice_off needs fresh low readings after answers to come back
     rig.session.set_voice_available(True)

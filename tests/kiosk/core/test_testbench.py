@@ -26,6 +26,10 @@ def test_replayed_patient_gives_the_test_bench_trace_event_by_event(n):
 
 
 def test_the_test_bench_patients_exercise_every_incident_kind():
-    kinds = {step.kind for n in range(1, 7)
-             for q in load_script(ROOT / f"recordings/patients/barthel{n}.yaml").questions for step in q.steps}
+    kinds = {
+        step.kind
+        for n in range(1, 7)
+        for q in load_script(ROOT / f"recordings/patients/barthel{n}.yaml").questions
+        for step in q.steps
+    }
     assert {"answer", "pause", "resume", "call_doctor", "continue", "person_lost", "person_back"} <= kinds

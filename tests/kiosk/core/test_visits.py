@@ -21,15 +21,31 @@ def test_names_and_malformed_identifiers_are_refused(name):
 
 
 def test_orders_the_kiosk_cannot_run_are_left_out_with_why():
-    entry = {"id": "order-1", "patient_id": "NHC-1", "instruments": ["barthel"], "language": "es",
-             "answered_by": "relative", "ordered_by": "nurse.kim"}
-    body = {"orders": [entry, entry | {"id": "order-2", "instruments": ["moca"]},
-                       entry | {"id": "order-3", "language": "de"}, entry | {"id": "order-4", "patient_id": "LOPEZ"},
-                       "nonsense"]}
+    entry = {
+        "id": "order-1",
+        "patient_id": "NHC-1",
+        "instruments": ["barthel"],
+        "language": "es",
+        "answered_by": "relative",
+        "ordered_by": "nurse.kim",
+    }
+    body = {
+        "orders": [
+            entry,
+            entry | {"id": "order-2", "instruments": ["moca"]},
+            entry | {"id": "order-3", "language": "de"},
+            entry | {"id": "order-4", "patient_id": "LOPEZ"},
+            "nonsense",
+        ]
+    }
     found, problems = parse_orders(body, ["barthel"], ["en", "es", "fr"])
     assert found == [Order("order-1", "NHC-1", ("barthel",), "es", "relative", "nurse.kim")]
-    assert [p.split(":")[0] for p in problems] == ["orders[1] (order-2)", "orders[2] (order-3)",
-                                                   "orders[3] (order-4)", "orders[4]"]
+    assert [p.split(":")[0] for p in problems] == [
+        "orders[1] (order-2)",
+        "orders[2] (order-3)",
+        "orders[3] (order-4)",
+        "orders[4]",
+    ]
     assert "this kiosk gives barthel" in problems[0] and "'de'" in problems[1] and "never a name" in problems[2]
     assert parse_orders({"oops": 1}, ["barthel"], ["en"]) == ([], ["the station's answer has no 'orders' list"])
 

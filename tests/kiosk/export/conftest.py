@@ -7,15 +7,20 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.export import ExportSite, export_identity
 from kiosk.commands.replay import load_script, run_script
+from kiosk.export import ExportSite, export_identity
 from kiosk.store.database import Store, StoredSession
 
 ROOT = Path(__file__).resolve().parents[3]
 PATIENTS = sorted((ROOT / "recordings/patients").glob("*.yaml"))
 #: the identity the replayed sessions are recorded under (a kiosk's site, kiosk id and FHIR systems)
-RECORDED_AT = export_identity(ExportSite(site="hosp-north", kiosk_id="ward3-bed2",
-                                         questionnaire_url="https://hosp-north.example/fhir/Questionnaire/barthel"))
+RECORDED_AT = export_identity(
+    ExportSite(
+        site="hosp-north",
+        kiosk_id="ward3-bed2",
+        questionnaire_url="https://hosp-north.example/fhir/Questionnaire/barthel",
+    )
+)
 
 
 @pytest.fixture(scope="session")

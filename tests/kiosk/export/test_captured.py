@@ -8,8 +8,8 @@ import sqlite3
 
 import pytest
 
-from kiosk.store import migrations as schema
-from kiosk.export.captured import questionnaire_of, site_of
+from kiosk.commands.results import main as results_main
+from kiosk.core.questionnaire import bundled_path, load_questionnaire
 from kiosk.core.questionnaire.definition import (
     DefinitionError,
     canonical,
@@ -17,8 +17,8 @@ from kiosk.core.questionnaire.definition import (
     digest,
     questionnaire_from,
 )
-from kiosk.core.questionnaire import bundled_path, load_questionnaire
-from kiosk.commands.results import main as results_main
+from kiosk.export.captured import questionnaire_of, site_of
+from kiosk.store import migrations as schema
 from kiosk.store.database import DB_NAME, Store
 from tests.kiosk.core.helpers import QUESTIONNAIRE, at_first_question
 from tests.kiosk.store.test_schema import v1_database
@@ -34,9 +34,13 @@ def test_a_definition_round_trips_to_an_equal_questionnaire(band_set):
     # every wording survives, in the order the kiosk had it
     for mine, theirs in zip(rebuilt.items, q.items):
         assert (list(mine.text.items()), list(mine.patient.items()), list(mine.spoken.items())) == (
-            list(theirs.text.items()), list(theirs.patient.items()), list(theirs.spoken.items()))
+            list(theirs.text.items()),
+            list(theirs.patient.items()),
+            list(theirs.spoken.items()),
+        )
         assert [(o.label, o.patient, o.synonyms, o.points, o.code) for o in mine.options] == [
-            (o.label, o.patient, o.synonyms, o.points, o.code) for o in theirs.options]
+            (o.label, o.patient, o.synonyms, o.points, o.code) for o in theirs.options
+        ]
     assert digest(canonical(q.with_band_set("shah"))) != digest(canonical(q.with_band_set("spanish")))
 
 
@@ -71,19 +75,22 @@ def _v2_database(data) -> None:
     for statement in schema._statements(schema.V2):  # noqa: SLF001 - the shipped v2 script
         db.execute(statement)
     db.execute("PRAGMA user_version = 2")
-    db.execute("INSERT INTO outbox (kind, session_id, payload, at) VALUES ('create_session', 'aaaa00000001', ?, ?)",
-               (json.dumps({"session_id": "aaaa00000001", "patient_id": "P-FIRST1"}), "2026-11-20T09:00:00Z"))
+    db.execute(
+        "INSERT INTO outbox (kind, session_id, payload, at) VALUES ('create_session', 'aaaa00000001', ?, ?)",
+        (json.dumps({"session_id": "aaaa00000001", "patient_id": "P-FIRST1"}), "2026-11-20T09:00:00Z"),
+    )
     db.close()
 
 
 def _config(path, site: str, kiosk: str, questionnaire=None):
-    path.write_text(f"site: {site}\nkiosk_id: {kiosk}\n" + (f"questionnaire: {questionnaire}\n" if questionnaire
-                                                           else ""), encoding="utf-8")
+    path.write_text(
+        f"site: {site}\nkiosk_id: {kiosk}\n" + (f"questionnaire: {questionnaire}\n" if questionnaire else ""),
+        encoding="utf-8",
+    )
     return path
 
 
-def test_an_upgrade_attaches_the_definition_and_identity_in_force_marked_attached_later(tmp_path, monkeypatch,
-                                                                                        capsys):
+def test_an_upgrade_attaches_the_definition_and_identity_in_force_marked_attached_later(tmp_path, monkeypatch, capsys):
     data = tmp_path / "data"
     _v2_database(data)
     monkeypatch.setenv("KIOSK_CONFIG", str(_config(tmp_path / "a.yaml", "sitea", "kiosk-a")))
@@ -103,8 +110,10 @@ def test_an_upgrade_attaches_the_definition_and_identity_in_force_marked_attache
     assert payload["export"]["site"] == "sitea" and payload["export_attached_later"] is True
     # later, another site and an edited file: the sessions keep what was attached
     edited = tmp_path / "edited.yaml"
-    edited.write_text(bundled_path().read_text(encoding="utf-8").replace(
-        "Feeding: how do you manage eating?", "Feeding, edited"), encoding="utf-8")
+    edited.write_text(
+        bundled_path().read_text(encoding="utf-8").replace("Feeding: how do you manage eating?", "Feeding, edited"),
+        encoding="utf-8",
+    )
     monkeypatch.setenv("KIOSK_CONFIG", str(_config(tmp_path / "b.yaml", "siteb", "laptop-7", edited)))
     assert results_main(["--data-dir", str(data), "--csv", str(tmp_path / "b.csv")]) == 0
     assert (tmp_path / "b.csv").read_bytes() == (tmp_path / "a.csv").read_bytes()
@@ -125,8 +134,9 @@ def test_an_upgrade_without_anything_in_force_is_refused_and_changes_nothing(tmp
     db.close()
 
 
-def test_an_upgrade_with_an_unusable_questionnaire_in_force_is_one_message_and_changes_nothing(tmp_path,
-                                                                                             monkeypatch, capsys):
+def test_an_upgrade_with_an_unusable_questionnaire_in_force_is_one_message_and_changes_nothing(
+    tmp_path, monkeypatch, capsys
+):
     data = tmp_path / "data"
     _v2_database(data)
     broken = tmp_path / "broken.yaml"

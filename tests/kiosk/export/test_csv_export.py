@@ -7,9 +7,9 @@ from dataclasses import replace
 
 import pandas as pd
 
-from kiosk.export import ExportSite, csv_text, questionnaire_version, wide_csv_text
 from kiosk.commands.results import main as results_main
 from kiosk.core.review import Correction, Review, ReviewState
+from kiosk.export import ExportSite, csv_text, questionnaire_version, wide_csv_text
 from tests.kiosk.core.helpers import QUESTIONNAIRE
 
 SITE = ExportSite(site="hosp-north", kiosk_id="0042")
@@ -24,8 +24,10 @@ def tricky_sessions(replayed):
 
 def test_ids_stay_text_in_pandas_in_both_layouts(replayed, tmp_path):
     sessions = tricky_sessions(replayed)
-    for name, text in (("long", csv_text(QUESTIONNAIRE, sessions, site=SITE)),
-                       ("wide", wide_csv_text(QUESTIONNAIRE, sessions, site=SITE))):
+    for name, text in (
+        ("long", csv_text(QUESTIONNAIRE, sessions, site=SITE)),
+        ("wide", wide_csv_text(QUESTIONNAIRE, sessions, site=SITE)),
+    ):
         path = tmp_path / f"{name}.csv"
         path.write_text(text, encoding="utf-8")
         frame = pd.read_csv(path)
@@ -44,7 +46,12 @@ def test_the_wide_csv_has_one_row_per_session_and_no_total_when_incomplete(repla
     frame = pd.read_csv(path, keep_default_na=False)
     assert len(frame) == 3
     complete, partial, french = (frame.iloc[i] for i in range(3))
-    assert (complete["total"], complete["complete"], complete["band"], complete["band_set"]) == ("100", True, "independent", "shah")  # a real boolean
+    assert (complete["total"], complete["complete"], complete["band"], complete["band_set"]) == (
+        "100",
+        True,
+        "independent",
+        "shah",
+    )  # a real boolean
     assert (partial["total"], partial["answered_points"], partial["complete"]) == ("", 65, False)
     assert partial["missing"] == "grooming bladder" and partial["grooming_option"] == ""
     assert partial["feeding_option"] == 3 and partial["feeding_points"] == 10
@@ -55,12 +62,17 @@ def test_the_wide_csv_has_one_row_per_session_and_no_total_when_incomplete(repla
 
 def test_the_long_csv_shows_the_review_and_what_the_kiosk_recorded(replayed):
     stored = replayed["TB-0004"]
-    review = Review(ReviewState.AMENDED, (Correction("grooming", 2, None, "asked again", "dr.lopez", "2026-11-23T15:00:00Z"),
-                                          Correction("feeding", 2, 3, "patient overstated", "dr.lopez", "2026-11-23T15:01:00Z"),
-                                          Correction("bladder", 3, None, "chart", "dr.lopez", "2026-11-23T15:01:00Z")),
-                    "dr.lopez", "2026-11-23T15:02:00Z")
-    frame = pd.read_csv(io.StringIO(csv_text(QUESTIONNAIRE, [stored], [review], SITE)),
-                        keep_default_na=False)
+    review = Review(
+        ReviewState.AMENDED,
+        (
+            Correction("grooming", 2, None, "asked again", "dr.lopez", "2026-11-23T15:00:00Z"),
+            Correction("feeding", 2, 3, "patient overstated", "dr.lopez", "2026-11-23T15:01:00Z"),
+            Correction("bladder", 3, None, "chart", "dr.lopez", "2026-11-23T15:01:00Z"),
+        ),
+        "dr.lopez",
+        "2026-11-23T15:02:00Z",
+    )
+    frame = pd.read_csv(io.StringIO(csv_text(QUESTIONNAIRE, [stored], [review], SITE)), keep_default_na=False)
     items = frame[frame["kind"] == "item"].set_index("item")
     assert (items.loc["feeding", "option"], items.loc["feeding", "recorded_option"]) == ("2", "3")
     assert items.loc["feeding", "corrected_by"] == "dr.lopez" and items.loc["feeding", "points"] == 5
@@ -84,8 +96,21 @@ def test_kiosk_results_writes_both_layouts_with_a_bom_and_accepts_tagged_ids(rep
     config.write_text("site: hosp-north\nkiosk_id: ward3-bed2\n", encoding="utf-8")
     monkeypatch.setenv("KIOSK_CONFIG", str(config))
     long, wide = tmp_path / "long.csv", tmp_path / "wide.csv"
-    assert results_main([f"S:{session_id}", "--data-dir", str(tmp_path / "data"), "--csv", str(long),
-                         "--csv-wide", str(wide), "--bom"]) == 0
+    assert (
+        results_main(
+            [
+                f"S:{session_id}",
+                "--data-dir",
+                str(tmp_path / "data"),
+                "--csv",
+                str(long),
+                "--csv-wide",
+                str(wide),
+                "--bom",
+            ]
+        )
+        == 0
+    )
     for path in (long, wide):
         assert path.read_bytes().startswith(b"\xef\xbb\xbfsession,")
         assert path.stat().st_mode & 0o777 == 0o600

@@ -10,16 +10,13 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.export import ExportError, csv_text, rescore
-from kiosk.export import ITEM_WEIGHT, fhir_questionnaire, fhir_response
 from kiosk.commands.replay import load_script, run_script
 from kiosk.commands.results import main as results_main
 from kiosk.core.channels import Channel
+from kiosk.export import ITEM_WEIGHT, ExportError, csv_text, fhir_questionnaire, fhir_response, rescore
 from kiosk.store.database import Store
-
-from tests.kiosk.export.standard import check_fhir
-
 from tests.kiosk.core.helpers import QUESTIONNAIRE, TIMING, make_rig
+from tests.kiosk.export.standard import check_fhir
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -43,8 +40,9 @@ def test_the_fhir_questionnaire_puts_each_items_points_on_its_options():
     items = {i["linkId"]: i for i in resource["item"]}
     weights = [[o["extension"][0]["valueDecimal"] for o in items[i.id]["answerOption"]] for i in QUESTIONNAIRE.items]
     assert weights == [[o.points for o in i.options] for i in QUESTIONNAIRE.items]
-    assert all(o["extension"][0]["url"] == ITEM_WEIGHT for i in QUESTIONNAIRE.items
-               for o in items[i.id]["answerOption"])
+    assert all(
+        o["extension"][0]["url"] == ITEM_WEIGHT for i in QUESTIONNAIRE.items for o in items[i.id]["answerOption"]
+    )
     assert items["feeding"]["code"][0]["code"] == "83184-2"
     assert items["total"]["readOnly"] and "calculatedExpression" in items["total"]["extension"][0]["url"]
     check_fhir(resource)  # valid R4 for the official schema and fhir.resources
@@ -100,7 +98,11 @@ def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path
     assert "total 65/100 (incomplete, missing grooming, bladder)" in shown
     bundle = json.loads(fhir.read_text())
     check_fhir(bundle)
-    assert [e["resource"]["resourceType"] for e in bundle["entry"]] == ["Questionnaire", "Device", "QuestionnaireResponse"]
+    assert [e["resource"]["resourceType"] for e in bundle["entry"]] == [
+        "Questionnaire",
+        "Device",
+        "QuestionnaireResponse",
+    ]
     assert fhir.stat().st_mode & 0o777 == 0o600 and table.stat().st_mode & 0o777 == 0o600
 
 
@@ -119,15 +121,18 @@ def test_the_configured_band_set_interprets_the_session_its_export_and_kiosk_res
     store.close()
     totals = [list(csv.DictReader(io.StringIO(csv_text(q, [stored]))))[-1] for q in (QUESTIONNAIRE, spanish)]
     assert [(t["item"], t["points"], t["label"], t["band_set"]) for t in totals] == [
-        ("total", "75", "moderate", "shah"), ("total", "75", "mild", "spanish")]
+        ("total", "75", "moderate", "shah"),
+        ("total", "75", "mild", "spanish"),
+    ]
 
     config = tmp_path / "config.yaml"
     config.write_text("bands: spanish\n")
     monkeypatch.setenv("KIOSK_CONFIG", str(config))
     table = tmp_path / "r.csv"
     assert results_main([stored.id, "--data-dir", str(tmp_path / "data"), "--csv", str(table)]) == 0
-    assert ("total 75/100 (complete); Mild dependence (bands: spanish, Spanish clinical practice "
-            "(unconfirmed source))") in capsys.readouterr().out
+    assert (
+        "total 75/100 (complete); Mild dependence (bands: spanish, Spanish clinical practice (unconfirmed source))"
+    ) in capsys.readouterr().out
     assert list(csv.DictReader(table.open()))[-1]["band_set"] == "spanish"
     # the session keeps the band set it was recorded with, whatever the configuration says today
     config.write_text("bands: shah\n")
@@ -151,16 +156,25 @@ def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_
 
     table = tmp_path / "r.csv"
     assert results_main([session_id, "--data-dir", str(tmp_path / "data"), "--csv", str(table)]) == 0
-    assert ("practice: hearing: skipped (no voice out); reading: wrong (chose No); selecting: not answered"
-            in capsys.readouterr().out.splitlines())
+    assert (
+        "practice: hearing: skipped (no voice out); reading: wrong (chose No); selecting: not answered"
+        in capsys.readouterr().out.splitlines()
+    )
     rows = list(csv.DictReader(table.open()))
-    practice = [(r["item"], r["checks"], r["option"], r["label"], r["channel"], r["points"])
-                for r in rows if r["kind"] == "practice"]
-    assert practice == [("practice_hear", "hear", "", "skipped (no voice out)", "", ""),
-                        ("practice_read", "read", "2", "wrong (chose No)", "remote", ""),
-                        ("practice_select", "select", "", "not answered", "", "")]
+    practice = [
+        (r["item"], r["checks"], r["option"], r["label"], r["channel"], r["points"])
+        for r in rows
+        if r["kind"] == "practice"
+    ]
+    assert practice == [
+        ("practice_hear", "hear", "", "skipped (no voice out)", "", ""),
+        ("practice_read", "read", "2", "wrong (chose No)", "remote", ""),
+        ("practice_select", "select", "", "not answered", "", ""),
+    ]
     assert [r["kind"] for r in rows] == ["practice"] * 3 + ["item"] * 10 + ["total"]
-    assert rows[-1]["points"] == "" and rows[-1]["label"] == "incomplete (0 points from 0 of 10 items)"  # practice never scores
+    assert (
+        rows[-1]["points"] == "" and rows[-1]["label"] == "incomplete (0 points from 0 of 10 items)"
+    )  # practice never scores
 
     with Store.open(tmp_path / "data") as reopened:
         response = fhir_response(QUESTIONNAIRE, reopened.session(session_id))

@@ -16,8 +16,8 @@ import subprocess
 
 import pytest
 
-from kiosk.export import ExportSite, export_identity
 from kiosk.commands.results import main as results_main
+from kiosk.export import ExportSite, export_identity
 from tests.station.conftest import PATIENCE_S, new_kiosk, shared_station  # noqa: F401 - the station fixture
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 
@@ -31,14 +31,16 @@ def apply(*bundles) -> dict:
     node = shutil.which("node")
     if node is None or not (JS / "node_modules/@medplum/fhir-router").is_dir():
         pytest.fail(f"node and @medplum/fhir-router are needed: run `npm ci` in {JS}")
-    done = subprocess.run([node, "apply.mjs", *map(str, bundles)], cwd=JS, capture_output=True, text=True, check=False,
-                          timeout=PATIENCE_S)
+    done = subprocess.run(
+        [node, "apply.mjs", *map(str, bundles)], cwd=JS, capture_output=True, text=True, check=False, timeout=PATIENCE_S
+    )
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
 
 def test_the_hospital_ends_with_one_result_per_session_the_amended_one_with_its_history(
-        shared_station, tmp_path, monkeypatch, capsys):  # noqa: F811
+    shared_station, tmp_path, monkeypatch, capsys
+):  # noqa: F811
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)
     site = ExportSite(site="hosp-north", kiosk_id=name)
@@ -79,8 +81,10 @@ def test_the_hospital_ends_with_one_result_per_session_the_amended_one_with_its_
     assert response["identifier"]["value"] == f"hosp-north/{name}/{session_id}"  # the kiosk's and the station's
     assert response["status"] == "amended" and total["status"] == "amended"
     assert next(i for i in response["item"] if i["linkId"] == "total")["answer"] == [{"valueInteger": 90}]
-    assert total["valueQuantity"]["value"] == 90 and total["derivedFrom"][0]["reference"] == \
-        f"QuestionnaireResponse/{response['id']}"
+    assert (
+        total["valueQuantity"]["value"] == 90
+        and total["derivedFrom"][0]["reference"] == f"QuestionnaireResponse/{response['id']}"
+    )
     assert len(resources["Device"]) == len(resources["Questionnaire"]) == 1
     assert response["author"]["reference"] == f"Device/{resources['Device'][0]['id']}"
     # the kiosk's re-sent Bundle (a conditional create) changed nothing; each sign-off made a version
@@ -93,5 +97,8 @@ def test_the_hospital_ends_with_one_result_per_session_the_amended_one_with_its_
     assert all(status.startswith("200") for status in kiosk_again), kiosk_again  # found, not created
     provenances = resources["Provenance"]
     assert sorted(p["reason"][0]["text"] for p in provenances) == [
-        "needs help cutting", "physio: stairs need help", "seen on the stairs"]  # sent twice, held once
+        "needs help cutting",
+        "physio: stairs need help",
+        "seen on the stairs",
+    ]  # sent twice, held once
     assert {p["target"][0]["reference"] for p in provenances} == {f"QuestionnaireResponse/{response['id']}"}

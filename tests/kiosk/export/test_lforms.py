@@ -12,16 +12,23 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import sync_playwright
 
-from kiosk.export import ExportSite, result
-from kiosk.export import fhir_questionnaire, fhir_response
 from kiosk.core.review import Correction, Review, ReviewState
+from kiosk.export import ExportSite, fhir_questionnaire, fhir_response, result
 from tests.kiosk.core.helpers import QUESTIONNAIRE
 from tests.station.conftest import shared_station  # noqa: F401 - the station fixture
 
 from .standard import JS
 
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 #: the longest wait for LHC-Forms to load or render a form (a bound, not a timing assertion)
 PATIENCE_MS = 60_000
 SITE = ExportSite(site="hosp-north", kiosk_id="ward3-bed2")
@@ -57,8 +64,7 @@ def lforms_page(npm_packages: Path, chromium: str):
             errors: list[str] = []
             page.on("pageerror", lambda error: errors.append(str(error)))
             page.goto(f"http://127.0.0.1:{server.server_port}/lforms.html")
-            page.wait_for_function("window.LForms && LForms.Util && LForms.FHIR && LForms.FHIR.R4",
-                                   timeout=PATIENCE_MS)
+            page.wait_for_function("window.LForms && LForms.Util && LForms.FHIR && LForms.FHIR.R4", timeout=PATIENCE_MS)
             yield page, errors
             browser.close()
     finally:
@@ -67,15 +73,23 @@ def lforms_page(npm_packages: Path, chromium: str):
 
 
 def _amended(stored):
-    corrections = tuple(Correction(item, 1, None, "asked the relative again", "dr.lopez", "2026-11-23T15:00:00Z")
-                        for item in stored.not_answered)
+    corrections = tuple(
+        Correction(item, 1, None, "asked the relative again", "dr.lopez", "2026-11-23T15:00:00Z")
+        for item in stored.not_answered
+    )
     return Review(ReviewState.AMENDED, corrections, "dr.lopez", "2026-11-23T15:02:00Z")
 
 
-@pytest.mark.parametrize(("patient", "language", "amend"), [
-    ("TB-0002", "en", False), ("TB-0004", "en", False), ("P-ES-0001", "es", False),
-    ("P-FR-0003", "fr", False), ("P-FR-0003", "fr", True),
-])
+@pytest.mark.parametrize(
+    ("patient", "language", "amend"),
+    [
+        ("TB-0002", "en", False),
+        ("TB-0004", "en", False),
+        ("P-ES-0001", "es", False),
+        ("P-FR-0003", "fr", False),
+        ("P-FR-0003", "fr", True),
+    ],
+)
 def test_lhc_forms_shows_every_answer_and_the_same_total(lforms_page, replayed, patient, language, amend):
     page, errors = lforms_page
     stored = replayed[patient]
@@ -99,8 +113,9 @@ def test_lhc_forms_shows_every_answer_and_the_same_total(lforms_page, replayed, 
     assert rendered["shown"]["total"] == (str(expected.score.total) if expected.complete else "")
     back = {i["linkId"]: i.get("answer") for i in rendered["back"]["item"]}
     ours = {i["linkId"]: i.get("answer") for i in response["item"]}
-    assert {k: [a["valueCoding"]["code"] for a in v] for k, v in back.items() if v and k != "total"} == \
-           {k: [a["valueCoding"]["code"] for a in v] for k, v in ours.items() if v and k != "total"}
+    assert {k: [a["valueCoding"]["code"] for a in v] for k, v in back.items() if v and k != "total"} == {
+        k: [a["valueCoding"]["code"] for a in v] for k, v in ours.items() if v and k != "total"
+    }
     assert back.get("total") == ours.get("total")
 
 
@@ -120,8 +135,11 @@ def test_lhc_forms_shows_a_station_bundles_corrected_and_signed_result(lforms_pa
         client.close()
     session = f"/sessions/{rows[0].session_id}"
     doctor = Staff(station.url)
-    for item, option, why in (("grooming", "2", "asked again"), ("bladder", "3", "asked again"),
-                              ("feeding", "2", "needs help cutting")):
+    for item, option, why in (
+        ("grooming", "2", "asked again"),
+        ("bladder", "3", "asked again"),
+        ("feeding", "2", "needs help cutting"),
+    ):
         assert doctor.post(f"{session}/items/{item}", option=option, reason=why).status_code == 303
     assert doctor.post(f"{session}/sign-off").status_code == 303
     bundle = doctor.http.get(f"{session}/export.json").json()

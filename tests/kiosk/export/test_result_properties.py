@@ -10,6 +10,7 @@ import io
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from kiosk.core.review import Correction, Review, ReviewState
 from kiosk.export import (
     ExportSite,
     csv_text,
@@ -17,7 +18,6 @@ from kiosk.export import (
     fhir_total,
     transaction_bundle,
 )
-from kiosk.core.review import Correction, Review, ReviewState
 from tests.kiosk.core.helpers import QUESTIONNAIRE
 
 from .standard import check_fhir
@@ -30,8 +30,12 @@ PATIENTS = ["TB-0001", "TB-0004", "TB-0005", "TB-0006", "P-ES-0001", "P-FR-0003"
 def reviews(draw):
     state = draw(st.sampled_from(list(ReviewState)))
     items = draw(st.lists(st.sampled_from(QUESTIONNAIRE.items), unique_by=lambda i: i.id, max_size=4))
-    corrections = tuple(Correction(item.id, draw(st.integers(1, len(item.options))), None, "checked",
-                                   "nurse.kim", f"2026-11-23T15:0{n}:00Z") for n, item in enumerate(items))
+    corrections = tuple(
+        Correction(
+            item.id, draw(st.integers(1, len(item.options))), None, "checked", "nurse.kim", f"2026-11-23T15:0{n}:00Z"
+        )
+        for n, item in enumerate(items)
+    )
     signed = state != ReviewState.UNREVIEWED
     return Review(state, corrections, "dr.lopez" if signed else None, "2026-11-23T15:09:00Z" if signed else None)
 
@@ -73,8 +77,9 @@ def test_the_export_never_states_a_total_or_a_state_it_does_not_have(replayed, p
     requests = {e["resource"]["resourceType"]: e["request"]["method"] for e in bundle["entry"]}
     assert requests["QuestionnaireResponse"] == ("PUT" if review.final else "POST")
     # one story: the CSV's review state is what the response and the Observation say
-    (state,) = {row["review_state"] for row in csv.DictReader(io.StringIO(csv_text(QUESTIONNAIRE, [stored], [review],
-                                                                                   SITE)))}
+    (state,) = {
+        row["review_state"] for row in csv.DictReader(io.StringIO(csv_text(QUESTIONNAIRE, [stored], [review], SITE)))
+    }
     assert (state in ("corrected", "amended")) == changed_now(stored, options)
     if complete:
         assert (response["status"] == "amended") == (state in ("corrected", "amended"))

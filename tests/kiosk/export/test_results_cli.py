@@ -6,8 +6,8 @@ import json
 
 import pandas as pd
 
-from kiosk.export import questionnaire_version
 from kiosk.commands.results import main as results_main
+from kiosk.export import questionnaire_version
 from tests.kiosk.core.helpers import QUESTIONNAIRE
 
 from .standard import check_fhir
@@ -15,14 +15,17 @@ from .standard import check_fhir
 
 def _configure(tmp_path, monkeypatch) -> None:
     config = tmp_path / "config.yaml"
-    config.write_text("site: hosp-north\nkiosk_id: ward3-bed2\n"
-                      "fhir: {questionnaire_url: 'https://hosp-north.example/fhir/Questionnaire/barthel'}\n",
-                      encoding="utf-8")
+    config.write_text(
+        "site: hosp-north\nkiosk_id: ward3-bed2\n"
+        "fhir: {questionnaire_url: 'https://hosp-north.example/fhir/Questionnaire/barthel'}\n",
+        encoding="utf-8",
+    )
     monkeypatch.setenv("KIOSK_CONFIG", str(config))
 
 
-def test_all_sessions_as_one_valid_transaction_bundle_with_the_site_identity(replay_dir, replayed, tmp_path,
-                                                                             monkeypatch, capsys):
+def test_all_sessions_as_one_valid_transaction_bundle_with_the_site_identity(
+    replay_dir, replayed, tmp_path, monkeypatch, capsys
+):
     _configure(tmp_path, monkeypatch)
     out = tmp_path / "all.json"
     assert results_main(["--data-dir", str(replay_dir), "--fhir", str(out)]) == 0
@@ -31,11 +34,16 @@ def test_all_sessions_as_one_valid_transaction_bundle_with_the_site_identity(rep
     check_fhir(bundle)
     responses = [e for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse"]
     assert {e["resource"]["identifier"]["value"] for e in responses} == {
-        f"hosp-north/ward3-bed2/{s.id}" for s in replayed.values()}
+        f"hosp-north/ward3-bed2/{s.id}" for s in replayed.values()
+    }
     conditions = {e["resource"]["resourceType"]: e["request"]["ifNoneExist"].split("=")[0] for e in bundle["entry"]}
     assert all(e["request"]["method"] == "POST" for e in bundle["entry"])  # nothing signed off on a kiosk
-    assert conditions == {"Questionnaire": "url", "Device": "identifier", "QuestionnaireResponse": "identifier",
-                          "Observation": "identifier"}
+    assert conditions == {
+        "Questionnaire": "url",
+        "Device": "identifier",
+        "QuestionnaireResponse": "identifier",
+        "Observation": "identifier",
+    }
     totals = [e for e in bundle["entry"] if e["resource"]["resourceType"] == "Observation"]
     complete = [s for s in replayed.values() if not s.not_answered]
     assert len(totals) == len(complete)
@@ -46,17 +54,41 @@ def test_chosen_sessions_and_the_questionnaire_in_one_language(replay_dir, repla
     _configure(tmp_path, monkeypatch)
     spanish, french = replayed["P-ES-0001"], replayed["P-FR-0003"]
     bundle_file, questionnaire_file = tmp_path / "two.json", tmp_path / "q-es.json"
-    assert results_main([spanish.id, french.id[:8], "--data-dir", str(replay_dir), "--fhir", str(bundle_file),
-                         "--fhir-questionnaire", str(questionnaire_file), "--language", "es"]) == 0
+    assert (
+        results_main(
+            [
+                spanish.id,
+                french.id[:8],
+                "--data-dir",
+                str(replay_dir),
+                "--fhir",
+                str(bundle_file),
+                "--fhir-questionnaire",
+                str(questionnaire_file),
+                "--language",
+                "es",
+            ]
+        )
+        == 0
+    )
     shown = capsys.readouterr().out
     assert f"session {spanish.id}" in shown and f"session {french.id}" in shown
     bundle = json.loads(bundle_file.read_text(encoding="utf-8"))
     assert [e["resource"]["resourceType"] for e in bundle["entry"]] == [
-        "Questionnaire", "Questionnaire", "Device", "QuestionnaireResponse", "Observation", "QuestionnaireResponse"]
+        "Questionnaire",
+        "Questionnaire",
+        "Device",
+        "QuestionnaireResponse",
+        "Observation",
+        "QuestionnaireResponse",
+    ]
     questionnaire = json.loads(questionnaire_file.read_text(encoding="utf-8"))
     check_fhir(questionnaire)
     assert (questionnaire["url"], questionnaire["version"], questionnaire["language"]) == (
-        "https://hosp-north.example/fhir/Questionnaire/barthel-es", questionnaire_version(QUESTIONNAIRE), "es")
+        "https://hosp-north.example/fhir/Questionnaire/barthel-es",
+        questionnaire_version(QUESTIONNAIRE),
+        "es",
+    )
     assert bundle["entry"][0]["resource"] == {k: v for k, v in questionnaire.items() if k != "id"}
 
 
@@ -83,8 +115,9 @@ def test_sessions_from_kiosk_replay_are_labelled_test_data(tmp_path, monkeypatch
     bundle = json.loads(out.read_text(encoding="utf-8"))
     check_fhir(bundle)
     labelled = {e["resource"]["resourceType"]: e["resource"].get("meta", {}).get("security") for e in bundle["entry"]}
-    test_data = [{"system": "http://terminology.hl7.org/CodeSystem/v3-ActReason", "code": "HTEST",
-                  "display": "test health data"}]
+    test_data = [
+        {"system": "http://terminology.hl7.org/CodeSystem/v3-ActReason", "code": "HTEST", "display": "test health data"}
+    ]
     assert labelled["QuestionnaireResponse"] == labelled["Observation"] == test_data
     assert labelled["Questionnaire"] is None and labelled["Device"] is None
     frame = pd.read_csv(table)

@@ -18,12 +18,20 @@ def config(tmp_path, text: str):
 
 
 def test_a_site_sets_its_identity_and_the_rest_keeps_documented_defaults(tmp_path):
-    site = site_from_config(config(tmp_path, "site: hosp-north\nkiosk_id: ward3-bed2\n"
-                                             "fhir: {patient_system: 'https://hosp-north.example/sid/kiosk-patient'}\n"))
-    assert site == ExportSite(site="hosp-north", kiosk_id="ward3-bed2",
-                              patient_system="https://hosp-north.example/sid/kiosk-patient",
-                              identifier_system="urn:barthel-kiosk:result",
-                              device_system="urn:barthel-kiosk:hosp-north:kiosk")
+    site = site_from_config(
+        config(
+            tmp_path,
+            "site: hosp-north\nkiosk_id: ward3-bed2\n"
+            "fhir: {patient_system: 'https://hosp-north.example/sid/kiosk-patient'}\n",
+        )
+    )
+    assert site == ExportSite(
+        site="hosp-north",
+        kiosk_id="ward3-bed2",
+        patient_system="https://hosp-north.example/sid/kiosk-patient",
+        identifier_system="urn:barthel-kiosk:result",
+        device_system="urn:barthel-kiosk:hosp-north:kiosk",
+    )
     assert site.result_id("0a1b2c3d4e5f") == "hosp-north/ward3-bed2/0a1b2c3d4e5f"
 
 
@@ -32,13 +40,16 @@ def test_without_config_the_kiosk_id_is_the_host_name_fit_for_an_identifier(tmp_
     assert site.site == "local" and re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}", site.kiosk_id)
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("site: hosp north\n", "1:1: site must be 1-64 letters, digits"),
-    ("kiosk_id: ward3/bed2\n", "1:1: kiosk_id must be 1-64 letters"),
-    ("fhir: {patient_sytem: 'urn:x:y'}\n", "unknown fhir setting 'patient_sytem'"),
-    ("fhir:\n  questionnaire_url: barthel\n", "2:3: fhir questionnaire_url must be an absolute URI"),
-    ("fhir: [urn:x]\n", "fhir must be a mapping"),
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("site: hosp north\n", "1:1: site must be 1-64 letters, digits"),
+        ("kiosk_id: ward3/bed2\n", "1:1: kiosk_id must be 1-64 letters"),
+        ("fhir: {patient_sytem: 'urn:x:y'}\n", "unknown fhir setting 'patient_sytem'"),
+        ("fhir:\n  questionnaire_url: barthel\n", "2:3: fhir questionnaire_url must be an absolute URI"),
+        ("fhir: [urn:x]\n", "fhir must be a mapping"),
+    ],
+)
 def test_bad_site_settings_are_one_clear_error_with_their_position(tmp_path, text, message):
     with pytest.raises(ConfigError, match=re.escape(message)):
         config(tmp_path, text)
@@ -73,7 +84,9 @@ def test_the_default_canonical_url_names_the_site_and_the_questionnaire_file_id(
     other = replace(QUESTIONNAIRE, id="barthel_short")
     assert questionnaire_canonical(other, site, "fr") == "urn:barthel-kiosk:hosp-north:questionnaire:barthel_short-fr"
     configured = replace(site, questionnaire_url="https://hosp-north.example/fhir/Questionnaire/barthel")
-    assert questionnaire_canonical(other, configured, "en") == "https://hosp-north.example/fhir/Questionnaire/barthel-en"
+    assert (
+        questionnaire_canonical(other, configured, "en") == "https://hosp-north.example/fhir/Questionnaire/barthel-en"
+    )
 
 
 def test_the_kiosk_app_exports_with_the_configured_site(tmp_path):

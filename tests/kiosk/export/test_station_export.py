@@ -66,8 +66,12 @@ def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_fi
     assert response["resource"]["identifier"]["value"].endswith(f"/{session_id}") and not of(before, "Observation")
     assert response["request"]["method"] == "POST" and csv_state(doctor, session_id) == {"unreviewed"}
     for item, option in (("grooming", 2), ("bladder", 3)):
-        assert doctor.post(f"/sessions/{session_id}/items/{item}", option=str(option),
-                           reason="asked the patient again").status_code == 303
+        assert (
+            doctor.post(
+                f"/sessions/{session_id}/items/{item}", option=str(option), reason="asked the patient again"
+            ).status_code
+            == 303
+        )
     assert doctor.post(f"/sessions/{session_id}/sign-off").status_code == 303
     after = bundle(doctor, session_id)
     (response,), (total,) = of(after, "QuestionnaireResponse"), of(after, "Observation")
@@ -82,7 +86,12 @@ def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_fi
     assert [p["target"][0]["extension"][0]["valueUri"] for p in provenances] == ["grooming", "bladder"]
     assert all(p["activity"]["coding"][0]["code"] == "CREATE" and "entity" not in p for p in provenances)
     assert {entry["resourceType"] for entry in (e["resource"] for e in after["entry"])} == {
-        "Questionnaire", "Device", "QuestionnaireResponse", "Observation", "Provenance"}
+        "Questionnaire",
+        "Device",
+        "QuestionnaireResponse",
+        "Observation",
+        "Provenance",
+    }
     assert csv_state(doctor, session_id) == {"amended"}
 
 
@@ -90,8 +99,12 @@ def test_a_corrected_result_says_the_same_in_csv_and_fhir_and_keeps_the_kiosks_a
     station, ward = shared_station
     session_id = synced(station, ward, "barthel1.yaml")  # 100: feeding independent (10)
     nurse, doctor = Staff(station.url, "nurse.kim", "nurse"), Staff(station.url)
-    assert nurse.post(f"/sessions/{session_id}/items/feeding", option="2",
-                      reason="needs help cutting; seen at lunch").status_code == 303
+    assert (
+        nurse.post(
+            f"/sessions/{session_id}/items/feeding", option="2", reason="needs help cutting; seen at lunch"
+        ).status_code
+        == 303
+    )
     in_review = bundle(nurse, session_id)
     (response,), (total,) = of(in_review, "QuestionnaireResponse"), of(in_review, "Observation")
     # corrected, not signed off: the CSV and the FHIR tell the same story
@@ -112,8 +125,12 @@ def test_a_corrected_result_says_the_same_in_csv_and_fhir_and_keeps_the_kiosks_a
     assert provenance["target"][0]["reference"] == of(signed, "QuestionnaireResponse")[0]["fullUrl"]
     (entity,) = provenance["entity"]
     assert entity["role"] == "revision"
-    assert entity["extension"] == [{"url": REPLACED_ANSWER, "valueCoding": {
-        "system": "http://loinc.org", "code": "LA12302-8", "display": "Independent"}}]
+    assert entity["extension"] == [
+        {
+            "url": REPLACED_ANSWER,
+            "valueCoding": {"system": "http://loinc.org", "code": "LA12302-8", "display": "Independent"},
+        }
+    ]
     assert entity["agent"][0]["who"]["reference"] == of(signed, "Device")[0]["fullUrl"]  # the kiosk's answer
 
 
@@ -139,8 +156,11 @@ def test_a_doctor_amends_a_signed_result_and_signs_it_again(shared_station):  # 
     assert csv_state(doctor, session_id) == {"corrected"}  # reopened, not final: no longer signed off
     # while reopened the hospital keeps the signed version: nothing is replaced
     while_open = bundle(doctor, session_id)
-    assert [e["request"]["method"] for e in while_open["entry"] if e["resource"]["resourceType"] in (
-        "QuestionnaireResponse", "Observation")] == ["POST", "POST"]
+    assert [
+        e["request"]["method"]
+        for e in while_open["entry"]
+        if e["resource"]["resourceType"] in ("QuestionnaireResponse", "Observation")
+    ] == ["POST", "POST"]
     assert doctor.post(f"{page}/items/stairs", option="2", reason="needs help on stairs").status_code == 303
     assert doctor.post(f"{page}/sign-off").status_code == 303
     amended = bundle(doctor, session_id)
@@ -158,5 +178,7 @@ def test_a_doctor_amends_a_signed_result_and_signs_it_again(shared_station):  # 
     check_fhir(period.json())
     values = [e["resource"]["identifier"]["value"] for e in of(period.json(), "QuestionnaireResponse")]
     assert any(v.endswith(f"/{session_id}") for v in values)
-    assert doctor.http.get("/exports/signed-off.json?from=2026-13-01&to=2026-12-01").text == \
-        "from='2026-13-01': give a day as YYYY-MM-DD"
+    assert (
+        doctor.http.get("/exports/signed-off.json?from=2026-13-01&to=2026-12-01").text
+        == "from='2026-13-01': give a day as YYYY-MM-DD"
+    )

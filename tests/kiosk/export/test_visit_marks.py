@@ -8,11 +8,11 @@ import io
 
 import pytest
 
-from kiosk.export import csv_text, fhir_response, wide_csv_text
-from kiosk.core.questionnaire import load_questionnaire
 from kiosk.commands.replay import load_script, run_script
-from kiosk.store.database import Store
+from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.visits import visit_of
+from kiosk.export import csv_text, fhir_response, wide_csv_text
+from kiosk.store.database import Store
 
 SCRIPT = "recordings/patients/barthel1.yaml"
 

@@ -71,8 +71,11 @@ class FakeHidBackend:
         device.gone.set()
 
     def enumerate(self, vendor_id: int = 0, product_id: int = 0) -> list[HidDeviceInfo]:
-        return [d.info for d in self._plugged.values()
-                if vendor_id in (0, d.info.vendor_id) and product_id in (0, d.info.product_id)]
+        return [
+            d.info
+            for d in self._plugged.values()
+            if vendor_id in (0, d.info.vendor_id) and product_id in (0, d.info.product_id)
+        ]
 
     def open(self, info: HidDeviceInfo) -> FakeHidDevice:
         if self.refuse_open:

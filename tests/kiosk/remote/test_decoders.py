@@ -64,8 +64,10 @@ def test_blank_lines_and_crlf_are_accepted():
     assert [p.button for p in decode_lines([b"\n\r\n  BTN 2 \r\n\n"])] == [2]
 
 
-junk_line = st.binary(max_size=80).filter(lambda b: b"\n" not in b).filter(
-    lambda b: b.strip(b" \t\r") not in {text.encode() for text in LINES}
+junk_line = (
+    st.binary(max_size=80)
+    .filter(lambda b: b"\n" not in b)
+    .filter(lambda b: b.strip(b" \t\r") not in {text.encode() for text in LINES})
 )
 
 
@@ -140,8 +142,10 @@ def test_unknown_reports_are_ignored_without_changing_state(caplog):
 
 
 def test_value_matches_decode_one_code_per_report():
-    decoder = ReportDecoder({Command.VOLUME_UP: ReportMatch(byte=1, value=0xE9),
-                             Command.VOLUME_DOWN: ReportMatch(byte=1, value=0xEA)}, report_id=2)
+    decoder = ReportDecoder(
+        {Command.VOLUME_UP: ReportMatch(byte=1, value=0xE9), Command.VOLUME_DOWN: ReportMatch(byte=1, value=0xEA)},
+        report_id=2,
+    )
     timeline = [(0.0, 0xE9), (0.1, 0x00), (0.2, 0xEA), (0.3, 0xE9)]
     presses = [p.button for t, code in timeline for p in decoder.feed(bytes([2, code]), t)]
     assert presses == [Command.VOLUME_UP, Command.VOLUME_DOWN, Command.VOLUME_UP]

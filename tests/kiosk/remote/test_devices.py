@@ -81,5 +81,6 @@ def test_a_bad_profile_file_is_one_line_and_exit_status_2(tmp_path, capsys):
     assert main(["devices", "--profiles", str(site)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert captured.err == (f"kiosk devices: {site}:3:5: profile 'serial-usb', field 'baud': "
-                            "must be at least 1, got -3\n")
+    assert captured.err == (
+        f"kiosk devices: {site}:3:5: profile 'serial-usb', field 'baud': must be at least 1, got -3\n"
+    )

@@ -29,8 +29,7 @@ def hid_wait():
 
 @pytest.fixture
 def hid_reader(hid_bus, hid_wait):
-    reader = HidRemote(PROFILE, backend=hid_bus, backoff=Backoff(0.5, 2, 4), wait=hid_wait,
-                       clock=hid_bus.clock)
+    reader = HidRemote(PROFILE, backend=hid_bus, backoff=Backoff(0.5, 2, 4), wait=hid_wait, clock=hid_bus.clock)
     yield reader
     reader.stop()
 
@@ -128,8 +127,9 @@ def test_other_devices_on_the_bus_are_not_used(hid_bus, hid_wait, hid_reader):
     sink.status(ChannelState.OFF)
 
 
-def test_an_undocumented_driver_failure_is_reported_lost_and_the_reader_carries_on(hid_bus, hid_wait, hid_reader,
-                                                                                   caplog):
+def test_an_undocumented_driver_failure_is_reported_lost_and_the_reader_carries_on(
+    hid_bus, hid_wait, hid_reader, caplog
+):
     device = hid_bus.plug(VID, PID)
     sink = Collector()
     hid_reader.start(sink)

@@ -16,11 +16,12 @@ def test_each_source_reports_its_own_state_and_the_connected_one_delivers(tmp_pa
     box = ButtonBox(tmp_path / "ttyUSB-test0")
     # keep the test off any real /dev/ttyUSB*/ttyACM* the machine may have: the box's own pty, and
     # a pattern under /dev that matches nothing
-    site.write_text(f"profiles:\n  - name: serial-usb\n    port: {box.slave_name}\n"
-                    f"  - name: serial-acm\n    port: /dev/ttyACM-kiosk-test*\n")
+    site.write_text(
+        f"profiles:\n  - name: serial-usb\n    port: {box.slave_name}\n"
+        f"  - name: serial-acm\n    port: /dev/ttyACM-kiosk-test*\n"
+    )
     sources = open_sources(site, backoff=Backoff(0.01, 2, 0.05))
-    assert [s.name for s in sources] == [f"serial {box.slave_name}", "serial /dev/ttyACM-kiosk-test*",
-                                         "hid 1209:0001"]
+    assert [s.name for s in sources] == [f"serial {box.slave_name}", "serial /dev/ttyACM-kiosk-test*", "hid 1209:0001"]
     sink = Collector()
     for source in sources:
         source.start(sink)
@@ -30,8 +31,11 @@ def test_each_source_reports_its_own_state_and_the_connected_one_delivers(tmp_pa
             item = sink.next()
             assert isinstance(item, ChannelStatus)
             statuses[item.source] = item.state
-        assert statuses == {sources[0].name: ChannelState.ON, sources[1].name: ChannelState.OFF,
-                            sources[2].name: ChannelState.OFF}  # real hidapi: no HID remote here
+        assert statuses == {
+            sources[0].name: ChannelState.ON,
+            sources[1].name: ChannelState.OFF,
+            sources[2].name: ChannelState.OFF,
+        }  # real hidapi: no HID remote here
         box.write(b"BTN 1\n")
         press = sink.next()
         assert isinstance(press, ChannelInput) and press.option == 1

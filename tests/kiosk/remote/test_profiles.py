@@ -26,7 +26,9 @@ def test_builtin_profiles_cover_every_kind_and_every_button():
 
 
 def test_a_site_file_overrides_fields_disables_and_adds_profiles(tmp_path):
-    path = write(tmp_path, """
+    path = write(
+        tmp_path,
+        """
 profiles:
   - name: serial-usb
     port: /dev/serial/by-id/usb-Clarc*
@@ -37,7 +39,8 @@ profiles:
     kind: serial
     port: /dev/ttyS4
     lines: {"K1": 1, "K2": 2, "HELP": call_doctor}
-""")
+""",
+    )
     profiles = load_profiles(path)
     usb = next(p for p in profiles.serial if p.name == "serial-usb")
     assert (usb.port, usb.baud, usb.lines["BTN 3"]) == ("/dev/serial/by-id/usb-Clarc*", 19200, 3)
@@ -49,44 +52,74 @@ profiles:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("profiles:\n  - name: serial-usb\n    baud: fast\n",
-         "profile 'serial-usb', field 'baud': must be a whole number, got 'fast'"),
-        ("profiles:\n  - name: new\n    kind: serial\n    port: /dev/x\n    lines: {BTN 1: 5}\n",
-         "profile 'new', field 'lines.BTN 1': answer buttons are 1 to 4, got 5"),
-        ("profiles:\n  - name: new\n    kind: serial\n    lines: {BTN 1: 1}\n",
-         "profile 'new', field 'port': is required"),
-        ("profiles:\n  - name: serial-usb\n    baudrate: 9600\n",
-         "profile 'serial-usb', field 'baudrate': is not a field of a serial profile"),
-        ("profiles:\n  - name: new\n    kind: usb\n",
-         "profile 'new', field 'kind': must be one of serial, hid, keyboard, got 'usb'"),
-        ("profiles:\n  - name: hid-bigbutton\n    vendor_id: 0x12345\n",
-         "profile 'hid-bigbutton', field 'vendor_id': must be from 0 to 65535, got 74565"),
-        ("profiles:\n  - name: hid-bigbutton\n    buttons: {1: {byte: 1}}\n",
-         "profile 'hid-bigbutton', field 'buttons.1': must be {byte: N, mask: M} or {byte: N, value: V}"),
-        ("profiles:\n  - name: hid-bigbutton\n    buttons: {ring: {byte: 1, mask: 1}}\n",
-         "profile 'hid-bigbutton', field 'buttons.ring': 'ring' is not a button"),
-        ("profiles:\n  - name: keypad-f13\n    keys: {p: pause}\n",
-         "profile 'keypad-f13', field 'keys.p': key 'p' is one of the kiosk's own keys"),
-        ("profiles:\n  - name: presenter\n    enabled: true\n    keys: {f13: 4}\n",
-         "profile 'presenter', field 'keys.f13': means '4' here but '1' in enabled profile 'keypad-f13'"),
-        ("profiles:\n  - name: serial-usb\n    enabled: maybe\n",
-         "profile 'serial-usb', field 'enabled': must be true or false, got 'maybe'"),
+        (
+            "profiles:\n  - name: serial-usb\n    baud: fast\n",
+            "profile 'serial-usb', field 'baud': must be a whole number, got 'fast'",
+        ),
+        (
+            "profiles:\n  - name: new\n    kind: serial\n    port: /dev/x\n    lines: {BTN 1: 5}\n",
+            "profile 'new', field 'lines.BTN 1': answer buttons are 1 to 4, got 5",
+        ),
+        (
+            "profiles:\n  - name: new\n    kind: serial\n    lines: {BTN 1: 1}\n",
+            "profile 'new', field 'port': is required",
+        ),
+        (
+            "profiles:\n  - name: serial-usb\n    baudrate: 9600\n",
+            "profile 'serial-usb', field 'baudrate': is not a field of a serial profile",
+        ),
+        (
+            "profiles:\n  - name: new\n    kind: usb\n",
+            "profile 'new', field 'kind': must be one of serial, hid, keyboard, got 'usb'",
+        ),
+        (
+            "profiles:\n  - name: hid-bigbutton\n    vendor_id: 0x12345\n",
+            "profile 'hid-bigbutton', field 'vendor_id': must be from 0 to 65535, got 74565",
+        ),
+        (
+            "profiles:\n  - name: hid-bigbutton\n    buttons: {1: {byte: 1}}\n",
+            "profile 'hid-bigbutton', field 'buttons.1': must be {byte: N, mask: M} or {byte: N, value: V}",
+        ),
+        (
+            "profiles:\n  - name: hid-bigbutton\n    buttons: {ring: {byte: 1, mask: 1}}\n",
+            "profile 'hid-bigbutton', field 'buttons.ring': 'ring' is not a button",
+        ),
+        (
+            "profiles:\n  - name: keypad-f13\n    keys: {p: pause}\n",
+            "profile 'keypad-f13', field 'keys.p': key 'p' is one of the kiosk's own keys",
+        ),
+        (
+            "profiles:\n  - name: presenter\n    enabled: true\n    keys: {f13: 4}\n",
+            "profile 'presenter', field 'keys.f13': means '4' here but '1' in enabled profile 'keypad-f13'",
+        ),
+        (
+            "profiles:\n  - name: serial-usb\n    enabled: maybe\n",
+            "profile 'serial-usb', field 'enabled': must be true or false, got 'maybe'",
+        ),
         ("profiles:\n  - kind: serial\n", "profile #1, field 'name': must be a non-empty text"),
-        ("profiles:\n  - name: a\n    kind: keyboard\n    keys: {f1: 1}\n  - name: a\n",
-         "profile 'a', field 'name': appears twice in this file"),
+        (
+            "profiles:\n  - name: a\n    kind: keyboard\n    keys: {f1: 1}\n  - name: a\n",
+            "profile 'a', field 'name': appears twice in this file",
+        ),
         ("profiles: [\n", ":2:1: YAML syntax: expected the node content"),
         ("profiles:\n  - name: serial-usb\n    baud: 1\n    baud: 2\n", ":4:5: duplicate key 'baud'"),
         ("- just a list\n", "expected a mapping with one key, 'profiles'"),
         # a port is globbed on every connection attempt: /**/* walked the whole file system
-        ("profiles:\n  - name: serial-usb\n    port: /**/*\n",
-         ":3:5: profile 'serial-usb', field 'port': must be a device path under /dev"),
-        ("profiles:\n  - name: serial-usb\n    port: /dev/**\n",
-         ":3:5: profile 'serial-usb', field 'port': may not hold '..' or '**'"),
+        (
+            "profiles:\n  - name: serial-usb\n    port: /**/*\n",
+            ":3:5: profile 'serial-usb', field 'port': must be a device path under /dev",
+        ),
+        (
+            "profiles:\n  - name: serial-usb\n    port: /dev/**\n",
+            ":3:5: profile 'serial-usb', field 'port': may not hold '..' or '**'",
+        ),
         ("profiles:\n  - name: serial-usb\n    port: /dev/../etc/*\n", "field 'port': may not hold '..' or '**'"),
         ("profiles:\n  - name: serial-usb\n    port: ttyUSB0\n", "field 'port': must be a device path under /dev"),
         ("profiles:\n  - name: serial-usb\n    port: /dev/*/*/*/*/*\n", "field 'port': must be at most 4 names"),
-        ("profiles:\n  - name: serial-usb\n    port: \"/dev/tty\\nUSB0\"\n",
-         "field 'port': may not hold spaces or control characters"),
+        (
+            'profiles:\n  - name: serial-usb\n    port: "/dev/tty\\nUSB0"\n',
+            "field 'port': may not hold spaces or control characters",
+        ),
     ],
 )
 def test_a_mistake_is_one_message_naming_file_profile_and_field(tmp_path, text, message):
@@ -101,24 +134,30 @@ def test_a_mistake_is_one_message_naming_file_profile_and_field(tmp_path, text, 
 def test_an_error_in_a_builtin_field_names_the_builtin_file(tmp_path):
     # the override changes the kind; the built-in's serial fields are now the wrong ones
     path = write(tmp_path, "profiles:\n  - name: serial-usb\n    kind: keyboard\n    keys: {f1: 1}\n")
-    with pytest.raises(ProfileError, match=f"^{BUILTIN_PROFILES}:[0-9]+:5: profile 'serial-usb', "
-                                           "field 'baud': is not a field of a keyboard profile"):
+    with pytest.raises(
+        ProfileError,
+        match=f"^{BUILTIN_PROFILES}:[0-9]+:5: profile 'serial-usb', field 'baud': is not a field of a keyboard profile",
+    ):
         load_profiles(path)
 
 
 def test_the_message_points_at_the_line_and_column_of_the_field(tmp_path):
-    path = write(tmp_path, """profiles:
+    path = write(
+        tmp_path,
+        """profiles:
   - name: serial-usb
     port: /dev/ttyUSB*
   - name: hid-bigbutton
     buttons:
       1: {byte: 1, mask: 1}
       2: {byte: 99, mask: 2}
-""")
+""",
+    )
     with pytest.raises(ProfileError) as caught:
         load_profiles(path)
-    assert str(caught.value) == (f"{path}:7:11: profile 'hid-bigbutton', field 'buttons.2.byte': "
-                                 "must be from 0 to 63, got 99")
+    assert str(caught.value) == (
+        f"{path}:7:11: profile 'hid-bigbutton', field 'buttons.2.byte': must be from 0 to 63, got 99"
+    )
 
 
 def test_a_missing_site_file_is_named(tmp_path):

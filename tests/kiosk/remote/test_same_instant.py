@@ -16,10 +16,10 @@ import pytest
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.core.clock import SimClock
 from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.session import AnswerRecorded, AttemptOpened, IgnoreReason, InputIgnored, Session
 from kiosk.remote.profiles import load_profiles
 from kiosk.remote.reconnect import Backoff
 from kiosk.remote.serial import SerialRemote
-from kiosk.core.session import AnswerRecorded, AttemptOpened, IgnoreReason, InputIgnored, Session
 
 from .boxes import PATIENCE, ButtonBox
 
@@ -69,8 +69,9 @@ def test_remote_press_and_touch_at_the_same_instant_record_one_answer(tmp_path, 
         box.unplug()
 
     assert session.now() == at
-    assert [i.channel for i in inputs] == ([Channel.REMOTE, Channel.TOUCH] if first == "remote"
-                                           else [Channel.TOUCH, Channel.REMOTE])
+    assert [i.channel for i in inputs] == (
+        [Channel.REMOTE, Channel.TOUCH] if first == "remote" else [Channel.TOUCH, Channel.REMOTE]
+    )
     recorded = [e for e in events if isinstance(e, AnswerRecorded)]
     ignored = [e for e in events if isinstance(e, InputIgnored)]
     assert len(recorded) == 1 and len(ignored) == 1

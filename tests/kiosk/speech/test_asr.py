@@ -39,14 +39,23 @@ def test_build_grammar_leaves_out_unknown_words_and_says_why(caplog):
 
 def test_grammar_formats():
     grammar = Grammar(("número dos", "l'option", "two"))
-    assert to_jsgf(grammar) == ("#JSGF V1.0;\ngrammar answer;\n<phrase> = número dos | l'option | two ;\n"
-                                "public <answer> = <phrase> ;\n")
+    assert to_jsgf(grammar) == (
+        "#JSGF V1.0;\ngrammar answer;\n<phrase> = número dos | l'option | two ;\npublic <answer> = <phrase> ;\n"
+    )
     assert json.loads(to_vosk(grammar)) == ["número dos", "l'option", "two", "[unk]"]
-    full = build_grammar(["two", "help", "repeat"], lambda w: True, "test", ["i need"], ["um", "what"],
-                         lambda p: "repeat" if p == "repeat" else 2)
-    assert to_jsgf(full) == ("#JSGF V1.0;\ngrammar answer;\n<lead> = i need ;\n<option> = two | help ;\n"
-                             "<other> = repeat ;\n<filler> = um | what ;\n"
-                             "public <answer> = /0.95/ ([<lead>] <option> | <other>) | /0.05/ <filler> ;\n")
+    full = build_grammar(
+        ["two", "help", "repeat"],
+        lambda w: True,
+        "test",
+        ["i need"],
+        ["um", "what"],
+        lambda p: "repeat" if p == "repeat" else 2,
+    )
+    assert to_jsgf(full) == (
+        "#JSGF V1.0;\ngrammar answer;\n<lead> = i need ;\n<option> = two | help ;\n"
+        "<other> = repeat ;\n<filler> = um | what ;\n"
+        "public <answer> = /0.95/ ([<lead>] <option> | <other>) | /0.05/ <filler> ;\n"
+    )
     assert json.loads(to_vosk(full)) == ["two", "help", "repeat", "i need two", "i need help", "um", "what", "[unk]"]
     assert full.core("i need help") == "help" and full.core("i need repeat") == "i need repeat"
     assert recogniser_words("Sube el volumen, ¿vale?") == ["sube", "el", "volumen", "vale"]
@@ -62,8 +71,9 @@ def test_pocketsphinx_checks_its_real_dictionary():
 
 
 def test_pocketsphinx_is_english_only():
-    with pytest.raises(AsrUnavailable, match="pocketsphinx only ships English; install one with "
-                                             "`kiosk models install fr`"):
+    with pytest.raises(
+        AsrUnavailable, match="pocketsphinx only ships English; install one with `kiosk models install fr`"
+    ):
         PocketSphinxRecogniser("fr")
 
 
@@ -90,8 +100,10 @@ def test_vosk_results_are_combined_and_unknown_words_are_not_answers():
     """Vosk's JSON (as KaldiRecognizer.Result/FinalResult print it with SetWords(True))."""
     two = '{"result": [{"conf": 0.93, "end": 1.2, "start": 0.9, "word": "two"}], "text": "two"}'
     number = '{"result": [{"conf": 0.71, "end": 0.8, "start": 0.4, "word": "number"}], "text": "number"}'
-    unk = ('{"result": [{"conf": 1.0, "end": 0.5, "start": 0.2, "word": "[unk]"}, '
-           '{"conf": 0.98, "end": 1.0, "start": 0.6, "word": "independent"}], "text": "[unk] independent"}')
+    unk = (
+        '{"result": [{"conf": 1.0, "end": 0.5, "start": 0.2, "word": "[unk]"}, '
+        '{"conf": 0.98, "end": 1.0, "start": 0.6, "word": "independent"}], "text": "[unk] independent"}'
+    )
     assert vosk_recognition([number, two]) == Recognition("number two", 0.71)
     assert vosk_recognition([two, '{"text": ""}']) == Recognition("two", 0.93)
     assert vosk_recognition([unk]) == Recognition("[unk] independent", 0.0)
@@ -106,8 +118,14 @@ def test_vosk_backend_reports_a_missing_model_clearly(tmp_path):
 def test_confusable_phrases_only_where_the_partner_means_something_else():
     first_third = (frozenset({"first", "third"}),)
     three = ["the first one", "first", "the second one", "the third one", "one", "repeat"]
-    meaning = {"the first one": 1, "first": 1, "one": 1, "the second one": 2, "the third one": 3,
-               "repeat": "repeat"}.__getitem__
+    meaning = {
+        "the first one": 1,
+        "first": 1,
+        "one": 1,
+        "the second one": 2,
+        "the third one": 3,
+        "repeat": "repeat",
+    }.__getitem__
     assert confusable_phrases(three, meaning, first_third) == {"the first one", "first", "the third one"}
     two = [p for p in three if p != "the third one"]
     assert confusable_phrases(two, meaning, first_third) == frozenset()
@@ -155,11 +173,24 @@ def test_pocketsphinx_adds_accent_pronunciations_for_the_grammars_words():
 
 
 def test_final_phrases_are_those_nothing_of_another_meaning_continues():
-    meaning = {"the second": 2, "the second one": 2, "help": 2, "help me up": 1, "one": 1,
-               "repeat": "repeat", "repeat that": "repeat"}.__getitem__
+    meaning = {
+        "the second": 2,
+        "the second one": 2,
+        "help": 2,
+        "help me up": 1,
+        "one": 1,
+        "repeat": "repeat",
+        "repeat that": "repeat",
+    }.__getitem__
     phrases = ["the second", "the second one", "help", "help me up", "one", "repeat", "repeat that"]
-    assert final_phrases(phrases, meaning) == {"the second", "the second one", "help me up", "one",
-                                               "repeat", "repeat that"}
+    assert final_phrases(phrases, meaning) == {
+        "the second",
+        "the second one",
+        "help me up",
+        "one",
+        "repeat",
+        "repeat that",
+    }
 
 
 def test_pocketsphinx_says_when_a_whole_answer_was_heard(spoken):
@@ -176,4 +207,3 @@ def test_pocketsphinx_says_when_a_whole_answer_was_heard(spoken):
     assert not first.complete  # a fresh decoder: the long hangover
     assert second.complete and second.result.text == "independent" and second.result.confidence > 0.9
     assert second.endpoint - second.speech_end < first.endpoint - first.speech_end
-

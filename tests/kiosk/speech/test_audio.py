@@ -75,7 +75,7 @@ def test_endpointer_finds_one_utterance_with_hangover():
     ep = Endpointer()
     events = []
     for i in range(0, len(signal) - FRAME_SAMPLES + 1, FRAME_SAMPLES):
-        if (event := ep.push(signal[i:i + FRAME_SAMPLES])) is not None:
+        if (event := ep.push(signal[i : i + FRAME_SAMPLES])) is not None:
             events.append((event, (i + FRAME_SAMPLES) / SAMPLE_RATE))
     assert [e for e, _ in events] == ["start", "end"]
     start, end = events[0][1], events[1][1]
@@ -88,9 +88,11 @@ def test_endpointer_ends_early_only_after_a_whole_answer():
     signal = np.concatenate([_silence(1.0), _tone(0.6, -20), _silence(1.0)])
     for complete, hangover in ((True, 0.24), (False, 0.5)):
         ep = Endpointer()
-        ends = [(i + FRAME_SAMPLES) / SAMPLE_RATE
-                for i in range(0, len(signal) - FRAME_SAMPLES + 1, FRAME_SAMPLES)
-                if ep.push(signal[i:i + FRAME_SAMPLES], complete) == "end"]
+        ends = [
+            (i + FRAME_SAMPLES) / SAMPLE_RATE
+            for i in range(0, len(signal) - FRAME_SAMPLES + 1, FRAME_SAMPLES)
+            if ep.push(signal[i : i + FRAME_SAMPLES], complete) == "end"
+        ]
         assert ends == [pytest.approx(1.6 + hangover, abs=0.04)], complete
 
 
@@ -100,8 +102,7 @@ def test_pipeline_ends_early_when_the_recogniser_has_a_whole_answer():
 
         def accept(self, pcm: bytes):
             super().accept(pcm)
-            return Recognition("independent", 0.0, final=False,
-                               complete=len(self.heard) > 0.4 * 2 * SAMPLE_RATE)
+            return Recognition("independent", 0.0, final=False, complete=len(self.heard) > 0.4 * 2 * SAMPLE_RATE)
 
     got = []
     pipe = UtterancePipeline(WholeAnswer(), got.append)
@@ -114,8 +115,11 @@ def test_pipeline_ends_early_when_the_recogniser_has_a_whole_answer():
 def test_endpointer_ignores_a_click_and_quiet_hum():
     signal = np.concatenate([_silence(0.5), _tone(0.03, -10), _tone(2.0, -60), _silence(0.5)])
     ep = Endpointer()
-    events = [ep.push(signal[i:i + FRAME_SAMPLES]) for i in range(0, len(signal), FRAME_SAMPLES)
-              if len(signal[i:i + FRAME_SAMPLES]) == FRAME_SAMPLES]
+    events = [
+        ep.push(signal[i : i + FRAME_SAMPLES])
+        for i in range(0, len(signal), FRAME_SAMPLES)
+        if len(signal[i : i + FRAME_SAMPLES]) == FRAME_SAMPLES
+    ]
     assert [e for e in events if e] == []
 
 
@@ -159,7 +163,7 @@ def test_each_utterance_says_how_far_the_voice_stood_above_the_room():
     assert utt.room_db == pytest.approx(-60, abs=0.5)
     # the tone and the hiss under it; the hangover's few hiss frames above the room's ceiling
     # (its 90th percentile) count too, and take a little off
-    assert utt.speech_db == pytest.approx(10 * np.log10(10 ** -4 + 10 ** -6), abs=1.0)
+    assert utt.speech_db == pytest.approx(10 * np.log10(10**-4 + 10**-6), abs=1.0)
     assert utt.above_room_db == pytest.approx(20, abs=1.0)
     # as loud as the room, and a room not yet heard
     assert audio.Utterance(0, 0, 0, 0, 0, speech_db=-50.0, room_db=-50.0).above_room_db == -30

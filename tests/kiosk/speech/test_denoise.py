@@ -26,10 +26,13 @@ def test_a_fans_noise_is_taken_out_and_the_words_are_kept(voice_of):
     speech = voice_of("I need a lot of help", "en-us+m3", 130)
     rng = np.random.default_rng(7)
     noisy = _in_noise(speech, rooms.white_noise(len(speech) / SAMPLE_RATE + 3.0, rng), snr_db=10)
-    clean = _in_noise(speech, None)[:len(noisy)]
+    clean = _in_noise(speech, None)[: len(noisy)]
     out = _pcm(noisy)
     assert len(out) == len(noisy)
-    before, words = slice(0, int(1.2 * SAMPLE_RATE)), slice(int(1.5 * SAMPLE_RATE), int(1.5 * SAMPLE_RATE) + len(speech))
+    before, words = (
+        slice(0, int(1.2 * SAMPLE_RATE)),
+        slice(int(1.5 * SAMPLE_RATE), int(1.5 * SAMPLE_RATE) + len(speech)),
+    )
     # spectral subtraction with a floor takes a few dB, not all of it (measured: 4-5 dB here)
     assert _db(out[before]) < _db(noisy[before]) - 3, "the noise between the words is at least halved"
     assert abs(_db(out[words]) - _db(clean[words])) < 3, "the words keep their level"
@@ -82,10 +85,14 @@ def test_noise_alone_is_never_cleaned_into_an_answer():
 def test_background_talk_is_left_as_it_is(voice_of):
     """People talking come and go: there is no one noise spectrum to take out (subtracting an
     average one cost right answers in bench/asr.py's babble)."""
-    talkers = [voice_of(text, voice, 170) for text, voice in (
-        ("could you bring the trolley round to bed twelve when you have a moment please", "en-gb+m1"),
-        ("the pharmacy said the new tablets will be ready after the lunch round", "en-us+f1"),
-        ("we went to the seaside last summer and the weather was lovely all week", "en+m6"))]
+    talkers = [
+        voice_of(text, voice, 170)
+        for text, voice in (
+            ("could you bring the trolley round to bed twelve when you have a moment please", "en-gb+m1"),
+            ("the pharmacy said the new tablets will be ready after the lunch round", "en-us+f1"),
+            ("we went to the seaside last summer and the weather was lovely all week", "en+m6"),
+        )
+    ]
     speech = voice_of("I need a lot of help", "en-us+m3", 130)
     rng = np.random.default_rng(5)
     noisy = _in_noise(speech, rooms.babble(talkers, len(speech) / SAMPLE_RATE + 3.0, rng), snr_db=10)

@@ -87,13 +87,13 @@ def test_official_model_is_checked_against_the_index_md5(models_served, tmp_path
     served, base = models_served
     _model_zip(served / "vosk-model-small-en-us-0.15.zip")
     md5 = hashlib.md5((served / "vosk-model-small-en-us-0.15.zip").read_bytes()).hexdigest()
-    (served / "model-list.json").write_text(json.dumps(
-        [{"lang": "en-us", "name": "vosk-model-small-en-us-0.15", "md5": md5, "size": 1}]))
+    (served / "model-list.json").write_text(
+        json.dumps([{"lang": "en-us", "name": "vosk-model-small-en-us-0.15", "md5": md5, "size": 1}])
+    )
     monkeypatch.setitem(models.OFFICIAL_MODELS, "en", f"{base}/vosk-model-small-en-us-0.15.zip")
     path = models.install("en", index_url=f"{base}/model-list.json")
     assert models.is_vosk_model(path)
-    (served / "model-list.json").write_text(json.dumps(
-        [{"name": "vosk-model-small-en-us-0.15", "md5": "0" * 32}]))
+    (served / "model-list.json").write_text(json.dumps([{"name": "vosk-model-small-en-us-0.15", "md5": "0" * 32}]))
     with pytest.raises(models.ModelError, match="checksum mismatch .* expected md5 0000"):
         models.install("en", index_url=f"{base}/model-list.json")
     (served / "model-list.json").write_text("[]")
@@ -107,8 +107,10 @@ def test_official_model_is_checked_against_the_index_md5(models_served, tmp_path
     [
         (lambda p: _model_zip(p, extra={"../../escape.txt": b"x"}), "unsafe path '../../escape.txt'"),
         (lambda p: _model_zip(p, model=False), "does not contain a Vosk model"),
-        (lambda p: (p.write_bytes(b"<html>not found</html>"), hashlib.sha256(p.read_bytes()).hexdigest())[1],
-         "not a zip archive"),
+        (
+            lambda p: (p.write_bytes(b"<html>not found</html>"), hashlib.sha256(p.read_bytes()).hexdigest())[1],
+            "not a zip archive",
+        ),
     ],
 )
 def test_bad_archives_install_nothing(models_served, tmp_path, build, message):

@@ -56,8 +56,9 @@ class Ear:
     def __init__(self, **channel) -> None:
         self.inputs: list[ChannelInput] = []
         self.utterances = []
-        self.channel = VoiceChannel("en", recogniser_factory=PocketSphinxRecogniser,
-                                    on_utterance=self.utterances.append, **channel)
+        self.channel = VoiceChannel(
+            "en", recogniser_factory=PocketSphinxRecogniser, on_utterance=self.utterances.append, **channel
+        )
         assert self.channel.attach(lambda item: self.inputs.append(item) if isinstance(item, ChannelInput) else None)
         self.channel.listen(True)
 
@@ -66,7 +67,7 @@ class Ear:
         return self
 
     def confirmation(self) -> Ear:
-        """"Is that right?" (the session's confirm prompt)."""
+        """ "Is that right?" (the session's confirm prompt)."""
         self.channel.set_question([OptionWords("Yes"), OptionWords("No")], "en", confirming=True)
         return self
 
@@ -86,14 +87,14 @@ def _in_noise(speech: np.ndarray, noise: np.ndarray | None, snr_db: float = 0, l
         noise, snr_db = np.zeros(int(len(speech) + (lead_s + 1.5) * SAMPLE_RATE)), 0
     out = noise * SPEECH_LEVEL * 10 ** (-snr_db / 20)
     start = int(lead_s * SAMPLE_RATE)
-    out[start:start + len(speech)] += speech
+    out[start : start + len(speech)] += speech
     return np.clip(np.round(out), -32768, 32767).astype(np.int16)
 
 
 def test_telephone_band_keeps_the_band_and_takes_no_audio_at_all():
     """Only 300-3400 Hz pass; an empty stretch (the room between answers) stays empty."""
     t = np.arange(SAMPLE_RATE) / SAMPLE_RATE
-    tones = (3000 * (np.sin(2 * np.pi * 100 * t) + np.sin(2 * np.pi * 1000 * t) + np.sin(2 * np.pi * 6000 * t)))
+    tones = 3000 * (np.sin(2 * np.pi * 100 * t) + np.sin(2 * np.pi * 1000 * t) + np.sin(2 * np.pi * 6000 * t))
     out = rooms.telephone_band(tones.astype(np.int16)).astype(np.float64)
     spectrum = np.abs(np.fft.rfft(out)) / len(out)
     assert spectrum[1000] > 1000 and spectrum[100] < 10 and spectrum[6000] < 10
@@ -134,11 +135,15 @@ def test_a_fan_switched_on_while_listening_does_not_make_the_kiosk_deaf(voice_of
 
 
 def _babble(voice_of, seconds: float, rng) -> np.ndarray:
-    talkers = [voice_of(text, voice, rate) for text, voice, rate in (
-        ("could you bring the trolley round to bed twelve please", "en-gb+m1", 170),
-        ("the pharmacy said the tablets will be ready after lunch", "en-us+f1", 180),
-        ("we went to the seaside last summer and it was lovely", "en+m6", 160),
-        ("has anyone seen the blood pressure cuff this morning", "en-gb-x-rp+f3", 175))]
+    talkers = [
+        voice_of(text, voice, rate)
+        for text, voice, rate in (
+            ("could you bring the trolley round to bed twelve please", "en-gb+m1", 170),
+            ("the pharmacy said the tablets will be ready after lunch", "en-us+f1", 180),
+            ("we went to the seaside last summer and it was lovely", "en+m6", 160),
+            ("has anyone seen the blood pressure cuff this morning", "en-gb-x-rp+f3", 175),
+        )
+    ]
     return rooms.babble(talkers, seconds, rng)
 
 
@@ -193,9 +198,10 @@ def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
     talkers around a short answer are not the patient's words; a quiet room and audio handed
     over without a pre-roll count every voiced frame."""
     speech = voice_of("two", *PATIENTS[0])
-    talk = _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.0, np.random.default_rng(5)),
-                     10, lead_s=0.3)
-    level = 10 * np.log10(np.maximum(frame_powers(talk) / 32768.0 ** 2, 1e-10))
+    talk = _in_noise(
+        speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.0, np.random.default_rng(5)), 10, lead_s=0.3
+    )
+    level = 10 * np.log10(np.maximum(frame_powers(talk) / 32768.0**2, 1e-10))
     counted = _above_room(talk.tobytes(), len(level))
     words = np.zeros(len(level), dtype=bool)
     active = 10 * np.log10(np.maximum(frame_powers(speech), 1e-9))
@@ -214,8 +220,9 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     left as it is. A quiet room (also where an answer was cut in two, the pre-roll holding its
     first part) and audio without a pre-roll are scored as they were heard."""
     speech = voice_of("yes", *PATIENTS[0])
-    talk = _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.5, np.random.default_rng(5)),
-                     10, lead_s=0.5)
+    talk = _in_noise(
+        speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.5, np.random.default_rng(5)), 10, lead_s=0.5
+    )
     gated = np.frombuffer(_gate_talk(talk.tobytes()), dtype="<i2")
     assert len(gated) == len(talk)
     before = 10 * np.log10(np.maximum(frame_powers(talk), 1e-9))
@@ -240,9 +247,9 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     first, second = voice_of("needs", *PATIENTS[0]), voice_of("help", *PATIENTS[0])
     level = 10 * np.log10(np.maximum(frame_powers(first), 1e-9))
     said = (np.flatnonzero(level >= level.max() - 15)[-1] + 1) * SAMPLE_RATE // 100  # where "needs" ends
-    trailing_off = rooms.scale_db(first[said - int(0.3 * SAMPLE_RATE):said], -12)
+    trailing_off = rooms.scale_db(first[said - int(0.3 * SAMPLE_RATE) : said], -12)
     cut = np.concatenate([trailing_off, second, np.zeros(int(0.5 * SAMPLE_RATE), np.int16)])
-    assert np.percentile(10 * np.log10(frame_powers(cut[:int(0.2 * SAMPLE_RATE)]) / 32768.0 ** 2), 90) > -55
+    assert np.percentile(10 * np.log10(frame_powers(cut[: int(0.2 * SAMPLE_RATE)]) / 32768.0**2), 90) > -55
     cut += np.round(np.random.default_rng(2).normal(0, 6, len(cut))).astype(np.int16)
     assert _gate_talk(cut.tobytes()) == cut.tobytes(), "a quiet room's answer cut in two is left as heard"
 
@@ -261,10 +268,17 @@ def test_yes_and_no_in_background_talk_are_not_taken_for_commands(voice_of):
             assert got is None or got.option == (1 if text == "yes" else 2), (voice, text, got)
 
 
-@pytest.mark.parametrize("item_id,text,meant", [
-    ("mobility", "um", None), ("mobility", "is it time for lunch yet", None), ("mobility", "<babble>", None),
-    ("transfers", "I need a lot of help", 2), ("feeding", "independent", 3), ("stairs", "one", 1),
-])
+@pytest.mark.parametrize(
+    "item_id,text,meant",
+    [
+        ("mobility", "um", None),
+        ("mobility", "is it time for lunch yet", None),
+        ("mobility", "<babble>", None),
+        ("transfers", "I need a lot of help", 2),
+        ("feeding", "independent", 3),
+        ("stairs", "one", 1),
+    ],
+)
 def test_babble_never_gives_a_sure_wrong_answer(voice_of, item_id, text, meant):
     """People talking nearby at SNR 10 dB: an option that is not the patient's is at worst sent
     for confirmation, and the patient's "no" to it is never heard as "yes"."""
@@ -272,8 +286,7 @@ def test_babble_never_gives_a_sure_wrong_answer(voice_of, item_id, text, meant):
     ear = Ear()
     for voice, rate in PATIENTS:
         speech = np.zeros(SAMPLE_RATE, dtype=np.int16) if text == "<babble>" else voice_of(text, voice, rate)
-        got = ear.question(item_id).hear(
-            _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 3, rng), 10))
+        got = ear.question(item_id).hear(_in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 3, rng), 10))
         if got is None or got.option == meant:
             continue
         assert got.option is None or got.needs_confirmation, (voice, text, got)
@@ -284,7 +297,7 @@ def test_babble_never_gives_a_sure_wrong_answer(voice_of, item_id, text, meant):
 
 @pytest.mark.parametrize("snr_db", [3, 10, 20])
 def test_a_yes_said_among_talkers_nearly_as_loud_is_never_taken_as_said(voice_of, snr_db):
-    """"Is that right?" answered where people talk nearly as loud as the patient (SNR 3 dB):
+    """ "Is that right?" answered where people talk nearly as loud as the patient (SNR 3 dB):
     a reply heard as yes is sent as unsure (the session then asks for Yes or No to be pressed),
     never as a yes that stores the answer, however sure the recogniser: a "no" was now and then
     heard as "yes" there. At 10 and 20 dB every yes heard is taken as said, and how far the
@@ -297,8 +310,9 @@ def test_a_yes_said_among_talkers_nearly_as_loud_is_never_taken_as_said(voice_of
         for text in ("yes", "yes that's right", "no", "yes", "no that's wrong"):
             speech = voice_of(text, voice, rate)
             ear.utterances.clear()
-            got = ear.confirmation().hear(_in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 3, rng),
-                                                    snr_db))
+            got = ear.confirmation().hear(
+                _in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 3, rng), snr_db)
+            )
             measured = [u.above_room_db for u in ear.utterances]
             assert measured and all(snr_db - 3 < m < snr_db + 5 for m in measured), (voice, text, measured)
             if got is None or got.option is None:
@@ -347,12 +361,13 @@ def test_confirmation_takes_natural_yes_and_no(voice_of, voice, rate):
         got = ear.confirmation().hear(_in_noise(voice_of(text, voice, rate), None))
         heard[text] = got.option if got else None
     assert {t: o for t, o in heard.items() if o is not None} == {
-        t: 1 if t.startswith("yes") else 2 for t, o in heard.items() if o is not None}
+        t: 1 if t.startswith("yes") else 2 for t, o in heard.items() if o is not None
+    }
     assert heard["yes"] == 1 and heard["no that's wrong"] == 2
 
 
 def test_issue_9_cases_are_never_recorded_as_something_else(voice_of):
-    """"all the time" does not call the doctor, "one" is not "go on", "I need a lot of help" on
+    """ "all the time" does not call the doctor, "one" is not "go on", "I need a lot of help" on
     transfers is never "Unable": at worst an option the patient is asked to confirm."""
     ear = Ear()
     for voice, rate in [("en-us", 160), *PATIENTS]:
@@ -374,23 +389,35 @@ def test_taking_back_an_answer_by_voice_is_undo(voice_of, text):
     assert got is not None and got.command is Command.UNDO
 
 
-@pytest.mark.parametrize("text,voice,option", [
-    ("start", "en-us", 1), ("begin", "en+f2", 1), ("English", "en-us+m3", 1),
-    ("español", "es", 2), ("español", "es+m3", 2), ("français", "fr", 3), ("français", "fr+f2", 3),
-])
+@pytest.mark.parametrize(
+    "text,voice,option",
+    [
+        ("start", "en-us", 1),
+        ("begin", "en+f2", 1),
+        ("English", "en-us+m3", 1),
+        ("español", "es", 2),
+        ("español", "es+m3", 2),
+        ("français", "fr", 3),
+        ("français", "fr+f2", 3),
+    ],
+)
 def test_the_welcome_hears_start_and_the_language_names(voice_of, text, voice, option):
     """The welcome listens with options naming the languages; each is heard from a speaker of it."""
     ear = Ear()
     # the options of the session's English welcome prompt (kiosk.core.session.core._welcome_prompt)
-    ear.channel.set_question([OptionWords(OWN_NAME[lang], (*LANGUAGE_NAMES["en"][lang],
-                                                           *(START_WORDS["en"] if lang == "en" else ())))
-                              for lang in ("en", "es", "fr")], "en")
+    ear.channel.set_question(
+        [
+            OptionWords(OWN_NAME[lang], (*LANGUAGE_NAMES["en"][lang], *(START_WORDS["en"] if lang == "en" else ())))
+            for lang in ("en", "es", "fr")
+        ],
+        "en",
+    )
     got = ear.hear(_in_noise(voice_of(text, voice, 150), None))
     assert got is not None and got.option == option and not got.needs_confirmation
 
 
 def test_a_british_one_is_heard(voice_of):
-    """"one" with the vowel of "lot" (espeak-ng's en-gb voice, the North of England): the US
+    """ "one" with the vowel of "lot" (espeak-ng's en-gb voice, the North of England): the US
     dictionary's only "W AH N" lost it to the filler "what"; the accent variant hears it."""
     ear = Ear()
     ear.confirmation().hear(_in_noise(voice_of("yes", "en-gb+klatt", 150), None))  # heard before (practice)
@@ -399,7 +426,7 @@ def test_a_british_one_is_heard(voice_of):
 
 
 def test_the_first_one_is_asked_about_and_a_declined_mishearing_is_not_offered_again(voice_of):
-    """"the first one" in a voice the model hears as "the third one" (espeak-ng's en-us): the
+    """ "the first one" in a voice the model hears as "the third one" (espeak-ng's en-us): the
     option is only ever offered for confirmation (never refused outright, never taken as sure);
     once the patient says No to the third option, asked again, the same words are heard as the
     first."""

@@ -61,7 +61,7 @@ def test_every_question_is_real_speech_of_plausible_length(tts_speaker, tmp_path
         assert 0.5 * expected <= seconds <= 1.5 * expected + 0.6, (item.id, words, seconds)
         total_seconds, total_expected = total_seconds + seconds, total_expected + expected
         frame = rate // 50  # 20 ms
-        levels = [frame_level_db(samples[i:i + frame]) for i in range(0, len(samples) - frame, frame)]
+        levels = [frame_level_db(samples[i : i + frame]) for i in range(0, len(samples) - frame, frame)]
         voiced = sum(level > -40 for level in levels) / len(levels)
         assert frame_level_db(samples) > -30, item.id  # loud enough to be speech, not hiss
         assert voiced > 0.5, (item.id, voiced)  # mostly speech, with pauses between words
@@ -71,8 +71,10 @@ def test_every_question_is_real_speech_of_plausible_length(tts_speaker, tmp_path
 
 def test_languages_sound_different(tts_speaker, tmp_path):
     """Each language gets its own voice: the same text is not read the same way."""
-    lengths = {lang: len(_wav(tts_speaker.save_to_file("Independiente", lang, tmp_path / f"{lang}.wav"))[0])
-               for lang in ("en", "es", "fr")}
+    lengths = {
+        lang: len(_wav(tts_speaker.save_to_file("Independiente", lang, tmp_path / f"{lang}.wav"))[0])
+        for lang in ("en", "es", "fr")
+    }
     assert len(set(lengths.values())) == 3
 
 
@@ -94,7 +96,7 @@ def test_rate_and_volume_change_the_speech(tmp_path, espeak_ng):
 def _voiced_words_per_minute(samples: np.ndarray, rate: int, words: int) -> float:
     """Words per minute of voiced audio (20 ms frames above -40 dBFS): the words' own pace."""
     frame = rate // 50
-    voiced = sum(frame_level_db(samples[i:i + frame]) > -40 for i in range(0, len(samples) - frame, frame))
+    voiced = sum(frame_level_db(samples[i : i + frame]) > -40 for i in range(0, len(samples) - frame, frame))
     return words * 60 / (voiced * 0.02)
 
 
@@ -132,10 +134,12 @@ def test_delivery_maps_slow_rates_to_pauses():
     assert slow.words_per_minute == MIN_RATE
     assert slow.sentence_break_ms - 400 == pytest.approx(2 * (slow.comma_break_ms - 150), abs=1)
     assert (slow.sentence_break_ms - 400) + (slow.comma_break_ms - 150) == pytest.approx(
-        1000 * 7 * (60 / 136 - 60 / 150), abs=2)
+        1000 * 7 * (60 / 136 - 60 / 150), abs=2
+    )
     assert slow.markup("Fish & chips, <now>. Yes") == (
         '<speak>Fish &amp; chips,<break time="%dms"/> &lt;now&gt;.<break time="%dms"/> Yes</speak>'
-        % (slow.comma_break_ms, slow.sentence_break_ms))
+        % (slow.comma_break_ms, slow.sentence_break_ms)
+    )
 
 
 def test_volume_steps_stay_in_range():
@@ -200,8 +204,9 @@ def test_a_failing_loudspeaker_is_reported_and_the_next_phrase_still_plays():
     player = FlakyPlayer()
     statuses = []
     ended = threading.Semaphore(0)
-    speaker = Speaker(on_status=statuses.append, player_factory=lambda: player,
-                      on_speech=lambda s: None if s else ended.release())
+    speaker = Speaker(
+        on_status=statuses.append, player_factory=lambda: player, on_speech=lambda s: None if s else ended.release()
+    )
     speaker.start()
     speaker.say("First", "en")
     speaker.say("Second", "en")
@@ -228,8 +233,7 @@ def test_stop_speaking_drops_the_phrase_being_synthesised(monkeypatch):
     player = _RecordingPlayer()
     events: list[bool] = []
     ended = threading.Event()
-    speaker = Speaker(player_factory=lambda: player,
-                      on_speech=lambda s: (events.append(s), None if s else ended.set()))
+    speaker = Speaker(player_factory=lambda: player, on_speech=lambda s: (events.append(s), None if s else ended.set()))
     speaker.start()
     speaker.say("How do you manage eating your meals?", "en")
     assert synthesising.wait(10)
@@ -253,5 +257,8 @@ def test_without_espeak_ng_voice_out_is_off_and_says_why(monkeypatch, tmp_path):
     with pytest.raises(TtsUnavailable, match="espeak-ng is not installed"):
         speaker.save_to_file("Hello", "en", tmp_path / "x.wav")
     speaker.close()
-    assert statuses == [ChannelStatus(Channel.VOICE, ChannelState.OFF, source="espeak-ng",
-                                      reason="voice out off: espeak-ng is not installed")]
+    assert statuses == [
+        ChannelStatus(
+            Channel.VOICE, ChannelState.OFF, source="espeak-ng", reason="voice out off: espeak-ng is not installed"
+        )
+    ]

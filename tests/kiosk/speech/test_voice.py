@@ -18,9 +18,9 @@ from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.session import DoctorCalled, ListeningChanged, Paused, Phase, Prompt, Resumed, Session
 from kiosk.speech.asr import AsrUnavailable, PocketSphinxRecogniser, VoskRecogniser, open_recogniser
 from kiosk.speech.audio import feed_wav, list_input_devices, resample
+from kiosk.speech.matching import OptionWords
 from kiosk.speech.models import find_model
 from kiosk.speech.tts import Speaker
-from kiosk.speech.matching import OptionWords
 from kiosk.speech.voice import VoiceChannel
 from kiosk.ui.widgets.channel_board import VOICE_IN, ChannelBoard
 
@@ -32,30 +32,39 @@ def _backends(language: str):
     if language == "en":
         params.append(pytest.param(lambda lang: PocketSphinxRecogniser(lang), id="pocketsphinx"))
     model = find_model(language)  # as the kiosk finds one: KIOSK_VOSK_MODEL, or installed
-    params.append(pytest.param(
-        lambda lang, model=model: VoskRecogniser(model, lang), id="vosk",
-        marks=pytest.mark.skipif(model is None, reason=f"no vosk model for {language!r}: set "
-                                 "KIOSK_VOSK_MODEL or run `kiosk models install` (none can be downloaded here)"),
-    ))
+    params.append(
+        pytest.param(
+            lambda lang, model=model: VoskRecogniser(model, lang),
+            id="vosk",
+            marks=pytest.mark.skipif(
+                model is None,
+                reason=f"no vosk model for {language!r}: set "
+                "KIOSK_VOSK_MODEL or run `kiosk models install` (none can be downloaded here)",
+            ),
+        )
+    )
     return params
 
 
 class _Kiosk:
     """The real session on a simulated clock, with a voice channel attached the way the app does."""
 
-    def __init__(self, recogniser_factory, language: str = "en", app_style: bool = False,
-                 microphone=None) -> None:
+    def __init__(self, recogniser_factory, language: str = "en", app_style: bool = False, microphone=None) -> None:
         self.clock = SimClock()
-        self.session = Session(QUESTIONNAIRE, clock=self.clock, engine=None, patient_id="P-0042",
-                               language=language, familiarisation=False)
+        self.session = Session(
+            QUESTIONNAIRE, clock=self.clock, engine=None, patient_id="P-0042", language=language, familiarisation=False
+        )
         self.events: list[object] = []
         self.statuses: list[ChannelStatus] = []
         self.unmatched: list[tuple[str, str]] = []
         #: every answer or command the voice channel sent
         self.inputs: list[ChannelInput] = []
-        self.voice = VoiceChannel(language, recogniser_factory=recogniser_factory,
-                                  on_unmatched=lambda u, r: self.unmatched.append((u, r)),
-                                  **({"microphone_factory": microphone} if microphone else {}))
+        self.voice = VoiceChannel(
+            language,
+            recogniser_factory=recogniser_factory,
+            on_unmatched=lambda u, r: self.unmatched.append((u, r)),
+            **({"microphone_factory": microphone} if microphone else {}),
+        )
         self.session.subscribe(self.events.append)
         self.session.subscribe(self._app_forward if app_style else self.voice.on_session_event)
         if microphone is None:
@@ -81,8 +90,9 @@ class _Kiosk:
     def to_question(self, item_id: str) -> None:
         self.session.start()
         self.session.acknowledge()
-        while self.session.current_item is None or self.session.current_item.id != item_id \
-                or not self.session.listening:
+        while (
+            self.session.current_item is None or self.session.current_item.id != item_id or not self.session.listening
+        ):
             if self.session.current_item is not None and self.session.listening:
                 self.session.handle(ChannelInput(Channel.TOUCH, option=1))
             self.clock.advance(0.5)
@@ -124,15 +134,22 @@ def test_spoken_answer_is_recorded_as_a_voice_answer(backend, spoken, item_id, u
 
 
 ANSWERS_OTHER = [
-    ("es", "feeding", "independiente", 3), ("es", "feeding", "dos", 2), ("es", "feeding", "la segunda", 2),
-    ("fr", "feeding", "autonome", 3), ("fr", "feeding", "deux", 2), ("fr", "feeding", "le premier", 1),
+    ("es", "feeding", "independiente", 3),
+    ("es", "feeding", "dos", 2),
+    ("es", "feeding", "la segunda", 2),
+    ("fr", "feeding", "autonome", 3),
+    ("fr", "feeding", "deux", 2),
+    ("fr", "feeding", "le premier", 1),
 ]
 
 
 @pytest.mark.parametrize(
     "language,item_id,utterance,option,backend",
-    [pytest.param(lang, item, utt, opt, *backend.values, marks=backend.marks, id=f"{lang}-{utt}-{backend.id}")
-     for lang, item, utt, opt in ANSWERS_OTHER for backend in _backends(lang)],
+    [
+        pytest.param(lang, item, utt, opt, *backend.values, marks=backend.marks, id=f"{lang}-{utt}-{backend.id}")
+        for lang, item, utt, opt in ANSWERS_OTHER
+        for backend in _backends(lang)
+    ],
 )
 def test_spoken_answer_in_spanish_and_french(spoken, language, item_id, utterance, option, backend):
     kiosk = _Kiosk(backend, language=language)
@@ -237,11 +254,15 @@ def test_every_voice_answer_to_a_scored_question_asks_for_confirmation(backend, 
 
 
 def test_a_confusable_answer_is_always_confirmed_and_refused_where_it_cannot_be(spoken):
-    """"the first one" where "the third one" selects another option: asked back even by a channel
+    """ "the first one" where "the third one" selects another option: asked back even by a channel
     told to confirm nothing, and not taken at all on a prompt whose answers are never confirmed."""
     inputs, unmatched = [], []
-    voice = VoiceChannel("en", recogniser_factory=PocketSphinxRecogniser, confirm_below=0.0,
-                         on_unmatched=lambda u, r: unmatched.append(r))
+    voice = VoiceChannel(
+        "en",
+        recogniser_factory=PocketSphinxRecogniser,
+        confirm_below=0.0,
+        on_unmatched=lambda u, r: unmatched.append(r),
+    )
     assert voice.attach(lambda i: inputs.append(i) if isinstance(i, ChannelInput) else None)
     voice.listen(True)
     options = [OptionWords(w) for w in ("unable", "needs help", "independent")]
@@ -308,8 +329,9 @@ def test_no_recogniser_for_the_language_turns_voice_off_and_the_session_goes_on(
     assert kiosk.session.answers["feeding"].channel is Channel.TOUCH
 
 
-@pytest.mark.parametrize("language,words", [("es", "respuestas habladas en español"),
-                                            ("fr", "réponses parlées en français")])
+@pytest.mark.parametrize(
+    "language,words", [("es", "respuestas habladas en español"), ("fr", "réponses parlées en français")]
+)
 def test_no_model_reason_is_shown_in_the_patients_language(monkeypatch, tmp_path, language, words):
     """The patient's screen says why voice is off in their language; the clinician still sees
     the technical reason with the command that fixes it."""
@@ -322,8 +344,10 @@ def test_no_model_reason_is_shown_in_the_patients_language(monkeypatch, tmp_path
     patient = next(line for line in board.lines(language) if not line.live and words in line.reason)
     assert "kiosk models" not in patient.reason
     clinician = [line.reason for line in board.lines("en", patient=False) if "kiosk models install" in line.reason]
-    assert clinician == [f"voice answers off: no speech model for language {language!r}: pocketsphinx only "
-                         f"ships English; install one with `kiosk models install {language}`"]
+    assert clinician == [
+        f"voice answers off: no speech model for language {language!r}: pocketsphinx only "
+        f"ships English; install one with `kiosk models install {language}`"
+    ]
 
 
 def test_no_microphone_turns_voice_off_with_a_reason():
@@ -333,8 +357,9 @@ def test_no_microphone_turns_voice_off_with_a_reason():
     voice = VoiceChannel("en")
     voice.start(statuses.append)
     voice.stop()
-    assert statuses == [ChannelStatus(Channel.VOICE, ChannelState.OFF, source="voice",
-                                      reason="voice answers off: no microphone found")]
+    assert statuses == [
+        ChannelStatus(Channel.VOICE, ChannelState.OFF, source="voice", reason="voice answers off: no microphone found")
+    ]
 
 
 def test_language_change_follows_the_prompts(spoken):
@@ -369,8 +394,9 @@ def test_the_kiosk_reading_options_aloud_into_its_own_microphone_records_nothing
         def stop(self):
             pass
 
-    speaker = Speaker(on_speech=lambda s: (kiosk.voice.set_muted(s), None if s else done.set()),
-                      player_factory=EchoingPlayer)
+    speaker = Speaker(
+        on_speech=lambda s: (kiosk.voice.set_muted(s), None if s else done.set()), player_factory=EchoingPlayer
+    )
     speaker.start()
     speaker.say("Independent", "en")
     assert done.wait(10)
@@ -412,8 +438,11 @@ def test_started_channel_hears_its_microphone_thread_and_follows_language_change
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     microphones: list[_WavMicrophone] = []
-    kiosk = _Kiosk(open_recogniser, language="es",
-                   microphone=lambda consumer: microphones.append(_WavMicrophone(consumer)) or microphones[-1])
+    kiosk = _Kiosk(
+        open_recogniser,
+        language="es",
+        microphone=lambda consumer: microphones.append(_WavMicrophone(consumer)) or microphones[-1],
+    )
     assert not kiosk.voice.wait_loaded()
     (loading, off) = kiosk.statuses  # the microphone works; Spanish has no recogniser here
     assert off.state is ChannelState.OFF and "no speech model for language 'es'" in off.reason
@@ -422,7 +451,8 @@ def test_started_channel_hears_its_microphone_thread_and_follows_language_change
     assert kiosk.voice.wait_loaded()
     assert [(s.state, s.source, s.reason) for s in kiosk.statuses[2:]] == [
         (ChannelState.CONNECTING, "voice", "loading the speech model for 'en'"),
-        (ChannelState.ON, "voice", "voice answers on: pocketsphinx")]
+        (ChannelState.ON, "voice", "voice answers on: pocketsphinx"),
+    ]
     (microphone,) = microphones
     microphone.files += [spoken("independent"), spoken("yes")]  # the answer, and yes to "Is that right?"
     microphone.thread.start()
@@ -456,7 +486,8 @@ def test_a_language_without_a_model_turns_voice_in_off_on_the_channel_board(spok
 
 
 def test_models_load_off_the_thread_that_changes_language_and_a_late_one_is_not_installed(
-        spoken, monkeypatch, tmp_path):
+    spoken, monkeypatch, tmp_path
+):
     _no_models(monkeypatch, tmp_path)
     english_loading, english_loaded = threading.Event(), threading.Event()
     loads: list[tuple[str, threading.Thread]] = []
@@ -477,8 +508,7 @@ def test_models_load_off_the_thread_that_changes_language_and_a_late_one_is_not_
     assert [language for language, _ in loads] == ["en", "es"]
     assert threading.current_thread() not in {thread for _, thread in loads}
     # the English recogniser arrived after Spanish was chosen: never installed, never ON
-    assert [s.state for s in kiosk.statuses] == [ChannelState.CONNECTING, ChannelState.CONNECTING,
-                                                 ChannelState.OFF]
+    assert [s.state for s in kiosk.statuses] == [ChannelState.CONNECTING, ChannelState.CONNECTING, ChannelState.OFF]
     kiosk.say(spoken("independent"))
     assert kiosk.session.answers == {}
 
@@ -498,9 +528,11 @@ def test_stop_while_the_microphone_opens_leaves_it_closed():
             self.open = False
 
     microphones: list[OpeningMicrophone] = []
-    voice = VoiceChannel("en", recogniser_factory=PocketSphinxRecogniser,
-                         microphone_factory=lambda consumer: microphones.append(OpeningMicrophone(consumer))
-                         or microphones[-1])
+    voice = VoiceChannel(
+        "en",
+        recogniser_factory=PocketSphinxRecogniser,
+        microphone_factory=lambda consumer: microphones.append(OpeningMicrophone(consumer)) or microphones[-1],
+    )
     statuses: list[ChannelStatus] = []
     voice.start(statuses.append)
     (microphone,) = microphones
@@ -526,8 +558,11 @@ def test_options_acted_on_without_asking_back_are_marked_for_the_recogniser(conf
     to make its two hearings agree (pocketsphinx in background talk); a scored question's
     answers are asked back, unless the channel is set to take sure answers without asking."""
     recognisers: list[_Recording] = []
-    channel = VoiceChannel("en", recogniser_factory=lambda lang: recognisers.append(_Recording(lang)) or recognisers[-1],
-                           confirm_below=confirm_below)
+    channel = VoiceChannel(
+        "en",
+        recogniser_factory=lambda lang: recognisers.append(_Recording(lang)) or recognisers[-1],
+        confirm_below=confirm_below,
+    )
     assert channel.attach(lambda item: None)
     item = QUESTIONNAIRE.items[0]
     channel.set_question([OptionWords(o.label_in("en")) for o in item.options], "en", scored=True, key="q1")

@@ -86,7 +86,7 @@ def test_an_answer_gives_partial_results_then_a_final_one(korean, korean_speech)
 
 
 def test_a_sentence_forced_into_grammar_phrases_is_not_an_answer(korean, korean_speech):
-    """"Hello, the weather is nice today": this model has no "[unk]" to put it in, so Vosk
+    """ "Hello, the weather is nice today": this model has no "[unk]" to put it in, so Vosk
     returns a run of grammar words, each fairly sure; the recogniser gives it no confidence."""
     korean.set_grammar(PHRASES)
     utterances = []
@@ -94,4 +94,3 @@ def test_a_sentence_forced_into_grammar_phrases_is_not_an_answer(korean, korean_
     assert utterances
     for utterance in utterances:
         assert utterance.result.confidence == 0.0 or len(utterance.result.text.split()) == 1
-

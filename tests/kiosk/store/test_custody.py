@@ -11,8 +11,8 @@ from contextlib import contextmanager
 
 import pytest
 
-from kiosk.store.lease import Owner, SessionTaken
 from kiosk.store.database import Store
+from kiosk.store.lease import Owner, SessionTaken
 
 TIMING = {"attempt_window_s": 30}
 
@@ -28,15 +28,32 @@ def process():
         child.wait(timeout=30)
 
 
-def create(store: Store, session_id: str = "s1", patient: str = "P-AAAAAA",
-           started_at: str = "2026-11-23T15:00:00+00:00") -> None:
-    store.create_session(session_id=session_id, patient_id=patient, questionnaire_id="barthel", language="en",
-                         answered_by="patient", started_at=started_at, timing=TIMING)
+def create(
+    store: Store, session_id: str = "s1", patient: str = "P-AAAAAA", started_at: str = "2026-11-23T15:00:00+00:00"
+) -> None:
+    store.create_session(
+        session_id=session_id,
+        patient_id=patient,
+        questionnaire_id="barthel",
+        language="en",
+        answered_by="patient",
+        started_at=started_at,
+        timing=TIMING,
+    )
 
 
 def answer(store: Store, item: str = "feeding", session_id: str = "s1") -> None:
-    store.record_answer(session_id, item_id=item, option=2, points=5, attempt=1, channel="touch",
-                        answered_by="patient", t=1.0, at="2026-11-23T15:00:01+00:00")
+    store.record_answer(
+        session_id,
+        item_id=item,
+        option=2,
+        points=5,
+        attempt=1,
+        channel="touch",
+        answered_by="patient",
+        t=1.0,
+        at="2026-11-23T15:00:01+00:00",
+    )
 
 
 def test_a_session_held_by_a_running_kiosk_is_neither_written_nor_offered_elsewhere(tmp_path):

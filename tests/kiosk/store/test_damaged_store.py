@@ -32,9 +32,15 @@ def data_dir(tmp_path: Path) -> Path:
 
 def results(data: Path, *args: str) -> subprocess.CompletedProcess:
     """A real `kiosk results` process on ``data``, with no user configuration."""
-    return subprocess.run([sys.executable, "-m", "kiosk", "results", "--data-dir", str(data), *args],
-                          capture_output=True, text=True, cwd=ROOT, timeout=HANG_S, check=False,
-                          env={"PATH": "/usr/bin:/bin", "HOME": str(data.parent)})
+    return subprocess.run(
+        [sys.executable, "-m", "kiosk", "results", "--data-dir", str(data), *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=HANG_S,
+        check=False,
+        env={"PATH": "/usr/bin:/bin", "HOME": str(data.parent)},
+    )
 
 
 def edit(data: Path, *statements: str) -> tuple[str, str]:
@@ -65,15 +71,22 @@ def test_a_dropped_table_is_named_with_the_database(data_dir, table):
     assert not (data_dir.parent / "out.csv").exists()
 
 
-@pytest.mark.parametrize(("statement", "what"), [
-    ("UPDATE answers SET channel = 'smoke' WHERE rowid = (SELECT min(rowid) FROM answers)",
-     "'smoke' is not a valid Channel"),
-    ("UPDATE answers SET channel = 7 WHERE rowid = (SELECT min(rowid) FROM answers)", "'7' is not a valid Channel"),
-    ("UPDATE answers SET answered_by = 'robot' WHERE rowid = (SELECT min(rowid) FROM answers)",
-     "'robot' is not a valid AnsweredBy"),
-    ("UPDATE sessions SET timing = '{not json'", "Expecting property name"),
-    ("UPDATE metric_samples SET fired = '3'", "'int' object is not iterable"),
-])
+@pytest.mark.parametrize(
+    ("statement", "what"),
+    [
+        (
+            "UPDATE answers SET channel = 'smoke' WHERE rowid = (SELECT min(rowid) FROM answers)",
+            "'smoke' is not a valid Channel",
+        ),
+        ("UPDATE answers SET channel = 7 WHERE rowid = (SELECT min(rowid) FROM answers)", "'7' is not a valid Channel"),
+        (
+            "UPDATE answers SET answered_by = 'robot' WHERE rowid = (SELECT min(rowid) FROM answers)",
+            "'robot' is not a valid AnsweredBy",
+        ),
+        ("UPDATE sessions SET timing = '{not json'", "Expecting property name"),
+        ("UPDATE metric_samples SET fired = '3'", "'int' object is not iterable"),
+    ],
+)
 def test_a_row_no_kiosk_writes_is_one_line_naming_the_database(data_dir, statement, what):
     session_id, before = edit(data_dir, statement)
     listed = results(data_dir)  # the list reads none of those values: it still works

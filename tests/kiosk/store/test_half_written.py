@@ -16,7 +16,6 @@ from kiosk.core.clock import SimClock
 from kiosk.core.session import AnswerRecorded, Session
 from kiosk.store.database import Store
 from qos import Engine
-
 from tests.kiosk.core.helpers import MODEL, QUESTIONNAIRE, TIMING, Rig, at_first_question
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -25,9 +24,11 @@ ROOT = Path(__file__).resolve().parents[3]
 def counts(path: Path) -> tuple[int, int, int]:
     """Answers, answer context batches and metric samples another connection sees."""
     with sqlite3.connect(path) as other:
-        return (other.execute("SELECT COUNT(*) FROM answers").fetchone()[0],
-                other.execute("SELECT COUNT(*) FROM contexts WHERE sets LIKE '%AttemptAnswered\": true%'").fetchone()[0],
-                other.execute("SELECT COUNT(*) FROM metric_samples").fetchone()[0])
+        return (
+            other.execute("SELECT COUNT(*) FROM answers").fetchone()[0],
+            other.execute("SELECT COUNT(*) FROM contexts WHERE sets LIKE '%AttemptAnswered\": true%'").fetchone()[0],
+            other.execute("SELECT COUNT(*) FROM metric_samples").fetchone()[0],
+        )
 
 
 class Interrupting(Engine):
@@ -45,8 +46,7 @@ class Interrupting(Engine):
         return super().update(t, set=set, emit=emit)
 
 
-@pytest.mark.parametrize("error", [KeyboardInterrupt(), RuntimeError("engine failed")],
-                         ids=["ctrl-c", "exception"])
+@pytest.mark.parametrize("error", [KeyboardInterrupt(), RuntimeError("engine failed")], ids=["ctrl-c", "exception"])
 def test_an_answer_cut_short_before_its_metrics_stores_nothing_of_it(tmp_path, error):
     store = Store.open(tmp_path / "data")
     rig = at_first_question(store, engine=Interrupting(MODEL, error))
@@ -104,8 +104,9 @@ SIGINT_CHILD = textwrap.dedent("""
 
 def test_a_real_ctrl_c_mid_answer_leaves_the_session_without_it_and_staff_continue_at_that_question(tmp_path):
     data = tmp_path / "data"
-    child = subprocess.run([sys.executable, "-c", SIGINT_CHILD, str(data)], capture_output=True, text=True,
-                           cwd=ROOT, timeout=120)
+    child = subprocess.run(
+        [sys.executable, "-c", SIGINT_CHILD, str(data)], capture_output=True, text=True, cwd=ROOT, timeout=120
+    )
     assert child.returncode != 0 and "KeyboardInterrupt" in child.stderr
     lines = child.stdout.split()
     assert lines[0] == "ASKING" and "STORED" not in lines
@@ -114,8 +115,14 @@ def test_a_real_ctrl_c_mid_answer_leaves_the_session_without_it_and_staff_contin
     assert counts(store.path)[:2] == (0, 0)
     (interrupted,) = store.unfinished_sessions()  # its process is gone: for staff, not a patient
     assert interrupted.id == session_id and interrupted.answers == ()
-    continued = Session.from_stored(QUESTIONNAIRE, store.continue_session(session_id), clock=SimClock(500),
-                                    engine=Engine(MODEL), store=store, timing=TIMING)
+    continued = Session.from_stored(
+        QUESTIONNAIRE,
+        store.continue_session(session_id),
+        clock=SimClock(500),
+        engine=Engine(MODEL),
+        store=store,
+        timing=TIMING,
+    )
     rig = Rig(continued, continued.clock)
     continued.start()
     continued.acknowledge()

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.store import migrations as schema
 from kiosk.commands.results import main as results_main
+from kiosk.store import migrations as schema
 from kiosk.store.database import DB_NAME, StorageError, Store
 
 V1_SQL = (Path(__file__).parent / "data" / "schema_v1.sql").read_text(encoding="utf-8")
@@ -29,23 +29,33 @@ def v1_database(data: Path) -> Path:
     db.executescript(V1_SQL)
     db.execute("PRAGMA foreign_keys=ON")
     timing = json.dumps({"attempt_window_s": 30})
-    for session_id, patient, started, status in [("aaaa00000001", "P-FIRST1", "2026-11-20T09:00:00+00:00", "finished"),
-                                                 ("bbbb00000002", "P-CUTOFF", "2026-11-21T10:00:00+00:00", "running"),
-                                                 ("cccc00000003", "TB-0002", "2026-01-01T00:00:05+00:00", "running"),
-                                                 ("dddd00000004", "P-NEWYEAR", "2026-01-01T00:20:41.532118+00:00",
-                                                  "finished")]:
+    for session_id, patient, started, status in [
+        ("aaaa00000001", "P-FIRST1", "2026-11-20T09:00:00+00:00", "finished"),
+        ("bbbb00000002", "P-CUTOFF", "2026-11-21T10:00:00+00:00", "running"),
+        ("cccc00000003", "TB-0002", "2026-01-01T00:00:05+00:00", "running"),
+        ("dddd00000004", "P-NEWYEAR", "2026-01-01T00:20:41.532118+00:00", "finished"),
+    ]:
         db.execute("INSERT INTO patients VALUES (?, ?)", (patient, started))
-        db.execute("INSERT INTO sessions VALUES (?, ?, 'barthel', 'en', 'patient', ?, ?, ?, NULL, NULL, NULL, NULL)",
-                   (session_id, patient, timing, started, status))
-        db.execute("INSERT INTO answers VALUES (?, 'feeding', 2, 5, 1, 'touch', 'patient', 28.0, ?, 'screen')",
-                   (session_id, started))
-        db.execute("INSERT INTO contexts VALUES (?, 0, 28.0, ?, '[]')",
-                   (session_id, json.dumps({"FirstAttemptAnswered": True})))
-        db.execute("INSERT INTO metric_samples VALUES (?, 0, 28.0, ?, '[]')",
-                   (session_id, json.dumps({"Performance": 0.7})))
+        db.execute(
+            "INSERT INTO sessions VALUES (?, ?, 'barthel', 'en', 'patient', ?, ?, ?, NULL, NULL, NULL, NULL)",
+            (session_id, patient, timing, started, status),
+        )
+        db.execute(
+            "INSERT INTO answers VALUES (?, 'feeding', 2, 5, 1, 'touch', 'patient', 28.0, ?, 'screen')",
+            (session_id, started),
+        )
+        db.execute(
+            "INSERT INTO contexts VALUES (?, 0, 28.0, ?, '[]')",
+            (session_id, json.dumps({"FirstAttemptAnswered": True})),
+        )
+        db.execute(
+            "INSERT INTO metric_samples VALUES (?, 0, 28.0, ?, '[]')", (session_id, json.dumps({"Performance": 0.7}))
+        )
         db.execute("INSERT INTO events VALUES (?, 0, 10.0, 'start', 'answered by patient')", (session_id,))
-    db.execute("UPDATE sessions SET status = 'finished', finished_at = '2026-11-20T09:12:00+00:00', total = 5,"
-               " complete = 0 WHERE id = 'aaaa00000001'")
+    db.execute(
+        "UPDATE sessions SET status = 'finished', finished_at = '2026-11-20T09:12:00+00:00', total = 5,"
+        " complete = 0 WHERE id = 'aaaa00000001'"
+    )
     db.commit()
     db.close()
     return path
@@ -59,7 +69,10 @@ def test_a_database_from_before_schema_versions_upgrades_and_keeps_every_row(tmp
         assert set(sessions) == {"aaaa00000001", "bbbb00000002", "cccc00000003", "dddd00000004"}
         finished = store.session("aaaa00000001")
         assert (finished.status, finished.finished_at, [a.option for a in finished.answers]) == (
-            "finished", "2026-11-20T09:12:00+00:00", [2])
+            "finished",
+            "2026-11-20T09:12:00+00:00",
+            [2],
+        )
         assert finished.trace == ({"t": 28.0, "set": {"FirstAttemptAnswered": True}},)
         assert finished.metrics[0].metrics == {"Performance": 0.7}
         assert [e.kind for e in finished.log] == ["start"]

@@ -14,14 +14,13 @@ from pathlib import Path
 
 import pytest
 
+from kiosk.commands.replay import load_script, run_script
 from kiosk.core.channels import Channel
 from kiosk.core.clock import SimClock
-from kiosk.export.opening import trace_main
-from kiosk.commands.replay import load_script, run_script
 from kiosk.core.session import AttemptOpened, Session
+from kiosk.export.opening import trace_main
 from kiosk.store.database import StorageError, Store, new_patient_id
 from qos import Engine, load_trace
-
 from tests.kiosk.core.helpers import MODEL, QUESTIONNAIRE, TIMING, Rig
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -29,8 +28,16 @@ ROOT = Path(__file__).resolve().parents[3]
 
 def stored_rig(store: Store, **kwargs) -> Rig:
     clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=Engine(MODEL), store=store, patient_id="P-TEST01",
-                      timing=TIMING, familiarisation=False, **kwargs)
+    session = Session(
+        QUESTIONNAIRE,
+        clock=clock,
+        engine=Engine(MODEL),
+        store=store,
+        patient_id="P-TEST01",
+        timing=TIMING,
+        familiarisation=False,
+        **kwargs,
+    )
     rig = Rig(session, clock)
     session.subscribe(rig.events.append)
     return rig
@@ -125,8 +132,9 @@ CHILD = textwrap.dedent("""
 @pytest.mark.slow
 def test_sigkill_mid_session_loses_no_answer_and_the_session_resumes_at_the_first_unanswered(tmp_path):
     data = tmp_path / "data"
-    child = subprocess.Popen([sys.executable, "-c", CHILD, str(data)], stdin=subprocess.PIPE,
-                             stdout=subprocess.PIPE, text=True, cwd=ROOT)
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(data)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, cwd=ROOT
+    )
     recorded = []
     try:
         for line in child.stdout:
@@ -148,13 +156,16 @@ def test_sigkill_mid_session_loses_no_answer_and_the_session_resumes_at_the_firs
     assert "stopped" in (unfinished.interrupted_reason or "")
     unfinished = store.continue_session(session_id)  # staff continue it on this kiosk
     assert [(a.item_id, a.option) for a in unfinished.answers] == [
-        ("feeding", 3), ("bathing", 1), ("grooming", 2), ("dressing", 2)]
+        ("feeding", 3),
+        ("bathing", 1),
+        ("grooming", 2),
+        ("dressing", 2),
+    ]
     last_t = unfinished.trace[-1]["t"]
 
     clock = SimClock(start=500)
     engine = Engine(MODEL)
-    session = Session.from_stored(QUESTIONNAIRE, unfinished, clock=clock, engine=engine, store=store,
-                                  timing=TIMING)
+    session = Session.from_stored(QUESTIONNAIRE, unfinished, clock=clock, engine=engine, store=store, timing=TIMING)
     rig = Rig(session, clock)
     session.subscribe(rig.events.append)
     assert session.now() == last_t + 1
@@ -186,8 +197,13 @@ def test_a_stored_trace_printed_by_kiosk_qos_trace_replays_to_the_recorded_metri
     assert [e.to_dict() for e in trace.events] == [e.to_dict() for e in result.trace.events]
 
     # the real `python -m qos replay` on the printed trace gives the session's last recorded metrics
-    out = subprocess.run([sys.executable, "-m", "qos", "replay", str(path), "--json"], capture_output=True,
-                         text=True, check=True, cwd=ROOT)
+    out = subprocess.run(
+        [sys.executable, "-m", "qos", "replay", str(path), "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    )
     replayed = json.loads(out.stdout)
     for name, value in stored.metrics[-1].metrics.items():
         assert replayed["metrics"][name]["last"] == pytest.approx(value, abs=1e-12)
@@ -220,7 +236,11 @@ def test_the_store_keeps_the_session_log_and_not_answered_questions(tmp_path):
     assert stored.not_answered == ("feeding", "bathing")
     assert stored.answered_by.value == "caregiver"
     assert [(e.kind, e.detail) for e in stored.log][:4] == [
-        ("start", "answered by caregiver"), ("language", "fr"), ("pause", ""), ("resume", "")]
+        ("start", "answered by caregiver"),
+        ("language", "fr"),
+        ("pause", ""),
+        ("resume", ""),
+    ]
     assert stored.timing["attempt_window_s"] == 30
     assert [s.id for s in store.sessions()] == [rig.session.id]
 
@@ -245,8 +265,9 @@ def test_reading_tools_refuse_a_missing_data_directory_or_database_and_create_no
     empty = tmp_path / "empty"
     empty.mkdir()
     assert results_main(["--data-dir", str(empty)]) == 2
-    assert capsys.readouterr().err == (f"kiosk results: no session database in {empty} "
-                                       "(expected kiosk.sqlite3; nothing stored there)\n")
+    assert capsys.readouterr().err == (
+        f"kiosk results: no session database in {empty} (expected kiosk.sqlite3; nothing stored there)\n"
+    )
     assert list(empty.iterdir()) == []
     with pytest.raises(StorageError, match="no data directory"):
         Store.open(typo, create=False)
@@ -261,8 +282,9 @@ def test_an_answer_and_its_qos_context_are_committed_together(tmp_path):
     def committed() -> tuple[int, int]:
         with sqlite3.connect(store.path) as other:
             answers = other.execute("SELECT COUNT(*) FROM answers").fetchone()[0]
-            answered = other.execute("SELECT COUNT(*) FROM contexts WHERE sets LIKE '%FirstAttemptAnswered%'"
-                                     ).fetchone()[0]
+            answered = other.execute(
+                "SELECT COUNT(*) FROM contexts WHERE sets LIKE '%FirstAttemptAnswered%'"
+            ).fetchone()[0]
         return answers, answered
 
     class Observed(Engine):
@@ -274,8 +296,15 @@ def test_an_answer_and_its_qos_context_are_committed_together(tmp_path):
             return super().update(t, set=set, emit=emit)
 
     clock = SimClock()
-    session = Session(QUESTIONNAIRE, clock=clock, engine=Observed(MODEL), store=store, patient_id="P-TEST01",
-                      timing=TIMING, familiarisation=False)
+    session = Session(
+        QUESTIONNAIRE,
+        clock=clock,
+        engine=Observed(MODEL),
+        store=store,
+        patient_id="P-TEST01",
+        timing=TIMING,
+        familiarisation=False,
+    )
     rig = Rig(session, clock)
     session.start()
     session.acknowledge()

@@ -21,9 +21,9 @@ import pytest
 
 from kiosk.core.questionnaire import bundled_path
 from station import auth, db
+from tests.kiosk.sync.test_station_e2e import free_port
 from tests.station.conftest import PASSWORDS, start_station
 from tests.station.helpers import Staff
-from tests.kiosk.sync.test_station_e2e import free_port
 
 ROOT = Path(__file__).resolve().parents[3]
 ORIGINAL_TEXT = "Feeding: how do you manage eating?"
@@ -38,7 +38,9 @@ def _config(path: Path, site: str, kiosk: str, questionnaire: Path, station: str
         f"fhir: {{patient_system: 'https://{site}.example/sid/patient', "
         f"questionnaire_url: 'https://{site}.example/fhir/Questionnaire/barthel', "
         f"identifier_system: 'https://{site}.example/sid/result', device_system: 'https://{site}.example/sid/kiosk'}}\n"
-        f"station: {{url: '{station}', token: '{token}', kiosk_id: {kiosk}}}\n", encoding="utf-8")
+        f"station: {{url: '{station}', token: '{token}', kiosk_id: {kiosk}}}\n",
+        encoding="utf-8",
+    )
     return path
 
 
@@ -57,8 +59,9 @@ def _edit(questionnaire: Path) -> None:
 
 def _kiosk(*args: str, config: Path) -> subprocess.CompletedProcess:
     env = os.environ | {"KIOSK_CONFIG": str(config)}
-    return subprocess.run([sys.executable, "-m", "kiosk", *args], capture_output=True, text=True, cwd=ROOT,
-                          env=env, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "kiosk", *args], capture_output=True, text=True, cwd=ROOT, env=env, timeout=300
+    )
 
 
 def _response(bundle: dict) -> dict:
@@ -68,8 +71,10 @@ def _response(bundle: dict) -> dict:
 
 def _words(response: dict) -> list:
     """What a response says: item texts and answer displays, in order."""
-    return [(i["linkId"], i.get("text"), [a.get("valueCoding", {}).get("display") for a in i.get("answer", [])])
-            for i in response["item"]]
+    return [
+        (i["linkId"], i.get("text"), [a.get("valueCoding", {}).get("display") for a in i.get("answer", [])])
+        for i in response["item"]
+    ]
 
 
 def test_a_result_keeps_its_identity_and_questionnaire_after_the_file_and_the_config_change(tmp_path):
@@ -87,15 +92,27 @@ def test_a_result_keeps_its_identity_and_questionnaire_after_the_file_and_the_co
     site_a = _config(tmp_path / "a.yaml", "sitea", "kiosk-a", questionnaire, url, tokens["kiosk-a"])
     site_b = _config(tmp_path / "b.yaml", "siteb", "laptop-7", questionnaire, url, tokens["laptop-7"])
     try:
-        recorded = _kiosk("replay", str(ROOT / "recordings/patients/barthel5.yaml"), "--data-dir", str(data),
-                          config=site_a)
+        recorded = _kiosk(
+            "replay", str(ROOT / "recordings/patients/barthel5.yaml"), "--data-dir", str(data), config=site_a
+        )
         assert recorded.returncode == 0, recorded.stderr
-        at_once = _kiosk("results", "--data-dir", str(data), "--fhir", str(tmp_path / "once.json"),
-                         "--csv", str(tmp_path / "once.csv"), config=site_a)
+        at_once = _kiosk(
+            "results",
+            "--data-dir",
+            str(data),
+            "--fhir",
+            str(tmp_path / "once.json"),
+            "--csv",
+            str(tmp_path / "once.csv"),
+            config=site_a,
+        )
         assert at_once.returncode == 0, at_once.stderr
         first = _response(json.loads((tmp_path / "once.json").read_text(encoding="utf-8")))
         session = first["identifier"]["value"].rsplit("/", 1)[1]
-        assert first["identifier"] == {"system": "https://sitea.example/sid/result", "value": f"sitea/kiosk-a/{session}"}
+        assert first["identifier"] == {
+            "system": "https://sitea.example/sid/result",
+            "value": f"sitea/kiosk-a/{session}",
+        }
         assert first["questionnaire"].startswith("https://sitea.example/fhir/Questionnaire/barthel-en|")
         assert next(i for i in first["item"] if i["linkId"] == "feeding")["text"] == ORIGINAL_TEXT
         station_first = staff.http.get(f"/sessions/{session}/export.json")
@@ -104,8 +121,16 @@ def test_a_result_keeps_its_identity_and_questionnaire_after_the_file_and_the_co
         assert station_first.json() == json.loads((tmp_path / "once.json").read_text(encoding="utf-8"))
 
         _edit(questionnaire)  # version 1 is gone from disk, and the site is now B
-        later = _kiosk("results", "--data-dir", str(data), "--fhir", str(tmp_path / "later.json"),
-                       "--csv", str(tmp_path / "later.csv"), config=site_b)
+        later = _kiosk(
+            "results",
+            "--data-dir",
+            str(data),
+            "--fhir",
+            str(tmp_path / "later.json"),
+            "--csv",
+            str(tmp_path / "later.csv"),
+            config=site_b,
+        )
         assert later.returncode == 0, later.stderr
         assert (tmp_path / "later.json").read_bytes() == (tmp_path / "once.json").read_bytes()
         assert (tmp_path / "later.csv").read_bytes() == (tmp_path / "once.csv").read_bytes()
@@ -129,20 +154,34 @@ def test_a_result_keeps_its_identity_and_questionnaire_after_the_file_and_the_co
         assert ORIGINAL_TEXT in page and EDITED_TEXT not in page
 
         # a session recorded after the edit, at B: the edited file, B's identity, at both ends
-        edited = _kiosk("replay", str(ROOT / "recordings/patients/barthel5.yaml"), "--data-dir", str(data),
-                        config=site_b)
+        edited = _kiosk(
+            "replay", str(ROOT / "recordings/patients/barthel5.yaml"), "--data-dir", str(data), config=site_b
+        )
         assert edited.returncode == 0, edited.stderr
-        both = _kiosk("results", "--data-dir", str(data), "--fhir", str(tmp_path / "both.json"),
-                      "--csv", str(tmp_path / "both.csv"), config=site_b)
+        both = _kiosk(
+            "results",
+            "--data-dir",
+            str(data),
+            "--fhir",
+            str(tmp_path / "both.json"),
+            "--csv",
+            str(tmp_path / "both.csv"),
+            config=site_b,
+        )
         assert both.returncode == 0, both.stderr
         bundle = json.loads((tmp_path / "both.json").read_text(encoding="utf-8"))
-        responses = {r["identifier"]["value"].split("/")[0]: r for r in
-                     (e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse")}
+        responses = {
+            r["identifier"]["value"].split("/")[0]: r
+            for r in (
+                e["resource"] for e in bundle["entry"] if e["resource"]["resourceType"] == "QuestionnaireResponse"
+            )
+        }
         assert set(responses) == {"sitea", "siteb"}
         table = list(csv.DictReader((tmp_path / "both.csv").open(encoding="utf-8")))
         assert {(r["kiosk_id"], r["questionnaire_version"]) for r in table} == {
             ("K:kiosk-a", responses["sitea"]["questionnaire"].split("|")[1]),
-            ("K:laptop-7", responses["siteb"]["questionnaire"].split("|")[1])}
+            ("K:laptop-7", responses["siteb"]["questionnaire"].split("|")[1]),
+        }
         newer = responses["siteb"]
         assert newer["questionnaire"].split("|")[1] != first["questionnaire"].split("|")[1]  # another version
         assert next(i for i in newer["item"] if i["linkId"] == "feeding")["text"] == EDITED_TEXT

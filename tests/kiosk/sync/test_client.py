@@ -20,8 +20,12 @@ KIOSK = "ward3-bed2"
 
 
 def outbox_rows(store: Store) -> list[tuple[int, str, str]]:
-    return [(seq, kind, json) for seq, kind, json in store._db.execute(  # noqa: SLF001
-        "SELECT seq, kind, payload FROM outbox ORDER BY seq")]
+    return [
+        (seq, kind, json)
+        for seq, kind, json in store._db.execute(  # noqa: SLF001
+            "SELECT seq, kind, payload FROM outbox ORDER BY seq"
+        )
+    ]
 
 
 def session_with_incidents(store: Store) -> Rig:
@@ -111,8 +115,10 @@ def test_a_connection_cut_after_the_station_stored_or_a_500_loses_and_duplicates
     try:
         session_with_incidents(store)
         everything = {seq for seq, _, _ in outbox_rows(store)} | {s for _, s in server.ward.stored}
-        server.until(lambda w: {s for _, s in w.stored} >= everything and not w.drop_after_store
-                     and not w.fail_500, "every row after the faults")
+        server.until(
+            lambda w: {s for _, s in w.stored} >= everything and not w.drop_after_store and not w.fail_500,
+            "every row after the faults",
+        )
         sent = [seq for request in server.ward.requests for seq in request]
         assert len(sent) > len(set(sent))  # the batches cut short were sent again...
         assert sorted(s for _, s in server.ward.stored) == sorted(everything)  # ...and stored once
@@ -146,8 +152,18 @@ def test_the_live_status_goes_on_each_change(tmp_path):
     sync = client(store, server)
     sync.start()
     try:
-        sync.set_status({"session_id": "abc", "phase": "questions", "question": 3, "of": 10, "paused": False,
-                         "person_away": False, "doctor_called": True, "simulated": False})
+        sync.set_status(
+            {
+                "session_id": "abc",
+                "phase": "questions",
+                "question": 3,
+                "of": 10,
+                "paused": False,
+                "person_away": False,
+                "doctor_called": True,
+                "simulated": False,
+            }
+        )
         server.until(lambda w: any(s.get("doctor_called") for s in w.statuses), "the doctor call in the status")
         status = next(s for s in server.ward.statuses if s.get("doctor_called"))
         assert (status["kiosk_id"], status["question"], status["session_id"]) == (KIOSK, 3, "abc")

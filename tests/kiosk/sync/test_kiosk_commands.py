@@ -10,10 +10,10 @@ import sys
 import threading
 from contextlib import contextmanager
 
-from kiosk.ui.app import KIOSK_SIZE, build_app
-from kiosk.store.lease import Owner
 from kiosk.core.session import Phase
 from kiosk.store.database import Store
+from kiosk.store.lease import Owner
+from kiosk.ui.app import KIOSK_SIZE, build_app
 from tests.kiosk.ui.helpers import until_thread
 
 from .ward import TOKEN, Server
@@ -34,8 +34,10 @@ def other_kiosk():
 
 def config_for(tmp_path, server: Server | None):
     config = tmp_path / "config.yaml"
-    text = (f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
-            'clinician_pin: "246813"\n')
+    text = (
+        f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
+        'clinician_pin: "246813"\n'
+    )
     if server is not None:
         text += f"station: {{url: '{server.url}', token: {TOKEN}, kiosk_id: {KIOSK}}}\n"
     config.write_text(text)
@@ -66,14 +68,28 @@ async def test_station_commands_continue_mark_away_and_back_and_end_the_running_
             session = app.session
             await pilot.press("d")  # the patient calls the doctor
             # the station is watched from the app's own loop: the commands need it running
-            await until_thread(lambda: any(e["kind"] == "record_event" and e["payload"]["kind"] == "doctor_called"
-                                           for e in list(ward.stored.values())), "the doctor call at the station")
-            await until_thread(lambda: any(s.get("doctor_called") and s["session_id"] == session.id
-                                           for s in list(ward.statuses)), "the status with the doctor called")
+            await until_thread(
+                lambda: any(
+                    e["kind"] == "record_event" and e["payload"]["kind"] == "doctor_called"
+                    for e in list(ward.stored.values())
+                ),
+                "the doctor call at the station",
+            )
+            await until_thread(
+                lambda: any(s.get("doctor_called") and s["session_id"] == session.id for s in list(ward.statuses)),
+                "the status with the doctor called",
+            )
 
             async def command(number: int, kind: str, session_id: str = session.id) -> dict:
-                ward.queue({"id": number, "kind": kind, "session_id": session_id, "by": "dr.lopez",
-                            "at": "2026-11-23T15:02:11Z"})
+                ward.queue(
+                    {
+                        "id": number,
+                        "kind": kind,
+                        "session_id": session_id,
+                        "by": "dr.lopez",
+                        "at": "2026-11-23T15:02:11Z",
+                    }
+                )
                 await until_thread(lambda: number in ward.acks, f"the ack of command {number}")
                 return ward.acks[number]
 
@@ -95,9 +111,15 @@ async def test_station_commands_continue_mark_away_and_back_and_end_the_running_
             # serve): its command is left for that process, never refused from here
             with other_kiosk() as pid:
                 elsewhere = Store.open(tmp_path / "data", owner=Owner(pid=pid))
-                elsewhere.create_session(session_id="other1", patient_id="P-OTHER1", questionnaire_id="barthel",
-                                         language="en", answered_by="patient", started_at="2026-11-23T15:00:00+00:00",
-                                         timing={})
+                elsewhere.create_session(
+                    session_id="other1",
+                    patient_id="P-OTHER1",
+                    questionnaire_id="barthel",
+                    language="en",
+                    answered_by="patient",
+                    started_at="2026-11-23T15:00:00+00:00",
+                    timing={},
+                )
                 ward.queue({"id": 7, "kind": "continue", "session_id": "other1", "by": "dr.lopez", "at": "x"})
                 assert await command(6, "end") == {"result": "done"}
                 assert 7 not in ward.acks
@@ -107,8 +129,12 @@ async def test_station_commands_continue_mark_away_and_back_and_end_the_running_
             stored = app.store.session(session.id)
             assert stored.status == "abandoned"
             assert stored.log[-1].detail == "ended from the ward station by dr.lopez"
-            await until_thread(lambda: any(e["kind"] == "abandon" and e["session_id"] == session.id
-                                           for e in list(ward.stored.values())), "the end reaching the station")
+            await until_thread(
+                lambda: any(
+                    e["kind"] == "abandon" and e["session_id"] == session.id for e in list(ward.stored.values())
+                ),
+                "the end reaching the station",
+            )
     finally:
         close()
         server.stop()

@@ -10,22 +10,24 @@ import re
 
 import sqlalchemy as sa
 
-from kiosk.ui.app import KIOSK_SIZE, build_app
 from kiosk.core.session import AnsweredBy, Phase
 from kiosk.core.visits import visit_of
+from kiosk.ui.app import KIOSK_SIZE, build_app
 from station import db
 from station.orders import orders as orders_table
+from tests.kiosk.ui.helpers import until_thread
 from tests.station.conftest import make_ward, start_station
 from tests.station.helpers import Staff
-from tests.kiosk.ui.helpers import until_thread
 
 CODE = re.compile(r'id="order-code"[^>]*>(\d{4})<')
 
 
 def config_for(tmp_path, station_url: str | None = None, token: str = "", walk_up: bool = True):
     config = tmp_path / "config.yaml"
-    text = (f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
-            f'clinician_pin: "246813"\nwalk_up: {str(walk_up).lower()}\n')
+    text = (
+        f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
+        f'clinician_pin: "246813"\nwalk_up: {str(walk_up).lower()}\n'
+    )
     if station_url:
         text += f"station: {{url: '{station_url}', token: '{token}', kiosk_id: ward3-bed2}}\n"
     config.write_text(text)
@@ -54,15 +56,22 @@ async def test_an_ordered_visit_starts_at_the_kiosk_only_with_its_code(tmp_path)
         async with app.run_test(size=KIOSK_SIZE) as pilot:
             await until_thread(lambda: screen(app) == "WelcomeScreen", "the welcome")
             nurse = Staff(station.url, "nurse.kim", "nurse")
-            placed = nurse.post("/orders", patient_id="NHC-4242", kiosk="ward3-bed2", instrument="barthel",
-                                language="es", relative="yes")
+            placed = nurse.post(
+                "/orders",
+                patient_id="NHC-4242",
+                kiosk="ward3-bed2",
+                instrument="barthel",
+                language="es",
+                relative="yes",
+            )
             order_id = placed.headers["location"].rsplit("/", 1)[1]
             code = CODE.search(nurse.http.get(placed.headers["location"]).text).group(1)
 
             await until_thread(lambda: screen(app) == "VisitReadyScreen", "the visit on the kiosk's welcome")
             await pilot.pause()  # the keypad laid out
             assert "Patient NHC-4242" in text_of(app, ".visit-order") and "a relative answers" in text_of(
-                app, ".visit-order")
+                app, ".visit-order"
+            )
             await pilot.press("1")  # a remote's 1 (a keyboard remote): a digit of the code, nothing starts
             await pilot.pause()
             assert app.session.phase is Phase.WELCOME and screen(app) == "VisitReadyScreen"
@@ -70,23 +79,28 @@ async def test_an_ordered_visit_starts_at_the_kiosk_only_with_its_code(tmp_path)
             await pilot.click("#visit-key-delete")
 
             await type_code(pilot, "0000" if code != "0000" else "1111")
-            await until_thread(lambda: "not one of this kiosk's visits" in text_of(app, "#visit-error"),
-                               "the wrong code refused")
+            await until_thread(
+                lambda: "not one of this kiosk's visits" in text_of(app, "#visit-error"), "the wrong code refused"
+            )
             assert app.session.phase is Phase.WELCOME
 
             await type_code(pilot, code)
             await until_thread(lambda: app.session.phase is not Phase.WELCOME, "the ordered session starting")
             session = app.session
-            assert (session.patient_id, session.language, session.answered_by) == ("NHC-4242", "es",
-                                                                                  AnsweredBy.RELATIVE)
+            assert (session.patient_id, session.language, session.answered_by) == (
+                "NHC-4242",
+                "es",
+                AnsweredBy.RELATIVE,
+            )
             assert visit_of(app.store.session(session.id).log) == f"order {order_id}"
 
             engine = db.make_engine(ward.db_url)
 
             def linked() -> bool:
                 with engine.connect() as connection:
-                    row = connection.execute(sa.select(orders_table.c.state, orders_table.c.session_id).where(
-                        orders_table.c.id == order_id)).one()
+                    row = connection.execute(
+                        sa.select(orders_table.c.state, orders_table.c.session_id).where(orders_table.c.id == order_id)
+                    ).one()
                 return tuple(row) == ("in_progress", session.id)
 
             await until_thread(linked, "the station filing the session under the order", patience_s=60)
@@ -139,7 +153,9 @@ async def test_a_code_typed_while_the_station_is_down_says_so_and_starts_nothing
             await pilot.pause()  # the keypad laid out
             station.stop()
             await type_code(pilot, code)
-            await until_thread(lambda: "cannot be reached" in text_of(app, "#visit-error"), "the station's absence said")
+            await until_thread(
+                lambda: "cannot be reached" in text_of(app, "#visit-error"), "the station's absence said"
+            )
             assert app.session.phase is Phase.WELCOME and screen(app) == "VisitReadyScreen"
     finally:
         close()

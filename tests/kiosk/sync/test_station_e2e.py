@@ -29,8 +29,12 @@ def free_port() -> int:
 
 def start_station(db_url: str, port: int, log: Path) -> subprocess.Popen:
     with open(log, "ab") as out:
-        process = subprocess.Popen([sys.executable, "-m", "kiosk", "station", "--db", db_url, "--port", str(port)],
-                                   stdout=out, stderr=subprocess.STDOUT, cwd=ROOT)
+        process = subprocess.Popen(
+            [sys.executable, "-m", "kiosk", "station", "--db", db_url, "--port", str(port)],
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            cwd=ROOT,
+        )
     deadline = time.monotonic() + PATIENCE_S
     while True:  # readiness, bounded by PATIENCE_S; nothing is timed
         assert process.poll() is None, log.read_text()
@@ -45,9 +49,24 @@ def start_station(db_url: str, port: int, log: Path) -> subprocess.Popen:
 
 
 def replay(script: str, data: Path, config: Path, *options: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "kiosk", "replay", str(ROOT / "recordings/patients" / script),
-                           "--data-dir", str(data), "--config", str(config), *options],
-                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+    return subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "kiosk",
+            "replay",
+            str(ROOT / "recordings/patients" / script),
+            "--data-dir",
+            str(data),
+            "--config",
+            str(config),
+            *options,
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+    )
 
 
 @pytest.mark.slow
@@ -105,8 +124,10 @@ async def test_a_doctor_call_reaches_the_real_station_and_its_continue_reaches_t
     token = auth.add_kiosk(engine, "ward3-bed2")
     port = free_port()
     config = tmp_path / "config.yaml"
-    config.write_text(f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
-                      f"station: {{url: 'http://127.0.0.1:{port}', token: '{token}', kiosk_id: ward3-bed2}}\n")
+    config.write_text(
+        f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
+        f"station: {{url: 'http://127.0.0.1:{port}', token: '{token}', kiosk_id: ward3-bed2}}\n"
+    )
     station = start_station(db_url, port, tmp_path / "station.log")
     app, close = build_app(config_path=config, voice=False, remote=False)
     try:
@@ -115,12 +136,18 @@ async def test_a_doctor_call_reaches_the_real_station_and_its_continue_reaches_t
             await until_thread(lambda: app.session.current_attempt == 1, "the first question", PATIENCE_S)
             session = app.session
             await pilot.press("d")
-            await until_thread(lambda: any(a.session_id == session.id for a in ward.open_alerts(engine, "ward3-bed2")),
-                               "the doctor call at the station", PATIENCE_S)
+            await until_thread(
+                lambda: any(a.session_id == session.id for a in ward.open_alerts(engine, "ward3-bed2")),
+                "the doctor call at the station",
+                PATIENCE_S,
+            )
             command = ward.queue_command(engine, "ward3-bed2", session.id, "continue", "dr.lopez")
             await until_thread(lambda: not session.halted, "the kiosk continuing", PATIENCE_S)
-            await until_thread(lambda: ward.recent_commands(engine, session.id)[0].get("result") == "done",
-                               f"the ack of command {command}", PATIENCE_S)
+            await until_thread(
+                lambda: ward.recent_commands(engine, session.id)[0].get("result") == "done",
+                f"the ack of command {command}",
+                PATIENCE_S,
+            )
     finally:
         close()
         station.terminate()

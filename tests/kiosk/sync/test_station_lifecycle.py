@@ -6,8 +6,10 @@ from station.sessions import Row, status_of
 
 
 def rows(*kinds: str) -> list[Row]:
-    payloads = {"create_session": {"patient_id": "P-AAAAAA", "started_at": "2026-11-23T15:00:00+00:00"},
-                "mark_interrupted": {"reason": "its kiosk vm (process 42) stopped"}}
+    payloads = {
+        "create_session": {"patient_id": "P-AAAAAA", "started_at": "2026-11-23T15:00:00+00:00"},
+        "mark_interrupted": {"reason": "its kiosk vm (process 42) stopped"},
+    }
     return [Row(seq, kind, payloads.get(kind, {}), "2026-11-23T15:00:00Z") for seq, kind in enumerate(kinds)]
 
 

@@ -10,13 +10,13 @@ from pathlib import Path
 import pytest
 
 from kiosk.core.adaptation import Adaptation, load_policy
-from kiosk.ui.app import KioskApp
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.clock import SimClock
 from kiosk.core.questionnaire import load_questionnaire
-from kiosk.export.opening import MODEL
 from kiosk.core.session import Session
+from kiosk.export.opening import MODEL
 from kiosk.store.database import Store
+from kiosk.ui.app import KioskApp
 from qos import Engine, load_model
 
 #: the PIN the test kiosks use (not the public default, so no warning on the clinician screen)
@@ -29,11 +29,23 @@ UI_PATIENT_ID = "P-TEST01"
 class UiKiosk:
     """A kiosk app with its clock and store, and helpers to move simulated time."""
 
-    def __init__(self, tmp_path: Path, *, familiarisation: bool = True, adaptation: bool = True,
-                 language: str = "en", session_id: str = UI_SESSION_ID,
-                 voice=None, keyboard=None, sources=(), poll_interval: float = 3600, speaker=None,
-                 show_score: bool = False, next_patient_after_s: float | None = None,
-                 model: str = MODEL) -> None:
+    def __init__(
+        self,
+        tmp_path: Path,
+        *,
+        familiarisation: bool = True,
+        adaptation: bool = True,
+        language: str = "en",
+        session_id: str = UI_SESSION_ID,
+        voice=None,
+        keyboard=None,
+        sources=(),
+        poll_interval: float = 3600,
+        speaker=None,
+        show_score: bool = False,
+        next_patient_after_s: float | None = None,
+        model: str = MODEL,
+    ) -> None:
         self.next_patient_after_s = next_patient_after_s
         self.clock = SimClock()
         #: the QoS model (``qos_model:``), loaded once as `kiosk run` does
@@ -41,32 +53,60 @@ class UiKiosk:
         self.questionnaire = load_questionnaire()
         self.store = Store.open(tmp_path / "data")
         self.session = Session(
-            self.questionnaire, clock=self.clock, engine=Engine(self.model), patient_id=UI_PATIENT_ID,
-            store=self.store, language=language, session_id=session_id,
-            adaptation=Adaptation(load_policy()) if adaptation else None, familiarisation=familiarisation,
+            self.questionnaire,
+            clock=self.clock,
+            engine=Engine(self.model),
+            patient_id=UI_PATIENT_ID,
+            store=self.store,
+            language=language,
+            session_id=session_id,
+            adaptation=Adaptation(load_policy()) if adaptation else None,
+            familiarisation=familiarisation,
             next_patient_after_s=next_patient_after_s,
         )
         self.app = KioskApp(
-            self.session, clinician_pin=UI_PIN, store=self.store, export_dir=tmp_path / "exports", voice=voice,
-            keyboard=keyboard, sources=sources, speaker=speaker,
-            statuses=[ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
-                      ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*")],
+            self.session,
+            clinician_pin=UI_PIN,
+            store=self.store,
+            export_dir=tmp_path / "exports",
+            voice=voice,
+            keyboard=keyboard,
+            sources=sources,
+            speaker=speaker,
+            statuses=[
+                ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
+                ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*"),
+            ],
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
             # of the real timer never finds anything due
             poll_interval=poll_interval,
-            resume=self._resume, new_session=self._fresh, show_score=show_score,
+            resume=self._resume,
+            new_session=self._fresh,
+            show_score=show_score,
         )
 
     def _fresh(self) -> Session:
         """A session for the next patient, as `kiosk run` builds it (a new id, so it can be stored)."""
-        return Session(self.questionnaire, clock=self.clock, engine=Engine(self.model),
-                       patient_id="P-TEST02", store=self.store, adaptation=Adaptation(load_policy()),
-                       next_patient_after_s=self.next_patient_after_s)
+        return Session(
+            self.questionnaire,
+            clock=self.clock,
+            engine=Engine(self.model),
+            patient_id="P-TEST02",
+            store=self.store,
+            adaptation=Adaptation(load_policy()),
+            next_patient_after_s=self.next_patient_after_s,
+        )
 
     def _resume(self, stored) -> Session:
         """The session continuing ``stored``, as `kiosk run` builds it."""
-        return Session.from_stored(self.questionnaire, stored, clock=self.clock, engine=Engine(self.model),
-                                   store=self.store, adaptation=Adaptation(load_policy()))
+        return Session.from_stored(
+            self.questionnaire,
+            stored,
+            clock=self.clock,
+            engine=Engine(self.model),
+            store=self.store,
+            adaptation=Adaptation(load_policy()),
+        )
 
     def advance(self, seconds: float) -> None:
         """Move simulated time on and let the app poll, as its timer would."""

@@ -28,8 +28,7 @@ def problems(screen: Screen) -> list[str]:
             box = label.content_region
             wanted = label.get_content_height(label.size, screen.size, box.width)
             if not button.region.contains_region(label.region) or wanted > box.height:
-                found.append(f"answer {button.option}'s text ({wanted} lines) is cut by its button "
-                             f"at {button.region}")
+                found.append(f"answer {button.option}'s text ({wanted} lines) is cut by its button at {button.region}")
         for other in answers:
             if other.option > button.option and button.region.overlaps(other.region):
                 found.append(f"answers {button.option} and {other.option} overlap")

@@ -70,8 +70,7 @@ async def start_in_english(kiosk: UiKiosk, pilot: Pilot) -> None:
     await settle(pilot, lambda: kiosk.session.phase is Phase.QUESTIONS)
 
 
-async def answer_every_question(kiosk: UiKiosk, pilot: Pilot,
-                                answer: Callable[[int, int], Awaitable[None]]) -> None:
+async def answer_every_question(kiosk: UiKiosk, pilot: Pilot, answer: Callable[[int, int], Awaitable[None]]) -> None:
     """For each of the ten questions: wait until it is open on screen, then ``answer(number, option)``
     with the last option (always allowed); finally wait for the summary."""
     for number in range(1, len(kiosk.questionnaire.items) + 1):
@@ -117,8 +116,15 @@ def drawn_text(app) -> str:
     from rich.console import Console
 
     width, height = app.size
-    console = Console(width=width, height=height, file=io.StringIO(), record=True, legacy_windows=False,
-                      force_terminal=True, color_system=None)
+    console = Console(
+        width=width,
+        height=height,
+        file=io.StringIO(),
+        record=True,
+        legacy_windows=False,
+        force_terminal=True,
+        color_system=None,
+    )
     console.print(app.screen._compositor.render_update(full=True, screen_stack=app._background_screens))
     return console.export_text()
 

@@ -18,8 +18,8 @@ import sys
 import time
 from pathlib import Path
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE, build_app
 from kiosk.core.session import Phase
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE, build_app
 
 #: how long a command may wait for the kiosk (real timers, real threads)
 PATIENCE_S = 30.0
@@ -49,9 +49,15 @@ async def main(config: Path, pin: str) -> None:
 
             def state(**extra) -> dict:
                 session = app.session
-                return {"session": session.id, "patient": session.patient_id, "phase": session.phase.value,
-                        "answers": sorted(session.answers), "screen": type(app.screen).__name__,
-                        "notices": notices, **extra}
+                return {
+                    "session": session.id,
+                    "patient": session.patient_id,
+                    "phase": session.phase.value,
+                    "answers": sorted(session.answers),
+                    "screen": type(app.screen).__name__,
+                    "notices": notices,
+                    **extra,
+                }
 
             loop = asyncio.get_running_loop()
             print(json.dumps(state(ready=True)), flush=True)

@@ -16,8 +16,16 @@ from pathlib import Path
 from kiosk.ui.serve.guard import token_digest
 
 CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 #: what a test waits for at most (server start, first paint, an answer reaching the database)
 PATIENCE_S = 30.0
 #: the device key the served kiosks of the tests are set up with
@@ -47,15 +55,30 @@ def serve(tmp_path: Path, config: str = "", *, between_questions_s: float = 0.5)
     """`kiosk serve` on a free localhost port, set up with :data:`TOKEN` and ``config`` lines
     (``between_questions_s``: the thank-you gap, long where a test looks at it)."""
     path = tmp_path / "config.yaml"
-    path.write_text('familiarisation: false\nclinician_pin: "246813"\n'
-                    f"timing: {{attempt_window_s: 300, between_questions_s: {between_questions_s}}}\n"
-                    f'serve_token_sha256: "{token_digest(TOKEN)}"\n' + config)
+    path.write_text(
+        'familiarisation: false\nclinician_pin: "246813"\n'
+        f"timing: {{attempt_window_s: 300, between_questions_s: {between_questions_s}}}\n"
+        f'serve_token_sha256: "{token_digest(TOKEN)}"\n' + config
+    )
     port = free_port()
     log = tmp_path / "serve.log"
     with open(log, "wb") as output:  # a file, not a pipe nobody reads, which would fill and stall it
         server = subprocess.Popen(
-            [sys.executable, "-m", "kiosk", "serve", "--port", str(port), "--data-dir", str(tmp_path / "data"),
-             "--no-voice"], env=dict(os.environ, KIOSK_CONFIG=str(path)), stdout=output, stderr=subprocess.STDOUT)
+            [
+                sys.executable,
+                "-m",
+                "kiosk",
+                "serve",
+                "--port",
+                str(port),
+                "--data-dir",
+                str(tmp_path / "data"),
+                "--no-voice",
+            ],
+            env=dict(os.environ, KIOSK_CONFIG=str(path)),
+            stdout=output,
+            stderr=subprocess.STDOUT,
+        )
     try:
         deadline = time.monotonic() + PATIENCE_S
         while True:
@@ -97,12 +120,13 @@ async def wait_until(page, check: Callable[[], bool], what: str) -> None:
 
 
 #: the backgrounds of what a patient taps on the page (kiosk.tcss), as RGB
-ANSWER_RGB = (0xdc, 0xe6, 0xf5)
-ACTION_RGB = (0x0b, 0x3d, 0x91)
+ANSWER_RGB = (0xDC, 0xE6, 0xF5)
+ACTION_RGB = (0x0B, 0x3D, 0x91)
 
 
-async def drawn(page, left: float, top: float, right: float, bottom: float, cell_h: float,
-                rgb: tuple[int, int, int]) -> bool:
+async def drawn(
+    page, left: float, top: float, right: float, bottom: float, cell_h: float, rgb: tuple[int, int, int]
+) -> bool:
     """The page shows a button of colour ``rgb`` exactly over this box, as a patient sees it before
     they tap: its colour just inside the top and bottom rows, not in the row above (a button drawn a
     row off, or in a frame laid out before the screen settled, fails one of them). The mouse is
@@ -116,12 +140,12 @@ async def drawn(page, left: float, top: float, right: float, bottom: float, cell
     def colour(y: float) -> tuple[int, int, int]:
         return shot.getpixel((x, min(max(int(y), 0), shot.height - 1)))
 
-    return (colour(top + 2) == rgb and colour(bottom - 2) == rgb
-            and (top < cell_h or colour(top - cell_h / 2) != rgb))
+    return colour(top + 2) == rgb and colour(bottom - 2) == rgb and (top < cell_h or colour(top - cell_h / 2) != rgb)
 
 
-async def wait_until_drawn(page, box: tuple[float, float, float, float], cell_h: float,
-                           rgb: tuple[int, int, int], what: str) -> None:
+async def wait_until_drawn(
+    page, box: tuple[float, float, float, float], cell_h: float, rgb: tuple[int, int, int], what: str
+) -> None:
     """Wait, at most :data:`PATIENCE_S`, until :func:`drawn` holds for ``box`` (left, top, right, bottom px)."""
     deadline = time.monotonic() + PATIENCE_S
     while not await drawn(page, *box, cell_h, rgb):

@@ -10,8 +10,8 @@ import stat
 
 from textual.widgets import DataTable, Label, Switch
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.session import AdaptationChanged
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.ui.widgets.metrics_plot import MetricsPlot
 from tests.kiosk.export.standard import check_fhir
 
@@ -45,7 +45,10 @@ async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk,
         assert text_of(screen.query_one("#total", Label)) == "Total 85 of 100 (complete); Moderate dependence"
         plot = screen.query_one(MetricsPlot)
         assert {name for name, (times, _) in plot.data.series.items() if times} == {
-            "Performance", "Interaction", "VoiceInteractionQuality"}
+            "Performance",
+            "Interaction",
+            "VoiceInteractionQuality",
+        }
 
         exports = tmp_path / "exports"
         for button, name in [("#export-fhir", "fhir.json"), ("#export-csv", "csv"), ("#export-png", "metrics.png")]:

@@ -10,7 +10,7 @@ from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.session import Phase
 
 from .fit import problems
-from .helpers import settle, screen_name
+from .helpers import screen_name, settle
 
 SIZES = [(100, 32), (80, 24), (73, 18), (60, 18)]
 
@@ -47,8 +47,10 @@ async def test_every_screen_and_question_fits(ui_kiosk, size, language):
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         _fits(kiosk, "the explanation")
         await pilot.press("1")
-        longest_item, longest = max(((i, o.number) for i in kiosk.questionnaire.items for o in i.options),
-                                    key=lambda io: len(io[0].option(io[1]).label_in(language)))
+        longest_item, longest = max(
+            ((i, o.number) for i in kiosk.questionnaire.items for o in i.options),
+            key=lambda io: len(io[0].option(io[1]).label_in(language)),
+        )
         for item in kiosk.questionnaire.items:
             kiosk.to_next_deadline()
             await settle(pilot, lambda: kiosk.session.current_item == item and kiosk.session.current_attempt == 1)
@@ -61,12 +63,14 @@ async def test_every_screen_and_question_fits(ui_kiosk, size, language):
                 await pilot.press("p")
                 await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
             if item.id == longest_item.id:  # asked back, and asked to press, about the longest answer
-                kiosk.app.forward(ChannelInput(Channel.VOICE, option=longest, detail="heard", confidence=0.9,
-                                               needs_confirmation=True))
+                kiosk.app.forward(
+                    ChannelInput(Channel.VOICE, option=longest, detail="heard", confidence=0.9, needs_confirmation=True)
+                )
                 await settle(pilot, lambda: bool(kiosk.app.screen.query("ConfirmPanel")))
                 _fits(kiosk, f"the question back on {item.id}")
-                kiosk.app.forward(ChannelInput(Channel.VOICE, option=1, detail="yes", confidence=0.9,
-                                               needs_confirmation=True))
+                kiosk.app.forward(
+                    ChannelInput(Channel.VOICE, option=1, detail="yes", confidence=0.9, needs_confirmation=True)
+                )
                 plea = kiosk.questionnaire.message("confirm_answer_press", language).split("{")[0]
                 await settle(pilot, lambda: plea in str(kiosk.app.screen.query_one("#confirm-question").render()))
                 await settle(pilot)

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.session import Phase
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 
 from .conftest import UI_PIN, UiKiosk
 from .helpers import screen_name, settle, start_in_english, until_drawn
@@ -27,8 +27,9 @@ OUT_OF_ORDER = "This kiosk is not working at the moment."
 def small_filesystem(folder: Path):
     """A 2 MB tmpfs at ``folder`` (skips where mounting is not allowed)."""
     folder.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m,mode=0700", "tmpfs", str(folder)],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", "size=2m,mode=0700", "tmpfs", str(folder)], capture_output=True, text=True
+    )
     if done.returncode != 0:
         pytest.skip(f"cannot mount a small filesystem here: {done.stderr.strip()}")
     try:
@@ -126,7 +127,8 @@ async def test_a_full_filesystem_shows_one_calm_screen_and_recovers_when_space_i
 def test_the_ward_station_takes_the_reason_in_the_kiosks_status():
     from station.ward import parse_status
 
-    status = parse_status({"phase": "welcome", "out_of_order": "the kiosk could not store its last step "
-                           "(database or disk is full)"})
+    status = parse_status(
+        {"phase": "welcome", "out_of_order": "the kiosk could not store its last step (database or disk is full)"}
+    )
     assert status["out_of_order"].endswith("(database or disk is full)")
     assert parse_status({"phase": "welcome"})["out_of_order"] is None

@@ -7,8 +7,8 @@ import time
 
 from textual.widgets import Label, Static
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.session import AttemptTimedOut, Phase, Prompt, QuestionNotAnswered
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.ui.widgets.bars import AdaptationBanner, VoiceAgainButton
 
 from .conftest import UI_PIN
@@ -121,10 +121,15 @@ async def test_the_patient_touches_answer_by_voice_again_and_the_kiosk_listens_a
         assert not kiosk.app.screen.query_one(AdaptationBanner).display
         assert not kiosk.app.screen.query_one(VoiceAgainButton).display
         assert [e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")] == [
-            "voice_off", "voice_on"]
+            "voice_off",
+            "voice_on",
+        ]
         stored = kiosk.store.session(kiosk.session.id)
         assert [(a.name, a.active, a.reason) for a in stored.adaptations][-1] == (
-            "voice_off", False, "the patient asked to answer by voice")
+            "voice_off",
+            False,
+            "the patient asked to answer by voice",
+        )
         assert [e.kind for e in stored.log][-1:] == ["voice_requested"]
 
 

@@ -8,12 +8,12 @@ import asyncio
 import threading
 import time
 
-from kiosk.ui import app as kiosk_app
 from kiosk import cli
-from kiosk.ui.serve import server as serve
-from kiosk.ui.app import KIOSK_SIZE, build_app
 from kiosk.core.channels import ChannelState
 from kiosk.core.session import Phase
+from kiosk.ui import app as kiosk_app
+from kiosk.ui.app import KIOSK_SIZE, build_app
+from kiosk.ui.serve import server as serve
 from kiosk.ui.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT
 
 #: real threads probe real devices and load a speech model: allow them this long
@@ -29,8 +29,9 @@ async def test_a_fresh_kiosk_starts_a_session_with_whatever_channels_it_has(tmp_
             deadline = time.monotonic() + PATIENCE_S
             # every channel has said what it is (on, or off with a reason) -- whatever this machine has
             while time.monotonic() < deadline and not all(
-                    app.board.state(name)[0] is ChannelState.ON or app.board.state(name)[1]
-                    for name in (VOICE_OUT, VOICE_IN, REMOTE)):
+                app.board.state(name)[0] is ChannelState.ON or app.board.state(name)[1]
+                for name in (VOICE_OUT, VOICE_IN, REMOTE)
+            ):
                 await asyncio.sleep(0.05)  # waiting on real device threads, bounded by PATIENCE_S
             for name in (VOICE_OUT, VOICE_IN, REMOTE):
                 state, reason = app.board.state(name)
@@ -78,8 +79,9 @@ def test_kiosk_serve_refuses_a_mistyped_run_option_before_starting_a_server(caps
     assert not thread.is_alive(), "kiosk serve started a server"
     assert results == [2]
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["kiosk serve: unrecognised arguments: --prot 8001 "
-                   "(neither `kiosk serve` nor `kiosk run` takes them)"]
+    assert err == [
+        "kiosk serve: unrecognised arguments: --prot 8001 (neither `kiosk serve` nor `kiosk run` takes them)"
+    ]
 
 
 def test_kiosk_serve_refuses_a_run_option_without_its_value(capsys):

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.pin import CORNER_TAPS
+from kiosk.ui.app import KIOSK_SIZE
 
 from .conftest import UI_PIN
 from .helpers import screen_name, settle, text_of

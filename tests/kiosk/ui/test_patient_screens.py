@@ -10,11 +10,11 @@ import pytest
 from textual.widgets import Button, Static
 
 from kiosk.core.adaptation import KNOWN
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.questionnaire import load_questionnaire
-from kiosk.ui.screens.base import PatientView, Ways, patient_notices
 from kiosk.core.session import Phase, Prompt
+from kiosk.ui.app import KIOSK_SIZE
+from kiosk.ui.screens.base import PatientView, Ways, patient_notices
 from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.change_answer import ChangeAnswerButton
 
@@ -25,8 +25,11 @@ QUESTIONNAIRE = load_questionnaire()
 SIZES = [(100, 32), (80, 24), (73, 18), (64, 18), (60, 18)]
 KEYS = {"en": "1", "es": "2", "fr": "3"}
 THANKS = {"en": "Thank you. Next question…", "es": "Gracias. Siguiente pregunta…", "fr": "Merci. Question suivante…"}
-KIND = {"en": "Take all the time you need.", "es": "Tómese todo el tiempo que necesite.",
-        "fr": "Prenez tout le temps qu'il vous faut."}
+KIND = {
+    "en": "Take all the time you need.",
+    "es": "Tómese todo el tiempo que necesite.",
+    "fr": "Prenez tout le temps qu'il vous faut.",
+}
 
 
 class _Snap:
@@ -179,8 +182,9 @@ async def test_language_buttons_are_equal_with_their_labels_lined_up(ui_kiosk, s
         assert len({(b.region.width, b.region.height) for b in buttons}) == 1
         assert buttons[0].region.height % 2 == 1  # the label on the middle row
         shown = drawn_text(kiosk.app).splitlines()
-        columns = {line.index(name[0]) - 3 for line in shown for name in ("English", "Español", "Français")
-                   if name in line}
+        columns = {
+            line.index(name[0]) - 3 for line in shown for name in ("English", "Español", "Français") if name in line
+        }
         assert len(columns) == 1, "the numbers do not line up"
 
 

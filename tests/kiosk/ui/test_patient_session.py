@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 from textual.widgets import DataTable, Label, Static
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.core.session import Phase
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 
 from .conftest import UI_PIN
 from .helpers import answer_every_question, deliver_from_thread, screen_name, settle, start_in_english, text_of
@@ -67,8 +67,9 @@ async def test_a_whole_session_answered_through_channel_messages_from_a_thread(u
 
         async def by_message(number: int, option: int) -> None:
             confidence = 0.9 if channel is Channel.VOICE else None
-            deliver_from_thread(kiosk, ChannelInput(channel, option=option, detail=detail.format(option=option),
-                                                    confidence=confidence))
+            deliver_from_thread(
+                kiosk, ChannelInput(channel, option=option, detail=detail.format(option=option), confidence=confidence)
+            )
 
         await answer_every_question(kiosk, pilot, by_message)
         assert _stored_channels(kiosk) == {channel.value}
@@ -80,7 +81,9 @@ async def test_a_remote_plugged_in_is_offered_to_the_patient_and_device_words_st
         welcome = kiosk.app.screen.query_one("#welcome-en", Static)
         await settle(pilot, lambda: "Welcome." in text_of(welcome))
         assert "remote" not in text_of(welcome)
-        deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.ON, "serial", "connected to /dev/ttyUSB0"))
+        deliver_from_thread(
+            kiosk, ChannelStatus(Channel.REMOTE, ChannelState.ON, "serial", "connected to /dev/ttyUSB0")
+        )
         await settle(pilot, lambda: "press its number on the remote" in text_of(welcome))
         assert "mando" in text_of(kiosk.app.screen.query_one("#welcome-es", Static))
         deliver_from_thread(kiosk, ChannelStatus(Channel.REMOTE, ChannelState.LOST, "serial", "unplugged"))
@@ -181,7 +184,8 @@ async def test_every_question_shows_its_own_text_and_answers_with_none_marked(ui
             assert text_of(screen.query_one("#question", Static)) == item.patient_text_in("en")
             buttons = list(screen.query(AnswerButton))
             assert [(b.option, text_of(b.query_one(".label", Label))) for b in buttons] == [
-                (o.number, o.patient_label_in("en")) for o in item.options]
+                (o.number, o.patient_label_in("en")) for o in item.options
+            ]
             assert not screen.query(".-chosen")
             await pilot.press(str(option))
 

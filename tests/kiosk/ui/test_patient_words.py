@@ -9,14 +9,14 @@ from dataclasses import replace
 import pytest
 from textual.widgets import Button, Static
 
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.session import Phase
+from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.screens.base import PatientView, Ways, patient_notices
 from kiosk.ui.screens.explanation import how_to_answer
 from kiosk.ui.screens.paused import how_to_continue
 from kiosk.ui.screens.welcome import welcome_line
-from kiosk.core.session import Phase
 from kiosk.ui.widgets.channel_board import ChannelBoard
 
 from .helpers import deliver_from_thread, screen_name, settle, text_of
@@ -38,22 +38,31 @@ def _view(language: str, ways: Ways, **snap) -> PatientView:
 
 def test_how_to_answer_names_only_the_channels_that_are_on():
     assert how_to_answer(_view("en", TOUCH_ONLY)) == (
-        "Answer by touching it on the screen. When you are ready, touch Start.")
+        "Answer by touching it on the screen. When you are ready, touch Start."
+    )
     assert how_to_answer(_view("en", ALL)) == (
         "Answer by touching it on the screen, pressing its number on the remote or saying it. "
-        "When you are ready, touch Start, press any number on the remote or say \"I'm ready\".")
+        'When you are ready, touch Start, press any number on the remote or say "I\'m ready".'
+    )
     assert how_to_answer(_view("es", Ways(remote=True))) == (
         "Responda tocando la respuesta en la pantalla o pulsando su número en el mando. "
-        "Cuando quiera, toque Empezar o pulse cualquier número en el mando.")
+        "Cuando quiera, toque Empezar o pulse cualquier número en el mando."
+    )
     assert how_to_answer(_view("fr", Ways(voice=True))) == (
         "Répondez en touchant la réponse sur l'écran ou en la disant à voix haute. "
-        "Quand vous voulez, touchez Commencer ou dites commencer.")
+        "Quand vous voulez, touchez Commencer ou dites commencer."
+    )
 
 
 @pytest.mark.parametrize("language", ["en", "es", "fr"])
 def test_nothing_promises_a_channel_that_is_off(language):
-    said = " ".join([how_to_answer(_view(language, TOUCH_ONLY)), how_to_continue(_view(language, TOUCH_ONLY)),
-                     welcome_line(_view(language, TOUCH_ONLY), language)]).lower()
+    said = " ".join(
+        [
+            how_to_answer(_view(language, TOUCH_ONLY)),
+            how_to_continue(_view(language, TOUCH_ONLY)),
+            welcome_line(_view(language, TOUCH_ONLY), language),
+        ]
+    ).lower()
     for promise in ("remote", "mando", "télécommande", "say", "diga", "dites", "voix", "voz", "speak"):
         assert promise not in said
 
@@ -77,8 +86,10 @@ def test_notices_never_mention_a_voice_that_is_off():
     assert patient_notices(slow) is None
     assert patient_notices(replace(slow, ways=ALL)) == "I am speaking more slowly now."
     voice_off = _view("fr", Ways(remote=True), adaptations=frozenset({"voice_off"}))
-    assert patient_notices(voice_off) == ("J'ai du mal à vous entendre. S'il vous plaît, touchez votre réponse "
-                                          "ou appuyez sur son numéro sur la télécommande.")
+    assert patient_notices(voice_off) == (
+        "J'ai du mal à vous entendre. S'il vous plaît, touchez votre réponse "
+        "ou appuyez sur son numéro sur la télécommande."
+    )
 
 
 def test_the_clinicians_channel_words_agree_in_gender():
@@ -99,9 +110,23 @@ def test_patient_wording_is_plain_and_the_clinical_label_stays_for_clinicians():
     for language in QUESTIONNAIRE.languages:
         for item in QUESTIONNAIRE.items:
             shown = " ".join([item.patient_text_in(language), *(o.patient_label_in(language) for o in item.options)])
-            for clinical in ("Bowels", "Transfers", "enema", "Incontinent", "Dependent", "Independent",
-                             "Deposición", "Traslado", "Incontinente", "Dependiente", "Independiente",
-                             "Transferts", "lavement", "Dépendant", "Autonome"):
+            for clinical in (
+                "Bowels",
+                "Transfers",
+                "enema",
+                "Incontinent",
+                "Dependent",
+                "Independent",
+                "Deposición",
+                "Traslado",
+                "Incontinente",
+                "Dependiente",
+                "Independiente",
+                "Transferts",
+                "lavement",
+                "Dépendant",
+                "Autonome",
+            ):
                 assert clinical.lower() not in shown.lower(), (item.id, language, clinical)
         # answers in the first person throughout (no "Needs help" beside "I need help")
         for item in QUESTIONNAIRE.items:
@@ -158,7 +183,8 @@ async def test_the_paused_screen_keeps_the_question_number(ui_kiosk):
         await settle(pilot, lambda: screen_name(kiosk) == "PausedScreen")
         assert text_of(kiosk.app.screen.query_one("#progress")) == "Question 1 of 10"
         assert text_of(kiosk.app.screen.query_one("#paused-text")) == (
-            "We are waiting for you. When you are ready, touch Continue.")
+            "We are waiting for you. When you are ready, touch Continue."
+        )
         assert kiosk.session.phase is Phase.QUESTIONS
 
 
@@ -167,8 +193,10 @@ def test_spoken_ways_follow_the_channels_in_every_language():
 
     said = next(p for p in QUESTIONNAIRE.familiarisation if p.id == "practice_select").spoken
     assert spoken_with_ways(said["en"], "en", ALL) == (
-        "Please choose answer number three. Touch it, press its number on the remote or say its number.")
+        "Please choose answer number three. Touch it, press its number on the remote or say its number."
+    )
     assert spoken_with_ways(said["es"], "es", Ways(voice=True)) == (
-        "Por favor, elija la respuesta número tres. Tóquela o diga su número.")
+        "Por favor, elija la respuesta número tres. Tóquela o diga su número."
+    )
     assert spoken_with_ways(said["fr"], "fr", TOUCH_ONLY) == "Veuillez choisir la réponse numéro trois. Touchez-la."
     assert spoken_with_ways("Welcome.", "en", ALL) == "Welcome."

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 from textual.widgets import Label, Static
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.session import Phase
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.ui.widgets.metrics_plot import METRICS, MetricsPlot, metrics_figure, plot_data, save_png
 from kiosk.ui.widgets.question_panel import QuestionPanel
 
@@ -50,8 +50,11 @@ async def test_a_kiosk_without_voice_out_never_asks_which_word_was_heard(ui_kios
         kiosk.to_next_deadline()
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
     outcomes = [(p.question_id, p.outcome, p.detail) for p in kiosk.store.session(kiosk.session.id).practice]
-    assert outcomes == [("practice_hear", "skipped", "no voice out"), ("practice_read", "right", "key 1"),
-                        ("practice_select", "right", "key 3")]
+    assert outcomes == [
+        ("practice_hear", "skipped", "no voice out"),
+        ("practice_read", "right", "key 1"),
+        ("practice_select", "right", "key 3"),
+    ]
 
 
 async def test_voice_out_on_asks_the_hearing_check_and_losing_it_skips_that_check(ui_kiosk):

@@ -4,8 +4,8 @@ and a minute after it was asked the model's inactivity timer fires on the sessio
 
 from __future__ import annotations
 
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.session import Phase
+from kiosk.ui.app import KIOSK_SIZE
 
 from .helpers import screen_name, settle, start_in_english
 

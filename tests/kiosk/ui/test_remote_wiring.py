@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from kiosk.ui.app import KIOSK_SIZE
+from textual.widgets import Label
+
 from kiosk.core.channels import Channel, ChannelState
 from kiosk.remote.profiles import load_profiles
 from kiosk.remote.reconnect import Backoff
 from kiosk.remote.serial import SerialRemote
-from textual.widgets import Label
-
+from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.widgets.channel_board import REMOTE
 from tests.kiosk.remote.boxes import PATIENCE, ButtonBox
 
@@ -24,7 +24,9 @@ async def test_a_serial_remote_answers_and_its_unplugging_shows(ui_kiosk, tmp_pa
     box = ButtonBox(tmp_path / "ttyUSB-ui0")
     kiosk = ui_kiosk(familiarisation=False, sources=[SerialRemote(profile, backoff=Backoff(0.01, 2, 0.05))])
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
-        await until_thread(lambda: kiosk.app.board.state(REMOTE)[0] is ChannelState.ON, "the remote's reader thread", PATIENCE)
+        await until_thread(
+            lambda: kiosk.app.board.state(REMOTE)[0] is ChannelState.ON, "the remote's reader thread", PATIENCE
+        )
         await start_in_english(kiosk, pilot)
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
@@ -35,7 +37,9 @@ async def test_a_serial_remote_answers_and_its_unplugging_shows(ui_kiosk, tmp_pa
         assert (answer.option, answer.channel) == (2, Channel.REMOTE)
 
         box.unplug()
-        await until_thread(lambda: kiosk.app.board.state(REMOTE)[0] is not ChannelState.ON, "the remote's reader thread", PATIENCE)
+        await until_thread(
+            lambda: kiosk.app.board.state(REMOTE)[0] is not ChannelState.ON, "the remote's reader thread", PATIENCE
+        )
         await settle(pilot)
         # the patient's row of ways to answer no longer offers it; no device words on their screen
         assert "remote" not in str(kiosk.app.screen.query_one("#ways", Label).render())

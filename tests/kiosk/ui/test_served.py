@@ -14,8 +14,18 @@ from kiosk.core.session import Phase
 from kiosk.ui.widgets.text import ui_text
 
 from .helpers import screen_name, settle
-from .serving import (ACTION_RGB, ANSWER_RGB, CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until,
-                      wait_until_drawn)
+from .serving import (
+    ACTION_RGB,
+    ANSWER_RGB,
+    CHROMIUM,
+    CHROMIUM_ARGS,
+    PATIENCE_S,
+    TOKEN,
+    Painted,
+    serve,
+    wait_until,
+    wait_until_drawn,
+)
 
 #: the served page's font size: a touch display shows big cells
 FONT_SIZE = 20
@@ -89,8 +99,7 @@ async def test_a_tap_on_the_served_page_records_the_answer(served_kiosk, ui_kios
             await page.goto(served_kiosk.url(f"/?token={TOKEN}&fontsize={FONT_SIZE}"))
             screen = page.locator(".xterm-screen")
             await screen.wait_for(timeout=PATIENCE_S * 1000)
-            await page.wait_for_function("document.body.classList.contains('-first-byte')",
-                                         timeout=PATIENCE_S * 1000)
+            await page.wait_for_function("document.body.classList.contains('-first-byte')", timeout=PATIENCE_S * 1000)
             query = dict(part.split("=") for part in sockets[0].url.split("?", 1)[1].split("&"))
             size = (int(query["width"]), int(query["height"]))
             english, start, answer = await _tap_targets(ui_kiosk, size)

@@ -6,7 +6,6 @@ size the page reports (as in test_served.py)."""
 
 from __future__ import annotations
 
-
 import pytest
 
 from kiosk.core.questionnaire import load_questionnaire
@@ -16,8 +15,18 @@ from kiosk.ui.widgets.text import language_name
 from .conftest import UiKiosk
 from .fit import problems
 from .helpers import screen_name, settle
-from .serving import (ACTION_RGB, ANSWER_RGB, CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until,
-                      wait_until_drawn)
+from .serving import (
+    ACTION_RGB,
+    ANSWER_RGB,
+    CHROMIUM,
+    CHROMIUM_ARGS,
+    PATIENCE_S,
+    TOKEN,
+    Painted,
+    serve,
+    wait_until,
+    wait_until_drawn,
+)
 from .test_served import _answers
 
 #: the smallest text the page may draw (px): what an 85-year-old can still read on the panel
@@ -75,8 +84,11 @@ def served_kiosk(tmp_path):
         yield served
 
 
-@pytest.mark.parametrize("viewport,fontsize", [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
-                         ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"])
+@pytest.mark.parametrize(
+    "viewport,fontsize",
+    [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
+    ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"],
+)
 @pytest.mark.parametrize("language", ["en", "es", "fr"])
 async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factory, viewport, fontsize, language):
     from playwright.async_api import async_playwright
@@ -88,8 +100,14 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
         try:
             page = await browser.new_page(viewport={"width": width, "height": height})
             outside = []
-            page.on("request", lambda r: outside.append(r.url) if not r.url.startswith(
-                ("http://127.0.0.1", "ws://127.0.0.1", "data:")) else None)
+            page.on(
+                "request",
+                lambda r: (
+                    outside.append(r.url)
+                    if not r.url.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:"))
+                    else None
+                ),
+            )
             painted = Painted(page)
             sockets = painted.sockets
 
@@ -102,8 +120,7 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
             await page.goto(served_kiosk.url(f"/?token={TOKEN}" + (f"&fontsize={fontsize}" if fontsize else "")))
             screen = page.locator(".xterm-screen")
             await screen.wait_for(timeout=PATIENCE_S * 1000)
-            await page.wait_for_function("document.body.classList.contains('-first-byte')",
-                                         timeout=PATIENCE_S * 1000)
+            await page.wait_for_function("document.body.classList.contains('-first-byte')", timeout=PATIENCE_S * 1000)
             # the size the page gave xterm.js (it may shrink the asked size, never below the floor)
             font_px = float(await page.evaluate("document.getElementById('terminal').dataset.fontSize"))
             assert font_px >= MIN_TEXT_PX
@@ -119,8 +136,12 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
             steps = await _layout(tmp_path_factory.mktemp("layout"), size, language)
 
             def pixels(region) -> tuple[float, float, float, float]:
-                return (box["x"] + region.x * cell_w, box["y"] + region.y * cell_h,
-                        box["x"] + region.right * cell_w, box["y"] + region.bottom * cell_h)
+                return (
+                    box["x"] + region.x * cell_w,
+                    box["y"] + region.y * cell_h,
+                    box["x"] + region.right * cell_w,
+                    box["y"] + region.bottom * cell_h,
+                )
 
             questionnaire = load_questionnaire()
             explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
@@ -130,7 +151,8 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                     left, top, right, bottom = pixels(region)
                     assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
                         f"{name}: an answer at {left:.0f},{top:.0f}-{right:.0f},{bottom:.0f} px is not "
-                        f"inside the {width}x{height} viewport")
+                        f"inside the {width}x{height} viewport"
+                    )
                 if name == "language":  # the welcome is on the page
                     await wait_until(page, shown_since(language_name(language), 0), "the welcome")
                 elif name == "start":  # the explanation is on the page
@@ -140,8 +162,9 @@ async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factor
                     await wait_until(page, shown_since(text, tapped_at), f"{name} on the page")
                 left, top, right, bottom = pixels(target)
                 # and what is tapped drawn where the headless app put it, as the patient sees it
-                await wait_until_drawn(page, (left, top, right, bottom), cell_h,
-                                       ANSWER_RGB if regions else ACTION_RGB, f"{name}'s button")
+                await wait_until_drawn(
+                    page, (left, top, right, bottom), cell_h, ANSWER_RGB if regions else ACTION_RGB, f"{name}'s button"
+                )
                 tapped_at = len(painted.data)
                 await page.mouse.click((left + right) / 2, (top + bottom) / 2)
                 if regions:

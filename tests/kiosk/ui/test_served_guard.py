@@ -38,8 +38,9 @@ async def _browser(pw, profile: Path | None = None):
     if profile is None:
         browser = await pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         return browser, await browser.new_context(viewport={"width": 1200, "height": 780})
-    context = await pw.chromium.launch_persistent_context(str(profile), executable_path=CHROMIUM, args=CHROMIUM_ARGS,
-                                                          viewport={"width": 1200, "height": 780})
+    context = await pw.chromium.launch_persistent_context(
+        str(profile), executable_path=CHROMIUM, args=CHROMIUM_ARGS, viewport={"width": 1200, "height": 780}
+    )
     return None, context
 
 
@@ -56,8 +57,10 @@ async def test_without_the_key_the_page_and_its_websocket_are_refused(tmp_path):
             assert "not set up as a kiosk" in await page.inner_text("body")
             assert painted.sockets == [], "the refusal page opens no websocket"
             # a page of the kiosk's own origin that has no key cannot open the websocket either
-            assert await page.evaluate(OPEN_SOCKET, served.url("/ws?width=80&height=24").replace("http", "ws")) \
+            assert (
+                await page.evaluate(OPEN_SOCKET, served.url("/ws?width=80&height=24").replace("http", "ws"))
                 == "refused"
+            )
             wrong = await page.goto(served.url("/?token=not-the-key"))
             assert wrong.status == 403 and await context.cookies() == []
             await browser.close()
@@ -75,8 +78,12 @@ async def test_the_key_once_then_a_cookie_that_outlives_the_browser(tmp_path):
             await page.goto(served.url(f"/?token={TOKEN}&fontsize=20"))
             assert page.url == served.url("/?fontsize=20"), "the key leaves the address bar at once"
             (cookie,) = await context.cookies()
-            assert (cookie["name"], cookie["value"], cookie["httpOnly"], cookie["sameSite"]) == \
-                (COOKIE, TOKEN, True, "Strict")
+            assert (cookie["name"], cookie["value"], cookie["httpOnly"], cookie["sameSite"]) == (
+                COOKIE,
+                TOKEN,
+                True,
+                "Strict",
+            )
             assert cookie["expires"] > 0, "kept beyond this browser session"
             await wait_until(page, painted.shows(WELCOME), "the welcome screen")
             await context.close()  # the kiosk's browser restarts (same profile)
@@ -146,27 +153,43 @@ async def test_at_the_cap_a_clear_busy_page_and_a_closed_tab_frees_its_place(tmp
             await browser.close()
 
 
-@pytest.mark.parametrize(("args", "message"), [
-    (["--host", "0.0.0.0"], "refusing to serve on 0.0.0.0 without TLS"),
-    (["--host", "192.168.1.20", "--tls-cert", "cert.pem"], "--tls-cert and --tls-key go together"),
-    (["--host", "0.0.0.0", "--insecure-network"], "needs --public-url"),
-])
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--host", "0.0.0.0"], "refusing to serve on 0.0.0.0 without TLS"),
+        (["--host", "192.168.1.20", "--tls-cert", "cert.pem"], "--tls-cert and --tls-key go together"),
+        (["--host", "0.0.0.0", "--insecure-network"], "needs --public-url"),
+    ],
+)
 def test_a_network_address_needs_tls_or_an_explicit_flag(tmp_path, args, message):
     config = tmp_path / "config.yaml"
     config.write_text('serve_token_sha256: "' + "0" * 64 + '"\n')
-    done = subprocess.run([sys.executable, "-m", "kiosk", "serve", *args, "--config", str(config)],
-                          capture_output=True, text=True, cwd=tmp_path, timeout=PATIENCE_S)
+    done = subprocess.run(
+        [sys.executable, "-m", "kiosk", "serve", *args, "--config", str(config)],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=PATIENCE_S,
+    )
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and message in done.stderr, done.stderr
 
 
 def test_serving_without_a_device_key_is_refused_with_the_way_to_set_one_up(tmp_path):
     config = tmp_path / "config.yaml"
     config.write_text("language: en\n")
-    done = subprocess.run([sys.executable, "-m", "kiosk", "serve", "--config", str(config)],
-                          capture_output=True, text=True, timeout=PATIENCE_S)
+    done = subprocess.run(
+        [sys.executable, "-m", "kiosk", "serve", "--config", str(config)],
+        capture_output=True,
+        text=True,
+        timeout=PATIENCE_S,
+    )
     assert done.returncode == 2 and "kiosk serve --new-token" in done.stderr and done.stderr.count("\n") == 1
-    made = subprocess.run([sys.executable, "-m", "kiosk", "serve", "--new-token", "--config", str(config)],
-                          capture_output=True, text=True, timeout=PATIENCE_S)
+    made = subprocess.run(
+        [sys.executable, "-m", "kiosk", "serve", "--new-token", "--config", str(config)],
+        capture_output=True,
+        text=True,
+        timeout=PATIENCE_S,
+    )
     assert made.returncode == 0 and "?token=" in made.stdout
     token = made.stdout.split("?token=")[1].split("&")[0]
     assert token not in config.read_text() and "language: en" in config.read_text()

@@ -16,8 +16,18 @@ from kiosk.ui.app import CLINICIAN_CHORD
 
 from .conftest import UI_PIN, UiKiosk
 from .helpers import screen_name, settle, until_drawn
-from .serving import (ACTION_RGB, ANSWER_RGB, CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, serve, wait_until,
-                      wait_until_drawn)
+from .serving import (
+    ACTION_RGB,
+    ANSWER_RGB,
+    CHROMIUM,
+    CHROMIUM_ARGS,
+    PATIENCE_S,
+    TOKEN,
+    Painted,
+    serve,
+    wait_until,
+    wait_until_drawn,
+)
 from .test_served import _answers
 
 pytestmark = [
@@ -27,7 +37,7 @@ pytestmark = [
 
 #: the served kiosk's PIN (tests/kiosk/ui/serving.py writes it into its configuration)
 SERVED_PIN = "246813"
-CHOSEN_RGB = (0x0b, 0x5d, 0x1e)
+CHOSEN_RGB = (0x0B, 0x5D, 0x1E)
 #: long enough to look at the gap on a busy machine (the first question waits as long)
 GAP_S = 12
 
@@ -101,10 +111,14 @@ def _share(shot, box: tuple[float, float, float, float], rgb: tuple[int, int, in
     return sum(p == rgb for p in pixels) / max(1, len(pixels))
 
 
-@pytest.mark.parametrize("viewport,fontsize", [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
-                         ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"])
+@pytest.mark.parametrize(
+    "viewport,fontsize",
+    [((1024, 600), 28), ((1280, 800), 28), ((1920, 1080), None)],
+    ids=["1024x600-28px", "1280x800-28px", "1920x1080-default"],
+)
 async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_touch(
-        tmp_path, tmp_path_factory, viewport, fontsize):
+    tmp_path, tmp_path_factory, viewport, fontsize
+):
     from PIL import Image
     from playwright.async_api import async_playwright
 
@@ -118,8 +132,9 @@ async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_to
                 await page.goto(served.url(f"/?token={TOKEN}" + (f"&fontsize={fontsize}" if fontsize else "")))
                 screen = page.locator(".xterm-screen")
                 await screen.wait_for(timeout=PATIENCE_S * 1000)
-                await page.wait_for_function("document.body.classList.contains('-first-byte')",
-                                             timeout=PATIENCE_S * 1000)
+                await page.wait_for_function(
+                    "document.body.classList.contains('-first-byte')", timeout=PATIENCE_S * 1000
+                )
                 query = dict(p.split("=") for p in painted.sockets[0].url.split("?", 1)[1].split("&"))
                 size = (int(query["width"]), int(query["height"]))
                 box = await screen.bounding_box()
@@ -127,13 +142,18 @@ async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_to
                 where = await _twin(tmp_path_factory.mktemp("twin"), size)
 
                 def pixels(region) -> tuple[float, float, float, float]:
-                    return (box["x"] + region.x * cell_w, box["y"] + region.y * cell_h,
-                            box["x"] + region.right * cell_w, box["y"] + region.bottom * cell_h)
+                    return (
+                        box["x"] + region.x * cell_w,
+                        box["y"] + region.y * cell_h,
+                        box["x"] + region.right * cell_w,
+                        box["y"] + region.bottom * cell_h,
+                    )
 
                 async def tap(region) -> int:
                     left, top, right, bottom = pixels(region)
                     assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
-                        f"{region} is not wholly inside the {width}x{height} viewport")
+                        f"{region} is not wholly inside the {width}x{height} viewport"
+                    )
                     offset = len(painted.data)
                     await page.mouse.click((left + right) / 2, (top + bottom) / 2)
                     return offset
@@ -151,8 +171,11 @@ async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_to
                 await wait_until(page, painted.shows("Tienen que darme"), "the first question")
                 await wait_until_drawn(page, pixels(where["answer"]), cell_h, ANSWER_RGB, "answer 2")
                 tapped = await tap(where["answer"])
-                await wait_until(page, since(tapped, "Gracias. Siguiente pregunta", "Cambiar mi respuesta",
-                                             "cortar o untar"), "the gap with the chosen answer")
+                await wait_until(
+                    page,
+                    since(tapped, "Gracias. Siguiente pregunta", "Cambiar mi respuesta", "cortar o untar"),
+                    "the gap with the chosen answer",
+                )
                 await page.mouse.move(1, 1)
                 shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
                 label = pixels(where["chosen_label"])
@@ -160,7 +183,8 @@ async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_to
                 # mostly the chosen green, with the words' white strokes in it (a few per cent of a
                 # wide label's box at 1920 px), never the thanks' pale green or the button's purple
                 assert green > 0.5 and white > 0.003, (
-                    f"the chosen answer's words are not drawn green and white at {label}: {green:.2f} {white:.2f}")
+                    f"the chosen answer's words are not drawn green and white at {label}: {green:.2f} {white:.2f}"
+                )
                 assert _answers(served.database) == [("feeding", 2, "touch")]
 
                 # staff: five taps on the corner, the PIN on the pad's keys, a stored session

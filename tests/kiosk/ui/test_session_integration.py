@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from textual.widgets import Label
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus
 from kiosk.core.session import ATTEMPTS, AttemptTimedOut, Phase, Prompt
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.ui.widgets.bars import AdaptationBanner
 from kiosk.ui.widgets.text import ui_text
 
@@ -48,11 +48,16 @@ async def test_voice_in_status_reaches_the_session_and_a_lost_microphone_lifts_v
         deliver_from_thread(kiosk, ChannelStatus(Channel.VOICE, ChannelState.LOST, "voice in", "microphone unplugged"))
         await settle(pilot, lambda: "voice_off" not in kiosk.session.snapshot().adaptations)
         await settle(pilot, lambda: not kiosk.app.screen.query_one(AdaptationBanner).display)
-        voice_prompts = [e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
+        voice_prompts = [
+            e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")
+        ]
         assert voice_prompts == ["voice_off"]  # no "I can hear you again" with the microphone gone
         stored = kiosk.store.session(kiosk.session.id)
         assert [(a.name, a.active, a.reason) for a in stored.adaptations][-1] == (
-            "voice_off", False, "voice in is unavailable")
+            "voice_off",
+            False,
+            "voice in is unavailable",
+        )
         # "available" came before the start, when there was no stored session to log it in
         assert [e.detail for e in stored.log if e.kind == "voice_in"] == ["unavailable"]
 
@@ -98,6 +103,9 @@ async def test_the_clinician_marks_the_patient_left_and_back_and_the_attempt_clo
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         assert kiosk.session.answers["feeding"].attempt == 1
 
-    presence = [e["set"]["PersonDetected"] for e in kiosk.store.session(kiosk.session.id).trace
-                if "PersonDetected" in e.get("set", {})]
+    presence = [
+        e["set"]["PersonDetected"]
+        for e in kiosk.store.session(kiosk.session.id).trace
+        if "PersonDetected" in e.get("set", {})
+    ]
     assert presence == [True, False, True]  # the start, the clinician's "left", then "back"

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 from textual.widgets import Button, Static
 
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelInput, Command
 from kiosk.core.session import Phase
+from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.widgets.change_answer import ChangeAnswerButton
 from kiosk.ui.widgets.waiting_sign import WaitingSign
 
@@ -94,8 +94,11 @@ async def test_im_fine_carry_on_after_an_accidental_d(ui_kiosk):
         await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
         log = [(e.kind, e.detail) for e in kiosk.store.session(kiosk.session.id).log]
         assert [entry for entry in log if entry[0] in ("call_doctor", "doctor_call_cancelled")] == [
-            ("call_doctor", "keyboard"), ("doctor_call_cancelled", "touch"),
-            ("call_doctor", "keyboard"), ("doctor_call_cancelled", "keyboard")]
+            ("call_doctor", "keyboard"),
+            ("doctor_call_cancelled", "touch"),
+            ("call_doctor", "keyboard"),
+            ("doctor_call_cancelled", "keyboard"),
+        ]
 
 
 async def test_the_waiting_sign_shows_while_an_answer_is_awaited_and_never_counts(ui_kiosk):
@@ -127,8 +130,12 @@ async def test_practice_starts_with_its_introduction_and_each_answer_gets_a_kind
         line = kiosk.app.screen.query_one("#interlude", Static)
         assert text_of(line).startswith("First, a few practice questions") and line.display
         await pilot.press("2")  # not the expected answer: still a kind word
-        await settle(pilot, lambda: text_of(kiosk.app.screen.query_one("#interlude", Static)).startswith(
-            "That was not the answer I expected, but that is fine."))
+        await settle(
+            pilot,
+            lambda: text_of(kiosk.app.screen.query_one("#interlude", Static)).startswith(
+                "That was not the answer I expected, but that is fine."
+            ),
+        )
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.snapshot().practice_number == 2)
         assert not kiosk.app.screen.query_one("#interlude", Static).display  # no introduction now

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import pytest
 
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelInput
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 
 from .conftest import UI_PIN
 from .helpers import deliver_from_thread, screen_name, settle, start_in_english, until_drawn
@@ -203,8 +203,11 @@ def test_four_answer_question_in_french_small(snap_compare, ui_kiosk, size):
         await pilot.press("3")
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         await pilot.press("1")
-        while kiosk.session.current_item is None or kiosk.session.current_item.id != "transfers" \
-                or kiosk.session.current_attempt != 1:
+        while (
+            kiosk.session.current_item is None
+            or kiosk.session.current_item.id != "transfers"
+            or kiosk.session.current_attempt != 1
+        ):
             if kiosk.session.current_attempt == 1:
                 await pilot.press("1")
                 await settle(pilot, lambda: kiosk.session.current_attempt is None)

@@ -10,17 +10,18 @@ import threading
 
 import pytest
 
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.channels import ChannelState
 from kiosk.core.session import Prompt
 from kiosk.speech.tts import Speaker
+from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.widgets.channel_board import VOICE_OUT
 
 from .helpers import late_touch_answer, settle, start_in_english, until_thread
 
-
-pytestmark = [pytest.mark.slow,
-              pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")]
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed"),
+]
 
 
 class RecordingPlayer:
@@ -48,7 +49,9 @@ async def test_prompts_are_spoken_and_a_spoken_repeat_is_reported_to_the_session
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         spoken = sum(1 for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken)
-        await until_thread(lambda: player.played >= spoken, "the speaker's worker")  # welcome, explanation, the first question
+        await until_thread(
+            lambda: player.played >= spoken, "the speaker's worker"
+        )  # welcome, explanation, the first question
         states = lambda: [e["set"]["TestState"] for e in kiosk.session.trace if "TestState" in e.get("set", {})]
         await pilot.press("r")  # repeat: TestState REPEATING until the repeat has been said
         await until_thread(lambda: states()[-2:] == ["REPEATING", "STARTED"], "the speaker's worker")
@@ -83,7 +86,7 @@ class SaidSpeaker(Speaker):
 
 
 async def test_the_spoken_practice_promises_only_the_channels_that_are_on(ui_kiosk):
-    """"Please choose answer number three" goes on with the ways that work: with no remote and no
+    """ "Please choose answer number three" goes on with the ways that work: with no remote and no
     voice in (this kiosk's channels), only touching it is said."""
     player = RecordingPlayer()
     speaker = SaidSpeaker(player_factory=lambda: player)

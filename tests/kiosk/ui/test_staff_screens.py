@@ -8,8 +8,8 @@ from __future__ import annotations
 import pytest
 from textual.widgets import Button, DataTable, Switch
 
-from kiosk.ui.app import CLINICIAN_IDLE_S, KIOSK_SIZE, PIN_IDLE_S
 from kiosk.core.pin import CORNER_TAPS
+from kiosk.ui.app import CLINICIAN_IDLE_S, KIOSK_SIZE, PIN_IDLE_S
 
 from .conftest import UI_PIN
 from .fit import problems
@@ -91,8 +91,7 @@ async def _reach(pilot, screen, selector: str, widget) -> None:
         if _visible(widget, body):
             return
         view = body.region
-        seen |= {y - widget.region.y for y in range(widget.region.y, widget.region.bottom)
-                 if view.y <= y < view.bottom}
+        seen |= {y - widget.region.y for y in range(widget.region.y, widget.region.bottom) if view.y <= y < view.bottom}
         if seen >= set(range(widget.region.height)):
             return
         await pilot.click("#page-down")
@@ -127,10 +126,20 @@ async def test_every_clinician_control_is_reached_and_tapped_by_touch(ui_kiosk, 
         await pilot.click("#key-ok")
         await until_drawn(pilot, "Back to the patient", "▼ Down")
         home = kiosk.app.screen
-        controls = [w for w in home.query(".staff-body Button, .staff-body Switch, .staff-body DataTable")
-                    if w.display and w.parent.display]
-        assert {w.id for w in controls} >= {"continue", "adaptation", "new-session", "person-lost", "person-back",
-                                            "quit-kiosk", "sessions"}
+        controls = [
+            w
+            for w in home.query(".staff-body Button, .staff-body Switch, .staff-body DataTable")
+            if w.display and w.parent.display
+        ]
+        assert {w.id for w in controls} >= {
+            "continue",
+            "adaptation",
+            "new-session",
+            "person-lost",
+            "person-back",
+            "quit-kiosk",
+            "sessions",
+        }
         for widget in controls:
             await _from_top(pilot, home)
             await _reach(pilot, home, widget.id, widget)
@@ -180,4 +189,4 @@ async def test_continue_this_test_shows_only_with_an_interrupted_test_and_events
         await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
         detail = kiosk.app.screen
         await _reach(pilot, detail, "#events", detail.query_one("#events"))
-        await until_drawn(pilot, "Doctor called (keyboard)", "\"I'm fine, carry on\"")
+        await until_drawn(pilot, "Doctor called (keyboard)", '"I\'m fine, carry on"')

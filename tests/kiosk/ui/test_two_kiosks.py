@@ -26,8 +26,14 @@ class Kiosk:
     """One real kiosk process and its command line."""
 
     def __init__(self, config: Path) -> None:
-        self.process = subprocess.Popen([sys.executable, str(DRIVER), str(config), PIN], cwd=ROOT, text=True,
-                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        self.process = subprocess.Popen(
+            [sys.executable, str(DRIVER), str(config), PIN],
+            cwd=ROOT,
+            text=True,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+        )
         self.ready = self.read()
 
     def read(self) -> dict:
@@ -61,8 +67,10 @@ class Kiosk:
 @pytest.fixture
 def kiosks(tmp_path):
     config = tmp_path / "config.yaml"
-    config.write_text(f"data_dir: {tmp_path / 'data'}\nclinician_pin: \"{PIN}\"\nfamiliarisation: false\n"
-                      "timing: {between_questions_s: 0.2, attempt_window_s: 600}\n")
+    config.write_text(
+        f'data_dir: {tmp_path / "data"}\nclinician_pin: "{PIN}"\nfamiliarisation: false\n'
+        "timing: {between_questions_s: 0.2, attempt_window_s: 600}\n"
+    )
     started: list[Kiosk] = []
 
     def start() -> Kiosk:
@@ -141,7 +149,9 @@ def test_a_dead_kiosks_test_is_for_staff_and_of_two_kiosks_continuing_it_one_is_
     assert b.do("continue")["session"] == session
     refused = c.do("continue")
     assert refused["session"] != session
-    assert refused["refused"] == (f"Not continued: session {session} is open on another kiosk, "
-                                  f"{os.uname().nodename} (process {b.process.pid}): one kiosk at a time records a test")
+    assert refused["refused"] == (
+        f"Not continued: session {session} is open on another kiosk, "
+        f"{os.uname().nodename} (process {b.process.pid}): one kiosk at a time records a test"
+    )
     errors = b.stop() + c.stop()
     assert "Traceback" not in errors

@@ -15,20 +15,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kiosk.ui.app import KIOSK_SIZE
 from kiosk.core.channels import Channel, ChannelState
 from kiosk.speech import rooms
 from kiosk.speech.audio import SAMPLE_RATE, feed_wav, read_wav
 from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel
+from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.widgets.channel_board import VOICE_IN
 
 from .helpers import settle, start_in_english, text_of, until_thread
 
 PATIENCE_S = 30.0
 
-pytestmark = [pytest.mark.slow,
-              pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")]
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed"),
+]
 
 
 class WavMicrophone:
@@ -61,7 +63,8 @@ async def test_a_spoken_answer_reaches_the_session_through_the_app(ui_kiosk, tmp
     two = synthesiser.synthesise("two", "en", tmp_path / "two.wav")
     microphones: list[WavMicrophone] = []
     voice = VoiceChannel(
-        "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1])
+        "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1]
+    )
     kiosk = ui_kiosk(familiarisation=False, voice=voice)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await until_thread(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON, "the voice channel")
@@ -99,7 +102,7 @@ def _in_a_fan(path: Path, speech: Path | None, seconds: float = 1.5) -> Path:
     words = words.astype(np.float64) * 32768 * 0.1 / np.sqrt(max(rooms.active_power(words), 1.0))
     out = rooms.white_noise(2 * seconds + len(words) / SAMPLE_RATE, np.random.default_rng(len(words))) * 32768 * 0.01
     start = int(seconds * SAMPLE_RATE)
-    out[start:start + len(words)] += words
+    out[start : start + len(words)] += words
     with wave.open(str(path), "wb") as f:
         f.setnchannels(1)
         f.setsampwidth(2)
@@ -120,8 +123,11 @@ async def test_a_yes_too_close_to_the_rooms_noise_asks_for_a_press_and_a_touch_s
     answer = _in_a_fan(tmp_path / "a.wav", synthesiser.synthesise("independent", "en", tmp_path / "independent.wav"))
     yes = _in_a_fan(tmp_path / "y.wav", synthesiser.synthesise("yes", "en", tmp_path / "yes.wav"))
     microphones: list[WavMicrophone] = []
-    voice = VoiceChannel("en", reply_min_above_room_db=30.0, microphone_factory=lambda consumer: (
-        microphones.append(WavMicrophone(consumer)) or microphones[-1]))
+    voice = VoiceChannel(
+        "en",
+        reply_min_above_room_db=30.0,
+        microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1],
+    )
     kiosk = ui_kiosk(familiarisation=False, voice=voice)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await until_thread(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON, "the voice channel")
@@ -154,8 +160,10 @@ async def test_the_welcome_listens_and_the_spoken_language_starts(ui_kiosk, tmp_
     microphones: list[WavMicrophone] = []
     heard: list[str] = []
     voice = VoiceChannel(
-        "en", microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1],
-        on_unmatched=lambda utterance, reason: heard.append(reason))
+        "en",
+        microphone_factory=lambda consumer: microphones.append(WavMicrophone(consumer)) or microphones[-1],
+        on_unmatched=lambda utterance, reason: heard.append(reason),
+    )
     kiosk = ui_kiosk(familiarisation=False, voice=voice)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await until_thread(lambda: kiosk.app.board.state(VOICE_IN)[0] is ChannelState.ON, "the voice channel")
