@@ -22,6 +22,7 @@ import sys
 
 from kiosk.config import ConfigError, configured_questionnaire, load_config
 from kiosk.core.questionnaire import QuestionnaireError
+from kiosk.core.words import languages
 from kiosk.export import (
     ID_TAGS,
     ExportError,
@@ -111,7 +112,7 @@ def main(argv: list[str]) -> int:
         metavar="FILE",
         help="write the FHIR R4 Questionnaire (with --language: that language's; else a Bundle of all)",
     )
-    parser.add_argument("--language", choices=("en", "es", "fr"), help="language of --fhir-questionnaire")
+    parser.add_argument("--language", choices=languages(), help="language of --fhir-questionnaire")
     parser.add_argument("--csv", metavar="FILE", help="write the sessions as CSV, rows per item")
     parser.add_argument("--csv-wide", metavar="FILE", help="write the sessions as CSV, one row per session")
     parser.add_argument("--bom", action="store_true", help="start CSV files with a UTF-8 byte-order mark")

@@ -86,7 +86,7 @@ class ChannelStatus:
     source: str = ""
     #: one sentence a clinician can act on, e.g. "no microphone found"
     reason: str = ""
-    #: the same reason as a key of the kiosk's screen texts (``widgets/ui_text.yaml``), so a
+    #: the same reason as a key of the kiosk's screen texts (``kiosk/core/words``), so a
     #: patient's screen can say it in the patient's language; empty when there is none
     reason_key: str = ""
 

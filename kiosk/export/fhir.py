@@ -64,6 +64,7 @@ from typing import Any
 from kiosk.core.questionnaire import Code, Questionnaire
 from kiosk.core.review import Review, ReviewState
 from kiosk.core.visits import visit_of
+from kiosk.core.words import Table
 from kiosk.export.result import (
     TOTAL_LINK,
     ExportError,
@@ -92,7 +93,8 @@ TEST_DATA = {
     "display": "test health data",
 }
 SURVEY = {"system": "http://terminology.hl7.org/CodeSystem/observation-category", "code": "survey", "display": "Survey"}
-TOTAL_TEXT = {"en": "Total score", "es": "Puntuación total", "fr": "Score total"}
+#: the total's label per language (``export.total_score`` in its words file)
+TOTAL_TEXT: Mapping[str, str] = Table(lambda words: words.export["total_score"])
 #: the words the kiosk used beside a code (see the module docstring): ``clinical``, ``patient``, ``spoken``
 WORDING = "urn:barthel-kiosk:fhir:StructureDefinition:wording"
 

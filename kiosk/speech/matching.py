@@ -1,11 +1,11 @@
-"""What the patient said → an answer option or a command, in English, Spanish or French.
+"""What the patient said → an answer option or a command, in any of the kiosk's languages.
 
 The vocabulary for one question is the question's option labels and voice synonyms, numbers and
 ordinals up to the number of options ("two", "number two", "the second", "la dos", "deux",
 "option 2"), and the kiosk's commands (repeat, pause, continue, call the doctor, louder,
-quieter). Matching ignores case and accents. Anything else -- an unsure recognition, a word
-that fits two options, noise the recogniser turned into "[unk]" -- is *no match* with a reason:
-speech noise is never an answer.
+quieter); each language's words are in its file in ``kiosk/core/words``. Matching ignores case and
+accents. Anything else -- an unsure recognition, a word that fits two options, noise the
+recogniser turned into "[unk]" -- is *no match* with a reason: speech noise is never an answer.
 
 :meth:`Matcher.phrases` lists every phrase the matcher understands, and is what
 :mod:`kiosk.speech.grammar` turns into a recogniser grammar, so the recogniser can only ever
@@ -20,8 +20,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from kiosk.core.channels import Command
+from kiosk.core.words import Table, languages
 
-LANGUAGES = ("en", "es", "fr")
+#: the languages with speech words: every language with a words file
+LANGUAGES = languages()
 
 #: below this recogniser confidence an utterance is not an answer (see asr.py for the scale)
 DEFAULT_MIN_CONFIDENCE = 0.6
@@ -30,159 +32,29 @@ DEFAULT_MIN_CONFIDENCE = 0.6
 #: "stop", "all the time" as "call the doctor"; bench/asr.py)
 COMMAND_MIN_CONFIDENCE = 0.8
 
+# The words per language, from each language's words file (its ``speech`` section, in order).
+
 #: cardinal words per language, 1..10; the first form of each is the one put in grammars first
-CARDINALS: dict[str, list[tuple[str, ...]]] = {
-    "en": [("one",), ("two",), ("three",), ("four",), ("five",), ("six",), ("seven",), ("eight",), ("nine",), ("ten",)],
-    "es": [
-        ("uno", "una", "un"),
-        ("dos",),
-        ("tres",),
-        ("cuatro",),
-        ("cinco",),
-        ("seis",),
-        ("siete",),
-        ("ocho",),
-        ("nueve",),
-        ("diez",),
-    ],
-    "fr": [
-        ("un", "une"),
-        ("deux",),
-        ("trois",),
-        ("quatre",),
-        ("cinq",),
-        ("six",),
-        ("sept",),
-        ("huit",),
-        ("neuf",),
-        ("dix",),
-    ],
-}
+CARDINALS: Mapping[str, tuple[tuple[str, ...], ...]] = Table(lambda words: words.speech["cardinals"])
 
 #: ordinal words per language, 1st..10th
-ORDINALS: dict[str, list[tuple[str, ...]]] = {
-    "en": [
-        ("first",),
-        ("second",),
-        ("third",),
-        ("fourth",),
-        ("fifth",),
-        ("sixth",),
-        ("seventh",),
-        ("eighth",),
-        ("ninth",),
-        ("tenth",),
-    ],
-    "es": [
-        ("primero", "primera", "primer"),
-        ("segundo", "segunda"),
-        ("tercero", "tercera", "tercer"),
-        ("cuarto", "cuarta"),
-        ("quinto", "quinta"),
-        ("sexto", "sexta"),
-        ("séptimo", "séptima"),
-        ("octavo", "octava"),
-        ("noveno", "novena"),
-        ("décimo", "décima"),
-    ],
-    "fr": [
-        ("premier", "première"),
-        ("deuxième", "second", "seconde"),
-        ("troisième",),
-        ("quatrième",),
-        ("cinquième",),
-        ("sixième",),
-        ("septième",),
-        ("huitième",),
-        ("neuvième",),
-        ("dixième",),
-    ],
-}
+ORDINALS: Mapping[str, tuple[tuple[str, ...], ...]] = Table(lambda words: words.speech["ordinals"])
 
 #: how a number is said around the number word: "{n}" is a cardinal, "{o}" an ordinal
-NUMBER_FORMS: dict[str, tuple[str, ...]] = {
-    "en": ("{n}", "number {n}", "option {n}", "{o}", "the {o}", "the {o} one"),
-    "es": ("{n}", "la {n}", "el {n}", "número {n}", "opción {n}", "la {o}", "el {o}", "{o}"),
-    "fr": ("{n}", "le {n}", "numéro {n}", "option {n}", "le {o}", "la {o}", "{o}"),
-}
+NUMBER_FORMS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["number_forms"])
 
 #: words that may surround a number without changing it ("it's number two please")
-NUMBER_FILLERS: dict[str, frozenset[str]] = {
-    "en": frozenset("number option answer the it its is it's i say please um uh er".split()),
-    "es": frozenset("la el numero opcion respuesta es por favor eh pues".split()),
-    "fr": frozenset("le la l numero option reponse c est s il vous plait euh".split()),
-}
+NUMBER_FILLERS: Mapping[str, frozenset[str]] = Table(lambda words: frozenset(words.speech["number_fillers"]))
+
+#: words that may follow a number word without changing it ("the second one")
+AFTER_NUMBER: Mapping[str, frozenset[str]] = Table(
+    lambda words: frozenset(normalise(w) for w in words.speech["after_number"])
+)
 
 #: spoken commands per language (accents as spoken; matching ignores them)
-COMMAND_PHRASES: dict[str, dict[Command, tuple[str, ...]]] = {
-    "en": {
-        Command.REPEAT: ("repeat", "repeat that", "say again", "say that again", "pardon", "again"),
-        Command.PAUSE: ("pause", "wait", "stop"),
-        Command.RESUME: ("continue", "resume", "go on"),
-        # whole phrases only: the single words caught "start" ("doctor", on the welcome) and
-        # "my daughter is coming later"; a false call takes a nurse from another patient
-        Command.CALL_DOCTOR: (
-            "call the doctor",
-            "call a doctor",
-            "call the nurse",
-            "call a nurse",
-            "get the doctor",
-            "get the nurse",
-            "i need a doctor",
-            "i need a nurse",
-        ),
-        Command.VOLUME_UP: ("louder", "speak up", "volume up"),
-        Command.VOLUME_DOWN: ("quieter", "softer", "volume down"),
-        # not "that's not what i said": in background talk it caught 33 of 528 non-answers
-        Command.UNDO: ("no that's wrong", "that's wrong", "change my answer", "change the answer"),
-    },
-    "es": {
-        Command.REPEAT: ("repite", "repita", "repetir", "otra vez", "cómo"),
-        Command.PAUSE: ("pausa", "espera", "espere"),
-        Command.RESUME: ("continuar", "continúa", "continúe", "sigue", "siga", "seguir"),
-        Command.CALL_DOCTOR: (
-            "llama al médico",
-            "llame al médico",
-            "llame a la enfermera",
-            "llama a la enfermera",
-            "necesito un médico",
-            "necesito una enfermera",
-        ),
-        Command.VOLUME_UP: ("más alto", "sube el volumen", "suba el volumen"),
-        Command.VOLUME_DOWN: ("más bajo", "baja el volumen", "baje el volumen"),
-        Command.UNDO: (
-            "no eso está mal",
-            "eso está mal",
-            "cambiar mi respuesta",
-            "cambia mi respuesta",
-            "me he equivocado",
-            "no es eso",
-        ),
-    },
-    "fr": {
-        Command.REPEAT: ("répète", "répétez", "répéter", "encore", "pardon", "comment"),
-        Command.PAUSE: ("pause", "attendez", "attends"),
-        Command.RESUME: ("continue", "continuez", "continuer", "reprenez", "reprendre"),
-        Command.CALL_DOCTOR: (
-            "appelez le médecin",
-            "appelle le médecin",
-            "appelez l'infirmière",
-            "appelle l'infirmière",
-            "j'ai besoin d'un médecin",
-            "j'ai besoin d'une infirmière",
-        ),
-        Command.VOLUME_UP: ("plus fort", "montez le son", "monte le son"),
-        Command.VOLUME_DOWN: ("moins fort", "plus bas", "baissez le son", "baisse le son"),
-        Command.UNDO: (
-            "non c'est faux",
-            "c'est faux",
-            "changer ma réponse",
-            "je me suis trompé",
-            "je me suis trompée",
-            "ce n'est pas ça",
-        ),
-    },
-}
+COMMAND_PHRASES: Mapping[str, dict[Command, tuple[str, ...]]] = Table(
+    lambda words: {Command(name): phrases for name, phrases in words.speech["commands"].items()}
+)
 
 #: commands that only mean something while the session is paused, and are left out of a
 #: question's grammar: "go on" competed with "one" for nothing, as resuming is no answer
@@ -205,79 +77,23 @@ def undo_commands(language: str) -> dict[Command, tuple[str, ...]]:
 
 #: natural ways to say yes / no, added to an option whose label is one of the first words (a
 #: confirmation: "I heard: Independent. Is that right?"); a no option also takes the UNDO phrases
-YES_NO: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "en": (
-        ("yes", "yeah", "yes that's right", "that's right", "yes it is", "correct", "yes please"),
-        ("no", "nope", "no it isn't", "it isn't", "wrong", "no no"),
-    ),
-    "es": (
-        ("sí", "si", "sí es correcto", "es correcto", "correcto", "eso es", "sí eso es", "claro"),
-        ("no", "no es correcto", "incorrecto", "no no"),
-    ),
-    "fr": (
-        ("oui", "oui c'est ça", "c'est ça", "c'est juste", "exact", "exactement", "correct"),
-        ("non", "non non", "pas du tout", "ce n'est pas juste"),
-    ),
-}
+YES_NO: Mapping[str, tuple[tuple[str, ...], tuple[str, ...]]] = Table(
+    lambda words: (words.speech["yes_words"], words.speech["no_words"])
+)
 
 #: the kiosk's languages by name, in any of its languages: a welcome option naming a language
 #: ("Empezar en español") also takes these
-LANGUAGE_NAMES: dict[str, tuple[str, ...]] = {
-    "en": ("english", "in english", "inglés", "en inglés", "anglais", "en anglais"),
-    "es": ("español", "spanish", "in spanish", "en español", "castellano", "espagnol", "en espagnol"),
-    "fr": ("français", "french", "in french", "en français", "francés", "en francés"),
-}
+LANGUAGE_NAMES: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["names"])
 #: ways to say "start": taken by a Start option, and in each language by the option naming it
-START_WORDS: dict[str, tuple[str, ...]] = {
-    "en": ("start", "begin", "let's start", "let's begin", "start please", "i'm ready"),
-    "es": ("empezar", "empiece", "empieza", "comenzar", "comience", "vamos a empezar", "estoy listo", "estoy lista"),
-    "fr": ("commencer", "commencez", "commence", "on commence", "démarrer", "je suis prêt", "je suis prête"),
-}
+START_WORDS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["start_words"])
 
 #: words a patient may put before an answer ("I need a lot of help", "I think two"); the
 #: recogniser's grammar allows one before any phrase, and matching ignores them
-LEAD_INS: dict[str, tuple[str, ...]] = {
-    "en": ("i need", "i can", "i think"),
-    "es": ("necesito", "yo", "creo que", "estoy"),
-    "fr": ("j'ai besoin", "je", "je suis", "je pense"),
-}
+LEAD_INS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["lead_ins"])
 
 #: what patients say that is not an answer: these are in the grammar so that "um", "what?" or
 #: "I don't know" have somewhere to go other than the nearest answer; they match nothing
-FILLERS: dict[str, tuple[str, ...]] = {
-    "en": (
-        "um",
-        "uh",
-        "hmm",
-        "what",
-        "sorry",
-        "what did you say",
-        "i don't know",
-        "hello",
-        "is it",
-        "all the time",
-        "what time is it",
-        "thank you",
-        "i see",
-        "let me think",
-        "where am i",
-        "how long",
-    ),
-    "es": ("eh", "em", "qué", "perdón", "no sé", "hola", "vale", "gracias", "a ver", "todo el tiempo", "qué hora es"),
-    "fr": (
-        "euh",
-        "hein",
-        "quoi",
-        "pardon",
-        "je ne sais pas",
-        "bonjour",
-        "d'accord",
-        "merci",
-        "voyons",
-        "tout le temps",
-        "quelle heure est il",
-    ),
-}
+FILLERS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["fillers"])
 
 #: what recognisers emit for sounds outside their grammar
 UNKNOWN_TOKENS = frozenset({"[unk]", "<unk>"})
@@ -459,7 +275,7 @@ class Matcher:
         lead = next((lead for lead in leads if tokens[: len(lead)] == lead), ())
         tokens = tokens[len(lead) :] if len(tokens) > len(lead) else tokens
         rest = [t for t in tokens if t not in NUMBER_FILLERS[self.language]]
-        if self.language == "en" and len(rest) == 2 and rest[1] == "one" and rest[0] in self._numbers:
+        if len(rest) == 2 and rest[1] in AFTER_NUMBER[self.language] and rest[0] in self._numbers:
             rest = rest[:1]  # "the second one"
         if len(rest) == 1 and rest[0] in self._numbers:
             return self._numbers[rest[0]]

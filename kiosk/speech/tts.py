@@ -1,4 +1,4 @@
-"""The kiosk's voice: questions read aloud by espeak-ng, in en, es or fr.
+"""The kiosk's voice: questions read aloud by espeak-ng, in each language's voice (its words file).
 
 All synthesis and playback happen on one worker thread. :class:`Speaker` reports when it
 starts and stops talking (``on_speech(True/False)``) so the recogniser can be muted: the kiosk
@@ -52,7 +52,7 @@ import subprocess
 import tempfile
 import threading
 import wave
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -60,11 +60,12 @@ from typing import Protocol
 import numpy as np
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
+from kiosk.core.words import Table
 
 log = logging.getLogger(__name__)
 
-#: espeak-ng voice per kiosk language
-VOICES = {"en": "gmw/en-us", "es": "roa/es", "fr": "roa/fr"}
+#: espeak-ng voice per kiosk language (``language.voice`` in its words file)
+VOICES: Mapping[str, str] = Table(lambda words: words.voice)
 #: words per minute: older listeners rate 150-200 wpm most comfortable, slower is harder
 DEFAULT_RATE = 160
 #: words per minute never spoken slower than this: slower is made of pauses (see the docstring)

@@ -25,14 +25,15 @@ from pathlib import Path
 from typing import Any
 
 from fileio.positions import Positions, Problem, describe, parse, parse_file, schema_problems
+from kiosk.core.words import languages
 
 #: where the bundled questionnaire and its schema live
 _PACKAGE_DIR = "kiosk.core.questionnaire.instruments"
 DEFAULT_FILE = "barthel.yaml"
 SCHEMA_FILE = "questionnaire.schema.json"
-#: the languages the kiosk's own screens are written in (kiosk/ui/widgets/ui_text.yaml): a
+#: the languages the kiosk's own screens are written in (a words file each, kiosk/core/words): a
 #: questionnaire in another language would start a session its screens cannot show
-SCREEN_LANGUAGES = ("en", "es", "fr")
+SCREEN_LANGUAGES = languages()
 #: the longest a timing setting may be: a day (a longer wait is a typo, and no session lasts it)
 MAX_TIMING_S = 86400.0
 

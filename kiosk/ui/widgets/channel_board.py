@@ -66,7 +66,7 @@ class ChannelBoard:
             state, _ = self.state(name)
             reason = self.patient_reason(name, language) if patient else self.state(name)[1]
             # the state word agrees with the channel's gender where the language needs it
-            word = ui_text(language, f"{state.value}_{name}", default="") or ui_text(language, state.value)
+            word = ui_text(language, f"{state.value}_{name}")
             if state is ChannelState.ON and name == VOICE_OUT and self.speaking:
                 word = ui_text(language, "speaking")
             elif state is ChannelState.ON and name == VOICE_IN and self.listening:

@@ -1,4 +1,5 @@
-"""The kiosk's own screen words (buttons, titles, progress) in each language, from ``ui_text.yaml``.
+"""The kiosk's own screen words (buttons, titles, progress) in each language, from the ``screen``
+section of its words file (``kiosk/core/words/<code>.yaml``).
 
 The questionnaire's texts (questions, options, explanations) come from the questionnaire; these are
 only the words around them.
@@ -6,20 +7,19 @@ only the words around them.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from functools import cache
-from importlib import resources
+from collections.abc import Mapping, Sequence
 
-import yaml
+from kiosk.core.words import TEMPLATE, Table
 
 #: the language whose words every other language falls back to
-FALLBACK = "en"
+FALLBACK = TEMPLATE
+
+_SCREENS: Mapping[str, Mapping[str, str]] = Table(lambda words: words.screen)
+_NAMES: Mapping[str, str] = Table(lambda words: words.name)
 
 
-@cache
-def _table() -> dict[str, dict[str, str]]:
-    text = resources.files("kiosk.ui.widgets").joinpath("ui_text.yaml").read_text(encoding="utf-8")
-    return yaml.safe_load(text)
+def _table() -> Mapping[str, Mapping[str, str]]:
+    return _SCREENS
 
 
 def ui_text(language: str, key: str, default: str | None = None, **values: object) -> str:
@@ -35,8 +35,8 @@ def ui_text(language: str, key: str, default: str | None = None, **values: objec
 
 
 def language_name(language: str) -> str:
-    """The language's own name for itself ("Español"), or its code for a language with no screen words."""
-    return _table().get(language, {}).get("language_name") or language
+    """The language's own name for itself ("Español"), or its code for a language with no words file."""
+    return _NAMES.get(language) or language
 
 
 def ways_sentence(language: str, sentence: str, ways: Sequence[str], suffix: str = "") -> str:

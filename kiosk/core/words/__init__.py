@@ -1,0 +1,323 @@
+"""The kiosk's own words, one file per language: ``kiosk/core/words/<code>.yaml``.
+
+A file names its language (code, own name, espeak-ng voice) and holds the words of the kiosk's
+screens, of the prompts the session builds itself, of what the voice channel understands, and the
+exports' own labels. The questionnaire's texts are not here: they are the instrument's translation,
+in its YAML. The kiosk's languages are the files present, so adding a language is adding a file.
+
+``en.yaml`` is the template: every file has exactly its keys (those outside the screen texts are
+fixed by :data:`SHAPE`), each screen text with the same ``{placeholders}``. A file that differs is
+refused with every difference as one ``file:line:col`` problem, and nothing is half-loaded: one bad
+file and :func:`load_words` loads none. Pure (``fileio`` only), so every layer reads its words here.
+"""
+
+from __future__ import annotations
+
+import re
+import string
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+from typing import Any, TypeVar
+
+from fileio.positions import Positions, Problem, describe, parse_file
+
+#: where the kiosk's words files are
+WORDS_DIR = Path(__file__).resolve().parent
+#: the language whose file every other is checked against, and that screens fall back to
+TEMPLATE = "en"
+#: a words file is named by its language's code, as BCP 47 writes it (en, es, pt-BR)
+LANGUAGE_CODE = re.compile(r"[a-z]{2,3}(-[A-Za-z0-9]{2,8})*")
+
+#: the spoken commands (``kiosk.core.channels.Command``'s values), in the order grammars list them
+COMMANDS = ("repeat", "pause", "resume", "call_doctor", "volume_up", "volume_down", "undo")
+
+# The kinds of value a words file holds (see SHAPE)
+TEXT = "text"  # a non-empty string
+WORDS = "words"  # a non-empty list of non-empty strings
+WORDS_OR_NONE = "words_or_none"  # a list of non-empty strings, possibly empty
+NUMBERS = "numbers"  # a list of WORDS, one per number from one up, as long as en.yaml's
+NUMBER_FORMS = "number_forms"  # WORDS each with one placeholder, {n} (a cardinal) or {o} (an ordinal)
+BY_LANGUAGE = "by_language"  # a mapping of language codes (with a words file) to WORDS
+SCREEN = "screen"  # a mapping with en.yaml's screen keys, each a SCREEN_TEXT
+SCREEN_TEXT = "screen_text"  # a TEXT with the placeholders of en.yaml's text of the same key
+
+#: what every words file holds, section by section (the screen texts' keys are en.yaml's own)
+SHAPE: Mapping[str, Any] = {
+    "language": {"code": TEXT, "name": TEXT, "voice": TEXT},
+    "screen": SCREEN,
+    "prompts": {
+        "yes_label": TEXT,
+        "yes_words": WORDS,
+        "no_label": TEXT,
+        "no_words": WORDS,
+        "start_words": WORDS,
+        "language_names": BY_LANGUAGE,
+    },
+    "speech": {
+        "cardinals": NUMBERS,
+        "ordinals": NUMBERS,
+        "number_forms": NUMBER_FORMS,
+        "number_fillers": WORDS_OR_NONE,
+        "after_number": WORDS_OR_NONE,
+        "commands": dict.fromkeys(COMMANDS, WORDS),
+        "yes_words": WORDS,
+        "no_words": WORDS,
+        "names": WORDS,
+        "start_words": WORDS,
+        "lead_ins": WORDS_OR_NONE,
+        "fillers": WORDS_OR_NONE,
+    },
+    "export": {"total_score": TEXT},
+}
+
+_KIND_WORDS = {
+    TEXT: "text",
+    SCREEN_TEXT: "text",
+    WORDS: "a list of words, at least one",
+    WORDS_OR_NONE: "a list of words (or [])",
+    NUMBER_FORMS: "a list of words, at least one",
+    NUMBERS: "a list with a list of words for each number",
+    BY_LANGUAGE: "a mapping of language codes to lists of words",
+}
+
+
+@dataclass(frozen=True)
+class Words:
+    """One language's words, as its file holds them (lists as tuples, sections as read-only maps).
+
+    ``prompts`` and ``speech`` are keyed as in :data:`SHAPE`; ``screen`` as en.yaml's screen texts.
+    """
+
+    code: str
+    name: str
+    voice: str
+    screen: Mapping[str, str]
+    prompts: Mapping[str, Any]
+    speech: Mapping[str, Any]
+    export: Mapping[str, str]
+
+
+class WordsError(ValueError):
+    """The words files cannot be used; ``problems`` lists every reason with its position."""
+
+    def __init__(self, problems: list[Problem]) -> None:
+        self.problems = problems
+        more = f" (and {len(problems) - 1} more problems)" if len(problems) > 1 else ""
+        super().__init__(str(problems[0]) + more)
+
+
+def language_files(directory: str | Path = WORDS_DIR) -> dict[str, Path]:
+    """Language code → words file, for every ``<code>.yaml`` in ``directory``, by code."""
+    files = sorted(Path(directory).glob("*.yaml"))
+    return {path.stem: path for path in files if LANGUAGE_CODE.fullmatch(path.stem)}
+
+
+@cache
+def languages() -> tuple[str, ...]:
+    """The kiosk's languages: the codes of its words files (a listing; the files are read on first use)."""
+    return tuple(language_files())
+
+
+def check_words(directory: str | Path = WORDS_DIR) -> tuple[dict[str, Words], list[Problem], bool]:
+    """Read every words file of ``directory``: (words by language, problems, whether every file
+    could be parsed as YAML). The words are only those of the files without a problem."""
+    directory = Path(directory)
+    problems: list[Problem] = []
+    paths = language_files(directory)
+    for path in sorted(set(directory.glob("*.yaml")) - set(paths.values())):
+        problems.append(
+            Problem(str(path), 1, 1, f"{path.name!r} is not named by a language code (en.yaml, pt-BR.yaml)")
+        )
+    if TEMPLATE not in paths:
+        where = str(directory / f"{TEMPLATE}.yaml")
+        return {}, [*problems, Problem(where, 1, 1, "missing: every language's words file is checked against it")], True
+    parsed: dict[str, tuple[Any, Positions]] = {}
+    readable = True
+    for code, path in paths.items():
+        data, positions, found = parse_file(path)
+        problems += found
+        readable = readable and not found
+        if positions is not None:
+            parsed[code] = (data, positions)
+    if TEMPLATE not in parsed:
+        return {}, problems, readable
+    template = parsed[TEMPLATE][0]
+    words = {}
+    for code, (data, positions) in parsed.items():
+        found = _Check(str(paths[code]), positions, template, set(paths)).problems(data, code)
+        problems += found
+        if not found:
+            words[code] = _words(code, data)
+    return words, problems, readable
+
+
+def load_words(directory: str | Path | None = None) -> dict[str, Words]:
+    """Every language's words, from ``directory`` (default: the kiosk's own, read once).
+
+    Raises :class:`WordsError` with every problem of every file when any file has one.
+    """
+    if directory is None:
+        return _kiosk_words()
+    words, problems, _ = check_words(directory)
+    if problems:
+        raise WordsError(problems)
+    return words
+
+
+@cache
+def _kiosk_words() -> dict[str, Words]:
+    return load_words(WORDS_DIR)
+
+
+T = TypeVar("T")
+
+
+class Table(Mapping[str, T]):
+    """One thing from every language's words, by language code (``VOICES["es"]``), read from the
+    kiosk's words files on first use, so importing a module with tables reads no file."""
+
+    def __init__(self, pick: Callable[[Words], T]) -> None:
+        self._pick = pick
+        self._values: dict[str, T] | None = None
+
+    def _all(self) -> dict[str, T]:
+        if self._values is None:
+            self._values = {code: self._pick(words) for code, words in load_words().items()}
+        return self._values
+
+    def __getitem__(self, language: str) -> T:
+        return self._all()[language]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._all())
+
+    def __len__(self) -> int:
+        return len(self._all())
+
+    def __repr__(self) -> str:
+        return f"Table({self._all()!r})"
+
+
+def _frozen(value: Any) -> Any:
+    if isinstance(value, list):
+        return tuple(_frozen(v) for v in value)
+    if isinstance(value, dict):
+        return {k: _frozen(v) for k, v in value.items()}
+    return value
+
+
+def _words(code: str, data: Mapping[str, Any]) -> Words:
+    """A checked file's data as :class:`Words`; sections of SHAPE keep SHAPE's order."""
+
+    def section(name: str) -> dict[str, Any]:
+        return {key: _frozen(data[name][key]) for key in SHAPE[name]}
+
+    speech = section("speech")
+    speech["commands"] = {key: _frozen(data["speech"]["commands"][key]) for key in SHAPE["speech"]["commands"]}
+    language = data["language"]
+    return Words(
+        code, language["name"], language["voice"], dict(data["screen"]), section("prompts"), speech, section("export")
+    )
+
+
+def _placeholders(text: Any) -> set[str] | None:
+    """The ``{names}`` in ``text``, or None when it is no text or its braces are not a format string's."""
+    if not isinstance(text, str):
+        return None
+    try:
+        return {name for _, name, _, _ in string.Formatter().parse(text) if name is not None}
+    except ValueError:
+        return None
+
+
+class _Check:
+    """The problems of one file's data against SHAPE and the template's (en.yaml's) screen texts."""
+
+    def __init__(self, name: str, positions: Positions, template: Any, codes: set[str]) -> None:
+        self.name, self.positions, self.codes = name, positions, codes
+        self.template = template if isinstance(template, dict) else {}
+        self.found: list[Problem] = []
+
+    def add(self, path: tuple[Any, ...], message: str, key: bool = False) -> None:
+        line, column = self.positions.of(path, key=key)
+        self.found.append(Problem(self.name, line, column, message))
+
+    def problems(self, data: Any, code: str) -> list[Problem]:
+        self.mapping((), data, SHAPE)
+        declared = data.get("language", {}).get("code") if isinstance(data, dict) else None
+        if isinstance(declared, str) and declared != code:
+            self.add(("language", "code"), f"language.code is {declared!r} but the file is {code}.yaml")
+        return self.found
+
+    def mapping(self, path: tuple[Any, ...], value: Any, shape: Mapping[str, Any]) -> None:
+        where = describe(path) or "the file"
+        if not isinstance(value, dict):
+            self.add(path, f"{where} must be a mapping" + (f" of {', '.join(map(repr, shape))}" if path else ""))
+            return
+        for key in shape:
+            if key not in value:
+                self.add(path, f"{where} is missing {describe(path + (key,))!r} (en.yaml has it)")
+        for key in value:
+            if not isinstance(key, str):
+                self.add(path + (key,), f"the key {key!r} in {where} must be text (write it in quotes)", key=True)
+            elif key not in shape:
+                self.add(path + (key,), f"unknown key {describe(path + (key,))!r} (en.yaml has no such key)", key=True)
+            else:
+                self.value(path + (key,), value[key], shape[key])
+
+    def value(self, path: tuple[Any, ...], value: Any, kind: Any) -> None:
+        if isinstance(kind, dict):
+            self.mapping(path, value, kind)
+        elif kind == SCREEN:
+            texts = self.template.get("screen")
+            if not isinstance(value, dict) or isinstance(texts, dict):  # en.yaml's own check reports its screen
+                self.mapping(path, value, dict.fromkeys(texts, SCREEN_TEXT) if isinstance(texts, dict) else {})
+        elif not self.fits(value, kind):
+            self.add(path, f"{describe(path)} must be {_KIND_WORDS[kind]}")
+        else:
+            self.details(path, value, kind)
+
+    def fits(self, value: Any, kind: str) -> bool:
+        def words(v: Any, empty: bool = False) -> bool:
+            return isinstance(v, list) and (empty or bool(v)) and all(isinstance(w, str) and w.strip() for w in v)
+
+        if kind in (TEXT, SCREEN_TEXT):
+            return isinstance(value, str) and bool(value.strip())
+        if kind in (WORDS, NUMBER_FORMS):
+            return words(value)
+        if kind == WORDS_OR_NONE:
+            return words(value, empty=True)
+        if kind == NUMBERS:
+            return isinstance(value, list) and bool(value) and all(words(v) for v in value)
+        return isinstance(value, dict) and all(isinstance(k, str) and words(v) for k, v in value.items())
+
+    def in_template(self, path: tuple[Any, ...]) -> Any:
+        """The template's value at ``path``, or None."""
+        value: Any = self.template
+        for key in path:
+            value = value.get(key) if isinstance(value, dict) else None
+        return value
+
+    def details(self, path: tuple[Any, ...], value: Any, kind: str) -> None:
+        """What a value of the right kind may still get wrong: placeholders, counts, codes."""
+        if kind == SCREEN_TEXT:
+            mine, theirs = _placeholders(value), _placeholders(self.in_template(path))
+            if mine is None:
+                self.add(path, f"{describe(path)}: a brace without its pair (write {{{{ or }}}} for a brace)")
+            elif theirs is not None and mine != theirs:
+                want = ", ".join(f"{{{p}}}" for p in sorted(theirs)) or "none"
+                self.add(path, f"{describe(path)} must have the placeholders of en.yaml ({want})")
+        elif kind == NUMBERS:
+            template = self.in_template(path)
+            if isinstance(template, list) and len(value) != len(template):
+                self.add(path, f"{describe(path)} must have the words for {len(template)} numbers, as en.yaml")
+        elif kind == NUMBER_FORMS:
+            for index, form in enumerate(value):
+                if _placeholders(form) not in ({"n"}, {"o"}):
+                    self.add(path + (index,), f"{describe(path + (index,))} must hold {{n}} or {{o}}")
+        elif kind == BY_LANGUAGE:
+            for code in value:
+                if code not in self.codes:
+                    self.add(path + (code,), f"{describe(path + (code,))}: no words file for {code!r}", key=True)
