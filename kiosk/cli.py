@@ -18,7 +18,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("kiosk.ui.app", "start the kiosk (the default when no sub-command is given)"),
     "serve": ("kiosk.ui.serve.server", "serve the kiosk to a browser on a touch display (localhost by default)"),
     "replay": ("kiosk.commands.replay", "run a scripted patient through the real session on a simulated clock"),
-    "validate": ("kiosk.commands.validate", "check a questionnaire YAML file and list every problem"),
+    "validate": ("kiosk.commands.validate", "check questionnaire files and the words files; list every problem"),
     "results": ("kiosk.commands.results", "list stored sessions, show one, or export it (FHIR JSON, CSV)"),
     "devices": ("kiosk.commands.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
     "pin": ("kiosk.commands.pin", "set the clinician PIN (`kiosk pin set`; stored hashed in the configuration)"),

@@ -216,6 +216,12 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
         if env.get(var):
             station = {**station, key: env[var]}
     values["station"] = _station(station, f"{path}: station" if path is not None else "KIOSK_STATION_URL")
+    from kiosk.core.words import WordsError, load_words
+
+    try:  # the screens' words, read now so a bad words file stops the kiosk before any screen
+        load_words()
+    except WordsError as exc:
+        raise ConfigError(str(exc)) from None
     if values.get("language", "en") not in SCREEN_LANGUAGES:
         raise ConfigError(f"language {values['language']!r} is not one of {', '.join(SCREEN_LANGUAGES)}")
     return Config(**values, source=Path(path) if path is not None else None)

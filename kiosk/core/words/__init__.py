@@ -108,9 +108,10 @@ class WordsError(ValueError):
         super().__init__(str(problems[0]) + more)
 
 
-def language_files(directory: str | Path = WORDS_DIR) -> dict[str, Path]:
-    """Language code → words file, for every ``<code>.yaml`` in ``directory``, by code."""
-    files = sorted(Path(directory).glob("*.yaml"))
+def language_files(directory: str | Path | None = None) -> dict[str, Path]:
+    """Language code → words file, for every ``<code>.yaml`` in ``directory`` (default: the
+    kiosk's own), by code."""
+    files = sorted(Path(WORDS_DIR if directory is None else directory).glob("*.yaml"))
     return {path.stem: path for path in files if LANGUAGE_CODE.fullmatch(path.stem)}
 
 
@@ -120,10 +121,11 @@ def languages() -> tuple[str, ...]:
     return tuple(language_files())
 
 
-def check_words(directory: str | Path = WORDS_DIR) -> tuple[dict[str, Words], list[Problem], bool]:
-    """Read every words file of ``directory``: (words by language, problems, whether every file
-    could be parsed as YAML). The words are only those of the files without a problem."""
-    directory = Path(directory)
+def check_words(directory: str | Path | None = None) -> tuple[dict[str, Words], list[Problem], bool]:
+    """Read every words file of ``directory`` (default: the kiosk's own): (words by language,
+    problems, whether every file could be parsed as YAML). The words are those of the files
+    without a problem."""
+    directory = Path(WORDS_DIR if directory is None else directory)
     problems: list[Problem] = []
     paths = language_files(directory)
     for path in sorted(set(directory.glob("*.yaml")) - set(paths.values())):
@@ -258,7 +260,7 @@ class _Check:
             return
         for key in shape:
             if key not in value:
-                self.add(path, f"{where} is missing {describe(path + (key,))!r} (en.yaml has it)")
+                self.add(path, f"missing {describe(path + (key,))!r} (en.yaml has it)", key=True)
         for key in value:
             if not isinstance(key, str):
                 self.add(path + (key,), f"the key {key!r} in {where} must be text (write it in quotes)", key=True)
