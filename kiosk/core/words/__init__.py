@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any, TypeVar
 
 from fileio.positions import Positions, Problem, describe, parse_file
@@ -161,7 +162,7 @@ def load_words(directory: str | Path | None = None) -> dict[str, Words]:
     Raises :class:`WordsError` with every problem of every file when any file has one.
     """
     if directory is None:
-        return _kiosk_words()
+        return dict(_kiosk_words())
     words, problems, _ = check_words(directory)
     if problems:
         raise WordsError(problems)
@@ -206,21 +207,27 @@ def _frozen(value: Any) -> Any:
     if isinstance(value, list):
         return tuple(_frozen(v) for v in value)
     if isinstance(value, dict):
-        return {k: _frozen(v) for k, v in value.items()}
+        return MappingProxyType({k: _frozen(v) for k, v in value.items()})
     return value
 
 
 def _words(code: str, data: Mapping[str, Any]) -> Words:
     """A checked file's data as :class:`Words`; sections of SHAPE keep SHAPE's order."""
 
-    def section(name: str) -> dict[str, Any]:
-        return {key: _frozen(data[name][key]) for key in SHAPE[name]}
+    def section(name: str) -> Mapping[str, Any]:
+        return MappingProxyType({key: _frozen(data[name][key]) for key in SHAPE[name]})
 
-    speech = section("speech")
-    speech["commands"] = {key: _frozen(data["speech"]["commands"][key]) for key in SHAPE["speech"]["commands"]}
+    speech = dict(section("speech"))
+    speech["commands"] = MappingProxyType({key: _frozen(data["speech"]["commands"][key]) for key in COMMANDS})
     language = data["language"]
     return Words(
-        code, language["name"], language["voice"], dict(data["screen"]), section("prompts"), speech, section("export")
+        code,
+        language["name"],
+        language["voice"],
+        MappingProxyType(dict(data["screen"])),
+        section("prompts"),
+        MappingProxyType(speech),
+        section("export"),
     )
 
 
