@@ -263,7 +263,8 @@ class _Check:
     def mapping(self, path: tuple[Any, ...], value: Any, shape: Mapping[str, Any]) -> None:
         where = describe(path) or "the file"
         if not isinstance(value, dict):
-            self.add(path, f"{where} must be a mapping" + (f" of {', '.join(map(repr, shape))}" if path else ""))
+            keys = f" of {', '.join(map(repr, shape))}" if path and shape else ""
+            self.add(path, f"{where} must be a mapping{keys}")
             return
         for key in shape:
             if key not in value:
@@ -279,10 +280,11 @@ class _Check:
     def value(self, path: tuple[Any, ...], value: Any, kind: Any) -> None:
         if isinstance(kind, dict):
             self.mapping(path, value, kind)
-        elif kind == SCREEN:
+        elif kind == SCREEN:  # en.yaml's screen keys (a template without them is reported in its own check)
             texts = self.template.get("screen")
-            if not isinstance(value, dict) or isinstance(texts, dict):  # en.yaml's own check reports its screen
-                self.mapping(path, value, dict.fromkeys(texts, SCREEN_TEXT) if isinstance(texts, dict) else {})
+            keys = dict.fromkeys(texts, SCREEN_TEXT) if isinstance(texts, dict) else None
+            if keys is not None or not isinstance(value, dict):
+                self.mapping(path, value, keys or {})
         elif not self.fits(value, kind):
             self.add(path, f"{describe(path)} must be {_KIND_WORDS[kind]}")
         else:

@@ -116,6 +116,17 @@ def test_each_difference_from_en_yaml_is_one_positioned_problem(tmp_path, old, n
     assert str(problems[0]).startswith(position(path, at).rsplit(":", 1)[0] + ":") and message in problems[0].message
 
 
+def test_a_broken_template_is_reported_in_the_template_only(tmp_path):
+    directory = words_dir(tmp_path)
+    template = directory / "en.yaml"
+    text = template.read_text(encoding="utf-8")
+    template.write_text(text[: text.index("\nscreen:\n")] + "\nscreen: none\n" + text[text.index("\nprompts:") :])
+    _, problems, _ = check_words(directory)
+    assert [str(p) for p in problems] == [
+        f"{position(template, 'screen: none').rsplit(':', 1)[0]}:9: screen must be a mapping"
+    ]
+
+
 def test_unreadable_or_misnamed_files_and_a_missing_template_are_refused(tmp_path, capsys):
     directory = words_dir(tmp_path)
     (directory / "xx.yaml").write_bytes(b"language: {code: xx\x00}\n")
