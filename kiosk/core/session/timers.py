@@ -55,6 +55,16 @@ class AttemptClock:
         """Whether anything stops the clock."""
         return bool(self.freezes)
 
+    @property
+    def paused(self) -> bool:
+        """Stopped by the patient's pause."""
+        return "paused" in self.freezes
+
+    @property
+    def halted(self) -> bool:
+        """Stopped by a call for the doctor, until a clinician (or the patient) carries on."""
+        return "doctor" in self.freezes
+
     def set(self, kind: str, start_t: float, seconds: float) -> None:
         """Replace the pending time-out by one ``seconds`` after session time ``start_t``."""
         if self.freezes:
