@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import sqlite3
+from collections.abc import Callable
 from pathlib import Path
 
 from kiosk.store.migrations import InForce, SchemaError, migrate
@@ -66,7 +67,7 @@ def _is_damage(exc: sqlite3.DatabaseError) -> bool:
     return type(exc) is sqlite3.DatabaseError or "malformed" in message or "not a database" in message
 
 
-def connect(data_dir: str | Path, create: bool, in_force: InForce) -> tuple[sqlite3.Connection, Path]:
+def connect(data_dir: str | Path, create: bool, in_force: Callable[[], InForce]) -> tuple[sqlite3.Connection, Path]:
     """The connection to the database in ``data_dir`` (created with it unless ``create`` is False)
     and its path, schema up to date (``in_force``: see :func:`kiosk.store.migrations.migrate`);
     StorageError naming the file and what to do otherwise."""

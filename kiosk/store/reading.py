@@ -61,7 +61,10 @@ class Reader:
             " (SELECT COUNT(*) FROM not_answered n WHERE n.session_id = s.id), s.simulated, s.interrupted_reason"
             " FROM sessions s ORDER BY s.started_at DESC, s.rowid DESC"
         ).fetchall()
-        return [SessionSummary(*row[:8], simulated=bool(row[8]), interrupted_reason=row[9]) for row in rows]
+        return [
+            SessionSummary(id_, patient, started, finished, status, language, answered, missed, bool(simulated), reason)
+            for id_, patient, started, finished, status, language, answered, missed, simulated, reason in rows
+        ]
 
     @_reading
     def outbox_waiting(self) -> tuple[int, int]:

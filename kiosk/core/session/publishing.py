@@ -51,7 +51,7 @@ class Batch:
 
 #: told of each QoS result as (session time, metrics, whether it published an answer)
 MetricsObserver = Callable[[float, Mapping[str, float], bool], None]
-#: acts on one time-out of a kind, due at a session time (see ``Session._fire``)
+#: acts on one time-out of a kind, due at a session time (see ``Router.fire`` in :mod:`kiosk.core.session.routing`)
 Fire = Callable[[str, float], None]
 
 
