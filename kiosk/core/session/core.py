@@ -79,9 +79,6 @@ class Session:
         self.clock = clock
         self.engine = engine
         self.store = store
-        self.next_patient_after_s = next_patient_after_s
-        #: how this visit began, logged as it starts ("order ID", "staff", "walk-up"; see kiosk.core.visits)
-        self.visit = visit
         resuming = resume_answers is not None
         self.state = state = SessionState(
             questionnaire=questionnaire,
@@ -183,6 +180,16 @@ class Session:
     def adaptation(self) -> Any:
         """The live adaptation policy (``kiosk.core.adaptation.Adaptation``), or None."""
         return self.state.adaptation
+
+    @property
+    def visit(self) -> str | None:
+        """How this visit began, logged as it starts ("order ID", "staff", "walk-up"; see kiosk.core.visits)."""
+        return self.opening.visit
+
+    @property
+    def next_patient_after_s(self) -> float | None:
+        """How long the end screen stays before NextPatient (None: it stays)."""
+        return self.flow.next_patient_after_s
 
     @property
     def trace(self) -> list[dict[str, Any]]:
