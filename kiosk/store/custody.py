@@ -1,36 +1,42 @@
-"""Who holds a session, for :class:`kiosk.store.database.Store` (a mixin: the store's own transaction and
-connection): the lease taken when a session is created or continued and checked in every write,
-its renewal and release, and the sweep that marks interrupted the running sessions whose kiosk is
-gone or that grew too old (see :mod:`kiosk.store.lease` for when a lease lapses)."""
+"""Who holds a session, for :class:`kiosk.store.database.Store`: the lease taken when a session is
+created or continued and checked in every write, its renewal and release, and the sweep that marks
+interrupted the running sessions whose kiosk is gone or that grew too old (see
+:mod:`kiosk.store.lease` for when a lease lapses). It shares the store's connection and
+transactions (:mod:`kiosk.store.transactions`), given to it when it is made."""
 
 from __future__ import annotations
 
 import sqlite3
 from collections.abc import Callable
 from datetime import datetime, timezone
-from typing import Any
 
 from kiosk.store.lease import Owner, SessionTaken, lapsed
-from kiosk.store.records import StoredSession
+from kiosk.store.transactions import Transactions
 
 
 class Custody:
-    """The lease half of the store; ``Store`` provides the attributes and helpers used here."""
+    """This kiosk's leases on sessions. ``owner`` is this kiosk process; ``lease_ttl_s`` how long an
+    unrenewed lease lasts; ``interrupt_after_s`` the age after which a running session counts as
+    interrupted (None: no limit); ``wall`` the epoch seconds leases are dated with."""
 
-    _db: sqlite3.Connection
-    owner: Owner
-    lease_ttl_s: float
-    interrupt_after_s: float | None
-    _wall: Callable[[], float]
-    _held: set[str]
-    transaction: Callable[[], Any]
-    _write: Callable[..., None]
-    _queue: Callable[..., None]
-    _iso_now: Callable[[], str]
-    resolve: Callable[[str], str]
-    session: Callable[[str], StoredSession]
+    def __init__(
+        self,
+        tx: Transactions,
+        *,
+        owner: Owner,
+        lease_ttl_s: float,
+        interrupt_after_s: float | None,
+        wall: Callable[[], float],
+    ) -> None:
+        self.tx = tx
+        self._db: sqlite3.Connection = tx.db
+        self.owner = owner
+        self.lease_ttl_s = lease_ttl_s
+        self.interrupt_after_s = interrupt_after_s
+        self._wall = wall
 
-    def _status(self, session_id: str) -> str | None:
+    def status(self, session_id: str) -> str | None:
+        """The session's status ("running", "finished", ...), or None if it is not stored."""
         row = self._db.execute("SELECT status FROM sessions WHERE id = ?", (session_id,)).fetchone()
         return row[0] if row else None
 
@@ -40,12 +46,11 @@ class Custody:
         ).fetchone()
         return (Owner(row[0], int(row[1]), row[2]), float(row[3])) if row else None
 
-    def _check_held(self, session_id: str) -> None:
+    def check_held(self, session_id: str) -> None:
         """Inside a write transaction: this kiosk holds the session, else SessionTaken."""
         why = self.why_not_held(session_id)
         if why is not None:
             raise SessionTaken(why)
-        self._held.add(session_id)
 
     def why_not_held(self, session_id: str) -> str | None:
         """Why this kiosk may not record in the session (a sentence for staff), or None if it holds it."""
@@ -63,7 +68,7 @@ class Custody:
         why = f" ({row[1]})" if row[0] == "interrupted" and row[1] else ""
         return f"session {session_id} is no longer held by this kiosk: it is {row[0]}{why}"
 
-    def _take(self, session_id: str) -> None:
+    def take(self, session_id: str) -> None:
         """Inside a write transaction: take the session's lease unless a live kiosk holds it."""
         holder = self._holder(session_id)
         now = self._wall()
@@ -80,9 +85,9 @@ class Custody:
             "INSERT OR REPLACE INTO leases VALUES (?, ?, ?, ?, ?, ?)",
             (session_id, self.owner.host, self.owner.pid, self.owner.token, now, now),
         )
-        self._held.add(session_id)
+        self.tx.held.add(session_id)
 
-    def _my_sessions(self) -> list[str]:
+    def my_sessions(self) -> list[str]:
         return [r[0] for r in self._db.execute("SELECT session_id FROM leases WHERE token = ?", (self.owner.token,))]
 
     def held_elsewhere(self, session_id: str) -> bool:
@@ -101,33 +106,33 @@ class Custody:
 
     def renew(self) -> None:
         """Renew this kiosk's leases (the running kiosk calls this every third of the lease time)."""
-        if not self._my_sessions():
+        if not self.my_sessions():
             return
-        with self.transaction():
-            self._write("UPDATE leases SET renewed_at = ? WHERE token = ?", (self._wall(), self.owner.token))
+        with self.tx.transaction():
+            self.tx.write("UPDATE leases SET renewed_at = ? WHERE token = ?", (self._wall(), self.owner.token))
 
     def release(self, session_id: str, reason: str = "its kiosk moved on to another test") -> None:
         """Give up the session: this kiosk no longer records in it. Still running, it is interrupted."""
-        with self.transaction():
+        with self.tx.transaction():
             if not self.holds(session_id):
                 return
-            if self._status(session_id) == "running":
+            if self.status(session_id) == "running":
                 self._interrupt(session_id, reason)
-            self._write("DELETE FROM leases WHERE session_id = ?", (session_id,))
+            self.tx.write("DELETE FROM leases WHERE session_id = ?", (session_id,))
 
     def release_others(self, keep: str) -> None:
         """Release every session this kiosk holds but ``keep`` (its running one)."""
-        for session_id in self._my_sessions():
+        for session_id in self.my_sessions():
             if session_id != keep:
                 self.release(session_id)
 
     def _interrupt(self, session_id: str, reason: str) -> None:
-        self._write(
+        self.tx.write(
             "UPDATE sessions SET status = 'interrupted', interrupted_at = ?, interrupted_reason = ?"
             " WHERE id = ? AND status = 'running'",
-            (self._iso_now(), reason, session_id),
+            (self.tx.iso_now(), reason, session_id),
         )
-        self._queue("mark_interrupted", session_id, {"reason": reason})
+        self.tx.queue("mark_interrupted", session_id, {"reason": reason})
 
     def _stale(self) -> list[tuple[str, str]]:
         """Running sessions whose kiosk is gone, or older than the limit: (id, why)."""
@@ -160,7 +165,7 @@ class Custody:
         is never offered one; staff may continue it (:meth:`continue_session`)."""
         if not self._stale():
             return []  # the usual case: a read, no write lock
-        with self.transaction():
+        with self.tx.transaction():
             self._db.execute("BEGIN IMMEDIATE")
             stale = self._stale()  # again under the lock: another kiosk may have acted meanwhile
             for session_id, why in stale:
@@ -168,12 +173,11 @@ class Custody:
                 self._db.execute("DELETE FROM leases WHERE session_id = ?", (session_id,))
         return [session_id for session_id, _ in stale]
 
-    def continue_session(self, ref: str) -> StoredSession:
+    def continue_session(self, session_id: str) -> None:
         """Staff continue an interrupted session on this kiosk: it is taken (atomically; SessionTaken
         if a running kiosk holds it) and running again. ValueError if it cannot be continued."""
-        session_id = self.resolve(ref)
         self.interrupt_stale()
-        with self.transaction():
+        with self.tx.transaction():
             self._db.execute("BEGIN IMMEDIATE")
             status, simulated = self._db.execute(
                 "SELECT status, simulated FROM sessions WHERE id = ?", (session_id,)
@@ -181,16 +185,15 @@ class Custody:
             if simulated:
                 raise ValueError(f"session {session_id} is a simulated (replayed) session: it cannot be continued")
             if status == "running":
-                self._take(session_id)  # SessionTaken unless it is this kiosk's already
+                self.take(session_id)  # SessionTaken unless it is this kiosk's already
             elif status != "interrupted":
                 raise ValueError(f"session {session_id} is {status}: only an interrupted test can be continued")
-            self._take(session_id)
+            self.take(session_id)
             self._db.execute(
                 "UPDATE sessions SET status = 'running', interrupted_at = NULL, interrupted_reason = NULL WHERE id = ?",
                 (session_id,),
             )
-            self._queue("continue_session", session_id, {})
-        return self.session(session_id)
+            self.tx.queue("continue_session", session_id, {})
 
 
 def _age_s(started_at: str, now: float) -> float:

@@ -47,12 +47,16 @@ lost/back -> ``PersonDetected: false/true``; finish -> ``TestState: FINISHED``.
 The keyboard maps to ``TOUCH_SCREEN``: the on-screen number keys are on the same kiosk panel as
 the touchscreen, and the CLARC model has no keyboard literal.
 
-The package, one concept a module: :mod:`.events` (what is published), :mod:`.snapshot` (what a
-screen renders), :mod:`.timers` (the attempt clock), :mod:`.questions` (attempts, answers,
-time-outs, finish), :mod:`.corrections` (confirm an unsure answer, undo the last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor,
-presence), :mod:`.live` (live adaptation), :mod:`.publishing` (prompts, QoS batches, log,
-listeners), :mod:`.ports` (what it needs of the engine and the store) and :mod:`.core` (the
-session's state and the steps before the questions).
+The package, one concept a module, each a plain class given what it needs in its constructor
+(none imports :class:`Session`): :mod:`.events` (what is published), :mod:`.snapshot` (what a
+screen renders), :mod:`.state` (the one shared state), :mod:`.timers` (the attempt clock),
+:mod:`.publishing` (QoS batches, log, listeners, the operation bracket), :mod:`.prompts` (what is
+shown and said), :mod:`.opening` (welcome, start, language, explanation), :mod:`.questions`
+(attempts, answers, time-outs, finish), :mod:`.corrections` (confirm an unsure answer, undo the
+last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor, presence),
+:mod:`.live` (live adaptation), :mod:`.routing` (which step takes an input or a time-out),
+:mod:`.resume` (continuing a stored session), :mod:`.ports` (what it needs of the engine and the
+store) and :mod:`.core` (the :class:`Session` that owns them).
 """
 
 from kiosk.core.session.core import Session

@@ -1,41 +1,42 @@
-"""The :class:`Session`: its state, what it shows of it, and the steps before the questions.
+"""The :class:`Session`: a small owner of collaborators, each given what it needs when made.
 
-The question flow, incidents (pause, call-doctor, presence), practice, live adaptation,
-publishing and the attempt clock live in their own modules of this package; :class:`Session`
-puts them together over one shared state."""
+:class:`~kiosk.core.session.state.SessionState` holds what the session is and knows;
+:class:`~kiosk.core.session.timers.AttemptClock` its one time-out; :class:`~kiosk.core.session.publishing.Outputs`
+its listeners, QoS batches, trace and log; :class:`~kiosk.core.session.prompts.Prompts` what it
+shows and says. The steps (:class:`~kiosk.core.session.opening.Opening`,
+:class:`~kiosk.core.session.questions.QuestionFlow`, :class:`~kiosk.core.session.corrections.Corrections`,
+:class:`~kiosk.core.session.practice.Practice`, :class:`~kiosk.core.session.incidents.Incidents`,
+:class:`~kiosk.core.session.live.LiveAdaptation`) act on those; none knows :class:`Session`.
+The session brackets every public call in one operation; :class:`~kiosk.core.session.routing.Router`
+sends each input and time-out to the step that handles it."""
 
 from __future__ import annotations
 
 import uuid
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.clock import Clock
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
-from kiosk.core.questionnaire.definition import canonical
 from kiosk.core.session.corrections import Corrections
-from kiosk.core.session.events import (
-    AnsweredBy,
-    IgnoreReason,
-    LanguageChanged,
-    Phase,
-    Prompt,
-    PromptOption,
-    SessionEvent,
-)
+from kiosk.core.session.events import AnsweredBy, Phase
 from kiosk.core.session.incidents import Incidents
 from kiosk.core.session.live import LiveAdaptation
+from kiosk.core.session.opening import Opening
 from kiosk.core.session.ports import QosEngine, SessionStore
 from kiosk.core.session.practice import Practice
-from kiosk.core.session.publishing import Batch, Listener, Operation, Publisher
-from kiosk.core.session.questions import OpenQuestion, QuestionFlow
+from kiosk.core.session.prompts import Prompts
+from kiosk.core.session.publishing import Listener, Operation, Outputs
+from kiosk.core.session.questions import QuestionFlow
+from kiosk.core.session.resume import replay_into, restore_adaptation
+from kiosk.core.session.routing import Router
 from kiosk.core.session.snapshot import Answer, Snapshot
+from kiosk.core.session.state import SessionState
 from kiosk.core.session.timers import AttemptClock
-from kiosk.core.session.words import LANGUAGE_NAMES, OWN_NAME, START_LABEL, START_WORDS
 
 
-class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Publisher):
+class Session:
     """One administration of a questionnaire. See the package docstring for the rules.
 
     ``engine`` is a ``qos.Engine`` (``None``: no QoS, contexts are still kept in :attr:`trace`).
@@ -78,51 +79,60 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         self.clock = clock
         self.engine = engine
         self.store = store
-        self.patient_id = patient_id
-        self.id = session_id or uuid.uuid4().hex[:12]
-        self.timing = timing if isinstance(timing, Timing) else questionnaire.timing.with_overrides(timing)
-        self.adaptation = adaptation
-        self.next_patient_after_s = next_patient_after_s
-        #: how this visit began, logged as it starts ("order ID", "staff", "walk-up"; see kiosk.core.visits)
-        self.visit = visit
-        self._language = language
-        self._answered_by = AnsweredBy(answered_by)
-        self._familiarisation = familiarisation and bool(questionnaire.familiarisation)
-        self._timers = AttemptClock(clock, clock.now() - t_offset)
-        self._resuming = resume_answers is not None
-        self._stored = self._resuming and store is not None
-        self._phase = Phase.WELCOME
-        #: the welcome prompt was published (see welcome()): listen for "start" until started
-        self._greeted = False
-        self._open: OpenQuestion | None = None
-        self._answers: dict[str, Answer] = dict(resume_answers or {})
-        self._not_answered: list[str] = list(resume_not_answered)
-        self._person_present = True
-        #: whether voice in works on this kiosk (see set_voice_available)
-        self._voice_available = True
-        #: whether voice out works on this kiosk (see set_voice_out_available)
-        self._voice_out_available = True
-        #: ids of the practice questions skipped before they were shown (see set_voice_out_available)
-        self._practice_unasked: set[str] = set()
-        self._prompt: Prompt | None = None
-        self._repeating = False
-        self._listening = False
-        self._score: Score | None = None
-        #: every context batch published, as trace events ({"t":..., "set":..., "emit":...})
-        self.trace: list[dict[str, Any]] = []
-        #: the latest metrics from the QoS engine
-        self.metrics: dict[str, float] = {}
-        self._batch: Batch | None = None
-        #: batches the engine ran since the session last looked (see Publisher._take_qos_results)
-        self._qos_results: list[Any] = []
-        #: time of the latest batch the engine ran on its own (timers, time windows)
-        self._timed_t = -1.0
-        if engine is not None:
-            engine.subscribe(self._qos_results.append)
-        self._listeners: list[Listener] = []
-        self._queue: list[SessionEvent] = []
-        self._depth = 0
-        self._dispatching = False
+        resuming = resume_answers is not None
+        self.state = state = SessionState(
+            questionnaire=questionnaire,
+            timing=timing if isinstance(timing, Timing) else questionnaire.timing.with_overrides(timing),
+            id=session_id or uuid.uuid4().hex[:12],
+            patient_id=patient_id,
+            adaptation=adaptation,
+            language=language,
+            answered_by=AnsweredBy(answered_by),
+            familiarisation=familiarisation and bool(questionnaire.familiarisation),
+            resuming=resuming,
+            stored=resuming and store is not None,
+            answers=dict(resume_answers or {}),
+            not_answered=list(resume_not_answered),
+        )
+        self.timers = timers = AttemptClock(clock, clock.now() - t_offset)
+        self.out = out = Outputs(state, timers, engine=engine, store=store, on_metrics=self._metrics_updated)
+        self.prompts = prompts = Prompts(state, timers, out)
+        self.live = LiveAdaptation(state, timers, out, prompts, store=store)
+        self.incidents = Incidents(state, timers, out, prompts)
+        self.flow = flow = QuestionFlow(
+            state,
+            timers,
+            out,
+            prompts,
+            store=store,
+            next_patient_after_s=next_patient_after_s,
+            practice_not_answered=self._practice_not_answered,
+        )
+        self.corrections = Corrections(
+            state, timers, out, prompts, store=store, record_answer=flow.record_answer, time_out=flow.attempt_timed_out
+        )
+        self.practice = practice = Practice(state, timers, out, prompts, store=store, open_question=flow.open_question)
+        self.opening = opening = Opening(
+            state,
+            out,
+            prompts,
+            clock=clock,
+            store=store,
+            visit=visit,
+            open_practice=practice.open,
+            schedule_next_item=flow.schedule_next_item,
+        )
+        self.router = Router(
+            state,
+            timers,
+            out,
+            prompts,
+            opening=opening,
+            flow=flow,
+            corrections=self.corrections,
+            practice=practice,
+            incidents=self.incidents,
+        )
 
     # -- construction from a stored, unfinished session -----------------------------------------
 
@@ -144,98 +154,116 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         ``PersonDetected: true, TestState: RESTARTED``) and the explanation, the session asks
         the first item that has neither an answer nor a "not answered" record.
         """
-        for event in stored.trace:
-            if engine is not None:
-                engine.update(event["t"], set=event.get("set") or {}, emit=list(event.get("emit") or []))
-        last = max((e["t"] for e in stored.trace), default=0.0)
-        # the model's timers that fired after the last context (stored as metrics) are not run twice
-        last_timed = max((m.t for m in stored.metrics), default=last)
-        if engine is not None and last_timed > last:
-            engine.advance(last_timed)
-        session = cls(
-            questionnaire,
-            clock=clock,
-            engine=engine,
-            store=store,
-            patient_id=stored.patient_id,
-            language=stored.language,
-            answered_by=stored.answered_by,
-            session_id=stored.id,
-            # the crash took some time: resumed batches come a second after the stored ones
-            t_offset=max(last, last_timed) + 1.0,
-            resume_answers={a.item_id: a for a in stored.answers},
-            resume_not_answered=tuple(stored.not_answered),
-            familiarisation=False,
-            **kwargs,
-        )
-        session.trace = [dict(e) for e in stored.trace]
-        if session.adaptation is not None:
-            # a crash must not undo the clinician's switch or listen again to a patient it stopped hearing
-            active: dict[str, bool] = {}
-            for record in stored.adaptations:
-                active[record.name] = record.active
-            switches = [entry.detail for entry in stored.log if entry.kind == "adaptation_enabled"]
-            enabled = switches[-1] == "on" if switches else session.adaptation.enabled
-            session.adaptation.restore((name for name, on in active.items() if on), enabled)
+        session = cls(questionnaire, clock=clock, engine=engine, store=store, **replay_into(engine, stored), **kwargs)
+        session.out.trace = [dict(e) for e in stored.trace]
+        restore_adaptation(session.adaptation, stored)
         return session
 
     # -- read-only state ---------------------------------------------------------------------------
 
     @property
+    def id(self) -> str:
+        """The session's id (in the store, on the station)."""
+        return self.state.id
+
+    @property
+    def patient_id(self) -> str:
+        """The patient's pseudonymous id."""
+        return self.state.patient_id
+
+    @property
+    def timing(self) -> Timing:
+        """The timing values in force."""
+        return self.state.timing
+
+    @property
+    def adaptation(self) -> Any:
+        """The live adaptation policy (``kiosk.core.adaptation.Adaptation``), or None."""
+        return self.state.adaptation
+
+    @property
+    def visit(self) -> str | None:
+        """How this visit began, logged as it starts ("order ID", "staff", "walk-up"; see kiosk.core.visits)."""
+        return self.opening.visit
+
+    @property
+    def next_patient_after_s(self) -> float | None:
+        """How long the end screen stays before NextPatient (None: it stays)."""
+        return self.flow.next_patient_after_s
+
+    @property
+    def trace(self) -> list[dict[str, Any]]:
+        """Every context batch published, as trace events ({"t":..., "set":..., "emit":...})."""
+        return self.out.trace
+
+    @property
+    def metrics(self) -> dict[str, float]:
+        """The latest metrics from the QoS engine."""
+        return self.out.metrics
+
+    @property
     def _origin(self) -> float:
         """Clock time of session time 0 (tests drive the simulated clock in session time)."""
-        return self._timers.origin
+        return self.timers.origin
 
     @property
     def phase(self) -> Phase:
         """The current phase."""
-        return self._phase
+        return self.state.phase
 
     @property
     def language(self) -> str:
         """The language of prompts."""
-        return self._language
+        return self.state.language
 
     @property
     def answered_by(self) -> AnsweredBy:
         """Who gives the answers."""
-        return self._answered_by
+        return self.state.answered_by
 
     @property
     def answers(self) -> Mapping[str, Answer]:
         """Recorded answers by item id."""
-        return dict(self._answers)
+        return dict(self.state.answers)
 
     @property
     def listening(self) -> bool:
         """Whether voice answers are wanted right now."""
-        return self._listening
+        return self.state.listening
 
     @property
     def finished(self) -> bool:
         """The session reached the summary."""
-        return self._phase is Phase.SUMMARY
+        return self.state.finished
+
+    @property
+    def paused(self) -> bool:
+        """Paused by the patient."""
+        return self.timers.paused
+
+    @property
+    def halted(self) -> bool:
+        """Waiting for a clinician after call-doctor."""
+        return self.timers.halted
 
     @property
     def current_item(self) -> Item | None:
         """The scored item on screen: the one being asked, or the one just answered until the next
         opens (None outside the questions phase and during closing)."""
-        if self._open and not self._open.practice:
-            return self.questionnaire.items[self._open.index]
-        return None
+        return self.state.current_item
 
     @property
     def current_attempt(self) -> int | None:
         """The open attempt's number (1 to :data:`ATTEMPTS`), else None."""
-        return self._open.attempt if self._open and self._open.outcome is None else None
+        return self.state.current_attempt
 
     def now(self) -> float:
         """Session time in seconds (the time the QoS engine and the trace use)."""
-        return self._timers.now()
+        return self.timers.now()
 
     def remaining(self) -> float | None:
         """Seconds left on the open attempt, or None when no attempt is open."""
-        return self._timers.attempt_remaining() if self.current_attempt is not None else None
+        return self.timers.attempt_remaining() if self.current_attempt is not None else None
 
     def next_deadline(self) -> float | None:
         """Clock time (``clock.now()`` scale) of the next time-out, or None if none is running.
@@ -243,22 +271,22 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         A driver calls :meth:`poll` once the clock has reached it. The QoS model's timers and
         time windows count too: time passes for the engine on every operation and poll.
         """
-        deadlines = [d for d in (self._timers.next_deadline(), self._qos_deadline()) if d is not None]
+        deadlines = [d for d in (self.timers.next_deadline(), self.out.qos_deadline()) if d is not None]
         return min(deadlines, default=None)
 
     def score(self) -> Score:
         """The score of the answers recorded so far, recomputed from them."""
-        return self.questionnaire.score({i: a.points for i, a in self._answers.items()})
+        return self.questionnaire.score({i: a.points for i, a in self.state.answers.items()})
 
     def snapshot(self) -> Snapshot:
         """A frozen picture of the session for a screen to render."""
-        practice = None
-        if self._open and self._open.practice:
-            practice = self.questionnaire.familiarisation[self._open.index]
+        state = self.state
+        open_ = state.open
+        practice = self.questionnaire.familiarisation[open_.index] if open_ and open_.practice else None
         item = self.current_item
         return Snapshot(
-            phase=self._phase,
-            language=self._language,
+            phase=state.phase,
+            language=state.language,
             item=item,
             number=item.number if item else None,
             count=len(self.questionnaire.items),
@@ -267,62 +295,50 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
             remaining=self.remaining(),
             paused=self.paused,
             halted=self.halted,
-            person_present=self._person_present,
-            listening=self._listening,
-            adaptations=self._active_adaptations(),
-            speech_rate=self._speech_rate(),
-            answers=dict(self._answers),
-            not_answered=tuple(self._not_answered),
-            score=self._score,
-            prompt=self._prompt,
-            interlude=self._interlude(),
-            **self._practice_progress(),
-            confirming=self._open.unconfirmed.option if self._open and self._open.unconfirmed else None,
-            can_undo=self._can_undo() and not self._timers.frozen,
+            person_present=state.person_present,
+            listening=state.listening,
+            adaptations=state.active_adaptations(),
+            speech_rate=state.speech_rate(),
+            answers=dict(state.answers),
+            not_answered=tuple(state.not_answered),
+            score=state.score,
+            prompt=state.prompt,
+            interlude=state.interlude(self.timers.kind),
+            **self.practice.progress(),
+            confirming=open_.unconfirmed.option if open_ and open_.unconfirmed else None,
+            can_undo=self.corrections.can_undo() and not self.timers.frozen,
         )
 
-    def _interlude(self) -> str | None:
-        """What to show while the next question (or the summary) is being waited for."""
-        kind = self._timers.kind
-        if self._phase is Phase.FAMILIARISATION and kind == "practice" and self._open is not None:
-            return self._open.feedback  # "Well done." stays while the next practice question waits
-        if self._phase is not Phase.QUESTIONS or kind is None:
-            return None
-        if kind == "finish":
-            return "last_question"
-        if kind != "open":
-            return None
-        if self._open is not None and self._open.outcome == "not_answered":
-            return "not_answered"
-        if self._open is None and not (self._answers or self._not_answered):
-            return "first_question"
-        return "next_question"
-
     # -- inputs ------------------------------------------------------------------------------------
+
+    def subscribe(self, listener: Listener) -> Callable[[], None]:
+        """Call ``listener(event)`` for every event from now on; returns a function to unsubscribe.
+
+        Listeners run on the thread that called the session, after the operation that caused
+        the event has completed; they may call the session again.
+        """
+        return self.out.subscribe(listener)
 
     def welcome(self) -> None:
         """The welcome is on screen: publish it as a prompt whose options are the languages to start
         in (say a language's name, "start", or its number) and listen for them."""
-        with Operation(self) as t:
-            if self._phase is Phase.WELCOME:
-                self._greeted = True
-                self._publish_prompt(self._welcome_prompt(t))
-                self._update_listening(t)
+        with self._operation() as t:
+            self.opening.welcome(t)
 
     def start(self, answered_by: AnsweredBy | str | None = None) -> None:
         """The patient started at the welcome screen (publishes PersonDetected and TestState)."""
-        with Operation(self) as t:
-            self._start(t, answered_by)
+        with self._operation() as t:
+            self.opening.start(t, answered_by)
 
     def choose_language(self, language: str) -> None:
         """Switch the language of prompts; the current prompt is given again in it."""
-        with Operation(self) as t:
-            self._choose_language(t, language)
+        with self._operation() as t:
+            self.opening.choose_language(t, language)
 
     def acknowledge(self) -> None:
         """The patient acknowledged the explanation; the first question comes next."""
-        with Operation(self) as t:
-            self._acknowledge(t)
+        with self._operation() as t:
+            self.opening.acknowledge(t)
 
     def handle(self, event: ChannelInput) -> None:
         """An input from a channel: an answer option or a command.
@@ -333,29 +349,20 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         after call-doctor 1 is "I'm fine, carry on"; while "Is that right?" is asked 1 is Yes and
         2 is No.
         """
-        with Operation(self) as t:
-            if event.command is not None:
-                self._command(t, event)
-            elif self._phase is Phase.WELCOME:
-                self._start_by_number(t, event)
-            elif self.halted:
-                self._doctor_reply(t, event)
-            elif self._phase is Phase.EXPLANATION and not self.paused:
-                self._acknowledge(t)
-            else:
-                self._answer(t, event)
+        with self._operation() as t:
+            self.router.input(t, event)
 
     def repeat(self, channel: Channel | None = None) -> None:
         """The patient asked to hear the question again (TestState REPEATING)."""
-        with Operation(self) as t:
-            self._repeat(t, channel)
+        with self._operation() as t:
+            self.flow.repeat(t, channel)
 
     def prompt_delivered(self) -> None:
         """The voice out finished speaking a repeated prompt: TestState goes back to STARTED."""
-        with Operation(self) as t:
-            if self._repeating:
-                self._repeating = False
-                self._context(t, {"TestState": "STARTED"})
+        with self._operation() as t:
+            if self.state.repeating:
+                self.state.repeating = False
+                self.out.context(t, {"TestState": "STARTED"})
 
     def abandon(self, reason: str = "a new session was started") -> bool:
         """The clinician starts over for the next patient (or staff end the test from the ward
@@ -363,120 +370,103 @@ class Session(QuestionFlow, Corrections, Incidents, Practice, LiveAdaptation, Pu
         abandoned in the store (its answers stay) so a restart does not offer to resume it. True
         if it was abandoned; a session still on the welcome screen or finished is left as it is.
         """
-        with Operation(self) as t:
+        with self._operation() as t:
             if self.phase is Phase.WELCOME or self.finished:
                 return False
-            self._log(t, "abandoned", reason)
+            self.out.log(t, "abandoned", reason)
             if self.store is not None:
                 self.store.abandon(self.id)
             return True
 
     def poll(self) -> None:
         """Let every time-out due by now happen (call at or after :meth:`next_deadline`)."""
-        with Operation(self, inclusive=True):
+        with self._operation(inclusive=True):
             pass
 
-    # -- internals: the steps before the questions ------------------------------------------------
+    def pause(self, channel: Channel | None = None) -> None:
+        """Pause (the Pause button); the attempt clock stops."""
+        with self._operation() as t:
+            self.incidents.pause(t, channel)
 
-    def _start(self, t: float, answered_by: AnsweredBy | str | None) -> None:
-        if self._phase is not Phase.WELCOME:
-            self._ignore(t, None, IgnoreReason.FINISHED if self.finished else IgnoreReason.NO_OPEN_ATTEMPT, "start")
-            return
-        if answered_by is not None:
-            self._answered_by = AnsweredBy(answered_by)
-        if self.store is not None and not self._resuming:
-            self.store.create_session(
-                session_id=self.id,
-                patient_id=self.patient_id,
-                questionnaire_id=self.questionnaire.id,
-                language=self._language,
-                answered_by=self._answered_by.value,
-                started_at=self.clock.wall().isoformat(),
-                timing=vars(self.timing),
-                definition=canonical(self.questionnaire),  # what describes this session from now on
-            )
-            self._stored = True
-        self._person_present = True
-        state = "RESTARTED" if self._resuming else "STARTED"
-        self._context(t, {"PersonDetected": True, "TestState": state})
-        self._log(t, "start", f"answered by {self._answered_by.value}")
-        if self.visit and not self._resuming:
-            self._log(t, "visit", self.visit)
-        if not self._voice_out_available:  # said before the start, when nothing was stored yet
-            self._log(t, "voice_out", "unavailable")
-        if self._familiarisation:
-            self._set_phase(t, Phase.FAMILIARISATION)
-            self._message(t, "familiarisation")
-            self._open_practice(t, 0)
-        else:
-            self._to_explanation(t)
+    def resume(self) -> None:
+        """End a pause; the attempt has at least ``resume_grace_s`` left."""
+        with self._operation() as t:
+            self.incidents.resume(t)
 
-    def _choose_language(self, t: float, language: str) -> None:
-        if language not in self.questionnaire.languages:
-            self._ignore(t, None, IgnoreReason.UNKNOWN_LANGUAGE, f"choose_language {language}")
-            return
-        if language == self._language:
-            return
-        self._language = language
-        self._log(t, "language", language)
-        self._emit(LanguageChanged(t, language))
-        if self._phase is Phase.WELCOME and self._greeted:
-            self._publish_prompt(self._welcome_prompt(t))
-        elif self._phase is Phase.WELCOME:
-            self._message(t, "welcome")
-        elif self._phase is Phase.EXPLANATION:
-            self._publish_prompt(self._explanation_prompt(t))
-        elif self.current_attempt is not None:
-            self._prompt_question(t, repeat=False)
+    def call_doctor(self, channel: Channel | None = None) -> None:
+        """Call the doctor: the session halts until :meth:`clinician_continue`."""
+        with self._operation() as t:
+            self.incidents.call_doctor(t, channel)
 
-    def _start_by_number(self, t: float, event: ChannelInput) -> None:
-        """An answer number on the welcome screen: the n-th language's start button (any other
-        number starts in the language shown)."""
-        assert event.option is not None
-        languages = self.questionnaire.languages
-        if event.option <= len(languages):
-            self._choose_language(t, languages[event.option - 1])
-        self._start(t, None)
+    def clinician_continue(self) -> None:
+        """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left."""
+        with self._operation() as t:
+            self.incidents.clinician_continue(t)
 
-    def _welcome_prompt(self, t: float) -> Prompt:
-        """The welcome message with one option per language: its own name, what it is called in
-        the prompt's language, and (for the language shown) the words for "start"."""
-        lang = self._language
-        text = self.questionnaire.message("welcome", lang)
-        options = tuple(
-            PromptOption(
-                number,
-                OWN_NAME.get(language, language),
-                (
-                    *LANGUAGE_NAMES.get(lang, {}).get(language, ()),
-                    *(START_WORDS.get(lang, ()) if language == lang else ()),
-                ),
-                None,
-            )
-            for number, language in enumerate(self.questionnaire.languages, start=1)
-        )
-        return Prompt(t, "welcome", "welcome", text, text, lang, options, speech_rate=self._speech_rate())
+    def cancel_doctor_call(self, channel: Channel | None = None) -> None:
+        """The patient says "I'm fine, carry on" after calling the doctor: the test goes on (a
+        pause from before the call stays); at least ``resume_grace_s`` left."""
+        with self._operation() as t:
+            self.incidents.cancel_doctor(t, channel)
 
-    def _acknowledge(self, t: float) -> None:
-        if self._phase is not Phase.EXPLANATION:
-            self._ignore(t, None, IgnoreReason.NO_OPEN_ATTEMPT, "acknowledge")
-            return
-        self._set_phase(t, Phase.QUESTIONS)
-        self._schedule_next_item(t, after=self.timing.between_questions_s)
-        self._update_listening(t)  # not in the gap before the first question
+    def person_lost(self) -> None:
+        """The presence source (or the clinician) says the patient left; the clock stops."""
+        with self._operation() as t:
+            self.incidents.person_lost(t)
 
-    def _explanation_prompt(self, t: float) -> Prompt:
-        """The explanation, with one option: Start, and the words for it ("I'm ready"), which the
-        voice channel listens for while it is on screen."""
-        lang = self._language
-        text = self.questionnaire.message("explanation", lang)
-        options = (PromptOption(1, START_LABEL.get(lang, "Start"), tuple(START_WORDS.get(lang, ())), None),)
-        return Prompt(t, "message", "explanation", text, text, lang, options, speech_rate=self._speech_rate())
+    def person_back(self) -> None:
+        """The patient is back; the attempt has at least ``person_back_grace_s`` left."""
+        with self._operation() as t:
+            self.incidents.person_back(t)
 
-    def _to_explanation(self, t: float) -> None:
-        self._set_phase(t, Phase.EXPLANATION)
-        self._publish_prompt(self._explanation_prompt(t))
-        self._update_listening(t)
+    def skip_familiarisation(self) -> None:
+        """Leave the practice questions (a clinician's or the patient's choice)."""
+        with self._operation() as t:
+            if self.phase is Phase.FAMILIARISATION:
+                self.practice.skip(t)
 
-    def _started(self) -> bool:
-        return self._phase not in (Phase.WELCOME, Phase.SUMMARY)
+    def set_voice_out_available(self, available: bool) -> None:
+        """Whether voice out works on this kiosk (the UI knows it from the voice-out channel's status).
+
+        Assumed True until told otherwise, like :meth:`set_voice_available`. While False, practice
+        questions that check hearing are skipped (logged and stored as skipped, published as
+        :class:`PracticeSkipped`). One open when voice out is lost is skipped at once; one skipped
+        is not asked again when voice out comes back. QoS contexts are not affected.
+        """
+        with self._operation() as t:
+            if available == self.state.voice_out_available:
+                return
+            self.state.voice_out_available = available
+            self.out.log(t, "voice_out", "available" if available else "unavailable")
+            self.practice.voice_out_changed(t)
+
+    def request_voice(self) -> None:
+        """The patient asks to answer by voice again (lifts a voice-off adaptation; logged)."""
+        with self._operation() as t:
+            self.live.request_voice(t)
+
+    def set_voice_available(self, available: bool) -> None:
+        """Whether voice in works on this kiosk (the UI knows it from the voice-in channel's status).
+
+        Assumed True until told otherwise, so sessions without a UI (replays, tests) behave as
+        the policy says. While False, the voice_off adaptation is neither switched on nor
+        announced -- "I am having trouble hearing you" is untrue when voice in is not running --
+        and one in force is lifted (recorded with that reason) without a voice_on message. The
+        QoS contexts and the listening state are not affected.
+        """
+        with self._operation() as t:
+            self.live.set_voice_available(t, available)
+
+    def set_adaptation_enabled(self, enabled: bool) -> None:
+        """The clinician turns live adaptation on or off (off lifts every active adaptation)."""
+        with self._operation() as t:
+            self.live.set_enabled(t, enabled)
+
+    def _operation(self, inclusive: bool = False) -> Operation:
+        return self.out.operation(self.router.fire, inclusive)
+
+    def _practice_not_answered(self, t: float) -> None:
+        self.practice.not_answered(t)
+
+    def _metrics_updated(self, t: float, metrics: Mapping[str, float], answered: bool) -> None:
+        self.live.observe(t, metrics, answered)

@@ -31,143 +31,144 @@ question). See docs/qos-model.md, "How the kiosk publishes contexts".
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from collections.abc import Callable
 
 from kiosk.core.channels import Channel, ChannelInput
-from kiosk.core.session.events import (
-    AnswerNotConfirmed,
-    AnswerWithdrawn,
-    ConfirmationAsked,
-    IgnoreReason,
-    Phase,
-    Prompt,
-    PromptOption,
-)
-from kiosk.core.session.words import CONFIRM_WORDS
+from kiosk.core.session.events import AnswerNotConfirmed, AnswerWithdrawn, ConfirmationAsked, IgnoreReason
+from kiosk.core.session.ports import SessionStore
+from kiosk.core.session.prompts import Prompts
+from kiosk.core.session.publishing import Outputs
+from kiosk.core.session.state import SessionState, Unconfirmed
+from kiosk.core.session.timers import AttemptClock
 
-if TYPE_CHECKING:
-    from kiosk.core.session.core import Session
+__all__ = ["NO", "YES", "Corrections", "Unconfirmed"]
 
 #: the confirmation's options: what 1 and 2 mean on the keys and the remote while it is asked
 YES, NO = 1, 2
 
 
-@dataclass
-class Unconfirmed:
-    """An answer heard but not stored yet, waiting for Yes or No."""
-
-    option: int
-    channel: Channel
-    detail: str
-    confidence: float | None
-    #: what was left of the attempt's window when the confirmation was asked
-    remaining: float
-    #: a "yes" came too unsure to store the answer: the patient is asked to press Yes or No
-    press: bool = False
-
-
 class Corrections:
-    """Confirmation and undo (a mixin of :class:`~kiosk.core.session.Session`)."""
+    """Confirmation and undo of scored answers.
 
-    def _can_undo(self: Session) -> bool:
+    ``record_answer(t, option, channel, detail)`` stores a confirmed answer; ``time_out(t)`` ends
+    the open attempt as if its window had run out (no reply to "Is that right?").
+    """
+
+    def __init__(
+        self,
+        state: SessionState,
+        timers: AttemptClock,
+        out: Outputs,
+        prompts: Prompts,
+        *,
+        store: SessionStore | None,
+        record_answer: Callable[[float, int, Channel, str], None],
+        time_out: Callable[[float], None],
+    ) -> None:
+        self.state = state
+        self.timers = timers
+        self.out = out
+        self.prompts = prompts
+        self.store = store
+        self._record_answer = record_answer
+        self._time_out = time_out
+
+    def can_undo(self) -> bool:
         """The thank-you gap after a stored answer is running (and nothing stops the clock)."""
-        open_ = self._open
-        return (
-            self._phase is Phase.QUESTIONS
-            and open_ is not None
-            and not open_.practice
-            and open_.outcome == "answered"
-            and self._timers.kind in ("open", "finish")
-            and self.questionnaire.items[open_.index].id in self._answers
-        )
+        return self.state.can_undo(self.timers.kind)
 
-    def _ask_confirmation(self: Session, t: float, event: ChannelInput) -> None:
-        open_ = self._open
+    def ask(self, t: float, event: ChannelInput) -> None:
+        """An unsure answer: ask "Is that right?" before storing it."""
+        state = self.state
+        open_ = state.open
         assert open_ is not None and event.option is not None
-        item = self.questionnaire.items[open_.index]
-        remaining = self._timers.attempt_remaining() or 0.0
+        item = state.questionnaire.items[open_.index]
+        remaining = self.timers.attempt_remaining() or 0.0
         open_.unconfirmed = Unconfirmed(event.option, event.channel, event.detail, event.confidence, remaining)
-        self._timers.set("confirm", t, self.timing.confirm_window_s)
+        window = state.timing.confirm_window_s
+        self.timers.set("confirm", t, window)
         confidence = f", confidence {event.confidence:.2f}" if event.confidence is not None else ""
-        self._log(
+        self.out.log(
             t,
             "confirmation_asked",
             f"{item.id} option {event.option} ({event.channel.value} {event.detail!r}{confidence})",
         )
-        self._emit(
-            ConfirmationAsked(
-                t, item.id, item.number, event.option, open_.attempt, event.channel, t + self.timing.confirm_window_s
-            )
+        self.out.emit(
+            ConfirmationAsked(t, item.id, item.number, event.option, open_.attempt, event.channel, t + window)
         )
-        self._prompt_question(t, repeat=False)
-        self._update_listening(t)
+        self.prompts.ask(t, repeat=False)
+        self.prompts.update_listening(t)
 
-    def _confirmation_reply(self: Session, t: float, event: ChannelInput) -> None:
+    def reply(self, t: float, event: ChannelInput) -> None:
         """Yes or No (an option 1 or 2 already checked) to the answer waiting for confirmation."""
-        open_ = self._open
+        state = self.state
+        open_ = state.open
         assert open_ is not None and open_.unconfirmed is not None
         pending = open_.unconfirmed
         if event.option != YES:
-            self._not_confirmed(t, "declined")
+            self.not_confirmed(t, "declined")
             return
         if event.needs_confirmation:
-            self._ignore(t, event, IgnoreReason.UNSURE_REPLY)
+            self.out.ignore(t, event, IgnoreReason.UNSURE_REPLY)
             pending.press = True
             # finding and pressing the button takes longer than saying yes
-            self._timers.at_least(self.timing.confirm_window_s)
-            self._prompt_question(t, repeat=True)
+            self.timers.at_least(state.timing.confirm_window_s)
+            self.prompts.ask(t, repeat=True)
             return
         open_.unconfirmed = None
-        item = self.questionnaire.items[open_.index]
-        self._log(t, "answer_confirmed", f"{item.id} option {pending.option} by {event.channel.value} {event.detail!r}")
+        item = state.questionnaire.items[open_.index]
+        self.out.log(
+            t, "answer_confirmed", f"{item.id} option {pending.option} by {event.channel.value} {event.detail!r}"
+        )
         self._record_answer(t, pending.option, pending.channel, f"{pending.detail} (confirmed)")
 
-    def _not_confirmed(self: Session, t: float, why: str) -> None:
+    def not_confirmed(self, t: float, why: str) -> None:
         """The answer waiting for confirmation is dropped: asked again, or (timed out) the attempt ends."""
-        open_ = self._open
+        state = self.state
+        open_ = state.open
         assert open_ is not None and open_.unconfirmed is not None
         pending, open_.unconfirmed = open_.unconfirmed, None
-        item = self.questionnaire.items[open_.index]
-        self._log(t, "answer_not_confirmed", f"{item.id} option {pending.option}: {why}")
-        self._emit(AnswerNotConfirmed(t, item.id, item.number, pending.option, open_.attempt, why))
+        item = state.questionnaire.items[open_.index]
+        self.out.log(t, "answer_not_confirmed", f"{item.id} option {pending.option}: {why}")
+        self.out.emit(AnswerNotConfirmed(t, item.id, item.number, pending.option, open_.attempt, why))
         if why == "timed_out":
-            self._attempt_timed_out(t)
+            self._time_out(t)
             return
-        self._timers.set("attempt", t, max(pending.remaining, self.timing.resume_grace_s))
-        self._prompt_question(t, repeat=True)
-        self._update_listening(t)
+        self.timers.set("attempt", t, max(pending.remaining, state.timing.resume_grace_s))
+        self.prompts.ask(t, repeat=True)
+        self.prompts.update_listening(t)
 
-    def _undo(self: Session, t: float, event: ChannelInput) -> None:
+    def undo(self, t: float, event: ChannelInput) -> None:
         """Take back the answer waiting for confirmation, or the last one stored during its gap."""
-        reason = IgnoreReason.DOCTOR_CALLED if self.halted else IgnoreReason.PAUSED if self.paused else None
-        open_ = self._open
+        state = self.state
+        timers = self.timers
+        reason = IgnoreReason.DOCTOR_CALLED if timers.halted else IgnoreReason.PAUSED if timers.paused else None
+        open_ = state.open
         if reason is None and open_ is not None and open_.unconfirmed is not None:
-            self._not_confirmed(t, "undone")
+            self.not_confirmed(t, "undone")
             return
-        if reason is None and not self._can_undo():
+        if reason is None and not self.can_undo():
             reason = IgnoreReason.NOTHING_TO_UNDO
         if reason is not None:
-            self._ignore(t, event, reason, "undo")
+            self.out.ignore(t, event, reason, "undo")
             return
         assert open_ is not None
-        item = self.questionnaire.items[open_.index]
-        answer = self._answers.pop(item.id)
-        if self.store is not None and self._stored:
+        item = state.questionnaire.items[open_.index]
+        answer = state.answers.pop(item.id)
+        if self.store is not None and state.stored:
             self.store.withdraw_answer(
-                self.id,
+                state.id,
                 item_id=item.id,
                 t=t,
-                at=self._wall(t),
+                at=self.out.wall(t),
                 reason=f"undo by {event.channel.value} {event.detail!r}",
             )
-        self._context(t, {"TestState": "REPEATING"})
+        self.out.context(t, {"TestState": "REPEATING"})
         open_.outcome = None
         open_.correcting = True
-        window = self._attempt_window()
-        self._timers.set("attempt", t, window)
-        self._emit(
+        window = state.attempt_window()
+        timers.set("attempt", t, window)
+        self.out.emit(
             AnswerWithdrawn(
                 t,
                 item.id,
@@ -180,22 +181,5 @@ class Corrections:
                 t + window,
             )
         )
-        self._prompt_question(t, repeat=True)
-        self._update_listening(t)
-
-    def _confirmation_prompt(self: Session, t: float, repeat: bool) -> Prompt:
-        """ "I heard: <option>. Is that right?" with the options Yes and No, in the patient's language."""
-        open_ = self._open
-        assert open_ is not None and open_.unconfirmed is not None
-        lang = self._language
-        item = self.questionnaire.items[open_.index]
-        heard = item.option(open_.unconfirmed.option).label_in(lang)
-        template = (
-            (open_.unconfirmed.press and self.questionnaire.message("confirm_answer_press", lang))
-            or self.questionnaire.message("confirm_answer", lang)
-            or "{answer}?"
-        )
-        text = template.replace("{answer}", heard)
-        words: Mapping[int, tuple[str, tuple[str, ...]]] = CONFIRM_WORDS.get(lang, CONFIRM_WORDS["en"])
-        options = tuple(PromptOption(number, label, synonyms, None) for number, (label, synonyms) in words.items())
-        return Prompt(t, "confirm", item.id, text, text, lang, options, repeat, open_.attempt, self._speech_rate())
+        self.prompts.ask(t, repeat=True)
+        self.prompts.update_listening(t)

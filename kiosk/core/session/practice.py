@@ -10,104 +10,110 @@ when nothing was said only upsets the patient.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.questionnaire import PracticeQuestion
-from kiosk.core.session.events import Phase, PracticeAnswered, PracticeSkipped
-from kiosk.core.session.publishing import Operation
-
-if TYPE_CHECKING:
-    from kiosk.core.session.core import Session
+from kiosk.core.session.events import PracticeAnswered, PracticeSkipped
+from kiosk.core.session.ports import SessionStore
+from kiosk.core.session.prompts import Prompts
+from kiosk.core.session.publishing import Outputs
+from kiosk.core.session.state import SessionState
+from kiosk.core.session.timers import AttemptClock
 
 
 class Practice:
-    """The familiarisation steps (a mixin of :class:`~kiosk.core.session.Session`)."""
+    """The familiarisation steps. ``open_question(t, practice=True, index=i)`` asks practice question i."""
 
-    def skip_familiarisation(self: Session) -> None:
-        """Leave the practice questions (a clinician's or the patient's choice)."""
-        with Operation(self) as t:
-            if self._phase is Phase.FAMILIARISATION:
-                self._open = None
-                self._timers.cancel()
-                self._to_explanation(t)
+    def __init__(
+        self,
+        state: SessionState,
+        timers: AttemptClock,
+        out: Outputs,
+        prompts: Prompts,
+        *,
+        store: SessionStore | None,
+        open_question: Callable[..., None],
+    ) -> None:
+        self.state = state
+        self.timers = timers
+        self.out = out
+        self.prompts = prompts
+        self.store = store
+        self._open_question = open_question
 
-    def set_voice_out_available(self: Session, available: bool) -> None:
-        """Whether voice out works on this kiosk (the UI knows it from the voice-out channel's status).
+    def skip(self, t: float) -> None:
+        """Leave the practice questions for the explanation."""
+        self.state.open = None
+        self.timers.cancel()
+        self.prompts.to_explanation(t)
 
-        Assumed True until told otherwise, like :meth:`set_voice_available`. While False, practice
-        questions that check hearing are skipped (logged and stored as skipped, published as
-        :class:`PracticeSkipped`). One open when voice out is lost is skipped at once; one skipped
-        is not asked again when voice out comes back. QoS contexts are not affected.
-        """
-        with Operation(self) as t:
-            if available == self._voice_out_available:
-                return
-            self._voice_out_available = available
-            self._log(t, "voice_out", "available" if available else "unavailable")
-            open_ = self._open
-            if open_ is not None and open_.practice:
-                question = self.questionnaire.familiarisation[open_.index]
-                if (reason := self._practice_skip_reason(question)) is not None:
-                    self._timers.cancel()
-                    if self.current_attempt is not None:
-                        self._skip_practice(t, question, reason, shown=True)
-                    # an answered hearing check's feedback gap ends at once too: without voice out
-                    # it must not stay on screen (its outcome is already stored)
-                    self._open_practice(t, open_.index + 1)
+    def voice_out_changed(self, t: float) -> None:
+        """Voice out was lost or came back (already in the state): an open hearing check is
+        skipped at once, and an answered one's feedback gap ends."""
+        state = self.state
+        open_ = state.open
+        if open_ is not None and open_.practice:
+            question = state.questionnaire.familiarisation[open_.index]
+            if (reason := state.practice_skip_reason(question)) is not None:
+                self.timers.cancel()
+                if state.current_attempt is not None:
+                    self._skip(t, question, reason, shown=True)
+                # an answered hearing check's feedback gap ends at once too: without voice out
+                # it must not stay on screen (its outcome is already stored)
+                self.open(t, open_.index + 1)
 
-    def _practice_progress(self: Session) -> dict[str, Any]:
+    def progress(self) -> dict[str, Any]:
         """The open practice question's place among those asked (or still to ask) on this kiosk."""
-        if self._open is None or not self._open.practice:
+        state = self.state
+        if state.open is None or not state.open.practice:
             return {}
-        current = self._open.index
+        current = state.open.index
         asked = [
             i
-            for i, question in enumerate(self.questionnaire.familiarisation)
-            if question.id not in self._practice_unasked
-            and (i <= current or self._practice_skip_reason(question) is None)
+            for i, question in enumerate(state.questionnaire.familiarisation)
+            if question.id not in state.practice_unasked
+            and (i <= current or state.practice_skip_reason(question) is None)
         ]
         return {"practice_number": asked.index(current) + 1, "practice_count": len(asked)}
 
-    def _next_practice(self: Session, t: float) -> None:
-        assert self._open is not None
-        self._open_practice(t, self._open.index + 1)
+    def next(self, t: float) -> None:
+        """The feedback gap is over: the next practice question."""
+        assert self.state.open is not None
+        self.open(t, self.state.open.index + 1)
 
-    def _open_practice(self: Session, t: float, index: int) -> None:
+    def open(self, t: float, index: int) -> None:
         """Ask the first practice question from ``index`` on that can be asked here (skipping the
         others, logged and stored); after the last, the explanation."""
-        questions = self.questionnaire.familiarisation
-        while index < len(questions) and (reason := self._practice_skip_reason(questions[index])) is not None:
-            self._skip_practice(t, questions[index], reason)
+        state = self.state
+        questions = state.questionnaire.familiarisation
+        while index < len(questions) and (reason := state.practice_skip_reason(questions[index])) is not None:
+            self._skip(t, questions[index], reason)
             index += 1
         if index < len(questions):
             self._open_question(t, practice=True, index=index)
         else:
-            self._open = None
-            self._timers.cancel()
-            self._to_explanation(t)
+            self.skip(t)
 
-    def _skip_practice(self: Session, t: float, question: PracticeQuestion, reason: str, shown: bool = False) -> None:
+    def _skip(self, t: float, question: PracticeQuestion, reason: str, shown: bool = False) -> None:
         """Leave ``question`` out (logged, stored and published); one never ``shown`` is not
         counted in "Practice k of n"."""
         if not shown:
-            self._practice_unasked.add(question.id)
-        self._log(t, "practice_skipped", f"{question.id}: {reason}")
-        self._record_practice(t, question, "skipped", detail=reason)
-        self._emit(PracticeSkipped(t, question.id, question.checks, reason))
+            self.state.practice_unasked.add(question.id)
+        self.out.log(t, "practice_skipped", f"{question.id}: {reason}")
+        self._record(t, question, "skipped", detail=reason)
+        self.out.emit(PracticeSkipped(t, question.id, question.checks, reason))
 
-    def _practice_skip_reason(self: Session, question: PracticeQuestion) -> str | None:
-        """Why ``question`` cannot be asked on this kiosk now, or None if it can."""
-        if question.checks == "hear" and not self._voice_out_available:
-            return "no voice out"
-        return None
-
-    def _practice_answered(self: Session, t: float, event: ChannelInput) -> None:
+    def answered(self, t: float, event: ChannelInput) -> None:
         """The open practice question got ``event``: stored, told right or wrong, the next asked."""
-        assert self._open is not None and event.option is not None
-        question = self.questionnaire.familiarisation[self._open.index]
+        open_ = self.state.open
+        assert open_ is not None and event.option is not None
+        open_.outcome = "answered"
+        self.timers.cancel()
+        question = self.state.questionnaire.familiarisation[open_.index]
         correct = event.option == question.expected
-        self._record_practice(
+        self._record(
             t,
             question,
             "right" if correct else "wrong",
@@ -115,23 +121,23 @@ class Practice:
             channel=event.channel,
             detail=event.detail,
         )
-        self._emit(PracticeAnswered(t, question.id, event.option, correct, event.channel))
-        self._open.feedback = "practice_right" if correct else "practice_wrong"
-        self._message(t, self._open.feedback)
+        self.out.emit(PracticeAnswered(t, question.id, event.option, correct, event.channel))
+        open_.feedback = "practice_right" if correct else "practice_wrong"
+        self.prompts.message(t, open_.feedback)
         # the kind word stays on screen (and is said) before the next practice question
-        self._timers.set("practice", t, self.timing.between_questions_s)
-        self._update_listening(t)
+        self.timers.set("practice", t, self.state.timing.between_questions_s)
+        self.prompts.update_listening(t)
 
-    def _practice_not_answered(self: Session, t: float) -> None:
+    def not_answered(self, t: float) -> None:
         """Both attempts at the open practice question timed out."""
-        assert self._open is not None
-        question = self.questionnaire.familiarisation[self._open.index]
-        self._record_practice(t, question, "not_answered")
-        self._emit(PracticeAnswered(t, question.id, None, False, None))
-        self._next_practice(t)
+        assert self.state.open is not None
+        question = self.state.questionnaire.familiarisation[self.state.open.index]
+        self._record(t, question, "not_answered")
+        self.out.emit(PracticeAnswered(t, question.id, None, False, None))
+        self.next(t)
 
-    def _record_practice(
-        self: Session,
+    def _record(
+        self,
         t: float,
         question: PracticeQuestion,
         outcome: str,
@@ -142,15 +148,16 @@ class Practice:
     ) -> None:
         """Store a practice question's outcome ("right", "wrong", "not_answered" or "skipped") for
         the clinician; practice never reaches the QoS engine."""
-        if self.store is not None and self._stored:
+        state = self.state
+        if self.store is not None and state.stored:
             self.store.record_practice(
-                self.id,
+                state.id,
                 question_id=question.id,
                 checks=question.checks,
                 outcome=outcome,
                 option=option,
                 channel=channel.value if channel else None,
                 t=t,
-                at=self._wall(t),
+                at=self.out.wall(t),
                 detail=detail,
             )

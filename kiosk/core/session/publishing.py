@@ -1,6 +1,5 @@
-"""How a session tells the world: prompts (what to show and say), QoS context batches (one engine
-update per instant), the stored log, and events queued for listeners until the operation that
-caused them is over.
+"""How a session tells the world: QoS context batches (one engine update per instant), the stored
+log, and events queued for listeners until the operation that caused them is over.
 
 :class:`Operation` brackets every public call: it catches up on time-outs, makes the call one
 store transaction, flushes the QoS batch and then dispatches the queued events.
@@ -12,25 +11,15 @@ from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from datetime import timedelta
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from kiosk.core.channels import Channel, ChannelInput
-from kiosk.core.session.events import (
-    IgnoreReason,
-    InputIgnored,
-    ListeningChanged,
-    MetricsUpdated,
-    Phase,
-    PhaseChanged,
-    Prompt,
-    PromptOption,
-    SessionEvent,
-)
+from kiosk.core.session.events import IgnoreReason, InputIgnored, MetricsUpdated, SessionEvent
+from kiosk.core.session.ports import QosEngine, SessionStore
+from kiosk.core.session.state import SessionState
+from kiosk.core.session.timers import AttemptClock
 
-if TYPE_CHECKING:
-    from kiosk.core.session.core import Session
-
-#: how much later a second context batch at the same instant is recorded (see ``Publisher._flush``)
+#: how much later a second context batch at the same instant is recorded (see ``Outputs._flush``)
 SAME_INSTANT_STEP_S = 0.001
 
 #: the CLARC model's UserInteraction literal for each channel. The keyboard maps to TOUCH_SCREEN:
@@ -60,10 +49,53 @@ class Batch:
     emit: list[str] = field(default_factory=list)
 
 
-class Publisher:
-    """The session's outputs (a mixin of :class:`~kiosk.core.session.Session`)."""
+#: told of each QoS result as (session time, metrics, whether it published an answer)
+MetricsObserver = Callable[[float, Mapping[str, float], bool], None]
+#: acts on one time-out of a kind, due at a session time (see ``Router.fire`` in :mod:`kiosk.core.session.routing`)
+Fire = Callable[[str, float], None]
 
-    def subscribe(self: Session, listener: Listener) -> Callable[[], None]:
+
+class Outputs:
+    """The session's outputs: listeners, QoS batches, the context trace and the stored log.
+
+    ``on_metrics`` hears every QoS result after it is published (the live adaptation policy).
+    """
+
+    def __init__(
+        self,
+        state: SessionState,
+        timers: AttemptClock,
+        *,
+        engine: QosEngine | None,
+        store: SessionStore | None,
+        on_metrics: MetricsObserver,
+    ) -> None:
+        self.state = state
+        self.timers = timers
+        self.engine = engine
+        self.store = store
+        self._on_metrics = on_metrics
+        #: every context batch published, as trace events ({"t":..., "set":..., "emit":...})
+        self.trace: list[dict[str, Any]] = []
+        #: the latest metrics from the QoS engine
+        self.metrics: dict[str, float] = {}
+        self._batch: Batch | None = None
+        #: batches the engine ran since the session last looked (see _take_qos_results)
+        self._qos_results: list[Any] = []
+        #: time of the latest batch the engine ran on its own (timers, time windows)
+        self._timed_t = -1.0
+        if engine is not None:
+            engine.subscribe(self._qos_results.append)
+        self._listeners: list[Listener] = []
+        self._queue: list[SessionEvent] = []
+        self._depth = 0
+        self._dispatching = False
+
+    def operation(self, fire: Fire, inclusive: bool = False) -> Operation:
+        """Bracket one public call (see :class:`Operation`); ``fire`` acts on each due time-out."""
+        return Operation(self, fire, inclusive)
+
+    def subscribe(self, listener: Listener) -> Callable[[], None]:
         """Call ``listener(event)`` for every event from now on; returns a function to unsubscribe.
 
         Listeners run on the thread that called the session, after the operation that caused
@@ -72,44 +104,53 @@ class Publisher:
         self._listeners.append(listener)
         return lambda: self._listeners.remove(listener) if listener in self._listeners else None
 
-    def _emit(self: Session, event: SessionEvent) -> None:
+    def emit(self, event: SessionEvent) -> None:
+        """Queue ``event`` for the listeners (they hear it once the operation is over)."""
         self._queue.append(event)
 
-    def _ignore(self: Session, t: float, event: ChannelInput | None, reason: IgnoreReason, action: str = "") -> None:
+    def ignore(self, t: float, event: ChannelInput | None, reason: IgnoreReason, action: str = "") -> None:
+        """An input or action that does nothing now: logged and published as InputIgnored."""
         what = f"{event.channel.value} {event.option or event.command.value}" if event else action  # type: ignore[union-attr]
-        self._log(t, "input_ignored", f"{what}: {reason.value}")
-        self._emit(InputIgnored(t, event, reason, action))
+        self.log(t, "input_ignored", f"{what}: {reason.value}")
+        self.emit(InputIgnored(t, event, reason, action))
 
-    def _log(self: Session, t: float, kind: str, detail: str = "") -> None:
+    def log(self, t: float, kind: str, detail: str = "") -> None:
         """Add a line to the stored session log (only once the session exists in the store)."""
-        if self.store is not None and self._stored:
-            self.store.record_event(self.id, t=t, kind=kind, detail=detail)
+        if self.store is not None and self.state.stored:
+            self.store.record_event(self.state.id, t=t, kind=kind, detail=detail)
 
-    def _wall(self: Session, t: float) -> str:
+    def wall(self, t: float) -> str:
         """The wall-clock time (ISO 8601, UTC) of session time ``t``."""
-        return (self.clock.wall() - timedelta(seconds=self.now() - t)).isoformat()
+        return (self.timers.clock.wall() - timedelta(seconds=self.timers.now() - t)).isoformat()
 
-    def _context(self: Session, t: float, set: Mapping[str, Any] | None = None, emit: list[str] | None = None) -> None:
+    def context(self, t: float, set: Mapping[str, Any] | None = None, emit: list[str] | None = None) -> None:
         """Add context changes to the batch of instant ``t`` (one engine update per instant)."""
         if self._batch is not None and self._batch.t != t:
             self._flush()
         if self._batch is None:
             self._batch = Batch(t)
-        if self._repeating and "TestState" not in (set or {}):
+        state = self.state
+        if state.repeating and "TestState" not in (set or {}):
             # the repeated prompt is over once anything else happens
             self._batch.set["TestState"] = "STARTED"
-            self._repeating = False
+            state.repeating = False
         elif set and "TestState" in set:
-            self._repeating = set["TestState"] == "REPEATING"
+            state.repeating = set["TestState"] == "REPEATING"
         self._batch.set.update(set or {})
         self._batch.emit.extend(e for e in emit or [] if e not in self._batch.emit)
 
-    def _emit_if_modelled(self: Session, t: float, eventtype: str) -> None:
+    def emit_if_modelled(self, t: float, eventtype: str) -> None:
         """Emit an eventtype beyond CLARC's contexts only when the engine's model declares it."""
         if self.engine is not None and eventtype in self.engine.model.contexts:
-            self._context(t, emit=[eventtype])
+            self.context(t, emit=[eventtype])
 
-    def _flush(self: Session) -> None:
+    def qos_deadline(self) -> float | None:
+        """Clock time at which the engine next needs time to pass (a timer, a time window), or None."""
+        engine = self.engine
+        due = engine.next_due() if engine is not None and self._qos_running() else None
+        return None if due is None else self.timers.origin + due
+
+    def _flush(self) -> None:
         batch, self._batch = self._batch, None
         if batch is None:
             return
@@ -128,32 +169,28 @@ class Publisher:
             event["emit"] = list(batch.emit)
         self.trace.append(event)
         if self.store is not None:
-            self.store.record_context(self.id, t=batch.t, set=batch.set, emit=batch.emit)
+            self.store.record_context(self.state.id, t=batch.t, set=batch.set, emit=batch.emit)
         if self.engine is None:
             return
         own = self.engine.update(batch.t, set=dict(batch.set), emit=list(batch.emit))
         self._take_qos_results(own, batch)
 
-    def _let_qos_time_pass(self: Session, t: float) -> None:
+    def _let_qos_time_pass(self, t: float) -> None:
         """Advance the engine to session time ``t``: its timers and time windows due by then run.
 
         Only once the engine has had the session's first batch (its timers start then, at time 0,
         as in a replay of the trace), so nothing happens before the patient starts, and only until
         the test is over: what a model says about the time after it is about no one.
         """
-        if self._qos_running() and t >= self.engine.t:
-            self.engine.advance(t)
+        engine = self.engine
+        if engine is not None and engine.t is not None and self._qos_running() and t >= engine.t:
+            engine.advance(t)
             self._take_qos_results(None, None)
 
-    def _qos_deadline(self: Session) -> float | None:
-        """Clock time at which the engine next needs time to pass (a timer, a time window), or None."""
-        due = self.engine.next_due() if self._qos_running() else None
-        return None if due is None else self._timers.origin + due
+    def _qos_running(self) -> bool:
+        return self.engine is not None and self.engine.t is not None and not self.state.finished
 
-    def _qos_running(self: Session) -> bool:
-        return self.engine is not None and self.engine.t is not None and not self.finished
-
-    def _take_qos_results(self: Session, own: Any, batch: Batch | None) -> None:
+    def _take_qos_results(self, own: Any, batch: Batch | None) -> None:
         """Publish every batch the engine ran since the last call, in order: the ones it ran on its
         own (timers, time windows, due before ``batch``) like the session's own ``batch`` (``own``
         is its result): metrics stored, MetricsUpdated published, the adaptation policy told."""
@@ -166,10 +203,10 @@ class Publisher:
             if mine is None:
                 self._timed_t = result.t
                 if result.timers:
-                    self._log(result.t, "qos_timers", ", ".join(result.timers))
+                    self.log(result.t, "qos_timers", ", ".join(result.timers))
             if self.store is not None:
-                self.store.record_metrics(self.id, t=result.t, metrics=self.metrics, fired=list(fired))
-            self._emit(
+                self.store.record_metrics(self.state.id, t=result.t, metrics=self.metrics, fired=list(fired))
+            self.emit(
                 MetricsUpdated(
                     result.t,
                     dict(self.metrics),
@@ -179,68 +216,7 @@ class Publisher:
                     tuple(result.timers),
                 )
             )
-            if self.adaptation is not None:
-                for change in self.adaptation.observe(self.metrics, answered=_is_answer(contexts)):
-                    self._apply_adaptation(result.t, change)
-
-    def _set_phase(self: Session, t: float, phase: Phase) -> None:
-        previous, self._phase = self._phase, phase
-        self._emit(PhaseChanged(t, phase, previous))
-
-    def _message(self: Session, t: float, name: str) -> None:
-        text = self.questionnaire.message(name, self._language)
-        if text:
-            self._publish_prompt(
-                Prompt(t, "message", name, text, text, self._language, speech_rate=self._speech_rate())
-            )
-
-    def _prompt_question(self: Session, t: float, repeat: bool) -> None:
-        """Ask the open question (or, while an answer waits for confirmation, "Is that right?")."""
-        assert self._open is not None
-        if self._open.unconfirmed is not None:
-            self._publish_prompt(self._confirmation_prompt(t, repeat))
-            return
-        lang = self._language
-        question = self._question()
-        options = tuple(
-            PromptOption(o.number, o.label_in(lang), o.synonyms_in(lang), o.points) for o in question.options
-        )
-        spoken = question.spoken[lang]
-        if repeat and self.questionnaire.message("repeat", lang):
-            spoken = f"{self.questionnaire.message('repeat', lang)} {spoken}"
-        self._publish_prompt(
-            Prompt(
-                t,
-                "practice" if self._open.practice else "question",
-                question.id,
-                question.text[lang],
-                spoken,
-                lang,
-                options,
-                repeat,
-                self._open.attempt,
-                self._speech_rate(),
-            )
-        )
-
-    def _publish_prompt(self: Session, prompt: Prompt) -> None:
-        self._prompt = prompt
-        self._emit(prompt)
-
-    def _update_listening(self: Session, t: float) -> None:
-        # on the welcome once it was shown (say a language), under the explanation (say "I'm
-        # ready"), while an attempt is open, and in the thank-you gap after an answer, when it can
-        # be taken back ("No, that's wrong")
-        wanted = (
-            (self._phase is Phase.WELCOME and self._greeted)
-            or self._phase is Phase.EXPLANATION
-            or self.current_attempt is not None
-            or self._can_undo()
-        )
-        listening = wanted and not self._timers.frozen and "voice_off" not in self._active_adaptations()
-        if listening != self._listening:
-            self._listening = listening
-            self._emit(ListeningChanged(t, listening))
+            self._on_metrics(result.t, self.metrics, _is_answer(contexts))
 
 
 def _is_answer(contexts: Mapping[str, Any]) -> bool:
@@ -256,8 +232,9 @@ class Operation:
     rolls the transaction back, and its events are dropped: nobody hears of what was not stored.
     """
 
-    def __init__(self, session: Session, inclusive: bool = False) -> None:
-        self.s = session
+    def __init__(self, outputs: Outputs, fire: Fire, inclusive: bool = False) -> None:
+        self.s = outputs
+        self.fire = fire
         self.inclusive = inclusive
         self._transaction: AbstractContextManager[None] | None = None
         #: session time of the operation
@@ -270,10 +247,10 @@ class Operation:
             self._transaction = s.store.transaction()
             self._transaction.__enter__()
         try:
-            now = s.clock.now()
-            for kind, due in s._timers.due(now, self.inclusive):
-                s._fire(kind, due)
-            self.t = s._timers.t(now)
+            now = s.timers.clock.now()
+            for kind, due in s.timers.due(now, self.inclusive):
+                self.fire(kind, due)
+            self.t = s.timers.t(now)
             return self.t
         except BaseException as error:  # `with` does not call __exit__ when __enter__ raises
             self.__exit__(type(error), error, error.__traceback__)

@@ -10,6 +10,7 @@ for.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 
 from kiosk.core.clock import Clock
@@ -20,7 +21,7 @@ class Timer:
     """The one pending time-out: ``due`` (clock time) while running, ``remaining`` while frozen."""
 
     #: "open" (next attempt 1), "attempt" (window ends), "finish" (the summary), and the others
-    #: the session schedules (see ``Session._fire``)
+    #: the session schedules (see ``Router.fire`` in :mod:`kiosk.core.session.routing`)
     kind: str
     due: float | None
     remaining: float = 0.0
@@ -55,6 +56,16 @@ class AttemptClock:
         """Whether anything stops the clock."""
         return bool(self.freezes)
 
+    @property
+    def paused(self) -> bool:
+        """Stopped by the patient's pause."""
+        return "paused" in self.freezes
+
+    @property
+    def halted(self) -> bool:
+        """Stopped by a call for the doctor, until a clinician (or the patient) carries on."""
+        return "doctor" in self.freezes
+
     def set(self, kind: str, start_t: float, seconds: float) -> None:
         """Replace the pending time-out by one ``seconds`` after session time ``start_t``."""
         if self.freezes:
@@ -87,7 +98,7 @@ class AttemptClock:
             self.timer.due = None
         self.freezes.add(reason)
 
-    def unfreeze(self, reasons: set[str], grace: float) -> bool:
+    def unfreeze(self, reasons: AbstractSet[str], grace: float) -> bool:
         """Lift freezes; once none is left the attempt gets at least the largest grace seen.
 
         False if none of ``reasons`` was in force (nothing changed).

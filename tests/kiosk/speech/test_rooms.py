@@ -404,7 +404,7 @@ def test_taking_back_an_answer_by_voice_is_undo(voice_of, text):
 def test_the_welcome_hears_start_and_the_language_names(voice_of, text, voice, option):
     """The welcome listens with options naming the languages; each is heard from a speaker of it."""
     ear = Ear()
-    # the options of the session's English welcome prompt (kiosk.core.session.core._welcome_prompt)
+    # the options of the session's English welcome prompt (kiosk.core.session.prompts.Prompts.welcome)
     ear.channel.set_question(
         [
             OptionWords(OWN_NAME[lang], (*LANGUAGE_NAMES["en"][lang], *(START_WORDS["en"] if lang == "en" else ())))
