@@ -58,29 +58,21 @@ log = logging.getLogger(__name__)
 
 #: a scored answer heard with less confidence than this is confirmed before it is stored
 #: ("I heard: Independent. Is that right?"). Above 1: every voice answer to a Barthel question
-#: is confirmed. Measured in bench/asr.py on 16 espeak-ng voices other than the kiosk's: answers
-#: stored unconfirmed at confidence >= 0.95 would still be wrong for 3.1 % of utterances in white
-#: noise at SNR 5 dB (held-out voices) and 3.3 % in babble at SNR 10 dB, against a 0.5 % limit;
-#: with every answer confirmed (and the confirmation's own yes/no recognised) none was stored wrong
+#: is confirmed, because even the surest unconfirmed answers were stored wrong far above the
+#: 0.5 % limit (measured: bench/RESULTS.md, asr.py)
 CONFIRM_BELOW = 1.01
 
 #: an answer heard with less than the matcher's minimum confidence, but at least this, twice in a
 #: row on the same question (the attempt and the patient's repeat), is asked back: two hearings
-#: that agree are worth an "Is that right?". On bench/asr.py's 16 voices in a quiet room the right
-#: option was heard twice at 0.25-0.55 for short answers ("one", "three", "help", "immobile") that
-#: were otherwise lost; it is never stored without the patient's yes
+#: that agree are worth an "Is that right?", and short answers were otherwise lost; it is never
+#: stored without the patient's yes (docs/speech-tuning.md)
 AGREE_MIN_CONFIDENCE = 0.2
 
 #: a reply to "Is that right?" spoken less than this far above the room (dB, see
 #: :attr:`kiosk.speech.audio.Utterance.above_room_db`) is sent as unsure, so a "yes" stores
 #: nothing: the session asks the patient to press Yes or No (a "no" still declines). Where
-#: people talk nearly as loud as the patient, a "no" was now and then heard as "yes" (at SNR
-#: 5 dB 2 of 480 on bench/asr.py's held-out voices, one of them storing a wrong answer), and
-#: the recogniser's confidence did not tell. Set on the dev voices' replies (80 yes and 80 no
-#: per room): a true yes measured below 8 dB in background talk at SNR 10 dB 0 of 80, in white
-#: noise at 10 dB 1 of 80, in talk at 7.5 dB 6 of 80, at 5 dB 74 of 80 (and the one "no" heard
-#: as "yes" there measured 5.1 dB); in the quiet, -20 dB, reverb and telephone rooms every reply
-#: measured above 30 dB. At 9 dB white noise at 10 dB would have lost 7 of 80 true yeses
+#: people talk nearly as loud as the patient a "no" was now and then heard as "yes", and the
+#: recogniser's confidence did not tell (docs/speech-tuning.md)
 REPLY_MIN_ABOVE_ROOM_DB = 8.0
 
 #: how long attach()/wait_loaded() wait for a speech model (a large vosk model takes seconds)
