@@ -21,9 +21,9 @@ Per condition, JSON: ``right`` (stored right, or the right command, within two a
 to take: the kiosk asks for a press, which this patient does not give), ``asked_to_press_right``
 (of those, the answer heard was the one meant), ``cut_off`` (utterances run to the 10 s limit:
 target 0 in steady noise at SNR >= 10 dB), ``rtf``, ``speech_end_to_answer_ms``, and
-``unconfirmed_wrong_by_confidence``: the wrong-stored rate if answers at or above a confidence were stored without asking (how
-:data:`kiosk.speech.voice.CONFIRM_BELOW` was chosen). Targets for ``right``: >= 0.8 clean,
->= 0.5 at SNR 10 dB.
+``unconfirmed_wrong_by_confidence``: the wrong-stored rate if answers at or above a confidence
+were stored without asking (how :data:`kiosk.speech.voice.CONFIRM_BELOW` was chosen). Targets for
+``right``: >= 0.8 clean, >= 0.5 at SNR 10 dB.
 
 Voices: ``dev`` tunes (thresholds, confusable words, grammar), ``held_out`` only reports. None is
 the kiosk's own voice. mbrola voices (``mbrola-us1`` ...) are in Debian's contrib section, which
@@ -35,54 +35,8 @@ this machine's sources do not carry; where they are installed, pass e.g. ``--voi
 ``--vad webrtc`` needs ``uv pip install webrtcvad-wheels``; ``--vad silero`` needs onnxruntime and
 silero-vad's ONNX model (see ``bench/_vads.py``): neither is a kiosk dependency.
 
-Measured here (pocketsphinx, 2 shared cores), dev / held-out, at `--cases 20` (160 utterances
-per condition and split) in every room, and at `--cases 40` (320) where noted:
-
-- wrong option stored (answers and non-answers): 0 in every condition, both splits (target
-  <= 0.5 %: met), also at `--cases 40` in babble 5 dB and white 5 dB, and in babble 10 dB
-  (measured before the rule below, which never acted there at `--cases 20`). The last
-  wrong store (babble 5 dB, held-out, 1 of 160 before) came from a "no" to "Is that right?"
-  heard as "yes" among talkers nearly as loud as the patient, 0.86-0.98 sure: in background
-  talk the confidence of a reply or of an answer asked back does not tell right from wrong
-  (babble 10 dB, both splits: at >= 0.9, 53 answers right and 33 wrong; a "no" heard as "yes"
-  2 of 480 replies at 5 dB held-out). Now a reply to "Is that right?" spoken less than 8 dB
-  above the room (:data:`kiosk.speech.voice.REPLY_MIN_ABOVE_ROOM_DB`) stores nothing: the
-  kiosk asks for Yes or No to be pressed. ``asked_to_press`` (and ``asked_to_press_right``:
-  of those, the option heard was the one meant) counts them: babble 5 dB 39 (39) / 40 (40) at
-  `--cases 40`, white 5 dB 26 (26) / 39 (39), white 10 dB 1 / 4, none in any other room. This
-  voice-only patient does not press, so those answers are not counted right;
-- cut-offs: none in any condition (target 0 in steady noise at SNR >= 10 dB: met);
-- right within two attempts (targets >= 0.8 clean, >= 0.5 at SNR 10 dB: met): clean 0.82 /
-  0.81, white 20 dB 0.82 / 0.74, white 10 dB 0.70 / 0.69, babble 20 dB 0.80 / 0.82, babble 10 dB
-  0.61 / 0.62 (0.58 / 0.61 at `--cases 40`), -20 dB 0.88 / 0.86, 4 s of silence first 0.79 /
-  0.74; in the rooms without a target: reverb 0.38 / 0.37, telephone band 0.18 / 0.17, white
-  5 dB 0.05 / 0.07 and babble 5 dB 0.10 / 0.06 at `--cases 40` (0.20 / 0.19 and 0.33 / 0.23 at
-  `--cases 20` before a spoken yes was refused there; the refused yeses above were all right answers a
-  press would store). What still fails: short words heard with too little confidence ("help",
-  "two" from whispering voices), in babble a "yes" heard as something else (about a third of
-  the time at 10 dB), in reverb and the telephone band the model's fit;
-- the talk gate (:func:`kiosk.speech.asr._gate_talk`) took babble 10 dB from 0.54 / 0.50 to
-  0.58 / 0.61 at `--cases 40`, babble 20 dB from 0.71 / 0.78 to 0.80 / 0.82;
-- wrong commands per 160: clean 3 / 5, white 20 dB 7 / 10, white 10 dB 14 / 23, babble 20 dB 5 /
-  9, 10 dB 15 / 24, 5 dB 19 / 27, reverb 25 / 14, telephone 10 / 16, -20 dB 5 / 4, silence first
-  3 / 8; at babble 10 dB, `--cases 40`, 32 / 41 per 320, the doctor called among them 17 / 19:
-  "all the time", "i can't", "is it time for lunch yet". Holding commands in babble to the
-  coverage that counts the talkers too took 3 of 15 false doctor calls away and 10 of 29 real
-  ones, so it was not kept;
-- RTF 0.015-0.045 (processor time); end of speech -> answer p50 345-545 ms, p95 595-680 ms.
-
-Tried against the last wrong store and not kept (each one event in a few hundred replies):
-refusing a yes standing less than 7 dB out of the talk in the utterance's own pre-roll (too
-noisy a yardstick: two other "no"s were heard as "yes" in a 40-case babble 10 dB run); the
-same yes on a second decode (caught 3 of 8 false yeses, cost 4-5 % of true ones); every word
-of the yes standing out of the talk in >= 10 % of its frames (cost 2-12.6 % of true yeses,
-caught 1 of 3). The room's level over the last 3 s outside the patient's speech, the yardstick
-kept, separates the rooms: a true yes measured below 8 dB in babble at 10 dB 0 of 80, at 5 dB
-74 of 80 (dev voices).
-
-Unconfirmed answers at confidence >= 0.95 would have been stored wrong for up to 20 % of
-utterances (held-out white 10 dB at `--cases 20`; 6-13 % in several conditions at `--cases 4`),
-which is why every voice answer is confirmed.
+Figures, dated with the command that produced them: bench/RESULTS.md. Why the recogniser's
+constants have their values: docs/speech-tuning.md.
 """
 
 from __future__ import annotations
@@ -90,18 +44,28 @@ from __future__ import annotations
 import argparse
 import json
 import random
-import statistics
 import sys
 import tempfile
 import time
 import zlib
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from _asr_cases import (  # noqa: E402
+    BABBLE_TALKERS,
+    BABBLE_TEXT,
+    CONDITIONS,
+    NO_EN,
+    QUICK_CONDITIONS,
+    SPEECH_LEVEL,
+    VOICES,
+    YES_EN,
+    Condition,
+    patient_cases,
+)
 from _vads import endpointer_factory  # noqa: E402
 
 from kiosk.core.channels import ChannelInput, Command  # noqa: E402
@@ -109,137 +73,9 @@ from kiosk.core.questionnaire import load_questionnaire  # noqa: E402
 from kiosk.speech import rooms  # noqa: E402
 from kiosk.speech.asr import PocketSphinxRecogniser  # noqa: E402
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav  # noqa: E402
-from kiosk.speech.matching import OptionWords, spoken_label  # noqa: E402
+from kiosk.speech.matching import OptionWords  # noqa: E402
 from kiosk.speech.tts import Synthesiser  # noqa: E402
 from kiosk.speech.voice import VoiceChannel  # noqa: E402
-
-#: patients' voices (espeak-ng voice+variant, words per minute); never the kiosk's own en-us at 160
-VOICES = {
-    "dev": [
-        ("en-us+m3", 130),
-        ("en+f2", 170),
-        ("en-gb+klatt", 150),
-        ("en+croak", 120),
-        ("en-us+f4", 185),
-        ("en-gb-scotland+m7", 145),
-        ("en+grandpa", 115),
-        ("en-us+whisperf", 150),
-    ],
-    "held_out": [
-        ("en+m5", 140),
-        ("en-us+f3", 160),
-        ("en+klatt3", 125),
-        ("en-gb-x-rp+m2", 180),
-        ("en+f5", 110),
-        ("en-029+m4", 155),
-        ("en-us+aunty", 135),
-        ("en+whisper", 165),
-    ],
-}
-#: other people talking in the ward, for babble (never a patient's voice)
-BABBLE_TALKERS = [("en-gb+m1", 170), ("en-us+f1", 180), ("en+m6", 160), ("en-gb-x-rp+f3", 175), ("en-us+m8", 165)]
-BABBLE_TEXT = [
-    "I told her the appointment was moved to Thursday afternoon but she did not listen",
-    "Could you bring the trolley round to bed twelve when you have a moment please",
-    "The pharmacy said the new tablets will be ready after the lunch round",
-    "We went to the seaside last summer and the weather was lovely all week",
-    "Has anyone seen the blood pressure cuff from the side room this morning",
-]
-
-
-#: every patient's active speech level (RMS, in int16 units): -20 dBFS, a clear voice at arm's length
-SPEECH_LEVEL = 32768 * 0.1
-
-
-@dataclass(frozen=True)
-class Condition:
-    """A room: noise kind and SNR, or an effect on the speech."""
-
-    noise: str = ""  # "", "white", "babble"
-    snr_db: float = 0.0
-    effect: str = ""  # "", "reverb", "telephone", "quiet", "leading_silence"
-    #: steady noise: utterances must never reach the cut-off here
-    steady: bool = False
-
-
-CONDITIONS = {
-    "clean": Condition(),
-    "white_20": Condition("white", 20, steady=True),
-    "white_10": Condition("white", 10, steady=True),
-    "white_5": Condition("white", 5, steady=True),
-    "babble_20": Condition("babble", 20),
-    "babble_10": Condition("babble", 10),
-    "babble_5": Condition("babble", 5),
-    "reverb": Condition(effect="reverb"),
-    "telephone": Condition(effect="telephone"),
-    "quiet_-20dB": Condition(effect="quiet"),
-    "leading_silence": Condition(effect="leading_silence"),
-}
-QUICK_CONDITIONS = ["clean", "white_10", "babble_10", "reverb"]
-
-#: answers in a patient's own words (item, text, option)
-NATURAL_EN = [
-    ("transfers", "I need a lot of help", 2),
-    ("transfers", "I need a little help", 3),
-    ("transfers", "I can do it by myself", 4),
-    ("feeding", "I need some help", 2),
-    ("feeding", "I eat by myself", 3),
-    ("mobility", "I use a wheelchair", 2),
-    ("mobility", "I walk with help", 3),
-    ("stairs", "I need help", 2),
-    ("bladder", "never", 3),
-    ("bowels", "sometimes", 2),
-    ("dressing", "I can't", 1),
-    ("toilet", "I need some help", 2),
-    ("grooming", "I need help", 1),
-    ("bathing", "by myself", 2),
-]
-#: things patients say that are not answers (every question); "<cough>" is a cough
-NON_ANSWERS_EN = [
-    "um",
-    "uh",
-    "what?",
-    "sorry?",
-    "<cough>",
-    "is it time for lunch yet",
-    "all the time",
-    "I don't know",
-    "the weather is nice today",
-    "where is my coat",
-    "hello",
-    "my daughter is coming later",
-    "banana split",
-    "can you say that again slowly",
-]
-COMMANDS_EN = [
-    ("call the doctor", Command.CALL_DOCTOR),
-    ("repeat", Command.REPEAT),
-    ("stop", Command.PAUSE),
-    ("louder", Command.VOLUME_UP),
-]
-YES_EN = ["yes", "yes that's right", "yes it is", "that's right"]
-NO_EN = ["no", "no that's wrong", "no it isn't", "no"]
-NUMBER_WORDS = ["one", "two", "three", "four"]
-ORDINAL_WORDS = ["first", "second", "third", "fourth"]
-
-
-def patient_cases(questionnaire) -> list[tuple[str, str, object]]:
-    """(item id, text, expected option / Command / None) for every question."""
-    cases = []
-    for item in questionnaire.items:
-        for option in item.options:
-            cases.append((item.id, spoken_label(option.label_in("en")), option.number))
-            cases += [(item.id, s, option.number) for s in option.synonyms_in("en")]
-            n = option.number - 1
-            cases += [
-                (item.id, NUMBER_WORDS[n], option.number),
-                (item.id, f"number {NUMBER_WORDS[n]}", option.number),
-                (item.id, f"the {ORDINAL_WORDS[n]} one", option.number),
-            ]
-        cases += [(item.id, text, None) for text in NON_ANSWERS_EN]
-        cases += [(item.id, text, command) for text, command in COMMANDS_EN]
-    cases += [(item, text, option) for item, text, option in NATURAL_EN]
-    return list(dict.fromkeys(cases))
 
 
 class Audio:

@@ -2,13 +2,86 @@
 derived), variables, parameters, timers, observations with their actions, and the terms in them.
 
 A :class:`Model` is immutable once loaded; every :class:`~qos.engine.Engine` built from it keeps its
-own run-time state, so one model can serve many engines.
+own run-time state, so one model can serve many engines. The value types live in :mod:`qos.values`
+and the terms (expressions and patterns) in :mod:`qos.nodes`; this module re-exports them, so
+``from qos.model import X`` names every part of a model.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Union
+
+from qos.nodes import (
+    Aggregate,
+    AllOf,
+    AndNot,
+    AnyOf,
+    Binary,
+    Call,
+    Changed,
+    Conditional,
+    Expr,
+    FollowedBy,
+    Literal,
+    Once,
+    Pattern,
+    Period,
+    Range,
+    Repeat,
+    Unary,
+    Updated,
+    Var,
+    While,
+)
+from qos.values import BOOLEAN, EVENTTYPE, NUMBER, ArrayType, EnumType, TypeSpec, ValueType, type_name
+
+#: the model's own names and the value types and terms it is built of (one import for callers)
+__all__ = [
+    "Action",
+    "Aggregate",
+    "AllOf",
+    "AndNot",
+    "AnyOf",
+    "ArrayType",
+    "BOOLEAN",
+    "Binary",
+    "Call",
+    "Changed",
+    "ClearEvidence",
+    "Conditional",
+    "Context",
+    "EVENTTYPE",
+    "EnumType",
+    "Evidence",
+    "Expr",
+    "FollowedBy",
+    "INTENSITY_LR",
+    "Literal",
+    "Model",
+    "NUMBER",
+    "Observation",
+    "Once",
+    "Pattern",
+    "Period",
+    "Property",
+    "REFERENCE_CLAMP",
+    "Range",
+    "Repeat",
+    "Schedule",
+    "SetVariable",
+    "Stream",
+    "Timer",
+    "TimerAction",
+    "TypeSpec",
+    "Unary",
+    "Updated",
+    "ValueType",
+    "Var",
+    "Variable",
+    "While",
+    "type_name",
+]
 
 #: likelihood ratio of each intensity (paper, Table 1); an undermining observation uses 1/LR
 INTENSITY_LR: dict[str, float] = {
@@ -22,63 +95,6 @@ INTENSITY_LR: dict[str, float] = {
 
 #: a reference of exactly 0 or 1 would make a property deaf to evidence (as RoQME's generator does)
 REFERENCE_CLAMP = (0.01, 0.99)
-
-
-@dataclass(frozen=True)
-class EnumType:
-    """An enumeration: a named type (``type T : enum {…}``) or the inline type of one context."""
-
-    name: str
-    literals: tuple[str, ...]
-
-    def __str__(self) -> str:
-        return f"enum {self.name} {{{', '.join(self.literals)}}}"
-
-
-@dataclass(frozen=True)
-class ArrayType:
-    """An array of at most ``size`` values of one scalar type (``number[3]``, ``enum[2] {…}``)."""
-
-    element: "ValueType"
-    size: int
-
-    def __str__(self) -> str:
-        return f"{type_name(self.element)}[{self.size}]"
-
-
-#: the type of a context or expression: "boolean", "number", "eventtype", an enumeration or an array
-ValueType = Union[str, EnumType, ArrayType]
-
-BOOLEAN = "boolean"
-NUMBER = "number"
-EVENTTYPE = "eventtype"
-
-
-def type_name(value_type: ValueType) -> str:
-    """How a type is named in messages: ``boolean``, ``number``, ``eventtype``, ``enum T`` or ``number[3]``."""
-    if isinstance(value_type, ArrayType):
-        return str(value_type)
-    return f"enum {value_type.name}" if isinstance(value_type, EnumType) else value_type
-
-
-@dataclass(frozen=True)
-class TypeSpec:
-    """A declared data type with its constraints: what ``type T : …`` names and a context or
-    variable declares. Bounds and units apply to numbers (and to the elements of number arrays)."""
-
-    type: ValueType
-    lower: float | None = None
-    upper: float | None = None
-    #: the unit a number is measured in (documentation; ``time`` is a number of seconds)
-    unit: str | None = None
-
-    def out_of_bounds(self, value: float) -> str | None:
-        """Why a number breaks the bounds, or None when it keeps them."""
-        if self.lower is not None and value < self.lower:
-            return f"{value:g} is below the lower bound {self.lower:g}"
-        if self.upper is not None and value > self.upper:
-            return f"{value:g} is above the upper bound {self.upper:g}"
-        return None
 
 
 @dataclass(frozen=True)
@@ -134,181 +150,6 @@ class Property:
     def decay_rate(self) -> float:
         """λ = 1/survival (per second); 0 when the evidence never fades."""
         return 0.0 if self.survival is None else 1.0 / self.survival
-
-
-# ---- expressions (values) and patterns (occurrences), as parsed and type-checked ----------------
-
-
-@dataclass(frozen=True)
-class Var:
-    """A context's current value in an expression."""
-
-    name: str
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Literal:
-    """A constant: boolean, number or enum literal."""
-
-    value: object
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Unary:
-    """``!e`` (boolean not) or ``-e`` (numeric negation)."""
-
-    op: str
-    operand: "Expr"
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Binary:
-    """``& | = != < <= > >= + - * /``."""
-
-    op: str
-    left: "Expr"
-    right: "Expr"
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Conditional:
-    """``condition ? then : otherwise``; undefined when the condition is."""
-
-    condition: "Expr"
-    then: "Expr"
-    otherwise: "Expr"
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Call:
-    """A function of values: ``pow sqrt exp abs`` (numbers) or ``size isEmpty first last at includes``
-    (arrays); ``X'f(a)`` is ``f(X, a)``."""
-
-    function: str
-    args: tuple["Expr", ...]
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Aggregate:
-    """``avg min max count sum increasing decreasing stable`` over the updates of one context.
-
-    ``window`` is None (every update so far), an int (the last n updates, Esper ``length(n)``) or a
-    float number of seconds (consecutive batches of that length, Esper ``time_batch``); ``where`` keeps
-    only the updates after which it is true. Checked models hold it as a stream (see ``Model.streams``).
-    """
-
-    function: str
-    source: str
-    window: int | float | None
-    where: "Expr | None"
-    type: ValueType
-
-
-@dataclass(frozen=True)
-class Period:
-    """``period(X)``: at an update that changes X, the seconds since X's previous update;
-    ``period(a -> b)``: at each ``b`` after an ``a``, the seconds since the latest ``a``."""
-
-    source: str | None
-    first: "Pattern | None" = None
-    then: "Pattern | None" = None
-    type: ValueType = NUMBER
-
-
-Expr = Union[Var, Literal, Unary, Binary, Conditional, Call]
-
-
-@dataclass(frozen=True)
-class Updated:
-    """Occurs on every update of a context in a batch (``update(var)``, a bare non-boolean
-    variable, or an eventtype occurring); with ``when_true``, only when the new value is true
-    (``eventWhen(var)`` or a bare boolean variable)."""
-
-    name: str
-    when_true: bool = False
-
-
-@dataclass(frozen=True)
-class Changed:
-    """Occurs when an expression's value changes (``update(expr)``); with ``when_true``, only when
-    it changes to true (``eventWhen(expr)``, or a bare boolean expression)."""
-
-    expr: Expr
-    when_true: bool = False
-
-
-@dataclass(frozen=True)
-class AnyOf:
-    """``a or b``."""
-
-    left: "Pattern"
-    right: "Pattern"
-
-
-@dataclass(frozen=True)
-class AllOf:
-    """``a and b``."""
-
-    left: "Pattern"
-    right: "Pattern"
-
-
-@dataclass(frozen=True)
-class FollowedBy:
-    """``a -> b``."""
-
-    first: "Pattern"
-    then: "Pattern"
-
-
-@dataclass(frozen=True)
-class Once:
-    """``once p``."""
-
-    pattern: "Pattern"
-
-
-@dataclass(frozen=True)
-class While:
-    """``p while(cond)``."""
-
-    pattern: "Pattern"
-    condition: Expr
-
-
-@dataclass(frozen=True)
-class Repeat:
-    """``p repeat(n)``."""
-
-    pattern: "Pattern"
-    times: int
-
-
-@dataclass(frozen=True)
-class AndNot:
-    """``a and not b``: ``a`` occurs before ``b`` has occurred since the pattern was (re-)armed; an
-    occurrence of ``b`` ends the attempt and the pattern starts again (Esper ``every (a and not b)``)."""
-
-    pattern: "Pattern"
-    excluded: "Pattern"
-
-
-@dataclass(frozen=True)
-class Range:
-    """``p range(a, b)``: occurs on the a-th to the b-th occurrence of ``p`` in the engine's life."""
-
-    pattern: "Pattern"
-    low: int
-    high: int
-
-
-Pattern = Union[Updated, Changed, AnyOf, AllOf, AndNot, FollowedBy, Once, While, Repeat, Range]
 
 
 # ---- actions, variables, timers ------------------------------------------------------------------

@@ -13,7 +13,6 @@ from pathlib import Path
 
 from lark import Token, Tree
 
-from fileio.bounded import BadFile, read_text
 from qos.errors import ModelError
 from qos.grammar import SyntaxProblem, parse_text
 from qos.model import (
@@ -37,35 +36,11 @@ from qos.model import (
     Variable,
     type_name,
 )
+from qos.source import MAX_IMPORT_DEPTH, Source, check_nesting, read_model
 from qos.terms import TermChecker, is_pattern, seconds_of
 from qos.timers import ScheduleError, parse_schedule
 
 _STRENGTHS = "verylow, low, medium, high, veryhigh"
-
-
-class _Source:
-    """The text of a model and the name used for it in messages."""
-
-    def __init__(self, text: str, filename: str, folder: Path | None):
-        self.text = text
-        self.filename = filename
-        #: where its imports are looked for
-        self.folder = folder
-
-    def error(self, line: int, column: int, message: str) -> ModelError:
-        return ModelError(f"{self.filename}:{line}:{column}: {message}")
-
-    def at(self, node, message: str) -> ModelError:
-        if isinstance(node, Token):
-            return self.error(node.line, node.column, message)
-        return self.error(node.meta.line, node.meta.column, message)
-
-
-def _read(path: Path) -> str:
-    try:
-        return read_text(path)  # the project's bounded reader
-    except BadFile as exc:
-        raise ModelError(str(exc)) from None
 
 
 def parse_model(text: str, filename: str = "<string>", folder: str | Path | None = None) -> Model:
@@ -73,35 +48,14 @@ def parse_model(text: str, filename: str = "<string>", folder: str | Path | None
 
     ``folder`` is where ``import`` looks for other models (default: the current directory).
     """
-    source = _Source(text, filename, Path(folder) if folder is not None else Path("."))
+    source = Source(text, filename, Path(folder) if folder is not None else Path("."))
     return _Checker(source).model(source)
 
 
 def load_model_file(path: str | Path) -> Model:
     """Read and parse a ``.roqme`` file; errors name the file by its base name."""
     path = Path(path)
-    return parse_model(_read(path), path.name, path.parent)
-
-
-#: how many models deep imports may go (each level is a few nested calls)
-MAX_IMPORT_DEPTH = 32
-#: how deeply terms may nest (parentheses, chains of operators): checking and running a term recurse
-#: once per level, and no model a person writes comes near this
-MAX_NESTING = 200
-
-
-def _check_nesting(source: _Source, tree: Tree) -> None:
-    """Refuse a term nested deeper than MAX_NESTING, naming its declaration (checked without recursion)."""
-    stack = [(declaration, 1, declaration) for declaration in tree.children]
-    while stack:
-        node, depth, declaration = stack.pop()
-        if depth > MAX_NESTING:
-            raise source.at(
-                declaration,
-                f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
-                "deep: split it with derived contexts",
-            )
-        stack.extend((child, depth + 1, declaration) for child in node.children if isinstance(child, Tree))
+    return parse_model(read_model(path), path.name, path.parent)
 
 
 def _description(token: Token) -> str:
@@ -113,7 +67,7 @@ def _description(token: Token) -> str:
 class _Checker(TermChecker):
     """Turns parse trees into a model, checking names and types on the way."""
 
-    def __init__(self, source: _Source):
+    def __init__(self, source: Source):
         super().__init__()
         self.source = source
         self.properties: dict[str, Property] = {}
@@ -128,15 +82,15 @@ class _Checker(TermChecker):
     def error(self, node, message: str) -> ModelError:
         return self.source.at(node, message)
 
-    def _tree(self, source: _Source) -> tuple[Tree, list[Token]]:
+    def _tree(self, source: Source) -> tuple[Tree, list[Token]]:
         try:
             tree, descriptions = parse_text(source.text)
         except SyntaxProblem as problem:
             raise source.error(problem.line, problem.column, problem.message) from None
-        _check_nesting(source, tree)
+        check_nesting(source, tree)
         return tree, descriptions
 
-    def model(self, source: _Source) -> Model:
+    def model(self, source: Source) -> Model:
         if source.folder is not None and source.filename != "<string>":
             self.reading.append((source.folder / source.filename).resolve())
         tree, descriptions = self._tree(source)
@@ -198,7 +152,7 @@ class _Checker(TermChecker):
         if len(self.reading) >= MAX_IMPORT_DEPTH:
             raise self.error(target, f"imports nest more than {MAX_IMPORT_DEPTH} models deep")
         outer = self.source
-        self.source = _Source(_read(path), path.name, path.parent)
+        self.source = Source(read_model(path), path.name, path.parent)
         self.reading.append(path)
         try:
             imported_tree, descriptions = self._tree(self.source)

@@ -1,21 +1,16 @@
 """Steady-noise reduction for one utterance before the recogniser scores it (spectral subtraction).
 
 A fan, an air conditioner or a corridor's hum fills the spectrum between the words; pocketsphinx's
-model was trained on clean speech, so in white noise at SNR 10 dB it heard the right phrase for
-52 of 80 answers on bench/asr.py's dev voices, but scored only 27 of them well enough to take.
+model was trained on clean speech, so it heard the right phrase but scored it too low to take.
 The noise's spectrum is estimated from the utterance's own quietest frames (the endpointer keeps
 a moment of room before and after the words), and subtracted from every frame, never below
-:data:`FLOOR` of the frame's own magnitude (deeper cuts left "musical noise" that the model heard
-as phones: over-subtracting 3x with a 0.02 floor took the right phrases from 52 down to 39).
-Measured on the same 80 answers (dev voices; over-subtraction and floor set on them): 53 right
-phrases, 42 of them taken (white noise at SNR 20 dB: 57 taken against 54 with 1x and 0.15).
+:data:`FLOOR` of the frame's own magnitude (deeper cuts leave "musical noise" the model hears as
+phones).
 
-Three cases are left alone. Background talk, which comes and goes (:data:`STEADY_SPREAD_DB`):
-subtracting its average spectrum took right answers at SNR 10 dB from 0.21 to 0.05. A quiet
-room (noise below :data:`QUIET_ROOM_DBFS`): there the quietest frames hold the ends of the words,
-and subtracting them took 8 of 55 answers below the confidence to take them. And an utterance
-with nothing above the noise: subtracting white noise from itself left warbling tones that
-pocketsphinx heard as "needs help" with confidence 0.84-0.95.
+Three cases are left alone: background talk, which comes and goes (:data:`STEADY_SPREAD_DB`); a
+quiet room (noise below :data:`QUIET_ROOM_DBFS`), where the quietest frames hold the ends of the
+words; and an utterance with nothing above the noise, where subtracting the noise from itself
+leaves warbling tones the recogniser takes for words. Measured: docs/speech-tuning.md.
 """
 
 from __future__ import annotations
@@ -57,7 +52,7 @@ def reduce_steady_noise(pcm: bytes) -> bytes:
     quietest, quiet = np.quantile(energy, [0.02, 0.1])  # the room between the words
     if quiet > quietest * 10 ** (STEADY_SPREAD_DB / 10):
         # the room's sound comes and goes (people talking): no one spectrum to take out, and
-        # subtracting an average of it took right answers in background talk from 0.21 to 0.05
+        # subtracting an average of it cost right answers in background talk
         return pcm
     noise = power[energy <= np.quantile(energy, QUIET_SHARE)].mean(axis=0)
     noise_energy = float(noise.sum())
@@ -66,7 +61,7 @@ def reduce_steady_noise(pcm: bytes) -> bytes:
     # window's power is its mean square)
     level = 10 * np.log10(max(noise_energy / (FRAME * float(squared.sum())), 1e-12) / 32768**2)
     if level < QUIET_ROOM_DBFS:
-        return pcm  # a quiet room: taking its hiss out only cost confidence (55 → 47 of 80 taken)
+        return pcm  # a quiet room: taking its hiss out only cost confidence
     if np.quantile(energy, 0.9) < noise_energy * 10 ** (SPEECH_ABOVE_NOISE_DB / 10):
         # nothing stands out of the noise: no words to clean, and subtracting the noise from
         # itself leaves warbling tones that the recogniser took for "needs help"

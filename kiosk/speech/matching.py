@@ -25,7 +25,7 @@ from kiosk.core.words import Table, languages
 #: the languages with speech words: every language with a words file
 LANGUAGES = languages()
 
-#: below this recogniser confidence an utterance is not an answer (see asr.py for the scale)
+#: below this recogniser confidence an utterance is not an answer (see kiosk.speech.asr for the scale)
 DEFAULT_MIN_CONFIDENCE = 0.6
 #: a command needs this much: it acts at once, with no confirmation, and on voices other than
 #: the kiosk's own short commands fit non-answers nearly as well as answers do ("uh" as

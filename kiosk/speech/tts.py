@@ -4,18 +4,10 @@ All synthesis and playback happen on one worker thread. :class:`Speaker` reports
 starts and stops talking (``on_speech(True/False)``) so the recogniser can be muted: the kiosk
 must never take its own voice for an answer.
 
-Why not plain pyttsx3: its espeak driver (2.99) proved unreliable here. Its ``say`` plays by
-shelling out to ``aplay`` with no error, no way to stop and no end-of-playback signal; after a
-``save_to_file`` it keeps writing later ``say`` calls to that file; it prints "Audio saved to
-..." on stdout (over the Textual screen); and, measured in this repository, ``save_to_file``
-now and then writes an empty WAV (1 phrase in 90) and applies the rate and volume set for one
-phrase to another (in 40 alternating-rate calls about half came out at the wrong rate): libespeak
-applies parameters asynchronously to its run loop (see also nateshmbhat/pyttsx3#194, #219).
-Setting the properties on the driver directly did not help: libespeak itself applied them late.
-So :class:`Synthesiser` runs the ``espeak-ng`` program once per phrase -- the same engine and
-voices, with voice, rate and volume passed per call, writing a WAV. Each phrase
-is then played through PortAudio (sounddevice) by a :class:`Player`, which knows when playback
-ends and can be stopped.
+:class:`Synthesiser` runs the ``espeak-ng`` program once per phrase, with voice, rate and
+volume passed per call, writing a WAV; a :class:`Player` plays it through PortAudio
+(sounddevice), knowing when playback ends and able to stop it. (Why not pyttsx3:
+docs/speech-tuning.md.)
 
 Slower speech is pauses, not slower words. Speech around 150-200 words per minute was rated
 most comfortable by older listeners, and slowing synthetic speech further made its words harder
@@ -30,11 +22,8 @@ the ``slow_speech`` adaptation is on, 136 wpm) to:
   (SSML ``<break>``, which replaces espeak-ng's own pause there). "Let me ask again. How do
   you manage eating your meals?" keeps its words whole and gains time between its sentences.
 
-Not used: a gap between every word (espeak-ng's ``-g``, or a ``<break>`` after each word).
-Measured here, espeak-ng then lengthens each word as if it ended a phrase: the words' own pace
-(words per voiced second) fell from 211 to 176-192 wpm-equivalent, as slow as asking for
-136 wpm outright -- isolated words, which the reference advises against. A prompt with no
-sentence end or comma inside is therefore only slowed to 150 wpm.
+Not used: a gap between every word, which makes espeak-ng speak isolated words
+(docs/speech-tuning.md); a prompt with no sentence end or comma inside is only slowed to 150 wpm.
 
 A rate of 150 wpm or more is spoken as asked, with espeak-ng's own pauses.
 """

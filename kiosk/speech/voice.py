@@ -20,6 +20,9 @@ asks for Yes or No to be pressed. A prompt
 without points (a confirmation, the welcome's start / language
 choice) is never itself confirmed.
 
+What is listened for on each prompt, and what an utterance means there, is
+:class:`kiosk.speech.listening.Listening`; this module is the audio, the threads and the status.
+
 Speech models load on the channel's own loader thread (seconds for vosk), never on the thread
 that changes the language; meanwhile voice in is CONNECTING and does not listen. Every status
 carries the source ``"voice"``, the latest one being the truth. Without a microphone or a
@@ -35,7 +38,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
 from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
 from kiosk.speech.audio import (
     AudioUnavailable,
@@ -45,42 +48,22 @@ from kiosk.speech.audio import (
     Utterance,
     UtterancePipeline,
 )
-from kiosk.speech.matching import (
-    DEFAULT_MIN_CONFIDENCE,
-    Match,
-    Matcher,
-    OptionWords,
-    undo_commands,
-    welcome_commands,
-)
+from kiosk.speech.listening import Listening
+from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, OptionWords
 
 log = logging.getLogger(__name__)
 
 #: a scored answer heard with less confidence than this is confirmed before it is stored
 #: ("I heard: Independent. Is that right?"). Above 1: every voice answer to a Barthel question
-#: is confirmed. Measured in bench/asr.py on 16 espeak-ng voices other than the kiosk's: answers
-#: stored unconfirmed at confidence >= 0.95 would still be wrong for 3.1 % of utterances in white
-#: noise at SNR 5 dB (held-out voices) and 3.3 % in babble at SNR 10 dB, against a 0.5 % limit;
-#: with every answer confirmed (and the confirmation's own yes/no recognised) none was stored wrong
+#: is confirmed, because even the surest unconfirmed answers were stored wrong far above the
+#: 0.5 % limit (measured: bench/RESULTS.md, asr.py)
 CONFIRM_BELOW = 1.01
-
-#: an answer heard with less than the matcher's minimum confidence, but at least this, twice in a
-#: row on the same question (the attempt and the patient's repeat), is asked back: two hearings
-#: that agree are worth an "Is that right?". On bench/asr.py's 16 voices in a quiet room the right
-#: option was heard twice at 0.25-0.55 for short answers ("one", "three", "help", "immobile") that
-#: were otherwise lost; it is never stored without the patient's yes
-AGREE_MIN_CONFIDENCE = 0.2
 
 #: a reply to "Is that right?" spoken less than this far above the room (dB, see
 #: :attr:`kiosk.speech.audio.Utterance.above_room_db`) is sent as unsure, so a "yes" stores
 #: nothing: the session asks the patient to press Yes or No (a "no" still declines). Where
-#: people talk nearly as loud as the patient, a "no" was now and then heard as "yes" (at SNR
-#: 5 dB 2 of 480 on bench/asr.py's held-out voices, one of them storing a wrong answer), and
-#: the recogniser's confidence did not tell. Set on the dev voices' replies (80 yes and 80 no
-#: per room): a true yes measured below 8 dB in background talk at SNR 10 dB 0 of 80, in white
-#: noise at 10 dB 1 of 80, in talk at 7.5 dB 6 of 80, at 5 dB 74 of 80 (and the one "no" heard
-#: as "yes" there measured 5.1 dB); in the quiet, -20 dB, reverb and telephone rooms every reply
-#: measured above 30 dB. At 9 dB white noise at 10 dB would have lost 7 of 80 true yeses
+#: people talk nearly as loud as the patient a "no" was now and then heard as "yes", and the
+#: recogniser's confidence did not tell (docs/speech-tuning.md)
 REPLY_MIN_ABOVE_ROOM_DB = 8.0
 
 #: how long attach()/wait_loaded() wait for a speech model (a large vosk model takes seconds)
@@ -117,40 +100,23 @@ class VoiceChannel:
         #: installed model, else pocketsphinx for English
         self._recogniser_factory = recogniser_factory or (lambda lang: open_recogniser(lang, vosk_model))
         self._microphone_factory = microphone_factory
-        self.min_confidence = min_confidence
-        #: a scored answer heard with a confidence below this is sent with needs_confirmation
-        self.confirm_below = confirm_below
+        #: what is listened for on the current prompt, and what an utterance means there
+        self._heard = Listening(
+            min_confidence=min_confidence,
+            confirm_below=confirm_below,
+            reply_min_above_room_db=reply_min_above_room_db,
+        )
         #: called with (utterance, reason) when speech was heard but was not an answer
         self.on_unmatched = on_unmatched
         #: called with every utterance the endpointer closed (timings, cut-offs: for the bench)
         self.on_utterance = on_utterance
         self._endpointer_factory = endpointer_factory
-        #: a reply to "Is that right?" spoken less far above the room than this is sent as unsure
-        self.reply_min_above_room_db = reply_min_above_room_db
-        #: whether the current prompt asks "Is that right?" (a reply stores an answer)
-        self._confirming = False
-        #: whether the current options score points (a Barthel question): only those answers
-        #: are ever confirmed; a confirmation's own yes/no or a language choice is not
-        self._scored = False
-        #: the prompt comes before the test (the welcome, the explanation's Start): only "call the
-        #: doctor" besides its options (:func:`kiosk.speech.matching.welcome_commands`)
-        self._welcome = False
-        #: an answer was just stored: only "No, that's wrong" (and the doctor) until the next prompt
-        self._undo_only = False
-        #: options the patient declined ("Is that right?" No) on the question ``_declined_on``
-        self._declined: set[int] = set()
-        self._declined_on: str | None = None
-        #: the option the latest utterance on this scored question was unsure of (see
-        #: :data:`AGREE_MIN_CONFIDENCE`)
-        self._unsure: int | None = None
         self._lock = threading.RLock()
         self._sink: Sink | None = None
         self._recogniser: Recogniser | None = None
         self._pipeline: UtterancePipeline | None = None
         self._microphone = None
-        self._matcher: Matcher | None = None
-        self._options: list[OptionWords] = []
-        self._listening = self._speaking = self._paused = False
+        self._listening = self._speaking = False
         #: notified when the loader thread ends (see wait_loaded)
         self._loaded = threading.Condition(self._lock)
         #: whether audio can arrive (microphone open, or attached): language changes load models
@@ -275,13 +241,7 @@ class VoiceChannel:
         ``key`` names the question: asked again under the same key, the options the patient
         declined on it are not listened for (see :meth:`declined`)."""
         with self._lock:
-            if scored:
-                self._on_question(key)
-            self._options = list(options)
-            self._scored = scored
-            self._welcome = welcome
-            self._confirming = confirming
-            self._undo_only = False
+            self._heard.set_question(options, scored=scored, welcome=welcome, key=key, confirming=confirming)
             if language != self.language:
                 self.language = language
                 # before start() the language is only noted; the model loads off the UI thread
@@ -296,25 +256,14 @@ class VoiceChannel:
         "the third one" again and again for some voices; "sometimes" as "never"). The option
         can still be touched or chosen with the remote; the next question listens for all."""
         with self._lock:
-            self._on_question(key)
-            self._declined.add(option)
-            self._unsure = None
-
-    def _on_question(self, key: str | None) -> None:
-        """What was declined or heard unsure belongs to one question: another one (or one
-        without a name) starts afresh."""
-        if key is None or key != self._declined_on:
-            self._declined_on, self._declined, self._unsure = key, set(), None
+            self._heard.declined(key, option)
 
     def expect_undo(self) -> None:
         """An answer was stored: until the next prompt only taking it back ("No, that's wrong",
         "change my answer") and calling the doctor are listened for. The answered question's own
         words would mean nothing in the thank-you gap."""
         with self._lock:
-            self._options = []
-            self._scored = self._confirming = False
-            self._welcome = False
-            self._undo_only = True
+            self._heard.expect_undo()
             self._apply_grammar()
 
     def listen(self, listening: bool) -> None:
@@ -333,15 +282,14 @@ class VoiceChannel:
 
     def _set_paused(self, paused: bool) -> None:
         with self._lock:
-            if paused != self._paused:
-                self._paused = paused
+            if self._heard.set_paused(paused):
                 self._apply_grammar()
                 self._gate()
 
     def _load(self, language: str) -> None:
         """(Lock held.) Have the loader thread load ``language``'s recogniser; until it is
         installed voice in does not listen, and its status says so."""
-        self._recogniser = self._matcher = None
+        self._recogniser = self._heard.matcher = None
         self._gate()
         self._wanted = language
         self._status(ChannelState.CONNECTING, f"loading the speech model for {language!r}")
@@ -390,88 +338,33 @@ class VoiceChannel:
         self._status(ChannelState.ON, f"voice answers on: {recogniser.name}")
 
     def _apply_grammar(self) -> None:
-        if self._recogniser is None or not (self._options or self._paused or self._undo_only):
+        """(Lock held.) Give the recogniser the current prompt's grammar, once there is one."""
+        if self._recogniser is None:
             return
-        options = [] if self._paused else self._options
-        commands = None  # all of them: a question, or only commands while paused
-        if self._welcome and not self._paused:
-            commands = welcome_commands(self.language)
-        elif self._undo_only and not self._paused:
-            commands = undo_commands(self.language)
-        self._matcher = Matcher(options, self.language, self.min_confidence, paused=self._paused, commands=commands)
-        phrases = self._matcher.phrases()
-        if self._scored and not self._paused and self._declined:
-            phrases = [p for p in phrases if self._matcher.meaning(p) not in self._declined]
-        # a scored question's answers are all asked back unless the channel takes sure ones as heard
-        asked_back = self._scored and self.confirm_below > 1
+        phrases = self._heard.grammar(self.language)
+        if phrases is None:
+            return
+        matcher = self._heard.matcher
         self._recogniser.set_grammar(
-            phrases,
-            self._matcher.meaning,
-            self._matcher.lead_ins(),
-            self._matcher.fillers(),
-            taken_as_heard=not asked_back,
+            phrases, matcher.meaning, matcher.lead_ins(), matcher.fillers(), taken_as_heard=self._heard.taken_as_heard
         )
         self._gate()
 
     def _gate(self) -> None:
         if self._pipeline is not None:
-            wanted = (self._listening or self._paused) and self._matcher is not None and self._recogniser is not None
+            heard = self._heard
+            wanted = (self._listening or heard.paused) and heard.matcher is not None and self._recogniser is not None
             self._pipeline.muted = self._speaking or not wanted
 
     def _on_utterance(self, utterance: Utterance) -> None:
+        """(Lock held, microphone thread.) An utterance to the session, or to ``on_unmatched``."""
         self.on_utterance(utterance)
-        result = utterance.result
-        match = self._matcher.match(result.text, result.confidence)
-        if not match.matched:
-            match = self._heard_twice(result) or match
-        if not match.matched:
-            log.info("voice: %s", match.reason)
-            self.on_unmatched(result.text, match.reason)
-            return
-        if result.confusable and match.option is not None and not self._scored:
-            # "the first one" heard where "the third one" means something else, and nothing to
-            # ask back with (only a scored question's answers are confirmed): asked again
-            reason = f"{result.text!r} is confusable with another answer and cannot be confirmed here"
-            log.info("voice: %s", reason)
-            self.on_unmatched(result.text, reason)
-            return
-        # a scored answer below confirm_below is asked back, and always a confusable phrase or
-        # one heard twice unsure
-        unsure = result.confusable or result.confidence < max(self.min_confidence, self.confirm_below)
-        confirm = self._scored and match.option is not None and unsure
-        if self._confirming and match.option is not None and self._too_loud(utterance):
-            confirm = True
-        self._unsure = None
-        if self._sink is not None:
-            self._sink(
-                ChannelInput(
-                    Channel.VOICE,
-                    option=match.option,
-                    command=match.command,
-                    detail=result.text,
-                    confidence=round(result.confidence, 3),
-                    needs_confirmation=confirm,
-                )
-            )
-
-    def _too_loud(self, utterance: Utterance) -> bool:
-        """Whether the room was nearly as loud as the voice (see :data:`REPLY_MIN_ABOVE_ROOM_DB`)."""
-        above = utterance.above_room_db
-        if above is None or above >= self.reply_min_above_room_db:
-            return False
-        log.info("voice: %r spoken %.1f dB above the room, too little to take as said", utterance.result.text, above)
-        return True
-
-    def _heard_twice(self, result: Any) -> Match | None:
-        """An unsure recognition that selects the same option as the one just before it on the
-        same scored question, both at least :data:`AGREE_MIN_CONFIDENCE` sure: its match."""
-        if not self._scored or self._paused:
-            return None
-        match = self._matcher.match(result.text)
-        unsure = match.option if result.confidence >= AGREE_MIN_CONFIDENCE else None
-        agreed = unsure is not None and unsure == self._unsure
-        self._unsure = None if agreed else unsure
-        return match if agreed else None
+        heard = self._heard.hear(utterance)
+        if isinstance(heard, str):
+            log.info("voice: %s", heard)
+            self.on_unmatched(utterance.result.text, heard)
+        elif self._sink is not None:
+            self._sink(heard)
 
     def _status(self, state: ChannelState, reason: str, reason_key: str = "") -> None:
         """Every status under the one source name, so the latest always wins on the channel

@@ -17,7 +17,8 @@ from kiosk.core.channels import ChannelInput, Command
 from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
 from kiosk.speech import rooms
-from kiosk.speech.asr import PocketSphinxRecogniser, _above_room, _gate_talk, _voiced_frames
+from kiosk.speech.asr import PocketSphinxRecogniser
+from kiosk.speech.asr.levels import above_room, gate_talk, voiced_frames
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, frame_powers, read_wav
 from kiosk.speech.matching import OptionWords
 from kiosk.speech.tts import Synthesiser
@@ -202,16 +203,16 @@ def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
         speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.0, np.random.default_rng(5)), 10, lead_s=0.3
     )
     level = 10 * np.log10(np.maximum(frame_powers(talk) / 32768.0**2, 1e-10))
-    counted = _above_room(talk.tobytes(), len(level))
+    counted = above_room(talk.tobytes(), len(level))
     words = np.zeros(len(level), dtype=bool)
     active = 10 * np.log10(np.maximum(frame_powers(speech), 1e-9))
     words[30 + np.flatnonzero(active >= active.max() - 15)] = True  # the loud part of the word
     assert counted[words].mean() > 0.8
     assert counted[~words].mean() < 0.2, "the talk before and after the word is not counted"
     quiet = _in_noise(speech, None, lead_s=0.3).tobytes()
-    voiced = _voiced_frames(quiet)
-    assert (voiced & _above_room(quiet, len(voiced)) == voiced).all(), "a quiet room: every voiced frame"
-    assert _above_room(speech.tobytes(), len(active)).all(), "no pre-roll: nothing to go by"
+    voiced = voiced_frames(quiet)
+    assert (voiced & above_room(quiet, len(voiced)) == voiced).all(), "a quiet room: every voiced frame"
+    assert above_room(speech.tobytes(), len(active)).all(), "no pre-roll: nothing to go by"
 
 
 def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
@@ -223,7 +224,7 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     talk = _in_noise(
         speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 1.5, np.random.default_rng(5)), 10, lead_s=0.5
     )
-    gated = np.frombuffer(_gate_talk(talk.tobytes()), dtype="<i2")
+    gated = np.frombuffer(gate_talk(talk.tobytes()), dtype="<i2")
     assert len(gated) == len(talk)
     before = 10 * np.log10(np.maximum(frame_powers(talk), 1e-9))
     after = 10 * np.log10(np.maximum(frame_powers(gated), 1e-9))
@@ -233,15 +234,15 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     # talk louder than the pre-roll's stands out of the room as the patient does, and is kept
     # with its 100 ms either side (and the gate's 5 ms ramp, in the frame after that); the rest
     # is turned down
-    loud = _above_room(talk.tobytes(), len(before))
+    loud = above_room(talk.tobytes(), len(before))
     near = np.convolve(loud, np.ones(2 * 11 + 1), mode="same") > 0
     assert (~near).mean() > 0.2, "a good part of the talk is quieter than the word"
     assert (before[~near] - after[~near]).min() > 25, "the talk around it is turned down"
     assert np.abs(after[loud] - before[loud]).max() < 3
     quiet = _in_noise(speech, None, lead_s=0.5)
     quiet += np.round(np.random.default_rng(1).normal(0, 6, len(quiet))).astype(np.int16)  # a microphone's hiss
-    assert _gate_talk(quiet.tobytes()) == quiet.tobytes(), "a quiet room is left as it was heard"
-    assert _gate_talk(speech.tobytes()) == speech.tobytes(), "no pre-roll: nothing to go by"
+    assert gate_talk(quiet.tobytes()) == quiet.tobytes(), "a quiet room is left as it was heard"
+    assert gate_talk(speech.tobytes()) == speech.tobytes(), "no pre-roll: nothing to go by"
     # an answer cut in two in a quiet room: the second part's pre-roll holds the first part's
     # words, at speech level, but the room around them is the microphone's hiss
     first, second = voice_of("needs", *PATIENTS[0]), voice_of("help", *PATIENTS[0])
@@ -251,7 +252,7 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     cut = np.concatenate([trailing_off, second, np.zeros(int(0.5 * SAMPLE_RATE), np.int16)])
     assert np.percentile(10 * np.log10(frame_powers(cut[: int(0.2 * SAMPLE_RATE)]) / 32768.0**2), 90) > -55
     cut += np.round(np.random.default_rng(2).normal(0, 6, len(cut))).astype(np.int16)
-    assert _gate_talk(cut.tobytes()) == cut.tobytes(), "a quiet room's answer cut in two is left as heard"
+    assert gate_talk(cut.tobytes()) == cut.tobytes(), "a quiet room's answer cut in two is left as heard"
 
 
 def test_yes_and_no_in_background_talk_are_not_taken_for_commands(voice_of):

@@ -1,0 +1,246 @@
+"""The rules a questionnaire file must follow that its JSON Schema cannot say.
+
+Translations for the declared languages, unique ids, distinct points, one display per code, and
+band sets covering every reachable total. Every problem is collected with its ``file:line:col``
+position, so a clinician editing the file by hand fixes them all in one pass.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from typing import Any
+
+from fileio.positions import Positions, Problem, describe, schema_problems
+from kiosk.core.words import languages
+
+#: the languages the kiosk's own screens are written in (a words file each, kiosk/core/words): a
+#: questionnaire in another language would start a session its screens cannot show
+SCREEN_LANGUAGES = languages()
+
+
+def check(
+    parsed: tuple[Any, Positions | None, list[Problem]], filename: str, schema: dict[str, Any]
+) -> tuple[Any, list[Problem]]:
+    """(data, every problem sorted by position) of a parsed file; data is None on a syntax error.
+
+    ``schema`` is the questionnaire JSON Schema; the rules it cannot say are checked here too."""
+    data, positions, problems = parsed
+    if positions is None:
+        return None, problems
+
+    def add(path: tuple[Any, ...], message: str, *, key: bool = False) -> None:
+        line, col = positions.of(path, key=key)
+        problems.append(Problem(filename, line, col, message))
+
+    schema_problems(data, schema, positions, add)
+    if isinstance(data, dict):
+        _check_semantics(data, add)
+    problems.sort(key=lambda p: (p.line, p.column, p.message))
+    return data, problems
+
+
+def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
+    """Rules a JSON Schema cannot say: translations, unique ids, distinct points, band coverage.
+
+    Runs even when the schema found problems, so every error is reported in one go; parts with
+    the wrong shape (already reported by the schema) are skipped.
+    """
+
+    def dicts(value: Any) -> list[tuple[int, dict[str, Any]]]:
+        return [(i, v) for i, v in enumerate(value) if isinstance(v, dict)] if isinstance(value, list) else []
+
+    languages = (
+        [x for x in data.get("languages", []) if isinstance(x, str)] if isinstance(data.get("languages"), list) else []
+    )
+    if len(set(languages)) != len(languages):
+        add(("languages",), "a language is listed twice in 'languages'")
+    for i, lang in enumerate(languages):
+        if lang not in SCREEN_LANGUAGES:
+            add(
+                ("languages", i),
+                f"language {lang!r}: the kiosk's screens have text in {', '.join(SCREEN_LANGUAGES)} only",
+            )
+
+    def texts(path: tuple[Any, ...], value: Any) -> None:
+        if not isinstance(value, dict):
+            return
+        for lang in languages:
+            if lang not in value:
+                add(path, f"{describe(path)} has no {lang!r} translation")
+        for lang, text in value.items():
+            if languages and lang not in languages:
+                add(
+                    path + (lang,), f"{describe(path)} has a {lang!r} text but {lang!r} is not in 'languages'", key=True
+                )
+            if isinstance(text, str) and text and not text.strip():  # "" is the schema's to report
+                add(path + (lang,), f"{describe(path)} in {lang!r} is blank: write the words")
+
+    texts(("title",), data.get("title"))
+    messages = data.get("messages")
+    for name, value in messages.items() if isinstance(messages, dict) else ():
+        texts(("messages", name), value)
+
+    def options(path: tuple[Any, ...], value: Any, scored: bool) -> None:
+        seen: set[Any] = set()
+        codes: set[tuple[Any, Any]] = set()
+        for i, option in dicts(value):
+            texts(path + (i, "label"), option.get("label"))
+            texts(path + (i, "patient"), option.get("patient"))
+            synonyms = option.get("synonyms")
+            for lang, words in synonyms.items() if isinstance(synonyms, dict) else ():
+                if languages and lang not in languages:
+                    add(path + (i, "synonyms", lang), f"synonyms in {lang!r}, which is not in 'languages'", key=True)
+                for n, word in enumerate(words if isinstance(words, list) else ()):
+                    if isinstance(word, str) and word and not word.strip():
+                        add(path + (i, "synonyms", lang, n), f"a synonym in {lang!r} is blank: write the words")
+            answer_code = option.get("code")
+            if isinstance(answer_code, dict):
+                key = (answer_code.get("system"), answer_code.get("code"))
+                if key in codes:
+                    add(path + (i, "code"), f"two options of {describe(path[:-1])} have the answer code {key[1]!r}")
+                codes.add(key)
+            points = option.get("points")
+            if scored and isinstance(points, int):
+                if points in seen:
+                    add(path + (i, "points"), f"two options of {describe(path[:-1])} score {points} points")
+                seen.add(points)
+
+    _check_displays(data, dicts, add)
+    ids: dict[str, tuple[Any, ...]] = {}
+    for section in ("items", "familiarisation"):
+        for i, entry in dicts(data.get(section)):
+            path = (section, i)
+            entry_id = entry.get("id")
+            if isinstance(entry_id, str) and entry_id in ids:
+                add(path + ("id",), f"duplicate id {entry_id!r} (also used at {describe(ids[entry_id])})")
+            elif isinstance(entry_id, str):
+                ids[entry_id] = path
+            texts(path + ("text",), entry.get("text"))
+            texts(path + ("patient",), entry.get("patient"))
+            texts(path + ("spoken",), entry.get("spoken"))
+            spoken = entry.get("spoken")
+            for lang, said in spoken.items() if isinstance(spoken, dict) else ():
+                for mark in re.findall(r"\{[^}]*\}", said) if isinstance(said, str) else ():
+                    if mark != "{ways}":
+                        add(
+                            path + ("spoken", lang),
+                            f"{mark} would be said aloud: the only mark a spoken "
+                            "text may hold is {ways} (how to answer)",
+                        )
+            options(path + ("options",), entry.get("options"), scored=section == "items")
+            expected, opts = entry.get("expected"), entry.get("options")
+            if (
+                section == "familiarisation"
+                and isinstance(expected, int)
+                and isinstance(opts, list)
+                and expected > len(opts)
+            ):
+                add(path + ("expected",), f"expected option {expected} but there are only {len(opts)} options")
+
+    _check_bands(data, dicts, texts, add)
+
+
+def _check_displays(
+    data: dict[str, Any], dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]], add: Callable[..., None]
+) -> None:
+    """One code, one display: a code system gives a code one display, so two places of the
+    file giving one code two displays is a mistake (an export would say both)."""
+    first: dict[tuple[Any, Any], tuple[str, tuple[Any, ...]]] = {}
+    places: list[tuple[tuple[Any, ...], Any]] = [
+        (("code",), data.get("code")),
+        (("total_code",), data.get("total_code")),
+    ]
+    for i, item in dicts(data.get("items")):
+        places.append((("items", i, "code"), item.get("code")))
+        places += [(("items", i, "options", j, "code"), option.get("code")) for j, option in dicts(item.get("options"))]
+    for path, code in places:
+        if not isinstance(code, dict) or not isinstance(code.get("display"), str):
+            continue
+        key = (code.get("system"), code.get("code"))
+        if key in first and first[key][0] != code["display"]:
+            add(
+                path + ("display",),
+                f"code {key[1]!r} has the display {code['display']!r} here but "
+                f"{first[key][0]!r} at {describe(first[key][1])}: one code, one display",
+            )
+        first.setdefault(key, (code["display"], path))
+
+
+def _reachable_totals(items: list[tuple[int, dict[str, Any]]]) -> set[int] | None:
+    """Every total a patient can score (one option's points per item), or None when some points
+    are not whole multiples of 5: the schema reports those, and bands judged against totals that
+    the corrected file cannot reach would only bury that one mistake under others."""
+    totals = {0}
+    for _, item in items:
+        options = item.get("options")
+        points = {o.get("points") for o in options if isinstance(o, dict)} if isinstance(options, list) else set()
+        if not all(isinstance(p, int) and not isinstance(p, bool) and p >= 0 and p % 5 == 0 for p in points):
+            return None
+        if points:
+            totals = {t + p for t in totals for p in points}
+    return totals
+
+
+def _check_bands(
+    data: dict[str, Any],
+    dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
+    texts: Callable[[tuple[Any, ...], Any], None],
+    add: Callable[..., None],
+) -> None:
+    """Each band set: labels translated, unique band ids, no two bands sharing a total, every total
+    a patient can reach in a band, and the last band ending at the highest possible total; the
+    default names one of the sets.
+
+    Gaps are judged on reachable totals: with points in steps of 5, "20-35, 40-55" (as published)
+    leaves no total out, so it is not a gap."""
+    block = data.get("bands")
+    if not isinstance(block, dict):
+        return
+    sets = block.get("sets") if isinstance(block.get("sets"), dict) else {}
+    default = block.get("default")
+    if isinstance(default, str) and sets and default not in sets:
+        add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")
+    items = dicts(data.get("items"))
+    # no items: the schema says so, and every band would only repeat it as "ends above 0"
+    reachable = _reachable_totals(items) if items else None
+    for name, band_set in sets.items():
+        path = ("bands", "sets", name, "ranges")
+        bands = dicts(band_set.get("ranges")) if isinstance(band_set, dict) else []
+        band_ids: set[Any] = set()
+        for i, band in bands:
+            texts(path + (i, "label"), band.get("label"))
+            if band.get("id") in band_ids:
+                add(path + (i, "id"), f"band set {name!r}: duplicate band id {band['id']!r}")
+            band_ids.add(band.get("id"))
+        if (
+            reachable is None
+            or not bands
+            or not all(isinstance(b.get("min"), int) and isinstance(b.get("max"), int) for _, b in bands)
+        ):
+            continue
+        for i, band in bands:
+            if band["min"] > band["max"]:
+                add(
+                    path + (i,),
+                    f"band set {name!r}: band {band.get('id')!r} has min {band['min']} above max {band['max']}",
+                )
+        ordered = sorted(bands, key=lambda ib: (ib[1]["min"], ib[1]["max"]))
+        below = -1  # the highest total covered so far
+        previous: dict[str, Any] | None = None
+        for i, band in ordered:
+            if previous is not None and band["min"] <= below:
+                add(
+                    path + (i, "min"),
+                    f"band set {name!r}: bands {previous.get('id')!r} and {band.get('id')!r} "
+                    f"overlap ({band['min']} to {min(below, band['max'])} are in both)",
+                )
+            elif missed := sorted(t for t in reachable if below < t < band["min"]):
+                add(
+                    path + (i, "min"),
+                    f"band set {name!r}: bands leave a gap before {band['min']} (a total of {missed[0]} is in no band)",
+                )
+            if band["max"] > below:
+                below, previous = band["max"], band
+        if below != max(reachable):
+            add(path, f"band set {name!r}: bands end at {below} but the highest possible total is {max(reachable)}")

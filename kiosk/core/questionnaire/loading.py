@@ -1,0 +1,156 @@
+"""Loading a questionnaire file: parse with positions, check everything, build the model.
+
+Nothing is half-loaded: a file with any problem raises :class:`QuestionnaireError` listing all of
+them, because clinicians edit the YAML by hand and should fix every mistake in one pass.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Mapping
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from fileio.positions import Problem, parse, parse_file
+from kiosk.core.questionnaire.checks import check
+from kiosk.core.questionnaire.model import (
+    Band,
+    BandSet,
+    Code,
+    Item,
+    Option,
+    PracticeQuestion,
+    Questionnaire,
+    Timing,
+)
+
+#: where the bundled questionnaire and its schema live
+_PACKAGE_DIR = "kiosk.core.questionnaire.instruments"
+DEFAULT_FILE = "barthel.yaml"
+SCHEMA_FILE = "questionnaire.schema.json"
+
+
+class QuestionnaireError(ValueError):
+    """A questionnaire file is unusable; ``problems`` lists every reason with its position."""
+
+    def __init__(self, problems: list[Problem]) -> None:
+        self.problems = problems
+        first = str(problems[0]) if problems else "invalid questionnaire"
+        more = f" (and {len(problems) - 1} more problems)" if len(problems) > 1 else ""
+        super().__init__(first + more)
+
+
+# --------------------------------------------------------------------------------------------
+
+
+def bundled_path(name: str = DEFAULT_FILE) -> Path:
+    """Path of a file shipped in ``kiosk/core/questionnaire/instruments``."""
+    return Path(str(resources.files(_PACKAGE_DIR).joinpath(name)))
+
+
+@cache
+def _schema() -> dict[str, Any]:
+    return json.loads(bundled_path(SCHEMA_FILE).read_text(encoding="utf-8"))
+
+
+def load_questionnaire(path: str | Path | None = None) -> Questionnaire:
+    """Load and validate a questionnaire (default: the bundled Barthel file).
+
+    Raises :class:`QuestionnaireError` listing every problem (an unreadable file is one problem).
+    """
+    file = Path(path) if path is not None else bundled_path()
+    name = str(path if path is not None else file)
+    data, problems = check(parse_file(file, name), name, _schema())
+    if problems:
+        raise QuestionnaireError(problems)
+    return _build(data, str(file))
+
+
+def check_questionnaire_file(path: str | Path) -> list[Problem]:
+    """Every problem in a questionnaire file (empty if it is valid): the checks :func:`load_questionnaire`
+    makes, so a file this accepts is one the kiosk runs. Unreadable: one problem."""
+    return check_questionnaire(path)[1]
+
+
+def check_questionnaire(path: str | Path) -> tuple[bool, list[Problem]]:
+    """(readable, every problem) of a questionnaire file; ``readable`` is False when the file could
+    not be read as YAML at all (then its one problem says why)."""
+    parsed = parse_file(path)
+    return parsed[1] is not None, check(parsed, str(path), _schema())[1]
+
+
+def check_questionnaire_text(text: str, filename: str) -> tuple[Any, list[Problem]]:
+    """Parse and check questionnaire YAML; returns (data, problems). Data is None on a syntax error."""
+    return check(parse(text, filename), filename, _schema())
+
+
+def _build(data: dict[str, Any], source: str) -> Questionnaire:
+    def code(value: Mapping[str, str] | None) -> Code | None:
+        return Code(value["system"], value["code"], value.get("display", "")) if value else None
+
+    def opts(values: list[dict[str, Any]]) -> tuple[Option, ...]:
+        return tuple(
+            Option(
+                number=i,
+                label=dict(v["label"]),
+                synonyms={lang: tuple(words) for lang, words in v.get("synonyms", {}).items()},
+                points=v.get("points"),
+                patient=dict(v.get("patient", {})),
+                code=code(v.get("code")),
+            )
+            for i, v in enumerate(values, start=1)
+        )
+
+    items = tuple(
+        Item(
+            id=v["id"],
+            number=n,
+            text=dict(v["text"]),
+            spoken=dict(v["spoken"]),
+            options=opts(v["options"]),
+            code=code(v.get("code")),
+            patient=dict(v.get("patient", {})),
+        )
+        for n, v in enumerate(data["items"], start=1)
+    )
+    practice = tuple(
+        PracticeQuestion(
+            id=v["id"],
+            checks=v["checks"],
+            text=dict(v["text"]),
+            spoken=dict(v["spoken"]),
+            options=opts(v["options"]),
+            expected=v["expected"],
+        )
+        for v in data.get("familiarisation", [])
+    )
+    band_sets = {
+        name: BandSet(
+            id=name,
+            source=v.get("source", ""),
+            bands=tuple(
+                Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]))
+                for b in sorted(v["ranges"], key=lambda b: b["min"])
+            ),
+        )
+        for name, v in data["bands"]["sets"].items()
+    }
+    return Questionnaire(
+        id=data["id"],
+        version=str(data.get("version", "")),
+        title=dict(data["title"]),
+        languages=tuple(data["languages"]),
+        items=items,
+        band_sets=band_sets,
+        band_set=data["bands"]["default"],
+        messages={k: dict(v) for k, v in data.get("messages", {}).items()},
+        familiarisation=practice,
+        timing=Timing().with_overrides(data.get("timing")),
+        code=code(data.get("code")),
+        total_code=code(data.get("total_code")),
+        source=source,
+        digest=hashlib.sha256(json.dumps(data, sort_keys=True, ensure_ascii=False).encode()).hexdigest(),
+    )
