@@ -177,14 +177,14 @@ async def get_commands(request: Request) -> Response:
     except ValueError:
         return _error(400, "'wait' must be a number of seconds")
     engine, bus = request.app.state.engine, request.app.state.bus
-    queue = bus.subscribe()
+    queue = bus.subscribe(kiosk, ("command", "resync"))
     try:
         await run_in_threadpool(ward.seen, engine, kiosk)
 
         def fetch() -> Awaitable[list[dict[str, Any]]]:
             return run_in_threadpool(ward.pending_commands, engine, kiosk)
 
-        pending = await long_poll(queue, kiosk, ("command", "resync"), wait, await fetch(), fetch, bool)
+        pending = await long_poll(queue, wait, await fetch(), fetch, bool)
     finally:
         bus.unsubscribe(queue)
     return JSONResponse({"commands": pending})

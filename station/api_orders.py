@@ -54,15 +54,13 @@ async def get_orders(request: Request) -> Response:
         return _error(400, "'wait' must be a number of seconds")
     known = request.query_params.get("version")
     engine, bus = request.app.state.engine, request.app.state.bus
-    queue = bus.subscribe()
+    queue = bus.subscribe(kiosk, ("order", "resync"))
     try:
 
         def fetch() -> Awaitable[dict[str, Any]]:
             return loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk)
 
-        current = await long_poll(
-            queue, kiosk, ("order", "resync"), wait, await fetch(), fetch, lambda listed: listed["version"] != known
-        )
+        current = await long_poll(queue, wait, await fetch(), fetch, lambda listed: listed["version"] != known)
     finally:
         bus.unsubscribe(queue)
     return JSONResponse(current)

@@ -92,9 +92,9 @@ def admit(engine: Engine, name: str, address: str) -> tuple[float, int]:
     try is then already counted as the pair's n-th failure, until :func:`record_success` forgives
     it; ``(seconds left, n)`` when the pair or the address is paused (nothing is counted)."""
     name, address = name[:64], address[:64]
-    now = db.now()
     with engine.begin() as connection:
         _lock(connection, address)
+        now = db.now()  # after the lock: a colleague's try admitted meanwhile is not in our future
         connection.execute(login_failures.delete().where(login_failures.c.at < now - WINDOW_S))
         pair_count, pair_last = connection.execute(
             sa.select(sa.func.count(), sa.func.max(login_failures.c.at)).where(
@@ -106,10 +106,13 @@ def admit(engine: Engine, name: str, address: str) -> tuple[float, int]:
                 login_failures.c.address == address
             )
         ).one()
+        # a count that earns no pause makes no one wait (tries in flight are counted too: two
+        # colleagues logging in together from one address were refused for each other's)
+        pair_pause, address_pause = pause_after(pair_count), pause_after(names, FREE_NAMES)
         wait = max(
             0.0,
-            pair_last + pause_after(pair_count) - now if pair_count else 0.0,
-            address_last + pause_after(names, FREE_NAMES) - now if names else 0.0,
+            pair_last + pair_pause - now if pair_pause else 0.0,
+            address_last + address_pause - now if address_pause else 0.0,
         )
         if wait > 0:
             return wait, pair_count

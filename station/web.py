@@ -11,6 +11,7 @@ from __future__ import annotations
 import asyncio
 import math
 from collections.abc import AsyncIterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Any
@@ -35,6 +36,9 @@ from station.rendering import Forbidden, checked_form, current_user, render
 
 HERE = Path(__file__).parent
 ROUTINE_WORKERS = 12
+#: threads for staff's login check alone: a nurse's order or sign-off never waits for it behind the
+#: kiosks' routine rows in the shared workers (measured: up to 375 ms there, bench/station.py)
+STAFF_LANE = ThreadPoolExecutor(max_workers=2, thread_name_prefix="station-staff")
 SECURITY_HEADERS = {
     # no inline script or style, nothing from elsewhere: the pages work with the network cut
     "content-security-policy": "default-src 'self'; img-src 'self' data:; frame-ancestors 'none'; form-action 'self'",
@@ -143,7 +147,7 @@ class LoginRequired:
             await self.app(scope, receive, send)
             return
         request = Request(scope, receive)
-        found = await run_in_threadpool(current_user, request)
+        found = await asyncio.get_running_loop().run_in_executor(STAFF_LANE, current_user, request)
         if found is None:
             response: Response = RedirectResponse(f"/login?next={scope['path']}", status_code=303)
             await response(scope, receive, send)
