@@ -10,12 +10,15 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from fileio.bounded import open_private, write_error
 from qos import load_model
 from qos.errors import QosError
 from qos.model import Model, type_name
-from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
+
+if TYPE_CHECKING:  # the replay tools load on use: `kiosk` imports run_command from here at every start
+    from qos.trace import ReplaySamples
 
 
 def _positive_seconds(text: str) -> float:
@@ -139,6 +142,8 @@ def main(argv: Sequence[str] | None = None, prog: str = "python -m qos", epilog:
             print(f"{prog} check: {exc}", file=sys.stderr)
             return 2
         return 0
+    from qos.trace import load_trace, sample_trace, summarise
+
     try:
         trace = load_trace(args.trace)
         samples = sample_trace(trace, args.sample_period)

@@ -55,11 +55,12 @@ import wave
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
-
-import numpy as np
+from typing import TYPE_CHECKING, Protocol
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
+
+if TYPE_CHECKING:  # numpy loads on the speaker's worker thread, not before the first screen
+    import numpy as np
 
 log = logging.getLogger(__name__)
 
@@ -370,6 +371,8 @@ class Speaker:
         fd, name = tempfile.mkstemp(suffix=".wav", prefix="kiosk-tts-")
         os.close(fd)
         try:
+            import numpy as np
+
             synth.synthesise(job.text, job.language, name, self.rate, self.volume)
             with wave.open(name, "rb") as wav:
                 rate = wav.getframerate()

@@ -51,7 +51,7 @@ from kiosk.core.session import (
     SessionEvent,
     VolumeChanged,
 )
-from kiosk.export import ExportSite, export_identity, site_from_config
+from kiosk.export.result import ExportSite, export_identity, site_from_config
 from kiosk.export.captured import questionnaire_of
 from kiosk.export.opening import in_force_of
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
