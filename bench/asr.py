@@ -21,8 +21,8 @@ Per condition, JSON: ``right`` (stored right, or the right command, within two a
 to take: the kiosk asks for a press, which this patient does not give), ``asked_to_press_right``
 (of those, the answer heard was the one meant), ``cut_off`` (utterances run to the 10 s limit:
 target 0 in steady noise at SNR >= 10 dB), ``rtf``, ``speech_end_to_answer_ms``, and
-``unconfirmed_wrong_by_confidence``: the wrong-stored rate if answers at or above a confidence were stored without asking (how
-:data:`kiosk.speech.voice.CONFIRM_BELOW` was chosen). Targets for ``right``: >= 0.8 clean,
+``unconfirmed_wrong_by_confidence``: the wrong-stored rate if answers at or above a confidence were
+stored without asking (how :data:`kiosk.speech.voice.CONFIRM_BELOW` was chosen). Targets for ``right``: >= 0.8 clean,
 >= 0.5 at SNR 10 dB.
 
 Voices: ``dev`` tunes (thresholds, confusable words, grammar), ``held_out`` only reports. None is
@@ -90,7 +90,6 @@ from __future__ import annotations
 import argparse
 import json
 import random
-import statistics
 import sys
 import tempfile
 import time

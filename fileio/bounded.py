@@ -165,7 +165,8 @@ class _BoundedComposer(Composer):
     Mixed into a loader below, which brings the parser."""
 
     def __init__(self, text: str, name: str) -> None:
-        self._loader().__init__(self, text)  # type: ignore[call-arg]
+        # the loader is a class chosen at run time; its __init__ sets up this mixin's reader and parser
+        self._loader().__init__(self, text)  # type: ignore[misc]  # __init__ called on purpose, on self
         Composer.__init__(self)
         self.name = name
         self._depth = 0
@@ -340,8 +341,8 @@ def _scan_json(text: str, name: str) -> None:
     for token in _JSON_TOKENS.finditer(text):
         kind = token.group()
 
-        def fail(message: str) -> BadFile:
-            return BadFile(Problem(name, *_position(text, token.start()), message))
+        def fail(message: str, at: int = token.start()) -> BadFile:
+            return BadFile(Problem(name, *_position(text, at), message))
 
         if kind in ("[", "{"):
             if len(objects) >= MAX_DEPTH:

@@ -10,7 +10,7 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from fileio.bounded import open_private, write_error
 from qos import load_model
@@ -117,7 +117,7 @@ def plot(samples: ReplaySamples, path: Path, title: str) -> None:
     for name, values in samples.series.items():
         axes.plot(samples.times, values, label=name, linewidth=1.8)
     for entry in samples.fired:
-        axes.axvline(float(entry["t"]), color="0.85", linewidth=0.8, zorder=0)
+        axes.axvline(float(cast(float, entry["t"])), color="0.85", linewidth=0.8, zorder=0)
     axes.set_xlabel("time since the session started (s)")
     axes.set_ylabel("metric")
     axes.set_ylim(-0.02, 1.02)

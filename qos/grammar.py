@@ -21,8 +21,9 @@ import os
 import sys
 from contextvars import ContextVar
 from pathlib import Path
+from typing import Any, cast
 
-from lark import Lark, Token
+from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 GRAMMAR = r"""
@@ -182,6 +183,14 @@ COMMENT: /\/\/[^\n]*/ | /\/\*(.|\n)*?\*\//
 
 #: the descriptions met while lexing the model being parsed (one list per parse, thread-safe)
 _DESCRIPTIONS: ContextVar[list[Token]] = ContextVar("descriptions")
+
+
+def children(tree: Tree) -> list[Any]:
+    """``tree``'s children, read as the grammar shapes them: at each position the grammar fixes
+    whether a child is a Token, a Tree or an absent optional (None); lark types them all as one
+    union, so the checkers read them through this."""
+    return tree.children
+
 
 #: how the grammar is compiled (LALR tables); the basic lexer keeps keywords reserved everywhere, so
 #: a misplaced 'reinforces' is reported as such instead of being read as a context name
@@ -346,14 +355,14 @@ def describe_expected(expected: set[str], previous: str | None) -> str:
 def syntax_error(text: str, exc: UnexpectedInput, previous: Token | None) -> tuple[int, int, str]:
     """Line, column and message of a lark error (the caller adds the file name)."""
     if isinstance(exc, UnexpectedCharacters):
-        return exc.line, exc.column, f"unexpected character {text[exc.pos_in_stream]!r}"
+        return exc.line, exc.column, f"unexpected character {text[exc.pos_in_stream or 0]!r}"
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
     if token.type != "$END" and text.startswith("/*", token.start_pos):
         return token.line, token.column, "unterminated comment: '/*' without '*/'"
     for word in (token, previous):
         if word is not None and word.type == "NAME" and str(word) in UNSUPPORTED_WORDS:
-            return word.line, word.column, UNSUPPORTED_WORDS[str(word)]
+            return cast(int, word.line), cast(int, word.column), UNSUPPORTED_WORDS[str(word)]  # lexed: positioned
     after = f" after {str(previous)!r}" if previous is not None else ""
     expected = describe_expected(set(exc.expected), str(previous) if previous is not None else None)
     if token.type == "$END":

@@ -8,7 +8,6 @@ own run-time state, so one model can serve many engines.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union
 
 #: likelihood ratio of each intensity (paper, Table 1); an undermining observation uses 1/LR
 INTENSITY_LR: dict[str, float] = {
@@ -39,7 +38,7 @@ class EnumType:
 class ArrayType:
     """An array of at most ``size`` values of one scalar type (``number[3]``, ``enum[2] {…}``)."""
 
-    element: "ValueType"
+    element: ValueType
     size: int
 
     def __str__(self) -> str:
@@ -47,7 +46,7 @@ class ArrayType:
 
 
 #: the type of a context or expression: "boolean", "number", "eventtype", an enumeration or an array
-ValueType = Union[str, EnumType, ArrayType]
+ValueType = str | EnumType | ArrayType
 
 BOOLEAN = "boolean"
 NUMBER = "number"
@@ -91,7 +90,7 @@ class Context:
     spec: TypeSpec | None = None
     #: a derived context's definition (``context X : T := …``): an expression or, for an eventtype,
     #: a pattern; None for a primitive context, which the kiosk sets
-    definition: Union["Expr", "Pattern", None] = None
+    definition: Expr | Pattern | None = None
     description: str | None = None
 
     @property
@@ -121,7 +120,7 @@ class Property:
     #: seconds; ``None`` means the evidence never fades
     survival: float | None = None
     #: ``property P : T := …``: the value published beside the metric, computed from ``belief``
-    transformation: "Expr | None" = None
+    transformation: Expr | None = None
     description: str | None = None
 
     @property
@@ -160,7 +159,7 @@ class Unary:
     """``!e`` (boolean not) or ``-e`` (numeric negation)."""
 
     op: str
-    operand: "Expr"
+    operand: Expr
     type: ValueType
 
 
@@ -169,8 +168,8 @@ class Binary:
     """``& | = != < <= > >= + - * /``."""
 
     op: str
-    left: "Expr"
-    right: "Expr"
+    left: Expr
+    right: Expr
     type: ValueType
 
 
@@ -178,9 +177,9 @@ class Binary:
 class Conditional:
     """``condition ? then : otherwise``; undefined when the condition is."""
 
-    condition: "Expr"
-    then: "Expr"
-    otherwise: "Expr"
+    condition: Expr
+    then: Expr
+    otherwise: Expr
     type: ValueType
 
 
@@ -190,7 +189,7 @@ class Call:
     (arrays); ``X'f(a)`` is ``f(X, a)``."""
 
     function: str
-    args: tuple["Expr", ...]
+    args: tuple[Expr, ...]
     type: ValueType
 
 
@@ -206,7 +205,7 @@ class Aggregate:
     function: str
     source: str
     window: int | float | None
-    where: "Expr | None"
+    where: Expr | None
     type: ValueType
 
 
@@ -216,12 +215,12 @@ class Period:
     ``period(a -> b)``: at each ``b`` after an ``a``, the seconds since the latest ``a``."""
 
     source: str | None
-    first: "Pattern | None" = None
-    then: "Pattern | None" = None
+    first: Pattern | None = None
+    then: Pattern | None = None
     type: ValueType = NUMBER
 
 
-Expr = Union[Var, Literal, Unary, Binary, Conditional, Call]
+Expr = Var | Literal | Unary | Binary | Conditional | Call
 
 
 @dataclass(frozen=True)
@@ -247,38 +246,38 @@ class Changed:
 class AnyOf:
     """``a or b``."""
 
-    left: "Pattern"
-    right: "Pattern"
+    left: Pattern
+    right: Pattern
 
 
 @dataclass(frozen=True)
 class AllOf:
     """``a and b``."""
 
-    left: "Pattern"
-    right: "Pattern"
+    left: Pattern
+    right: Pattern
 
 
 @dataclass(frozen=True)
 class FollowedBy:
     """``a -> b``."""
 
-    first: "Pattern"
-    then: "Pattern"
+    first: Pattern
+    then: Pattern
 
 
 @dataclass(frozen=True)
 class Once:
     """``once p``."""
 
-    pattern: "Pattern"
+    pattern: Pattern
 
 
 @dataclass(frozen=True)
 class While:
     """``p while(cond)``."""
 
-    pattern: "Pattern"
+    pattern: Pattern
     condition: Expr
 
 
@@ -286,7 +285,7 @@ class While:
 class Repeat:
     """``p repeat(n)``."""
 
-    pattern: "Pattern"
+    pattern: Pattern
     times: int
 
 
@@ -295,20 +294,20 @@ class AndNot:
     """``a and not b``: ``a`` occurs before ``b`` has occurred since the pattern was (re-)armed; an
     occurrence of ``b`` ends the attempt and the pattern starts again (Esper ``every (a and not b)``)."""
 
-    pattern: "Pattern"
-    excluded: "Pattern"
+    pattern: Pattern
+    excluded: Pattern
 
 
 @dataclass(frozen=True)
 class Range:
     """``p range(a, b)``: occurs on the a-th to the b-th occurrence of ``p`` in the engine's life."""
 
-    pattern: "Pattern"
+    pattern: Pattern
     low: int
     high: int
 
 
-Pattern = Union[Updated, Changed, AnyOf, AllOf, AndNot, FollowedBy, Once, While, Repeat, Range]
+Pattern = Updated | Changed | AnyOf | AllOf | AndNot | FollowedBy | Once | While | Repeat | Range
 
 
 # ---- actions, variables, timers ------------------------------------------------------------------
@@ -354,7 +353,7 @@ class TimerAction:
     timer: str
 
 
-Action = Union[Evidence, SetVariable, ClearEvidence, TimerAction]
+Action = Evidence | SetVariable | ClearEvidence | TimerAction
 
 
 @dataclass(frozen=True)
@@ -425,7 +424,7 @@ class Observation:
 
 #: a computed value the engine keeps up to date each batch, in ``Model.streams`` order: a derived
 #: context (by name), a variable with a definition (by name), or an Aggregate/Period (hidden name ``#n``)
-Stream = Union[Context, Variable, Aggregate, Period]
+Stream = Context | Variable | Aggregate | Period
 
 
 @dataclass(frozen=True)

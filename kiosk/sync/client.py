@@ -22,7 +22,7 @@ import sqlite3
 import threading
 import time
 from collections.abc import Callable, Mapping
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -207,7 +207,7 @@ class SyncClient:
             code, body = self.station.request(
                 "POST",
                 "/api/v1/status",
-                {**status, "kiosk_id": self.kiosk_id, "at": datetime.now(timezone.utc).isoformat()},
+                {**status, "kiosk_id": self.kiosk_id, "at": datetime.now(UTC).isoformat()},
             )
         except Unreachable:
             with self._lock:

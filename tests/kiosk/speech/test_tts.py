@@ -137,8 +137,8 @@ def test_delivery_maps_slow_rates_to_pauses():
         1000 * 7 * (60 / 136 - 60 / 150), abs=2
     )
     assert slow.markup("Fish & chips, <now>. Yes") == (
-        '<speak>Fish &amp; chips,<break time="%dms"/> &lt;now&gt;.<break time="%dms"/> Yes</speak>'
-        % (slow.comma_break_ms, slow.sentence_break_ms)
+        f'<speak>Fish &amp; chips,<break time="{slow.comma_break_ms}ms"/> &lt;now&gt;.'
+        f'<break time="{slow.sentence_break_ms}ms"/> Yes</speak>'
     )
 
 
