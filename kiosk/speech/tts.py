@@ -129,9 +129,10 @@ class Synthesiser:
     """espeak-ng, text → WAV file (22.05 kHz mono 16-bit). Thread-safe: one process per phrase."""
 
     def __init__(self) -> None:
-        self._command = shutil.which("espeak-ng")
-        if self._command is None:
+        command = shutil.which("espeak-ng")
+        if command is None:
             raise TtsUnavailable("espeak-ng is not installed")
+        self._command = command
         listing = subprocess.run(
             [self._command, "--voices"], capture_output=True, text=True, timeout=SYNTH_TIMEOUT_S
         ).stdout

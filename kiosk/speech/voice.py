@@ -34,7 +34,7 @@ import threading
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Sink
 from kiosk.speech.matching import (
@@ -47,7 +47,7 @@ from kiosk.speech.matching import (
 )
 
 if TYPE_CHECKING:  # the recognisers and the audio pipeline (numpy) load on the channel's own threads
-    from kiosk.speech.asr import Recogniser
+    from kiosk.speech.asr import Recogniser, Recognition
     from kiosk.speech.audio import Endpointer, PcmConsumer, Utterance, UtterancePipeline
 
 log = logging.getLogger(__name__)
@@ -143,7 +143,7 @@ class VoiceChannel:
         self._sink: Sink | None = None
         self._recogniser: Recogniser | None = None
         self._pipeline: UtterancePipeline | None = None
-        self._microphone = None
+        self._microphone: Any = None  # a kiosk.speech.audio.MicrophoneStream, or what the factory made
         self._matcher: Matcher | None = None
         self._options: list[OptionWords] = []
         self._listening = self._speaking = self._paused = False
@@ -423,8 +423,11 @@ class VoiceChannel:
 
     def _on_utterance(self, utterance: Utterance) -> None:
         self.on_utterance(utterance)
-        result = utterance.result
-        match = self._matcher.match(result.text, result.confidence)
+        result = cast("Recognition", utterance.result)
+        matcher = self._matcher
+        if matcher is None:  # the grammar was taken away while this was being heard
+            return
+        match = matcher.match(result.text, result.confidence)
         if not match.matched:
             match = self._heard_twice(result) or match
         if not match.matched:
@@ -462,7 +465,8 @@ class VoiceChannel:
         above = utterance.above_room_db
         if above is None or above >= self.reply_min_above_room_db:
             return False
-        log.info("voice: %r spoken %.1f dB above the room, too little to take as said", utterance.result.text, above)
+        heard = cast("Recognition", utterance.result).text
+        log.info("voice: %r spoken %.1f dB above the room, too little to take as said", heard, above)
         return True
 
     def _heard_twice(self, result: Any) -> Match | None:
@@ -470,6 +474,7 @@ class VoiceChannel:
         same scored question, both at least :data:`AGREE_MIN_CONFIDENCE` sure: its match."""
         if not self._scored or self._paused:
             return None
+        assert self._matcher is not None  # called from _on_utterance, which has one
         match = self._matcher.match(result.text)
         unsure = match.option if result.confidence >= AGREE_MIN_CONFIDENCE else None
         agreed = unsure is not None and unsure == self._unsure
