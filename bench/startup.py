@@ -8,8 +8,10 @@ what a patient waits for. One warm-up launch of each is not counted (it writes t
 QoS grammar's cache, as a kiosk's first start after installing does). Rounds alternate the two apps
 so machine load hits both alike; the medians' ratio is the figure. The CPU seconds each process used
 to the welcome (its rusage when killed there) are reported too: they move less with machine load
-than the wall clock. Also reports ``python -X importtime`` of ``kiosk.ui.app``'s heaviest imports
-and the load average before and after. Prints JSON. Run: uv run python bench/startup.py [--rounds N]
+than the wall clock. ``kiosk_phases`` splits the kiosk's start (imports, build_app, the first frame
+drawn headless) in one process, to show where the time goes. Also reports ``python -X importtime``
+of ``kiosk.ui.app``'s heaviest imports and the load average before and after. Prints JSON.
+Run: uv run python bench/startup.py [--rounds N]
 """
 
 from __future__ import annotations
@@ -74,17 +76,57 @@ def time_to_marker(argv: list[str], env: dict[str, str], timeout_s: float = 60.0
     return wall, usage.ru_utime + usage.ru_stime
 
 
+#: where the kiosk's start goes, in one process: imports, `kiosk run`'s build_app (configuration,
+#: questionnaire, QoS model, store, channels), and the app run headless until the welcome is drawn
+PHASES = """
+import asyncio, json, sys, time
+marks = [(time.perf_counter(), time.process_time())]
+import kiosk.cli, qos.cli
+from kiosk.ui.app import KIOSK_SIZE, build_app
+marks.append((time.perf_counter(), time.process_time()))
+app, close = build_app()
+marks.append((time.perf_counter(), time.process_time()))
+async def welcome():
+    async with app.run_test(size=KIOSK_SIZE) as pilot:
+        while not (type(app.screen).__name__ == "WelcomeScreen" and app.screen.query("Button")):
+            await pilot.pause()
+        marks.append((time.perf_counter(), time.process_time()))
+asyncio.run(welcome())
+close()
+names = ("import", "build_app", "first_frame_headless")
+print(json.dumps({n: [b[0] - a[0], b[1] - a[1]] for n, a, b in zip(names, marks, marks[1:])}))
+"""
+
+
+def phases(env: dict[str, str], rounds: int) -> dict[str, dict[str, float]]:
+    """Median wall and CPU seconds of each phase of PHASES over ``rounds`` fresh processes (CPU
+    counts every thread: the channels start theirs when the app mounts)."""
+    runs = [
+        json.loads(
+            subprocess.run([sys.executable, "-c", PHASES], env=env, capture_output=True, text=True, check=True).stdout
+        )
+        for _ in range(rounds)
+    ]
+    return {
+        name: {
+            "wall_s": round(statistics.median(run[name][0] for run in runs), 3),
+            "cpu_s": round(statistics.median(run[name][1] for run in runs), 3),
+        }
+        for name in runs[0]
+    }
+
+
 def heaviest_imports(n: int = 8) -> list[dict[str, object]]:
     """The ``n`` largest cumulative import times (ms) under ``import kiosk.ui.app``."""
     err = subprocess.run(
         [sys.executable, "-X", "importtime", "-c", "import kiosk.ui.app"], capture_output=True, text=True, check=True
     ).stderr
-    rows = []
+    rows: list[tuple[float, str]] = []
     for line in err.splitlines():
         parts = line.split("|")
         if len(parts) == 3 and parts[1].strip().isdigit():
-            rows.append({"module": parts[2].strip(), "cumulative_ms": int(parts[1]) / 1000})
-    return sorted(rows, key=lambda r: -float(r["cumulative_ms"]))[:n]
+            rows.append((int(parts[1]) / 1000, parts[2].strip()))
+    return [{"module": module, "cumulative_ms": ms} for ms, module in sorted(rows, reverse=True)[:n]]
 
 
 def main(argv: list[str]) -> int:
@@ -110,6 +152,7 @@ def main(argv: list[str]) -> int:
         for _ in range(args.rounds):
             for name, command in apps.items():
                 runs[name].append(time_to_marker(command, env))
+        kiosk_phases = phases(env, max(3, args.rounds // 2))
     wall = {name: [w for w, _ in found] for name, found in runs.items()}
     cpu = {name: [c for _, c in found] for name, found in runs.items()}
     two, kiosk = wall["two_widget"], wall["kiosk"]
@@ -128,6 +171,7 @@ def main(argv: list[str]) -> int:
                 "two_widget_cpu_s_median": round(statistics.median(cpu["two_widget"]), 3),
                 "kiosk_cpu_s_median": round(statistics.median(cpu["kiosk"]), 3),
                 "cpu_ratio_median": round(cpu_ratio, 2),
+                "kiosk_phases": kiosk_phases,
                 "load_average_before_after": [round(load_before[0], 2), round(os.getloadavg()[0], 2)],
                 "heaviest_imports_ms": heaviest_imports(),
             },
