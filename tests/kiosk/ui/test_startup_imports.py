@@ -10,6 +10,7 @@ import json
 import subprocess
 import sys
 import textwrap
+from typing import Any
 
 import pytest
 
@@ -38,7 +39,7 @@ NOT_BEFORE_THE_WELCOME = (
 NOT_WHILE_BUILDING = ("numpy", "sounddevice", "vosk", "pocketsphinx", "kiosk.speech.asr", "kiosk.speech.audio")
 
 
-def _run(tmp_path, body: str) -> dict[str, object]:
+def _run(tmp_path, body: str) -> dict[str, Any]:
     config = tmp_path / "config.yaml"
     config.write_text(f"data_dir: {tmp_path / 'data'}\n")
     code = textwrap.dedent(
@@ -76,7 +77,7 @@ def test_the_welcome_is_drawn_before_exports_plots_and_the_station_are_imported(
         """,
     )
     assert "English" in str(found["drawn"])
-    modules = set(found["modules"])  # type: ignore[arg-type]  # a JSON list of names
+    modules = set(found["modules"])
     early = sorted(
         m for m in modules if m.split(".")[0] in NOT_BEFORE_THE_WELCOME or m.startswith(NOT_BEFORE_THE_WELCOME)
     )
@@ -97,5 +98,5 @@ def test_building_the_kiosk_with_voice_and_remotes_loads_no_speech_stack(tmp_pat
         """,
     )
     assert found["voice"] == "VoiceChannel"  # the channel is there: it loads its stack when started
-    modules = set(found["modules"])  # type: ignore[arg-type]  # a JSON list of names
+    modules = set(found["modules"])
     assert sorted(m for m in modules if m.split(".")[0] in NOT_WHILE_BUILDING or m in NOT_WHILE_BUILDING) == []
