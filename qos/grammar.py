@@ -227,23 +227,17 @@ def parser() -> Lark:
 
 
 def _cache_file() -> Path | None:
-    """Where the compiled tables are kept, or None when no private directory can be had (the
-    tables are pickled: only a directory of this user's own, closed to others, is trusted)."""
+    """Where the compiled tables are kept (:func:`fileio.cache.private_dir`: they are pickled, so
+    only a directory of this user's own, closed to others, is trusted), or None."""
     import hashlib
 
     import lark
-    import platformdirs
+
+    from fileio.cache import private_dir
 
     key = hashlib.sha256(f"{GRAMMAR}{sorted(_OPTIONS.items())}{lark.__version__}{sys.version_info[:2]}".encode())
-    folder = Path(platformdirs.user_cache_dir("kiosk")) / "qos"
-    try:
-        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-        status = folder.stat()
-    except OSError:
-        return None
-    if status.st_uid != os.getuid() or status.st_mode & 0o077:
-        return None
-    return folder / f"roqme-{key.hexdigest()[:24]}.lark"
+    folder = private_dir("qos")
+    return None if folder is None else folder / f"roqme-{key.hexdigest()[:24]}.lark"
 
 
 #: seconds per time unit (RoQME's words and the short forms older models use)

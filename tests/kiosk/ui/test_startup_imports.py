@@ -2,11 +2,13 @@
 (issue 24, part 8; the time it takes is measured by bench/startup.py, never here).
 
 Each check runs a fresh interpreter, as `kiosk run` starts, so modules other tests loaded do not hide
-an import."""
+an import; it is the kiosk's second start, the first having filled its cache (the QoS grammar's
+tables, the questionnaire's passed schema check: fileio.cache)."""
 
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -27,6 +29,7 @@ NOT_BEFORE_THE_WELCOME = (
     "kiosk.sync",
     "kiosk.commands",
     "qos.trace",
+    "jsonschema",
     "plotext",
     "textual_plotext",
     "matplotlib",
@@ -51,8 +54,10 @@ def _run(tmp_path, body: str) -> dict[str, Any]:
         config = Path({str(config)!r})
         """
     ) + textwrap.dedent(body)
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert out.returncode == 0, out.stderr
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))
+    for _start in ("first", "second"):
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env)
+        assert out.returncode == 0, out.stderr
     return json.loads(out.stdout.splitlines()[-1])
 
 
