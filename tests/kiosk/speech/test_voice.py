@@ -121,6 +121,7 @@ ANSWERS_EN = [
 ]
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 @pytest.mark.parametrize("item_id,utterance,option", ANSWERS_EN)
 def test_spoken_answer_is_recorded_as_a_voice_answer(backend, spoken, item_id, utterance, option):
@@ -143,6 +144,7 @@ ANSWERS_OTHER = [
 ]
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize(
     "language,item_id,utterance,option,backend",
     [
@@ -159,6 +161,7 @@ def test_spoken_answer_in_spanish_and_french(spoken, language, item_id, utteranc
     assert (answer.option, answer.channel) == (option, Channel.VOICE)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_spoken_commands_reach_the_session(backend, spoken):
     kiosk = _Kiosk(backend)
@@ -177,6 +180,7 @@ def test_spoken_commands_reach_the_session(backend, spoken):
     assert any(isinstance(e, DoctorCalled) and e.channel is Channel.VOICE for e in kiosk.events)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_the_patient_starts_by_saying_the_language_then_im_ready(backend, spoken):
     """What the welcome and the explanation promise by voice works: "English" on the welcome,
@@ -192,6 +196,7 @@ def test_the_patient_starts_by_saying_the_language_then_im_ready(backend, spoken
     assert [i.channel for i in kiosk.inputs] == [Channel.VOICE, Channel.VOICE]
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 @pytest.mark.parametrize("said", ["stop", "doctor", "again"])
 def test_before_the_test_short_command_words_do_nothing(backend, spoken, said):
@@ -206,6 +211,7 @@ def test_before_the_test_short_command_words_do_nothing(backend, spoken, said):
     assert kiosk.inputs[-1].command is Command.CALL_DOCTOR
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_no_thats_wrong_in_the_thank_you_gap_takes_the_answer_back(backend, spoken):
     """Any answer (here a touch) can be taken back by voice for the thank-you gap; in the gap the
@@ -224,6 +230,7 @@ def test_no_thats_wrong_in_the_thank_you_gap_takes_the_answer_back(backend, spok
     assert kiosk.inputs[-1].option == 3
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 @pytest.mark.parametrize("noise", ["the weather is nice today", "banana split"])
 def test_other_speech_is_never_an_answer(backend, spoken, noise):
@@ -237,6 +244,7 @@ def test_other_speech_is_never_an_answer(backend, spoken, noise):
     assert len(kiosk.unmatched) + len(sent) == 1
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_every_voice_answer_to_a_scored_question_asks_for_confirmation(backend, spoken):
     """Measured on voices other than the kiosk's own (bench/asr.py), no confidence made an
@@ -253,6 +261,7 @@ def test_every_voice_answer_to_a_scored_question_asks_for_confirmation(backend, 
     assert (kiosk.inputs[-1].option, kiosk.inputs[-1].needs_confirmation) == (1, False)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_confusable_answer_is_always_confirmed_and_refused_where_it_cannot_be(spoken):
     """ "the first one" where "the third one" selects another option: asked back even by a channel
     told to confirm nothing, and not taken at all on a prompt whose answers are never confirmed."""
@@ -275,6 +284,7 @@ def test_a_confusable_answer_is_always_confirmed_and_refused_where_it_cannot_be(
     assert inputs == [got] and "confusable" in unmatched[-1]
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_an_option_declined_is_not_heard_again_on_that_question(backend, spoken):
     """The patient says No to "I heard: Independent": asked again, "independent" is no longer
@@ -303,6 +313,7 @@ def test_an_option_declined_is_not_heard_again_on_that_question(backend, spoken)
     assert kiosk.inputs[-1].option == 2
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("backend", _backends("en"))
 def test_the_kiosks_own_voice_and_closed_attempts_are_not_heard(backend, spoken):
     kiosk = _Kiosk(backend)
@@ -362,6 +373,7 @@ def test_no_microphone_turns_voice_off_with_a_reason():
     ]
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_language_change_follows_the_prompts(spoken):
     opened = []
 
@@ -379,6 +391,7 @@ def test_language_change_follows_the_prompts(spoken):
     assert kiosk.statuses[-1].state is ChannelState.OFF
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_the_kiosk_reading_options_aloud_into_its_own_microphone_records_nothing(spoken):
     """The speaker's start/end events mute voice in: its own "Independent" is not an answer."""
     kiosk = _Kiosk(lambda lang: PocketSphinxRecogniser(lang))
@@ -406,6 +419,7 @@ def test_the_kiosk_reading_options_aloud_into_its_own_microphone_records_nothing
     assert kiosk.session.answers["feeding"].option == 3
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_the_apps_calls_drive_the_channel(spoken):
     """The app forwards only Prompt (expect) and ListeningChanged (listen); that is enough."""
     kiosk = _Kiosk(lambda lang: PocketSphinxRecogniser(lang), app_style=True)
@@ -434,6 +448,7 @@ class _WavMicrophone:
         pass
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_started_channel_hears_its_microphone_thread_and_follows_language_changes(spoken, monkeypatch, tmp_path):
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
@@ -467,6 +482,7 @@ def _no_models(monkeypatch, tmp_path) -> None:
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_language_without_a_model_turns_voice_in_off_on_the_channel_board(spoken, monkeypatch, tmp_path):
     _no_models(monkeypatch, tmp_path)
     kiosk = _Kiosk(open_recogniser, microphone=_WavMicrophone)
@@ -485,6 +501,7 @@ def test_a_language_without_a_model_turns_voice_in_off_on_the_channel_board(spok
     assert kiosk.session.answers == {} and kiosk.unmatched == []
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_models_load_off_the_thread_that_changes_language_and_a_late_one_is_not_installed(
     spoken, monkeypatch, tmp_path
 ):
