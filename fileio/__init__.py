@@ -1,1 +1,3 @@
-"""Every file the project loads or writes: bounded, positioned reading and owner-only writing (imports nothing of ours)."""
+"""Every file the project loads or writes: bounded, positioned reading and owner-only writing.
+
+Imports nothing of ours."""

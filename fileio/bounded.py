@@ -98,9 +98,9 @@ class BadFile(ValueError):
 
 
 def _position(data: bytes | str, offset: int) -> tuple[int, int]:
-    newline = b"\n" if isinstance(data, bytes) else "\n"
-    line = data.count(newline, 0, offset) + 1  # type: ignore[arg-type]
-    return line, offset - (data.rfind(newline, 0, offset) + 1) + 1  # type: ignore[arg-type]
+    if isinstance(data, bytes):
+        return data.count(b"\n", 0, offset) + 1, offset - (data.rfind(b"\n", 0, offset) + 1) + 1
+    return data.count("\n", 0, offset) + 1, offset - (data.rfind("\n", 0, offset) + 1) + 1
 
 
 def read_text(path: str | Path, limit: int = MAX_BYTES) -> str:
@@ -165,7 +165,8 @@ class _BoundedComposer(Composer):
     Mixed into a loader below, which brings the parser."""
 
     def __init__(self, text: str, name: str) -> None:
-        self._loader().__init__(self, text)  # type: ignore[call-arg]
+        # the loader is a class chosen at run time; its __init__ sets up this mixin's reader and parser
+        self._loader().__init__(self, text)  # type: ignore[misc]  # __init__ called on purpose, on self
         Composer.__init__(self)
         self.name = name
         self._depth = 0
@@ -340,8 +341,8 @@ def _scan_json(text: str, name: str) -> None:
     for token in _JSON_TOKENS.finditer(text):
         kind = token.group()
 
-        def fail(message: str) -> BadFile:
-            return BadFile(Problem(name, *_position(text, token.start()), message))
+        def fail(message: str, at: int = token.start()) -> BadFile:
+            return BadFile(Problem(name, *_position(text, at), message))
 
         if kind in ("[", "{"):
             if len(objects) >= MAX_DEPTH:

@@ -9,12 +9,14 @@ the one bounded reader every loader of the project shares.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from fileio import cache
 from fileio.bounded import MAX_YAML_BYTES, BadFile, Problem, compose_yaml, construct_yaml, read_text
 
 __all__ = ["Positions", "Problem", "describe", "parse", "parse_file", "schema_problems"]
@@ -89,11 +91,19 @@ def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add
     """Check ``data`` against a JSON Schema, reporting each error through ``add(path, message, key=)``.
 
     Messages are rewritten for people: unknown keys and missing keys by name, multiples of 5 as such.
+    A document that passed the same schema before, under the same jsonschema, is not checked again
+    (:mod:`fileio.cache`): importing jsonschema alone costs a kiosk's start a third of Textual's.
     """
+    key = _schema_key(data, schema)
+    if key is not None and cache.passed("json-schema", key):
+        return
     import jsonschema
 
     validator = jsonschema.Draft202012Validator(schema)
-    for error in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
+    errors = sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
+    if key is not None and not errors:
+        cache.remember("json-schema", key)
+    for error in errors:
         path = tuple(error.absolute_path)
         where = describe(path) or "the file"
         if error.validator == "additionalProperties":
@@ -108,3 +118,18 @@ def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add
             add(path, f"{where}: must be a multiple of {error.validator_value}, got {error.instance!r}")
         else:
             add(path, f"{where}: {error.message}")
+
+
+def _schema_key(data: Any, schema: dict[str, Any]) -> str | None:
+    """What a schema check's result depends on: the document, the schema and the installed
+    jsonschema (its file, found without importing it); None when that cannot be told."""
+    from importlib.util import find_spec
+
+    spec = find_spec("jsonschema")
+    if spec is None or spec.origin is None:
+        return None
+    try:
+        installed = os.stat(spec.origin)
+    except OSError:
+        return None
+    return cache.digest(repr(schema), repr(data), spec.origin, f"{installed.st_size}:{installed.st_mtime_ns}")

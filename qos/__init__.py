@@ -16,23 +16,39 @@ replayed with :func:`replay`, or from the shell with ``python -m qos replay TRAC
 
 from __future__ import annotations
 
+import importlib
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from qos.engine import Engine, UpdateResult
 from qos.errors import ContextError, ModelError, QosError, TraceError
-from qos.model import Context, EnumType, Model, Observation, Property, Timer, Variable
-from qos.parser import load_model_file, parse_model
-from qos.trace import (
-    ReplaySamples,
-    Trace,
-    TraceEvent,
-    TraceRecorder,
-    dump_trace,
-    load_trace,
-    replay,
-    sample_trace,
-)
+
+if TYPE_CHECKING:
+    from qos.engine import Engine, UpdateResult
+    from qos.model import Context, EnumType, Model, Observation, Property, Timer, Variable
+    from qos.parser import parse_model
+    from qos.trace import (
+        ReplaySamples,
+        Trace,
+        TraceEvent,
+        TraceRecorder,
+        dump_trace,
+        load_trace,
+        replay,
+        sample_trace,
+    )
+
+#: each public name -> its module, imported on first use: a program that only names a model, or
+#: only reads a trace, does not wait for the grammar, the engine or YAML
+_MODULES: dict[str, str] = {
+    **dict.fromkeys(("Engine", "UpdateResult"), "qos.engine"),
+    **dict.fromkeys(("Context", "EnumType", "Model", "Observation", "Property", "Timer", "Variable"), "qos.model"),
+    "parse_model": "qos.parser",
+    **dict.fromkeys(
+        ("ReplaySamples", "Trace", "TraceEvent", "TraceRecorder", "dump_trace", "load_trace", "replay", "sample_trace"),
+        "qos.trace",
+    ),
+}
 
 __all__ = [
     "Context",
@@ -73,6 +89,8 @@ def load_model(name_or_path: str | Path) -> Model:
 
     Raises :class:`ModelError` with file, line and column when the model is malformed.
     """
+    from qos.parser import load_model_file, parse_model
+
     text = str(name_or_path)
     if isinstance(name_or_path, Path) or text.endswith(".roqme") or "/" in text or "\\" in text:
         return load_model_file(name_or_path)
@@ -84,3 +102,16 @@ def load_model(name_or_path: str | Path) -> Model:
     folder = resources.files("qos") / "models"
     # bundled models may import each other (the package is installed as files, not zipped)
     return parse_model((folder / f"{text}.roqme").read_text(encoding="utf-8"), f"{text}.roqme", Path(str(folder)))
+
+
+def __getattr__(name: str) -> Any:
+    """The public name ``name`` from the module that defines it (PEP 562)."""
+    if name not in _MODULES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_MODULES[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -9,7 +9,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 
 from qos.errors import ContextError
-from qos.model import BOOLEAN, EVENTTYPE, NUMBER, ArrayType, Context, Model, ValueType, Variable
+from qos.model import BOOLEAN, EVENTTYPE, NUMBER, ArrayType, Context, EnumType, Model, ValueType, Variable
 
 
 def _describe(value: object) -> str:
@@ -83,6 +83,7 @@ def check_value(context: Context | Variable, name: str, value_type: ValueType, v
         if problem:
             raise ContextError(f"{what} {name}: {problem}")
         return float(value)
+    assert isinstance(value_type, EnumType)  # the one type left
     literal = value
     if isinstance(value, str) and "::" in value:
         type_name, _, literal = value.partition("::")

@@ -10,12 +10,15 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 from fileio.bounded import open_private, write_error
 from qos import load_model
 from qos.errors import QosError
 from qos.model import Model, type_name
-from qos.trace import ReplaySamples, load_trace, sample_trace, summarise
+
+if TYPE_CHECKING:  # the replay tools load on use: `kiosk` imports run_command from here at every start
+    from qos.trace import ReplaySamples
 
 
 def _positive_seconds(text: str) -> float:
@@ -114,7 +117,7 @@ def plot(samples: ReplaySamples, path: Path, title: str) -> None:
     for name, values in samples.series.items():
         axes.plot(samples.times, values, label=name, linewidth=1.8)
     for entry in samples.fired:
-        axes.axvline(float(entry["t"]), color="0.85", linewidth=0.8, zorder=0)
+        axes.axvline(float(cast(float, entry["t"])), color="0.85", linewidth=0.8, zorder=0)
     axes.set_xlabel("time since the session started (s)")
     axes.set_ylabel("metric")
     axes.set_ylim(-0.02, 1.02)
@@ -139,6 +142,8 @@ def main(argv: Sequence[str] | None = None, prog: str = "python -m qos", epilog:
             print(f"{prog} check: {exc}", file=sys.stderr)
             return 2
         return 0
+    from qos.trace import load_trace, sample_trace, summarise
+
     try:
         trace = load_trace(args.trace)
         samples = sample_trace(trace, args.sample_period)

@@ -12,6 +12,7 @@ import dataclasses
 import math
 import operator
 from collections.abc import Callable, Iterator, Mapping
+from typing import Any, cast
 
 from qos.model import Binary, Call, Conditional, Expr, Literal, Unary, Var
 
@@ -23,7 +24,8 @@ def _divide(left: float, right: float) -> float | None:
     return None if right == 0 else left / right
 
 
-_BINARY: dict[str, Callable[[object, object], object]] = {
+#: the operands are numbers or booleans as the checker typed them
+_BINARY: dict[str, Callable[[Any, Any], Any]] = {
     "=": operator.eq,
     "!=": operator.ne,
     "<": operator.lt,
@@ -74,7 +76,7 @@ def compile_expr(expr: Expr) -> Evaluator:
         inner = compile_expr(expr.operand)
         if expr.op == "!":
             return lambda values: None if (x := inner(values)) is None else not x
-        return lambda values: None if (x := inner(values)) is None else -x
+        return lambda values: None if (x := inner(values)) is None else -cast(float, x)  # typed a number
     if isinstance(expr, Conditional):
         condition, then, otherwise = (compile_expr(part) for part in (expr.condition, expr.then, expr.otherwise))
 

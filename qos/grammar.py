@@ -15,9 +15,15 @@ the grammar, collected by :func:`descriptions_of` and attached to the declaratio
 
 from __future__ import annotations
 
+import fcntl
+import functools
+import os
+import sys
 from contextvars import ContextVar
+from pathlib import Path
+from typing import Any, cast
 
-from lark import Lark, Token
+from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 GRAMMAR = r"""
@@ -178,15 +184,61 @@ COMMENT: /\/\/[^\n]*/ | /\/\*(.|\n)*?\*\//
 #: the descriptions met while lexing the model being parsed (one list per parse, thread-safe)
 _DESCRIPTIONS: ContextVar[list[Token]] = ContextVar("descriptions")
 
-# The basic lexer keeps keywords reserved everywhere, so a misplaced 'reinforces' is reported as such
-# instead of being read as a context name.
-PARSER = Lark(
-    GRAMMAR,
-    parser="lalr",
-    lexer="basic",
-    propagate_positions=True,
-    lexer_callbacks={"DESCRIPTION": lambda token: _DESCRIPTIONS.get().append(token)},
-)
+
+def children(tree: Tree) -> list[Any]:
+    """``tree``'s children, read as the grammar shapes them: at each position the grammar fixes
+    whether a child is a Token, a Tree or an absent optional (None); lark types them all as one
+    union, so the checkers read them through this."""
+    return tree.children
+
+
+#: how the grammar is compiled (LALR tables); the basic lexer keeps keywords reserved everywhere, so
+#: a misplaced 'reinforces' is reported as such instead of being read as a context name
+_OPTIONS: dict[str, object] = {"parser": "lalr", "lexer": "basic", "propagate_positions": True}
+
+
+def _keep_description(token: Token) -> Token:
+    _DESCRIPTIONS.get().append(token)
+    return token
+
+
+@functools.cache
+def parser() -> Lark:
+    """The RoQME parser, built on first use and kept.
+
+    Building the LALR tables takes longer than starting Textual, so they are kept between runs in
+    the user's cache directory (``<user cache dir>/kiosk/qos``, 0700), keyed by the grammar, lark's
+    version and Python's; a missing, stale or unreadable cache only means building them again.
+    """
+    options = dict(_OPTIONS, lexer_callbacks={"DESCRIPTION": _keep_description})
+    cache = _cache_file()
+    if cache is None:
+        return Lark(GRAMMAR, **options)
+    try:
+        lock = os.open(cache.with_suffix(".lock"), os.O_RDWR | os.O_CREAT, 0o600)
+    except OSError:
+        return Lark(GRAMMAR, **options)
+    try:
+        # one process at a time reads, or builds and writes, the cache: none sees half a file
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return Lark(GRAMMAR, cache=str(cache), **options)  # lark checks the key inside, rebuilds on a mismatch
+    finally:
+        os.close(lock)
+
+
+def _cache_file() -> Path | None:
+    """Where the compiled tables are kept (:func:`fileio.cache.private_dir`: they are pickled, so
+    only a directory of this user's own, closed to others, is trusted), or None."""
+    import hashlib
+
+    import lark
+
+    from fileio.cache import private_dir
+
+    key = hashlib.sha256(f"{GRAMMAR}{sorted(_OPTIONS.items())}{lark.__version__}{sys.version_info[:2]}".encode())
+    folder = private_dir("qos")
+    return None if folder is None else folder / f"roqme-{key.hexdigest()[:24]}.lark"
+
 
 #: seconds per time unit (RoQME's words and the short forms older models use)
 TIME_UNITS = {
@@ -288,7 +340,7 @@ def describe_expected(expected: set[str], previous: str | None) -> str:
             continue
         text = _TERMINAL_TEXT.get(name)
         if text is None:
-            pattern = PARSER.get_terminal(name).pattern
+            pattern = parser().get_terminal(name).pattern
             text = repr(pattern.value) if pattern.type == "str" else name.lower()
         texts.append(text)
     return " or ".join(texts[:6]) or "the end of the file"
@@ -297,14 +349,14 @@ def describe_expected(expected: set[str], previous: str | None) -> str:
 def syntax_error(text: str, exc: UnexpectedInput, previous: Token | None) -> tuple[int, int, str]:
     """Line, column and message of a lark error (the caller adds the file name)."""
     if isinstance(exc, UnexpectedCharacters):
-        return exc.line, exc.column, f"unexpected character {text[exc.pos_in_stream]!r}"
+        return exc.line, exc.column, f"unexpected character {text[exc.pos_in_stream or 0]!r}"
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
     if token.type != "$END" and text.startswith("/*", token.start_pos):
         return token.line, token.column, "unterminated comment: '/*' without '*/'"
     for word in (token, previous):
         if word is not None and word.type == "NAME" and str(word) in UNSUPPORTED_WORDS:
-            return word.line, word.column, UNSUPPORTED_WORDS[str(word)]
+            return cast(int, word.line), cast(int, word.column), UNSUPPORTED_WORDS[str(word)]  # lexed: positioned
     after = f" after {str(previous)!r}" if previous is not None else ""
     expected = describe_expected(set(exc.expected), str(previous) if previous is not None else None)
     if token.type == "$END":
@@ -318,14 +370,14 @@ def parse_text(text: str):
     descriptions: list[Token] = []
     reset = _DESCRIPTIONS.set(descriptions)
     try:
-        parser = PARSER.parse_interactive(text)
+        interactive = parser().parse_interactive(text)
         # fed token by token so that an error can say what it came after
         previous = current = None
         try:
-            for token in parser.iter_parse():
+            for token in interactive.iter_parse():
                 previous, current = current, token
             previous = current
-            tree = parser.feed_eof(current)
+            tree = interactive.feed_eof(current)
         except UnexpectedInput as exc:
             raise SyntaxProblem(*syntax_error(text, exc, previous)) from None
     finally:

@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import MutableMapping
+from typing import cast
 
 from qos.expressions import compile_expr, variables_of
 from qos.model import EVENTTYPE, Aggregate, Context, Model, Period, Stream, Variable
@@ -49,9 +50,10 @@ class _Accumulator:
 
     __slots__ = ("count", "total", "low", "high", "last", "steps", "rising", "falling", "flat")
 
-    def __init__(self, last: object = None):
+    def __init__(self, last: float | None = None):
         self.count, self.total, self.steps = 0, 0.0, 0
-        self.low = self.high = None
+        self.low: float | None = None
+        self.high: float | None = None
         #: the update before this window's first (its first step starts there)
         self.last = last
         self.rising = self.falling = self.flat = True
@@ -155,7 +157,7 @@ class _Aggregate(StreamRunner):
         if self.end is not None and t >= self.end:  # a time batch is over
             if self.running.count:
                 self._produce(self.running.value(self.function), values, updated)
-                self.end += self.window
+                self.end += cast(float, self.window)  # a time window
             else:
                 self.end = None
             self.running = _Accumulator(self.running.last)
@@ -198,6 +200,7 @@ class _PeriodOfContext(StreamRunner):
 class _PeriodOfSequence(StreamRunner):
     def __init__(self, name: str, period: Period):
         super().__init__(name)
+        assert period.first is not None and period.then is not None  # a period of a sequence has both
         self.first, self.then = PatternRunner(period.first), PatternRunner(period.then)
         self.since: float | None = None
 

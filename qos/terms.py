@@ -8,10 +8,12 @@ context. Every error names the node's line and column.
 
 from __future__ import annotations
 
+from typing import cast
+
 from lark import Token, Tree
 
 from qos.expressions import variables_of
-from qos.grammar import TIME_UNITS
+from qos.grammar import TIME_UNITS, children
 from qos.model import (
     BOOLEAN,
     EVENTTYPE,
@@ -130,53 +132,53 @@ class TermChecker:
 
     def pattern(self, node) -> Pattern:
         """A pattern; a value standing as a pattern becomes an occurrence."""
-        if isinstance(node, Tree) and node.data == "postfix_call" and node.children[1].type in ("UPDATE", "EVENTWHEN"):
-            subject, keyword, arguments = node.children  # X'update is update(X), X'eventWhen is eventWhen(X)
-            if arguments is not None and any(child is not None for child in arguments.children):
+        if isinstance(node, Tree) and node.data == "postfix_call" and children(node)[1].type in ("UPDATE", "EVENTWHEN"):
+            subject, keyword, arguments = children(node)  # X'update is update(X), X'eventWhen is eventWhen(X)
+            if arguments is not None and any(child is not None for child in children(arguments)):
                 raise self.error(node, f"{subject}'{keyword} takes no arguments")
             kind = "update" if keyword.type == "UPDATE" else "event_when"
             node = Tree(kind, [keyword, Tree("var", [subject], node.meta)], node.meta)
         if not is_pattern(node):
             return self._occurrence(node)
         kind = node.data
-        children = node.children
+        kids = children(node)
         if kind == "followed_by":
-            return FollowedBy(self.pattern(children[0]), self.pattern(children[2]))
+            return FollowedBy(self.pattern(kids[0]), self.pattern(kids[2]))
         if kind == "p_or":
-            return AnyOf(self.pattern(children[0]), self.pattern(children[2]))
+            return AnyOf(self.pattern(kids[0]), self.pattern(kids[2]))
         if kind == "p_and":
-            left, right = children[0], children[2]
+            left, right = kids[0], kids[2]
             left_not = isinstance(left, Tree) and left.data == "not_event"
             right_not = isinstance(right, Tree) and right.data == "not_event"
             if left_not and right_not:
                 raise self.error(node, "'not a and not b' never occurs: one side of 'and' must occur")
             if right_not:
-                return AndNot(self.pattern(left), self.pattern(right.children[1]))
+                return AndNot(self.pattern(left), self.pattern(children(right)[1]))
             if left_not:
-                return AndNot(self.pattern(right), self.pattern(left.children[1]))
+                return AndNot(self.pattern(right), self.pattern(children(left)[1]))
             return AllOf(self.pattern(left), self.pattern(right))
         if kind == "not_event":
             raise self.error(node, "'not p' never occurs on its own: use it beside 'and' (a and not p)")
         if kind == "once":
-            return Once(self.pattern(children[1]))
+            return Once(self.pattern(kids[1]))
         if kind == "while_":
-            condition = self.expr(children[2], role="the while condition")
+            condition = self.expr(kids[2], role="the while condition")
             if condition.type != BOOLEAN:
-                raise self.error(children[2], f"the while condition must be boolean, not {type_name(condition.type)}")
-            return While(self.pattern(children[0]), condition)
+                raise self.error(kids[2], f"the while condition must be boolean, not {type_name(condition.type)}")
+            return While(self.pattern(kids[0]), condition)
         if kind == "repeat":
-            return Repeat(self.pattern(children[0]), self._count(children[2], "repeat needs a whole number of times"))
+            return Repeat(self.pattern(kids[0]), self._count(kids[2], "repeat needs a whole number of times"))
         if kind == "range":
-            low = self._count(children[2], "range needs whole numbers of times")
-            high = self._count(children[3], "range needs whole numbers of times")
+            low = self._count(kids[2], "range needs whole numbers of times")
+            high = self._count(kids[3], "range needs whole numbers of times")
             if high < low:
-                raise self.error(children[3], f"range({low}, {high}) is empty: the upper bound is below the lower")
-            return Range(self.pattern(children[0]), low, high)
+                raise self.error(kids[3], f"range({low}, {high}) is empty: the upper bound is below the lower")
+            return Range(self.pattern(kids[0]), low, high)
         # update(…) / eventWhen(…)
-        keyword, argument = children
+        keyword, argument = kids
         when_true = kind == "event_when"
-        if isinstance(argument, Tree) and argument.data == "var" and str(argument.children[0]) in self.contexts:
-            context = self.contexts[str(argument.children[0])]
+        if isinstance(argument, Tree) and argument.data == "var" and str(children(argument)[0]) in self.contexts:
+            context = self.contexts[str(children(argument)[0])]
             if when_true and context.type != BOOLEAN:
                 raise self.error(
                     argument, f"eventWhen needs a boolean, but {context.name} is {type_name(context.type)}"
@@ -204,7 +206,7 @@ class TermChecker:
 
     def _occurrence(self, node) -> Pattern:
         if isinstance(node, Tree) and node.data == "var":
-            name = str(node.children[0])
+            name = str(children(node)[0])
             if name in self.timers:
                 return Updated(name)
             if name in self.contexts:
@@ -222,7 +224,7 @@ class TermChecker:
     def _enum_occurrence(self, node: Tree) -> Pattern:
         """``ctx::LIT`` as a pattern: every update of ctx to LIT (RoQME's enum filter)."""
         literal = self.expr(node)
-        qualifier = str(node.children[0])
+        qualifier = str(children(node)[0])
         if qualifier in self.contexts:
             context = self.contexts[qualifier]
         else:
@@ -230,8 +232,8 @@ class TermChecker:
             if len(users) != 1:
                 raise self.error(
                     node,
-                    f"{qualifier}::{node.children[1]} as a pattern needs the context it is "
-                    f"about: write CONTEXT::{node.children[1]}",
+                    f"{qualifier}::{children(node)[1]} as a pattern needs the context it is "
+                    f"about: write CONTEXT::{children(node)[1]}",
                 )
             context = users[0]
         return While(Updated(context.name), Binary("=", Var(context.name, context.type), literal, BOOLEAN))
@@ -247,15 +249,15 @@ class TermChecker:
                 "only values and & | ! comparisons and arithmetic can",
             )
         kind = node.data
-        children = node.children
+        kids = children(node)
         if kind == "var":
-            return self._name_value(children[0])
+            return self._name_value(kids[0])
         if kind == "number":
-            return Literal(float(children[0]), NUMBER)
+            return Literal(float(kids[0]), NUMBER)
         if kind == "unit_number":  # a unit-measured value: the unit documents it
-            return Literal(float(children[0]), NUMBER)
+            return Literal(float(kids[0]), NUMBER)
         if kind == "time":
-            return Literal(seconds_of(children[0]), NUMBER)
+            return Literal(seconds_of(kids[0]), NUMBER)
         if kind in ("true", "false"):
             return Literal(kind == "true", BOOLEAN)
         if kind == "string":
@@ -277,16 +279,16 @@ class TermChecker:
         if kind == "conditional":
             return self._conditional(node, role)
         if kind == "not_":
-            operand = self.expr(children[0], role)
-            self._expect(children[0], operand, BOOLEAN, "'!'")
+            operand = self.expr(kids[0], role)
+            self._expect(kids[0], operand, BOOLEAN, "'!'")
             return Unary("!", operand, BOOLEAN)
         if kind == "negate":
-            operand = self.expr(children[1], role)
-            self._expect(children[1], operand, NUMBER, f"'{children[0]}'")
-            if str(children[0]) == "+":
+            operand = self.expr(kids[1], role)
+            self._expect(kids[1], operand, NUMBER, f"'{kids[0]}'")
+            if str(kids[0]) == "+":
                 return operand
             if isinstance(operand, Literal):
-                return Literal(-operand.value, NUMBER)
+                return Literal(-cast(float, operand.value), NUMBER)
             return Unary("-", operand, NUMBER)
         if kind == "binary":
             return self._binary(node, role)
@@ -312,7 +314,7 @@ class TermChecker:
         raise self.error(name, f"unknown context {text}{detail}")
 
     def _enum_literal(self, node: Tree) -> Literal:
-        type_token, literal = node.children
+        type_token, literal = children(node)
         qualifier = str(type_token)
         enum = None
         if qualifier in self.types:
@@ -334,18 +336,18 @@ class TermChecker:
         return Literal(str(literal), enum)
 
     def _array(self, node: Tree) -> Literal:
-        values = [self.expr(child) for child in node.children]
-        for child, value in zip(node.children, values):
+        values = [self.expr(child) for child in children(node)]
+        for child, value in zip(children(node), values):
             if not isinstance(value, Literal) or isinstance(value.type, ArrayType):
                 raise self.error(child, "an array holds constants: numbers, booleans or enum literals")
             if value.type != values[0].type:
                 raise self.error(
                     child, f"an array holds one type: {type_name(values[0].type)}, not {type_name(value.type)}"
                 )
-        return Literal(tuple(value.value for value in values), ArrayType(values[0].type, len(values)))
+        return Literal(tuple(cast(Literal, value).value for value in values), ArrayType(values[0].type, len(values)))
 
     def _conditional(self, node: Tree, role: str) -> Conditional:
-        condition_node, then_node, otherwise_node = node.children
+        condition_node, then_node, otherwise_node = children(node)
         condition = self.expr(condition_node, role)
         self._expect(condition_node, condition, BOOLEAN, "the condition of '? :'")
         then, otherwise = self.expr(then_node, role), self.expr(otherwise_node, role)
@@ -357,7 +359,7 @@ class TermChecker:
         return Conditional(condition, then, otherwise, then.type)
 
     def _binary(self, node: Tree, role: str) -> Binary:
-        left_node, op_token, right_node = node.children
+        left_node, op_token, right_node = children(node)
         op = str(op_token)
         left, right = self.expr(left_node, role), self.expr(right_node, role)
         if op in ("&", "|"):
@@ -380,7 +382,7 @@ class TermChecker:
 
     def _call(self, node: Tree) -> Expr:
         if node.data == "postfix_call":
-            subject, function, arguments = node.children
+            subject, function, arguments = children(node)
             if isinstance(subject, Token) and subject.type == "BELIEF":
                 raise self.error(
                     node,
@@ -388,10 +390,10 @@ class TermChecker:
                     "by updates; aggregate a context instead",
                 )
             args = [Tree("var", [subject], node.meta)] + (
-                [child for child in arguments.children if child is not None] if arguments is not None else []
+                [child for child in children(arguments) if child is not None] if arguments is not None else []
             )
         else:
-            function, *rest = node.children
+            function, *rest = children(node)
             args = [child for child in rest if child is not None]
         name = str(function)
         if name in ("update", "eventWhen"):
@@ -439,7 +441,7 @@ class TermChecker:
             )
         source_node = args[0]
         source_name = (
-            str(source_node.children[0]) if isinstance(source_node, Tree) and source_node.data == "var" else None
+            str(children(source_node)[0]) if isinstance(source_node, Tree) and source_node.data == "var" else None
         )
         if source_name in self.contexts:
             source_type = self.contexts[source_name].type
@@ -455,9 +457,9 @@ class TermChecker:
             window_node = args[1]
             kind = window_node.data if isinstance(window_node, Tree) else None
             if kind == "time":
-                window = seconds_of(window_node.children[0])
-            elif kind == "number" and "." not in window_node.children[0] and int(window_node.children[0]) >= 1:
-                window = int(window_node.children[0])
+                window = seconds_of(children(window_node)[0])
+            elif kind == "number" and "." not in children(window_node)[0] and int(children(window_node)[0]) >= 1:
+                window = int(children(window_node)[0])
             else:
                 raise self.error(
                     window_node, f"the window of {name} is a whole number of updates (3) or a time (5 minutes)"
@@ -475,10 +477,10 @@ class TermChecker:
         if len(args) != 1:
             raise self.error(node, "period takes one argument: a context, or 'a -> b'")
         (argument,) = args
-        if isinstance(argument, Tree) and argument.data == "var" and str(argument.children[0]) in self.contexts:
-            return self._stream(Period(str(argument.children[0])), NUMBER)
+        if isinstance(argument, Tree) and argument.data == "var" and str(children(argument)[0]) in self.contexts:
+            return self._stream(Period(str(children(argument)[0])), NUMBER)
         if isinstance(argument, Tree) and argument.data == "followed_by":
-            first, then = self.pattern(argument.children[0]), self.pattern(argument.children[2])
+            first, then = self.pattern(children(argument)[0]), self.pattern(children(argument)[2])
             return self._stream(Period(None, first, then), NUMBER)
         raise self.error(
             argument, "period needs a context (how long it kept its value) or 'a -> b' (the time from a to b)"

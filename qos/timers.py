@@ -23,7 +23,7 @@ list in brackets ``[0, 30]``. Days of week count from 0 = Sunday. A missing seco
 from __future__ import annotations
 
 import re
-from datetime import datetime, timedelta, timezone
+from datetime import UTC, datetime, timedelta
 
 from qos.model import Schedule, Timer
 
@@ -102,7 +102,7 @@ def next_match(schedule: Schedule, after: float, origin: float) -> float | None:
 
 
 def _next_match(schedule: Schedule, after: float, origin: float) -> float | None:
-    moment = datetime.fromtimestamp(origin + after, timezone.utc).replace(microsecond=0) + timedelta(seconds=1)
+    moment = datetime.fromtimestamp(origin + after, UTC).replace(microsecond=0) + timedelta(seconds=1)
     day = moment.replace(hour=0, minute=0, second=0)
     for _ in range(_HORIZON_DAYS):
         if day.month in schedule.months and day.day in schedule.days and (day.weekday() + 1) % 7 in schedule.weekdays:
@@ -132,6 +132,7 @@ class TimerClock:
         if timer.schedule is not None:
             match = next_match(timer.schedule, t - timer.offset, self.origin)
             return None if match is None else match + timer.offset
+        assert timer.interval is not None  # a timer without a schedule has an interval (the parser checks)
         return t + timer.interval + timer.offset
 
     def start(self, t: float) -> None:
@@ -158,16 +159,19 @@ class TimerClock:
             return 0
         if self.timer.onetime:
             return 1
-        spacing = self.timer.interval or (1.0 if len(self.timer.schedule.seconds) > 1 else 60.0)
+        schedule = self.timer.schedule
+        spacing = self.timer.interval or (1.0 if schedule is not None and len(schedule.seconds) > 1 else 60.0)
         return (t - self.due) / spacing + 1
 
     def fired(self) -> None:
         """The timer fired at its due time: plan the next firing."""
         timer, at = self.timer, self.due
+        assert at is not None  # fired only when due
         if timer.onetime:
             self.due = None
         elif timer.schedule is not None:
             match = next_match(timer.schedule, at - timer.offset, self.origin)
             self.due = None if match is None else match + timer.offset
         else:
+            assert timer.interval is not None  # neither one-time nor scheduled: periodic
             self.due = at + timer.interval

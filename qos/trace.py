@@ -19,7 +19,7 @@ import math
 import statistics
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -236,7 +236,7 @@ def _calendar(text: str, name: str) -> float:
         raise TraceError(
             f"{name}: 'origin' must be a date and time such as 2026-11-23T09:00:00Z, not {text!r}"
         ) from None
-    return (moment if moment.tzinfo else moment.replace(tzinfo=timezone.utc)).timestamp()
+    return (moment if moment.tzinfo else moment.replace(tzinfo=UTC)).timestamp()
 
 
 def load_trace(path: str | Path) -> Trace:

@@ -283,10 +283,13 @@ def insert_ignore(connection: Connection, table: sa.Table, rows: list[dict[str, 
     if not rows:
         return
     if connection.dialect.name == "postgresql":
-        from sqlalchemy.dialects.postgresql import insert
+        from sqlalchemy.dialects.postgresql import insert as postgresql_insert
+
+        connection.execute(postgresql_insert(table).on_conflict_do_nothing(index_elements=keys), rows)
     else:
-        from sqlalchemy.dialects.sqlite import insert
-    connection.execute(insert(table).on_conflict_do_nothing(index_elements=keys), rows)
+        from sqlalchemy.dialects.sqlite import insert as sqlite_insert
+
+        connection.execute(sqlite_insert(table).on_conflict_do_nothing(index_elements=keys), rows)
 
 
 def migrate(engine: Engine) -> None:

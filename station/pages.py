@@ -10,7 +10,7 @@ not fit its questionnaire (rows stored before they were checked) is left out, ne
 from __future__ import annotations
 
 import json
-from typing import Any
+from typing import Any, cast
 from urllib.parse import quote
 
 from starlette.applications import Starlette
@@ -116,7 +116,8 @@ def _score(q: Questionnaire, stored: StoredSession, review: Any) -> Score:
     """The score of the answers (after corrections) that fit the questionnaire."""
     items = {item.id: item for item in q.items}
     options = review.options({a.item_id: a.option for a in stored.answers})
-    return q.score({i: items[i].option(o).points for i, o in options.items() if i in items and _fits(items[i], o)})
+    points = {i: items[i].option(o).points for i, o in options.items() if i in items and _fits(items[i], o)}
+    return q.score(cast(dict[str, int], points))  # score() refuses a value without points
 
 
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:

@@ -8,6 +8,7 @@ corrected answers), never a stored copy.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -81,7 +82,7 @@ def waiting_count(engine: Engine) -> int:
         )
 
 
-def results_of(engine: Engine, q: Questionnaire, rows: list[Any]) -> list[Result]:
+def results_of(engine: Engine, q: Questionnaire, rows: Sequence[Any]) -> list[Result]:
     """The results of these session rows (anything with an ``id``), in their order."""
     ids = [r.id for r in rows]
     reviews = validation.reviews(engine, ids)

@@ -38,7 +38,7 @@ def grant_app_role(engine: Engine, role: str) -> None:
         _grant(engine, role)
     except sa.exc.SQLAlchemyError as exc:
         raise RoleError(
-            f"cannot grant role {role!r} the station's tables: {str(exc.orig or exc).splitlines()[0]}"
+            f"cannot grant role {role!r} the station's tables: {str(getattr(exc, 'orig', None) or exc).splitlines()[0]}"
         ) from None
 
 

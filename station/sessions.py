@@ -98,7 +98,7 @@ def fold(session_id: str, rows: Iterable[Row]) -> StoredSession:
         except (KeyError, TypeError, ValueError, AttributeError):
             log.append(LogEntry(0.0, f"unreadable:{row.kind}", json.dumps(row.payload)[:200]))
     ordered = sorted(answers.values(), key=lambda a: a.t)
-    language = head.get("language") if isinstance(head.get("language"), str) else "en"
+    language = head["language"] if isinstance(head.get("language"), str) else "en"
     try:
         answered_by = AnsweredBy(head.get("answered_by", "patient"))
     except ValueError:

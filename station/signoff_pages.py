@@ -17,6 +17,7 @@ from starlette.routing import Route
 from kiosk.core.review import state_once_signed
 from kiosk.export import ExportError
 from kiosk.export.captured import questionnaire_of
+from kiosk.store.records import StoredSession
 from station import validation
 from station.rendering import render
 from station.sessions import NotFound, load
@@ -26,7 +27,7 @@ async def confirm_page(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id = request.path_params["session_id"]
 
-    def read() -> tuple[str, object]:
+    def read() -> tuple[str, StoredSession]:
         with engine.connect() as connection:
             return load(connection, session_id)
 
@@ -35,7 +36,7 @@ async def confirm_page(request: Request) -> Response:
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
     current = await run_in_threadpool(validation.review, engine, session_id)
-    if current.final or stored.status not in validation.REVIEWABLE:  # type: ignore[attr-defined]
+    if current.final or stored.status not in validation.REVIEWABLE:
         return RedirectResponse(f"/sessions/{session_id}", status_code=303)
     if not request.state.user.is_doctor:
         return RedirectResponse(

@@ -18,7 +18,7 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import Any, cast
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
@@ -130,6 +130,7 @@ def parse(body: Any) -> list[Event]:
             for name, value in (("kind", kind), ("session_id", session_id)):
                 text(value, f"{where}: {name}", ID_MAX, empty=False)
             iso_time(at, f"{where}: at")
+            kind, session_id, at = cast(str, kind), cast(str, session_id), cast(str, at)  # text: checked above
             if not isinstance(payload, dict):
                 raise RowRefused(f"{where}: payload: must be an object")
             missing = [k for k in REQUIRED.get(kind, ()) if k not in payload]

@@ -9,7 +9,7 @@ always be traced to who did it and why.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
@@ -168,4 +168,5 @@ def corrected(stored: StoredSession, q: Questionnaire, current: Review) -> dict[
     """The items' options after corrections, and the score they give (for the page and exports)."""
     options = current.options({a.item_id: a.option for a in stored.answers})
     points = {item_id: q.item(item_id).option(option).points for item_id, option in options.items()}
-    return {"options": options, "score": q.score(points)}
+    # score() checks every value: an option without points is refused there, as it always was
+    return {"options": options, "score": q.score(cast(dict[str, int], points))}

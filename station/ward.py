@@ -162,9 +162,11 @@ def queue_command(engine: Engine, kiosk_id: str, session_id: str, kind: str, by:
     with engine.begin() as connection:
         if connection.execute(sa.select(kiosks.c.name).where(kiosks.c.name == kiosk_id)).first() is None:
             raise WardError(f"no kiosk {kiosk_id!r}")
-        command_id = connection.execute(
+        inserted = connection.execute(
             commands.insert().values(kiosk_id=kiosk_id, session_id=session_id, kind=kind, by=by, at=at)
-        ).inserted_primary_key[0]
+        ).inserted_primary_key
+        assert inserted is not None  # a single-row INSERT has its key
+        command_id = inserted[0]
         connection.execute(
             audit.insert().values(
                 session_id=session_id,

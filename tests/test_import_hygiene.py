@@ -7,6 +7,8 @@ import pkgutil
 import subprocess
 import sys
 
+import pytest
+
 import qos
 
 #: the pure-Python parts of the kiosk (imported by module name; missing ones are an error)
@@ -48,17 +50,20 @@ def _imported_after(modules: list[str]) -> set[str]:
     return set(out.stdout.split())
 
 
+@pytest.mark.slow  # a subprocess
 def test_qos_never_imports_textual_or_kiosk():
     loaded = _imported_after(_modules_of(qos))
     assert "textual" not in loaded
     assert not any(name == "kiosk" or name.startswith("kiosk.") for name in loaded)
 
 
+@pytest.mark.slow  # a subprocess
 def test_session_core_never_imports_textual():
     loaded = _imported_after(PURE_KIOSK_MODULES)
     assert "textual" not in loaded
 
 
+@pytest.mark.slow  # a subprocess
 def test_channels_never_import_textual():
     """Speech and remote readers run on their own threads: they hand inputs to a sink, never to widgets."""
     import kiosk.remote

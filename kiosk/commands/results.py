@@ -98,7 +98,8 @@ def main(argv: list[str]) -> int:
     """List, show or export stored sessions; returns the exit status."""
     parser = argparse.ArgumentParser(
         prog="kiosk results",
-        description="List stored sessions, show some, or export them as FHIR R4 JSON or CSV (totals recomputed from the answers).",
+        description="List stored sessions, show some, or export them as FHIR R4 JSON or CSV "
+        "(totals recomputed from the answers).",
     )
     parser.add_argument(
         "sessions",

@@ -8,7 +8,7 @@ to, so a 20-minute session replays in milliseconds and never sleeps.
 from __future__ import annotations
 
 import time
-from datetime import datetime, timedelta, timezone
+from datetime import UTC, datetime, timedelta
 from typing import Protocol
 
 
@@ -31,11 +31,11 @@ class SystemClock:
 
     def wall(self) -> datetime:
         """The system's current UTC time."""
-        return datetime.now(timezone.utc)
+        return datetime.now(UTC)
 
 
 #: the date a simulated clock's zero corresponds to, so replays store reproducible timestamps
-SIM_EPOCH = datetime(2026, 1, 1, tzinfo=timezone.utc)
+SIM_EPOCH = datetime(2026, 1, 1, tzinfo=UTC)
 
 
 class SimClock:

@@ -10,6 +10,7 @@ Models that declare ``QuestionAsked`` (an eventtype) also get it when a question
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from kiosk.core.session.publishing import QUESTION_ASKED
@@ -20,7 +21,7 @@ from qos.batches import check_batch
 DEFAULT_MODEL = "clarc"
 
 #: every context value a session publishes, as (set, emit) batches to check a model against
-KIOSK_BATCHES: tuple[tuple[dict[str, object], list[str]], ...] = (
+KIOSK_BATCHES: tuple[tuple[Mapping[str, object], Sequence[str]], ...] = (
     *(({"PersonDetected": value}, []) for value in (True, False)),
     *(({"TestState": state}, []) for state in ("STARTED", "PAUSED", "RESTARTED", "REPEATING", "FINISHED")),
     *(({name: value}, []) for name in ("FirstAttemptAnswered", "SecondAttemptAnswered") for value in (True, False)),
@@ -52,7 +53,9 @@ def load_kiosk_model(name_or_path: str | Path = DEFAULT_MODEL) -> Model:
     """
     model = load_model(name_or_path)
     # QuestionAsked is optional, but a model declaring it must take it as the session emits it
-    optional = [({}, [QUESTION_ASKED])] if QUESTION_ASKED in model.contexts else []
+    optional: list[tuple[Mapping[str, object], Sequence[str]]] = (
+        [({}, [QUESTION_ASKED])] if QUESTION_ASKED in model.contexts else []
+    )
     for values, emitted in (*KIOSK_BATCHES, *optional):
         try:
             check_batch(model, values, emitted)

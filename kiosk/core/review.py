@@ -95,14 +95,23 @@ class Review:
 class Step(Protocol):
     """One row of a station's audit trail, as :func:`review_from_steps` reads it."""
 
-    at: str
-    author: str
+    # read-only: a frozen dataclass (the station's AuditEntry) is a Step
+
+    @property
+    def at(self) -> str: ...
+    @property
+    def author(self) -> str: ...
     #: "correct", "fill", "sign_off", "amend" (reopen a signed result); other actions are ignored
-    action: str
-    item_id: str | None
-    option: int | None
-    previous_option: int | None
-    reason: str
+    @property
+    def action(self) -> str: ...
+    @property
+    def item_id(self) -> str | None: ...
+    @property
+    def option(self) -> int | None: ...
+    @property
+    def previous_option(self) -> int | None: ...
+    @property
+    def reason(self) -> str: ...
 
 
 def review_from_steps(steps: Iterable[Step], staff_system: str = STAFF_SYSTEM) -> Review:

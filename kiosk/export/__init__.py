@@ -15,24 +15,12 @@ its own exports results as unreviewed. Every function takes the questionnaire an
 (:class:`ExportSite`) it is given, and reads no file or configuration.
 """
 
-from kiosk.export.bundle import Described, bundle_of, questionnaire_bundle, transaction_bundle
-from kiosk.export.fhir import (
-    ITEM_WEIGHT,
-    ORDINAL_VALUE,
-    SIGNATURE,
-    TRANSLATION,
-    WORDING,
-    fhir_device,
-    fhir_questionnaire,
-    fhir_response,
-    fhir_total,
-    observation_status,
-    practitioner,
-    questionnaire_canonical,
-    response_status,
-)
-from kiosk.export.provenance import REPLACED_ANSWER, fhir_provenances
-from kiosk.export.result import (
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from kiosk.export.result import (  # eager: `result` is both this module and its function
     PRACTICE_CHECKS,
     TOTAL_LINK,
     ExportError,
@@ -52,7 +40,55 @@ from kiosk.export.result import (
     write_json,
     write_private,
 )
-from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, wide_columns, wide_csv_text
+
+if TYPE_CHECKING:
+    from kiosk.export.bundle import Described, bundle_of, questionnaire_bundle, transaction_bundle
+    from kiosk.export.fhir import (
+        ITEM_WEIGHT,
+        ORDINAL_VALUE,
+        SIGNATURE,
+        TRANSLATION,
+        WORDING,
+        fhir_device,
+        fhir_questionnaire,
+        fhir_response,
+        fhir_total,
+        observation_status,
+        practitioner,
+        questionnaire_canonical,
+        response_status,
+    )
+    from kiosk.export.provenance import REPLACED_ANSWER, fhir_provenances
+    from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, wide_columns, wide_csv_text
+
+#: each public name -> the module that defines it: imported on first use, so the kiosk's first
+#: screen (which needs only kiosk.export.result, imported above) does not wait for FHIR, bundles and CSV
+_MODULES: dict[str, str] = {
+    "CSV_COLUMNS": "kiosk.export.tables",
+    "Described": "kiosk.export.bundle",
+    "ID_TAGS": "kiosk.export.tables",
+    "ITEM_WEIGHT": "kiosk.export.fhir",
+    "ORDINAL_VALUE": "kiosk.export.fhir",
+    "REPLACED_ANSWER": "kiosk.export.provenance",
+    "SIGNATURE": "kiosk.export.fhir",
+    "TRANSLATION": "kiosk.export.fhir",
+    "WORDING": "kiosk.export.fhir",
+    "bundle_of": "kiosk.export.bundle",
+    "csv_text": "kiosk.export.tables",
+    "fhir_device": "kiosk.export.fhir",
+    "fhir_provenances": "kiosk.export.provenance",
+    "fhir_questionnaire": "kiosk.export.fhir",
+    "fhir_response": "kiosk.export.fhir",
+    "fhir_total": "kiosk.export.fhir",
+    "observation_status": "kiosk.export.fhir",
+    "practitioner": "kiosk.export.fhir",
+    "questionnaire_bundle": "kiosk.export.bundle",
+    "questionnaire_canonical": "kiosk.export.fhir",
+    "response_status": "kiosk.export.fhir",
+    "transaction_bundle": "kiosk.export.bundle",
+    "wide_columns": "kiosk.export.tables",
+    "wide_csv_text": "kiosk.export.tables",
+}
 
 __all__ = [
     "CSV_COLUMNS",
@@ -98,3 +134,16 @@ __all__ = [
     "write_json",
     "write_private",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """The public name ``name`` from the module that defines it (PEP 562)."""
+    if name not in _MODULES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_MODULES[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -21,14 +21,7 @@ from kiosk.config import default_kiosk_id
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.questionnaire.definition import DefinitionError, canonical_json, questionnaire_from
 from kiosk.core.review import Review
-from kiosk.export import (
-    ExportError,
-    ExportSite,
-    csv_text,
-    site_from_identity,
-    transaction_bundle,
-    wide_csv_text,
-)
+from kiosk.export.result import ExportError, ExportSite, site_from_identity
 from kiosk.store.records import StoredSession
 
 __all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of"]
@@ -90,6 +83,8 @@ def bundle_of(
     """One FHIR transaction Bundle of ``sessions``, each described by its own definition and
     identity (:func:`kiosk.export.transaction_bundle` per group; an entry several groups share,
     such as the kiosk's Device, appears once)."""
+    from kiosk.export.bundle import transaction_bundle  # FHIR loads when a bundle is asked for
+
     groups = _groups(sessions, reviews, kiosk_id)
     if not groups:
         q, site = _empty(empty, kiosk_id)
@@ -146,6 +141,8 @@ def csv_of(
 ) -> str:
     """The long CSV (:func:`kiosk.export.csv_text`) of ``sessions``, each with its own definition
     and identity."""
+    from kiosk.export.tables import csv_text
+
     groups = _groups(sessions, reviews, kiosk_id)
     if not groups:
         q, site = _empty(empty, kiosk_id)
@@ -165,6 +162,8 @@ def wide_csv_of(
 ) -> str:
     """The wide CSV (:func:`kiosk.export.wide_csv_text`) of ``sessions``: one row each, under the
     columns of every definition among them."""
+    from kiosk.export.tables import wide_csv_text
+
     groups = _groups(sessions, reviews, kiosk_id)
     if not groups:
         q, site = _empty(empty, kiosk_id)

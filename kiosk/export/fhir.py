@@ -58,7 +58,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Any
 
 from kiosk.core.questionnaire import Code, Questionnaire
@@ -106,7 +106,7 @@ def instant(value: str) -> str:
     except ValueError:
         raise ExportError(f"{value!r} is not an ISO-8601 date and time") from None
     if moment.tzinfo is None:
-        moment = moment.replace(tzinfo=timezone.utc)
+        moment = moment.replace(tzinfo=UTC)
     return moment.isoformat(timespec="milliseconds" if moment.microsecond else "seconds")
 
 

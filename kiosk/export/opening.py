@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +31,7 @@ def in_force_of(config: Config) -> InForce:
     return InForce(
         canonical(configured_questionnaire(config)),
         export_identity(site_from_config(config)),
-        datetime.now(timezone.utc).isoformat().replace("+00:00", "Z"),
+        datetime.now(UTC).isoformat().replace("+00:00", "Z"),
     )
 
 

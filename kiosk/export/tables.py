@@ -79,7 +79,7 @@ def _band(q: Questionnaire, r: Result) -> str:
     return r.score.band.id if r.score.band else ""
 
 
-def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, str]:
+def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, object]:
     stored = r.stored
     return {
         "session": tag("session", stored.id),

@@ -2,8 +2,9 @@
 
 The port is given by the profile as a path or a glob (``/dev/ttyUSB*``); on every connection
 attempt the first matching port that opens is used, so a box that comes back under another
-number is found again, and a port already held by another reader is skipped. Each connection gets a fresh :class:`~kiosk.remote.decoders.LineDecoder`:
-half a line from an unplugged box never joins the first line of the next one.
+number is found again, and a port already held by another reader is skipped. Each connection gets a
+fresh :class:`~kiosk.remote.decoders.LineDecoder`: half a line from an unplugged box never joins the
+first line of the next one.
 """
 
 from __future__ import annotations

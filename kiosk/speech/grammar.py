@@ -58,7 +58,8 @@ def build_grammar(
     """Keep the phrases whose every word ``known`` accepts; log and list the others. Lead-ins
     and fillers with an unknown word, or that are also phrases, are left out silently; lead-ins
     go only before the phrases whose ``meaning`` is an option number."""
-    kept = _known(phrases, known, recogniser, dropped := [])
+    dropped: list[tuple[str, str]] = []
+    kept = _known(phrases, known, recogniser, dropped)
     extra = [p for p in _known(lead_ins, known, "", []) if p not in kept]
     noise = [p for p in _known(fillers, known, "", []) if p not in kept]
     answers = [p for p in kept if meaning is not None and isinstance(meaning(p), int)]

@@ -129,6 +129,8 @@ class Listening:
     def hear(self, utterance: Utterance) -> ChannelInput | str:
         """What the utterance means on this prompt: the input for the session, or why it is none."""
         result = utterance.result
+        if self.matcher is None:  # the grammar was taken away while this was being heard
+            return "heard after the grammar was taken away"
         match = self.matcher.match(result.text, result.confidence)
         if not match.matched:
             match = self._heard_twice(result) or match

@@ -253,7 +253,12 @@ class Matcher:
             if command in self.commands or command is Command.UNDO:
                 out += phrases
         seen: set[str] = set()
-        return [p for p in out if p and not (normalise(p) in seen or seen.add(normalise(p)))]
+        unique = []
+        for phrase in out:
+            if phrase and normalise(phrase) not in seen:
+                seen.add(normalise(phrase))
+                unique.append(phrase)
+        return unique
 
     def lead_ins(self) -> tuple[str, ...]:
         """Words the grammar allows before any phrase (:data:`LEAD_INS`)."""

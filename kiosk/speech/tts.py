@@ -44,12 +44,13 @@ import wave
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
-
-import numpy as np
+from typing import TYPE_CHECKING, Protocol
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.words import Table
+
+if TYPE_CHECKING:  # numpy loads on the speaker's worker thread, not before the first screen
+    import numpy as np
 
 log = logging.getLogger(__name__)
 
@@ -118,9 +119,10 @@ class Synthesiser:
     """espeak-ng, text → WAV file (22.05 kHz mono 16-bit). Thread-safe: one process per phrase."""
 
     def __init__(self) -> None:
-        self._command = shutil.which("espeak-ng")
-        if self._command is None:
+        command = shutil.which("espeak-ng")
+        if command is None:
             raise TtsUnavailable("espeak-ng is not installed")
+        self._command = command
         listing = subprocess.run(
             [self._command, "--voices"], capture_output=True, text=True, timeout=SYNTH_TIMEOUT_S
         ).stdout
@@ -360,6 +362,8 @@ class Speaker:
         fd, name = tempfile.mkstemp(suffix=".wav", prefix="kiosk-tts-")
         os.close(fd)
         try:
+            import numpy as np
+
             synth.synthesise(job.text, job.language, name, self.rate, self.volume)
             with wave.open(name, "rb") as wav:
                 rate = wav.getframerate()

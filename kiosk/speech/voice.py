@@ -35,21 +35,17 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
-from kiosk.speech.asr import AsrUnavailable, Recogniser, open_recogniser
-from kiosk.speech.audio import (
-    AudioUnavailable,
-    Endpointer,
-    MicrophoneStream,
-    PcmConsumer,
-    Utterance,
-    UtterancePipeline,
-)
 from kiosk.speech.listening import Listening
 from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, OptionWords
+
+if TYPE_CHECKING:  # the recognisers and the audio pipeline (numpy) load on the channel's own threads
+    from kiosk.speech.asr import Recogniser
+    from kiosk.speech.audio import Endpointer, PcmConsumer, Utterance, UtterancePipeline
 
 log = logging.getLogger(__name__)
 
@@ -87,18 +83,18 @@ class VoiceChannel:
         *,
         vosk_model: str | Path | None = None,
         recogniser_factory: Callable[[str], Recogniser] | None = None,
-        microphone_factory: Callable[[PcmConsumer], Any] = MicrophoneStream,
+        microphone_factory: Callable[[PcmConsumer], Any] | None = None,
         min_confidence: float = DEFAULT_MIN_CONFIDENCE,
         confirm_below: float = CONFIRM_BELOW,
         on_unmatched: Callable[[str, str], None] = lambda utterance, reason: None,
         on_utterance: Callable[[Utterance], None] = lambda utterance: None,
-        endpointer_factory: Callable[[], Endpointer] = Endpointer,
+        endpointer_factory: Callable[[], Endpointer] | None = None,
         reply_min_above_room_db: float = REPLY_MIN_ABOVE_ROOM_DB,
     ) -> None:
         self.language = language
         #: language → recogniser; by default vosk with ``vosk_model`` (the config's) or an
         #: installed model, else pocketsphinx for English
-        self._recogniser_factory = recogniser_factory or (lambda lang: open_recogniser(lang, vosk_model))
+        self._recogniser_factory = recogniser_factory or partial(_open_recogniser, vosk_model=vosk_model)
         self._microphone_factory = microphone_factory
         #: what is listened for on the current prompt, and what an utterance means there
         self._heard = Listening(
@@ -140,7 +136,9 @@ class VoiceChannel:
             if self._stopped:
                 return
             self._sink = sink
-        microphone = self._microphone_factory(self)
+        from kiosk.speech.audio import AudioUnavailable, MicrophoneStream
+
+        microphone = (self._microphone_factory or MicrophoneStream)(self)
         try:
             microphone.start()
         except AudioUnavailable as exc:
@@ -308,6 +306,8 @@ class VoiceChannel:
                     self._loaded.notify_all()
                     return
             recogniser, failure, key = None, "", ""
+            from kiosk.speech.asr import AsrUnavailable
+
             try:
                 recogniser = self._recogniser_factory(language)
             except AsrUnavailable as exc:
@@ -329,7 +329,10 @@ class VoiceChannel:
         """(Lock held.) Make ``recogniser`` the one the audio reaches, with the current grammar."""
         self._recogniser = recogniser
         if self._pipeline is None:
-            self._pipeline = UtterancePipeline(recogniser, self._on_utterance, endpointer=self._endpointer_factory())
+            from kiosk.speech.audio import Endpointer, UtterancePipeline
+
+            endpointer = (self._endpointer_factory or Endpointer)()
+            self._pipeline = UtterancePipeline(recogniser, self._on_utterance, endpointer=endpointer)
         else:
             self._pipeline.muted = True  # drop an utterance the old recogniser was hearing
             self._pipeline.recogniser = recogniser
@@ -373,3 +376,10 @@ class VoiceChannel:
             if state is ChannelState.OFF:
                 reason = f"voice answers off: {reason}"
             self._sink(ChannelStatus(Channel.VOICE, state, source=self.name, reason=reason, reason_key=reason_key))
+
+
+def _open_recogniser(language: str, vosk_model: str | Path | None) -> Recogniser:
+    """The default recogniser (vosk, else pocketsphinx), imported on the loader thread."""
+    from kiosk.speech.asr import open_recogniser
+
+    return open_recogniser(language, vosk_model)

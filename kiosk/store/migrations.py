@@ -16,7 +16,7 @@ import json
 import sqlite3
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Any
 
 from kiosk.core.questionnaire import load_questionnaire
@@ -200,7 +200,7 @@ def bundled_in_force(export: Mapping[str, str], wall: Callable[[], float]) -> Ca
     """The default :class:`InForce`: the bundled questionnaire (loaded only when asked) and ``export``."""
 
     def now() -> InForce:
-        at = datetime.fromtimestamp(wall(), timezone.utc).isoformat().replace("+00:00", "Z")
+        at = datetime.fromtimestamp(wall(), UTC).isoformat().replace("+00:00", "Z")
         return InForce(canonical(load_questionnaire()), dict(export), at)
 
     return now

@@ -22,9 +22,9 @@ import sqlite3
 import threading
 import time
 from collections.abc import Callable, Mapping
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from kiosk.sync.http import Station, Unreachable
 from kiosk.sync.outbox import Outbox
@@ -191,7 +191,8 @@ class SyncClient:
         # "seq"), else narrow the batch down to the row; the rest goes on in the next request
         named = body.get("seq") if isinstance(body, dict) else None
         if len(rows) == 1 or any(r.seq == named for r in rows):
-            self.outbox.park(named if len(rows) > 1 else rows[0].seq, f"{status}{_reason(body)}")
+            # several rows: the station named one of them (an int, checked just above)
+            self.outbox.park(cast(int, named) if len(rows) > 1 else rows[0].seq, f"{status}{_reason(body)}")
         else:
             self._batch = max(1, len(rows) // 2)
         return True
@@ -207,7 +208,7 @@ class SyncClient:
             code, body = self.station.request(
                 "POST",
                 "/api/v1/status",
-                {**status, "kiosk_id": self.kiosk_id, "at": datetime.now(timezone.utc).isoformat()},
+                {**status, "kiosk_id": self.kiosk_id, "at": datetime.now(UTC).isoformat()},
             )
         except Unreachable:
             with self._lock:

@@ -51,9 +51,9 @@ from kiosk.core.session import (
     SessionEvent,
     VolumeChanged,
 )
-from kiosk.export import ExportSite, export_identity, site_from_config
 from kiosk.export.captured import questionnaire_of
 from kiosk.export.opening import in_force_of
+from kiosk.export.result import ExportSite, export_identity, site_from_config
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
 from kiosk.store.database import Store, StoredSession
 from kiosk.store.lease import LEASE_TTL_S, SessionTaken

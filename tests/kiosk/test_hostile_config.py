@@ -58,6 +58,7 @@ COMMANDS = [
 ]
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("text", "where"),
     [
@@ -81,6 +82,7 @@ def test_a_hostile_setting_is_one_line_in_every_command(tmp_path, text, where):
         one_line(done, f"kiosk {' '.join(command[:2]) if command[0] == 'qos' else command[0]}: {config}{where}")
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("variable", "value", "where"),
     [
@@ -95,6 +97,7 @@ def test_a_hostile_environment_override_is_one_line(tmp_path, variable, value, w
         one_line(kiosk(*command, cwd=tmp_path, env=env), where)
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     "command", [("run", "--no-voice", "--no-remote"), ("replay", str(SCRIPT)), ("results",), ("qos", "trace", "abc")]
 )
@@ -116,6 +119,7 @@ def _line_of(text: str, line: str) -> int:
     return text.splitlines().index(line) + 1
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("old", "new", "where"),
     [
@@ -149,6 +153,7 @@ def test_validate_and_run_refuse_invalid_unicode_written_as_an_escape(tmp_path, 
     )
 
 
+@pytest.mark.slow  # a subprocess
 def test_validate_refuses_blank_texts_and_synonyms_where_they_are(tmp_path):
     text = _questionnaire("  en: Barthel Index", '  en: "  "')
     item = '      en: "Feeding: how do you manage eating?"\n'
@@ -164,6 +169,7 @@ def test_validate_refuses_blank_texts_and_synonyms_where_they_are(tmp_path):
     ]
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize("rate", ["0", "0.4", "-1"])
 def test_a_speech_rate_that_would_stop_the_voice_is_refused(tmp_path, rate):
     policy = (ROOT / "kiosk/core/adaptation.yaml").read_text(encoding="utf-8")
@@ -177,6 +183,7 @@ def test_a_speech_rate_that_would_stop_the_voice_is_refused(tmp_path, rate):
     )
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("port", "where"),
     [
@@ -195,6 +202,7 @@ def test_a_port_glob_over_the_file_system_is_refused_at_once(tmp_path, port, whe
     )
 
 
+@pytest.mark.slow  # a subprocess
 def test_an_id_or_language_ending_in_a_line_break_is_refused(tmp_path):
     """A pattern ending in a bare '$' lets a final line break through: ids go into exports."""
     item = "  - id: feeding\n"

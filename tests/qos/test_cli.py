@@ -118,6 +118,7 @@ def test_kiosk_qos_trace_prints_a_stored_sessions_trace_that_replays_to_its_metr
         assert replayed["metrics"][name]["last"] == pytest.approx(value, abs=1e-12)
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize("command", [["-m", "qos"], ["-m", "kiosk", "qos"]])
 def test_a_reader_closing_the_pipe_early_is_not_an_error(command):
     """`… | head -c 0`: the reader is gone before anything is written; no traceback, exit 0."""

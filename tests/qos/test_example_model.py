@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from kiosk.commands import qos as qos_cli
 from qos import Engine, load_model, load_trace, replay
 
@@ -41,6 +43,7 @@ def test_the_replay_reports_belief_variables_apart_from_the_published_properties
     assert "belief variables (not published):\nFatigue" in capsys.readouterr().out
 
 
+@pytest.mark.slow  # a subprocess
 def test_the_example_replays_identically_from_python_and_from_the_shell():
     done = subprocess.run(
         [sys.executable, "-m", "qos", "replay", str(SLOW_PATIENT), "--json"], capture_output=True, text=True, cwd=ROOT

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import pytest
 
@@ -98,7 +98,7 @@ def test_a_timer_due_at_an_update_joins_its_batch():
 
 
 def test_a_scheduled_timer_fires_at_calendar_times_from_the_origin():
-    origin = datetime(2026, 11, 23, 8, 0, tzinfo=timezone.utc).timestamp()  # a Monday
+    origin = datetime(2026, 11, 23, 8, 0, tzinfo=UTC).timestamp()  # a Monday
     body = (
         'timer Morning := schedule("30, 9, *, *, [1, 2]")\ntimer Often := schedule("*/20, *, *, *, *")\n'
         "observation O : Morning reinforces P\nobservation F : Often reinforces P\n"

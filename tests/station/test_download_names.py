@@ -50,6 +50,7 @@ def test_the_header_names_one_safe_file_whatever_the_id(session_id):
     assert safe_stem("2026-11-26T08-00-00-ab12") == "2026-11-26T08-00-00-ab12"  # ordinary ids kept as they are
 
 
+@pytest.mark.slow  # a station process
 def test_a_hostile_session_id_downloads_under_a_safe_name(shared_station):
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)

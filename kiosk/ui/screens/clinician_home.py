@@ -13,7 +13,6 @@ from textual.widgets import Button, DataTable, Label, Static, Switch
 from kiosk.core.session import Phase
 from kiosk.export.captured import questionnaire_of
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
-from kiosk.ui.screens.session_detail import SessionDetailScreen
 
 #: how often the running session's line is redrawn (seconds)
 REFRESH_S = 1.0
@@ -223,6 +222,9 @@ class ClinicianHomeScreen(ClinicianScreen):
     def _open(self, event: DataTable.RowSelected) -> None:
         store = self.app.store  # type: ignore[attr-defined]
         stored = store.session(str(event.row_key.value))
+        # the detail's plot (plotext) and exports load when staff first open one, not at start-up
+        from kiosk.ui.screens.session_detail import SessionDetailScreen
+
         self.app.push_screen(SessionDetailScreen(stored))
 
     def action_close(self) -> None:

@@ -26,8 +26,9 @@ class QuestionScreen(PatientScreen):
     marked, under a calm line such as "Thank you. Next question…", as the session's
     :attr:`Snapshot.interlude` says, so the patient never faces an empty screen meanwhile; during
     that thank-you gap "Change my answer" is offered beside it. The line and the button take the
-    question text's rows (the answers keep theirs), so the chosen answer is never covered. While the session asks back an unsure answer
-    ("I heard: … Is that right?") the question's panel gives way to the Yes/No panel. While an
+    question text's rows (the answers keep theirs), so the chosen answer is never covered. While the
+    session asks back an unsure answer ("I heard: … Is that right?") the question's panel gives way
+    to the Yes/No panel. While an
     answer is awaited a gentle sign says so.
     """
 

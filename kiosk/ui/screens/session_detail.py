@@ -73,7 +73,7 @@ class SessionDetailScreen(ClinicianScreen):
             yield Label(
                 "Events:" if events else "Events: none (no doctor call, pause or patient away).", id="events-label"
             )
-            table = DataTable(id="events", zebra_stripes=True, cursor_type="row")
+            table: DataTable[str] = DataTable(id="events", zebra_stripes=True, cursor_type="row")
             table.display = bool(events)
             yield table
             yield Static(metrics_key(), id="metrics-key")

@@ -194,7 +194,8 @@ class KioskServer(Server):
         self.public_url = f"{self.scheme}://{request.host}"  # read before this handler's first await
         return await super().handle_index(request)
 
-    async def handle_websocket(self, request: web.Request) -> web.StreamResponse:
+    # a plain busy page answers when no place is free (textual-serve's own handler always upgrades)
+    async def handle_websocket(self, request: web.Request) -> web.StreamResponse:  # type: ignore[override]
         """One browser connection: one kiosk process, if a place is free; reaped when it closes."""
         if not await self._place_free():
             return busy_page(self.max_sessions)
@@ -214,7 +215,7 @@ class KioskServer(Server):
             self.command,
             write_bytes=websocket.send_bytes,
             write_str=websocket.send_str,
-            close=websocket.close,
+            close=websocket.close,  # type: ignore[arg-type]  # awaited; its bool result is not used
             download_manager=self.download_manager,
             debug=self.debug,
         )

@@ -59,6 +59,7 @@ def write(tmp_path: Path, name: str, content: str | bytes) -> Path:
     return path
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("name", "content", "where"),
     [
@@ -82,6 +83,7 @@ def test_kiosk_run_and_validate_refuse_the_same_questionnaires(tmp_path, name, c
         assert "language 'de'" in validated.stdout and validated.returncode == 1
 
 
+@pytest.mark.slow  # a subprocess
 def test_an_empty_item_list_is_reported_as_such(tmp_path):
     data = yaml.safe_load(bundled_path().read_text(encoding="utf-8"))
     data["items"] = []
@@ -92,6 +94,7 @@ def test_an_empty_item_list_is_reported_as_such(tmp_path):
     ]
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("content", "where"),
     [
@@ -113,6 +116,7 @@ def test_kiosk_qos_replay_refuses_bad_traces(tmp_path, content, where):
     one_line(kiosk("qos", "replay", str(trace), cwd=tmp_path), where)
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("change", "where"),
     [
@@ -128,6 +132,7 @@ def test_kiosk_replay_refuses_bad_scripts(tmp_path, change, where):
     one_line(kiosk("replay", str(script), cwd=tmp_path), where)
 
 
+@pytest.mark.slow  # a subprocess
 def test_a_policy_that_is_not_utf8_stops_kiosk_run_with_one_line(tmp_path):
     policy = write(tmp_path, "policy.yaml", "rules: []\n# réglée\n".encode("latin-1"))
     config = write(tmp_path, "config.yaml", f"adaptation_policy: {policy}\n")
@@ -146,6 +151,7 @@ def test_a_policy_that_is_not_utf8_stops_kiosk_run_with_one_line(tmp_path):
     )
 
 
+@pytest.mark.slow  # a subprocess
 def test_duplicate_keys_in_site_remote_profiles_are_refused(tmp_path):
     profiles = write(tmp_path, "site.yaml", "profiles:\n  - name: a\n    name: b\n")
     one_line(kiosk("devices", "--profiles", str(profiles), cwd=tmp_path), "site.yaml:3:5: duplicate key 'name'")

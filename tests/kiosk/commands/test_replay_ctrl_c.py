@@ -12,6 +12,8 @@ import sys
 import threading
 from pathlib import Path
 
+import pytest
+
 from kiosk.store.database import DB_NAME
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -42,6 +44,7 @@ def _statuses(db: Path) -> dict[str, int]:
             return {}
 
 
+@pytest.mark.slow  # a subprocess
 def test_ctrl_c_in_kiosk_replay_is_one_line_exit_130_and_nothing_half_stored(tmp_path):
     # a station nobody answers: once every script is stored the replay keeps trying to deliver for
     # up to --station-wait, so the Ctrl-C below always lands before the command could end

@@ -11,6 +11,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from kiosk.commands.results import main as results_main
 from kiosk.store.database import Store
 
@@ -39,6 +41,7 @@ KILLED_REPLAY = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow  # a subprocess
 def test_a_killed_replay_leaves_a_simulated_session_the_kiosk_never_offers(tmp_path, capsys):
     data = tmp_path / "data"
     config = tmp_path / "config.yaml"

@@ -93,6 +93,7 @@ print(sum(not v.early for v in verdicts), flush=True)
 """
 
 
+@pytest.mark.slow  # a subprocess
 def test_two_kiosk_processes_on_one_data_directory_share_one_failure_count(tmp_path):
     secret, tries = hash_pin("482193"), 2 * FREE_FAILURES + 2
     guessers = [
@@ -139,6 +140,7 @@ def test_legacy_plain_pin_still_works_with_a_warning_and_short_ones_are_refused(
     assert "default" in PinGuard(load_config(None, environ={}).pin_secret).warning
 
 
+@pytest.mark.slow  # a subprocess
 def test_kiosk_pin_set_writes_the_hash_owner_only_and_keeps_the_rest(tmp_path):
     config = tmp_path / "config.yaml"
     config.write_text('language: es\n# the ward kiosk\nclinician_pin: "1234"\n')

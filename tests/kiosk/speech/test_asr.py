@@ -82,6 +82,7 @@ def test_pocketsphinx_needs_a_grammar_first():
         PocketSphinxRecogniser("en").accept(b"\0\0" * 160)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_pocketsphinx_decodes_speech_and_scores_it(spoken):
     recogniser = PocketSphinxRecogniser("en")
     recogniser.set_grammar(["unable", "needs help", "independent", "one", "two", "three", "repeat"])
@@ -135,6 +136,7 @@ def test_confusable_phrases_only_where_the_partner_means_something_else():
     assert confusable_phrases(["first", "third"], lambda p: p, first_third) == {"first", "third"}
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_pocketsphinx_flags_first_and_third_as_confusable(spoken):
     """espeak-ng's "the first one" sounds like "the third one" to the wheel's model: with a third
     option the result is flagged confusable (the voice channel then always asks the patient),
@@ -193,6 +195,7 @@ def test_final_phrases_are_those_nothing_of_another_meaning_continues():
     }
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_pocketsphinx_says_when_a_whole_answer_was_heard(spoken):
     """A whole answer ends after the short hangover, once the decoder has settled on a voice."""
     path = spoken("independent")

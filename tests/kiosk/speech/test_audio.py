@@ -174,6 +174,7 @@ def test_each_utterance_says_how_far_the_voice_stood_above_the_room():
     assert utt.room_db is None and utt.above_room_db is None
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_read_wav_resamples_espeak_output(spoken):
     path = spoken("two")
     with wave.open(str(path)) as w:

@@ -22,6 +22,7 @@ def _pcm(samples: np.ndarray) -> np.ndarray:
     return np.frombuffer(reduce_steady_noise(samples.astype("<i2").tobytes()), dtype="<i2")
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_fans_noise_is_taken_out_and_the_words_are_kept(voice_of):
     speech = voice_of("I need a lot of help", "en-us+m3", 130)
     rng = np.random.default_rng(7)
@@ -41,6 +42,7 @@ def test_a_fans_noise_is_taken_out_and_the_words_are_kept(voice_of):
     assert residual(out) < residual(noisy) - 3
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_quiet_room_is_left_as_it_was(voice_of):
     speech = voice_of("independent", "en+f2", 170)
     quiet = _in_noise(speech, None)
@@ -56,6 +58,7 @@ def test_too_short_to_estimate_is_returned_unchanged():
     assert reduce_steady_noise(b"") == b""
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("text,option", [("independent", 3), ("needs help", 2), ("two", 2)])
 def test_answers_in_a_fans_noise_are_heard(voice_of, text, option):
     """The kiosk's own voice at SNR 10 dB of white noise: each answer is heard as itself and sure
@@ -82,6 +85,7 @@ def test_noise_alone_is_never_cleaned_into_an_answer():
         assert recogniser.finish().confidence < 0.6, seed
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_background_talk_is_left_as_it_is(voice_of):
     """People talking come and go: there is no one noise spectrum to take out (subtracting an
     average one cost right answers in bench/asr.py's babble)."""

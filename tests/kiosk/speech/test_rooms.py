@@ -102,6 +102,7 @@ def test_telephone_band_keeps_the_band_and_takes_no_audio_at_all():
     assert len(rooms.telephone_band(np.zeros(0, dtype=np.int16))) == 0
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("snr_db", [20, 10])
 def test_steady_noise_does_not_run_to_the_cut_off(voice_of, snr_db):
     """A fan at SNR 20 or 10 dB: each answer ends where the speech ends, not at the 10 s cut-off,
@@ -121,6 +122,7 @@ def test_steady_noise_does_not_run_to_the_cut_off(voice_of, snr_db):
             assert got is None or got.option == option or got.needs_confirmation
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_fan_switched_on_while_listening_does_not_make_the_kiosk_deaf(voice_of):
     """The noise starts mid-listen (no quiet to learn it from): the floor learns it while it
     goes on, the utterance it opened ends before the cut-off, and the next answer is heard."""
@@ -148,6 +150,7 @@ def _babble(voice_of, seconds: float, rng) -> np.ndarray:
     return rooms.babble(talkers, seconds, rng)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("snr_db", [20, 10, 5])
 def test_background_talk_ends_each_answer_where_the_speech_ends(voice_of, snr_db):
     """People talking nearby come and go above the room's floor: each answer still ends within
@@ -180,6 +183,7 @@ def test_background_talk_ends_each_answer_where_the_speech_ends(voice_of, snr_db
             assert end - 0.15 <= answer.speech_end <= end + 0.3, (voice, text)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_microphone_opened_in_background_talk_does_not_run_to_the_cut_off(voice_of):
     """Talk heard as the microphone opens starts an utterance before the room is known; it ends
     once a window of the room has been heard, not at the 10 s cut-off, and the answer after it
@@ -194,6 +198,7 @@ def test_a_microphone_opened_in_background_talk_does_not_run_to_the_cut_off(voic
     assert any(8.5 < u.speech_start < 9.3 for u in ear.utterances), "the answer is an utterance of its own"
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
     """Only what stands out of the room heard in the pre-roll counts towards coverage: the
     talkers around a short answer are not the patient's words; a quiet room and audio handed
@@ -215,6 +220,7 @@ def test_coverage_counts_the_patient_not_the_talk_around_them(voice_of):
     assert above_room(speech.tobytes(), len(active)).all(), "no pre-roll: nothing to go by"
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     """Where people talk nearby, what does not stand out of the room heard in the pre-roll is
     turned down by 30 dB (100 ms kept either side of the words); the loud part of the word is
@@ -255,6 +261,7 @@ def test_talk_around_the_words_is_turned_down_before_scoring(voice_of):
     assert gate_talk(cut.tobytes()) == cut.tobytes(), "a quiet room's answer cut in two is left as heard"
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_yes_and_no_in_background_talk_are_not_taken_for_commands(voice_of):
     """A short "yes" or "no" among people talking at SNR 10 dB: never heard as a command (a
     doctor called, the question repeated) nor as the other reply. With the talk around it left
@@ -269,6 +276,7 @@ def test_yes_and_no_in_background_talk_are_not_taken_for_commands(voice_of):
             assert got is None or got.option == (1 if text == "yes" else 2), (voice, text, got)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize(
     "item_id,text,meant",
     [
@@ -296,6 +304,7 @@ def test_babble_never_gives_a_sure_wrong_answer(voice_of, item_id, text, meant):
         assert reply is None or reply.option != 1, (voice, text, got, reply)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("snr_db", [3, 10, 20])
 def test_a_yes_said_among_talkers_nearly_as_loud_is_never_taken_as_said(voice_of, snr_db):
     """ "Is that right?" answered where people talk nearly as loud as the patient (SNR 3 dB):
@@ -327,6 +336,7 @@ def test_a_yes_said_among_talkers_nearly_as_loud_is_never_taken_as_said(voice_of
     assert snr_db < 5 or sure_yes >= 6, "most yeses are heard in a room of 10 dB or more"
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_only_the_reply_to_is_that_right_is_held_to_the_room(voice_of):
     """A practice question's yes, a scored answer and undo are not held to the room's level; the
     reply to "Is that right?" is, until another prompt comes. (A fan at SNR 20 dB, and the
@@ -354,6 +364,7 @@ def test_only_the_reply_to_is_that_right_is_held_to_the_room(voice_of):
     assert got is not None and got.option == 3 and got.needs_confirmation  # as every answer is
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("voice,rate", [("en-us", 160), *PATIENTS])
 def test_confirmation_takes_natural_yes_and_no(voice_of, voice, rate):
     ear = Ear()
@@ -367,6 +378,7 @@ def test_confirmation_takes_natural_yes_and_no(voice_of, voice, rate):
     assert heard["yes"] == 1 and heard["no that's wrong"] == 2
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_issue_9_cases_are_never_recorded_as_something_else(voice_of):
     """ "all the time" does not call the doctor, "one" is not "go on", "I need a lot of help" on
     transfers is never "Unable": at worst an option the patient is asked to confirm."""
@@ -383,6 +395,7 @@ def test_issue_9_cases_are_never_recorded_as_something_else(voice_of):
     assert heard is not None and heard.option == 2 and heard.needs_confirmation
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("text", ["change my answer", "no that's wrong"])
 def test_taking_back_an_answer_by_voice_is_undo(voice_of, text):
     ear = Ear().question("feeding")
@@ -390,6 +403,7 @@ def test_taking_back_an_answer_by_voice_is_undo(voice_of, text):
     assert got is not None and got.command is Command.UNDO
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize(
     "text,voice,option",
     [
@@ -417,6 +431,7 @@ def test_the_welcome_hears_start_and_the_language_names(voice_of, text, voice, o
     assert got is not None and got.option == option and not got.needs_confirmation
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_british_one_is_heard(voice_of):
     """ "one" with the vowel of "lot" (espeak-ng's en-gb voice, the North of England): the US
     dictionary's only "W AH N" lost it to the filler "what"; the accent variant hears it."""
@@ -426,6 +441,7 @@ def test_a_british_one_is_heard(voice_of):
     assert got is not None and got.option == 1 and got.needs_confirmation, got
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_the_first_one_is_asked_about_and_a_declined_mishearing_is_not_offered_again(voice_of):
     """ "the first one" in a voice the model hears as "the third one" (espeak-ng's en-us): the
     option is only ever offered for confirmation (never refused outright, never taken as sure);
@@ -444,6 +460,7 @@ def test_the_first_one_is_asked_about_and_a_declined_mishearing_is_not_offered_a
     assert ear.hear(speech).option == 3
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("voice,rate,item_id,text,option", [("en-gb+klatt", 150, "grooming", "number one", 1)])
 def test_an_unsure_answer_heard_twice_alike_is_asked_about(voice_of, voice, rate, item_id, text, option):
     """A British "number one": too unsure to offer the first time (0.26-0.36);

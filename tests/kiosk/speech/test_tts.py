@@ -45,6 +45,7 @@ def tts_speaker(espeak_ng):
     speaker.close()
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 @pytest.mark.parametrize("language", ["en", "es", "fr"])
 def test_every_question_is_real_speech_of_plausible_length(tts_speaker, tmp_path, language):
     total_seconds = total_expected = 0.0
@@ -69,6 +70,7 @@ def test_every_question_is_real_speech_of_plausible_length(tts_speaker, tmp_path
     assert 0.75 <= total_seconds / total_expected <= 1.25, total_seconds / total_expected
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_languages_sound_different(tts_speaker, tmp_path):
     """Each language gets its own voice: the same text is not read the same way."""
     lengths = {
@@ -78,6 +80,7 @@ def test_languages_sound_different(tts_speaker, tmp_path):
     assert len(set(lengths.values())) == 3
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_rate_and_volume_change_the_speech(tmp_path, espeak_ng):
     speaker = Speaker(rate=DEFAULT_RATE)
     speaker.start()
@@ -100,6 +103,7 @@ def _voiced_words_per_minute(samples: np.ndarray, rate: int, words: int) -> floa
     return words * 60 / (voiced * 0.02)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_slower_speech_is_pauses_not_slower_words(tmp_path, espeak_ng):
     """slow_speech asks for 0.85 x 160 = 136 wpm: the prompt takes longer, its words do not."""
     text = f"{QUESTIONNAIRE.message('repeat', 'en')} {QUESTIONNAIRE.items[0].spoken['en']}"
@@ -137,8 +141,8 @@ def test_delivery_maps_slow_rates_to_pauses():
         1000 * 7 * (60 / 136 - 60 / 150), abs=2
     )
     assert slow.markup("Fish & chips, <now>. Yes") == (
-        '<speak>Fish &amp; chips,<break time="%dms"/> &lt;now&gt;.<break time="%dms"/> Yes</speak>'
-        % (slow.comma_break_ms, slow.sentence_break_ms)
+        f'<speak>Fish &amp; chips,<break time="{slow.comma_break_ms}ms"/> &lt;now&gt;.'
+        f'<break time="{slow.sentence_break_ms}ms"/> Yes</speak>'
     )
 
 
@@ -188,6 +192,7 @@ def test_no_audio_output_turns_voice_out_off_without_crashing(tmp_path):
     assert status.reason == "voice out off: no audio output found"
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_unknown_language_is_a_clear_error(tts_speaker, tmp_path):
     with pytest.raises(TtsUnavailable, match="no voice for language 'xx'"):
         tts_speaker.save_to_file("Hallo", "xx", tmp_path / "x.wav")

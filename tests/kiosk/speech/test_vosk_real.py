@@ -70,6 +70,7 @@ def test_the_models_own_dictionary_decides_the_grammar(korean):
     assert "vosk dictionary" in grammar.dropped[0][1]
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_an_answer_gives_partial_results_then_a_final_one(korean, korean_speech):
     korean.set_grammar(PHRASES)
     recogniser = _Partials(korean)
@@ -85,6 +86,7 @@ def test_an_answer_gives_partial_results_then_a_final_one(korean, korean_speech)
     assert (result.confidence > 0) == (len(words) == 1)
 
 
+@pytest.mark.slow  # real audio (espeak-ng)
 def test_a_sentence_forced_into_grammar_phrases_is_not_an_answer(korean, korean_speech):
     """ "Hello, the weather is nice today": this model has no "[unk]" to put it in, so Vosk
     returns a run of grammar words, each fairly sure; the recogniser gives it no confidence."""

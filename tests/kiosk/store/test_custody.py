@@ -8,6 +8,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from contextlib import contextmanager
+from datetime import UTC
 
 import pytest
 
@@ -116,9 +117,9 @@ def test_a_session_older_than_the_limit_is_interrupted_even_if_its_kiosk_runs(tm
     started = 1_800_000_000.0
     now = [started + 2 * 3600 + 1]
     store = Store.open(tmp_path, wall=lambda: now[0], interrupt_after_s=2 * 3600)
-    from datetime import datetime, timezone
+    from datetime import datetime
 
-    create(store, started_at=datetime.fromtimestamp(started, timezone.utc).isoformat())
+    create(store, started_at=datetime.fromtimestamp(started, UTC).isoformat())
     assert store.interrupt_stale() == ["s1"]
     assert store.session("s1").interrupted_reason == "not finished within 120 minutes"
     with pytest.raises(SessionTaken, match="no longer held by this kiosk: it is interrupted"):

@@ -62,6 +62,7 @@ def refused(done: subprocess.CompletedProcess, *words: str) -> None:
     assert done.stderr.startswith("kiosk results: ") and all(w in done.stderr for w in words), done.stderr
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize("table", _TABLES)
 def test_a_dropped_table_is_named_with_the_database(data_dir, table):
     _, before = edit(data_dir, "PRAGMA foreign_keys=OFF", f"DROP TABLE {table}")
@@ -71,6 +72,7 @@ def test_a_dropped_table_is_named_with_the_database(data_dir, table):
     assert not (data_dir.parent / "out.csv").exists()
 
 
+@pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("statement", "what"),
     [

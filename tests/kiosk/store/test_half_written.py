@@ -102,6 +102,7 @@ SIGINT_CHILD = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow  # a subprocess
 def test_a_real_ctrl_c_mid_answer_leaves_the_session_without_it_and_staff_continue_at_that_question(tmp_path):
     data = tmp_path / "data"
     child = subprocess.run(

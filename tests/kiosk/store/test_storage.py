@@ -186,6 +186,7 @@ def test_sigkill_mid_session_loses_no_answer_and_the_session_resumes_at_the_firs
     assert not store.unfinished_sessions()
 
 
+@pytest.mark.slow  # a subprocess
 def test_a_stored_trace_printed_by_kiosk_qos_trace_replays_to_the_recorded_metrics(tmp_path, capsys):
     store = Store.open(tmp_path / "data")
     result = run_script(load_script(ROOT / "recordings/patients/barthel5.yaml"), store=store)

@@ -10,6 +10,8 @@ import sys
 import threading
 from contextlib import contextmanager
 
+import pytest
+
 from kiosk.core.session import Phase
 from kiosk.store.database import Store
 from kiosk.store.lease import Owner
@@ -57,6 +59,7 @@ async def test_a_kiosk_without_a_station_starts_no_sync_thread_and_queues_nothin
         close()
 
 
+@pytest.mark.slow  # a subprocess
 async def test_station_commands_continue_mark_away_and_back_and_end_the_running_session(tmp_path):
     server = Server().start()
     app, close = build_app(config_path=config_for(tmp_path, server), voice=False, remote=False)

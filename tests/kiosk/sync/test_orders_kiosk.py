@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 
+import pytest
 import sqlalchemy as sa
 
 from kiosk.core.session import AnsweredBy, Phase
@@ -48,6 +49,7 @@ async def type_code(pilot, code: str) -> None:
     await pilot.click("#visit-key-ok")
 
 
+@pytest.mark.slow  # a station process
 async def test_an_ordered_visit_starts_at_the_kiosk_only_with_its_code(tmp_path):
     ward = make_ward(db.sqlite_url(tmp_path / "station"))
     station = start_station(ward.db_url, tmp_path / "station.log")
@@ -140,6 +142,7 @@ async def test_without_a_station_staff_start_a_visit_by_touch_and_no_walk_up_sta
         close()
 
 
+@pytest.mark.slow  # a station process
 async def test_a_code_typed_while_the_station_is_down_says_so_and_starts_nothing(tmp_path):
     ward = make_ward(db.sqlite_url(tmp_path / "station"))
     station = start_station(ward.db_url, tmp_path / "station.log")

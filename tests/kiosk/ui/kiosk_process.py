@@ -34,7 +34,7 @@ async def main(config: Path, pin: str) -> None:
         notices.append(message)
         notify(message, **kwargs)
 
-    app.notify = noting  # type: ignore[method-assign]
+    app.notify = noting  # type: ignore[method-assign]  # the notices the kiosk showed, for the test
     try:
         async with app.run_test(size=KIOSK_SIZE) as pilot:
 

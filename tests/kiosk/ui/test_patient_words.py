@@ -33,6 +33,7 @@ class _Snap:
 
 
 def _view(language: str, ways: Ways, **snap) -> PatientView:
+    # a stand-in with only the fields the words read, not a whole Snapshot
     return PatientView(_Snap(language, **snap), QUESTIONNAIRE, ways)  # type: ignore[arg-type]
 
 

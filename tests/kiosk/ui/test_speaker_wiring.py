@@ -52,7 +52,10 @@ async def test_prompts_are_spoken_and_a_spoken_repeat_is_reported_to_the_session
         await until_thread(
             lambda: player.played >= spoken, "the speaker's worker"
         )  # welcome, explanation, the first question
-        states = lambda: [e["set"]["TestState"] for e in kiosk.session.trace if "TestState" in e.get("set", {})]
+
+        def states() -> list[str]:
+            return [e["set"]["TestState"] for e in kiosk.session.trace if "TestState" in e.get("set", {})]
+
         await pilot.press("r")  # repeat: TestState REPEATING until the repeat has been said
         await until_thread(lambda: states()[-2:] == ["REPEATING", "STARTED"], "the speaker's worker")
         assert player.played >= spoken + 1

@@ -16,6 +16,7 @@ async def test_a_write_the_database_refuses_drops_the_test_plainly_and_staff_get
     kiosk = ui_kiosk(familiarisation=False)
     seen: list[str] = []
     notify = kiosk.app.notify
+    # the test reads what the screen showed
     kiosk.app.notify = lambda message, **kw: (seen.append(message), notify(message, **kw))  # type: ignore[method-assign]
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await start_in_english(kiosk, pilot)

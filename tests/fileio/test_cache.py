@@ -1,0 +1,80 @@
+"""What a start need not do twice: a document that passed its JSON Schema is remembered (in a
+private cache directory) and not checked again; one with a problem is checked every time, and
+changing a single value means checking again."""
+
+from __future__ import annotations
+
+import os
+import stat
+import subprocess
+import sys
+
+import pytest
+
+from fileio import cache
+from fileio.positions import parse, schema_problems
+
+SCHEMA = {
+    "type": "object",
+    "properties": {"points": {"type": "integer", "multipleOf": 5}},
+    "required": ["points"],
+    "additionalProperties": False,
+}
+
+
+@pytest.fixture
+def cache_home(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    return tmp_path / "kiosk" / "checked"
+
+
+def _problems(text: str) -> list[str]:
+    data, positions, problems = parse(text, "doc.yaml")
+    assert positions is not None and problems == []
+    found: list[str] = []
+    schema_problems(data, SCHEMA, positions, lambda path, message, key=False: found.append(message))
+    return found
+
+
+def test_a_document_with_a_problem_is_checked_every_time(cache_home):
+    assert _problems("points: 7\n") == ["points: must be a multiple of 5, got 7"]
+    assert _problems("points: 7\n") == ["points: must be a multiple of 5, got 7"]
+    assert not (cache_home / "json-schema").exists()  # nothing remembered for a failing document
+
+
+def test_a_remembered_document_changed_by_one_value_is_checked_again(cache_home):
+    assert _problems("points: 10\n") == []
+    assert len((cache_home / "json-schema").read_text().split()) == 1
+    assert stat.S_IMODE(cache_home.stat().st_mode) == 0o700
+    assert _problems("points: 10\n") == []  # remembered
+    assert _problems("points: 11\n") == ["points: must be a multiple of 5, got 11"]
+    assert _problems("points: 10\nextra: 1\n") == ["unknown key 'extra'"]
+
+
+def test_only_the_latest_are_remembered(cache_home):
+    keys = [cache.digest(str(n)) for n in range(cache.REMEMBERED + 5)]
+    for key in keys:
+        cache.remember("json-schema", key)
+    assert not cache.passed("json-schema", keys[0])
+    assert all(cache.passed("json-schema", key) for key in keys[5:])
+    assert os.listdir(cache_home) == ["json-schema"]  # no half-written file left beside it
+
+
+def test_a_cache_directory_others_may_write_is_not_used(cache_home):
+    cache_home.mkdir(parents=True)
+    cache_home.chmod(0o777)
+    assert _problems("points: 10\n") == []
+    assert list(cache_home.iterdir()) == []
+    cache.remember("json-schema", "x")
+    assert not cache.passed("json-schema", "x")
+
+
+@pytest.mark.slow  # fresh interpreters, as two starts of the kiosk
+def test_the_second_start_loads_the_questionnaire_without_jsonschema(tmp_path):
+    code = (
+        "import sys\nfrom kiosk.core.questionnaire import load_questionnaire\n"
+        "load_questionnaire()\nprint('jsonschema' in sys.modules)\n"
+    )
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path))
+    runs = [subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True) for _ in range(2)]
+    assert [run.stdout.strip() for run in runs] == ["True", "False"], [run.stderr for run in runs]

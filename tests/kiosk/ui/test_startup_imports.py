@@ -1,0 +1,107 @@
+"""The welcome comes first: what the first screen does not need is not imported before it is drawn
+(issue 24, part 8; the time it takes is measured by bench/startup.py, never here).
+
+Each check runs a fresh interpreter, as `kiosk run` starts, so modules other tests loaded do not hide
+an import; it is the kiosk's second start, the first having filled its cache (the QoS grammar's
+tables, the questionnaire's passed schema check: fileio.cache)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from typing import Any
+
+import pytest
+
+pytestmark = pytest.mark.slow  # fresh interpreters
+
+#: loaded only when staff open a result, export, plot, or the kiosk talks to a station
+NOT_BEFORE_THE_WELCOME = (
+    "kiosk.export.bundle",
+    "kiosk.export.fhir",
+    "kiosk.export.provenance",
+    "kiosk.export.tables",
+    "kiosk.ui.screens.session_detail",
+    "kiosk.ui.widgets.metrics_plot",
+    "kiosk.sync",
+    "kiosk.commands",
+    "qos.trace",
+    "jsonschema",
+    "plotext",
+    "textual_plotext",
+    "matplotlib",
+    "numpy",
+    "station",
+    "starlette",
+    "sqlalchemy",
+)
+#: the speech stack loads on the channels' own threads once the app runs, never while it is built
+NOT_WHILE_BUILDING = ("numpy", "sounddevice", "vosk", "pocketsphinx", "kiosk.speech.asr", "kiosk.speech.audio")
+
+
+def _run(tmp_path, body: str) -> dict[str, Any]:
+    config = tmp_path / "config.yaml"
+    config.write_text(f"data_dir: {tmp_path / 'data'}\n")
+    code = textwrap.dedent(
+        f"""
+        import asyncio, json, sys
+        from pathlib import Path
+        import kiosk.cli, qos.cli  # what `kiosk` imports before it dispatches to `run`
+        from kiosk.ui.app import KIOSK_SIZE, build_app
+        config = Path({str(config)!r})
+        """
+    ) + textwrap.dedent(body)
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))
+    for _start in ("first", "second"):
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env)
+        assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def test_the_welcome_is_drawn_before_exports_plots_and_the_station_are_imported(tmp_path):
+    found = _run(
+        tmp_path,
+        """
+        app, close = build_app(config_path=config, voice=False, remote=False)
+
+        async def welcome():
+            async with app.run_test(size=KIOSK_SIZE) as pilot:
+                while not (type(app.screen).__name__ == "WelcomeScreen" and app.screen.query("Button")):
+                    await pilot.pause()
+                drawn = " ".join(str(b.label) for b in app.screen.query("Button"))
+                return drawn, sorted(sys.modules)
+
+        try:
+            drawn, modules = asyncio.run(welcome())
+        finally:
+            close()
+        print(json.dumps({"drawn": drawn, "modules": modules}))
+        """,
+    )
+    assert "English" in str(found["drawn"])
+    modules = set(found["modules"])
+    early = sorted(
+        m for m in modules if m.split(".")[0] in NOT_BEFORE_THE_WELCOME or m.startswith(NOT_BEFORE_THE_WELCOME)
+    )
+    assert early == []
+
+
+def test_building_the_kiosk_with_voice_and_remotes_loads_no_speech_stack(tmp_path):
+    found = _run(
+        tmp_path,
+        """
+        app, close = build_app(config_path=config)
+        try:
+            loaded = sorted(sys.modules)
+            voice = type(app.voice).__name__
+        finally:
+            close()
+        print(json.dumps({"voice": voice, "modules": loaded}))
+        """,
+    )
+    assert found["voice"] == "VoiceChannel"  # the channel is there: it loads its stack when started
+    modules = set(found["modules"])
+    assert sorted(m for m in modules if m.split(".")[0] in NOT_WHILE_BUILDING or m in NOT_WHILE_BUILDING) == []
