@@ -10,7 +10,6 @@ and the terms (expressions and patterns) in :mod:`qos.nodes`; this module re-exp
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union
 
 from qos.nodes import (
     Aggregate,
@@ -107,7 +106,7 @@ class Context:
     spec: TypeSpec | None = None
     #: a derived context's definition (``context X : T := …``): an expression or, for an eventtype,
     #: a pattern; None for a primitive context, which the kiosk sets
-    definition: Union["Expr", "Pattern", None] = None
+    definition: Expr | Pattern | None = None
     description: str | None = None
 
     @property
@@ -137,7 +136,7 @@ class Property:
     #: seconds; ``None`` means the evidence never fades
     survival: float | None = None
     #: ``property P : T := …``: the value published beside the metric, computed from ``belief``
-    transformation: "Expr | None" = None
+    transformation: Expr | None = None
     description: str | None = None
 
     @property
@@ -195,7 +194,7 @@ class TimerAction:
     timer: str
 
 
-Action = Union[Evidence, SetVariable, ClearEvidence, TimerAction]
+Action = Evidence | SetVariable | ClearEvidence | TimerAction
 
 
 @dataclass(frozen=True)
@@ -266,7 +265,7 @@ class Observation:
 
 #: a computed value the engine keeps up to date each batch, in ``Model.streams`` order: a derived
 #: context (by name), a variable with a definition (by name), or an Aggregate/Period (hidden name ``#n``)
-Stream = Union[Context, Variable, Aggregate, Period]
+Stream = Context | Variable | Aggregate | Period
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
 
 from qos.values import NUMBER, ValueType
 
@@ -30,7 +29,7 @@ class Unary:
     """``!e`` (boolean not) or ``-e`` (numeric negation)."""
 
     op: str
-    operand: "Expr"
+    operand: Expr
     type: ValueType
 
 
@@ -39,8 +38,8 @@ class Binary:
     """``& | = != < <= > >= + - * /``."""
 
     op: str
-    left: "Expr"
-    right: "Expr"
+    left: Expr
+    right: Expr
     type: ValueType
 
 
@@ -48,9 +47,9 @@ class Binary:
 class Conditional:
     """``condition ? then : otherwise``; undefined when the condition is."""
 
-    condition: "Expr"
-    then: "Expr"
-    otherwise: "Expr"
+    condition: Expr
+    then: Expr
+    otherwise: Expr
     type: ValueType
 
 
@@ -60,7 +59,7 @@ class Call:
     (arrays); ``X'f(a)`` is ``f(X, a)``."""
 
     function: str
-    args: tuple["Expr", ...]
+    args: tuple[Expr, ...]
     type: ValueType
 
 
@@ -76,7 +75,7 @@ class Aggregate:
     function: str
     source: str
     window: int | float | None
-    where: "Expr | None"
+    where: Expr | None
     type: ValueType
 
 
@@ -86,12 +85,12 @@ class Period:
     ``period(a -> b)``: at each ``b`` after an ``a``, the seconds since the latest ``a``."""
 
     source: str | None
-    first: "Pattern | None" = None
-    then: "Pattern | None" = None
+    first: Pattern | None = None
+    then: Pattern | None = None
     type: ValueType = NUMBER
 
 
-Expr = Union[Var, Literal, Unary, Binary, Conditional, Call]
+Expr = Var | Literal | Unary | Binary | Conditional | Call
 
 
 @dataclass(frozen=True)
@@ -117,38 +116,38 @@ class Changed:
 class AnyOf:
     """``a or b``."""
 
-    left: "Pattern"
-    right: "Pattern"
+    left: Pattern
+    right: Pattern
 
 
 @dataclass(frozen=True)
 class AllOf:
     """``a and b``."""
 
-    left: "Pattern"
-    right: "Pattern"
+    left: Pattern
+    right: Pattern
 
 
 @dataclass(frozen=True)
 class FollowedBy:
     """``a -> b``."""
 
-    first: "Pattern"
-    then: "Pattern"
+    first: Pattern
+    then: Pattern
 
 
 @dataclass(frozen=True)
 class Once:
     """``once p``."""
 
-    pattern: "Pattern"
+    pattern: Pattern
 
 
 @dataclass(frozen=True)
 class While:
     """``p while(cond)``."""
 
-    pattern: "Pattern"
+    pattern: Pattern
     condition: Expr
 
 
@@ -156,7 +155,7 @@ class While:
 class Repeat:
     """``p repeat(n)``."""
 
-    pattern: "Pattern"
+    pattern: Pattern
     times: int
 
 
@@ -165,17 +164,17 @@ class AndNot:
     """``a and not b``: ``a`` occurs before ``b`` has occurred since the pattern was (re-)armed; an
     occurrence of ``b`` ends the attempt and the pattern starts again (Esper ``every (a and not b)``)."""
 
-    pattern: "Pattern"
-    excluded: "Pattern"
+    pattern: Pattern
+    excluded: Pattern
 
 
 @dataclass(frozen=True)
 class Range:
     """``p range(a, b)``: occurs on the a-th to the b-th occurrence of ``p`` in the engine's life."""
 
-    pattern: "Pattern"
+    pattern: Pattern
     low: int
     high: int
 
 
-Pattern = Union[Updated, Changed, AnyOf, AllOf, AndNot, FollowedBy, Once, While, Repeat, Range]
+Pattern = Updated | Changed | AnyOf | AllOf | AndNot | FollowedBy | Once | While | Repeat | Range

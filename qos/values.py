@@ -4,7 +4,6 @@ declared type's bounds and unit. Shared by the model, its terms and the engine's
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
 
 
 @dataclass(frozen=True)
@@ -22,7 +21,7 @@ class EnumType:
 class ArrayType:
     """An array of at most ``size`` values of one scalar type (``number[3]``, ``enum[2] {…}``)."""
 
-    element: "ValueType"
+    element: ValueType
     size: int
 
     def __str__(self) -> str:
@@ -30,7 +29,7 @@ class ArrayType:
 
 
 #: the type of a context or expression: "boolean", "number", "eventtype", an enumeration or an array
-ValueType = Union[str, EnumType, ArrayType]
+ValueType = str | EnumType | ArrayType
 
 BOOLEAN = "boolean"
 NUMBER = "number"

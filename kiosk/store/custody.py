@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sqlite3
 from collections.abc import Callable
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 from kiosk.store.lease import Owner, SessionTaken, lapsed
 from kiosk.store.transactions import Transactions
@@ -203,5 +203,5 @@ def _age_s(started_at: str, now: float) -> float:
     except ValueError:
         return 0.0
     if started.tzinfo is None:
-        started = started.replace(tzinfo=timezone.utc)
+        started = started.replace(tzinfo=UTC)
     return now - started.timestamp()

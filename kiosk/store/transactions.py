@@ -11,7 +11,7 @@ import contextlib
 import json
 import sqlite3
 from collections.abc import Callable, Iterator
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Any
 
 #: session-log kinds that are alerts for the ward, with the name the station protocol gives them
@@ -128,4 +128,4 @@ class Transactions:
 
     def iso_now(self) -> str:
         """Now, ISO 8601 UTC with a Z."""
-        return datetime.fromtimestamp(self.wall(), timezone.utc).isoformat().replace("+00:00", "Z")
+        return datetime.fromtimestamp(self.wall(), UTC).isoformat().replace("+00:00", "Z")
