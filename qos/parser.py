@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import cast
 
 from lark import Token, Tree
 
 from qos.errors import ModelError
-from qos.grammar import SyntaxProblem, parse_text
+from qos.grammar import SyntaxProblem, children, parse_text
 from qos.model import (
     BOOLEAN,
     EVENTTYPE,
@@ -25,14 +26,17 @@ from qos.model import (
     Context,
     EnumType,
     Evidence,
+    Expr,
     Literal,
     Model,
     Observation,
+    Pattern,
     Property,
     SetVariable,
     Timer,
     TimerAction,
     TypeSpec,
+    ValueType,
     Variable,
     type_name,
 )
@@ -98,9 +102,9 @@ class _Checker(TermChecker):
         if name is None:
             name = Path(source.filename).stem if source.filename != "<string>" else "model"
         if not self.properties:
-            header = tree.children[0] if tree.children and tree.children[0].data == "header" else None
-            where = (header.children[1].line, header.children[1].column) if header else (1, 1)
-            raise source.error(*where, f"model {name} declares no property")
+            header = children(tree)[0] if children(tree) and children(tree)[0].data == "header" else None
+            line, column = (children(header)[1].line, children(header)[1].column) if header else (1, 1)
+            raise source.error(line, column, f"model {name} declares no property")
         return Model(
             name,
             source.filename,
@@ -119,13 +123,14 @@ class _Checker(TermChecker):
     def _declarations(self, tree: Tree, descriptions: list[Token]) -> tuple[str | None, str | None]:
         name = model_description = None
         previous_end = 0
-        for declaration in tree.children:
+        for declaration in children(tree):
             start = declaration.meta.start_pos
-            mine = [d for d in descriptions if previous_end <= d.start_pos and d.end_pos <= start]
+            # the lexer's tokens carry their offsets (lark types them optional for hand-made tokens)
+            mine = [d for d in descriptions if previous_end <= cast(int, d.start_pos) and cast(int, d.end_pos) <= start]
             described = _description(mine[-1]) if mine else None
             previous_end = declaration.meta.end_pos
             if declaration.data == "header":
-                name, model_description = self._name(declaration.children[1]), described
+                name, model_description = self._name(children(declaration)[1]), described
             elif declaration.data == "import_":
                 self._import(declaration)
             else:
@@ -138,10 +143,12 @@ class _Checker(TermChecker):
 
     def _import(self, tree: Tree) -> None:
         """Merge another model's declarations into this one (names share one namespace)."""
-        target = tree.children[1]
+        target = children(tree)[1]
         relative = self._name(target)
         if not relative.endswith(".roqme"):
             relative += ".roqme"
+        if self.source.folder is None:
+            raise self.error(target, f"cannot import {relative}: this model was not read from a file")
         path = (self.source.folder / relative).resolve()
         if path in self.reading:
             raise self.error(target, f"import cycle: {relative} imports this model back")
@@ -179,7 +186,7 @@ class _Checker(TermChecker):
                     node, f"unknown type {node} (declare it with 'type {node} : enum {{…}}' before this {what})"
                 )
             return self.types[str(node)]
-        keyword, cardinality, *rest = node.children
+        keyword, cardinality, *rest = children(node)
         kind = node.data
         lower = upper = unit = None
         if kind == "enum_type":
@@ -188,13 +195,13 @@ class _Checker(TermChecker):
                 if str(literal) in literals:
                     raise self.error(literal, f"enum literal {literal} appears twice in {owner}")
                 literals.append(str(literal))
-            scalar = EnumType(owner, tuple(literals))
+            scalar: ValueType = EnumType(owner, tuple(literals))
         elif kind == "number_type":
             scalar = NUMBER
             for part in rest:
                 if isinstance(part, Tree):  # a bound
-                    word, signed = part.children
-                    value = float(signed.children[1]) * (-1 if signed.children[0] == "-" else 1)
+                    word, signed = children(part)
+                    value = float(children(signed)[1]) * (-1 if children(signed)[0] == "-" else 1)
                     lower, upper = (value, upper) if word == "lower" else (lower, value)
                 elif part is not None and part.type in ("NAME", "STRING"):
                     unit = self._name(part)
@@ -204,9 +211,9 @@ class _Checker(TermChecker):
             scalar, unit = NUMBER, "s"
         else:
             scalar = BOOLEAN if kind == "boolean_type" else EVENTTYPE
-        value_type = scalar
+        value_type: ValueType = scalar
         if cardinality is not None:
-            size = cardinality.children[0]
+            size = children(cardinality)[0]
             if "." in size or int(size) < 1:
                 raise self.error(size, f"an array holds a whole number ≥ 1 of values, not {size}")
             if scalar == EVENTTYPE:
@@ -215,7 +222,7 @@ class _Checker(TermChecker):
         return TypeSpec(value_type, lower, upper, unit)
 
     def type_decl(self, tree: Tree) -> None:
-        _, name_token, data_type = tree.children
+        _, name_token, data_type = children(tree)
         self._declare(name_token, "type")
         name = self._name(name_token)
         self.types[name] = self._type_spec(name, data_type, "type")
@@ -231,7 +238,7 @@ class _Checker(TermChecker):
             and value.type.element == spec.type.element
         ):
             raise self.error(node, f"{role} is {type_name(value.type)}, but {owner} is {type_name(spec.type)}")
-        if isinstance(spec.type, ArrayType) and len(value.value) > spec.type.size:
+        if isinstance(spec.type, ArrayType) and isinstance(value.value, tuple) and len(value.value) > spec.type.size:
             raise self.error(node, f"{role} has {len(value.value)} values; {owner} holds at most {spec.type.size}")
         for number in value.value if isinstance(value.value, tuple) else (value.value,):
             problem = spec.out_of_bounds(number) if isinstance(number, float) else None
@@ -242,7 +249,7 @@ class _Checker(TermChecker):
     # ---- contexts, variables, timers --------------------------------------------------------------
 
     def context_decl(self, tree: Tree) -> None:
-        _, name, type_node, _define, definition = tree.children
+        _, name, type_node, _define, definition = children(tree)
         self._declare(name, "context")
         spec = self._type_spec(str(name), type_node, "context")
         if definition is None:
@@ -251,7 +258,7 @@ class _Checker(TermChecker):
         self.defining = (str(name), spec.type)
         try:
             if spec.type == EVENTTYPE:
-                value = self.pattern(definition)
+                value: Expr | Pattern = self.pattern(definition)
             else:
                 if is_pattern(definition):
                     raise self.error(
@@ -272,7 +279,7 @@ class _Checker(TermChecker):
         self.streams.append((str(name), context))
 
     def var_decl(self, tree: Tree) -> None:
-        _, name, type_node, _define, definition = tree.children
+        _, name, type_node, _define, definition = children(tree)
         self._declare(name, "variable")
         spec = self._type_spec(str(name), type_node, "variable")
         self.defining = (str(name), spec.type)  # its own enum literals: var W : enum {C, D} := W::D
@@ -300,7 +307,7 @@ class _Checker(TermChecker):
         self.variables[str(name)] = variable
 
     def param_decl(self, tree: Tree) -> None:
-        _, name, type_node, _default, default = tree.children
+        _, name, type_node, _default, default = children(tree)
         self._declare(name, "parameter")
         spec = self._type_spec(str(name), type_node, "parameter")
         if spec.type == EVENTTYPE:
@@ -313,24 +320,24 @@ class _Checker(TermChecker):
         self.variables[str(name)] = Variable(str(name), spec.type, spec, initial, None, True, self.description)
 
     def timer_decl(self, tree: Tree) -> None:
-        _, name, *parts = tree.children
+        _, name, *parts = children(tree)
         self._declare(name, "timer")
         seen: set[str] = set()
         interval = schedule = None
         offset, onetime, paused = 0.0, False, False
         for part in parts:
-            keyword = part.children[0]
+            keyword = children(part)[0]
             if part.data in seen:
                 raise self.error(keyword, f"{keyword} is given twice for timer {name}")
             seen.add(part.data)
             if part.data == "offset":
-                offset = seconds_of(part.children[1])
+                offset = seconds_of(children(part)[1])
             elif part.data == "onetime":
                 onetime = True
             elif part.data == "paused":
                 paused = True
             else:
-                interval, schedule = self._timer_definition(name, part.children[1])
+                interval, schedule = self._timer_definition(name, children(part)[1])
         if "definition" not in seen:
             raise self.error(
                 name, f'timer {name} needs a definition: timer {name} := 1 minutes, or := schedule("0, 9, *, *, *")'
@@ -339,16 +346,16 @@ class _Checker(TermChecker):
 
     def _timer_definition(self, name: Token, node):
         if isinstance(node, Tree) and node.data == "time":
-            interval = seconds_of(node.children[0])
+            interval = seconds_of(children(node)[0])
             if interval <= 0:
                 raise self.error(node, f"the interval of timer {name} must be longer than 0")
             return interval, None
-        if isinstance(node, Tree) and node.data == "call" and str(node.children[0]) == "schedule":
-            args = [child for child in node.children[1:] if child is not None]
+        if isinstance(node, Tree) and node.data == "call" and str(children(node)[0]) == "schedule":
+            args = [child for child in children(node)[1:] if child is not None]
             if len(args) != 1 or not (isinstance(args[0], Tree) and args[0].data == "string"):
                 raise self.error(node, 'schedule takes one string: schedule("minutes, hours, days, months, weekdays")')
             try:
-                return None, parse_schedule(str(args[0].children[0])[1:-1])
+                return None, parse_schedule(str(children(args[0])[0])[1:-1])
             except ScheduleError as exc:
                 raise self.error(args[0], f"bad schedule: {exc}") from None
         raise self.error(node, f'timer {name} is defined by a time (1 minutes) or schedule("…")')
@@ -356,7 +363,7 @@ class _Checker(TermChecker):
     # ---- properties and belief variables ---------------------------------------------------------
 
     def property_decl(self, tree: Tree) -> None:
-        _, name, type_node, _define, transformation, *options = tree.children
+        _, name, type_node, _define, transformation, *options = children(tree)
         self._declare(name, "property")
         output = None
         if transformation is not None:
@@ -374,33 +381,33 @@ class _Checker(TermChecker):
         self.beliefs[str(name)] = self.properties[str(name)]
 
     def beliefvar_decl(self, tree: Tree) -> None:
-        _, name, *options = tree.children
+        _, name, *options = children(tree)
         self._declare(name, "belief variable")
         self.beliefvars[str(name)] = self.beliefs[str(name)] = self._belief(name, "belief variable", options, None)
 
     def _belief(self, name: Token, what: str, options: list, output) -> Property:
         reference, survival, seen = 0.5, None, set()
         for option in options:
-            keyword = option.children[0]
+            keyword = children(option)[0]
             if option.data in seen:
                 raise self.error(keyword, f"{keyword} is given twice for {what} {name}")
             seen.add(option.data)
             if option.data == "reference":
-                reference = float(option.children[1])
+                reference = float(children(option)[1])
                 if not 0.0 <= reference <= 1.0:
                     raise self.error(
-                        option.children[1], f"reference {option.children[1]} of {what} {name} is outside [0, 1]"
+                        children(option)[1], f"reference {children(option)[1]} of {what} {name} is outside [0, 1]"
                     )
             else:
-                survival = seconds_of(option.children[1])
+                survival = seconds_of(children(option)[1])
                 if survival <= 0:
-                    raise self.error(option.children[1], f"survival of {what} {name} must be positive")
+                    raise self.error(children(option)[1], f"survival of {what} {name} must be positive")
         return Property(str(name), reference, survival, output, self.description)
 
     # ---- observations ----------------------------------------------------------------------------
 
     def observation_decl(self, tree: Tree) -> None:
-        _, name, pattern_tree, *action_trees = tree.children
+        _, name, pattern_tree, *action_trees = children(tree)
         self._declare(name, "observation")
         description = self.description
         pattern = self.pattern(pattern_tree)
@@ -419,12 +426,12 @@ class _Checker(TermChecker):
         return str(target)
 
     def _evidence(self, name: Token, tree: Tree) -> Evidence:
-        verb, target, *options = tree.children
+        verb, target, *options = children(tree)
         level, survival, seen = "default", None, set()
         previous = target
         for option in options:
             if option.data == "strength":
-                word = option.children[0]
+                word = children(option)[0]
                 if str(word).lower().replace("_", "") not in INTENSITY_LR or str(word) == "default":
                     # a misspelt keyword on the next line lands here too, so say what it came after
                     raise self.error(
@@ -435,17 +442,17 @@ class _Checker(TermChecker):
                     option, f"observation {name} gives {option.data.replace('evidence_', '')} twice for {target}"
                 )
             seen.add(option.data)
-            previous = option.children[-1]
+            previous = children(option)[-1]
             if option.data == "strength":
-                level = str(option.children[0]).lower().replace("_", "")
+                level = str(children(option)[0]).lower().replace("_", "")
             else:
-                survival = seconds_of(option.children[1])
+                survival = seconds_of(children(option)[1])
                 if survival <= 0:
-                    raise self.error(option.children[1], "the survival of evidence must be positive")
+                    raise self.error(children(option)[1], "the survival of evidence must be positive")
         return Evidence(self._belief_target(name, verb, target), str(verb) == "reinforces", level, survival)
 
     def _sets(self, name: Token, tree: Tree) -> SetVariable:
-        _, target, _define, value_node = tree.children
+        _, target, _define, value_node = children(tree)
         variable = self.variables.get(str(target))
         if variable is None or variable.parameter:
             what = "a parameter, a constant" if variable is not None else self.declared.get(str(target), "undeclared")
@@ -456,11 +463,11 @@ class _Checker(TermChecker):
         return SetVariable(str(target), value)
 
     def _clears(self, name: Token, tree: Tree) -> ClearEvidence:
-        verb, target = tree.children
+        verb, target = children(tree)
         return ClearEvidence(self._belief_target(name, verb, target))
 
     def _timer_action(self, name: Token, tree: Tree) -> TimerAction:
-        verb, target = tree.children
+        verb, target = children(tree)
         if str(target) not in self.timers:
             raise self.error(target, f"observation {name} {verb} {target}, which is not a timer")
         return TimerAction(str(verb), str(target))

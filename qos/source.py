@@ -7,11 +7,13 @@ of a huge or unreadable file is one clear error, never a hang.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import cast
 
 from lark import Token, Tree
 
 from fileio.bounded import BadFile, read_text
 from qos.errors import ModelError
+from qos.grammar import children
 
 
 class Source:
@@ -27,8 +29,8 @@ class Source:
         return ModelError(f"{self.filename}:{line}:{column}: {message}")
 
     def at(self, node, message: str) -> ModelError:
-        if isinstance(node, Token):
-            return self.error(node.line, node.column, message)
+        if isinstance(node, Token):  # lark's tokens from the lexer all have a position
+            return self.error(cast(int, node.line), cast(int, node.column), message)
         return self.error(node.meta.line, node.meta.column, message)
 
 
@@ -48,13 +50,13 @@ MAX_NESTING = 200
 
 def check_nesting(source: Source, tree: Tree) -> None:
     """Refuse a term nested deeper than MAX_NESTING, naming its declaration (checked without recursion)."""
-    stack = [(declaration, 1, declaration) for declaration in tree.children]
+    stack = [(declaration, 1, declaration) for declaration in children(tree)]
     while stack:
         node, depth, declaration = stack.pop()
         if depth > MAX_NESTING:
             raise source.at(
                 declaration,
-                f"{declaration.children[1]} nests operators more than {MAX_NESTING} levels "
+                f"{children(declaration)[1]} nests operators more than {MAX_NESTING} levels "
                 "deep: split it with derived contexts",
             )
-        stack.extend((child, depth + 1, declaration) for child in node.children if isinstance(child, Tree))
+        stack.extend((child, depth + 1, declaration) for child in children(node) if isinstance(child, Tree))
