@@ -11,11 +11,14 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 from kiosk.core.channels import Channel, ChannelInput
-from kiosk.speech.audio import Utterance
 from kiosk.speech.matching import Match, Matcher, OptionWords, undo_commands, welcome_commands
+
+if TYPE_CHECKING:  # the audio pipeline (numpy) loads on the channel's own threads
+    from kiosk.speech.asr import Recognition
+    from kiosk.speech.audio import Utterance
 
 #: the voice channel's own log: what was heard and why it was not taken
 log = logging.getLogger("kiosk.speech.voice")
@@ -128,7 +131,7 @@ class Listening:
 
     def hear(self, utterance: Utterance) -> ChannelInput | str:
         """What the utterance means on this prompt: the input for the session, or why it is none."""
-        result = utterance.result
+        result = cast("Recognition", utterance.result)
         if self.matcher is None:  # the grammar was taken away while this was being heard
             return "heard after the grammar was taken away"
         match = self.matcher.match(result.text, result.confidence)
@@ -161,7 +164,8 @@ class Listening:
         above = utterance.above_room_db
         if above is None or above >= self.reply_min_above_room_db:
             return False
-        log.info("voice: %r spoken %.1f dB above the room, too little to take as said", utterance.result.text, above)
+        heard = cast("Recognition", utterance.result).text
+        log.info("voice: %r spoken %.1f dB above the room, too little to take as said", heard, above)
         return True
 
     def _heard_twice(self, result: Any) -> Match | None:
@@ -169,6 +173,7 @@ class Listening:
         same scored question, both at least :data:`AGREE_MIN_CONFIDENCE` sure: its match."""
         if not self.scored or self.paused:
             return None
+        assert self.matcher is not None  # called from hear(), which has one
         match = self.matcher.match(result.text)
         unsure = match.option if result.confidence >= AGREE_MIN_CONFIDENCE else None
         agreed = unsure is not None and unsure == self._unsure

@@ -37,14 +37,14 @@ import threading
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
 from kiosk.speech.listening import Listening
 from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, OptionWords
 
 if TYPE_CHECKING:  # the recognisers and the audio pipeline (numpy) load on the channel's own threads
-    from kiosk.speech.asr import Recogniser
+    from kiosk.speech.asr import Recogniser, Recognition
     from kiosk.speech.audio import Endpointer, PcmConsumer, Utterance, UtterancePipeline
 
 log = logging.getLogger(__name__)
@@ -111,7 +111,7 @@ class VoiceChannel:
         self._sink: Sink | None = None
         self._recogniser: Recogniser | None = None
         self._pipeline: UtterancePipeline | None = None
-        self._microphone = None
+        self._microphone: Any = None  # a kiosk.speech.audio.MicrophoneStream, or what the factory made
         self._listening = self._speaking = False
         #: notified when the loader thread ends (see wait_loaded)
         self._loaded = threading.Condition(self._lock)
@@ -348,6 +348,7 @@ class VoiceChannel:
         if phrases is None:
             return
         matcher = self._heard.matcher
+        assert matcher is not None  # phrases come from a matcher
         self._recogniser.set_grammar(
             phrases, matcher.meaning, matcher.lead_ins(), matcher.fillers(), taken_as_heard=self._heard.taken_as_heard
         )
@@ -365,7 +366,7 @@ class VoiceChannel:
         heard = self._heard.hear(utterance)
         if isinstance(heard, str):
             log.info("voice: %s", heard)
-            self.on_unmatched(utterance.result.text, heard)
+            self.on_unmatched(cast("Recognition", utterance.result).text, heard)
         elif self._sink is not None:
             self._sink(heard)
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 from fileio.bounded import BadFile
@@ -17,6 +18,7 @@ from kiosk.core.clock import SimClock
 from kiosk.core.qos_model import DEFAULT_MODEL
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.session import (
+    AdaptationChanged,
     AnswerRecorded,
     AttemptOpened,
     AttemptTimedOut,
@@ -74,7 +76,7 @@ class ReplayResult:
             "adaptations": [
                 {"t": _num(e.t), "name": e.name, "active": e.active, "reason": e.reason}
                 for e in self.events
-                if type(e).__name__ == "AdaptationChanged"
+                if isinstance(e, AdaptationChanged)
             ],
             "qos": self.qos,
             "simulated_s": _num(self.simulated_s),
@@ -118,7 +120,7 @@ class _Driver:
         elif isinstance(event, AttemptOpened) and event.practice:
             if self.script.practice is not None and event.attempt == 1 and event.number <= len(self.script.practice):
                 step = self.script.practice[event.number - 1]
-                self.arm(now + step.after, lambda s=step: self._give_answer(s, None))
+                self.arm(now + step.after, partial(self._give_answer, step, None))
         elif isinstance(event, AttemptOpened):
             index = event.number - 1
             self.opened[(index, event.attempt)] = now
@@ -308,18 +310,18 @@ def run_script(
     from qos import Engine, Trace, replay
 
     questionnaire = questionnaire or load_questionnaire()
-    reference, model = model, load_kiosk_model(model)
+    reference, loaded = model, load_kiosk_model(model)
     clock = SimClock()
     session = Session(
         questionnaire,
         clock=clock,
-        engine=Engine(model),
+        engine=Engine(loaded),
         store=store,
         patient_id=script.patient,
         language=script.language,
         answered_by=script.answered_by,
         timing=script.timing,
-        adaptation=Adaptation(policy or load_policy(model=model)) if script.adaptation else None,
+        adaptation=Adaptation(policy or load_policy(model=loaded)) if script.adaptation else None,
         familiarisation=script.practice is not None,
         visit=visit,
     )
@@ -327,7 +329,7 @@ def run_script(
     try:
         driver.run()
         trace = Trace.from_events(reference, session.trace)
-        summary = replay(trace, model=model)
+        summary = replay(trace, model=loaded)
     except KeyboardInterrupt:
         if store is not None:
             # Ctrl-C mid-script: the half-replayed patient is closed, never left for anyone to resume

@@ -11,7 +11,10 @@ class QosEngine(Protocol):
     """What the session needs of ``qos.Engine``."""
 
     model: Any
-    t: float | None
+
+    @property
+    def t(self) -> float | None:
+        """The engine's time: the last batch's or advance's (None before the first)."""
 
     def update(self, t: float, set: Mapping[str, Any] | None = None, emit: list[str] | None = None) -> Any:
         """Apply one batch of context changes at ``t``; the result has ``.metrics`` and ``.fired``."""

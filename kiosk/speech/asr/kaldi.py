@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Hashable, Sequence
 from pathlib import Path
+from typing import Any
 
 from kiosk.speech.asr.base import AsrUnavailable, Recognition
 from kiosk.speech.audio import SAMPLE_RATE
@@ -36,7 +37,7 @@ class VoskRecogniser:
         self._vosk = vosk
         self.language = language
         self.model_path = path
-        self._recogniser = None
+        self._recogniser: Any = None  # a vosk.KaldiRecognizer once a grammar is set
         self._grammar: Grammar | None = None
         #: Vosk's JSON results for the segments of the current utterance
         self._segments: list[str] = []

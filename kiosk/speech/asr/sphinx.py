@@ -216,6 +216,7 @@ class PocketSphinxRecogniser:
         self._end()
         self._settled = True
         result, core = self._score(gated, cleaned)
+        assert self._grammar is not None  # an utterance is only scored under a grammar
         answers = self._grammar.answers
         if self._taken_as_heard and gated is not pcm and result.confidence > 0 and core in answers:
             # acted on without asking back: heard with the talk turned down and as it came in,
@@ -256,6 +257,7 @@ class PocketSphinxRecogniser:
         if hyp is None or not hyp.hypstr:
             return Recognition("", 0.0), ""
         words = [seg for seg in self._decoder.seg() if seg.word not in _FILLERS]
+        assert self._grammar is not None  # an utterance is only scored under a grammar
         core = self._grammar.core(hyp.hypstr)
         if not words or core not in self._grammar.phrases or not voiced.any():
             return Recognition(hyp.hypstr, 0.0), core  # stopped inside a phrase: not something said

@@ -10,6 +10,7 @@ import queue
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from kiosk.speech.audio.pcm import FRAME_SAMPLES, SAMPLE_RATE, PcmConsumer
 
@@ -101,7 +102,7 @@ class MicrophoneStream:
         self.pipeline = pipeline
         self.device = device
         self._queue: queue.Queue[bytes | None] = queue.Queue()
-        self._stream = None
+        self._stream: Any = None  # a sounddevice.RawInputStream once started
         self._worker: threading.Thread | None = None
 
     def start(self) -> None:

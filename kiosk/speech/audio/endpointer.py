@@ -87,7 +87,8 @@ class Endpointer:
         self._levels: deque[float] = deque(maxlen=max(1, round(self.settings.floor_window_s * 1000 / frame_ms)))
         self.noise_db = -90.0
         #: the levels of the frames heard outside utterances, for the ceiling
-        self._room: deque[float] = deque(maxlen=self._levels.maxlen)
+        self._window = max(1, round(self.settings.floor_window_s * 1000 / frame_ms))
+        self._room: deque[float] = deque(maxlen=self._window)
         self.ceiling_db = -90.0
         self.reset()
 
@@ -119,13 +120,13 @@ class Endpointer:
             # too little heard to know the room: a quiet one, so an answer spoken as the
             # microphone opens is heard from its first sound
             self.noise_db = -90.0
-        elif len(self._levels) < self._levels.maxlen:
+        elif len(self._levels) < self._window:
             # until a whole window is heard, the quietest frame so far: a fan running as the
             # microphone opens is learned within a third of a second
             self.noise_db = min(self._levels)
         else:
             self.noise_db = float(np.percentile(self._levels, self.settings.floor_percentile))
-        if not self.in_speech or (len(self._room) < self._room.maxlen and self._speech_frames >= self._room.maxlen):
+        if not self.in_speech or (len(self._room) < self._window and self._speech_frames >= self._window):
             # until a whole window of the room is known, an utterance longer than the window
             # counts too: a microphone opened in a noisy room starts an "utterance" on its first
             # frames, and an answer given as it opens is shorter than that
