@@ -121,12 +121,14 @@ def make_kiosk(
     patient_ids: Callable[[], str] = new_patient_id,
     poll_interval: float = POLL_INTERVAL,
     visits: bool = True,
+    clinician_pin: str | PinGuard | None = None,
 ) -> KioskApp:
     """The kiosk ``config`` describes, on ``clock`` and ``store``, with ``channels`` (default:
     touch only). ``parts`` are loaded from ``config`` when not given (see :meth:`KioskParts.load`
     for the errors). ``first`` are :meth:`SessionMaker.fresh`'s arguments for the first session
     (``patient``: `kiosk run --patient`). ``visits=False`` leaves out the visits desk (every
-    welcome a walk-up; staff cannot start a visit by identifier). With ``config.station`` the
+    welcome a walk-up; staff cannot start a visit by identifier). ``clinician_pin`` replaces the
+    configured PIN guard (a plain PIN: counted in memory, not in the data directory). With ``config.station`` the
     station's client and order watcher are wired, not started (the app starts them on mount)."""
     parts = parts or KioskParts.load(config)
     maker = SessionMaker(config, parts, clock=clock, store=store, patient_ids=patient_ids)
@@ -144,7 +146,7 @@ def make_kiosk(
     app = KioskApp(
         controller,
         channels,
-        clinician_pin=PinGuard(config.pin_secret, config.data_dir),
+        clinician_pin=clinician_pin or PinGuard(config.pin_secret, config.data_dir),
         export_dir=config.data_dir / "exports",
         export_site=site_from_config(config),
         poll_interval=poll_interval,
