@@ -24,6 +24,7 @@ PURE_KIOSK_MODULES = [
     "kiosk.export",
     "kiosk.commands.results",
     "kiosk.commands.validate",
+    "kiosk.ui.controller",
     "fileio.positions",
 ]
 

@@ -29,7 +29,7 @@ from textual.message import Message
 
 from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command
 from kiosk.core.pin import CornerTaps, PinGuard
-from kiosk.core.session import Phase, Prompt, Session, SessionEvent
+from kiosk.core.session import Session, SessionEvent
 from kiosk.export import ExportSite
 from kiosk.store.lease import LEASE_TTL_S
 from kiosk.ui.channels import KioskChannels
@@ -38,14 +38,10 @@ from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView
 from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
 from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 from kiosk.ui.screens.explanation import ExplanationScreen
-from kiosk.ui.screens.familiarisation import FamiliarisationScreen
-from kiosk.ui.screens.out_of_order import OutOfOrderScreen
-from kiosk.ui.screens.paused import PausedScreen
 from kiosk.ui.screens.pin import PinScreen
-from kiosk.ui.screens.question import QuestionScreen
-from kiosk.ui.screens.summary import SummaryScreen
 from kiosk.ui.screens.visit_ready import VisitReadyScreen
 from kiosk.ui.screens.welcome import WelcomeScreen
+from kiosk.ui.stage import PatientStage
 from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.ui.widgets.change_answer import ChangeAnswerButton
@@ -63,14 +59,6 @@ POLL_INTERVAL = 0.1
 PIN_IDLE_S = 60.0
 #: the same for the clinician screens behind the PIN (staff walked away: the patient's screen returns)
 CLINICIAN_IDLE_S = 300.0
-#: the screen of each phase of a session
-_PHASE_SCREENS: dict[Phase, type[PatientScreen]] = {
-    Phase.WELCOME: WelcomeScreen,
-    Phase.FAMILIARISATION: FamiliarisationScreen,
-    Phase.EXPLANATION: ExplanationScreen,
-    Phase.QUESTIONS: QuestionScreen,
-    Phase.SUMMARY: SummaryScreen,
-}
 
 
 @dataclass
@@ -137,11 +125,11 @@ class KioskApp(App[int], inherit_bindings=False):
         self.show_score = show_score
         if (speaker := channels.speaker) is not None:  # its worker thread reports through these
             speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
-        self._screen_key: tuple[type, object] | None = None
+        self.stage = PatientStage(self)
         #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
         self._staff_seen = 0.0
         controller.attach(self)
-        self.session_swapped()
+        self.tell_channels()
 
     @property
     def session(self) -> Session:
@@ -163,12 +151,12 @@ class KioskApp(App[int], inherit_bindings=False):
         if self.controller.store is not None:
             self.set_interval(LEASE_TTL_S / 3, self.controller.keep_session)
         self.controller.greet()
-        self.controller.start()
+        self.controller.start_station()
         self._render()
 
     def on_unmount(self) -> None:
         """Stop every channel (each stop is safe to call twice) and the station's client."""
-        self.controller.stop()
+        self.controller.stop_station()
         self.channels.close()
 
     # -- from other threads -----------------------------------------------------------------------
@@ -197,7 +185,7 @@ class KioskApp(App[int], inherit_bindings=False):
         if isinstance(message.item, ChannelStatus):
             self.board.update(message.item)
             if self.channels.about_voice(message.item):
-                self.controller.drive(self.session_swapped)
+                self.controller.drive(self.tell_channels)
             self._render()
         else:
             self.controller.forward(message.item)
@@ -285,14 +273,14 @@ class KioskApp(App[int], inherit_bindings=False):
     def redraw(self, *, rebuild: bool = False) -> None:
         """Show the screens the session calls for (``rebuild``: even if they look the same)."""
         if rebuild:
-            self._screen_key = None
+            self.stage.forget()
         self._render()
 
     def session_event(self, event: SessionEvent) -> None:
         """Carry out what an event asks of the channels; the redraw follows the operation."""
-        self.channels.follow(event, self._view().ways if isinstance(event, Prompt) else None)
+        self.channels.follow(event, lambda: self._view().ways)
 
-    def session_swapped(self) -> None:
+    def tell_channels(self) -> None:
         """Tell the session whether voice in and voice out are on (it decides what that means for
         adaptation and for the practice questions)."""
         self.session.set_voice_available(self.channels.on(VOICE_IN))
@@ -335,39 +323,10 @@ class KioskApp(App[int], inherit_bindings=False):
         )
 
     def _render(self) -> None:
-        """Show the screens the session's state calls for, or refresh the ones shown.
-
-        The phase's screen stays mounted under a paused or doctor-called screen, so resuming
-        only uncovers it; it is rebuilt only when its :meth:`PatientScreen.key` changes.
-        """
-        if not self.is_running or self.clinician_open:
-            return
-        view = self._view()
-        snap, visits = view.snapshot, self.controller.visits
-        base_cls = _PHASE_SCREENS[snap.phase]
-        overlay_cls = DoctorCalledScreen if snap.halted else PausedScreen if snap.paused else None
-        if self.controller.out_of_order is not None:
-            base_cls, overlay_cls = OutOfOrderScreen, None
-        shown = [s for s in self.screen_stack if isinstance(s, PatientScreen)]
-        base, overlay = (shown + [None, None])[:2]
-        key = (base_cls, base_cls.key(view))
-        if base_cls is WelcomeScreen and self.controller.welcome_held():  # kiosk.core.visits: staff confirm first
-            base_cls, key = VisitReadyScreen, (VisitReadyScreen, visits.ready)
-        if overlay is not None and (type(overlay) is not overlay_cls or key != self._screen_key):
-            self.pop_screen()
-            overlay = None
-        if base is None or key != self._screen_key:
-            screen = (
-                VisitReadyScreen(view, visits.ready, visits.walk_up) if base_cls is VisitReadyScreen else base_cls(view)
-            )
-            (self.push_screen if base is None else self.switch_screen)(screen)
-        else:
-            base.show(view)
-        self._screen_key = key
-        if overlay is not None:
-            overlay.show(view)
-        elif overlay_cls is not None:
-            self.push_screen(overlay_cls(view))
+        """Show the screens the session's state calls for (none over the clinician's)."""
+        if self.is_running and not self.clinician_open:
+            held = self.controller.visits if self.controller.welcome_held() else None
+            self.stage.show(self._view(), out_of_order=self.controller.out_of_order is not None, held_visits=held)
 
     # -- the clinician side -------------------------------------------------------------------
 
@@ -424,5 +383,5 @@ class KioskApp(App[int], inherit_bindings=False):
         while self.clinician_open:
             self.pop_screen()
         self.controller.release()
-        self._screen_key = None
+        self.stage.forget()
         self.call_after_refresh(self._render)

@@ -7,7 +7,7 @@ threads, hands their deliveries over to the UI thread and calls these methods th
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
@@ -102,8 +102,8 @@ class KioskChannels:
             )
         return item
 
-    def follow(self, event: SessionEvent, ways: Ways | None = None) -> None:
-        """Carry out what a session event asks of the channels; ``ways`` are said with a prompt."""
+    def follow(self, event: SessionEvent, ways: Callable[[], Ways]) -> None:
+        """Carry out what a session event asks of the channels; ``ways()`` are said with a prompt."""
         if self.voice is not None:  # its grammar follows the prompts, its gate the listening state
             self.voice.on_session_event(event)
         if isinstance(event, Prompt):
@@ -120,7 +120,7 @@ class KioskChannels:
         elif isinstance(event, VolumeChanged) and self.speaker is not None:
             (self.speaker.volume_up if event.step > 0 else self.speaker.volume_down)()
 
-    def _speak(self, prompt: Prompt, ways: Ways | None) -> None:
+    def _speak(self, prompt: Prompt, ways: Callable[[], Ways]) -> None:
         if self.speaker is None or not prompt.spoken:
             return
         from kiosk.speech.tts import DEFAULT_RATE
@@ -129,8 +129,7 @@ class KioskChannels:
             self.speaker.stop_speaking()
             self._repeat = "queued"
         self.speaker.rate = round(DEFAULT_RATE * prompt.speech_rate)
-        spoken = spoken_with_ways(prompt.spoken, prompt.language, ways) if ways is not None else prompt.spoken
-        self.speaker.say(spoken, prompt.language)
+        self.speaker.say(spoken_with_ways(prompt.spoken, prompt.language, ways()), prompt.language)
 
     def speaking(self, speaking: bool) -> bool:
         """Voice out started or stopped talking; True once a repeated prompt has been said (the

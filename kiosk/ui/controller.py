@@ -45,8 +45,8 @@ class Screens(Protocol):
     def session_event(self, event: SessionEvent) -> None:
         """The channels follow a session event (speak a prompt, listen, stop talking)."""
 
-    def session_swapped(self) -> None:
-        """A new session runs: tell it which channels are on."""
+    def tell_channels(self) -> None:
+        """Tell the session which channels are on (a new one runs, or voice came or went)."""
 
     def stopped(self, reason: str) -> None:
         """Tell whoever is in front of the kiosk that the test stopped (naming no one)."""
@@ -109,13 +109,13 @@ class KioskController:
 
     # -- the station's threads (started and stopped with the app) ---------------------------------
 
-    def start(self) -> None:
+    def start_station(self) -> None:
         """Start the station's client and order watcher (each runs its own thread)."""
         for part in (self.sync, self.orders):
             if part is not None:
                 part.start()
 
-    def stop(self) -> None:
+    def stop_station(self) -> None:
         """Stop them (safe to call twice)."""
         for part in (self.sync, self.orders):
             if part is not None:
@@ -184,7 +184,7 @@ class KioskController:
             with contextlib.suppress(sqlite3.Error):  # else keep_session lets it go later
                 self.store.release(old.id)
         self._unsubscribe = session.subscribe(self._on_event)
-        self._screens().session_swapped()
+        self._screens().tell_channels()
         if self.visits is not None:
             self.visits.next_visit()
 

@@ -43,7 +43,7 @@ class Drawn:
     def session_event(self, event: SessionEvent) -> None:
         self.events.append(event)
 
-    def session_swapped(self) -> None:
+    def tell_channels(self) -> None:
         self.swaps += 1
 
     def stopped(self, reason: str) -> None:
