@@ -1,16 +1,10 @@
 """The kiosk's Textual app: mounts the screens, routes input to the controller, draws the session.
 
-Nothing is decided here. Every input -- a touch, a key, a remote press or a voice answer -- goes
-to the :class:`~kiosk.ui.controller.KioskController` (and on to the session) as a
-:class:`~kiosk.core.channels.ChannelInput`; the controller swaps, holds and ends sessions and asks
-the app to redraw. A timer polls the session so its own time-outs happen (the session reads time
-from its injected clock; tests use a :class:`~kiosk.core.clock.SimClock`). The app makes the
-channels follow the session's events (speak prompts, listen) and shows the screen the session's
-:meth:`~kiosk.core.session.Session.snapshot` calls for.
-
-Channels run on their own threads and only ever call :meth:`KioskApp.channel_sink`, which posts a
-small message to the UI thread; no thread touches a widget. A channel that is missing (no
-microphone, no espeak-ng, no remote) is shown as off with its reason and the session goes on.
+Nothing is decided here. Every input (a touch, a key, a remote press, a voice answer) goes to the
+:class:`~kiosk.ui.controller.KioskController` as a :class:`~kiosk.core.channels.ChannelInput`;
+the controller swaps, holds and ends sessions and asks for a redraw. A timer polls the session
+so its time-outs happen on its injected clock. Channels run on their own threads and only call
+:meth:`KioskApp.channel_sink`, which posts a message to the UI thread: no thread touches a widget.
 Build the app with :func:`kiosk.ui.compose.make_kiosk`; `kiosk run` is :mod:`kiosk.commands.run`.
 """
 
@@ -41,7 +35,7 @@ from kiosk.ui.screens.explanation import ExplanationScreen
 from kiosk.ui.screens.pin import PinScreen
 from kiosk.ui.screens.visit_ready import VisitReadyScreen
 from kiosk.ui.screens.welcome import WelcomeScreen
-from kiosk.ui.stage import PatientStage
+from kiosk.ui.stage import PatientStage, patient_view
 from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.ui.widgets.change_answer import ChangeAnswerButton
@@ -124,7 +118,7 @@ class KioskApp(App[int], inherit_bindings=False):
         #: the end screen shows the patient their total and band (config show_score_to_patient)
         self.show_score = show_score
         if (speaker := channels.speaker) is not None:  # its worker thread reports through these
-            speaker.on_status, speaker.on_speech = self.speaker_status, self.speaker_activity
+            speaker.on_status, speaker.on_speech = self.channel_sink, self.speaker_activity
         self.stage = PatientStage(self)
         #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
         self._staff_seen = 0.0
@@ -162,12 +156,9 @@ class KioskApp(App[int], inherit_bindings=False):
     # -- from other threads -----------------------------------------------------------------------
 
     def channel_sink(self, item: ChannelInput | ChannelStatus) -> None:
-        """The sink every channel delivers to, from its own thread: posts to the UI thread."""
+        """The sink every channel (and the speaker's status) delivers to, from its own thread:
+        posts to the UI thread."""
         self.post_message(ChannelReceived(item))
-
-    def speaker_status(self, status: ChannelStatus) -> None:
-        """The speaker's status callback (worker thread)."""
-        self.post_message(ChannelReceived(status))
 
     def speaker_activity(self, speaking: bool) -> None:
         """The speaker's speech start/end callback (worker thread). The recogniser is muted right
@@ -295,32 +286,13 @@ class KioskApp(App[int], inherit_bindings=False):
             timeout=60,
         )
 
-    def leave_staff(self) -> None:
-        self.close_clinician()
-
     def later(self, callback: Callable[[], None]) -> None:
         self.call_later(callback)
 
     # -- drawing -------------------------------------------------------------------------------
 
     def _view(self) -> PatientView:
-        snap = self.session.snapshot()
-        # the session lifts voice_off when voice in goes; checked here too so the button never
-        # promises listening that cannot happen (and not over Continue while paused)
-        voice_again = (
-            "voice_off" in snap.adaptations and not (snap.paused or snap.halted) and self.channels.on(VOICE_IN)
-        )
-        question = snap.item or snap.practice
-        hint = len(question.options) if self.channels.no_such_option and question is not None else None
-        return PatientView(
-            snap,
-            self.questionnaire,
-            self.channels.ways(snap),
-            voice_again=voice_again,
-            hint_options=hint,
-            now=self.session.now(),
-            show_score=self.show_score,
-        )
+        return patient_view(self.session, self.channels, self.questionnaire, show_score=self.show_score)
 
     def _render(self) -> None:
         """Show the screens the session's state calls for (none over the clinician's)."""

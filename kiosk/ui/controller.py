@@ -51,7 +51,7 @@ class Screens(Protocol):
     def stopped(self, reason: str) -> None:
         """Tell whoever is in front of the kiosk that the test stopped (naming no one)."""
 
-    def leave_staff(self) -> None:
+    def close_clinician(self) -> None:
         """Close the clinician screens and show the patient's."""
 
     def later(self, callback: Callable[[], None]) -> None:
@@ -220,7 +220,7 @@ class KioskController:
         if self.fresh is None:
             return
         self.start_over(abandon=True)
-        self._screens().leave_staff()
+        self._screens().close_clinician()
 
     def end_session(self, reason: str) -> None:
         """Staff end the running test (stored as abandoned, with why); the welcome is next."""
@@ -308,7 +308,7 @@ class KioskController:
 
     def _begin(self, session: Session, *start: object) -> None:
         self.swap(session)
-        self._screens().leave_staff()
+        self._screens().close_clinician()
         self.drive(self.session.start, *start)
 
     def welcome_held(self) -> bool:

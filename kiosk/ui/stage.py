@@ -1,5 +1,5 @@
 """The patient's screens on the app's stack: the screen of the session's phase, and the paused or
-doctor-called screen covering it.
+doctor-called screen covering it; and :func:`patient_view`, what they show.
 
 The phase's screen stays mounted under a covering screen, so resuming only uncovers it; it is
 rebuilt only when its :meth:`PatientScreen.key` changes (a rebuild loses focus and scrolling).
@@ -11,7 +11,9 @@ from typing import Any
 
 from textual.app import App
 
-from kiosk.core.session import Phase
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.session import Phase, Session
+from kiosk.ui.channels import KioskChannels
 from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 from kiosk.ui.screens.explanation import ExplanationScreen
@@ -22,6 +24,7 @@ from kiosk.ui.screens.question import QuestionScreen
 from kiosk.ui.screens.summary import SummaryScreen
 from kiosk.ui.screens.visit_ready import VisitReadyScreen
 from kiosk.ui.screens.welcome import WelcomeScreen
+from kiosk.ui.widgets.channel_board import VOICE_IN
 
 #: the screen of each phase of a session
 PHASE_SCREENS: dict[Phase, type[PatientScreen]] = {
@@ -75,3 +78,24 @@ class PatientStage:
             overlay.show(view)
         elif overlay_cls is not None:
             app.push_screen(overlay_cls(view))
+
+
+def patient_view(
+    session: Session, channels: KioskChannels, questionnaire: Questionnaire, *, show_score: bool = False
+) -> PatientView:
+    """What the patient's screens show now: the session's snapshot and the ways to answer."""
+    snap = session.snapshot()
+    # the session lifts voice_off when voice in goes; checked here too so the button never
+    # promises listening that cannot happen (and not over Continue while paused)
+    voice_again = "voice_off" in snap.adaptations and not (snap.paused or snap.halted) and channels.on(VOICE_IN)
+    question = snap.item or snap.practice
+    hint = len(question.options) if channels.no_such_option and question is not None else None
+    return PatientView(
+        snap,
+        questionnaire,
+        channels.ways(snap),
+        voice_again=voice_again,
+        hint_options=hint,
+        now=session.now(),
+        show_score=show_score,
+    )

@@ -49,7 +49,7 @@ class Drawn:
     def stopped(self, reason: str) -> None:
         self.notices.append(reason)
 
-    def leave_staff(self) -> None:
+    def close_clinician(self) -> None:
         self.staff_left += 1
 
     def later(self, callback: Callable[[], None]) -> None:
