@@ -64,8 +64,6 @@ def build_app(
             export=export_identity(site_from_config(config)),
             in_force=lambda: in_force_of(config),
         )
-        # what a kiosk that stopped left running is interrupted now: for staff, never a patient
-        store.interrupt_stale()
     except QuestionnaireError as error:
         problems = getattr(error, "problems", None)
         raise SetupError("\n".join(str(p) for p in problems) if problems else str(error)) from None
@@ -83,6 +81,9 @@ def build_app(
     app = make_kiosk(
         config, clock=SystemClock(), store=store, channels=channels, parts=parts, first={"patient": patient_id}
     )
+    # what a kiosk that stopped left running is interrupted now (after the station's client is
+    # wired, so it hears of them): for staff, never a patient
+    store.interrupt_stale()
     return app, store.close
 
 

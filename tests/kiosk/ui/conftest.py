@@ -4,8 +4,9 @@ deliver remote and voice inputs through the app's sink from a real thread, as th
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -109,13 +110,13 @@ class UiKiosk:
 
 
 @pytest.fixture
-def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
+def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
     voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model)."""
     made: list[UiKiosk] = []
 
-    def make(**options: object) -> UiKiosk:
-        kiosk = UiKiosk(tmp_path, **options)  # type: ignore[arg-type]
+    def make(**options: Any) -> UiKiosk:
+        kiosk = UiKiosk(tmp_path, **options)
         made.append(kiosk)
         return kiosk
 

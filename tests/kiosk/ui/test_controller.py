@@ -10,6 +10,7 @@ import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -64,14 +65,15 @@ class Drawn:
 class Kiosk:
     """A controller on a store in ``data_dir``, with a simulated clock, as make_kiosk wires it."""
 
-    def __init__(self, data_dir: Path, *, store: dict | None = None, **config: object) -> None:
-        """``store`` are Store.open's options (``owner``, ``wall``, ``lease_ttl_s``)."""
+    def __init__(self, data_dir: Path, *, store: dict[str, Any] | None = None, **config: Any) -> None:
+        """``store`` are Store.open's options (``owner``, ``wall``, ``lease_ttl_s``); ``config``
+        overrides the configuration (``next_patient_after_s``)."""
         self.clock = SimClock()
         self.config = Config(
             data_dir=data_dir,
             familiarisation=False,
             timing={"attempt_window_s": ATTEMPT_S},
-            **config,  # type: ignore[arg-type]  # test options: next_patient_after_s
+            **config,
         )
         self.store = Store.open(data_dir, **(store or {}))
         numbers = iter(range(1, 1000))
@@ -109,6 +111,7 @@ class Kiosk:
     def answer(self, option: int = 1) -> None:
         session = self.controller.session
         item = session.current_item
+        assert item is not None, "no question is open"
         self.controller.forward(ChannelInput(Channel.KEYBOARD, option=option, detail=f"key {option}"))
         assert item.id in session.answers
 
