@@ -38,8 +38,9 @@ async def test_pause_freezes_the_attempt_and_continue_comes_back_to_the_question
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         assert kiosk.session.answers["feeding"].attempt == 1
         log = [e.kind for e in kiosk.store.session(kiosk.session.id).log]
-        # the "2" while paused is logged (and, at the start, that this kiosk has no voice out)
-        assert log[:5] == ["start", "voice_out", "pause", "input_ignored", "resume"]
+        # the "2" while paused is logged (and, at the start, how the visit began, a walk-up, and
+        # that this kiosk has no voice out)
+        assert log[:6] == ["start", "visit", "voice_out", "pause", "input_ignored", "resume"]
 
 
 async def test_call_doctor_halts_until_a_clinician_continues_behind_the_pin(ui_kiosk):
