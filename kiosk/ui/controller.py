@@ -18,12 +18,13 @@ from __future__ import annotations
 import contextlib
 import os
 import sqlite3
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
 from kiosk.core.channels import ChannelInput
 from kiosk.core.session import NextPatient, Phase, Session, SessionEvent
+from kiosk.core.visits import Order, VisitDesk
 from kiosk.store.database import Store, StoredSession
 from kiosk.store.lease import SessionTaken
 
@@ -75,7 +76,7 @@ class KioskController:
         store: Store | None = None,
         fresh: Callable[[], Session] | None = None,
         resume: Callable[[StoredSession], Session] | None = None,
-        visits: Any = None,
+        visits: VisitDesk | None = None,
         sync: Any = None,
         orders: Any = None,
         start_order: Callable[[str], Any] | None = None,
@@ -315,20 +316,20 @@ class KioskController:
         """The welcome waits for staff to confirm an ordered visit (or the site allows no walk-up)."""
         return self.visits is not None and self.visits.holds_welcome()
 
-    def orders_changed(self, orders: Any, problems: Iterable[str] = ()) -> None:
+    def orders_changed(self, orders: Sequence[Order], problems: Sequence[str] = ()) -> None:
         """The station's list of visits for this kiosk: the welcome follows it."""
         if self.visits is not None and self.visits.set_orders(orders, problems) and self.session.phase is Phase.WELCOME:
             self._screens().redraw()
 
-    def order_started(self, order: Any) -> None:
+    def order_started(self, order: Order) -> None:
         """The station started the visit: a session for its patient, in its language, begins."""
-        if self.session.phase is Phase.WELCOME:
+        if self.visits is not None and self.session.phase is Phase.WELCOME:
             self.swap(self.visits.for_order(order))
             self.drive(self.session.start, order.answered_by)
 
     def walk_up(self) -> None:
         """Staff let a walk-up patient start at the welcome."""
-        if self.visits.choose_walk_up():
+        if self.visits is not None and self.visits.choose_walk_up():
             self.greet()
             self._screens().redraw()
 
