@@ -30,14 +30,13 @@ from pathlib import Path
 
 from textual import events
 
-from kiosk.core.adaptation import Adaptation, load_policy
+from kiosk.config import Config
 from kiosk.core.clock import SimClock
-from kiosk.core.questionnaire import load_questionnaire
-from kiosk.core.session import Phase, Session
+from kiosk.core.session import Phase
 from kiosk.export.opening import MODEL
 from kiosk.store.database import Store
 from kiosk.ui.app import KIOSK_SIZE, KioskApp
-from qos import Engine, load_model
+from kiosk.ui.compose import make_kiosk
 
 GOAL_SESSION_S = 3.0
 GOAL_MEDIAN_MS = 50.0
@@ -46,19 +45,13 @@ SCREEN_CHANGES = ("pause", "resume", "next_question")
 
 
 def build(data_dir: Path) -> tuple[KioskApp, SimClock, Store]:
-    """A kiosk as `kiosk run` builds it, but on a simulated clock and without device channels."""
+    """A kiosk as `kiosk run` builds it (:func:`make_kiosk`), but on a simulated clock and without
+    device channels."""
     clock = SimClock()
-    questionnaire = load_questionnaire()
+    config = Config(data_dir=data_dir, clinician_pin="2468", qos_model=MODEL)
     store = Store.open(data_dir)
-    session = Session(
-        questionnaire,
-        clock=clock,
-        engine=Engine(load_model(MODEL)),
-        patient_id="P-BENCH1",
-        store=store,
-        adaptation=Adaptation(load_policy()),
-    )
-    return KioskApp(session, clinician_pin="2468", store=store, poll_interval=3600), clock, store
+    app = make_kiosk(config, clock=clock, store=store, patient_ids=lambda: "P-BENCH1", poll_interval=3600)
+    return app, clock, store
 
 
 async def until(condition: Callable[[], object]) -> None:
@@ -108,9 +101,9 @@ async def one_session(data_dir: Path, latencies: dict[str, list[float]]) -> floa
         while session.phase is Phase.FAMILIARISATION:
             practice = session.snapshot().practice
             if practice is not None and session.current_attempt is not None:
-                answered = len(app.events)
+                answered = len(app.controller.events)
                 await press(app, str(practice.expected))
-                await until(lambda: len(app.events) > answered)
+                await until(lambda: len(app.controller.events) > answered)
             else:
                 to_deadline(app, clock)
         await until(lambda: drawn(app, "ExplanationScreen"))

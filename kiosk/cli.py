@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 #: sub-command -> (module exposing main(argv), one-line description)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "run": ("kiosk.ui.app", "start the kiosk (the default when no sub-command is given)"),
+    "run": ("kiosk.commands.run", "start the kiosk (the default when no sub-command is given)"),
     "serve": ("kiosk.ui.serve.server", "serve the kiosk to a browser on a touch display (localhost by default)"),
     "replay": ("kiosk.commands.replay", "run a scripted patient through the real session on a simulated clock"),
     "validate": ("kiosk.commands.validate", "check questionnaire files and the words files; list every problem"),

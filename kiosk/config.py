@@ -153,8 +153,9 @@ class Config:
     #: a running test older than this is marked interrupted (staff may continue it; no patient is offered it)
     interrupt_after_minutes: float = 120.0
     #: seconds the end screen ("Thank you, you are done. Please call the nurse.") stays before the
-    #: kiosk goes back to the welcome for the next patient; the result stays stored for staff
-    next_patient_after_s: float = 90.0
+    #: kiosk goes back to the welcome for the next patient; the result stays stored for staff (None,
+    #: never from a file: the end screen stays until staff start over, as in the UI tests)
+    next_patient_after_s: float | None = 90.0
     #: the end screen shows the patient their total and band (default: only staff see them)
     show_score_to_patient: bool = False
     #: an unordered test may be started at the welcome (stored and shown as a walk-up); false: only

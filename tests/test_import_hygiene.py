@@ -26,6 +26,7 @@ PURE_KIOSK_MODULES = [
     "kiosk.export",
     "kiosk.commands.results",
     "kiosk.commands.validate",
+    "kiosk.ui.controller",
     "fileio.positions",
 ]
 

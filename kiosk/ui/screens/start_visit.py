@@ -83,7 +83,7 @@ class StartVisitScreen(ClinicianScreen):
     def _go(self, event: Button.Pressed) -> None:
         event.stop()
         relative = self.query_one("#visit-relative", Switch).value
-        refused = self.app.start_staff_visit(self._typed, self._language, relative)  # type: ignore[attr-defined]
+        refused = self.app.controller.start_staff_visit(self._typed, self._language, relative)  # type: ignore[attr-defined]
         if refused:
             self.query_one("#start-visit-error", Label).update(f"Not started: {refused}")
 

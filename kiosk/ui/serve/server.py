@@ -40,7 +40,7 @@ def build_command(run_args: list[str]) -> str:
 def run_args_problem(run_args: list[str]) -> str | None:
     """What is wrong with the options passed on to `kiosk run`, or None: checked before serving,
     because every browser connection would otherwise only show `kiosk run`'s usage error."""
-    from kiosk.ui.app import run_parser
+    from kiosk.ui.options import run_parser
 
     parser = run_parser()
     parser.exit_on_error = False  # report the problem as one line here, not argparse's usage text
@@ -121,7 +121,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _config_path(run_args: list[str]) -> Path | None:
-    from kiosk.ui.app import run_parser
+    from kiosk.ui.options import run_parser
 
     return run_parser().parse_known_args(run_args)[0].config
 

@@ -90,7 +90,7 @@ def test_the_default_canonical_url_names_the_site_and_the_questionnaire_file_id(
 
 
 def test_the_kiosk_app_exports_with_the_configured_site(tmp_path):
-    from kiosk.ui.app import build_app
+    from kiosk.commands.run import build_app
 
     path = tmp_path / "config.yaml"
     path.write_text("data_dir: data\nsite: hosp-north\nkiosk_id: ward3-bed2\n", encoding="utf-8")

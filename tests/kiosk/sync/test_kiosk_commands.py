@@ -12,10 +12,11 @@ from contextlib import contextmanager
 
 import pytest
 
+from kiosk.commands.run import build_app
 from kiosk.core.session import Phase
 from kiosk.store.database import Store
 from kiosk.store.lease import Owner
-from kiosk.ui.app import KIOSK_SIZE, build_app
+from kiosk.ui.app import KIOSK_SIZE
 from tests.kiosk.ui.helpers import until_thread
 
 from .ward import TOKEN, Server
@@ -52,9 +53,9 @@ async def test_a_kiosk_without_a_station_starts_no_sync_thread_and_queues_nothin
         async with app.run_test(size=KIOSK_SIZE) as pilot:
             await pilot.press("1", "1")
             await until_thread(lambda: app.session.phase is Phase.QUESTIONS, "the questions")
-            assert app.sync is None
+            assert app.controller.sync is None
             assert not [t for t in threading.enumerate() if t.name.startswith("station")]
-            assert app.store._db.execute("SELECT COUNT(*) FROM outbox").fetchone() == (0,)  # noqa: SLF001
+            assert app.controller.store._db.execute("SELECT COUNT(*) FROM outbox").fetchone() == (0,)  # noqa: SLF001
     finally:
         close()
 
@@ -129,7 +130,7 @@ async def test_station_commands_continue_mark_away_and_back_and_end_the_running_
             await until_thread(lambda: app.session is not session, "the kiosk starting over")
             await pilot.pause()
             assert app.session.phase is Phase.WELCOME and type(app.screen).__name__ == "WelcomeScreen"
-            stored = app.store.session(session.id)
+            stored = app.controller.store.session(session.id)
             assert stored.status == "abandoned"
             assert stored.log[-1].detail == "ended from the ward station by dr.lopez"
             await until_thread(

@@ -11,9 +11,10 @@ import re
 import pytest
 import sqlalchemy as sa
 
+from kiosk.commands.run import build_app
 from kiosk.core.session import AnsweredBy, Phase
 from kiosk.core.visits import visit_of
-from kiosk.ui.app import KIOSK_SIZE, build_app
+from kiosk.ui.app import KIOSK_SIZE
 from station import db
 from station.orders import orders as orders_table
 from tests.kiosk.ui.helpers import until_thread
@@ -94,7 +95,7 @@ async def test_an_ordered_visit_starts_at_the_kiosk_only_with_its_code(tmp_path)
                 "es",
                 AnsweredBy.RELATIVE,
             )
-            assert visit_of(app.store.session(session.id).log) == f"order {order_id}"
+            assert visit_of(app.controller.store.session(session.id).log) == f"order {order_id}"
 
             engine = db.make_engine(ward.db_url)
 
@@ -137,7 +138,7 @@ async def test_without_a_station_staff_start_a_visit_by_touch_and_no_walk_up_sta
             await pilot.click("#start-visit-go")
             await until_thread(lambda: app.session.phase is not Phase.WELCOME, "the staff's visit starting")
             assert app.session.patient_id == "NHC-70"
-            assert visit_of(app.store.session(app.session.id).log) == "staff"
+            assert visit_of(app.controller.store.session(app.session.id).log) == "staff"
     finally:
         close()
 

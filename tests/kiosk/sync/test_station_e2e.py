@@ -115,7 +115,8 @@ async def test_a_doctor_call_reaches_the_real_station_and_its_continue_reaches_t
     """The kiosk as `kiosk run` builds it, reporting to a `kiosk station` process: the patient's
     doctor call becomes the station's alert; staff's continue (queued in the station's database)
     is long-polled, applied to the running session and acknowledged."""
-    from kiosk.ui.app import KIOSK_SIZE, build_app
+    from kiosk.commands.run import build_app
+    from kiosk.ui.app import KIOSK_SIZE
     from station import auth, db, ward
     from tests.kiosk.ui.helpers import until_thread
 

@@ -4,20 +4,20 @@ deliver remote and voice inputs through the app's sink from a real thread, as th
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-from kiosk.core.adaptation import Adaptation, load_policy
+from kiosk.config import Config
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.clock import SimClock
-from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.session import Session
 from kiosk.export.opening import MODEL
 from kiosk.store.database import Store
-from kiosk.ui.app import KioskApp
-from qos import Engine, load_model
+from kiosk.ui.channels import KioskChannels
+from kiosk.ui.compose import KioskParts, make_kiosk
 
 #: the PIN the test kiosks use (not the public default, so no warning on the clinician screen)
 UI_PIN = "2468"
@@ -27,7 +27,10 @@ UI_PATIENT_ID = "P-TEST01"
 
 
 class UiKiosk:
-    """A kiosk app with its clock and store, and helpers to move simulated time."""
+    """A kiosk app built by `kiosk run`'s own :func:`make_kiosk`, with its clock and store, and
+    helpers to move simulated time. The options other than the first session's (``familiarisation``,
+    ``language``, ``session_id``) are the configuration's, so they hold for every later session;
+    the next patients are P-TEST02 (the first is :data:`UI_PATIENT_ID`)."""
 
     def __init__(
         self,
@@ -46,67 +49,48 @@ class UiKiosk:
         next_patient_after_s: float | None = None,
         model: str = MODEL,
     ) -> None:
-        self.next_patient_after_s = next_patient_after_s
         self.clock = SimClock()
-        #: the QoS model (``qos_model:``), loaded once as `kiosk run` does
-        self.model = load_model(model)
-        self.questionnaire = load_questionnaire()
-        self.store = Store.open(tmp_path / "data")
-        self.session = Session(
-            self.questionnaire,
-            clock=self.clock,
-            engine=Engine(self.model),
-            patient_id=UI_PATIENT_ID,
-            store=self.store,
-            language=language,
-            session_id=session_id,
-            adaptation=Adaptation(load_policy()) if adaptation else None,
-            familiarisation=familiarisation,
+        self.config = Config(
+            data_dir=tmp_path / "data",
+            adaptation=adaptation,
+            qos_model=model,  # loaded once, as `kiosk run` does
             next_patient_after_s=next_patient_after_s,
+            show_score_to_patient=show_score,
         )
-        self.app = KioskApp(
-            self.session,
-            clinician_pin=UI_PIN,
-            store=self.store,
-            export_dir=tmp_path / "exports",
-            voice=voice,
-            keyboard=keyboard,
-            sources=sources,
+        parts = KioskParts.load(self.config)
+        self.questionnaire, self.model = parts.questionnaire, parts.model
+        self.store = Store.open(self.config.data_dir)
+        patients = iter([UI_PATIENT_ID])
+        channels = KioskChannels(
             speaker=speaker,
+            voice=voice,
+            sources=sources,
+            keyboard=keyboard,
             statuses=[
                 ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
                 ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*"),
             ],
+        )
+        self.app = make_kiosk(
+            self.config,
+            clock=self.clock,
+            store=self.store,
+            channels=channels,
+            parts=parts,
+            first={"language": language, "session_id": session_id, "familiarisation": familiarisation},
+            patient_ids=lambda: next(patients, "P-TEST02"),
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
             # of the real timer never finds anything due
             poll_interval=poll_interval,
-            resume=self._resume,
-            new_session=self._fresh,
-            show_score=show_score,
+            visits=False,  # the snapshots show "Start a visit" off, as before visits existed
+            # failed attempts counted in memory: the full-disk test's staff must still get in
+            clinician_pin=UI_PIN,
         )
-
-    def _fresh(self) -> Session:
-        """A session for the next patient, as `kiosk run` builds it (a new id, so it can be stored)."""
-        return Session(
-            self.questionnaire,
-            clock=self.clock,
-            engine=Engine(self.model),
-            patient_id="P-TEST02",
-            store=self.store,
-            adaptation=Adaptation(load_policy()),
-            next_patient_after_s=self.next_patient_after_s,
-        )
-
-    def _resume(self, stored) -> Session:
-        """The session continuing ``stored``, as `kiosk run` builds it."""
-        return Session.from_stored(
-            self.questionnaire,
-            stored,
-            clock=self.clock,
-            engine=Engine(self.model),
-            store=self.store,
-            adaptation=Adaptation(load_policy()),
-        )
+        #: the kiosk's controller, and its first session
+        self.controller = self.app.controller
+        self.session: Session = self.app.session
+        #: where the clinician's exports go
+        self.exports = self.config.data_dir / "exports"
 
     def advance(self, seconds: float) -> None:
         """Move simulated time on and let the app poll, as its timer would."""
@@ -126,13 +110,13 @@ class UiKiosk:
 
 
 @pytest.fixture
-def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
+def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    offer_resume, voice, keyboard, sources, poll_interval, speaker, model)."""
+    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model)."""
     made: list[UiKiosk] = []
 
-    def make(**options: object) -> UiKiosk:
-        kiosk = UiKiosk(tmp_path, **options)  # type: ignore[arg-type]
+    def make(**options: Any) -> UiKiosk:
+        kiosk = UiKiosk(tmp_path, **options)
         made.append(kiosk)
         return kiosk
 

@@ -18,8 +18,9 @@ import sys
 import time
 from pathlib import Path
 
+from kiosk.commands.run import build_app
 from kiosk.core.session import Phase
-from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE, build_app
+from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 
 #: how long a command may wait for the kiosk (real timers, real threads)
 PATIENCE_S = 30.0

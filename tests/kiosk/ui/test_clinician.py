@@ -24,7 +24,7 @@ async def _open_clinician(kiosk, pilot) -> None:
     await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
 
 
-async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk, tmp_path):
+async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await start_in_english(kiosk, pilot)
@@ -50,7 +50,7 @@ async def test_a_finished_session_shows_answers_total_plot_and_exports(ui_kiosk,
             "VoiceInteractionQuality",
         }
 
-        exports = tmp_path / "exports"
+        exports = kiosk.exports
         for button, name in [("#export-fhir", "fhir.json"), ("#export-csv", "csv"), ("#export-png", "metrics.png")]:
             await pilot.click(button)
             path = exports / f"session-{kiosk.session.id}.{name}"
@@ -81,7 +81,7 @@ async def test_the_clinician_switches_live_adaptation_off(ui_kiosk):
         await settle(pilot, lambda: not kiosk.session.adaptation.enabled)
         await pilot.click("#back")
         await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
-        assert not [e for e in kiosk.app.events if isinstance(e, AdaptationChanged) and e.active]
+        assert not [e for e in kiosk.controller.events if isinstance(e, AdaptationChanged) and e.active]
 
 
 async def test_a_new_patient_after_a_halted_session_abandons_it_and_welcomes_the_next(ui_kiosk):
@@ -116,7 +116,7 @@ async def test_opening_the_clinician_screens_pauses_the_session_and_leaving_resu
         assert "paused while you are here" in text_of(home.query_one("#current"))
         assert home.query_one("#continue").disabled  # leaving resumes; Continue is for a halt
         # the home follows the running session (its timer calls this every second)
-        kiosk.app.person_lost()
+        kiosk.controller.person_lost()
         home.refresh_session()
         assert "patient away" in text_of(home.query_one("#current"))
         # at 80x24 every button shown reads in full and the stored sessions show several rows

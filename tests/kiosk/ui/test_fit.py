@@ -63,12 +63,12 @@ async def test_every_screen_and_question_fits(ui_kiosk, size, language):
                 await pilot.press("p")
                 await settle(pilot, lambda: screen_name(kiosk) == "QuestionScreen")
             if item.id == longest_item.id:  # asked back, and asked to press, about the longest answer
-                kiosk.app.forward(
+                kiosk.controller.forward(
                     ChannelInput(Channel.VOICE, option=longest, detail="heard", confidence=0.9, needs_confirmation=True)
                 )
                 await settle(pilot, lambda: bool(kiosk.app.screen.query("ConfirmPanel")))
                 _fits(kiosk, f"the question back on {item.id}")
-                kiosk.app.forward(
+                kiosk.controller.forward(
                     ChannelInput(Channel.VOICE, option=1, detail="yes", confidence=0.9, needs_confirmation=True)
                 )
                 plea = kiosk.questionnaire.message("confirm_answer_press", language).split("{")[0]
@@ -96,7 +96,7 @@ async def test_answers_do_not_move_when_one_is_chosen(ui_kiosk):
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         await settle(pilot)
         before = [b.region for b in kiosk.app.screen.query("AnswerButton")]
-        kiosk.app.forward(ChannelInput(Channel.TOUCH, option=2, detail="screen"))
+        kiosk.controller.forward(ChannelInput(Channel.TOUCH, option=2, detail="screen"))
         await settle(pilot, lambda: kiosk.app.screen.query_one("#interlude").display)
         await settle(pilot)
         assert [b.region for b in kiosk.app.screen.query("AnswerButton")] == before

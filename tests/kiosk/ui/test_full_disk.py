@@ -55,15 +55,15 @@ def fill(folder: Path) -> Path:
 async def _answer_until_out_of_order(kiosk: UiKiosk, pilot) -> None:
     """Go on answering (as the patient would) until a step cannot be stored."""
     for _ in range(len(kiosk.questionnaire.items)):
-        if kiosk.app.out_of_order is not None:
+        if kiosk.controller.out_of_order is not None:
             return
         kiosk.to_next_deadline()
-        await settle(pilot, lambda: kiosk.session.current_attempt == 1 or kiosk.app.out_of_order is not None)
-        if kiosk.app.out_of_order is None:
+        await settle(pilot, lambda: kiosk.session.current_attempt == 1 or kiosk.controller.out_of_order is not None)
+        if kiosk.controller.out_of_order is None:
             item = kiosk.session.current_item
             await pilot.press("1")
-            await settle(pilot, lambda: item.id in kiosk.session.answers or kiosk.app.out_of_order is not None)
-    assert kiosk.app.out_of_order is not None, "the store never filled up"
+            await settle(pilot, lambda: item.id in kiosk.session.answers or kiosk.controller.out_of_order is not None)
+    assert kiosk.controller.out_of_order is not None, "the store never filled up"
 
 
 async def _the_out_of_order_kiosk_and_its_recovery(kiosk: UiKiosk, pilot, free_space) -> None:
@@ -85,19 +85,19 @@ async def _the_out_of_order_kiosk_and_its_recovery(kiosk: UiKiosk, pilot, free_s
     kiosk.app.close_clinician()
     await settle(pilot, lambda: screen_name(kiosk) == "OutOfOrderScreen")
 
-    kiosk.app.keep_session()  # the lease timer's round: still full, still out of order
+    kiosk.controller.keep_session()  # the lease timer's round: still full, still out of order
     await settle(pilot)
     assert screen_name(kiosk) == "OutOfOrderScreen"
     free_space()
-    kiosk.app.keep_session()  # space freed: the welcome is back for the next patient
+    kiosk.controller.keep_session()  # space freed: the welcome is back for the next patient
     await until_drawn(pilot, "1  English")
-    assert screen_name(kiosk) == "WelcomeScreen" and kiosk.app.out_of_order is None
+    assert screen_name(kiosk) == "WelcomeScreen" and kiosk.controller.out_of_order is None
     await pilot.press("1")  # the next patient starts, and their test is stored
     await settle(pilot, lambda: kiosk.app.session.phase is not Phase.WELCOME)
     await until_drawn(pilot, "Practice 1 of")
     assert kiosk.store.session(kiosk.app.session.id).status == "running"
-    kiosk.app.keep_session()
-    assert first.id in [t.id for t in kiosk.app.interrupted_tests()]  # the dropped test, for staff
+    kiosk.controller.keep_session()
+    assert first.id in [t.id for t in kiosk.controller.interrupted_tests()]  # the dropped test, for staff
 
 
 async def test_a_full_filesystem_shows_one_calm_screen_and_recovers_when_space_is_freed(tmp_path):
@@ -113,7 +113,7 @@ async def test_a_full_filesystem_shows_one_calm_screen_and_recovers_when_space_i
                     (small / "one-more").write_bytes(bytes(4096))
                 assert full.value.errno == errno.ENOSPC
                 await _answer_until_out_of_order(kiosk, pilot)
-                assert "full" in kiosk.app.out_of_order
+                assert "full" in kiosk.controller.out_of_order
 
                 def free_space() -> None:
                     filler.unlink()

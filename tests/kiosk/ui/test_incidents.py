@@ -38,8 +38,9 @@ async def test_pause_freezes_the_attempt_and_continue_comes_back_to_the_question
         await settle(pilot, lambda: "feeding" in kiosk.session.answers)
         assert kiosk.session.answers["feeding"].attempt == 1
         log = [e.kind for e in kiosk.store.session(kiosk.session.id).log]
-        # the "2" while paused is logged (and, at the start, that this kiosk has no voice out)
-        assert log[:5] == ["start", "voice_out", "pause", "input_ignored", "resume"]
+        # the "2" while paused is logged (and, at the start, how the visit began, a walk-up, and
+        # that this kiosk has no voice out)
+        assert log[:6] == ["start", "visit", "voice_out", "pause", "input_ignored", "resume"]
 
 
 async def test_call_doctor_halts_until_a_clinician_continues_behind_the_pin(ui_kiosk):
@@ -83,8 +84,8 @@ async def test_an_attempt_times_out_twice_and_the_next_question_comes(ui_kiosk):
         kiosk.advance(0.2)
         await settle(pilot, lambda: text_of(attempt) == "Attempt 2 of 2")
         kiosk.advance(20.1)
-        await settle(pilot, lambda: any(isinstance(e, QuestionNotAnswered) for e in kiosk.app.events))
-        assert [e.attempt for e in kiosk.app.events if isinstance(e, AttemptTimedOut)] == [1, 2]
+        await settle(pilot, lambda: any(isinstance(e, QuestionNotAnswered) for e in kiosk.controller.events))
+        assert [e.attempt for e in kiosk.controller.events if isinstance(e, AttemptTimedOut)] == [1, 2]
         kiosk.to_next_deadline()
         await settle(pilot, lambda: text_of(kiosk.app.screen.query_one("#progress", Label)) == "Question 2 of 10")
         assert text_of(kiosk.app.screen.query_one("#attempt", Label)) == "Attempt 1 of 2"
@@ -120,10 +121,8 @@ async def test_the_patient_touches_answer_by_voice_again_and_the_kiosk_listens_a
         assert "voice_off" not in kiosk.session.snapshot().adaptations
         assert not kiosk.app.screen.query_one(AdaptationBanner).display
         assert not kiosk.app.screen.query_one(VoiceAgainButton).display
-        assert [e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")] == [
-            "voice_off",
-            "voice_on",
-        ]
+        said = [e.key for e in kiosk.controller.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
+        assert said == ["voice_off", "voice_on"]
         stored = kiosk.store.session(kiosk.session.id)
         assert [(a.name, a.active, a.reason) for a in stored.adaptations][-1] == (
             "voice_off",
@@ -155,7 +154,7 @@ async def test_no_trouble_hearing_notice_when_voice_in_never_ran(ui_kiosk):
         assert "voice_off" not in kiosk.session.snapshot().adaptations  # the session knows voice in is off
         assert "trouble hearing" not in text_of(kiosk.app.screen.query_one(AdaptationBanner))
         assert not kiosk.app.screen.query_one(VoiceAgainButton).display
-        assert not [e for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
+        assert not [e for e in kiosk.controller.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")]
         assert "voice_off" not in {a.name for a in kiosk.store.session(kiosk.session.id).adaptations}
 
 

@@ -9,10 +9,11 @@ import threading
 import time
 
 from kiosk import cli
+from kiosk.commands import run as kiosk_run
+from kiosk.commands.run import build_app
 from kiosk.core.channels import ChannelState
 from kiosk.core.session import Phase
-from kiosk.ui import app as kiosk_app
-from kiosk.ui.app import KIOSK_SIZE, build_app
+from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.serve import server as serve
 from kiosk.ui.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT
 
@@ -40,7 +41,7 @@ async def test_a_fresh_kiosk_starts_a_session_with_whatever_channels_it_has(tmp_
             await pilot.pause()
             assert app.session.phase is Phase.FAMILIARISATION
             assert type(app.screen).__name__ == "FamiliarisationScreen"
-            assert app.store.session(app.session.id).status == "running"
+            assert app.controller.store.session(app.session.id).status == "running"
     finally:
         close()
     assert (tmp_path / "data" / "kiosk.sqlite3").stat().st_mode & 0o077 == 0
@@ -49,7 +50,7 @@ async def test_a_fresh_kiosk_starts_a_session_with_whatever_channels_it_has(tmp_
 def test_kiosk_run_with_a_bad_configuration_says_where_and_exits_2(tmp_path, capsys):
     config = tmp_path / "config.yaml"
     config.write_text("data_dir: data\nclinician_pin: 12\n")
-    assert kiosk_app.main(["--config", str(config)]) == 2
+    assert kiosk_run.main(["--config", str(config)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"kiosk run: {config}:2:1: ") and "PIN" in err[0]
 
@@ -57,7 +58,7 @@ def test_kiosk_run_with_a_bad_configuration_says_where_and_exits_2(tmp_path, cap
 def test_kiosk_run_rejects_a_patient_id_that_looks_like_a_name(tmp_path, capsys):
     config = tmp_path / "config.yaml"
     config.write_text("data_dir: data\n")
-    assert kiosk_app.main(["--config", str(config), "--patient", "Ann Smith"]) == 2
+    assert kiosk_run.main(["--config", str(config), "--patient", "Ann Smith"]) == 2
     assert capsys.readouterr().err.startswith("kiosk run: --patient 'Ann Smith' is not a pseudonymous id")
     assert not (tmp_path / "data").exists()  # refused before anything was opened
 

@@ -197,10 +197,10 @@ async def test_the_doctor_called_screen_counts_no_attempt_and_the_next_attempt_i
         assert "Attempt" not in shown and "Question 1 of 10" in shown
         await pilot.press("1")  # "I'm fine, carry on"
         await until_drawn(pilot, "Attempt 1 of 2")
-        seen = len(kiosk.app.events)
+        seen = len(kiosk.controller.events)
         kiosk.to_next_deadline()
         await until_drawn(pilot, "Attempt 2 of 2", "Someone has to feed me")
-        asked = [e for e in kiosk.app.events[seen:] if isinstance(e, Prompt) and e.kind == "question"]
+        asked = [e for e in kiosk.controller.events[seen:] if isinstance(e, Prompt) and e.kind == "question"]
         assert asked and asked[0].key == "feeding" and asked[0].repeat  # asked again, as attempt 2
 
 

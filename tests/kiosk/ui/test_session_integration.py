@@ -49,7 +49,7 @@ async def test_voice_in_status_reaches_the_session_and_a_lost_microphone_lifts_v
         await settle(pilot, lambda: "voice_off" not in kiosk.session.snapshot().adaptations)
         await settle(pilot, lambda: not kiosk.app.screen.query_one(AdaptationBanner).display)
         voice_prompts = [
-            e.key for e in kiosk.app.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")
+            e.key for e in kiosk.controller.events if isinstance(e, Prompt) and e.key in ("voice_off", "voice_on")
         ]
         assert voice_prompts == ["voice_off"]  # no "I can hear you again" with the microphone gone
         stored = kiosk.store.session(kiosk.session.id)
@@ -86,7 +86,7 @@ async def test_the_clinician_marks_the_patient_left_and_back_and_the_attempt_clo
         await settle(pilot, lambda: notice in text_of(kiosk.app.screen.query_one(AdaptationBanner)))
         kiosk.advance(10 * timing.attempt_window_s)  # far past the deadline: the clock is frozen
         await settle(pilot)
-        assert not [e for e in kiosk.app.events if isinstance(e, AttemptTimedOut)]
+        assert not [e for e in kiosk.controller.events if isinstance(e, AttemptTimedOut)]
         assert kiosk.session.current_attempt == 1 and kiosk.session.remaining() == left_with
         assert notice in text_of(kiosk.app.screen.query_one(AdaptationBanner))
 

@@ -48,7 +48,7 @@ async def test_prompts_are_spoken_and_a_spoken_repeat_is_reported_to_the_session
         await start_in_english(kiosk, pilot)
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
-        spoken = sum(1 for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken)
+        spoken = sum(1 for e in kiosk.controller.events if isinstance(e, Prompt) and e.spoken)
         await until_thread(
             lambda: player.played >= spoken, "the speaker's worker"
         )  # welcome, explanation, the first question
@@ -69,7 +69,7 @@ async def test_trouble_hearing_is_never_said_while_voice_in_is_off(ui_kiosk):
         await start_in_english(kiosk, pilot)
         for _ in range(8):  # with voice in on, these late answers switch voice_off on
             await late_touch_answer(kiosk, pilot)
-        prompts = [e for e in kiosk.app.events if isinstance(e, Prompt) and e.spoken]
+        prompts = [e for e in kiosk.controller.events if isinstance(e, Prompt) and e.spoken]
         assert not [p for p in prompts if p.key in ("voice_off", "voice_on")]  # the session never asked...
         await until_thread(lambda: player.played >= len(prompts), "the speaker's worker")
         await settle(pilot)

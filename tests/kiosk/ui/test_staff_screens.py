@@ -109,7 +109,7 @@ async def _from_top(pilot, screen) -> None:
 
 
 @pytest.mark.parametrize("size", [(80, 24), (73, 18), (64, 18)], ids=lambda s: f"{s[0]}x{s[1]}")
-async def test_every_clinician_control_is_reached_and_tapped_by_touch(ui_kiosk, tmp_path, size):
+async def test_every_clinician_control_is_reached_and_tapped_by_touch(ui_kiosk, size):
     kiosk = ui_kiosk(familiarisation=False)
     async with kiosk.app.run_test(size=size) as pilot:
         await start_in_english(kiosk, pilot)
@@ -160,7 +160,7 @@ async def test_every_clinician_control_is_reached_and_tapped_by_touch(ui_kiosk, 
         await until_drawn(pilot, "session time (s)")
         for button, name in (("#export-fhir", "fhir.json"), ("#export-csv", "csv"), ("#export-png", "metrics.png")):
             await pilot.click(button)
-            path = tmp_path / "exports" / f"session-{kiosk.session.id}.{name}"
+            path = kiosk.exports / f"session-{kiosk.session.id}.{name}"
             await settle(pilot, lambda: path.exists())
         await pilot.click("#back")
         await until_drawn(pilot, "Stored sessions")

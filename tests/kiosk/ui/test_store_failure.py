@@ -30,12 +30,12 @@ async def test_a_write_the_database_refuses_drops_the_test_plainly_and_staff_get
             await pilot.press("2")
             await settle(pilot, lambda: kiosk.app.session is not session)
             await until_drawn(pilot, "This kiosk is not working at the moment.")
-            assert "database is locked" in kiosk.app.out_of_order and seen == []  # for staff, not the patient
+            assert "database is locked" in kiosk.controller.out_of_order and seen == []  # for staff, not the patient
         finally:
             other.execute("ROLLBACK")
             other.close()
-        kiosk.app.keep_session()  # the lease timer's round, now that the database answers
+        kiosk.controller.keep_session()  # the lease timer's round, now that the database answers
         await until_drawn(pilot, "1  English")
         assert kiosk.store.session(session.id).answers == ()
-        (interrupted,) = kiosk.app.interrupted_tests()
+        (interrupted,) = kiosk.controller.interrupted_tests()
         assert interrupted.id == session.id and interrupted.patient_id == session.patient_id

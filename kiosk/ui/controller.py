@@ -1,0 +1,397 @@
+"""What the kiosk does between the session and the screens, with no Textual in it.
+
+:class:`KioskController` owns the running :class:`~kiosk.core.session.Session` and everything that
+replaces it: the next patient, staff's "New patient", a test ended from the ward station, a test
+continued or a visit started on the clinician screen, a test this kiosk lost (another kiosk took
+it, or the store failed). All of these go through one path, :meth:`KioskController.start_over`
+(or :meth:`~KioskController.swap` for a session staff chose). It also holds a session while the
+clinician screens are open, renews this kiosk's lease on its session, applies station commands
+and tells the station what the ward view shows.
+
+The Textual app (:mod:`kiosk.ui.app`) routes input here and draws what the controller asks for,
+through the small :class:`Screens` port; the controller is tested without Pilot for that reason.
+Everything here runs on the UI thread: threads reach it only through the app.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sqlite3
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, Protocol
+
+from kiosk.core.channels import ChannelInput
+from kiosk.core.session import NextPatient, Phase, Session, SessionEvent
+from kiosk.core.visits import Order, VisitDesk
+from kiosk.store.database import Store, StoredSession
+from kiosk.store.lease import SessionTaken
+
+#: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
+#: patients again (a test's rows, its QoS trace and the WAL need room to grow)
+PROBE_BYTES = 256 * 1024
+#: what staff read when they try to replace a test that is still going
+IN_PROGRESS = "a test is in progress on this kiosk: finish it, or start a new patient, first"
+#: the phases a clinician's visit pauses (the welcome and the end have nothing to time out)
+_RUNNING = (Phase.FAMILIARISATION, Phase.EXPLANATION, Phase.QUESTIONS)
+
+
+class Screens(Protocol):
+    """What the controller asks of the UI (the Textual app implements it)."""
+
+    def redraw(self, *, rebuild: bool = False) -> None:
+        """Show the screens the session calls for (``rebuild``: even if they look the same)."""
+
+    def session_event(self, event: SessionEvent) -> None:
+        """The channels follow a session event (speak a prompt, listen, stop talking)."""
+
+    def tell_channels(self) -> None:
+        """Tell the session which channels are on (a new one runs, or voice came or went)."""
+
+    def stopped(self, reason: str) -> None:
+        """Tell whoever is in front of the kiosk that the test stopped (naming no one)."""
+
+    def close_clinician(self) -> None:
+        """Close the clinician screens and show the patient's."""
+
+    def later(self, callback: Callable[[], None]) -> None:
+        """Call ``callback`` once the current event is handled."""
+
+
+class KioskController:
+    """The running session of one kiosk and the operations that replace, hold or end it.
+
+    ``session`` is the first (not yet started) session. ``fresh()`` builds a session for the next
+    patient and ``resume(stored)`` one continuing an interrupted test (None: this kiosk cannot).
+    ``visits`` is a :class:`kiosk.core.visits.VisitDesk` (None: every welcome is a walk-up);
+    ``sync`` the station's client, ``orders`` its order watcher and ``start_order(code)`` the call
+    that starts an ordered visit (all None without a station). Call :meth:`attach` before use.
+    """
+
+    def __init__(
+        self,
+        session: Session,
+        *,
+        store: Store | None = None,
+        fresh: Callable[[], Session] | None = None,
+        resume: Callable[[StoredSession], Session] | None = None,
+        visits: VisitDesk | None = None,
+        sync: Any = None,
+        orders: Any = None,
+        start_order: Callable[[str], Any] | None = None,
+    ) -> None:
+        self.session = session
+        self.store = store
+        self.fresh = fresh
+        self.resume = resume
+        self.visits = visits
+        self.sync = sync
+        self.orders = orders
+        self.start_order = start_order
+        #: every session event received, in order (the clinician screens and tests read it)
+        self.events: list[SessionEvent] = []
+        #: why the kiosk takes no patient now (the store failed), for staff; None while it works
+        self.out_of_order: str | None = None
+        self.view: Screens | None = None
+        self._held: Session | None = None
+        self._dirty = False
+        self._unsubscribe: Callable[[], None] = lambda: None
+
+    def attach(self, view: Screens) -> None:
+        """Draw on ``view`` and follow the session's events from now on."""
+        self.view = view
+        self._unsubscribe()
+        self._unsubscribe = self.session.subscribe(self._on_event)
+
+    def _screens(self) -> Screens:
+        assert self.view is not None, "attach a view first"
+        return self.view
+
+    # -- the station's threads (started and stopped with the app) ---------------------------------
+
+    def start_station(self) -> None:
+        """Start the station's client and order watcher (each runs its own thread)."""
+        for part in (self.sync, self.orders):
+            if part is not None:
+                part.start()
+
+    def stop_station(self) -> None:
+        """Stop them (safe to call twice)."""
+        for part in (self.sync, self.orders):
+            if part is not None:
+                part.stop()
+
+    # -- running session operations ---------------------------------------------------------------
+
+    def drive(self, operation: Callable[..., object], *args: object) -> None:
+        """Run a session operation, then redraw if it published anything. A session another kiosk
+        took over (or that was interrupted) stores nothing more here: the kiosk lets it go."""
+        try:
+            operation(*args)
+        except SessionTaken as taken:
+            self.session_lost(str(taken))
+            return
+        except sqlite3.Error as failed:  # the step was rolled back: the session in memory is ahead of it
+            self._store_failed(failed)
+            return
+        if self._dirty:
+            self._dirty = False
+            self._screens().redraw()
+        self.report_status()
+
+    def _on_event(self, event: SessionEvent) -> None:
+        self.events.append(event)
+        self._dirty = True
+        self._screens().session_event(event)
+        if isinstance(event, NextPatient):
+            self._screens().later(self.next_patient)
+
+    def forward(self, item: ChannelInput) -> None:
+        """Hand an input to the session (what a number means on each screen is the session's call);
+        nothing while the kiosk is out of order, and none starts a test while the welcome waits for
+        staff (an ordered visit, no walk-ups)."""
+        if self.out_of_order is not None:
+            return
+        if self.session.phase is Phase.WELCOME and self.welcome_held():
+            return
+        self.drive(self.session.handle, item)
+
+    def start_in(self, language: str) -> None:
+        """The patient chose a language on the welcome: the test starts in it."""
+        if self.out_of_order is not None or self.welcome_held():
+            return
+
+        def start() -> None:
+            self.session.choose_language(language)
+            self.session.start()
+
+        self.drive(start)
+
+    def greet(self) -> None:
+        """A fresh session's welcome is said, and listened to: "start", or a language's name
+        (not while the welcome waits for staff to confirm an ordered visit)."""
+        if self.session.phase is Phase.WELCOME and not self.welcome_held():
+            self.drive(self.session.welcome)
+
+    # -- replacing the session: the one way to start over ---------------------------------------
+
+    def swap(self, session: Session) -> None:
+        """Run ``session`` from now on; the one it replaces is let go (released if finished,
+        interrupted if still running)."""
+        old, self.session = self.session, session
+        self._unsubscribe()
+        if self.store is not None and old.id != session.id:
+            with contextlib.suppress(sqlite3.Error):  # else keep_session lets it go later
+                self.store.release(old.id)
+        self._unsubscribe = session.subscribe(self._on_event)
+        self._screens().tell_channels()
+        if self.visits is not None:
+            self.visits.next_visit()
+
+    def start_over(self, *, abandon: bool = False, reason: str | None = None) -> None:
+        """The welcome, with a fresh session, for the next patient. ``abandon``: the session it
+        replaces is stored as abandoned (with ``reason``) first; the session decides whether it
+        counts (:meth:`Session.abandon`). Without a way to build one the session stays."""
+        if abandon:
+            try:
+                self.session.abandon(reason) if reason is not None else self.session.abandon()
+            except SessionTaken:
+                pass  # another kiosk holds it now: nothing of it is this kiosk's to end
+        fresh = self.fresh() if self.fresh is not None else None
+        if fresh is not None:
+            self.swap(fresh)
+        self._screens().redraw(rebuild=True)
+        if fresh is not None:
+            self.greet()
+
+    def next_patient(self) -> None:
+        """The end screen was shown long enough (the session's :class:`NextPatient`): the welcome
+        for the next patient; the finished result stays in the store for staff."""
+        if self.fresh is not None and self.session.finished:
+            self.start_over()
+
+    @property
+    def can_start_new_session(self) -> bool:
+        """A fresh session for the next patient can be built."""
+        return self.fresh is not None
+
+    def start_new_session(self) -> None:
+        """Staff start over for the next patient (clinician screen, "New patient")."""
+        if self.fresh is None:
+            return
+        self.start_over(abandon=True)
+        self._screens().close_clinician()
+
+    def end_session(self, reason: str) -> None:
+        """Staff end the running test (stored as abandoned, with why); the welcome is next."""
+        self.start_over(abandon=True, reason=reason)
+        self.report_status()
+
+    def session_lost(self, reason: str, *, tell_patient: bool = True) -> None:
+        """This kiosk may no longer record in its session: say so plainly (naming no one: the
+        next patient may be reading) and start over."""
+        if tell_patient:
+            self._screens().stopped(reason)
+        self.start_over()
+
+    def _busy(self) -> bool:
+        return self.session.phase is not Phase.WELCOME and not self.session.finished
+
+    # -- the clinician's hold -------------------------------------------------------------------
+
+    @property
+    def held_for_clinician(self) -> bool:
+        """The session is paused because the clinician screens are open (not by the patient)."""
+        return self._held is self.session and self.session.paused
+
+    def hold(self) -> None:
+        """Pause a running session while the clinician screens are open, so nothing times out
+        unseen underneath (one already paused or halted stays as it is)."""
+        session = self.session
+        if session.phase in _RUNNING and not (session.paused or session.halted):
+            self.drive(session.pause)
+            self._held = session if session.paused else None
+
+    def release(self) -> None:
+        """Resume the session the clinician screens paused (not one the patient paused)."""
+        if self.held_for_clinician and not self.session.halted:
+            self.drive(self.session.resume)
+        self._held = None
+
+    def clinician_continue(self) -> None:
+        """A clinician continues a session halted by call-doctor (or paused)."""
+        self.drive(self.session.clinician_continue)
+
+    def person_lost(self) -> None:
+        """A clinician says the patient left the kiosk (it has no presence sensor)."""
+        self.drive(self.session.person_lost)
+
+    def person_back(self) -> None:
+        """A clinician says the patient is back in front of the kiosk."""
+        self.drive(self.session.person_back)
+
+    def set_adaptation(self, enabled: bool) -> None:
+        """A clinician switches live adaptation on or off for this session."""
+        self.drive(self.session.set_adaptation_enabled, enabled)
+
+    # -- tests staff continue, visits staff or the station start ---------------------------------
+
+    def interrupted_tests(self) -> list[StoredSession]:
+        """The tests staff may continue here (their kiosk stopped, or they grew too old), newest first."""
+        return self.store.unfinished_sessions() if self.store is not None else []
+
+    def continue_test(self, session_id: str) -> str | None:
+        """Staff continue an interrupted test on this kiosk (clinician screen, behind the PIN).
+        Returns why not, as a sentence for staff, or None once it continues."""
+        if self.store is None or self.resume is None:
+            return "this kiosk stores no sessions"
+        if self._busy():
+            return IN_PROGRESS
+        try:
+            stored = self.store.continue_session(session_id)
+        except (SessionTaken, ValueError, KeyError) as refused:
+            return str(refused.args[0] if isinstance(refused, KeyError) else refused)
+        self._begin(self.resume(stored))
+        return None
+
+    def start_staff_visit(self, patient_id: str, language: str, relative: bool) -> str | None:
+        """Staff start a visit for the identifier they typed (clinician screen): why not, or None."""
+        if self.visits is None:
+            return "this kiosk cannot start visits for a patient identifier"
+        if self._busy():
+            return IN_PROGRESS
+        session, why = self.visits.for_staff(patient_id, language, relative)
+        if session is None:
+            return why
+        self._begin(session, session.answered_by)
+        return None
+
+    def _begin(self, session: Session, *start: object) -> None:
+        self.swap(session)
+        self._screens().close_clinician()
+        self.drive(self.session.start, *start)
+
+    def welcome_held(self) -> bool:
+        """The welcome waits for staff to confirm an ordered visit (or the site allows no walk-up)."""
+        return self.visits is not None and self.visits.holds_welcome()
+
+    def orders_changed(self, orders: Sequence[Order], problems: Sequence[str] = ()) -> None:
+        """The station's list of visits for this kiosk: the welcome follows it."""
+        if self.visits is not None and self.visits.set_orders(orders, problems) and self.session.phase is Phase.WELCOME:
+            self._screens().redraw()
+
+    def order_started(self, order: Order) -> None:
+        """The station started the visit: a session for its patient, in its language, begins."""
+        if self.visits is not None and self.session.phase is Phase.WELCOME:
+            self.swap(self.visits.for_order(order))
+            self.drive(self.session.start, order.answered_by)
+
+    def walk_up(self) -> None:
+        """Staff let a walk-up patient start at the welcome."""
+        if self.visits is not None and self.visits.choose_walk_up():
+            self.greet()
+            self._screens().redraw()
+
+    # -- the ward station ------------------------------------------------------------------------
+
+    def report_status(self) -> None:
+        """Give the station's client what the ward view shows of this kiosk (sent when it changes)."""
+        if self.sync is not None:
+            from kiosk.sync.commands import live_status
+
+            self.sync.set_status({**live_status(self.session), "out_of_order": self.out_of_order})
+
+    def station_command(self, command: Any) -> tuple[str, str | None] | None:
+        """Apply a station command (on the UI thread: the app hands it over from the client's)."""
+        from kiosk.sync.commands import apply_command
+
+        return apply_command(self, dict(command))
+
+    # -- this kiosk's hold on its session, and a store that fails ---------------------------------
+
+    def keep_session(self) -> None:
+        """Renew this kiosk's hold on its session and interrupt the tests whose kiosk is gone (a
+        timer calls this); a running session this kiosk no longer holds is let go."""
+        assert self.store is not None
+        session = self.session
+        try:
+            self.store.renew()
+            self.store.release_others(session.id)  # one this kiosk dropped when it could not write
+            self.store.interrupt_stale()
+            why = None if session.phase is Phase.WELCOME or session.finished else self.store.why_not_held(session.id)
+        except sqlite3.Error:
+            return  # the database is busy or failing: the next round tries again
+        if why is not None:
+            self.session_lost(why)
+        elif self.out_of_order is not None and self._can_write():
+            self.out_of_order = None  # space was freed (or the lock let go): the welcome is back
+            self._screens().redraw(rebuild=True)
+            self.report_status()
+
+    def _store_failed(self, failed: sqlite3.Error) -> None:
+        """The store refused a step (a full disk, a failing drive, a lock held too long; what it
+        refused was rolled back, what was stored stays for staff to continue). The kiosk takes no
+        patient until it can write again: the patient sees one calm out-of-order screen, staff
+        the reason on the clinician screen and the station (:meth:`keep_session` recovers)."""
+        self.out_of_order = f"the kiosk could not store its last step ({failed})"
+        self.session_lost(self.out_of_order, tell_patient=False)
+        self.report_status()
+
+    def _can_write(self) -> bool:
+        """The data directory takes :data:`PROBE_BYTES` more (written, synced and removed)."""
+        assert self.store is not None
+        probe = Path(self.store.path).parent / ".kiosk-write-probe"
+        try:
+            handle = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            try:
+                os.write(handle, bytes(PROBE_BYTES))
+                os.fsync(handle)
+            finally:
+                os.close(handle)
+            return True
+        except OSError:
+            return False
+        finally:
+            with contextlib.suppress(OSError):
+                probe.unlink()

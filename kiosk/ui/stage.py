@@ -1,0 +1,101 @@
+"""The patient's screens on the app's stack: the screen of the session's phase, and the paused or
+doctor-called screen covering it; and :func:`patient_view`, what they show.
+
+The phase's screen stays mounted under a covering screen, so resuming only uncovers it; it is
+rebuilt only when its :meth:`PatientScreen.key` changes (a rebuild loses focus and scrolling).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from textual.app import App
+
+from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.session import Phase, Session
+from kiosk.ui.channels import KioskChannels
+from kiosk.ui.screens.base import PatientScreen, PatientView
+from kiosk.ui.screens.doctor_called import DoctorCalledScreen
+from kiosk.ui.screens.explanation import ExplanationScreen
+from kiosk.ui.screens.familiarisation import FamiliarisationScreen
+from kiosk.ui.screens.out_of_order import OutOfOrderScreen
+from kiosk.ui.screens.paused import PausedScreen
+from kiosk.ui.screens.question import QuestionScreen
+from kiosk.ui.screens.summary import SummaryScreen
+from kiosk.ui.screens.visit_ready import VisitReadyScreen
+from kiosk.ui.screens.welcome import WelcomeScreen
+from kiosk.ui.widgets.channel_board import VOICE_IN
+
+#: the screen of each phase of a session
+PHASE_SCREENS: dict[Phase, type[PatientScreen]] = {
+    Phase.WELCOME: WelcomeScreen,
+    Phase.FAMILIARISATION: FamiliarisationScreen,
+    Phase.EXPLANATION: ExplanationScreen,
+    Phase.QUESTIONS: QuestionScreen,
+    Phase.SUMMARY: SummaryScreen,
+}
+
+
+class PatientStage:
+    """Keeps ``app``'s patient screens in step with what it is shown (:meth:`show`)."""
+
+    def __init__(self, app: App[Any]) -> None:
+        self.app = app
+        #: (screen class, its key) of the phase's screen shown; None: rebuild on the next show
+        self.key: tuple[type, object] | None = None
+
+    def forget(self) -> None:
+        """Rebuild the phase's screen on the next :meth:`show`, even if it looks the same."""
+        self.key = None
+
+    def show(self, view: PatientView, *, out_of_order: bool = False, held_visits: Any = None) -> None:
+        """Show the screens ``view`` calls for, or refresh the ones shown. ``out_of_order``: one
+        calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff."""
+        app, snap = self.app, view.snapshot
+        base_cls = PHASE_SCREENS[snap.phase]
+        overlay_cls = DoctorCalledScreen if snap.halted else PausedScreen if snap.paused else None
+        if out_of_order:
+            base_cls, overlay_cls = OutOfOrderScreen, None
+        shown = [s for s in app.screen_stack if isinstance(s, PatientScreen)]
+        base, overlay = (shown + [None, None])[:2]
+        key = (base_cls, base_cls.key(view))
+        if base_cls is WelcomeScreen and held_visits is not None:  # kiosk.core.visits: staff confirm first
+            base_cls, key = VisitReadyScreen, (VisitReadyScreen, held_visits.ready)
+        if overlay is not None and (type(overlay) is not overlay_cls or key != self.key):
+            app.pop_screen()
+            overlay = None
+        if base is None or key != self.key:
+            screen = (
+                VisitReadyScreen(view, held_visits.ready, held_visits.walk_up)
+                if base_cls is VisitReadyScreen
+                else base_cls(view)
+            )
+            (app.push_screen if base is None else app.switch_screen)(screen)
+        else:
+            base.show(view)
+        self.key = key
+        if overlay is not None:
+            overlay.show(view)
+        elif overlay_cls is not None:
+            app.push_screen(overlay_cls(view))
+
+
+def patient_view(
+    session: Session, channels: KioskChannels, questionnaire: Questionnaire, *, show_score: bool = False
+) -> PatientView:
+    """What the patient's screens show now: the session's snapshot and the ways to answer."""
+    snap = session.snapshot()
+    # the session lifts voice_off when voice in goes; checked here too so the button never
+    # promises listening that cannot happen (and not over Continue while paused)
+    voice_again = "voice_off" in snap.adaptations and not (snap.paused or snap.halted) and channels.on(VOICE_IN)
+    question = snap.item or snap.practice
+    hint = len(question.options) if channels.no_such_option and question is not None else None
+    return PatientView(
+        snap,
+        questionnaire,
+        channels.ways(snap),
+        voice_again=voice_again,
+        hint_options=hint,
+        now=session.now(),
+        show_score=show_score,
+    )
