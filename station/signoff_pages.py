@@ -59,6 +59,7 @@ async def confirm_page(request: Request) -> Response:
         review=current,
         score=score,
         labels=labels,
+        title=q.title.get(stored.language) or q.title.get("en") or q.id,  # type: ignore[attr-defined]
         will_be=will_be.value,
     )
 

@@ -111,8 +111,11 @@ def instant(value: str) -> str:
 
 
 def questionnaire_canonical(q: Questionnaire, site: ExportSite, language: str) -> str:
-    """The canonical URL of the questionnaire in one language (without the version)."""
-    return f"{site.questionnaire_url or f'urn:barthel-kiosk:{site.site}:questionnaire:{q.id}'}-{language}"
+    """The canonical URL of the questionnaire in one language (without the version). A site's
+    ``questionnaire_url`` with ``{id}`` in it gives each instrument of a battery its own URL
+    (``.../Questionnaire/{id}``); one without names a single instrument, as it always did."""
+    base = site.questionnaire_url.replace("{id}", q.id) if site.questionnaire_url else ""
+    return f"{base or f'urn:barthel-kiosk:{site.site}:questionnaire:{q.id}'}-{language}"
 
 
 def _text(key: str, texts: Mapping[str, str], language: str) -> dict[str, Any]:
