@@ -183,8 +183,8 @@ def main(argv: list[str]) -> int:
                     print("no sessions stored", file=sys.stderr)
                 for s in summaries:
                     print(
-                        f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} {s.language}  "
-                        f"{s.answered} answered, {s.not_answered} not answered"
+                        f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "
+                        f"{s.language}  {s.answered} answered, {s.not_answered} not answered"
                     )
                 waiting, parked = store.outbox_waiting()
                 if waiting or parked:

@@ -364,8 +364,9 @@ def observation_status(r: Result) -> str:
 def fhir_total(
     q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
 ) -> dict[str, Any] | None:
-    """The total as an R4 Observation (LOINC 96761-2) derived from the response; None when the
-    result is incomplete, so a partial sum is never charted as a Barthel total."""
+    """The total as an R4 Observation (coded with the instrument's ``total_code``, the Barthel's
+    LOINC 96761-2) derived from the response; None when the result is incomplete, so a partial sum
+    is never charted as a total."""
     site = site or ExportSite()
     response = {
         "type": "QuestionnaireResponse",
@@ -407,7 +408,8 @@ def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, 
             {
                 "coding": [
                     {
-                        "system": f"urn:barthel-kiosk:band-set:{band_set.id}",
+                        # the instrument's id too: two instruments' "normal" bands are not one code
+                        "system": f"urn:barthel-kiosk:band-set:{q.id}:{band_set.id}",
                         "code": r.score.band.id,
                         "display": r.score.band.label["en"],
                     }

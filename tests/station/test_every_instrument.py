@@ -16,6 +16,7 @@ import uuid
 import pytest
 
 from kiosk.core.questionnaire import load_questionnaire
+from kiosk.core.questionnaire.definition import digest
 from tests.instruments import MOOD4, MOOD4_PATIENT
 from tests.kiosk.export.standard import check_fhir
 from tests.station.conftest import PASSWORDS, make_ward
@@ -160,3 +161,42 @@ def test_a_doctor_corrects_and_signs_off_a_non_barthel_result_in_chromium(
     # the plot fits the width at both sizes (no sideways scroll)
     assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
     page.context.close()
+
+
+def test_an_instrument_whose_options_subtract_points_is_stored_shown_and_plotted(sqlite_url, station_factory):
+    """Negative points (an error counted against the total) and a total below zero's reach: the
+    station stores the definition, scores, plots from the lowest total and exports it."""
+    ward = make_ward(sqlite_url)
+    station = station_factory(ward.db_url)
+    patient = "NHC-" + uuid.uuid4().hex[:6]
+    rows = record_patient(MOOD4_PATIENT, patient=patient, questionnaire=load_questionnaire(MOOD4))
+    create = rows[0].payload
+    definition = create["definition"]
+    bored = next(i for i in definition["items"] if i["id"] == "bored")
+    bored["options"][0]["points"] = -5  # "Yes" now subtracts
+    (band_set,) = definition["band_sets"]
+    band_set["bands"][0]["min"] = -5
+    definition["version"] = "negative"
+    create["definition_sha256"] = digest(definition)
+    for row in rows:
+        if row.kind == "record_answer" and row.payload["item_id"] == "bored":
+            row.payload["points"] = -5
+        if row.kind == "finish_session":
+            row.payload |= {"total": 10, "band": "normal"}
+    client = KioskClient(station.url, ward.token, ward.kiosk_id)
+    try:
+        answer = client.sync(rows)
+    finally:
+        client.close()
+    assert answer.status_code == 200 and answer.json().get("parked", []) == [], answer.text
+    staff = Staff(station.url)
+    page = staff.http.get(f"/sessions/{rows[0].session_id}").text
+    assert re.search(r'id="total">10</b> of 20 — <span id="band"[^>]*>normal<', page)
+    assert "(-5)" in page  # the correction form says what "Yes" scores
+    bundle = staff.http.get(f"/sessions/{rows[0].session_id}/export.json").json()
+    check_fhir(bundle)
+    (total,) = _entries(bundle, "Observation")
+    assert total["valueQuantity"]["value"] == 10
+    course = staff.http.get(f"/patients/{patient}").text
+    assert re.findall(r'text-anchor="end">(-?\d+)</text>', course) == ["-5", "7", "20"]
+    staff.http.close()
