@@ -45,12 +45,14 @@ class UiKiosk:
         show_score: bool = False,
         next_patient_after_s: float | None = None,
         model: str = MODEL,
+        questionnaire: str | Path | None = None,
     ) -> None:
         self.next_patient_after_s = next_patient_after_s
         self.clock = SimClock()
         #: the QoS model (``qos_model:``), loaded once as `kiosk run` does
         self.model = load_model(model)
-        self.questionnaire = load_questionnaire()
+        #: the instrument (a file; None: the bundled Barthel)
+        self.questionnaire = load_questionnaire(questionnaire)
         self.store = Store.open(tmp_path / "data")
         self.session = Session(
             self.questionnaire,
@@ -128,7 +130,7 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Callable[..., UiKiosk]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    offer_resume, voice, keyboard, sources, poll_interval, speaker, model)."""
+    offer_resume, voice, keyboard, sources, poll_interval, speaker, model, questionnaire)."""
     made: list[UiKiosk] = []
 
     def make(**options: object) -> UiKiosk:
