@@ -27,6 +27,8 @@ async def test_the_end_screen_and_the_clinicians_detail_describe_the_instrument_
         assert "Total: 20 of 25" in total and "Suggests depression" in total
         await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")
         await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        sessions = kiosk.app.screen.query_one("#sessions", DataTable)
+        assert sessions.get_row_at(0)[-1] == "mood4"  # the list names the instrument of each session
         await pilot.press("enter")
         await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
         screen = kiosk.app.screen
