@@ -11,6 +11,8 @@ from __future__ import annotations
 import csv
 import io
 import re
+import subprocess
+import sys
 import uuid
 
 import pytest
@@ -19,7 +21,7 @@ from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.questionnaire.definition import digest
 from tests.instruments import MOOD4, MOOD4_PATIENT
 from tests.kiosk.export.standard import check_fhir
-from tests.station.conftest import PASSWORDS, make_ward
+from tests.station.conftest import PASSWORDS, ROOT, make_ward
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient, response_in
 
 pytestmark = pytest.mark.slow
@@ -199,4 +201,38 @@ def test_an_instrument_whose_options_subtract_points_is_stored_shown_and_plotted
     assert total["valueQuantity"]["value"] == 10
     course = staff.http.get(f"/patients/{patient}").text
     assert re.findall(r'text-anchor="end">(-?\d+)</text>', course) == ["-5", "7", "20"]
+    staff.http.close()
+
+
+def test_the_kiosks_own_sync_delivers_two_instruments_to_a_postgresql_station(pg_url, station_factory, tmp_path):
+    """Real `kiosk replay --data-dir` processes, one per instrument, configured with the station:
+    the kiosk's own outbox and sync client deliver both results, which the station lists and
+    exports each with its own instrument."""
+    ward = make_ward(pg_url)
+    station = station_factory(ward.db_url)
+    data = tmp_path / "data"
+    link = f"station: {{url: '{station.url}', token: '{ward.token}', kiosk_id: {ward.kiosk_id}}}\n"
+    for name, extra, script in (
+        ("barthel", "", PATIENTS / "barthel1.yaml"),
+        ("mood", f"questionnaire: {MOOD4}\n", MOOD4_PATIENT),
+    ):
+        config = tmp_path / f"{name}.yaml"
+        config.write_text(link + extra, encoding="utf-8")
+        ran = subprocess.run(
+            [sys.executable, "-m", "kiosk", "replay", str(script), "--data-dir", str(data), "--config", str(config)],
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+            timeout=300,
+        )
+        assert ran.returncode == 0 and ran.stderr == "", ran.stderr  # delivered before it exited
+    staff = Staff(station.url)
+    inbox = staff.http.get("/inbox").text
+    assert "20/25 · suggests" in inbox and "100/100 · independent" in inbox
+    (mood,) = re.findall(r'data-session="(\w+)">\s*<a[^>]*><b>TB-0900</b>', inbox)
+    page = staff.http.get(f"/sessions/{mood}")
+    assert page.status_code == 200 and MOOD_TITLE in page.text
+    bundle = staff.http.get(f"/sessions/{mood}/export.json").json()
+    check_fhir(bundle)
+    assert response_in(bundle)["questionnaire"].split("|")[0].endswith(":questionnaire:mood4-en")
     staff.http.close()
