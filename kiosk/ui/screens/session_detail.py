@@ -182,7 +182,7 @@ class SessionDetailScreen(ClinicianScreen):
             path = save_png(
                 plot_data(self.stored),
                 self._export_path(".metrics.png"),
-                f"Session {self.stored.id}, patient {self.stored.patient_id}",
+                f"{self._title()}: session {self.stored.id}, patient {self.stored.patient_id}",
             )
         except OSError as error:
             self._done(f"Saving the plot failed: {error}")
