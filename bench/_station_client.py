@@ -51,6 +51,7 @@ def record_patient(
     export: dict[str, str] | None = None,
     data_dir: Path | None = None,
     visit: str | None = None,
+    questionnaire: Any = None,
 ) -> list[Row]:
     """The outbox rows a kiosk writes while a scripted patient runs: a real session and QoS engine
     on the kiosk's real :class:`kiosk.store.database.Store` with a station configured, its outbox read
@@ -63,13 +64,13 @@ def record_patient(
     from kiosk.commands.replay import load_script, run_script
     from kiosk.store.database import DB_NAME, Store
 
-    loaded = load_script(script)
+    loaded = load_script(script, questionnaire)
     if patient is not None:
         loaded = replace(loaded, patient=patient)
     kept = contextlib.nullcontext(str(data_dir)) if data_dir is not None else tempfile.TemporaryDirectory()
     with kept as directory:
         with Store.open(directory, outbox=True, export=export) as store:
-            run_script(loaded, store=store, visit=visit)
+            run_script(loaded, questionnaire, store=store, visit=visit)
         with sqlite3.connect(Path(directory) / DB_NAME) as connection:
             stored = connection.execute("SELECT kind, session_id, payload, at FROM outbox ORDER BY seq").fetchall()
     rows, t = [], 0.0

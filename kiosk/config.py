@@ -25,7 +25,7 @@ Example ``config.yaml`` (every key optional)::
     kiosk_id: ward3-bed2              # this kiosk (default: the host name): exports and the station
     fhir:                             # FHIR identity of this site's exports (defaults: urn:barthel-kiosk:...)
       patient_system: https://hosp-north.example/sid/kiosk-patient
-      questionnaire_url: https://hosp-north.example/fhir/Questionnaire/barthel
+      questionnaire_url: https://hosp-north.example/fhir/Questionnaire/{id}   # {id}: each instrument's id
       identifier_system: https://hosp-north.example/sid/kiosk-result
       device_system: https://hosp-north.example/sid/kiosk
     interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it

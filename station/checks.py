@@ -136,7 +136,8 @@ def check_definition(definition: Any, where: str) -> Questionnaire:
     for item in q.items:
         text(item.id, f"{where}.items.id", ID_MAX, empty=False)
         for option in item.options:
-            integer(option.points, f"{where}.items.{item.id}.points", 0, 1000)
+            # any integer an instrument scores, negative ones too (errors counted against a total)
+            integer(option.points, f"{where}.items.{item.id}.points", -1000, 1000)
     maps: list[tuple[str, Mapping[str, str]]] = [("title", q.title)]
     maps += [(f"items.{i.id}.{part}", getattr(i, part)) for i in q.items for part in ("text", "spoken")]
     maps += [(f"items.{i.id}.options.{o.number}.label", o.label) for i in q.items for o in i.options]
@@ -292,7 +293,7 @@ def _event(p: Mapping[str, Any], where: str, q: Questionnaire | None) -> None:
 def _finish(p: Mapping[str, Any], where: str, q: Questionnaire | None) -> None:
     iso_time(p["finished_at"], f"{where}.finished_at")
     if "total" in p:
-        integer(p["total"], f"{where}.total", 0, 100000)
+        integer(p["total"], f"{where}.total", -100000, 100000)
     if "complete" in p:
         flag(p["complete"], f"{where}.complete")
     if p.get("band") is not None:

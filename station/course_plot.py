@@ -1,5 +1,7 @@
 """A patient's course as a server-rendered SVG step plot per instrument: the total of each signed
-or waiting visit over calendar time, with the questionnaire's bands shaded behind.
+or waiting visit over calendar time, with the questionnaire's bands shaded behind. The y axis spans
+the instrument's own total range (:attr:`Questionnaire.total_range`: 0-15, 0-8, -10-30...), so each
+instrument plots on its own scale.
 
 Steps, not lines: a total holds until the next visit measures it again, and a line between visits
 would invent values nobody measured. Incomplete visits have no total and are not drawn; a visit
@@ -26,10 +28,15 @@ def _when(result: Result) -> datetime:
 def course_svg(q: Questionnaire, results: list[Result]) -> str:
     """The plot of ``results`` for questionnaire ``q`` as an inline ``<svg>`` (a note when no visit
     has a total yet)."""
+    name = q.title.get("en") or q.id
     points = [(r, _when(r)) for r in results if r.questionnaire_id == q.id and r.total is not None]
     if not points:
-        return f'<p class="muted">No complete {escape(q.id)} total yet.</p>'
-    top = max(r.max_total for r, _ in points) or 1
+        return f'<p class="muted">No complete {escape(name)} total yet.</p>'
+    low, high = q.total_range
+    low = min([low] + [r.total or 0 for r, _ in points])
+    high = max([high] + [r.total or 0 for r, _ in points])
+    if high == low:
+        high = low + 1
     first, last = points[0][1], points[-1][1]
     span = max((last - first).total_seconds(), 1.0)
     t_end = span * 1.08 if len(points) > 1 else 1.0
@@ -39,20 +46,22 @@ def course_svg(q: Questionnaire, results: list[Result]) -> str:
         return LEFT + plot_w * ((when - first).total_seconds() / t_end if len(points) > 1 else 0.5)
 
     def y(total: float) -> float:
-        return TOP + plot_h * (1 - total / top)
+        return TOP + plot_h * (high - total) / (high - low)
 
     parts = [
         f'<svg class="course-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
-        f'aria-label="{escape(q.id)} totals over time" xmlns="http://www.w3.org/2000/svg">'
+        f'aria-label="{escape(name)} totals over time" xmlns="http://www.w3.org/2000/svg">'
     ]
     for index, band in enumerate(q.bands_named(None).bands):
-        y1, y2 = y(min(band.max, top) + 0.5), y(max(band.min, 0) - 0.5)
+        if band.max < low or band.min > high:
+            continue
+        y1, y2 = y(min(band.max + 0.5, high)), y(max(band.min - 0.5, low))
         parts.append(
             f'<rect x="{LEFT}" y="{max(TOP, y1):.1f}" width="{plot_w}" '
             f'height="{max(0.0, min(TOP + plot_h, y2) - max(TOP, y1)):.1f}" '
             f'fill="{BAND_FILLS[index % len(BAND_FILLS)]}"><title>{escape(band.id)}</title></rect>'
         )
-    for tick in (0, top // 2, top):
+    for tick in sorted({low, (low + high) // 2, high}):
         parts.append(f'<text x="{LEFT - 6}" y="{y(tick) + 4:.1f}" text-anchor="end">{tick}</text>')
     steps: list[str] = []
     for index, (result, when) in enumerate(points):

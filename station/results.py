@@ -48,6 +48,13 @@ class Result:
     simulated: bool
     visit: str
     order_id: str | None
+    #: the instrument's title as the session's captured definition gives it ("" if it has none)
+    title: str = ""
+
+    @property
+    def instrument(self) -> str:
+        """What a clinician reads for the instrument: its title, else its id."""
+        return self.title or self.questionnaire_id
 
     @property
     def review_words(self) -> str:
@@ -120,6 +127,7 @@ def results_of(engine: Engine, q: Questionnaire, rows: Sequence[Any]) -> list[Re
                     stored.simulated,
                     kind,
                     order_id,
+                    (ran.title.get(stored.language) or ran.title.get("en") or "") if ran else "",
                 )
             )
     return found

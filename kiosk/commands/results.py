@@ -4,7 +4,9 @@ Without SESSION: list stored sessions; exports then cover every stored session. 
 id, a unique prefix, or the CSV's tagged ``S:id``), exports cover those sessions: ``--fhir`` one
 FHIR R4 transaction Bundle (Questionnaires, kiosk Device, responses, totals; see
 :mod:`kiosk.export.fhir`), ``--csv`` the long CSV and ``--csv-wide`` one row per session (see
-:mod:`kiosk.export.tables`). Each session is described with what it captured as it started (its
+:mod:`kiosk.export.tables`), one table per instrument: sessions of several instruments (a battery)
+give ``FILE-<id>.csv`` each, since a wide table's columns are one instrument's items.
+Each session is described with what it captured as it started (its
 questionnaire definition and its site, kiosk and FHIR systems, :mod:`kiosk.export.captured`), whatever
 the questionnaire file and configuration say today; ``--fhir-questionnaire`` writes today's
 questionnaire. The listing ends with the outbox: changes waiting for the ward station and those
@@ -18,7 +20,9 @@ Exports are written readable by their owner only. Exit 2 on an unknown session o
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+from pathlib import Path
 
 from kiosk.config import ConfigError, configured_questionnaire, load_config
 from kiosk.core.questionnaire import QuestionnaireError
@@ -35,7 +39,7 @@ from kiosk.export import (
     write_export,
     write_json,
 )
-from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, wide_csv_of
+from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, wide_csv_tables
 from kiosk.export.opening import in_force_of, open_store
 from kiosk.store.database import StorageError, StoredSession
 
@@ -94,6 +98,18 @@ def _show(stored: StoredSession) -> None:
         print("QoS at the end: " + ", ".join(f"{k} {v:.3f}" for k, v in last.metrics.items()))
 
 
+def wide_paths(file: str, instruments: list[str]) -> dict[Path, str]:
+    """Where ``--csv-wide FILE`` writes each instrument's table: FILE itself for one instrument;
+    for several, ``STEM-<id>SUFFIX`` beside it (``wide.csv`` -> ``wide-barthel.csv``,
+    ``wide-gds15.csv``): a wide table has one instrument's item columns."""
+    path = Path(file)
+    if len(instruments) == 1:
+        return {path: instruments[0]}
+    return {
+        path.with_name(f"{path.stem}-{re.sub(r'[^A-Za-z0-9_.-]', '_', qid)}{path.suffix}"): qid for qid in instruments
+    }
+
+
 def main(argv: list[str]) -> int:
     """List, show or export stored sessions; returns the exit status."""
     parser = argparse.ArgumentParser(
@@ -115,7 +131,12 @@ def main(argv: list[str]) -> int:
     )
     parser.add_argument("--language", choices=languages(), help="language of --fhir-questionnaire")
     parser.add_argument("--csv", metavar="FILE", help="write the sessions as CSV, rows per item")
-    parser.add_argument("--csv-wide", metavar="FILE", help="write the sessions as CSV, one row per session")
+    parser.add_argument(
+        "--csv-wide",
+        metavar="FILE",
+        help="write the sessions as CSV, one row per session; sessions of several instruments: "
+        "one file per instrument, FILE's name with -ID before its suffix",
+    )
     parser.add_argument("--bom", action="store_true", help="start CSV files with a UTF-8 byte-order mark")
     parser.add_argument("--data-dir", help="data directory (default: from the kiosk configuration)")
     args = parser.parse_args(argv)
@@ -148,15 +169,23 @@ def main(argv: list[str]) -> int:
             if args.csv:
                 write_export(args.csv, csv_of(chosen, bom=args.bom, empty=empty))
             if args.csv_wide:
-                write_export(args.csv_wide, wide_csv_of(chosen, bom=args.bom, empty=empty))
+                tables = wide_csv_tables(chosen, bom=args.bom, empty=empty)
+                for path, qid in wide_paths(args.csv_wide, list(tables)).items():
+                    write_export(path, tables[qid])
+                if len(tables) > 1:
+                    print(
+                        "wide CSV: one table per instrument: "
+                        + ", ".join(str(p) for p in wide_paths(args.csv_wide, list(tables))),
+                        file=sys.stderr,
+                    )
             if not refs:
                 summaries = store.sessions()
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
                 for s in summaries:
                     print(
-                        f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.label:<9} {s.language}  "
-                        f"{s.answered} answered, {s.not_answered} not answered"
+                        f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "
+                        f"{s.language}  {s.answered} answered, {s.not_answered} not answered"
                     )
                 waiting, parked = store.outbox_waiting()
                 if waiting or parked:

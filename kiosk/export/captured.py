@@ -24,7 +24,7 @@ from kiosk.core.review import Review
 from kiosk.export.result import ExportError, ExportSite, site_from_identity
 from kiosk.store.records import StoredSession
 
-__all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of"]
+__all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of", "wide_csv_tables"]
 
 
 @lru_cache(maxsize=64)
@@ -152,6 +152,30 @@ def csv_of(
     )
 
 
+def wide_csv_tables(
+    sessions: Sequence[StoredSession],
+    reviews: Sequence[Review | None] | None = None,
+    kiosk_id: str | None = None,
+    *,
+    bom: bool = False,
+    empty: Empty | None = None,
+) -> dict[str, str]:
+    """The wide CSV (:func:`kiosk.export.wide_csv_text`) of ``sessions`` as one table per
+    instrument, by questionnaire id in order of first appearance: one row per session under that
+    instrument's own item columns (the versions of one instrument share a table, under the
+    union of their columns). A researcher's table never mixes a Barthel row with a GDS row."""
+    from kiosk.export.tables import wide_csv_text
+
+    groups = _groups(sessions, reviews, kiosk_id)
+    if not groups:
+        q, site = _empty(empty, kiosk_id)
+        return {q.id: wide_csv_text(q, [], None, site, bom=bom)}
+    texts: dict[str, list[str]] = {}
+    for q, site, group, found in groups:
+        texts.setdefault(q.id, []).append(wide_csv_text(q, group, _reviews(found), site))
+    return {qid: ("\ufeff" if bom else "") + _merge_csv(parts) for qid, parts in texts.items()}
+
+
 def wide_csv_of(
     sessions: Sequence[StoredSession],
     reviews: Sequence[Review | None] | None = None,
@@ -160,14 +184,12 @@ def wide_csv_of(
     bom: bool = False,
     empty: Empty | None = None,
 ) -> str:
-    """The wide CSV (:func:`kiosk.export.wide_csv_text`) of ``sessions``: one row each, under the
-    columns of every definition among them."""
-    from kiosk.export.tables import wide_csv_text
-
-    groups = _groups(sessions, reviews, kiosk_id)
-    if not groups:
-        q, site = _empty(empty, kiosk_id)
-        return wide_csv_text(q, [], None, site, bom=bom)
-    return ("\ufeff" if bom else "") + _merge_csv(
-        [wide_csv_text(q, group, _reviews(found), site) for q, site, group, found in groups]
-    )
+    """The wide CSV of ``sessions`` of one instrument (:func:`wide_csv_tables`); ExportError naming
+    the instruments when they ran several, which need a table each."""
+    tables = wide_csv_tables(sessions, reviews, kiosk_id, bom=bom, empty=empty)
+    if len(tables) > 1:
+        raise ExportError(
+            f"these sessions ran {len(tables)} instruments ({', '.join(tables)}): "
+            "the wide CSV is one table per instrument"
+        )
+    return next(iter(tables.values()))

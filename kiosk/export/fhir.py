@@ -111,8 +111,11 @@ def instant(value: str) -> str:
 
 
 def questionnaire_canonical(q: Questionnaire, site: ExportSite, language: str) -> str:
-    """The canonical URL of the questionnaire in one language (without the version)."""
-    return f"{site.questionnaire_url or f'urn:barthel-kiosk:{site.site}:questionnaire:{q.id}'}-{language}"
+    """The canonical URL of the questionnaire in one language (without the version). A site's
+    ``questionnaire_url`` with ``{id}`` in it gives each instrument of a battery its own URL
+    (``.../Questionnaire/{id}``); one without names a single instrument, as it always did."""
+    base = site.questionnaire_url.replace("{id}", q.id) if site.questionnaire_url else ""
+    return f"{base or f'urn:barthel-kiosk:{site.site}:questionnaire:{q.id}'}-{language}"
 
 
 def _text(key: str, texts: Mapping[str, str], language: str) -> dict[str, Any]:
@@ -361,8 +364,9 @@ def observation_status(r: Result) -> str:
 def fhir_total(
     q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
 ) -> dict[str, Any] | None:
-    """The total as an R4 Observation (LOINC 96761-2) derived from the response; None when the
-    result is incomplete, so a partial sum is never charted as a Barthel total."""
+    """The total as an R4 Observation (coded with the instrument's ``total_code``, the Barthel's
+    LOINC 96761-2) derived from the response; None when the result is incomplete, so a partial sum
+    is never charted as a total."""
     site = site or ExportSite()
     response = {
         "type": "QuestionnaireResponse",
@@ -404,7 +408,8 @@ def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, 
             {
                 "coding": [
                     {
-                        "system": f"urn:barthel-kiosk:band-set:{band_set.id}",
+                        # the instrument's id too: two instruments' "normal" bands are not one code
+                        "system": f"urn:barthel-kiosk:band-set:{q.id}:{band_set.id}",
                         "code": r.score.band.id,
                         "display": r.score.band.label["en"],
                     }

@@ -67,6 +67,8 @@ CSV_COLUMNS = [
     "corrected_by",
     "simulated",
     "visit",
+    # last, so the columns before keep their places: which instrument (the versions tell edits apart)
+    "questionnaire",
 ]
 
 

@@ -58,12 +58,14 @@ class Reader:
         rows = self._db.execute(
             "SELECT s.id, s.patient_id, s.started_at, s.finished_at, s.status, s.language,"
             " (SELECT COUNT(*) FROM answers a WHERE a.session_id = s.id),"
-            " (SELECT COUNT(*) FROM not_answered n WHERE n.session_id = s.id), s.simulated, s.interrupted_reason"
-            " FROM sessions s ORDER BY s.started_at DESC, s.rowid DESC"
+            " (SELECT COUNT(*) FROM not_answered n WHERE n.session_id = s.id), s.simulated, s.interrupted_reason,"
+            " s.questionnaire_id FROM sessions s ORDER BY s.started_at DESC, s.rowid DESC"
         ).fetchall()
         return [
-            SessionSummary(id_, patient, started, finished, status, language, answered, missed, bool(simulated), reason)
-            for id_, patient, started, finished, status, language, answered, missed, simulated, reason in rows
+            SessionSummary(
+                id_, patient, started, finished, status, language, answered, missed, bool(simulated), reason, qid
+            )
+            for id_, patient, started, finished, status, language, answered, missed, simulated, reason, qid in rows
         ]
 
     @_reading

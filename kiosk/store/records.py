@@ -26,6 +26,8 @@ class SessionSummary:
     simulated: bool = False
     #: why a session with status "interrupted" stopped ("its kiosk ward3 (process 4242) stopped")
     interrupted_reason: str | None = None
+    #: the instrument it ran (a battery's sessions list side by side)
+    questionnaire_id: str = ""
 
     @property
     def label(self) -> str:

@@ -4,23 +4,27 @@ next visit measures it), only complete totals drawn, a result not yet signed off
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from kiosk.core.questionnaire import load_questionnaire
 from station.course_plot import course_svg
 from station.results import Result
+from tests.instruments import MOOD4
 
 
-def visit(day: int, total: int | None, review: str = "signed_off") -> Result:
+def visit(
+    day: int, total: int | None, review: str = "signed_off", instrument: str = "barthel", top: int = 100
+) -> Result:
     return Result(
         f"s{day}",
         "bed1",
         "NHC-1",
-        "barthel",
+        instrument,
         f"2026-0{day}-01T10:00:00+00:00",
         f"2026-0{day}-01T10:20:00+00:00",
         "finished",
         total,
-        100,
+        top,
         total is not None,
         "moderate" if total else None,
         review,
@@ -42,4 +46,44 @@ def test_totals_are_steps_and_unsigned_results_hollow():
 
 
 def test_a_patient_without_a_complete_total_gets_a_sentence():
-    assert course_svg(load_questionnaire(), [visit(1, None)]) == '<p class="muted">No complete barthel total yet.</p>'
+    assert (
+        course_svg(load_questionnaire(), [visit(1, None)])
+        == '<p class="muted">No complete Barthel Index total yet.</p>'
+    )
+
+
+def _ticks(svg: str) -> list[str]:
+    return re.findall(r'<text x="\d+" y="[\d.]+" text-anchor="end">(-?\d+)</text>', svg)
+
+
+def _ys(svg: str) -> list[float]:
+    return [float(v) for v in re.findall(r'<circle cx="[\d.]+" cy="([\d.]+)"', svg)]
+
+
+def test_each_instrument_plots_on_its_own_scale():
+    barthel = course_svg(load_questionnaire(), [visit(1, 20)])
+    mood = load_questionnaire(MOOD4)
+    own = course_svg(mood, [visit(1, 20, instrument="mood4", top=25)])
+    assert _ticks(barthel) == ["0", "50", "100"] and _ticks(own) == ["0", "12", "25"]
+    # 20 of 100 sits low on the Barthel's axis, 20 of 25 high on the mood scale's
+    assert _ys(own)[0] < _ys(barthel)[0]
+    assert 'aria-label="Mood check (4 items) totals over time"' in own and "20/25" in own
+    # both of its bands are shaded, and nothing is drawn outside the plot
+    assert re.findall(r"<title>(\w+)</title></rect>", own) == ["normal", "suggests"]
+
+
+def test_a_scale_with_negative_totals_keeps_its_points_inside_the_plot():
+    """An instrument whose options subtract points (totals -8 to 4 here) has an axis from its
+    lowest to its highest total, not from 0."""
+    mood = load_questionnaire(MOOD4)
+    negative = replace(
+        mood,
+        items=tuple(
+            replace(item, options=tuple(replace(o, points=o.points - 2) for o in item.options)) for item in mood.items
+        ),
+    )
+    assert negative.total_range == (-8, 17)
+    svg = course_svg(negative, [visit(1, -8, instrument="mood4"), visit(2, 17, instrument="mood4")])
+    assert _ticks(svg) == ["-8", "4", "17"]
+    low, high = _ys(svg)
+    assert high < low and 12 <= high and low <= 12 + 220 - 12 - 34

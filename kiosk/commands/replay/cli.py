@@ -22,7 +22,10 @@ def _print_human(result: ReplayResult) -> None:
     band = f", {score['band']}" if score["band"] else ""
     status = "complete" if score["complete"] else f"incomplete ({len(data['not_answered'])} not answered)"
     print(f"{data['script']}: patient {data['patient']} ({data['language']}, answered by {data['answered_by']})")
-    print(f"score {score['total']}/{score['max_total']} {status}{band}; simulated {data['simulated_s']} s")
+    print(
+        f"{data['instrument']} total {score['total']}/{score['max_total']} {status}{band}; "
+        f"simulated {data['simulated_s']} s"
+    )
     for answer in data["answers"]:
         print(
             f"  {answer['item']:<10} option {answer['option']}  {answer['points']:>2} points  "

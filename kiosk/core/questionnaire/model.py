@@ -53,7 +53,7 @@ class Option:
 
 @dataclass(frozen=True)
 class Item:
-    """One scored Barthel item (feeding, bathing, ...)."""
+    """One scored item of an instrument (the Barthel's feeding, a mood scale's question, ...)."""
 
     id: str
     #: 1-based position in the questionnaire
@@ -84,6 +84,11 @@ class Item:
     def max_points(self) -> int:
         """The most this item can score."""
         return max(self.points)
+
+    @property
+    def min_points(self) -> int:
+        """The least this item can score."""
+        return min(self.points)
 
 
 @dataclass(frozen=True)
@@ -252,6 +257,12 @@ class Questionnaire:
     def with_band_set(self, band_set: str) -> Questionnaire:
         """A copy that scores with another of its band sets; ``KeyError`` if there is none of that id."""
         return replace(self, band_set=self.bands_named(band_set).id)
+
+    @property
+    def total_range(self) -> tuple[int, int]:
+        """The lowest and the highest total a complete answer can reach: what a chart's axis of
+        this instrument spans (its own scale, never the Barthel's 0-100)."""
+        return sum(i.min_points for i in self.items), sum(i.max_points for i in self.items)
 
     def band_for(self, total: int, band_set: str | None = None) -> Band | None:
         """The band containing ``total`` in ``band_set`` (None: the set scoring uses)."""

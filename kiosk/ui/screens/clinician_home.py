@@ -89,7 +89,7 @@ class ClinicianHomeScreen(ClinicianScreen):
                 "Interrupted tests (continue one only with that patient in front of the kiosk):"
             )
         table = self.query_one("#sessions", DataTable)
-        table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered")
+        table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered", "instrument")
         self._fill_sessions()
         self.refresh_session()
         self.set_interval(REFRESH_S, self.refresh_session)
@@ -98,7 +98,10 @@ class ClinicianHomeScreen(ClinicianScreen):
         table = self.query_one("#sessions", DataTable)
         store = self.app.controller.store  # type: ignore[attr-defined]
         for s in store.sessions() if store is not None else []:
-            row = (s.id, s.patient_id, s.started_at[:19], s.label, s.language, str(s.answered), str(s.not_answered))
+            row = (
+                *(s.id, s.patient_id, s.started_at[:19], s.label, s.language),
+                *(str(s.answered), str(s.not_answered), s.questionnaire_id),
+            )
             if s.id in table.rows:
                 for column, value in zip(table.columns, row):
                     table.update_cell(s.id, column, value)

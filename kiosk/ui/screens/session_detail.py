@@ -62,7 +62,7 @@ class SessionDetailScreen(ClinicianScreen):
             yield from staff_nav("Back")
         with VerticalScroll(classes="clinician staff-body", id="detail-body"):
             yield Static(
-                f"Session {s.id}  patient {s.patient_id}  {s.status}  language {s.language}  "
+                f"Session {s.id}  {self._title()}  patient {s.patient_id}  {s.status}  language {s.language}  "
                 f"answered by {s.answered_by.value}",
                 classes="heading",
             )
@@ -110,13 +110,18 @@ class SessionDetailScreen(ClinicianScreen):
                     a.channel.value,
                 )
 
+    def _title(self) -> str:
+        """The instrument's own title (the session's captured one), so no line assumes the Barthel."""
+        title = self.q.title
+        return title.get(self.stored.language) or title.get("en") or self.q.id
+
     def _total_line(self) -> str:
         q = self.q
         try:
             score = rescore(q, self.stored)
         except ExportError as error:
             return f"Cannot score: {error}"
-        if not score.complete:  # a partial sum is no Barthel total: never shown as one
+        if not score.complete:  # a partial sum is no total: never shown as one
             return (
                 f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
                 f"(the answered ones add up to {score.total})"
@@ -177,7 +182,7 @@ class SessionDetailScreen(ClinicianScreen):
             path = save_png(
                 plot_data(self.stored),
                 self._export_path(".metrics.png"),
-                f"Session {self.stored.id}, patient {self.stored.patient_id}",
+                f"{self._title()}: session {self.stored.id}, patient {self.stored.patient_id}",
             )
         except OSError as error:
             self._done(f"Saving the plot failed: {error}")

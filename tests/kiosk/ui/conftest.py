@@ -48,12 +48,14 @@ class UiKiosk:
         show_score: bool = False,
         next_patient_after_s: float | None = None,
         model: str = MODEL,
+        questionnaire: str | Path | None = None,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
             data_dir=tmp_path / "data",
             adaptation=adaptation,
             qos_model=model,  # loaded once, as `kiosk run` does
+            questionnaire=Path(questionnaire) if questionnaire is not None else None,
             next_patient_after_s=next_patient_after_s,
             show_score_to_patient=show_score,
         )
@@ -112,7 +114,7 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model)."""
+    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model, questionnaire)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
