@@ -47,7 +47,7 @@ async def confirm_page(request: Request) -> Response:
     except ExportError as exc:
         return PlainTextResponse(f"session {session_id} cannot be described: {exc}", status_code=422)
     score = validation.corrected(stored, q, current)["score"]
-    language = stored.language  # type: ignore[attr-defined]
+    language = stored.language
     labels = {item.id: item.text.get(language) or item.text.get("en") or item.id for item in q.items}
     # what the result will be called once signed: the one review-state function's answer, so the
     # step never says "amended" for changes that came back to the kiosk's answers

@@ -174,8 +174,9 @@ def _reachable_totals(items: list[tuple[int, dict[str, Any]]]) -> set[int] | Non
     totals = {0}
     for _, item in items:
         options = item.get("options")
-        points = {o.get("points") for o in options if isinstance(o, dict)} if isinstance(options, list) else set()
-        if not all(isinstance(p, int) and not isinstance(p, bool) and p >= 0 and p % 5 == 0 for p in points):
+        given = [o.get("points") for o in options if isinstance(o, dict)] if isinstance(options, list) else []
+        points = {p for p in given if isinstance(p, int) and not isinstance(p, bool) and p >= 0 and p % 5 == 0}
+        if len(points) != len(set(map(repr, given))):
             return None
         if points:
             totals = {t + p for t in totals for p in points}
@@ -197,7 +198,7 @@ def _check_bands(
     block = data.get("bands")
     if not isinstance(block, dict):
         return
-    sets = block.get("sets") if isinstance(block.get("sets"), dict) else {}
+    sets: dict[str, Any] = block["sets"] if isinstance(block.get("sets"), dict) else {}
     default = block.get("default")
     if isinstance(default, str) and sets and default not in sets:
         add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")
