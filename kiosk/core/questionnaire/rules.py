@@ -147,6 +147,10 @@ def check_scoring(
     """The formula parses and gives one whole number in its range on sample answers; subscales
     name existing scored items once each, with ids of their own."""
     formula = _formula(data)
+    scoring = data.get("scoring")
+    total = scoring.get("total") if isinstance(scoring, dict) else None
+    if isinstance(total, str) and total != "sum":
+        add(("scoring", "total"), f"scoring.total is 'sum' or a formula ({{fhirpath, min, max}}), not {total!r}")
     if formula is not None:
         path = ("scoring", "total")
         low, high = formula.get("min"), formula.get("max")
@@ -158,7 +162,6 @@ def check_scoring(
             add(path + ("fhirpath",), f"scoring.total.fhirpath is not valid FHIRPath ({why})")
         elif isinstance(expression, str) and _integer(low) and _integer(high) and low <= high:
             _try_formula(expression, low, high, _samples(data, items) or [], add)
-    scoring = data.get("scoring")
     subscales = scoring.get("subscales") if isinstance(scoring, dict) else None
     by_id = {item.get("id"): item for _, item in items}
     seen: set[Any] = set()
