@@ -65,6 +65,17 @@ from kiosk.core.questionnaire import Code, Questionnaire
 from kiosk.core.review import Review, ReviewState
 from kiosk.core.visits import visit_of
 from kiosk.core.words import Table
+from kiosk.export.calculated import (
+    calculated,
+    entry_answer,
+    entry_fields,
+    staff_mark,
+    subscale_code,
+    subscale_components,
+    subscale_expression,
+    subscale_items,
+    total_expression,
+)
 from kiosk.export.result import (
     TOTAL_LINK,
     ExportError,
@@ -79,7 +90,6 @@ ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
 TRANSLATION = "http://hl7.org/fhir/StructureDefinition/translation"
 SIGNATURE = "http://hl7.org/fhir/StructureDefinition/questionnaireresponse-signature"
-CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
 #: ASTM E1762-95 "Verification Signature": the signer checked the content is complete and correct
 VERIFICATION = {
     "system": "urn:iso-astm:E1762-95:2013",
@@ -156,12 +166,6 @@ def wording(
     return {"url": WORDING, "extension": [{"url": name, "valueString": text} for name, text in parts]}
 
 
-def _total_expression(q: Questionnaire) -> str:
-    """The total as FHIRPath: the sum of the answers' weights, and nothing while an item is unanswered."""
-    answered = f"%resource.item.where(linkId != '{TOTAL_LINK}' and answer.exists())"
-    return f"iif({answered}.count() = {len(q.items)}, {answered}.answer.value.weight().sum(), {{}})"
-
-
 def _computable_name(title: str) -> str:
     """A title as R4 wants a computable name (invariant que-0): letters and digits, a capital first."""
     name = "".join(word[:1].upper() + word[1:] for word in re.findall(r"[A-Za-z0-9]+", title)).lstrip("0123456789")
@@ -176,7 +180,10 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
     items = []
     for item in q.items:
         entry: dict[str, Any] = {
-            "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+            "extension": [
+                wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken),
+                *staff_mark(item),
+            ],
             "linkId": item.id,
             **_text("text", item.text, language),
             "type": "choice",
@@ -184,6 +191,11 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
         }
         if item.code:
             entry["code"] = [_coding(item.code)]
+        if item.entry is not None:
+            fields = entry_fields(item)
+            entry |= {"type": fields["type"], "extension": entry["extension"] + fields["extension"]}
+            items.append(entry)
+            continue
         entry["answerOption"] = [
             {
                 "extension": [
@@ -196,10 +208,19 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
             for option in item.options
         ]
         items.append(entry)
+    for subscale in q.subscales:
+        items.append(
+            {
+                "extension": [calculated(subscale_expression(subscale))],
+                "linkId": subscale.id,
+                **_text("text", subscale.label, language),
+                "code": [subscale_code(q, subscale)],
+                "type": "integer",
+                "readOnly": True,
+            }
+        )
     total: dict[str, Any] = {
-        "extension": [
-            {"url": CALCULATED, "valueExpression": {"language": "text/fhirpath", "expression": _total_expression(q)}}
-        ],
+        "extension": [calculated(total_expression(q))],
         "linkId": TOTAL_LINK,
         **_text("text", {lang: TOTAL_TEXT.get(lang, TOTAL_TEXT["en"]) for lang in q.languages}, language),
         "type": "integer",
@@ -279,8 +300,17 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
     changed = {c.item_id for c in r.review.corrections}
     items = []
     for item in q.items:
+        if item.entry is not None and item.id in r.values:
+            items.append(
+                {
+                    "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+                    "linkId": item.id,
+                    "text": item.text[language],
+                    "answer": [entry_answer(item, r.values[item.id])],
+                }
+            )
         if item.id not in r.options:
-            continue  # unanswered: left out, as SDC does
+            continue  # unanswered (or a number, above): left out, as SDC does
         option = item.option(r.options[item.id])
         entry: dict[str, Any] = {"id": item.id} if item.id in changed else {}  # a Provenance's targetElement
         entry |= {
@@ -295,6 +325,7 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
             ],
         }
         items.append(entry)
+    items += subscale_items(q, r, language)
     if r.complete:
         items.append(
             {
@@ -398,6 +429,9 @@ def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, 
             "code": "{score}",
         },
     }
+    components = subscale_components(q, r, language)
+    if components:
+        observation["component"] = components
     band_set = q.bands_named(r.score.band_set)
     if r.score.band is not None:
         observation["interpretation"] = [
