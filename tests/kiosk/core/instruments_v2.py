@@ -17,6 +17,7 @@ version: "1"
 source: "A test instrument (no publication)"
 title: {{en: {title}, es: {title}}}
 languages: [en, es]
+total_code: {{system: "urn:test:total", code: "{id}", display: "{title} total"}}
 timing: {{attempt_window_s: 20}}
 """
 
