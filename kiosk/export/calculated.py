@@ -68,7 +68,10 @@ def entry_fields(item: Item) -> dict[str, Any]:
     def number(value: float) -> float | int:
         return int(value) if kind == "integer" else value
 
-    extension = [{"url": MIN_VALUE, bound: number(item.entry.min)}, {"url": MAX_VALUE, bound: number(item.entry.max)}]
+    extension: list[dict[str, Any]] = [
+        {"url": MIN_VALUE, bound: number(item.entry.min)},
+        {"url": MAX_VALUE, bound: number(item.entry.max)},
+    ]
     if item.entry.unit:
         extension.append({"url": UNIT, "valueCoding": {"system": UCUM, "code": item.entry.unit}})
     return {"type": kind, "extension": extension}

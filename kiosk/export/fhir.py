@@ -47,6 +47,10 @@ Choices, each from the R4 specification:
 - **Test data**: a session stored by ``kiosk replay`` (a scripted patient) is labelled ``HTEST``
   (``meta.security``, "test health data") on its response and total, so no EHR takes it for a
   patient's result.
+- **Format v2** (:mod:`kiosk.export.calculated`): the total item's ``calculatedExpression`` is
+  the instrument's FHIRPath formula when it has one; subscales are calculated items and
+  components of the total Observation; staff items carry the ``answered-by`` extension, and a
+  number staff enter is an ``integer``/``decimal`` item with its range and unit.
 - **Bundle** (transaction, :mod:`kiosk.export.bundle`): the Questionnaires used and the kiosk
   Device are conditional creates (``ifNoneExist`` on url+version / identifier). Results not yet
   signed off are conditional creates on their identifier, so re-sending never duplicates and never
@@ -288,10 +292,15 @@ def _authored(r: Result) -> str:
 
 
 def fhir_response(
-    q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
+    q: Questionnaire,
+    stored: StoredSession,
+    review: Review | None = None,
+    site: ExportSite | None = None,
+    values: Mapping[str, float] | None = None,
 ) -> dict[str, Any]:
-    """A stored session (with its clinician's review, if any) as an R4 QuestionnaireResponse."""
-    return response_of(q, result(q, stored, review), site or ExportSite())
+    """A stored session (with its clinician's review, if any, and the numbers staff entered for
+    its ``input`` items, ``values``) as an R4 QuestionnaireResponse."""
+    return response_of(q, result(q, stored, review, values), site or ExportSite())
 
 
 def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
@@ -390,7 +399,11 @@ def observation_status(r: Result) -> str:
 
 
 def fhir_total(
-    q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
+    q: Questionnaire,
+    stored: StoredSession,
+    review: Review | None = None,
+    site: ExportSite | None = None,
+    values: Mapping[str, float] | None = None,
 ) -> dict[str, Any] | None:
     """The total as an R4 Observation (LOINC 96761-2) derived from the response; None when the
     result is incomplete, so a partial sum is never charted as a Barthel total."""
@@ -399,7 +412,7 @@ def fhir_total(
         "type": "QuestionnaireResponse",
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
     }
-    return total_of(q, result(q, stored, review), site, response)
+    return total_of(q, result(q, stored, review, values), site, response)
 
 
 def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
