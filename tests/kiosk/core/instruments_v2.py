@@ -112,6 +112,22 @@ STAFFED = instrument(
     f'scoring:\n  total:\n    fhirpath: "{FORMULA}"\n    min: -1\n    max: 5\n',
 )
 
+#: MNA-SF-like: staff measure weight and height (decimals); the formula turns the BMI into points
+HEIGHT_M = "(%resource.item.where(linkId = 'height').answer.value / 100)"
+BMI = f"(%resource.item.where(linkId = 'weight').answer.value / ({HEIGHT_M} * {HEIGHT_M}))"
+BMI_FORMULA = (
+    "%resource.item.where(linkId = 'intake').answer.value.weight().sum() + "
+    f"iif({BMI} < 19, 0, iif({BMI} < 21, 1, iif({BMI} < 23, 2, 3)))"
+)
+MEASURED = instrument(
+    "measured",
+    choice("intake", [0, 1, 2])
+    + staff_input("weight", "decimal", 20, 250, "kg")
+    + staff_input("height", "decimal", 100, 220, "cm"),
+    bands(("malnourished", 0, 1), ("at_risk", 2, 3), ("normal", 4, 5)),
+    f'scoring:\n  total:\n    fhirpath: "{BMI_FORMULA}"\n    min: 0\n    max: 5\n',
+)
+
 
 def write(tmp_path: Path, text: str, name: str = "instrument.yaml") -> Path:
     path = tmp_path / name

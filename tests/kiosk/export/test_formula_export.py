@@ -19,7 +19,7 @@ from kiosk.export import ExportSite, fhir_questionnaire, result
 from kiosk.export.calculated import ANSWERED_BY, CALCULATED, MAX_VALUE, MIN_VALUE, UNIT
 from kiosk.export.fhir import response_of, total_of
 from kiosk.store.records import StoredSession
-from tests.kiosk.core.instruments_v2 import GDS, MIXED, STAFFED, load
+from tests.kiosk.core.instruments_v2 import GDS, MEASURED, MIXED, STAFFED, load
 from tests.prerequisites import JS, ensure_npm_packages
 
 from .standard import check_fhir
@@ -170,3 +170,19 @@ def test_yes_no_answers_are_loinc_yes_and_no_with_their_weights(tmp_path):
     total = expressions(questionnaire)["total"]
     assert fhirpath_js([total], response, questionnaire) == [[2]]
     assert evaluate(q, total, response) == [2]
+
+
+@pytest.mark.parametrize(
+    ("weight", "height", "total"),
+    [(50.0, 170.0, 2), (60.5, 170.0, 3), (65.0, 170.0, 4), (80.0, 165.5, 5), (20.0, 220.0, 2)],
+)
+def test_a_formula_over_decimals_staff_measured_agrees_everywhere(tmp_path, weight, height, total):
+    """BMI from weight (kg) and height (cm), as MNA-SF's F1: 17.3 -> 0, 20.9 -> 1, 22.5 -> 2, >= 23 -> 3."""
+    q = load(tmp_path, MEASURED)
+    questionnaire, response, observation, r = exported(q, {"intake": 3}, {"weight": weight, "height": height})
+    assert (r.complete, r.score.total, observation["valueQuantity"]["value"]) == (True, total, total)
+    items = {i["linkId"]: i["answer"] for i in response["item"]}
+    assert items["weight"] == [{"valueDecimal": weight}] and items["height"] == [{"valueDecimal": height}]
+    expression = expressions(questionnaire)["total"]
+    assert fhirpath_js([expression], response, questionnaire) == [[total]]
+    assert evaluate(q, expression, response) == [total]

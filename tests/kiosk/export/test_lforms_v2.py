@@ -9,7 +9,7 @@ import pytest
 
 from kiosk.export import fhir_questionnaire, result
 from kiosk.export.fhir import response_of
-from tests.kiosk.core.instruments_v2 import GDS, MIXED, STAFFED, load
+from tests.kiosk.core.instruments_v2 import GDS, MEASURED, MIXED, STAFFED, load
 
 from .test_formula_export import SITE, stored
 from .test_lforms import PATIENCE_MS, RENDER, lforms_page  # noqa: F401 - the page fixture
@@ -25,6 +25,7 @@ pytestmark = pytest.mark.slow
         (MIXED, {"pain": 1, "steps": 6, "sleep": 2, "appetite": 1}, {}, "en", {"total": 5, "body": 3, "rest": 2}),
         (MIXED, {"pain": 1, "steps": 1, "sleep": 1, "appetite": 1}, {}, "es", {"total": -2, "body": -2, "rest": 0}),
         (GDS, {"satisfied": 2, "bored": 1, "helpless": 2}, {}, "en", {"total": 2}),
+        (MEASURED, {"intake": 3}, {"weight": 60.5, "height": 170.0}, "en", {"total": 3}),
     ],
 )
 def test_lhc_forms_computes_the_kiosks_total_and_subscales(
@@ -54,7 +55,7 @@ def test_lhc_forms_computes_the_kiosks_total_and_subscales(
     for link, value in computed.items():
         assert rendered["shown"][link] == str(value), (link, rendered["shown"])
     for item, number in values.items():
-        assert rendered["shown"][item] == str(number)
+        assert float(rendered["shown"][item]) == number, (item, rendered["shown"][item])
     for item, number in options.items():
         option = q.item(item).option(number)
         assert rendered["shown"][item].endswith(f" - {option.points}"), (item, rendered["shown"][item])
