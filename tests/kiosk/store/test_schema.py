@@ -133,7 +133,7 @@ def damage(path: Path) -> None:
 
 @pytest.mark.parametrize("how", ["garbage", "pages", "truncated"])
 def test_a_damaged_database_is_one_message_naming_the_file_and_what_to_do(tmp_path, capsys, how):
-    from kiosk.ui import app as kiosk_app
+    from kiosk.commands import run as kiosk_run
 
     data = tmp_path / "data"
     with Store.open(data) as store:
@@ -153,6 +153,6 @@ def test_a_damaged_database_is_one_message_naming_the_file_and_what_to_do(tmp_pa
     assert err[0].startswith(f"kiosk results: {path} is damaged") and "restore a backup" in err[0]
     config = tmp_path / "config.yaml"
     config.write_text(f"data_dir: {data}\n")
-    assert kiosk_app.main(["--config", str(config), "--no-voice", "--no-remote"]) == 2
+    assert kiosk_run.main(["--config", str(config), "--no-voice", "--no-remote"]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith(f"kiosk run: {path} is damaged"), err
