@@ -27,7 +27,12 @@ NOT_BEFORE_THE_WELCOME = (
     "kiosk.ui.screens.session_detail",
     "kiosk.ui.widgets.metrics_plot",
     "kiosk.sync",
-    "kiosk.commands",
+    "kiosk.commands.devices",
+    "kiosk.commands.pin",
+    "kiosk.commands.qos",
+    "kiosk.commands.replay",
+    "kiosk.commands.results",
+    "kiosk.commands.validate",
     "qos.trace",
     "jsonschema",
     "plotext",
@@ -50,7 +55,8 @@ def _run(tmp_path, body: str) -> dict[str, Any]:
         import asyncio, json, sys
         from pathlib import Path
         import kiosk.cli, qos.cli  # what `kiosk` imports before it dispatches to `run`
-        from kiosk.ui.app import KIOSK_SIZE, build_app
+        from kiosk.commands.run import build_app
+        from kiosk.ui.app import KIOSK_SIZE
         config = Path({str(config)!r})
         """
     ) + textwrap.dedent(body)
@@ -96,7 +102,7 @@ def test_building_the_kiosk_with_voice_and_remotes_loads_no_speech_stack(tmp_pat
         app, close = build_app(config_path=config)
         try:
             loaded = sorted(sys.modules)
-            voice = type(app.voice).__name__
+            voice = type(app.channels.voice).__name__
         finally:
             close()
         print(json.dumps({"voice": voice, "modules": loaded}))
