@@ -30,7 +30,8 @@ class UiKiosk:
     """A kiosk app built by `kiosk run`'s own :func:`make_kiosk`, with its clock and store, and
     helpers to move simulated time. The options other than the first session's (``familiarisation``,
     ``language``, ``session_id``) are the configuration's, so they hold for every later session;
-    the next patients are P-TEST02 (the first is :data:`UI_PATIENT_ID`)."""
+    the next patients are P-TEST02 (the first is :data:`UI_PATIENT_ID`). ``pin_on_disk``: the PIN
+    guard the kiosk builds itself, counting failures in the data directory (else in memory)."""
 
     def __init__(
         self,
@@ -48,6 +49,7 @@ class UiKiosk:
         show_score: bool = False,
         next_patient_after_s: float | None = None,
         model: str = MODEL,
+        pin_on_disk: bool = False,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -56,6 +58,7 @@ class UiKiosk:
             qos_model=model,  # loaded once, as `kiosk run` does
             next_patient_after_s=next_patient_after_s,
             show_score_to_patient=show_score,
+            **({"clinician_pin": UI_PIN} if pin_on_disk else {}),
         )
         parts = KioskParts.load(self.config)
         self.questionnaire, self.model = parts.questionnaire, parts.model
@@ -83,8 +86,9 @@ class UiKiosk:
             # of the real timer never finds anything due
             poll_interval=poll_interval,
             visits=False,  # the snapshots show "Start a visit" off, as before visits existed
-            # failed attempts counted in memory: the full-disk test's staff must still get in
-            clinician_pin=UI_PIN,
+            # failed attempts counted in memory, or (pin_on_disk) the kiosk's own guard, counting
+            # them in the data directory
+            clinician_pin=None if pin_on_disk else UI_PIN,
         )
         #: the kiosk's controller, and its first session
         self.controller = self.app.controller
@@ -112,7 +116,8 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model)."""
+    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model,
+    pin_on_disk)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
