@@ -29,7 +29,6 @@ from kiosk.store.lease import LEASE_TTL_S
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.controller import KioskController
 from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView
-from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
 from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 from kiosk.ui.screens.explanation import ExplanationScreen
 from kiosk.ui.screens.pin import PinScreen
@@ -326,7 +325,9 @@ class KioskApp(App[int], inherit_bindings=False):
             return
 
         def unlocked(ok: bool | None) -> None:
-            if ok:
+            if ok:  # its table, switches and the stored tests' exports load when staff first get in
+                from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
+
                 self.push_screen(ClinicianHomeScreen())
             else:
                 self.controller.release()

@@ -25,6 +25,7 @@ NOT_BEFORE_THE_WELCOME = (
     "kiosk.export.provenance",
     "kiosk.export.tables",
     "kiosk.ui.screens.session_detail",
+    "kiosk.ui.screens.clinician_home",
     "kiosk.ui.widgets.metrics_plot",
     "kiosk.sync",
     "kiosk.commands.devices",
