@@ -82,7 +82,8 @@ PHASES = """
 import asyncio, json, sys, time
 marks = [(time.perf_counter(), time.process_time())]
 import kiosk.cli, qos.cli
-from kiosk.ui.app import KIOSK_SIZE, build_app
+from kiosk.commands.run import build_app
+from kiosk.ui.app import KIOSK_SIZE
 marks.append((time.perf_counter(), time.process_time()))
 app, close = build_app()
 marks.append((time.perf_counter(), time.process_time()))

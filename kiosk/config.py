@@ -59,7 +59,8 @@ import platformdirs
 from fileio.bounded import BadFile, open_private, read_text
 from fileio.positions import Problem, parse_file
 from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
-from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
+from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
+from kiosk.core.questionnaire.kept import load_questionnaire_kept
 from qos import bundled_models
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
@@ -415,7 +416,7 @@ def configured_questionnaire(config: Config) -> Questionnaire:
     Raises :class:`~kiosk.core.questionnaire.QuestionnaireError` for a bad questionnaire file and
     :class:`ConfigError` when ``bands`` names a set the questionnaire does not have.
     """
-    questionnaire = load_questionnaire(config.questionnaire)
+    questionnaire = load_questionnaire_kept(config.questionnaire)  # read back when it loaded before
     where = f"{config.source}: " if config.source else ""
     if config.language not in questionnaire.languages:
         raise ConfigError(

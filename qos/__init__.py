@@ -87,9 +87,11 @@ def bundled_models() -> list[str]:
 def load_model(name_or_path: str | Path) -> Model:
     """Load a bundled model by name (``"clarc"``) or a ``.roqme`` file by path.
 
-    Raises :class:`ModelError` with file, line and column when the model is malformed.
+    Raises :class:`ModelError` with file, line and column when the model is malformed. A model
+    that parsed is kept and read back on the next start (:mod:`qos.kept`): no lark, no parse.
     """
-    from qos.parser import load_model_file, parse_model
+    from qos.kept import load_model_file_kept as load_model_file
+    from qos.kept import parse_model_kept as parse_model
 
     text = str(name_or_path)
     if isinstance(name_or_path, Path) or text.endswith(".roqme") or "/" in text or "\\" in text:

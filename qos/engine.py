@@ -16,11 +16,10 @@ from dataclasses import dataclass, field
 from qos.batches import check_batch, check_time, check_value
 from qos.errors import ContextError
 from qos.expressions import compile_expr, names_in
-from qos.model import ClearEvidence, Evidence, Model, SetVariable, TimerAction
+from qos.model import SELF_BELIEF, ClearEvidence, Evidence, Model, SetVariable, TimerAction
 from qos.patterns import Batch, ObservationMatcher
 from qos.reasoner import PropertyBelief
 from qos.streams import build_streams
-from qos.terms import SELF_BELIEF
 from qos.timers import TimerClock
 
 __all__ = ["Engine", "UpdateResult", "check_batch", "check_time", "check_value", "observation_sort_key"]

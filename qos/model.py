@@ -92,6 +92,9 @@ INTENSITY_LR: dict[str, float] = {
     "verylow": 0.9,
 }
 
+#: the name the engine gives the belief a property's output transformation reads
+SELF_BELIEF = "#belief"
+
 #: a reference of exactly 0 or 1 would make a property deaf to evidence (as RoQME's generator does)
 REFERENCE_CLAMP = (0.01, 0.99)
 

@@ -18,6 +18,7 @@ from qos.model import (
     BOOLEAN,
     EVENTTYPE,
     NUMBER,
+    SELF_BELIEF,
     Aggregate,
     AllOf,
     AndNot,
@@ -86,8 +87,6 @@ _OPERATOR = {
     "event_when": "eventWhen",
     "not_event": "not",
 }
-#: the name the engine gives the belief a property's output transformation reads
-SELF_BELIEF = "#belief"
 
 
 def seconds_of(token: Token) -> float:

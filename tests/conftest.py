@@ -3,11 +3,35 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
 
 from tests.prerequisites import ensure_npm_packages, require_debian
+
+#: the test run's own user cache directory and the XDG_CACHE_HOME it replaced
+_CACHE_HOME = pytest.StashKey[tuple[str, str | None]]()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """What the code keeps in the user's cache (the QoS grammar's tables, parsed models, passed
+    schema checks) goes to a directory of this test run, inherited by the processes tests start,
+    never to the user's home; it is removed when the run ends."""
+    folder = tempfile.mkdtemp(prefix="kiosk-tests-cache-")
+    config.stash[_CACHE_HOME] = (folder, os.environ.get("XDG_CACHE_HOME"))
+    os.environ["XDG_CACHE_HOME"] = folder
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    folder, before = config.stash[_CACHE_HOME]
+    if before is None:
+        os.environ.pop("XDG_CACHE_HOME", None)
+    else:
+        os.environ["XDG_CACHE_HOME"] = before
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.fixture(scope="session")

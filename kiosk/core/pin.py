@@ -13,6 +13,10 @@ this turns 12 guesses a second into about 20 guesses an hour.
 The count is the data directory's, not the process's: every kiosk process on one data directory (a
 `kiosk run` and the served page's `kiosk serve` sessions) reads, checks and updates it under one
 exclusive file lock (:data:`LOCK_FILE`), so two processes together get no more guesses than one.
+
+When the count cannot be written (a full disk) the process keeps counting in memory, never below
+what the file says, and a right PIN still lets staff in: the out-of-order screen sends them to the
+clinician screen to see why. What could not be written goes to the Python log.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ import fcntl
 import hashlib
 import hmac
 import json
+import logging
 import math
 import os
 import secrets
@@ -49,6 +54,8 @@ STATE_FILE = "pin_lockout.json"
 #: held (flock, exclusive) while a process reads, checks and rewrites the count
 LOCK_FILE = "pin_lockout.lock"
 LOG_FILE = "security.log"
+
+log = logging.getLogger(__name__)
 
 
 class PinError(ValueError):
@@ -129,6 +136,8 @@ class PinGuard:
         self._now = now
         #: the count as last read from the data directory (another process may have moved it since)
         self.failures, self.not_before = 0, 0.0
+        #: the count this process could not write (disk full), kept until a write succeeds
+        self._unsaved: tuple[int, float] | None = None
         with self._shared_count():
             pass
 
@@ -185,11 +194,21 @@ class PinGuard:
         if self._dir is None:
             yield
             return
-        self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
-        descriptor = os.open(self._dir / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o600)
+        try:
+            self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
+            descriptor = os.open(self._dir / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o600)
+        except OSError as error:  # no lock to be had (disk full): this process's count alone
+            log.warning("PIN lock file %s cannot be opened (%s); counting failures in memory", LOCK_FILE, error)
+            if self._unsaved is not None:
+                self.failures, self.not_before = self._unsaved
+            yield
+            return
         try:
             fcntl.flock(descriptor, fcntl.LOCK_EX)
             self.failures, self.not_before = self._load()
+            if self._unsaved is not None:  # what this process counted and could not write still holds
+                self.failures = max(self.failures, self._unsaved[0])
+                self.not_before = max(self.not_before, self._unsaved[1])
             yield
         finally:
             os.close(descriptor)  # closing releases the lock
@@ -219,24 +238,41 @@ class PinGuard:
         return max(0, failures), min(not_before, self._now() + LOCKOUT_S)
 
     def _save(self) -> None:
+        """Write the count; when it cannot be written it is kept in memory (and logged)."""
         if self._dir is None:
             return
-        self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
         temporary = self._dir / f".{STATE_FILE}.{os.getpid()}"
-        with open_private(temporary) as handle:
-            json.dump({"failures": self.failures, "not_before": self.not_before}, handle)
-        os.replace(temporary, self._dir / STATE_FILE)  # never half-written: a reader sees old or new
+        try:
+            self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
+            with open_private(temporary) as handle:
+                json.dump({"failures": self.failures, "not_before": self.not_before}, handle)
+            os.replace(temporary, self._dir / STATE_FILE)  # never half-written: a reader sees old or new
+        except OSError as error:
+            with contextlib.suppress(OSError):
+                temporary.unlink(missing_ok=True)
+            log.warning(
+                "PIN failure count (%d) cannot be written to %s (%s); counting in memory",
+                self.failures,
+                STATE_FILE,
+                error,
+            )
+            self._unsaved = (self.failures, self.not_before)
+        else:
+            self._unsaved = None
 
     def _log(self, event: str, detail: str) -> None:
         if self._dir is None:
             return
-        self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
         line = json.dumps(
             {"at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(self._now())), "event": event, "detail": detail}
         )
-        descriptor = os.open(self._dir / LOG_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-        with os.fdopen(descriptor, "a", encoding="utf-8") as handle:
-            handle.write(line + "\n")
+        try:
+            self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
+            descriptor = os.open(self._dir / LOG_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+            with os.fdopen(descriptor, "a", encoding="utf-8") as handle:
+                handle.write(line + "\n")
+        except OSError as error:  # a full disk must not keep staff out: the event goes to the Python log
+            log.warning("%s cannot be written (%s): %s", LOG_FILE, error, line)
 
 
 #: staff open the PIN pad by touch alone: this many taps in the top-left corner of a patient screen,

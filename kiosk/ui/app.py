@@ -29,7 +29,6 @@ from kiosk.store.lease import LEASE_TTL_S
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.controller import KioskController
 from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView
-from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
 from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 from kiosk.ui.screens.explanation import ExplanationScreen
 from kiosk.ui.screens.pin import PinScreen
@@ -122,6 +121,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self.stage = PatientStage(self)
         #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
         self._staff_seen = 0.0
+        #: the app is unmounting: threads not started by now are never started
+        self._unmounted = False
         controller.attach(self)
         self.tell_channels()
 
@@ -133,7 +134,21 @@ class KioskApp(App[int], inherit_bindings=False):
     # -- start and stop -------------------------------------------------------------------------
 
     def on_mount(self) -> None:
-        """Start the channels and the poll timer, and show the welcome screen."""
+        """Start the poll timer and show the welcome screen; the channels and the station's client
+        start once it is drawn (:meth:`_start_threads`)."""
+        self.set_interval(self.poll_interval, self.poll_session)
+        if self.controller.store is not None:
+            self.set_interval(LEASE_TTL_S / 3, self.controller.keep_session)
+        self.controller.greet()
+        self._render()
+        self.call_after_refresh(self._start_threads)
+
+    def _start_threads(self) -> None:
+        """Start the speaker, the input sources and the station's client, after the first frame:
+        their threads (numpy, PortAudio, device probes) would otherwise hold the GIL while the
+        patient waits for the welcome. What the session said before is queued for the speaker."""
+        if self._unmounted:
+            return
         if self.channels.speaker is not None:
             self.channels.speaker.start()
         for source in self.channels.input_sources():
@@ -141,15 +156,12 @@ class KioskApp(App[int], inherit_bindings=False):
             self.run_worker(
                 partial(source.start, self.channel_sink), thread=True, name=f"start {source.name}", group="channels"
             )
-        self.set_interval(self.poll_interval, self.poll_session)
-        if self.controller.store is not None:
-            self.set_interval(LEASE_TTL_S / 3, self.controller.keep_session)
-        self.controller.greet()
         self.controller.start_station()
-        self._render()
 
     def on_unmount(self) -> None:
-        """Stop every channel (each stop is safe to call twice) and the station's client."""
+        """Stop every channel (each stop is safe to call twice, and before a start) and the
+        station's client."""
+        self._unmounted = True
         self.controller.stop_station()
         self.channels.close()
 
@@ -313,7 +325,9 @@ class KioskApp(App[int], inherit_bindings=False):
             return
 
         def unlocked(ok: bool | None) -> None:
-            if ok:
+            if ok:  # its table, switches and the stored tests' exports load when staff first get in
+                from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
+
                 self.push_screen(ClinicianHomeScreen())
             else:
                 self.controller.release()

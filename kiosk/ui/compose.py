@@ -130,7 +130,7 @@ def make_kiosk(
     welcome a walk-up; staff cannot start a visit by identifier). ``clinician_pin`` replaces the
     configured PIN guard (a plain PIN: failures counted in memory, not in the data directory).
     With ``config.station`` the station's client and order watcher are wired, not started (the
-    app starts them on mount)."""
+    app starts them once the welcome is drawn)."""
     parts = parts or KioskParts.load(config)
     maker = SessionMaker(config, parts, clock=clock, store=store, patient_ids=patient_ids)
     sync, orders, start_order = _station(config, parts.questionnaire, store, lambda: app)

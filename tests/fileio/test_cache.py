@@ -8,6 +8,7 @@ import os
 import stat
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -78,3 +79,10 @@ def test_the_second_start_loads_the_questionnaire_without_jsonschema(tmp_path):
     env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path))
     runs = [subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True) for _ in range(2)]
     assert [run.stdout.strip() for run in runs] == ["True", "False"], [run.stderr for run in runs]
+
+
+def test_the_test_run_keeps_its_caches_out_of_the_users_home():
+    import platformdirs
+
+    folder = Path(platformdirs.user_cache_dir("kiosk")).resolve()
+    assert not folder.is_relative_to(Path.home().resolve()), folder

@@ -110,7 +110,10 @@ class Outputs:
 
     def ignore(self, t: float, event: ChannelInput | None, reason: IgnoreReason, action: str = "") -> None:
         """An input or action that does nothing now: logged and published as InputIgnored."""
-        what = f"{event.channel.value} {event.option or event.command.value}" if event else action  # type: ignore[union-attr]
+        what = action
+        if event is not None:
+            did = event.option or event.command.value  # type: ignore[union-attr]  # no option: a command
+            what = f"{event.channel.value} {did}"
         self.log(t, "input_ignored", f"{what}: {reason.value}")
         self.emit(InputIgnored(t, event, reason, action))
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Hashable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
 
 from textual import events, on
 from textual.app import ComposeResult
@@ -17,6 +18,9 @@ from kiosk.core.session import ATTEMPTS, Snapshot
 from kiosk.ui.widgets.bars import AdaptationBanner, VoiceAgainButton
 from kiosk.ui.widgets.text import join_or, ui_text, ways_sentence
 from kiosk.ui.widgets.waiting_sign import WaitingSign
+
+if TYPE_CHECKING:
+    from kiosk.ui.app import KioskApp
 
 #: screen heights (rows) from which a patient screen uses its roomy layout: padded text and the
 #: big block digits on the answers; below, it packs everything tighter (a 1024x600 panel at a
@@ -104,7 +108,17 @@ def patient_notices(view: PatientView) -> str | None:
     return " ".join(notices) or None
 
 
-class PatientScreen(Screen):
+class KioskScreen(Screen):
+    """Base of every kiosk screen: :attr:`kiosk` is the running app with its own type."""
+
+    @property
+    def kiosk(self) -> KioskApp:
+        """``self.app`` as the :class:`~kiosk.ui.app.KioskApp` it always is (Textual types it as
+        any App); a screen reads the session and asks the controller through it."""
+        return cast("KioskApp", self.app)
+
+
+class PatientScreen(KioskScreen):
     """Base of the patient's screens: built from a view, refreshed in place by :meth:`show`.
 
     The app switches to a new screen only when :meth:`key` of the new view differs (another
@@ -199,7 +213,7 @@ class PatientScreen(Screen):
         for command, letter in (("pause", "p"), ("repeat", "r"), ("call_doctor", "d")):
             if key.removeprefix("shift+").lower() == ui_text(self.language, f"key_{command}"):
                 key = letter
-        if self.app.patient_key(key):  # type: ignore[attr-defined]
+        if self.kiosk.patient_key(key):
             event.stop()
             event.prevent_default()
 
@@ -222,7 +236,7 @@ def staff_nav(back: str = "Back to the patient") -> ComposeResult:
         yield PageButton("▼ Down", id="page-down")
 
 
-class ClinicianScreen(Screen):
+class ClinicianScreen(KioskScreen):
     """Base of the screens behind the PIN; the patient's screen waits underneath until they close.
     A screen with :func:`staff_nav` pages its ``.staff-body`` with Up and Down."""
 

@@ -26,11 +26,11 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def compose(self) -> ComposeResult:
         """The running session, channels, stored sessions, and the way back."""
-        app = self.app
-        session = app.session  # type: ignore[attr-defined]
+        app = self.kiosk
+        session = app.session
         with VerticalScroll(classes="clinician staff-body", id="clinician-body"):
             yield Static("Clinician", classes="heading")
-            if (warning := app.pin_guard.warning) is not None:  # type: ignore[attr-defined]
+            if (warning := app.pin_guard.warning) is not None:
                 yield Static(warning, id="pin-warning")
             yield Static("", id="out-of-order-reason")
             yield Static(self._session_line(), id="current")
@@ -42,8 +42,8 @@ class ClinicianHomeScreen(ClinicianScreen):
                     id="adaptation",
                     disabled=session.adaptation is None,
                 )
-                yield Button("New patient", id="new-session", disabled=not app.controller.can_start_new_session)  # type: ignore[attr-defined]
-                yield Button("Start a visit", id="start-visit", disabled=app.controller.visits is None)  # type: ignore[attr-defined]
+                yield Button("New patient", id="new-session", disabled=not app.controller.can_start_new_session)
+                yield Button("Start a visit", id="start-visit", disabled=app.controller.visits is None)
             # the kiosk has no presence sensor: the clinician says when the patient leaves and returns
             with Horizontal(id="presence-actions"):
                 yield Button("Patient left", id="person-lost")
@@ -51,7 +51,7 @@ class ClinicianHomeScreen(ClinicianScreen):
                 # the only way out of the locked-down kiosk, on the shorter row so it always shows
                 yield Button("Quit the kiosk", id="quit-kiosk", variant="error")
             yield Static(self._channels_text(), id="channel-reasons")
-            if app.controller.sync is not None:  # type: ignore[attr-defined]
+            if app.controller.sync is not None:
                 yield Static(self._station_text(), id="station")
             # continuing a test is the staff's decision: only with the same patient at the kiosk
             yield Label("Interrupted tests: none.", id="interrupted-label")
@@ -67,8 +67,8 @@ class ClinicianHomeScreen(ClinicianScreen):
         """Fill the tables, and keep the running session's line current while it runs."""
         interrupted = self.query_one("#interrupted", DataTable)
         interrupted.add_columns("patient", "started", "progress", "why it stopped", "session")
-        for test in self.app.controller.interrupted_tests():  # type: ignore[attr-defined]
-            count = len(questionnaire_of(test, fallback=self.app.questionnaire).items)  # type: ignore[attr-defined]
+        for test in self.kiosk.controller.interrupted_tests():
+            count = len(questionnaire_of(test, fallback=self.kiosk.questionnaire).items)
             progress = f"{len(test.answers)} of {count} answered" + (
                 f", {len(test.not_answered)} not answered" if test.not_answered else ""
             )
@@ -96,7 +96,7 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def _fill_sessions(self) -> None:
         table = self.query_one("#sessions", DataTable)
-        store = self.app.controller.store  # type: ignore[attr-defined]
+        store = self.kiosk.controller.store
         for s in store.sessions() if store is not None else []:
             row = (
                 *(s.id, s.patient_id, s.started_at[:19], s.label, s.language),
@@ -111,10 +111,10 @@ class ClinicianHomeScreen(ClinicianScreen):
     def refresh_session(self) -> None:
         """Redraw what a running session changes: its line, the channels, which actions apply,
         and the stored sessions' progress."""
-        app = self.app
-        session = app.session  # type: ignore[attr-defined]
+        app = self.kiosk
+        session = app.session
         self.query_one("#current", Static).update(self._session_line())
-        reason = app.controller.out_of_order  # type: ignore[attr-defined]
+        reason = app.controller.out_of_order
         line = self.query_one("#out-of-order-reason", Static)
         line.display = reason is not None
         if reason is not None:
@@ -125,7 +125,7 @@ class ClinicianHomeScreen(ClinicianScreen):
         self.query_one("#channel-reasons", Static).update(self._channels_text())
         # Continue is for a session halted by call-doctor or paused by the patient, not for the
         # pause that opening these screens made (leaving them resumes that one)
-        paused_by_patient = session.paused and not app.controller.held_for_clinician  # type: ignore[attr-defined]
+        paused_by_patient = session.paused and not app.controller.held_for_clinician
         self.query_one("#continue", Button).disabled = not (session.halted or paused_by_patient)
         running = session.phase not in (Phase.WELCOME, Phase.SUMMARY)
         present = session.snapshot().person_present
@@ -134,13 +134,13 @@ class ClinicianHomeScreen(ClinicianScreen):
         self._fill_sessions()
 
     def _session_line(self) -> str:
-        session = self.app.session  # type: ignore[attr-defined]
+        session = self.kiosk.session
         state = (
             "waiting for a clinician (doctor called)"
             if session.halted
             else (
                 "paused while you are here"
-                if self.app.controller.held_for_clinician  # type: ignore[attr-defined]
+                if self.kiosk.controller.held_for_clinician
                 else "paused"
                 if session.paused
                 else session.phase.value
@@ -157,18 +157,20 @@ class ClinicianHomeScreen(ClinicianScreen):
         return line
 
     def _station_text(self) -> str:
-        sync, store = self.app.controller.sync, self.app.controller.store  # type: ignore[attr-defined]
+        sync, store = self.kiosk.controller.sync, self.kiosk.controller.store
+        if sync is None or store is None:  # shown only with a station, which needs a store
+            return "No ward station."
         waiting, parked = store.outbox_waiting()
         state = f"not reachable ({sync.problem})" if sync.problem else "reachable"
         text = f"Ward station {sync.station.url}: {state}; {waiting} stored changes waiting to be sent"
         text += (f", {parked} refused by the station (kept for an engineer)" if parked else "") + "."
-        visits = self.app.controller.visits  # type: ignore[attr-defined]
+        visits = self.kiosk.controller.visits
         if visits is not None and visits.problems:  # ordered visits this kiosk cannot run (kiosk.core.visits)
             text += " Orders this kiosk cannot run: " + "; ".join(visits.problems) + "."
         return text
 
     def _channels_text(self) -> str:
-        lines = self.app.board.lines("en", patient=False)  # type: ignore[attr-defined]
+        lines = self.kiosk.board.lines("en", patient=False)
         return "Channels: " + "; ".join(
             f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
             for line in lines
@@ -176,18 +178,18 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     @on(Button.Pressed, "#continue")
     def _continue(self) -> None:
-        self.app.controller.clinician_continue()  # type: ignore[attr-defined]
-        self.app.close_clinician()  # type: ignore[attr-defined]
+        self.kiosk.controller.clinician_continue()
+        self.kiosk.close_clinician()
 
     @on(Button.Pressed, "#person-lost")
     def _person_lost(self) -> None:
-        self.app.controller.person_lost()  # type: ignore[attr-defined]
-        self.app.close_clinician()  # type: ignore[attr-defined]
+        self.kiosk.controller.person_lost()
+        self.kiosk.close_clinician()
 
     @on(Button.Pressed, "#person-back")
     def _person_back(self) -> None:
-        self.app.controller.person_back()  # type: ignore[attr-defined]
-        self.app.close_clinician()  # type: ignore[attr-defined]
+        self.kiosk.controller.person_back()
+        self.kiosk.close_clinician()
 
     @on(Button.Pressed, "#continue-test")
     def _continue_test(self) -> None:
@@ -195,13 +197,13 @@ class ClinicianHomeScreen(ClinicianScreen):
         if not table.row_count:
             return
         row_key, _ = table.coordinate_to_cell_key(table.cursor_coordinate)
-        refused = self.app.controller.continue_test(str(row_key.value))  # type: ignore[attr-defined]
+        refused = self.kiosk.controller.continue_test(str(row_key.value))
         if refused:
             self.query_one("#continue-result", Static).update(f"Not continued: {refused}")
 
     @on(Button.Pressed, "#new-session")
     def _new_session(self) -> None:
-        self.app.controller.start_new_session()  # type: ignore[attr-defined]
+        self.kiosk.controller.start_new_session()
 
     @on(Button.Pressed, "#start-visit")
     def _start_visit(self) -> None:
@@ -211,19 +213,21 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     @on(Button.Pressed, "#back")
     def _back(self) -> None:
-        self.app.close_clinician()  # type: ignore[attr-defined]
+        self.kiosk.close_clinician()
 
     @on(Button.Pressed, "#quit-kiosk")
     def _quit(self) -> None:
-        self.app.quit_kiosk()  # type: ignore[attr-defined]
+        self.kiosk.quit_kiosk()
 
     @on(Switch.Changed, "#adaptation")
     def _adaptation(self, event: Switch.Changed) -> None:
-        self.app.controller.set_adaptation(event.value)  # type: ignore[attr-defined]
+        self.kiosk.controller.set_adaptation(event.value)
 
     @on(DataTable.RowSelected, "#sessions")
     def _open(self, event: DataTable.RowSelected) -> None:
-        store = self.app.controller.store  # type: ignore[attr-defined]
+        store = self.kiosk.controller.store
+        if store is None:  # without a store the table has no rows to select
+            return
         stored = store.session(str(event.row_key.value))
         # the detail's plot (plotext) and exports load when staff first open one, not at start-up
         from kiosk.ui.screens.session_detail import SessionDetailScreen
@@ -232,4 +236,4 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def action_close(self) -> None:
         """Escape from here goes back to the patient."""
-        self.app.close_clinician()  # type: ignore[attr-defined]
+        self.kiosk.close_clinician()

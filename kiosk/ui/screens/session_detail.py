@@ -82,7 +82,7 @@ class SessionDetailScreen(ClinicianScreen):
     @property
     def q(self):  # -> Questionnaire
         """The questionnaire this session ran (captured as it started), not today's file."""
-        return questionnaire_of(self.stored, fallback=self.app.questionnaire)  # type: ignore[attr-defined]
+        return questionnaire_of(self.stored, fallback=self.kiosk.questionnaire)
 
     def on_mount(self) -> None:
         """One row per item, in questionnaire order, answered or not."""
@@ -147,7 +147,9 @@ class SessionDetailScreen(ClinicianScreen):
         return "Practice: " + " / ".join(parts)
 
     def _export_path(self, suffix: str) -> Path:
-        folder: Path = self.app.export_dir  # type: ignore[attr-defined]
+        folder = self.kiosk.export_dir
+        if folder is None:  # make_kiosk always gives one; an app built by hand may not
+            raise RuntimeError("this kiosk was built without an export folder")
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         return folder / f"session-{self.stored.id}{suffix}"
 

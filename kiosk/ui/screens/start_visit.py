@@ -37,8 +37,8 @@ class StartVisitScreen(ClinicianScreen):
         self._language = ""
 
     def compose(self) -> ComposeResult:
-        app = self.app
-        self._language = app.session.language  # type: ignore[attr-defined]
+        app = self.kiosk
+        self._language = app.session.language
         with Vertical(classes="clinician"):
             yield Static("Start a visit", classes="heading")
             yield Label("Patient identifier as the hospital gives it (never a name):")
@@ -47,7 +47,7 @@ class StartVisitScreen(ClinicianScreen):
                 for label in _KEYS:
                     yield pad_key(Button(label, id=_key_id(label)))
             with Horizontal(id="visit-languages"):
-                for language in app.questionnaire.languages:  # type: ignore[attr-defined]
+                for language in app.questionnaire.languages:
                     yield Button(
                         language_name(language),
                         id=f"visit-lang-{language}",
@@ -83,7 +83,7 @@ class StartVisitScreen(ClinicianScreen):
     def _go(self, event: Button.Pressed) -> None:
         event.stop()
         relative = self.query_one("#visit-relative", Switch).value
-        refused = self.app.controller.start_staff_visit(self._typed, self._language, relative)  # type: ignore[attr-defined]
+        refused = self.kiosk.controller.start_staff_visit(self._typed, self._language, relative)
         if refused:
             self.query_one("#start-visit-error", Label).update(f"Not started: {refused}")
 

@@ -194,8 +194,9 @@ class KioskServer(Server):
         self.public_url = f"{self.scheme}://{request.host}"  # read before this handler's first await
         return await super().handle_index(request)
 
-    # a plain busy page answers when no place is free (textual-serve's own handler always upgrades)
-    async def handle_websocket(self, request: web.Request) -> web.StreamResponse:  # type: ignore[override]
+    # a plain busy page answers when no place is free (textual-serve's own handler always upgrades,
+    # and is typed to return a WebSocketResponse: the busy page is the wider StreamResponse)
+    async def handle_websocket(self, request: web.Request) -> web.StreamResponse:  # type: ignore[override]  # busy page
         """One browser connection: one kiosk process, if a place is free; reaped when it closes."""
         if not await self._place_free():
             return busy_page(self.max_sessions)

@@ -30,7 +30,8 @@ class UiKiosk:
     """A kiosk app built by `kiosk run`'s own :func:`make_kiosk`, with its clock and store, and
     helpers to move simulated time. The options other than the first session's (``familiarisation``,
     ``language``, ``session_id``) are the configuration's, so they hold for every later session;
-    the next patients are P-TEST02 (the first is :data:`UI_PATIENT_ID`)."""
+    the next patients are P-TEST02 (the first is :data:`UI_PATIENT_ID`). ``pin_on_disk``: the PIN
+    guard the kiosk builds itself, counting failures in the data directory (else in memory)."""
 
     def __init__(
         self,
@@ -49,6 +50,7 @@ class UiKiosk:
         next_patient_after_s: float | None = None,
         model: str = MODEL,
         questionnaire: str | Path | None = None,
+        pin_on_disk: bool = False,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -58,6 +60,7 @@ class UiKiosk:
             questionnaire=Path(questionnaire) if questionnaire is not None else None,
             next_patient_after_s=next_patient_after_s,
             show_score_to_patient=show_score,
+            **({"clinician_pin": UI_PIN} if pin_on_disk else {}),
         )
         parts = KioskParts.load(self.config)
         self.questionnaire, self.model = parts.questionnaire, parts.model
@@ -85,8 +88,9 @@ class UiKiosk:
             # of the real timer never finds anything due
             poll_interval=poll_interval,
             visits=False,  # the snapshots show "Start a visit" off, as before visits existed
-            # failed attempts counted in memory: the full-disk test's staff must still get in
-            clinician_pin=UI_PIN,
+            # failed attempts counted in memory, or (pin_on_disk) the kiosk's own guard, counting
+            # them in the data directory
+            clinician_pin=None if pin_on_disk else UI_PIN,
         )
         #: the kiosk's controller, and its first session
         self.controller = self.app.controller
@@ -114,7 +118,8 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model, questionnaire)."""
+    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model,
+    questionnaire, pin_on_disk)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:

@@ -1,7 +1,8 @@
 """A full disk, as a patient and staff meet it: on a real 2 MB filesystem the kiosk's SQLite store
 fills up mid-test. The patient sees one calm out-of-order screen (no notice, nobody's pseudonym,
-nothing a tap can start), staff read the reason behind the PIN, and once space is freed the
-welcome comes back and the next test is stored. It needs to mount a tmpfs (root, as in CI's
+nothing a tap can start), staff get past the kiosk's own on-disk PIN guard (which counts failures
+in memory while it cannot write them) and read the reason, and once space is freed the welcome
+comes back and the next test is stored. It needs to mount a tmpfs (root, as in CI's
 container); elsewhere it is skipped, saying so."""
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from kiosk.core.pin import FREE_FAILURES, STATE_FILE, PinGuard
 from kiosk.core.session import Phase
 from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 
@@ -79,7 +81,10 @@ async def _the_out_of_order_kiosk_and_its_recovery(kiosk: UiKiosk, pilot, free_s
     assert screen_name(kiosk) == "OutOfOrderScreen" and kiosk.app.session.phase is Phase.WELCOME
     assert len(kiosk.store.sessions()) == sessions_before and not kiosk.app._notifications  # noqa: SLF001
 
-    await pilot.press(CLINICIAN_CHORD, *UI_PIN, "enter")  # staff see why
+    await pilot.press(CLINICIAN_CHORD, *"0000", "enter")  # a slip: counted, though not writable
+    await until_drawn(pilot, "Wrong PIN.")
+    assert kiosk.app.pin_guard.failures == 1 and not (kiosk.config.data_dir / STATE_FILE).exists()
+    await pilot.press(*UI_PIN, "enter")  # staff see why
     await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
     await until_drawn(pilot, "Out of order: the kiosk could not store its last step", "disk is full")
     kiosk.app.close_clinician()
@@ -102,7 +107,7 @@ async def _the_out_of_order_kiosk_and_its_recovery(kiosk: UiKiosk, pilot, free_s
 
 async def test_a_full_filesystem_shows_one_calm_screen_and_recovers_when_space_is_freed(tmp_path):
     with small_filesystem(tmp_path / "small") as small:
-        kiosk = UiKiosk(small, familiarisation=False)
+        kiosk = UiKiosk(small, familiarisation=False, pin_on_disk=True)
         try:
             async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
                 await start_in_english(kiosk, pilot)
@@ -122,6 +127,20 @@ async def test_a_full_filesystem_shows_one_calm_screen_and_recovers_when_space_i
                 await _the_out_of_order_kiosk_and_its_recovery(kiosk, pilot, free_space)
         finally:
             kiosk.store.close()
+
+
+def test_on_a_full_disk_the_pin_lockout_holds_in_memory_and_the_right_pin_gets_in(tmp_path):
+    now = [1_800_000_000.0]
+    with small_filesystem(tmp_path / "small") as small:
+        guard = PinGuard(UI_PIN, small, now=lambda: now[0])  # its lock file is made while there is room
+        fill(small)
+        verdicts = [guard.attempt("0000") for _ in range(FREE_FAILURES)]
+        assert [v.wait_s > 0 for v in verdicts] == [False] * (FREE_FAILURES - 1) + [True]
+        assert not (small / STATE_FILE).exists()  # nothing could be written
+        early = guard.attempt(UI_PIN)
+        assert not early.ok and early.early, "the delay still holds though it is only in memory"
+        now[0] += verdicts[-1].wait_s
+        assert guard.attempt(UI_PIN).ok
 
 
 def test_the_ward_station_takes_the_reason_in_the_kiosks_status():

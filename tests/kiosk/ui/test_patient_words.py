@@ -34,7 +34,7 @@ class _Snap:
 
 def _view(language: str, ways: Ways, **snap) -> PatientView:
     # a stand-in with only the fields the words read, not a whole Snapshot
-    return PatientView(_Snap(language, **snap), QUESTIONNAIRE, ways)  # type: ignore[arg-type]
+    return PatientView(_Snap(language, **snap), QUESTIONNAIRE, ways)  # type: ignore[arg-type]  # a stand-in
 
 
 def test_how_to_answer_names_only_the_channels_that_are_on():
