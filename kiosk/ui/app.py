@@ -840,7 +840,7 @@ def build_app(
 ) -> tuple[KioskApp, Callable[[], None]]:
     """The kiosk as configured, with whatever channels this machine has, and a function that
     closes what it opened. Raises :class:`SetupError` (one sentence) for a user's mistake."""
-    from kiosk.config import ConfigError, configured_questionnaire, load_config
+    from kiosk.config import ConfigError, configured_questionnaire, load_config, offered_to_patients
     from kiosk.core.adaptation import Adaptation, PolicyError, load_policy
     from kiosk.core.clock import SystemClock
     from kiosk.core.qos_model import load_kiosk_model
@@ -857,7 +857,8 @@ def build_app(
 
     try:
         config = load_config(config_path)
-        questionnaire = configured_questionnaire(config)
+        # a site offers patients only validated translations and those it accepts
+        questionnaire = offered_to_patients(config, configured_questionnaire(config))
         model = load_kiosk_model(config.qos_model)
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
         store = Store.open(
