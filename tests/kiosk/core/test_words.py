@@ -249,7 +249,7 @@ def test_a_new_words_file_is_all_a_new_language_needs(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     seen = json.loads(done.stdout)
-    assert seen["welcome"] == ["English", "Español", "Français", "Xish"]
+    assert seen["welcome"] == ["English", "Español", "Français", "Deutsch", "Xish"]
     assert seen["language"] == "xx" and seen["explanation"] == ["xx", ["Go"]] and seen["ready"] == 1
     assert seen["config"] == "xx" and "language 'zz' is not one of de, en, es, fr, xx" in seen["refused"]
     assert seen["screen"] == ["Go", "Xish", "Question 1 of 10"] and seen["voice"] == "gmw/en-gb"
