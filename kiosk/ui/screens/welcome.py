@@ -40,16 +40,21 @@ class LanguageList(Vertical):
         self.lay_out()
 
     def lay_out(self) -> None:
-        """Give every button the same height; spare rows stay below the last."""
+        """Give every button the same height; spare rows stay below the last. When buttons three
+        rows high with a row of margin do not all fit (four languages on a short panel), the
+        margin goes and they shrink, so no language is ever cut off."""
         buttons = list(self.query(Button))
         rows = self.content_region.height
         if not buttons or rows <= 0:
             return
-        height = max(3, (rows - len(buttons)) // len(buttons))  # one row of margin above each
+        margin = 1 if rows >= 4 * len(buttons) else 0  # one row of margin above each while it fits
+        height = max(1, (rows - margin * len(buttons)) // len(buttons))
         if height % 2 == 0:
             height -= 1
         for button in buttons:
             button.styles.height = height
+            button.styles.min_height = min(3, height)
+            button.styles.margin = (margin, 0, 0, 0)
 
 
 def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:
