@@ -3,10 +3,10 @@
 Clinicians edit the instruments (``kiosk/core/questionnaire/instruments/*.yaml``) by hand, so
 loading is strict: every problem (YAML syntax, unknown keys, missing translations, duplicate ids,
 an item without options, a formula that is not FHIRPath, bands with gaps...) is collected with its
-``file:line:col`` position and reported together, and
-nothing is half-loaded. The structural rules live in ``questionnaire.schema.json`` (which editors
-can also use while typing); the rules a JSON Schema cannot express (translations for the declared
-languages, unique ids, band coverage) are checked in :mod:`.checks`.
+``file:line:col`` position and reported together, and nothing is half-loaded. The structural
+rules live in ``questionnaire.schema.json`` (which editors can also use while typing); the rules a
+JSON Schema cannot express (translations for the declared languages, unique ids, band coverage,
+the formula) are checked in :mod:`.checks` and :mod:`.rules`.
 
 Interpretation bands come as named band sets (Shah 1989, a Spanish clinical-practice set...), one
 of them the file's default. A kiosk may choose another (``bands:`` in its config,

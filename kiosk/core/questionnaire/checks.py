@@ -198,7 +198,8 @@ def _check_bands(
     block = data.get("bands")
     if not isinstance(block, dict):
         return
-    sets = block.get("sets") if isinstance(block.get("sets"), dict) else {}
+    found = block.get("sets")
+    sets: dict[str, Any] = found if isinstance(found, dict) else {}
     default = block.get("default")
     if isinstance(default, str) and sets and default not in sets:
         add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")

@@ -8,7 +8,7 @@ report through the same ``add(path, message, key=)`` so every problem is one ``f
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, TypeGuard
 
 from fileio.positions import describe
 from kiosk.core.questionnaire.scoring import ITEM_WEIGHT, local_code, run, syntax_problem
@@ -21,8 +21,12 @@ YES_NO_CODES = {"yes": ("http://loinc.org", "LA33-6"), "no": ("http://loinc.org"
 KINDS = ("options", "answers", "input")
 
 
-def _integer(value: Any) -> bool:
+def _integer(value: Any) -> TypeGuard[int]:
     return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _number(value: Any) -> TypeGuard[float]:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def check_items(items: Items, add: Callable[..., None]) -> None:
@@ -50,8 +54,7 @@ def check_items(items: Items, add: Callable[..., None]) -> None:
         entry = item.get("input")
         if isinstance(entry, dict):
             low, high = entry.get("min"), entry.get("max")
-            numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (low, high))
-            if numbers and low > high:
+            if _number(low) and _number(high) and low > high:
                 add(path + ("input", "min"), f"{describe(path + ('input',))}: min {low} is above max {high}")
             if entry.get("type") == "integer":
                 for name in ("min", "max"):
@@ -72,7 +75,7 @@ def _choices(data: dict[str, Any], item: dict[str, Any]) -> list[tuple[tuple[str
     options = item.get("options")
     if not isinstance(options, list) or not options:
         return None
-    found = []
+    found: list[tuple[tuple[str, str], int]] = []
     for n, option in enumerate(options, start=1):
         if not isinstance(option, dict) or not _integer(option.get("points")):
             return None
@@ -119,7 +122,7 @@ def _samples(data: dict[str, Any], items: Items) -> list[tuple[str, list[dict[st
             return None
         if isinstance(entry, dict):
             low, high = entry.get("min"), entry.get("max")
-            if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (low, high)):
+            if not (_number(low) and _number(high)):
                 return None
             key = "valueInteger" if entry.get("type") == "integer" else "valueDecimal"
             middle = (low + high) / 2
@@ -147,6 +150,11 @@ def check_scoring(
     """The formula parses and gives one whole number in its range on sample answers; subscales
     name existing scored items once each, with ids of their own."""
     formula = _formula(data)
+    scoring = data.get("scoring")
+    total = scoring.get("total") if isinstance(scoring, dict) else None
+    if isinstance(total, str) and total != "sum":
+        add(("scoring", "total"), f"scoring.total is 'sum' or a formula ({{fhirpath, min, max}}), not {total!r}")
+    path: tuple[Any, ...]
     if formula is not None:
         path = ("scoring", "total")
         low, high = formula.get("min"), formula.get("max")
@@ -158,7 +166,6 @@ def check_scoring(
             add(path + ("fhirpath",), f"scoring.total.fhirpath is not valid FHIRPath ({why})")
         elif isinstance(expression, str) and _integer(low) and _integer(high) and low <= high:
             _try_formula(expression, low, high, _samples(data, items) or [], add)
-    scoring = data.get("scoring")
     subscales = scoring.get("subscales") if isinstance(scoring, dict) else None
     by_id = {item.get("id"): item for _, item in items}
     seen: set[Any] = set()
@@ -179,7 +186,7 @@ def check_scoring(
                 add(path + ("items", k), f"subscale {sub_id!r}: there is no item {item_id!r}")
             elif "input" in item:
                 add(path + ("items", k), f"subscale {sub_id!r}: item {item_id!r} is an input, with no points")
-            elif members.index(item_id) != k:
+            elif isinstance(members, list) and members.index(item_id) != k:
                 add(path + ("items", k), f"subscale {sub_id!r} lists item {item_id!r} twice")
 
 
@@ -196,8 +203,7 @@ def _try_formula(
             add(where, f"scoring.total.fhirpath cannot be evaluated with {described}: {exc}")
             return
         value = result[0] if len(result) == 1 else None
-        whole = isinstance(value, (int, float)) and not isinstance(value, bool) and value == int(value)
-        if not whole or not low <= value <= high:
+        if not (_number(value) and value == int(value) and low <= value <= high):
             shown = value if len(result) == 1 else result
             add(
                 where,

@@ -112,8 +112,8 @@ def syntax_problem(expression: str) -> str | None:
 
     fhirpathpy's own parser recovers from errors silently, so this runs its grammar with a
     listener that keeps them, and insists the whole text was read."""
-    from antlr4 import CommonTokenStream, InputStream, Token
-    from antlr4.error.ErrorListener import ErrorListener
+    from antlr4 import CommonTokenStream, InputStream, Token  # type: ignore[import-untyped]  # ships no hints
+    from antlr4.error.ErrorListener import ErrorListener  # type: ignore[import-untyped]
     from fhirpathpy.parser.generated.FHIRPathLexer import FHIRPathLexer
     from fhirpathpy.parser.generated.FHIRPathParser import FHIRPathParser
 
@@ -175,8 +175,10 @@ def with_weights(q: Questionnaire, response: Mapping[str, Any]) -> dict[str, Any
     copied = copy.deepcopy(dict(response))
     choice = {item.id: item for item in q.items if item.options}
     for entry in copied.get("item", ()):
-        item = choice.get(entry.get("linkId")) if isinstance(entry, dict) else None
-        for answer in entry.get("answer", ()) if item is not None else ():
+        item = choice.get(str(entry.get("linkId"))) if isinstance(entry, dict) else None
+        if item is None:
+            continue
+        for answer in entry.get("answer", ()):
             coding = answer.get("valueCoding") if isinstance(answer, dict) else None
             if not isinstance(coding, dict):
                 continue
