@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from kiosk.store.database import Store
+
 ROOT = Path(__file__).resolve().parents[3]
 SCRIPTS = ROOT / "recordings/patients/instruments"
 
@@ -37,3 +39,8 @@ def test_each_shipped_instrument_has_a_scripted_patient(tmp_path, name, language
     assert result["language"] == language
     assert (result["score"]["total"], result["score"]["band"], result["score"]["complete"]) == (total, band, True)
     assert result["score"]["max_total"] == maximum
+    # the stored result keeps the translation it ran in: its source and whether it is validated
+    with Store.open(tmp_path / "data", create=False) as store:
+        (stored,) = [store.session(s.id) for s in store.sessions()]
+    translation = stored.definition["translations"][language]
+    assert translation["validated"] is (language == "en") and translation["source"].strip()
