@@ -100,8 +100,16 @@ class WelcomeScreen(PatientScreen):
                 line.update(welcome_line(view, language))
 
     def progress_text(self, view: PatientView) -> str:
-        """The title in every language: the patient has not chosen one yet."""
-        return " · ".join(dict.fromkeys(view.questionnaire.title.values()))
+        """The title in every language (the patient has not chosen one yet), as many as fit the
+        top bar's one row: four languages' titles are longer than a narrow screen."""
+        titles = list(dict.fromkeys(view.questionnaire.title.values()))
+        room = self.size.width - 2  # the bar's padding; 0 or less before the screen is laid out
+        shown = titles[:1]
+        for title in titles[1:]:
+            if room > 0 and len(" · ".join([*shown, title])) > room:
+                break
+            shown.append(title)
+        return " · ".join(shown)
 
     @on(Button.Pressed, "#languages Button")
     def _language(self, event: Button.Pressed) -> None:
