@@ -40,21 +40,19 @@ class LanguageList(Vertical):
         self.lay_out()
 
     def lay_out(self) -> None:
-        """Give every button the same height; spare rows stay below the last. When buttons three
-        rows high with a row of margin do not all fit (four languages on a short panel), the
-        margin goes and they shrink, so no language is ever cut off."""
+        """Give every button the same height, a row of margin above each so no two run together;
+        spare rows stay below the last. Where three rows each do not fit (four languages on a
+        short panel) they shrink to two, then one, so no language is ever cut off."""
         buttons = list(self.query(Button))
         rows = self.content_region.height
         if not buttons or rows <= 0:
             return
-        margin = 1 if rows >= 4 * len(buttons) else 0  # one row of margin above each while it fits
-        height = max(1, (rows - margin * len(buttons)) // len(buttons))
-        if height % 2 == 0:
+        height = max(1, (rows - len(buttons)) // len(buttons))
+        if height % 2 == 0 and height > 2:  # an odd height centres the label; two rows beat one
             height -= 1
         for button in buttons:
             button.styles.height = height
             button.styles.min_height = min(3, height)
-            button.styles.margin = (margin, 0, 0, 0)
 
 
 def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:
