@@ -17,6 +17,8 @@ Example ``config.yaml`` (every key optional)::
     qos_model: /etc/kiosk/ward.roqme  # the QoS model (default: the bundled clarc; also kiosk_pace)
     questionnaire: /etc/kiosk/barthel.yaml
     bands: spanish                    # a band set of the questionnaire (default: the file's default)
+    accept_unvalidated_translations: [de]   # or true: unvalidated translations this site accepts
+                                      # for clinical use (default none; see below)
     familiarisation: true             # practice questions before the questionnaire
     timing: {attempt_window_s: 30}    # overrides of the questionnaire's timing block
     vosk_model: /opt/vosk/vosk-model-small-es-0.42
@@ -38,6 +40,13 @@ Example ``config.yaml`` (every key optional)::
       token: "…"                      # from `kiosk station add-kiosk NAME`
       kiosk_id: ward3-bed2            # the same as kiosk_id (older place; give one of the two)
 
+Translations: an instrument's file marks each language's text validated (a published, validated
+translation) or not (``translations:``). Without a configuration file the kiosk offers every
+language, as it always did. A site's configuration offers patients only the validated languages
+and those it names in ``accept_unvalidated_translations`` (``true``: all), and `kiosk run`
+refuses a ``language:`` that is neither (:func:`offered_to_patients`), because an unvalidated
+translation may not measure what the original does.
+
 A legacy plain ``clinician_pin: "482193"`` still works (6 to 12 digits, or the default), with a
 warning to run `kiosk pin set`. A bad file is one :class:`ConfigError` naming the file, line and
 column and what is wrong.
@@ -49,7 +58,7 @@ import os
 import re
 import socket
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
@@ -136,6 +145,9 @@ class Config:
     questionnaire: Path | None = None
     #: the questionnaire's band set that interprets totals (None: the file's default, Shah 1989)
     bands: str | None = None
+    #: languages whose unvalidated translations this site accepts for clinical use (True: all);
+    #: only read with a configuration file (see :func:`offered_to_patients`)
+    accept_unvalidated_translations: tuple[str, ...] | bool = ()
     #: practice questions before the questionnaire
     familiarisation: bool = True
     #: overrides of the questionnaire's timing (attempt_window_s, between_questions_s, ...)
@@ -342,10 +354,27 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "next_patient_after_s":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
                 raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
+        elif key == "accept_unvalidated_translations":
+            value = _accepted_languages(value, lambda message: fail((key,), message))
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
     return values
+
+
+def _accepted_languages(value: object, fail: Any) -> tuple[str, ...] | bool:
+    """``accept_unvalidated_translations``: true, false, or a list of the kiosk's language codes."""
+    if isinstance(value, bool):
+        return value
+    if not isinstance(value, list) or not all(isinstance(code, str) for code in value):
+        raise fail("accept_unvalidated_translations must be true or a list of language codes such as [de, es]")
+    unknown = [code for code in value if code not in SCREEN_LANGUAGES]
+    if unknown:
+        raise fail(
+            f"accept_unvalidated_translations: {unknown[0]!r} is not a language of the kiosk "
+            f"(it has {', '.join(SCREEN_LANGUAGES)})"
+        )
+    return tuple(dict.fromkeys(value))
 
 
 def _path(value: object, name: str) -> Path:
@@ -432,6 +461,44 @@ def configured_questionnaire(config: Config) -> Questionnaire:
             f"{where}bands: {config.bands!r} is not a band set of {questionnaire.source} "
             f"(it has {', '.join(questionnaire.band_sets)})"
         ) from None
+
+
+def offered_to_patients(config: Config, questionnaire: Questionnaire) -> Questionnaire:
+    """The questionnaire with only the languages this site offers patients: every language
+    without a configuration file (as the kiosk always ran); with one, the validated translations
+    and those ``accept_unvalidated_translations`` accepts.
+
+    Raises :class:`ConfigError` (naming the file, line and column of ``language:``) when the
+    kiosk's own language is not offered: an unvalidated translation is not used clinically
+    until the site says it accepts it.
+    """
+    if config.source is None:
+        return questionnaire
+    accepted = config.accept_unvalidated_translations
+    offered = tuple(
+        language
+        for language in questionnaire.languages
+        if questionnaire.validated(language) or accepted is True or (accepted and language in accepted)
+    )
+    if config.language not in offered:
+        entry = questionnaire.translations.get(config.language)
+        what = f"its source: {entry.source}" if entry is not None else "the file names no source for it"
+        raise ConfigError(
+            f"{_setting_at(config.source, 'language')}language: {config.language!r} is an unvalidated "
+            f"translation of {questionnaire.id} ({what}); add it to accept_unvalidated_translations "
+            f"to accept it for clinical use, or set language: to one of {', '.join(offered) or 'none'}"
+        )
+    return replace(questionnaire, languages=offered)
+
+
+def _setting_at(path: Path, key: str) -> str:
+    """ "FILE:LINE:COL: " of ``key`` in a configuration file, "FILE: " when the file does not set it
+    (the default or an environment override)."""
+    data, positions, _ = parse_file(path)
+    if positions is None or not isinstance(data, dict) or key not in data:
+        return f"{path}: "
+    line, column = positions.of((key,), key=True)
+    return f"{path}:{line}:{column}: "
 
 
 def write_settings(path: Path, changes: Mapping[str, str | None]) -> None:

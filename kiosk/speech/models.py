@@ -3,7 +3,7 @@
     kiosk models install LANG [--url URL --sha256 HEX]
     kiosk models list
 
-``install`` downloads the official small Vosk model for LANG (en, es, fr) from alphacephei.com
+``install`` downloads the official small Vosk model for LANG (en, es, fr, de) from alphacephei.com
 and checks it against the MD5 the official model index publishes, or any model zip from
 ``--url`` checked against ``--sha256`` (required then). The archive is downloaded, verified and
 unpacked beside the models folder and only then moved into place, so a failed or tampered
@@ -34,6 +34,7 @@ OFFICIAL_MODELS = {
     "en": "https://alphacephei.com/vosk/models/vosk-model-small-en-us-0.15.zip",
     "es": "https://alphacephei.com/vosk/models/vosk-model-small-es-0.42.zip",
     "fr": "https://alphacephei.com/vosk/models/vosk-model-small-fr-0.22.zip",
+    "de": "https://alphacephei.com/vosk/models/vosk-model-small-de-0.15.zip",
 }
 #: the official index: one entry per model with its name and MD5
 OFFICIAL_INDEX = "https://alphacephei.com/vosk/models/model-list.json"

@@ -45,9 +45,10 @@ class KioskParts:
     def load(cls, config: Config) -> KioskParts:
         """Load them; raises QuestionnaireError, ConfigError, ModelError or PolicyError (one
         sentence, with the file and where) for a bad file."""
-        from kiosk.config import configured_questionnaire
+        from kiosk.config import configured_questionnaire, offered_to_patients
 
-        questionnaire = configured_questionnaire(config)
+        # a site offers patients only validated translations and those it accepts
+        questionnaire = offered_to_patients(config, configured_questionnaire(config))
         model = load_kiosk_model(config.qos_model)
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
         return cls(questionnaire, model, policy)

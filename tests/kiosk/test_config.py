@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.config import DEFAULT_PIN, Config, ConfigError, load_config
+from kiosk.config import DEFAULT_PIN, Config, ConfigError, configured_questionnaire, load_config, offered_to_patients
 from kiosk.core.clock import SimClock, SystemClock
 
 
@@ -65,8 +65,8 @@ def test_bad_environment(tmp_path, monkeypatch):
     monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
     with pytest.raises(ConfigError, match="KIOSK_CONFIG names .* which is not a file"):
         load_config(environ={"KIOSK_CONFIG": str(tmp_path / "missing.yaml")})
-    with pytest.raises(ConfigError, match="language 'de' is not one of en, es, fr"):
-        load_config(environ={"KIOSK_CONFIG": "", "KIOSK_LANGUAGE": "de"})
+    with pytest.raises(ConfigError, match="language 'pt' is not one of de, en, es, fr"):
+        load_config(environ={"KIOSK_CONFIG": "", "KIOSK_LANGUAGE": "pt"})
     with pytest.raises(ConfigError, match="^KIOSK_DATA_DIR '~nosuchuser/x': there is no user 'nosuchuser'"):
         load_config(environ={"KIOSK_DATA_DIR": "~nosuchuser/x"})
     with pytest.raises(ConfigError, match="^" + re.escape("KIOSK_DATA_DIR '/tmp/a\\nb' holds a control character")):
@@ -177,3 +177,83 @@ def test_bad_station_settings_say_where(tmp_path, text, message):
     with pytest.raises(ConfigError) as caught:
         load_config(path, environ={})
     assert str(caught.value).startswith(f"{path}{message}")
+
+
+# --- accept_unvalidated_translations: which translations a site uses clinically -------------------
+
+
+def _site(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "site.yaml"
+    path.write_text("data_dir: data\n" + text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("accept_unvalidated_translations: de\n", ":2:1: accept_unvalidated_translations must be true or a list"),
+        (
+            "accept_unvalidated_translations: [de, xx]\n",
+            ":2:1: accept_unvalidated_translations: 'xx' is not a language",
+        ),
+        ("accept_unvalidated_translations: [1]\n", ":2:1: accept_unvalidated_translations must be true or a list"),
+    ],
+)
+def test_a_bad_accept_unvalidated_translations_says_where(tmp_path, text, message):
+    path = _site(tmp_path, text)
+    with pytest.raises(ConfigError) as caught:
+        load_config(path, environ={})
+    assert str(caught.value).startswith(f"{path}{message}")
+
+
+@pytest.mark.parametrize(
+    ("text", "offered"),
+    [
+        ("", ("en",)),  # a site accepts no unvalidated translation unless it says so
+        ("accept_unvalidated_translations: [de]\n", ("en", "de")),
+        ("accept_unvalidated_translations: [fr, de, fr]\n", ("en", "fr", "de")),
+        ("accept_unvalidated_translations: true\n", ("en", "es", "fr", "de")),
+        ("accept_unvalidated_translations: false\n", ("en",)),
+    ],
+)
+def test_a_site_offers_validated_and_accepted_translations_only(tmp_path, text, offered):
+    config = load_config(_site(tmp_path, text), environ={})
+    barthel = configured_questionnaire(config)
+    assert barthel.languages == ("en", "es", "fr", "de")  # the file still has them all
+    assert offered_to_patients(config, barthel).languages == offered
+
+
+def test_without_a_config_file_every_language_is_offered_as_before(tmp_path, monkeypatch):
+    monkeypatch.setattr("kiosk.config.default_config_path", lambda: tmp_path / "none.yaml")
+    config = load_config(environ={"KIOSK_LANGUAGE": "de"})
+    barthel = configured_questionnaire(config)
+    assert offered_to_patients(config, barthel).languages == ("en", "es", "fr", "de")
+
+
+def test_a_site_language_that_is_unvalidated_and_not_accepted_is_refused_where_it_is_set(tmp_path):
+    path = _site(tmp_path, "language: de\naccept_unvalidated_translations: [es]\n")
+    config = load_config(path, environ={})
+    with pytest.raises(ConfigError) as caught:
+        offered_to_patients(config, configured_questionnaire(config))
+    message = str(caught.value)
+    assert message.startswith(f"{path}:2:1: language: 'de' is an unvalidated translation of barthel (its source: ")
+    assert "add it to accept_unvalidated_translations" in message and "\n" not in message
+    # set by the environment instead: the file is named, without a line it does not have
+    config = load_config(_site(tmp_path, ""), environ={"KIOSK_LANGUAGE": "fr"})
+    with pytest.raises(ConfigError, match=rf"^{re.escape(str(tmp_path / 'site.yaml'))}: language: 'fr'"):
+        offered_to_patients(config, configured_questionnaire(config))
+
+
+def test_kiosk_run_refuses_an_unaccepted_translation_in_one_line_and_runs_an_accepted_one(tmp_path, capsys):
+    from kiosk.ui import app as kiosk_app
+
+    path = _site(tmp_path, "language: de\n")
+    assert kiosk_app.main(["--config", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"kiosk run: {path}:2:1: language: 'de' is an unvalidated translation")
+    path.write_text("data_dir: data\nlanguage: de\naccept_unvalidated_translations: [de]\n")
+    app, close = kiosk_app.build_app(config_path=path, voice=False, remote=False)
+    try:
+        assert app.session.language == "de" and app.session.questionnaire.languages == ("en", "de")
+    finally:
+        close()

@@ -173,7 +173,7 @@ def test_staff_order_a_visit_of_the_sites_own_questionnaire(shared_station):  # 
             "location"
         ]
         assert [o["instruments"] for o in kiosk.orders()["orders"]] == [["site-adl"]]
-        refused = nurse.post("/orders", patient_id="NHC-0044001", kiosk=name, instrument="site-adl", language="de")
+        refused = nurse.post("/orders", patient_id="NHC-0044001", kiosk=name, instrument="site-adl", language="pt")
         assert refused.headers["location"].startswith("/orders?error=")
     finally:
         nurse.http.close()

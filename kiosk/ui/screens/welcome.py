@@ -40,16 +40,19 @@ class LanguageList(Vertical):
         self.lay_out()
 
     def lay_out(self) -> None:
-        """Give every button the same height; spare rows stay below the last."""
+        """Give every button the same height, a row of margin above each so no two run together;
+        spare rows stay below the last. Where three rows each do not fit (four languages on a
+        short panel) they shrink to two, then one, so no language is ever cut off."""
         buttons = list(self.query(Button))
         rows = self.content_region.height
         if not buttons or rows <= 0:
             return
-        height = max(3, (rows - len(buttons)) // len(buttons))  # one row of margin above each
-        if height % 2 == 0:
+        height = max(1, (rows - len(buttons)) // len(buttons))
+        if height % 2 == 0 and height > 2:  # an odd height centres the label; two rows beat one
             height -= 1
         for button in buttons:
             button.styles.height = height
+            button.styles.min_height = min(3, height)
 
 
 def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:
@@ -95,8 +98,16 @@ class WelcomeScreen(PatientScreen):
                 line.update(welcome_line(view, language))
 
     def progress_text(self, view: PatientView) -> str:
-        """The title in every language: the patient has not chosen one yet."""
-        return " · ".join(dict.fromkeys(view.questionnaire.title.values()))
+        """The title in every language (the patient has not chosen one yet), as many as fit the
+        top bar's one row: four languages' titles are longer than a narrow screen."""
+        titles = list(dict.fromkeys(view.questionnaire.title.values()))
+        room = self.size.width - 2  # the bar's padding; 0 or less before the screen is laid out
+        shown = titles[:1]
+        for title in titles[1:]:
+            if room > 0 and len(" · ".join([*shown, title])) > room:
+                break
+            shown.append(title)
+        return " · ".join(shown)
 
     @on(Button.Pressed, "#languages Button")
     def _language(self, event: Button.Pressed) -> None:

@@ -37,19 +37,20 @@ def one_line(done: subprocess.CompletedProcess, where: str) -> str:
     return done.stderr
 
 
-def german_only() -> str:
-    """The bundled questionnaire with every English text moved to German and the rest dropped."""
+def portuguese_only() -> str:
+    """The bundled questionnaire with every English text moved to Portuguese (a language the kiosk's
+    screens do not have) and the rest dropped."""
     data = yaml.safe_load(bundled_path().read_text(encoding="utf-8"))
 
-    def german(value):
+    def portuguese(value):
         if isinstance(value, dict):
-            if "en" in value and set(value) <= {"en", "es", "fr"}:
-                return {"de": german(value["en"])}
-            return {key: german(inner) for key, inner in value.items()}
-        return [german(inner) for inner in value] if isinstance(value, list) else value
+            if "en" in value and set(value) <= {"en", "es", "fr", "de"}:
+                return {"pt": portuguese(value["en"])}
+            return {key: portuguese(inner) for key, inner in value.items()}
+        return [portuguese(inner) for inner in value] if isinstance(value, list) else value
 
-    data = german(data)
-    data["languages"] = ["de"]
+    data = portuguese(data)
+    data["languages"] = ["pt"]
     return yaml.safe_dump(data, allow_unicode=True, sort_keys=False)
 
 
@@ -67,7 +68,7 @@ def write(tmp_path: Path, name: str, content: str | bytes) -> Path:
         ("deep.yaml", "items:\n" + "  " * 1 + "- " + "[" * 5000 + "]" * 5000 + "\n", "deep.yaml:2:"),
         ("nul.yaml", b"id: barthel\x00\n", "nul.yaml:1:12: a NUL byte"),
         ("latin.yaml", "title: {en: Índice}\n".encode("latin-1"), "latin.yaml:1:"),
-        ("de.yaml", german_only(), "de.yaml:"),
+        ("pt.yaml", portuguese_only(), "pt.yaml:"),
     ],
 )
 def test_kiosk_run_and_validate_refuse_the_same_questionnaires(tmp_path, name, content, where):
@@ -79,8 +80,8 @@ def test_kiosk_run_and_validate_refuse_the_same_questionnaires(tmp_path, name, c
     assert one_line(run, f"kiosk run: {questionnaire}:").count(where) == 1
     validated = kiosk("validate", str(questionnaire), cwd=tmp_path)
     assert validated.returncode in (1, 2) and where in validated.stdout, validated.stdout
-    if name == "de.yaml":
-        assert "language 'de'" in validated.stdout and validated.returncode == 1
+    if name == "pt.yaml":
+        assert "language 'pt'" in validated.stdout and validated.returncode == 1
 
 
 @pytest.mark.slow  # a subprocess

@@ -64,7 +64,7 @@ def test_the_welcome_listens_for_start_and_for_a_language_name():
     rig.session.welcome()
     prompt = rig.of(Prompt)[-1]
     assert (prompt.kind, prompt.key, prompt.text) == ("welcome", "welcome", QUESTIONNAIRE.message("welcome", "en"))
-    assert [o.label for o in prompt.options] == ["English", "Español", "Français"]
+    assert [o.label for o in prompt.options] == ["English", "Español", "Français", "Deutsch"]
     assert "start" in prompt.options[0].synonyms and "Spanish" in prompt.options[1].synonyms
     assert rig.session.listening and rig.of(ListeningChanged)[-1].listening
     rig.session.choose_language("fr")  # the welcome is said again, with French words

@@ -20,7 +20,7 @@ Q = load_questionnaire()
 TEXT = bundled_path().read_text(encoding="utf-8")
 
 
-def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
+def test_the_bundled_file_has_the_ten_barthel_items_in_four_languages():
     assert [i.id for i in Q.items] == [
         "feeding",
         "bathing",
@@ -33,7 +33,7 @@ def test_the_bundled_file_has_the_ten_barthel_items_in_three_languages():
         "mobility",
         "stairs",
     ]
-    assert Q.languages == ("en", "es", "fr")
+    assert Q.languages == ("en", "es", "fr", "de")
     assert sorted(len(i.options) for i in Q.items) == [2, 2, 3, 3, 3, 3, 3, 3, 4, 4]
     for item in Q.items:
         for lang in Q.languages:
@@ -237,7 +237,7 @@ def test_unknown_keys(tmp_path):
 
 
 def test_yaml_syntax(tmp_path):
-    path, text = broken(tmp_path, "languages: [en, es, fr]", "languages: [en, es, fr")
+    path, text = broken(tmp_path, "languages: [en, es, fr, de]", "languages: [en, es, fr, de")
     (problem,) = check_questionnaire_file(path)
     assert str(problem).startswith(f"{path}:") and "YAML syntax" in problem.message
 
@@ -336,10 +336,10 @@ def test_loading_a_missing_file_is_a_questionnaire_error(tmp_path):
 def test_a_patient_wording_needs_every_language_and_only_text(tmp_path):
     path, text = broken(
         tmp_path,
-        'patient: {en: "Sometimes", es: "A veces", fr: "Parfois"}',
-        'patient: {en: "Sometimes", es: "A veces"}',
+        'patient: {en: "Sometimes", es: "A veces", fr: "Parfois", de: "Manchmal"}',
+        'patient: {en: "Sometimes", es: "A veces", de: "Manchmal"}',
     )
-    where = position(text, '{en: "Sometimes", es: "A veces"}')
+    where = position(text, '{en: "Sometimes", es: "A veces", de: "Manchmal"}')
     assert [str(p) for p in check_questionnaire_file(path)] == [
         f"{path}:{where}: items[4].options[1].patient has no 'fr' translation"
     ]
@@ -349,7 +349,7 @@ def test_a_patient_wording_needs_every_language_and_only_text(tmp_path):
 
 
 def test_without_a_patient_wording_the_screen_shows_the_clinical_one(tmp_path):
-    path, _ = broken(tmp_path, '        patient: {en: "Sometimes", es: "A veces", fr: "Parfois"}\n', "")
+    path, _ = broken(tmp_path, '        patient: {en: "Sometimes", es: "A veces", fr: "Parfois", de: "Manchmal"}\n', "")
     questionnaire = load_questionnaire(path)
     option = questionnaire.item("bowels").option(2)
     assert option.patient_label_in("en") == option.label_in("en") == "Occasional accident"

@@ -52,9 +52,10 @@ def edit(path: Path, old: str, new: str) -> None:
 
 
 def test_the_kiosk_speaks_the_languages_whose_files_are_present():
-    assert languages() == ("en", "es", "fr")
+    assert languages() == ("de", "en", "es", "fr")
     words = load_words()
     assert [(w.code, w.name, w.voice) for w in words.values()] == [
+        ("de", "Deutsch", "gmw/de"),
         ("en", "English", "gmw/en-us"),
         ("es", "Español", "roa/es"),
         ("fr", "Français", "roa/fr"),
@@ -70,10 +71,10 @@ def test_adding_a_language_is_adding_a_file(tmp_path, capsys):
     add_language(directory)
     words, problems, readable = check_words(directory)
     assert problems == [] and readable
-    assert list(words) == ["en", "es", "fr", "xx"]
+    assert list(words) == ["de", "en", "es", "fr", "xx"]
     assert (words["xx"].name, words["xx"].voice, words["xx"].screen["start"]) == ("Xish", "gmw/en-gb", "Go")
     assert validate_main(["--words", str(directory)]) == 0
-    assert f"{directory}: ok, languages en, es, fr, xx" in capsys.readouterr().err
+    assert f"{directory}: ok, languages de, en, es, fr, xx" in capsys.readouterr().err
 
 
 def test_a_file_missing_a_key_is_refused_naming_where_and_the_key(tmp_path, capsys):
@@ -102,7 +103,12 @@ def test_a_file_missing_a_key_is_refused_naming_where_and_the_key(tmp_path, caps
         ("[[one], [two],", "[[one],", "cardinals", "speech.cardinals must have the words for 10 numbers"),
         ('"number {n}"', '"number"', '"number"', "speech.number_forms[1] must hold {n} or {o}"),
         ("  lead_ins: [", "  lead_ins: [3, ", "lead_ins", "speech.lead_ins must be a list of words (or [])"),
-        ("    fr: [French]\n", "    fr: [French]\n    de: [German]\n", "de: [German]", "no words file for 'de'"),
+        (
+            "    fr: [French]\n",
+            "    fr: [French]\n    pt: [Portuguese]\n",
+            "pt: [Portuguese]",
+            "no words file for 'pt'",
+        ),
         ("  code: xx", "  code: en", "code:", "language.code is 'en' but the file is xx.yaml"),
         ("  start: Go\n", "  start: Go\n  start: Went\n", "start: Went", "duplicate key 'start'"),
     ],
@@ -154,7 +160,7 @@ def test_a_bad_words_file_stops_the_configuration_with_its_position(tmp_path, mo
     finally:
         monkeypatch.undo()
         words_module._kiosk_words.cache_clear()  # noqa: SLF001
-    assert list(load_words()) == ["en", "es", "fr"]
+    assert list(load_words()) == ["de", "en", "es", "fr"]
 
 
 def test_every_screen_text_the_screens_name_is_in_en_yaml():
@@ -226,7 +232,7 @@ def test_a_new_words_file_is_all_a_new_language_needs(tmp_path):
     def with_xx(value):  # the instrument's translation: here its English texts under the new code
         if isinstance(value, dict):
             inner = {key: with_xx(v) for key, v in value.items()}
-            return {**inner, "xx": inner["en"]} if "en" in value and set(value) <= {"en", "es", "fr"} else inner
+            return {**inner, "xx": inner["en"]} if "en" in value and set(value) <= {"en", "es", "fr", "de"} else inner
         return [with_xx(v) for v in value] if isinstance(value, list) else value
 
     data = with_xx(data)
@@ -243,9 +249,9 @@ def test_a_new_words_file_is_all_a_new_language_needs(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     seen = json.loads(done.stdout)
-    assert seen["welcome"] == ["English", "Español", "Français", "Xish"]
+    assert seen["welcome"] == ["English", "Español", "Français", "Deutsch", "Xish"]
     assert seen["language"] == "xx" and seen["explanation"] == ["xx", ["Go"]] and seen["ready"] == 1
-    assert seen["config"] == "xx" and "language 'zz' is not one of en, es, fr, xx" in seen["refused"]
+    assert seen["config"] == "xx" and "language 'zz' is not one of de, en, es, fr, xx" in seen["refused"]
     assert seen["screen"] == ["Go", "Xish", "Question 1 of 10"] and seen["voice"] == "gmw/en-gb"
     assert seen["instrument"] == []
     # the kiosk's own words have no such file, so the same instrument is refused there

@@ -190,6 +190,7 @@ def test_responses_match_their_questionnaire_word_for_word_in_every_language(rep
     assert translations == {
         "en": QUESTIONNAIRE.item("feeding").text["en"],
         "fr": QUESTIONNAIRE.item("feeding").text["fr"],
+        "de": QUESTIONNAIRE.item("feeding").text["de"],
     }
 
 

@@ -190,8 +190,8 @@ def test_normalise_and_spoken_label():
 
 
 def test_unknown_language_is_one_clear_error():
-    with pytest.raises(ValueError, match="no speech vocabulary for language 'de'"):
-        Matcher(FEEDING["en"], "de")
+    with pytest.raises(ValueError, match="no speech vocabulary for language 'pt'"):
+        Matcher(FEEDING["en"], "pt")
 
 
 def test_every_label_and_synonym_of_the_bundled_questionnaire_selects_its_own_option():

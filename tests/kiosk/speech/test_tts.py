@@ -46,7 +46,7 @@ def tts_speaker(espeak_ng):
 
 
 @pytest.mark.slow  # real audio (espeak-ng)
-@pytest.mark.parametrize("language", ["en", "es", "fr"])
+@pytest.mark.parametrize("language", ["en", "es", "fr", "de"])
 def test_every_question_is_real_speech_of_plausible_length(tts_speaker, tmp_path, language):
     total_seconds = total_expected = 0.0
     for item in QUESTIONNAIRE.items:

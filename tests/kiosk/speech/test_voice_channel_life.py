@@ -35,7 +35,12 @@ def test_no_recogniser_for_the_language_turns_voice_off_and_the_session_goes_on(
 
 
 @pytest.mark.parametrize(
-    "language,words", [("es", "respuestas habladas en español"), ("fr", "réponses parlées en français")]
+    "language,words",
+    [
+        ("es", "respuestas habladas en español"),
+        ("fr", "réponses parlées en français"),
+        ("de", "gesprochenen Antworten auf Deutsch"),
+    ],
 )
 def test_no_model_reason_is_shown_in_the_patients_language(monkeypatch, tmp_path, language, words):
     """The patient's screen says why voice is off in their language; the clinician still sees

@@ -53,10 +53,11 @@ class Served:
 @contextmanager
 def serve(tmp_path: Path, config: str = "", *, between_questions_s: float = 0.5) -> Iterator[Served]:
     """`kiosk serve` on a free localhost port, set up with :data:`TOKEN` and ``config`` lines
-    (``between_questions_s``: the thank-you gap, long where a test looks at it)."""
+    (``between_questions_s``: the thank-you gap, long where a test looks at it). The site accepts
+    every unvalidated translation, so the page offers every language the headless layout has."""
     path = tmp_path / "config.yaml"
     path.write_text(
-        'familiarisation: false\nclinician_pin: "246813"\n'
+        'familiarisation: false\nclinician_pin: "246813"\naccept_unvalidated_translations: true\n'
         f"timing: {{attempt_window_s: 300, between_questions_s: {between_questions_s}}}\n"
         f'serve_token_sha256: "{token_digest(TOKEN)}"\n' + config
     )

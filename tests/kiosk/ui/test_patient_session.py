@@ -164,7 +164,7 @@ async def test_any_other_remote_button_on_the_welcome_screen_starts_in_the_langu
     kiosk = ui_kiosk(familiarisation=False, language="fr")
     async with kiosk.app.run_test(size=KIOSK_SIZE) as pilot:
         await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
-        deliver_from_thread(kiosk, ChannelInput(Channel.REMOTE, option=4, detail="BTN 4"))
+        deliver_from_thread(kiosk, ChannelInput(Channel.REMOTE, option=5, detail="BTN 5"))  # four languages
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
         assert kiosk.session.language == "fr"
 

@@ -26,7 +26,7 @@ def test_welcome(snap_compare, ui_kiosk):
 
     async def run_before(pilot) -> None:
         await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
-        await until_drawn(pilot, "3  Français")
+        await until_drawn(pilot, "3  Français", "4  Deutsch")
 
     assert snap_compare(kiosk.app, terminal_size=KIOSK_SIZE, run_before=run_before)
 
@@ -189,7 +189,7 @@ def test_welcome_small(snap_compare, ui_kiosk, size):
 
     async def run_before(pilot) -> None:
         await settle(pilot, lambda: screen_name(kiosk) == "WelcomeScreen")
-        await until_drawn(pilot, "Français")
+        await until_drawn(pilot, "Français", "Deutsch")
 
     assert snap_compare(kiosk.app, terminal_size=size, run_before=run_before)
 
