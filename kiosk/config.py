@@ -355,7 +355,7 @@ def _read(path: Path) -> dict[str, Any]:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
                 raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
         elif key == "accept_unvalidated_translations":
-            value = _accepted_languages(value, lambda message: fail((key,), message))
+            value = _accepted_languages(value, lambda message, key=key: fail((key,), message))
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value

@@ -17,10 +17,9 @@ replayed with :func:`replay`, or from the shell with ``python -m qos replay TRAC
 from __future__ import annotations
 
 import importlib
-from importlib import resources
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from qos.bundled import bundled_models, load_model
 from qos.errors import ContextError, ModelError, QosError, TraceError
 
 if TYPE_CHECKING:
@@ -76,34 +75,6 @@ __all__ = [
     "replay",
     "sample_trace",
 ]
-
-
-def bundled_models() -> list[str]:
-    """Names of the models shipped inside the package (``qos/models/NAME.roqme``)."""
-    folder = resources.files("qos") / "models"
-    return sorted(entry.name[: -len(".roqme")] for entry in folder.iterdir() if entry.name.endswith(".roqme"))
-
-
-def load_model(name_or_path: str | Path) -> Model:
-    """Load a bundled model by name (``"clarc"``) or a ``.roqme`` file by path.
-
-    Raises :class:`ModelError` with file, line and column when the model is malformed. A model
-    that parsed is kept and read back on the next start (:mod:`qos.kept`): no lark, no parse.
-    """
-    from qos.kept import load_model_file_kept as load_model_file
-    from qos.kept import parse_model_kept as parse_model
-
-    text = str(name_or_path)
-    if isinstance(name_or_path, Path) or text.endswith(".roqme") or "/" in text or "\\" in text:
-        return load_model_file(name_or_path)
-    if text not in bundled_models():
-        raise ModelError(
-            f"no bundled model named {text!r} (bundled: {', '.join(bundled_models())}); "
-            "give a path to a .roqme file instead"
-        )
-    folder = resources.files("qos") / "models"
-    # bundled models may import each other (the package is installed as files, not zipped)
-    return parse_model((folder / f"{text}.roqme").read_text(encoding="utf-8"), f"{text}.roqme", Path(str(folder)))
 
 
 def __getattr__(name: str) -> Any:

@@ -92,7 +92,7 @@ class Trace:
 
     def load_model(self) -> Model:
         """Load the trace's model (a bundled name, or a path relative to the trace's folder)."""
-        from qos import load_model  # the package function, which knows the bundled models
+        from qos.bundled import load_model  # knows the bundled models
 
         model = self.model
         is_path = model.endswith(".roqme") or "/" in model

@@ -20,13 +20,7 @@ PACKAGES = ("fileio", "qos", "kiosk", "station")
 
 #: cycles known and owned elsewhere, each with what breaks it; the test fails on any other cycle,
 #: and on one of these once it is gone (strike it from here then)
-KNOWN = {
-    ("qos", "qos.trace", "qos"): (
-        "Trace.load_model imports qos.load_model lazily, and qos/__init__.py defines it while importing "
-        "qos.trace: move bundled_models/load_model into a module of their own (qos/__init__.py is being "
-        "reworked for start-up, issue 24 part 8)"
-    ),
-}
+KNOWN: dict[tuple[str, ...], str] = {}
 
 
 def _modules() -> dict[str, Path]:

@@ -36,19 +36,13 @@ from kiosk.core.questionnaire.loading import (
 )
 from kiosk.core.questionnaire.model import (
     MAX_TIMING_S,
-    PATIENT,
-    STAFF,
-    Band,
-    BandSet,
-    Code,
-    Entry,
     Item,
-    Option,
     PracticeQuestion,
     Questionnaire,
     Timing,
     Translation,
 )
+from kiosk.core.questionnaire.parts import PATIENT, STAFF, Band, BandSet, Code, Entry, Option
 from kiosk.core.questionnaire.scoring import (
     ITEM_WEIGHT,
     Formula,

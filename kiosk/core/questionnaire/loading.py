@@ -17,18 +17,13 @@ from typing import Any
 from fileio.positions import Problem, parse, parse_file
 from kiosk.core.questionnaire.checks import check
 from kiosk.core.questionnaire.model import (
-    PATIENT,
-    Band,
-    BandSet,
-    Code,
-    Entry,
     Item,
-    Option,
     PracticeQuestion,
     Questionnaire,
     Timing,
     Translation,
 )
+from kiosk.core.questionnaire.parts import PATIENT, Band, BandSet, Code, Entry, Option
 from kiosk.core.questionnaire.scoring import Formula, Subscale
 from kiosk.core.words import load_words
 

@@ -17,10 +17,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal
 from functools import lru_cache
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
-if TYPE_CHECKING:
-    from kiosk.core.questionnaire.model import Band, BandSet, Code, Option, Questionnaire
+from kiosk.core.questionnaire.parts import Band, BandSet, Code, Entry, Option
 
 #: SDC/R5 extension giving an answer option its score (on answerOption or on the Coding)
 ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
@@ -30,6 +29,39 @@ ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
 
 class ScoringError(ValueError):
     """A total formula gave no whole number in its declared range for some answers."""
+
+
+class ScoredItem(Protocol):
+    """What scoring reads of an item (:class:`~kiosk.core.questionnaire.model.Item` has it)."""
+
+    @property
+    def id(self) -> str: ...
+    @property
+    def options(self) -> tuple[Option, ...]: ...
+    @property
+    def entry(self) -> Entry | None: ...
+    @property
+    def staff(self) -> bool: ...
+    def option(self, number: int) -> Option: ...
+
+
+class Questionnaire(Protocol):
+    """What scoring reads of an instrument (:class:`~kiosk.core.questionnaire.model.Questionnaire`
+    has it): stated here, so scoring needs nothing of the model's module."""
+
+    @property
+    def id(self) -> str: ...
+    @property
+    def items(self) -> tuple[ScoredItem, ...]: ...
+    @property
+    def formula(self) -> Formula | None: ...
+    @property
+    def subscales(self) -> tuple[Subscale, ...]: ...
+    @property
+    def min_total(self) -> int: ...
+    @property
+    def max_total(self) -> int: ...
+    def item(self, item_id: str) -> ScoredItem: ...
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Protocol, cast
 
 from textual import events, on
 from textual.app import ComposeResult
@@ -20,7 +20,30 @@ from kiosk.ui.widgets.text import join_or, ui_text, ways_sentence
 from kiosk.ui.widgets.waiting_sign import WaitingSign
 
 if TYPE_CHECKING:
-    from kiosk.ui.app import KioskApp
+    from pathlib import Path
+
+    from kiosk.core.pin import PinGuard
+    from kiosk.core.session import Session
+    from kiosk.ui.controller import KioskController
+    from kiosk.ui.widgets.channel_board import ChannelBoard
+
+
+class KioskHost(Protocol):
+    """What a screen may use of the running app (:class:`~kiosk.ui.app.KioskApp` has it): stated
+    here, so the screens need nothing of the app's module and the app imports its screens alone."""
+
+    controller: KioskController
+    board: ChannelBoard
+    pin_guard: PinGuard
+    export_dir: Path | None
+    questionnaire: Questionnaire
+
+    @property
+    def session(self) -> Session: ...
+    def patient_key(self, key: str) -> bool: ...
+    def close_clinician(self) -> None: ...
+    def quit_kiosk(self) -> None: ...
+
 
 #: screen heights (rows) from which a patient screen uses its roomy layout: padded text and the
 #: big block digits on the answers; below, it packs everything tighter (a 1024x600 panel at a
@@ -112,10 +135,10 @@ class KioskScreen(Screen):
     """Base of every kiosk screen: :attr:`kiosk` is the running app with its own type."""
 
     @property
-    def kiosk(self) -> KioskApp:
-        """``self.app`` as the :class:`~kiosk.ui.app.KioskApp` it always is (Textual types it as
-        any App); a screen reads the session and asks the controller through it."""
-        return cast("KioskApp", self.app)
+    def kiosk(self) -> KioskHost:
+        """``self.app`` as the kiosk it always is (Textual types it as any App); a screen reads the
+        session and asks the controller through it."""
+        return cast(KioskHost, self.app)
 
 
 class PatientScreen(KioskScreen):
