@@ -91,6 +91,8 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                 add(path + (lang,), f"{describe(path)} in {lang!r} is blank: write the words")
 
     texts(("title",), data.get("title"))
+    if "patient_title" in data:
+        texts(("patient_title",), data.get("patient_title"))
     messages = data.get("messages")
     for name, value in messages.items() if isinstance(messages, dict) else ():
         texts(("messages", name), value)

@@ -89,6 +89,8 @@ def _v2(q: Questionnaire) -> dict[str, Any]:
     extra: dict[str, Any] = {}
     if q.reference:
         extra["source"] = q.reference
+    if q.patient_title:
+        extra["patient_title"] = dict(q.patient_title)
     if q.translations:
         extra["translations"] = {lang: asdict(t) for lang, t in q.translations.items()}
     if q.formula is not None:
@@ -242,6 +244,7 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
         id=str(d["id"]),
         version=str(d["version"]),
         title=texts(d["title"]),
+        patient_title=texts(d.get("patient_title", {})),
         languages=languages,
         items=items,
         band_sets=band_sets,

@@ -161,6 +161,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         id=data["id"],
         version=str(data.get("version", "")),
         title=dict(data["title"]),
+        patient_title=dict(data.get("patient_title") or {}),
         languages=languages,
         items=items,
         band_sets=band_sets,

@@ -171,6 +171,13 @@ class Questionnaire:
     formula: Formula | None = None
     #: sums of some items' points, reported beside the total
     subscales: tuple[Subscale, ...] = ()
+    #: what the patient's screens call it, in plain words (the file's ``patient_title:``; empty:
+    #: the title): "Questions about how you feel", never "Geriatric Depression Scale"
+    patient_title: Mapping[str, str] = field(default_factory=dict)
+
+    def title_for_patient(self, language: str) -> str:
+        """The instrument's name on the patient's screens in ``language``."""
+        return self.patient_title.get(language) or self.title.get(language, "")
 
     def validated(self, language: str) -> bool:
         """Whether the text in ``language`` is a published, validated translation (a language

@@ -225,7 +225,7 @@ class PatientScreen(KioskScreen):
         paused and doctor-called screens over it), else the questionnaire's title."""
         snap = view.snapshot
         if snap.number is None:
-            return view.questionnaire.title.get(self.language, "")
+            return view.questionnaire.title_for_patient(self.language)
         return ui_text(self.language, "question_of", number=snap.number, total=snap.count)
 
     def on_key(self, event: events.Key) -> None:

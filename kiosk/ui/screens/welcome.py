@@ -100,7 +100,8 @@ class WelcomeScreen(PatientScreen):
     def progress_text(self, view: PatientView) -> str:
         """The title in every language (the patient has not chosen one yet), as many as fit the
         top bar's one row: four languages' titles are longer than a narrow screen."""
-        titles = list(dict.fromkeys(view.questionnaire.title.values()))
+        q = view.questionnaire
+        titles = list(dict.fromkeys(q.title_for_patient(lang) for lang in q.languages))
         room = self.size.width - 2  # the bar's padding; 0 or less before the screen is laid out
         shown = titles[:1]
         for title in titles[1:]:

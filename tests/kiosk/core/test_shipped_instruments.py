@@ -132,6 +132,7 @@ CLINICAL = re.compile(
 def test_the_patient_hears_and_reads_no_clinical_terms(name):
     q = instrument(name)
     said = [q.message(m, lang) for m in q.messages for lang in q.languages]
+    said += [q.title_for_patient(lang) for lang in q.languages]  # the welcome's and top bar's name
     for item in q.patient_items:
         for lang in q.languages:
             said += [item.patient_text_in(lang), item.spoken[lang]]

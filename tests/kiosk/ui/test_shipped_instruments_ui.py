@@ -6,17 +6,15 @@ from __future__ import annotations
 
 import pytest
 
-from kiosk.core.questionnaire import bundled_path, load_questionnaire
+from kiosk.core.questionnaire import bundled_path
 from kiosk.core.session import Phase
 
-from . import conftest
-from .helpers import screen_name, settle, until_drawn
+from .helpers import drawn_text, screen_name, settle, until_drawn
 
 
 def _kiosk_with(monkeypatch, ui_kiosk, name: str, **options):
     """The UI test kiosk running the shipped ``name`` instead of the Barthel."""
-    monkeypatch.setattr(conftest, "load_questionnaire", lambda: load_questionnaire(bundled_path(f"{name}.yaml")))
-    return ui_kiosk(familiarisation=False, **options)
+    return ui_kiosk(familiarisation=False, questionnaire=bundled_path(f"{name}.yaml"), **options)
 
 
 async def _start(kiosk, pilot, language_number: int, explanation: tuple[str, ...] = ()) -> None:
@@ -47,7 +45,11 @@ async def test_gds15_in_german_by_keys_scores_as_published(monkeypatch, ui_kiosk
     kiosk = _kiosk_with(monkeypatch, ui_kiosk, "gds15", show_score=True)
     async with kiosk.app.run_test() as pilot:
         # how many questions, and about which time: the past week
+        # the welcome and the questions name it in plain words, never "depression"
+        await until_drawn(pilot, "Questions about how you feel")
+        assert "epress" not in drawn_text(kiosk.app)
         await _start(kiosk, pilot, kiosk.questionnaire.languages.index("de") + 1, ("fünfzehn Fragen", "letzten Woche"))
+        assert "epress" not in drawn_text(kiosk.app)
         # "Ja" to every question: one point on each item scored on Yes (10 of the 15)
         await _answer_all(kiosk, pilot, lambda item: 1, drawn=("Ja", "Nein"))
     score = kiosk.session.score()
