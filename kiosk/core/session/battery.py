@@ -68,7 +68,8 @@ class Battery:
         self.instruments = tuple(instruments)
         self.visit_id = visit_id or uuid.uuid4().hex[:12]
         self._make_engine = make_engine
-        self._shared = dict(shared)
+        #: the keywords every instrument's session gets
+        self.shared = dict(shared)
         self._qos: dict[Hashable | None, _Qos] = {}
 
     @property
@@ -129,7 +130,7 @@ class Battery:
                 trace.append(dict(event))
         engine, trace = self.qos(place.index)
         session = Session.from_stored(
-            self.instruments[place.index].questionnaire, stored, engine=engine, battery=place, **self._shared
+            self.instruments[place.index].questionnaire, stored, engine=engine, battery=place, **self.shared
         )
         trace.extend(session.out.trace)
         session.out.trace = trace
@@ -143,7 +144,7 @@ class Battery:
 
     def _session(self, index: int, kwargs: Mapping[str, Any]) -> Session:
         engine, trace = self.qos(index)
-        options = {**self._shared, **kwargs}
+        options = {**self.shared, **kwargs}
         session = Session(self.instruments[index].questionnaire, engine=engine, battery=self.place(index), **options)
         session.out.trace = trace  # one trace per engine: the visit's, across its instruments
         return session
