@@ -20,8 +20,8 @@ def write_mini(directory: Path, *, id: str = "mini") -> Path:
     data["id"] = id
     data["title"] = dict(MINI_TITLE)
     data["items"] = data["items"][:2]
-    for key in ("code", "total_code"):
-        data.pop(key, None)
+    data.pop("code", None)
+    data["total_code"] = {"system": "urn:kiosk-test", "code": f"{id}-total", "display": "Two questions total"}
     for item in data["items"]:
         item.pop("code", None)
         for option in item.get("options", []):
