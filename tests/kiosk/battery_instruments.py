@@ -14,11 +14,12 @@ from kiosk.core.questionnaire.loading import bundled_path
 MINI_TITLE = {"en": "Two questions", "es": "Dos preguntas", "fr": "Deux questions"}
 
 
-def write_mini(directory: Path, *, id: str = "mini") -> Path:
-    """Write the short instrument into ``directory`` and return its path."""
+def write_mini(directory: Path, *, id: str = "mini", title: str | None = None) -> Path:
+    """Write the short instrument into ``directory`` and return its path (``title``: its English
+    title instead of "Two questions")."""
     data = yaml.safe_load(Path(bundled_path("barthel.yaml")).read_text(encoding="utf-8"))
     data["id"] = id
-    data["title"] = dict(MINI_TITLE)
+    data["title"] = dict(MINI_TITLE) | ({"en": title} if title else {})
     data["items"] = data["items"][:2]
     data.pop("code", None)
     data["total_code"] = {"system": "urn:kiosk-test", "code": f"{id}-total", "display": "Two questions total"}
