@@ -183,3 +183,22 @@ def test_a_malformed_battery_entry_is_no_place(detail):
     from kiosk.core.session.state import BatteryPlace
 
     assert BatteryPlace.parse(detail) is None
+
+
+def test_an_instrument_with_its_own_model_gets_its_own_engine_and_trace(tmp_path):
+    from kiosk.core.qos_model import load_kiosk_model
+
+    models = {None: MODEL, "kiosk_pace": load_kiosk_model("kiosk_pace")}
+    bat = Battery(
+        [Instrument(QUESTIONNAIRE), Instrument(load_mini(tmp_path), "kiosk_pace")],
+        make_engine=lambda name: Engine(models[name]),
+        shared={"clock": SimClock(), "timing": TIMING},
+    )
+    visit = Visit(bat)
+    through_first(visit)
+    visit.next_instrument()
+    first, second = visit.sessions
+    assert second.engine is not first.engine and second.engine.model is models["kiosk_pace"]
+    assert second.trace is not first.trace  # one trace per model
+    assert second.trace[0]["t"] >= first.trace[-1]["t"]  # on the visit's one session time
+    assert second.trace[0]["set"]["TestState"] == "STARTED"
