@@ -145,6 +145,8 @@ class Battery:
     def _session(self, index: int, kwargs: Mapping[str, Any]) -> Session:
         engine, trace = self.qos(index)
         options = {**self.shared, **kwargs}
-        session = Session(self.instruments[index].questionnaire, engine=engine, battery=self.place(index), **options)
+        # a battery of one is a plain session, logged as sessions always were
+        place = self.place(index) if len(self.instruments) > 1 else None
+        session = Session(self.instruments[index].questionnaire, engine=engine, battery=place, **options)
         session.out.trace = trace  # one trace per engine: the visit's, across its instruments
         return session
