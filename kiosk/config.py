@@ -16,6 +16,8 @@ Example ``config.yaml`` (every key optional)::
     adaptation_policy: /etc/kiosk/adaptation.yaml
     qos_model: /etc/kiosk/ward.roqme  # the QoS model (default: the bundled clarc; also kiosk_pace)
     questionnaire: /etc/kiosk/barthel.yaml
+    instruments: [barthel, lawton, gds15]   # or a battery, in order (instead of questionnaire:): shipped
+                                      # ids or files; {id: gds15, qos_model: FILE} gives one its own model
     bands: spanish                    # a band set of the questionnaire (default: the file's default)
     accept_unvalidated_translations: [de]   # or true: unvalidated translations this site accepts
                                       # for clinical use (default none; see below)
@@ -68,8 +70,9 @@ import platformdirs
 from fileio.bounded import BadFile, open_private, read_text
 from fileio.positions import Problem, parse_file
 from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
-from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
+from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
 from kiosk.core.questionnaire.kept import load_questionnaire_kept
+from kiosk.core.questionnaire.loading import bundled_path
 from qos import bundled_models
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
@@ -120,6 +123,19 @@ class Station:
 
 
 @dataclass(frozen=True)
+class InstrumentChoice:
+    """One instrument of the configured battery (``instruments:``): a shipped instrument's id or a
+    file, and the RoQME model its QoS runs on (None: the kiosk's ``qos_model``)."""
+
+    #: the shipped instrument's id, or the file's path as given
+    name: str
+    #: the file (None: the shipped instrument ``name``)
+    path: Path | None = None
+    #: a bundled model's name or a .roqme file's absolute path (see kiosk.core.qos_model)
+    qos_model: str | None = None
+
+
+@dataclass(frozen=True)
 class Config:
     """Settings of one kiosk. Build with :func:`load_config`."""
 
@@ -143,6 +159,8 @@ class Config:
     qos_model: str = "clarc"
     #: a questionnaire file (None: the bundled Barthel questionnaire)
     questionnaire: Path | None = None
+    #: a battery: the instruments of one visit, in order (empty: the one ``questionnaire``)
+    instruments: tuple[InstrumentChoice, ...] = ()
     #: the questionnaire's band set that interprets totals (None: the file's default, Shah 1989)
     bands: str | None = None
     #: languages whose unvalidated translations this site accepts for clinical use (True: all);
@@ -340,17 +358,17 @@ def _read(path: Path) -> dict[str, Any]:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1 <= value <= 7 * 24 * 60:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
         elif key == "qos_model":
-            from kiosk.core.qos_model import resolve_model
-
-            if not isinstance(value, str) or not value.strip():
-                raise fail((key,), "qos_model must name a bundled model (clarc, kiosk_pace) or a .roqme file")
-            value = resolve_model(value, path.parent)
-            if "/" not in value and value not in bundled_models():
+            try:
+                value = _model(value, path.parent)
+            except ConfigError as exc:
+                raise fail((key,), str(exc)) from None
+        elif key == "instruments":
+            if "questionnaire" in data:
                 raise fail(
                     (key,),
-                    f"no bundled model named {value!r} (bundled: {', '.join(bundled_models())}); "
-                    "give a path to a .roqme file instead",
+                    "give either questionnaire: (one instrument) or instruments: (a battery), not both",
                 )
+            value = _instruments(value, path.parent, fail)
         elif key == "next_patient_after_s":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
                 raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
@@ -375,6 +393,57 @@ def _accepted_languages(value: object, fail: Any) -> tuple[str, ...] | bool:
             f"(it has {', '.join(SCREEN_LANGUAGES)})"
         )
     return tuple(dict.fromkeys(value))
+
+
+def _model(value: object, folder: Path) -> str:
+    """A ``qos_model:`` value resolved (see kiosk.core.qos_model.resolve_model); ConfigError if unusable."""
+    from kiosk.core.qos_model import resolve_model
+
+    if not isinstance(value, str) or not value.strip():
+        raise ConfigError("qos_model must name a bundled model (clarc, kiosk_pace) or a .roqme file")
+    value = resolve_model(value, folder)
+    if "/" not in value and value not in bundled_models():
+        raise ConfigError(
+            f"no bundled model named {value!r} (bundled: {', '.join(bundled_models())}); "
+            "give a path to a .roqme file instead"
+        )
+    return value
+
+
+def _instruments(value: object, folder: Path, fail: Any) -> tuple[InstrumentChoice, ...]:
+    """``instruments:``: a non-empty list of shipped ids or files, each also as ``{id: ..., qos_model:
+    ...}`` (``file:`` for a file); ``fail(key, message)`` makes the positioned ConfigError."""
+    key = "instruments"
+    if not isinstance(value, list) or not value:
+        raise fail((key,), "instruments must be a list such as [barthel, lawton, gds15]")
+    chosen: list[InstrumentChoice] = []
+    for index, entry in enumerate(value):
+        where = (key, index)
+        model = None
+        if isinstance(entry, dict):
+            unknown = set(entry) - {"id", "file", "qos_model"}
+            if unknown or len({"id", "file"} & set(entry)) != 1:
+                raise fail(
+                    where,
+                    "an instrument is a shipped id, a file, or {id: ID (or file: PATH), qos_model: MODEL}",
+                )
+            if "qos_model" in entry:
+                try:
+                    model = _model(entry["qos_model"], folder)
+                except ConfigError as exc:
+                    raise fail((key, index, "qos_model"), str(exc)) from None
+            entry = entry.get("id", entry.get("file"))
+        if not isinstance(entry, str) or not entry.strip():
+            raise fail(where, "an instrument is a shipped instrument's id or a file's path")
+        if "/" in entry or entry.endswith((".yaml", ".yml")):
+            file = _path(entry, key)
+            chosen.append(InstrumentChoice(entry, file if file.is_absolute() else folder / file, model))
+        elif not bundled_path(f"{entry}.yaml").is_file():
+            shipped = sorted(p.stem for p in bundled_path().parent.glob("*.yaml"))
+            raise fail(where, f"no shipped instrument {entry!r} (shipped: {', '.join(shipped)}); or give a file")
+        else:
+            chosen.append(InstrumentChoice(entry, None, model))
+    return tuple(chosen)
 
 
 def _path(value: object, name: str) -> Path:
@@ -439,20 +508,44 @@ def _station(values: Mapping[str, str], where: str) -> Station | None:
     return Station(url.rstrip("/"), values["token"], kiosk_id)
 
 
+def configured_instruments(config: Config) -> list[tuple[Questionnaire, str | None]]:
+    """The battery this kiosk gives, in order: each instrument with its own QoS model (None: the
+    kiosk's). ``questionnaire:`` (or nothing) is a battery of one. A ``bands`` set applies to the
+    instruments that have it (ConfigError if none has). Raises QuestionnaireError or ConfigError."""
+    if not config.instruments:
+        return [(configured_questionnaire(config), None)]
+    found: list[tuple[Questionnaire, str | None]] = []
+    where = f"{config.source}: " if config.source else ""
+    for choice in config.instruments:
+        questionnaire = load_questionnaire(choice.path or bundled_path(f"{choice.name}.yaml"))
+        if questionnaire.id in (q.id for q, _ in found):
+            raise ConfigError(f"{where}instruments: {questionnaire.id!r} is given twice; a visit gives it once")
+        found.append((_configured(config, questionnaire, needs_bands=False), choice.qos_model))
+    if config.bands is not None and not any(config.bands in q.band_sets for q, _ in found):
+        raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of any of the instruments")
+    return found
+
+
 def configured_questionnaire(config: Config) -> Questionnaire:
-    """The questionnaire this kiosk uses, scoring with the configured band set.
+    """The questionnaire this kiosk uses, scoring with the configured band set (with a battery,
+    its first instrument).
 
     Raises :class:`~kiosk.core.questionnaire.QuestionnaireError` for a bad questionnaire file and
     :class:`ConfigError` when ``bands`` names a set the questionnaire does not have.
     """
-    questionnaire = load_questionnaire_kept(config.questionnaire)  # read back when it loaded before
+    if config.instruments:
+        return configured_instruments(config)[0][0]
+    return _configured(config, load_questionnaire_kept(config.questionnaire))  # read back when it loaded before
+
+
+def _configured(config: Config, questionnaire: Questionnaire, *, needs_bands: bool = True) -> Questionnaire:
     where = f"{config.source}: " if config.source else ""
     if config.language not in questionnaire.languages:
         raise ConfigError(
             f"{where}language: {config.language!r} is not a language of {questionnaire.source} "
             f"(it has {', '.join(questionnaire.languages)}); set language: to one of them"
         )
-    if config.bands is None:
+    if config.bands is None or (not needs_bands and config.bands not in questionnaire.band_sets):
         return questionnaire
     try:
         return questionnaire.with_band_set(config.bands)

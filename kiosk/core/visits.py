@@ -102,7 +102,8 @@ def visit_of(log: Iterable[Any]) -> str | None:
 class VisitDesk:
     """What the kiosk's welcome offers and how a visit's session is made, for the app to follow.
 
-    ``make_session(patient_id, language, answered_by, visit)`` builds a fresh session;
+    ``make_session(patient_id, language, answered_by, visit, instruments=ids)`` builds a fresh
+    session (``instruments``: an order's, else the kiosk's battery);
     ``walk_up`` says whether anyone may start a test at the welcome (the site's config). The app
     tells the desk the orders the station lists (:meth:`set_orders`) and asks it what to show
     (:meth:`holds_welcome`) and which session to start.
@@ -139,9 +140,12 @@ class VisitDesk:
         self.walk_up_chosen = False
 
     def for_order(self, order: Order) -> Any:
-        """The session of an ordered visit: its patient, language and who answers."""
+        """The session of an ordered visit: its patient, language, who answers and its instruments
+        (the first one's session; the others follow it in the order's order)."""
         self.ready = tuple(o for o in self.ready if o.id != order.id)
-        return self._make(order.patient_id, order.language, order.answered_by, order.visit)
+        return self._make(
+            order.patient_id, order.language, order.answered_by, order.visit, instruments=order.instruments
+        )
 
     def for_staff(self, patient_id: str, language: str, relative: bool) -> tuple[Any, str | None]:
         """The session of a visit staff start by typing the identifier: (session, None), or

@@ -304,7 +304,8 @@ class KioskApp(App[int], inherit_bindings=False):
     # -- drawing -------------------------------------------------------------------------------
 
     def _view(self) -> PatientView:
-        return patient_view(self.session, self.channels, self.questionnaire, show_score=self.show_score)
+        # the running session's instrument: a battery's changes from one instrument to the next
+        return patient_view(self.session, self.channels, self.session.questionnaire, show_score=self.show_score)
 
     def _render(self) -> None:
         """Show the screens the session's state calls for (none over the clinician's)."""

@@ -9,8 +9,8 @@ has (:class:`~kiosk.ui.channels.KioskChannels`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Hashable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from kiosk.core.adaptation import Adaptation, Policy, load_policy
@@ -19,6 +19,7 @@ from kiosk.core.pin import PinGuard
 from kiosk.core.qos_model import load_kiosk_model
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Session
+from kiosk.core.session.battery import Battery, Instrument
 from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
 from kiosk.export import site_from_config
 from kiosk.export.captured import questionnaire_of
@@ -34,24 +35,52 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class KioskParts:
-    """What a configuration names and every session shares: the questionnaire, the QoS model
-    and the adaptation policy (None: adaptation off)."""
+    """What a configuration names and every session shares: the questionnaire (a battery's
+    first instrument), the QoS model and the adaptation policy (None: adaptation off); and the
+    battery: every instrument in order with the name of its own QoS model (None: ``model``),
+    ``models`` holding each such model loaded."""
 
     questionnaire: Questionnaire
     model: Model
     policy: Policy | None
+    instruments: tuple[tuple[Questionnaire, str | None], ...] = ()
+    models: Mapping[str, Model] = field(default_factory=dict)
 
     @classmethod
     def load(cls, config: Config) -> KioskParts:
         """Load them; raises QuestionnaireError, ConfigError, ModelError or PolicyError (one
         sentence, with the file and where) for a bad file."""
-        from kiosk.config import configured_questionnaire, offered_to_patients
+        from kiosk.config import configured_instruments, offered_to_patients
 
-        # a site offers patients only validated translations and those it accepts
-        questionnaire = offered_to_patients(config, configured_questionnaire(config))
+        # a site offers patients only validated translations and those it accepts, per instrument
+        instruments = tuple((offered_to_patients(config, q), name) for q, name in configured_instruments(config))
         model = load_kiosk_model(config.qos_model)
+        models = {name: load_kiosk_model(name) for _, name in instruments if name is not None}
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
-        return cls(questionnaire, model, policy)
+        return cls(instruments[0][0], model, policy, instruments, models)
+
+    def battery(self, ids: Sequence[str] | None = None) -> list[Instrument]:
+        """The instruments of a visit, in order (a battery of one without ``instruments:``);
+        ``ids``: those instruments, in that order (a station's order)."""
+        given = [Instrument(q, name) for q, name in self.instruments or ((self.questionnaire, None),)]
+        if ids is None:
+            return given
+        by_id = {i.questionnaire.id: i for i in given}
+        return [by_id[i] for i in ids if i in by_id] or given
+
+    @property
+    def ids(self) -> list[str]:
+        """The ids of the instruments this kiosk gives."""
+        return [i.questionnaire.id for i in self.battery()]
+
+    @property
+    def languages(self) -> list[str]:
+        """The languages every instrument of the battery has."""
+        return [lang for lang in self.questionnaire.languages if all(lang in q.languages for q, _ in self.instruments)]
+
+    def model_for(self, name: Hashable | None) -> Model:
+        """The QoS model an instrument runs on (None: the kiosk's)."""
+        return self.models[str(name)] if name is not None else self.model
 
 
 class SessionMaker:
@@ -70,18 +99,26 @@ class SessionMaker:
         self.config, self.parts, self.clock, self.store = config, parts, clock, store
         self.patient_ids = patient_ids
 
-    def _shared(self) -> dict[str, Any]:
+        #: the battery of the latest visit (its next instrument comes from it)
+        self.battery: Battery | None = None
+
+    def _battery(self, visit_id: str | None = None, ids: Sequence[str] | None = None) -> Battery:
         from qos import Engine
 
-        policy, config = self.parts.policy, self.config
-        return {
-            "clock": self.clock,
-            "engine": Engine(self.parts.model),
-            "store": self.store,
-            "timing": config.timing,
-            "adaptation": Adaptation(policy) if policy else None,
-            "next_patient_after_s": config.next_patient_after_s,
-        }
+        policy, config, parts = self.parts.policy, self.config, self.parts
+        self.battery = Battery(
+            parts.battery(ids),
+            make_engine=lambda name: Engine(parts.model_for(name)),
+            shared={
+                "clock": self.clock,
+                "store": self.store,
+                "timing": config.timing,
+                "adaptation": Adaptation(policy) if policy else None,
+                "next_patient_after_s": config.next_patient_after_s,
+            },
+            visit_id=visit_id,
+        )
+        return self.battery
 
     def fresh(
         self,
@@ -89,26 +126,44 @@ class SessionMaker:
         language: str | None = None,
         answered_by: str = "patient",
         visit: str | None = None,
+        instruments: Sequence[str] | None = None,
         **first: Any,
     ) -> Session:
-        """A session for ``patient`` (None: a walk-up with a new id); ``first`` overrides the
-        configuration for one session (``session_id``, ``familiarisation``)."""
+        """The first instrument's session for ``patient`` (None: a walk-up with a new id);
+        ``instruments``: an order's instruments (default: the configured battery); ``first``
+        overrides the configuration for one session (``session_id``, ``familiarisation``)."""
         options = {"familiarisation": self.config.familiarisation, **first}
-        return Session(
-            self.parts.questionnaire,
+        return self._battery(ids=instruments).first(
             patient_id=patient or self.patient_ids(),
             language=language or self.config.language,
             answered_by=answered_by,
             visit=visit or (STAFF if patient else WALK_UP),
-            **self._shared(),
             **options,
         )
 
+    def after(self, session: Session) -> Session | None:
+        """The session of the battery's next instrument after ``session`` (None: the visit is over)."""
+        return self.battery.after(session) if self.battery is not None else None
+
     def resume(self, stored: StoredSession) -> Session:
         """The session continuing ``stored``, with the questionnaire it started with, whatever
-        the file says now."""
+        the file says now. Part of a battery, the visit goes on with its remaining instruments and
+        the QoS trace of its earlier ones (found in the store)."""
         questionnaire = questionnaire_of(stored, fallback=self.parts.questionnaire)
-        return Session.from_stored(questionnaire, stored, **self._shared())
+        place = Battery.place_of(stored)
+        battery = self._battery(place.visit_id if place else None)
+        if place is None or place.instruments != battery.ids or self.store is None:
+            self.battery = None  # not a battery this kiosk gives (any more): this test alone
+            engine, _ = battery.qos(0)
+            return Session.from_stored(questionnaire, stored, engine=engine, **battery.shared)
+        before = []
+        for summary in self.store.sessions():
+            if summary.patient_id == stored.patient_id and summary.id != stored.id:
+                earlier = self.store.session(summary.id)
+                found = Battery.place_of(earlier)
+                if found is not None and found.visit_id == place.visit_id and found.index < place.index:
+                    before.append((found.index, earlier))
+        return battery.resume(stored, [earlier for _, earlier in sorted(before, key=lambda pair: pair[0])])
 
 
 def make_kiosk(
@@ -134,12 +189,13 @@ def make_kiosk(
     app starts them once the welcome is drawn)."""
     parts = parts or KioskParts.load(config)
     maker = SessionMaker(config, parts, clock=clock, store=store, patient_ids=patient_ids)
-    sync, orders, start_order = _station(config, parts.questionnaire, store, lambda: app)
+    sync, orders, start_order = _station(config, parts, store, lambda: app)
     controller = KioskController(
         maker.fresh(**(first or {})),
         store=store,
         fresh=maker.fresh,
         resume=maker.resume,
+        after=maker.after,
         visits=VisitDesk(maker.fresh, walk_up=config.walk_up) if visits else None,
         sync=sync,
         orders=orders,
@@ -157,9 +213,7 @@ def make_kiosk(
     return app
 
 
-def _station(
-    config: Config, questionnaire: Questionnaire, store: Store, app: Callable[[], KioskApp]
-) -> tuple[Any, Any, Any]:
+def _station(config: Config, parts: KioskParts, store: Store, app: Callable[[], KioskApp]) -> tuple[Any, Any, Any]:
     """The ward station's client, the watcher of this kiosk's ordered visits and the call that
     starts one with its code; (None, None, None) without a station (staff then start visits on
     the clinician screen). Both report to the app from their own threads."""
@@ -178,7 +232,7 @@ def _station(
         on_command=lambda command: app().station_command(command),
     )
     store.on_outbox = client.wake
-    instruments, languages = [questionnaire.id], list(questionnaire.languages)
+    instruments, languages = parts.ids, parts.languages
     watcher = OrderWatcher(
         Station(station.url, station.token),
         instruments=instruments,

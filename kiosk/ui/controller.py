@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from kiosk.core.channels import ChannelInput
-from kiosk.core.session import NextPatient, Phase, Session, SessionEvent
+from kiosk.core.session import Finished, NextPatient, Phase, Session, SessionEvent
 from kiosk.core.visits import Order, VisitDesk
 from kiosk.store.database import Store, StoredSession
 from kiosk.store.lease import SessionTaken
@@ -34,7 +34,7 @@ PROBE_BYTES = 256 * 1024
 #: what staff read when they try to replace a test that is still going
 IN_PROGRESS = "a test is in progress on this kiosk: finish it, or start a new patient, first"
 #: the phases a clinician's visit pauses (the welcome and the end have nothing to time out)
-_RUNNING = (Phase.FAMILIARISATION, Phase.EXPLANATION, Phase.QUESTIONS)
+_RUNNING = (Phase.FAMILIARISATION, Phase.EXPLANATION, Phase.REST, Phase.QUESTIONS)
 
 
 class Screens(Protocol):
@@ -63,7 +63,8 @@ class KioskController:
     """The running session of one kiosk and the operations that replace, hold or end it.
 
     ``session`` is the first (not yet started) session. ``fresh()`` builds a session for the next
-    patient and ``resume(stored)`` one continuing an interrupted test (None: this kiosk cannot).
+    patient and ``resume(stored)`` one continuing an interrupted test (None: this kiosk cannot);
+    ``after(session)`` the session of a battery's next instrument (None: the visit is over).
     ``visits`` is a :class:`kiosk.core.visits.VisitDesk` (None: every welcome is a walk-up);
     ``sync`` the station's client, ``orders`` its order watcher and ``start_order(code)`` the call
     that starts an ordered visit (all None without a station). Call :meth:`attach` before use.
@@ -76,6 +77,7 @@ class KioskController:
         store: Store | None = None,
         fresh: Callable[[], Session] | None = None,
         resume: Callable[[StoredSession], Session] | None = None,
+        after: Callable[[Session], Session | None] | None = None,
         visits: VisitDesk | None = None,
         sync: Any = None,
         orders: Any = None,
@@ -85,6 +87,7 @@ class KioskController:
         self.store = store
         self.fresh = fresh
         self.resume = resume
+        self.after = after
         self.visits = visits
         self.sync = sync
         self.orders = orders
@@ -144,6 +147,8 @@ class KioskController:
         self.events.append(event)
         self._dirty = True
         self._screens().session_event(event)
+        if isinstance(event, Finished) and self.after is not None:
+            self._screens().later(self.next_instrument)
         if isinstance(event, NextPatient):
             self._screens().later(self.next_patient)
 
@@ -204,6 +209,22 @@ class KioskController:
         self._screens().redraw(rebuild=True)
         if fresh is not None:
             self.greet()
+
+    def next_instrument(self) -> None:
+        """The running instrument finished: the visit's next one (a battery) starts on its rest
+        screen, in the same visit; after the last, nothing (the end screen stays)."""
+        finished = self.session
+        after = self.after(finished) if self.after is not None and finished.finished else None
+        if after is None:
+            return
+        self.session = after
+        self._unsubscribe()
+        if self.store is not None:
+            with contextlib.suppress(sqlite3.Error):
+                self.store.release(finished.id)
+        self._unsubscribe = after.subscribe(self._on_event)
+        self._screens().tell_channels()
+        self.drive(after.start)
 
     def next_patient(self) -> None:
         """The end screen was shown long enough (the session's :class:`NextPatient`): the welcome

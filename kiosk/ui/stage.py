@@ -21,6 +21,7 @@ from kiosk.ui.screens.familiarisation import FamiliarisationScreen
 from kiosk.ui.screens.out_of_order import OutOfOrderScreen
 from kiosk.ui.screens.paused import PausedScreen
 from kiosk.ui.screens.question import QuestionScreen
+from kiosk.ui.screens.rest import RestScreen
 from kiosk.ui.screens.summary import SummaryScreen
 from kiosk.ui.screens.visit_ready import VisitReadyScreen
 from kiosk.ui.screens.welcome import WelcomeScreen
@@ -31,6 +32,7 @@ PHASE_SCREENS: dict[Phase, type[PatientScreen]] = {
     Phase.WELCOME: WelcomeScreen,
     Phase.FAMILIARISATION: FamiliarisationScreen,
     Phase.EXPLANATION: ExplanationScreen,
+    Phase.REST: RestScreen,
     Phase.QUESTIONS: QuestionScreen,
     Phase.SUMMARY: SummaryScreen,
 }

@@ -9,8 +9,8 @@ from dataclasses import replace
 from typing import Any
 
 from fileio.bounded import BadFile
-from kiosk.commands.replay.driver import ReplayResult, run_script
-from kiosk.commands.replay.script import ScriptError, load_script
+from kiosk.commands.replay.driver import ReplayResult, run_battery, run_script
+from kiosk.commands.replay.script import ScriptError, is_battery_script, load_battery_script, load_script
 from kiosk.core.questionnaire import Questionnaire, QuestionnaireError
 from kiosk.store.lease import SessionTaken
 from qos.errors import QosError
@@ -45,7 +45,7 @@ class _NoOrder(Exception):
     """The station did not give the ordered visit (message says why)."""
 
 
-def _take_order(code: str, config: Any, questionnaire: Questionnaire) -> Any:
+def _take_order(code: str, config: Any, battery: list[tuple[Questionnaire, Any]]) -> Any:
     """The ordered visit whose code staff gave, started at the configured station."""
     if config.station is None:
         raise _NoOrder("--order-code needs a station in the configuration (station: {url, token, kiosk_id})")
@@ -56,8 +56,8 @@ def _take_order(code: str, config: Any, questionnaire: Questionnaire) -> Any:
         return start_order(
             Station(config.station.url, config.station.token),
             code,
-            instruments=[questionnaire.id],
-            languages=list(questionnaire.languages),
+            instruments=[q.id for q, _ in battery],
+            languages=[lang for lang in battery[0][0].languages if all(lang in q.languages for q, _ in battery)],
         )
     except (OrderRefused, Unreachable) as exc:
         raise _NoOrder(f"the visit with code {code} was not started: {exc}") from None
@@ -102,13 +102,14 @@ def main(argv: list[str]) -> int:
         parser.error("--trace takes one script")
     if args.order_code and (len(args.files) != 1 or not args.data_dir):
         parser.error("--order-code takes one script and --data-dir")
-    from kiosk.config import ConfigError, configured_questionnaire, load_config
+    from kiosk.config import ConfigError, configured_instruments, load_config
     from kiosk.core.adaptation import PolicyError, load_policy
     from kiosk.core.qos_model import load_kiosk_model
 
     try:
         config = load_config(args.config)
-        questionnaire = configured_questionnaire(config)
+        battery = configured_instruments(config)
+        questionnaire = battery[0][0]
         policy = load_policy(config.adaptation_policy, model=load_kiosk_model(config.qos_model))
     except QuestionnaireError as exc:
         print(f"kiosk replay: the questionnaire is invalid: {exc}", file=sys.stderr)
@@ -137,8 +138,27 @@ def main(argv: list[str]) -> int:
             return 2
     results = []
     try:
-        order = _take_order(args.order_code, config, questionnaire) if args.order_code else None
+        order = _take_order(args.order_code, config, battery) if args.order_code else None
         for file in args.files:
+            if is_battery_script(file):  # a visit of several instruments: one result each
+                battery_script = load_battery_script(file, {q.id: q for q, _ in battery})
+                if order is not None:
+                    battery_script = replace(
+                        battery_script,
+                        scripts=tuple(
+                            replace(s, patient=order.patient_id, language=order.language, answered_by=order.answered_by)
+                            for s in battery_script.scripts
+                        ),
+                    )
+                results += run_battery(
+                    battery_script,
+                    models={q.id: m for q, m in battery},
+                    store=store,
+                    model=config.qos_model,
+                    policy=policy,
+                    visit=order.visit if order is not None else None,
+                )
+                continue
             script = load_script(file, questionnaire)
             if order is not None:  # the ordered patient, language and answerer, never the script's own
                 script = replace(

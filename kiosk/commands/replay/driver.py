@@ -6,13 +6,13 @@ script declared really happened under the session's rules.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
 from fileio.bounded import BadFile
-from kiosk.commands.replay.script import ANY, COMMANDS, UNSURE_CONFIDENCE, Script, ScriptError, Step
+from kiosk.commands.replay.script import ANY, COMMANDS, UNSURE_CONFIDENCE, BatteryScript, Script, ScriptError, Step
 from kiosk.core.channels import ChannelInput, Command
 from kiosk.core.clock import SimClock
 from kiosk.core.qos_model import DEFAULT_MODEL
@@ -52,6 +52,7 @@ class ReplayResult:
         score = self.session.score()
         return {
             "script": self.script.source,
+            "instrument": self.session.questionnaire.id,
             "patient": self.script.patient,
             "language": self.script.language,
             "answered_by": self.script.answered_by,
@@ -118,6 +119,8 @@ class _Driver:
         now = self.clock.now()
         if isinstance(event, PhaseChanged) and event.phase is Phase.EXPLANATION:
             self.arm(now + self.script.acknowledge_after, self.session.acknowledge)
+        elif isinstance(event, PhaseChanged) and event.phase is Phase.REST:  # a battery's next instrument
+            self.arm(now + self.script.rest_after, self.session.acknowledge)
         elif isinstance(event, AttemptOpened) and event.practice:
             if self.script.practice is not None and event.attempt == 1 and event.number <= len(self.script.practice):
                 step = self.script.practice[event.number - 1]
@@ -345,3 +348,67 @@ def run_script(
         # the session ran, but its QoS replay is refused (a session of weeks at 1 s samples)
         raise ScriptError(f"{script.source}:1:1: the simulated session cannot be replayed: {exc}") from None
     return ReplayResult(script, session, trace, summary, session.now(), driver.events)
+
+
+def run_battery(
+    script: BatteryScript,
+    *,
+    models: Mapping[str, str | None] | None = None,
+    store: Any = None,
+    model: str = DEFAULT_MODEL,
+    policy: Any = None,
+    visit: str | None = None,
+) -> list[ReplayResult]:
+    """Run a battery script as the kiosk runs a battery (:class:`kiosk.core.session.battery.Battery`):
+    each instrument's session after the previous one finished, on one simulated clock, one
+    engine and trace per QoS model. One :class:`ReplayResult` per instrument, whose ``trace`` and
+    ``qos`` are the visit's up to that instrument's end. ``models``: an instrument id's own QoS
+    model (a bundled name or a .roqme path; missing or None: ``model``)."""
+    from kiosk.core.adaptation import Adaptation, load_policy
+    from kiosk.core.qos_model import load_kiosk_model
+    from kiosk.core.session.battery import Battery, Instrument
+    from qos import Engine, Trace, replay
+
+    own = dict(models or {})
+    loaded = {name: load_kiosk_model(name) for name in {model, *(m for m in own.values() if m)}}
+    first = script.scripts[0]
+    clock = SimClock()
+    battery = Battery(
+        [Instrument(q, own.get(q.id)) for q in script.instruments],
+        make_engine=lambda name: Engine(loaded[str(name or model)]),
+        shared={
+            "clock": clock,
+            "store": store,
+            "timing": first.timing,
+            "adaptation": Adaptation(policy or load_policy(model=loaded[model])) if first.adaptation else None,
+        },
+    )
+    results: list[ReplayResult] = []
+    session: Session | None = None
+    for index, part in enumerate(script.scripts):
+        if session is None:
+            session = battery.first(
+                patient_id=part.patient,
+                language=part.language,
+                answered_by=part.answered_by,
+                familiarisation=part.practice is not None,
+                visit=visit,
+            )
+        else:
+            session = battery.after(session)
+            assert session is not None
+            part = replace(part, start_at=clock.now())  # the kiosk starts the next one at once
+        driver = _Driver(part, session, clock)
+        name = own.get(part_id := script.instruments[index].id) or model
+        try:
+            driver.run()
+            trace = Trace.from_events(name, list(session.trace))
+            summary = replay(trace, model=loaded[name])
+        except (ScriptError, QosError, BadFile) as exc:
+            if store is not None:
+                store.abandon(session.id)
+            if isinstance(exc, ScriptError):
+                raise
+            raise ScriptError(f"{script.source}:1:1: the simulated {part_id} cannot be replayed: {exc}") from None
+        results.append(ReplayResult(part, session, trace, summary, session.now(), driver.events))
+    return results

@@ -6,7 +6,8 @@ Every problem is reported with its ``file:line:col``; a script that loads is one
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -93,6 +94,117 @@ class Script:
     timing: dict[str, float]
     practice: tuple[Step, ...] | None
     questions: tuple[Question, ...]
+    #: seconds on the rest screen before Continue (a battery's later instruments)
+    rest_after: float = 0.0
+
+
+@dataclass(frozen=True)
+class BatteryScript:
+    """A scripted patient answering a battery: one :class:`Script` per instrument, in order."""
+
+    source: str
+    scripts: tuple[Script, ...]
+    #: each instrument's questionnaire, in the same order
+    instruments: tuple[Questionnaire, ...]
+
+
+class _Within:
+    """Positions of an instrument's entry in a battery script: the entry's own keys are under
+    ``instruments[index]``, the visit's (patient, language, timing...) at the top."""
+
+    def __init__(self, positions: Any, index: int, own: set[str]) -> None:
+        self.positions, self.index, self.own = positions, index, own
+
+    def of(self, path: tuple[Any, ...], key: bool = False) -> tuple[int, int]:
+        if path and path[0] in self.own:
+            return self.positions.of(("instruments", self.index, *path), key=key)
+        return self.positions.of(path if path else ("instruments", self.index), key=key)
+
+
+def is_battery_script(path: str | Path) -> bool:
+    """The file is a battery script (``instruments:``); False for anything else (bad files too:
+    :func:`load_script` then says what is wrong)."""
+    data, _, problems = parse_file(path)
+    return not problems and isinstance(data, dict) and "instruments" in data
+
+
+def load_battery_script(path: str | Path, instruments: Mapping[str, Questionnaire] | None = None) -> BatteryScript:
+    """Read and check a battery script. Each ``instruments:`` entry names an instrument by ``id``
+    (one of ``instruments``, the configuration's, else a shipped one) or ``file`` (relative to the
+    script) and gives its answers as a one-instrument script does; the visit's keys (patient,
+    language, timing, ...) are at the top. :class:`ScriptError` names every problem's position."""
+    from kiosk.core.questionnaire import QuestionnaireError
+    from kiosk.core.questionnaire.loading import bundled_path
+
+    name = str(path)
+    data, positions, problems = parse_file(path)
+    if positions is None or not isinstance(data, dict):
+        raise _script_error(problems or [Problem(name, 1, 1, "a script is a mapping (patient:, instruments:, ...)")])
+
+    def add(p: tuple[Any, ...], message: str, *, key: bool = False) -> None:
+        line, col = positions.of(p, key=key)
+        problems.append(Problem(name, line, col, message))
+
+    schema_problems(data, _schema(), positions, add)
+    if "questions" in data or "familiarisation" in data:
+        add(
+            ("questions" if "questions" in data else "familiarisation",),
+            "a battery script gives questions per instrument",
+            key=True,
+        )
+    if problems:
+        raise _script_error(problems)
+    known = dict(instruments or {})
+    shared = {k: v for k, v in data.items() if k != "instruments"}
+    scripts: list[Script] = []
+    found: list[Questionnaire] = []
+    for index, entry in enumerate(data["instruments"]):
+        where = ("instruments", index)
+        if ("id" in entry) == ("file" in entry):
+            add(where, f"{describe(where)} names its instrument by id or by file (one of them)")
+            continue
+        try:
+            if "id" in entry and entry["id"] in known:
+                questionnaire = known[entry["id"]]
+            elif "id" in entry and bundled_path(f"{entry['id']}.yaml").is_file():
+                questionnaire = load_questionnaire(bundled_path(f"{entry['id']}.yaml"))
+            elif "id" in entry:
+                add(where + ("id",), f"no instrument {entry['id']!r} in the configuration or shipped with the kiosk")
+                continue
+            else:
+                questionnaire = load_questionnaire(Path(path).parent / entry["file"])
+        except QuestionnaireError as exc:
+            add(where + ("id" if "id" in entry else "file",), f"the instrument is invalid: {exc}")
+            continue
+        if questionnaire.id in (q.id for q in found):
+            add(where, f"{questionnaire.id!r} is answered twice in one visit")
+            continue
+        if index > 0 and isinstance(entry.get("familiarisation"), list):
+            add(where + ("familiarisation",), "only the first instrument has practice questions", key=True)
+            continue
+        own = {k: v for k, v in entry.items() if k not in ("id", "file", "rest_after")}
+        merged = {**shared, **own}
+        try:
+            script = _build(merged, _Within(positions, index, set(own)), name, questionnaire, [])
+            script = replace(script, rest_after=float(entry.get("rest_after", 0)))
+        except ScriptError as exc:
+            problems.append(_parse_problem(str(exc), name))
+            continue
+        scripts.append(script)
+        found.append(questionnaire)
+    if problems:
+        raise _script_error(problems)
+    return BatteryScript(name, tuple(scripts), tuple(found))
+
+
+def _parse_problem(message: str, name: str) -> Problem:
+    """A ScriptError's first problem back as a Problem (its position leads the message)."""
+    rest = message[len(name) + 1 :] if message.startswith(name + ":") else message
+    line, _, rest = rest.partition(":")
+    col, _, text = rest.partition(":")
+    if line.isdigit() and col.isdigit():
+        return Problem(name, int(line), int(col), text.strip())
+    return Problem(name, 1, 1, message)
 
 
 def load_script(path: str | Path, questionnaire: Questionnaire | None = None) -> Script:
@@ -103,6 +215,18 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
     if positions is None or not isinstance(data, dict):
         problems = problems or [Problem(name, 1, 1, "a script is a mapping (patient:, questions:, ...)")]
         raise _script_error(problems)
+    if "instruments" in data:
+        line, col = positions.of(("instruments",), key=True)
+        raise _script_error(
+            [Problem(name, line, col, "a battery script: replay it with `kiosk replay` (load_battery_script)")]
+        )
+    return _build(data, positions, name, questionnaire, problems)
+
+
+def _build(
+    data: dict[str, Any], positions: Any, name: str, questionnaire: Questionnaire, problems: list[Problem]
+) -> Script:
+    """The script ``data`` describes for ``questionnaire`` (positions for the messages)."""
 
     def where(p: tuple[Any, ...], key: bool = False) -> str:
         line, col = positions.of(p, key=key)
@@ -113,6 +237,8 @@ def load_script(path: str | Path, questionnaire: Questionnaire | None = None) ->
         problems.append(Problem(name, line, col, message))
 
     schema_problems(data, _schema(), positions, add)
+    if "questions" not in data and not problems:
+        add((), "the script is missing 'questions'")
     if problems:
         raise _script_error(problems)
 

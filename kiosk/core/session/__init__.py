@@ -16,7 +16,9 @@ dataclass events (:class:`Prompt`, :class:`AttemptOpened`, :class:`AnswerRecorde
 operation that caused them has finished, in order.
 
 Flow: WELCOME --start()--> FAMILIARISATION (practice questions, optional) --> EXPLANATION
---acknowledge()--> QUESTIONS --> SUMMARY. Each question: attempt 1 (prompt; wait
+--acknowledge()--> QUESTIONS --> SUMMARY. A battery's later instrument (:mod:`.battery`) starts
+in REST ("Well done. Next: <title>.") --acknowledge()--> EXPLANATION, with no practice questions.
+Each question: attempt 1 (prompt; wait
 ``attempt_window_s``) -> attempt 2 (prompt repeated; wait) -> not answered, next question.
 
 Timing rules (all values from :class:`~kiosk.core.questionnaire.Timing`):

@@ -32,7 +32,7 @@ from kiosk.core.session.questions import QuestionFlow
 from kiosk.core.session.resume import replay_into, restore_adaptation
 from kiosk.core.session.routing import Router
 from kiosk.core.session.snapshot import Answer, Snapshot
-from kiosk.core.session.state import SessionState
+from kiosk.core.session.state import BatteryPlace, SessionState
 from kiosk.core.session.timers import AttemptClock
 
 
@@ -47,6 +47,8 @@ class Session:
     published (``None``: it stays).
     ``session_id``, ``t_offset``, ``resume_answers`` and ``resume_not_answered`` are for
     :meth:`from_stored` (continuing a stored session); other callers leave them alone.
+    ``battery`` says where the session stands in a battery of instruments (see
+    :mod:`kiosk.core.session.battery`); a later instrument starts with the rest screen.
     ``visit`` says how the visit began (``kiosk.core.visits``: an order, staff, a walk-up); it is
     logged at the start, in the start's transaction, so the result is always marked.
     """
@@ -70,6 +72,7 @@ class Session:
         resume_answers: Mapping[str, Answer] | None = None,
         resume_not_answered: tuple[str, ...] = (),
         visit: str | None = None,
+        battery: BatteryPlace | None = None,
     ) -> None:
         if language not in questionnaire.languages:
             raise ValueError(f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
@@ -93,7 +96,10 @@ class Session:
             stored=resuming and store is not None,
             answers=dict(resume_answers or {}),
             not_answered=list(resume_not_answered),
+            rest=battery is not None and battery.index > 0 and not resuming,
         )
+        #: where this session stands in its visit's battery (None: a visit of one instrument)
+        self.battery = battery
         self.timers = timers = AttemptClock(clock, clock.now() - t_offset)
         self.out = out = Outputs(state, timers, engine=engine, store=store, on_metrics=self._metrics_updated)
         self.prompts = prompts = Prompts(state, timers, out)
@@ -119,6 +125,7 @@ class Session:
             clock=clock,
             store=store,
             visit=visit,
+            battery=battery.detail() if battery is not None else None,
             open_practice=practice.open,
             schedule_next_item=flow.schedule_next_item,
         )

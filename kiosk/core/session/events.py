@@ -21,6 +21,8 @@ class Phase(str, Enum):
     WELCOME = "welcome"
     FAMILIARISATION = "familiarisation"
     EXPLANATION = "explanation"
+    #: between two instruments of a battery: "Well done. Next: <title>. Take a breath." (Continue)
+    REST = "rest"
     QUESTIONS = "questions"
     SUMMARY = "summary"
 

@@ -31,6 +31,7 @@ class Opening:
         clock: Clock,
         store: SessionStore | None,
         visit: str | None,
+        battery: str | None = None,
         open_practice: Callable[[float, int], None],
         schedule_next_item: Callable[[float, float], None],
     ) -> None:
@@ -40,6 +41,7 @@ class Opening:
         self.clock = clock
         self.store = store
         self.visit = visit
+        self.battery = battery
         self._open_practice = open_practice
         self._schedule_next_item = schedule_next_item
 
@@ -75,9 +77,15 @@ class Opening:
         out.log(t, "start", f"answered by {state.answered_by.value}")
         if self.visit and not state.resuming:
             out.log(t, "visit", self.visit)
+        if self.battery and not state.resuming:
+            out.log(t, "battery", self.battery)
         if not state.voice_out_available:  # said before the start, when nothing was stored yet
             out.log(t, "voice_out", "unavailable")
-        if state.familiarisation:
+        if state.rest:
+            self.prompts.set_phase(t, Phase.REST)
+            self.prompts.publish(self.prompts.rest(t))
+            self.prompts.update_listening(t)
+        elif state.familiarisation:
             self.prompts.set_phase(t, Phase.FAMILIARISATION)
             self.prompts.message(t, "familiarisation")
             self._open_practice(t, 0)
@@ -101,6 +109,8 @@ class Opening:
             self.prompts.message(t, "welcome")
         elif state.phase is Phase.EXPLANATION:
             self.prompts.publish(self.prompts.explanation(t))
+        elif state.phase is Phase.REST:
+            self.prompts.publish(self.prompts.rest(t))
         elif state.current_attempt is not None:
             self.prompts.ask(t, repeat=False)
 
@@ -114,7 +124,11 @@ class Opening:
         self.start(t, None)
 
     def acknowledge(self, t: float) -> None:
-        """The patient acknowledged the explanation; the first question comes after the gap."""
+        """The patient acknowledged the explanation; the first question comes after the gap. On
+        the rest screen between two instruments, Continue shows the next one's explanation."""
+        if self.state.phase is Phase.REST:
+            self.prompts.to_explanation(t)
+            return
         if self.state.phase is not Phase.EXPLANATION:
             self.out.ignore(t, None, IgnoreReason.NO_OPEN_ATTEMPT, "acknowledge")
             return

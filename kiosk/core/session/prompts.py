@@ -12,7 +12,15 @@ from kiosk.core.session.events import ListeningChanged, Phase, PhaseChanged, Pro
 from kiosk.core.session.publishing import Outputs
 from kiosk.core.session.state import SessionState
 from kiosk.core.session.timers import AttemptClock
-from kiosk.core.session.words import CONFIRM_WORDS, LANGUAGE_NAMES, OWN_NAME, START_LABEL, START_WORDS
+from kiosk.core.session.words import (
+    CONFIRM_WORDS,
+    CONTINUE_LABEL,
+    LANGUAGE_NAMES,
+    OWN_NAME,
+    REST_TEXT,
+    START_LABEL,
+    START_WORDS,
+)
 
 
 class Prompts:
@@ -76,7 +84,7 @@ class Prompts:
         state = self.state
         wanted = (
             (state.phase is Phase.WELCOME and state.greeted)
-            or state.phase is Phase.EXPLANATION
+            or state.phase in (Phase.EXPLANATION, Phase.REST)
             or state.current_attempt is not None
             or state.can_undo(self.timers.kind)
         )
@@ -113,6 +121,17 @@ class Prompts:
         text = state.questionnaire.message("explanation", lang)
         options = (PromptOption(1, START_LABEL.get(lang, "Start"), tuple(START_WORDS.get(lang, ())), None),)
         return Prompt(t, "message", "explanation", text, text, lang, options, speech_rate=state.speech_rate())
+
+    def rest(self, t: float) -> Prompt:
+        """The rest screen before a battery's next instrument ("Well done. Next: <title>. Take a
+        breath."), with one option: Continue (and the words for "start")."""
+        state = self.state
+        lang = state.language
+        title = state.questionnaire.title.get(lang) or state.questionnaire.id
+        text = REST_TEXT.get(lang, REST_TEXT["en"]).format(title=title)
+        label = CONTINUE_LABEL.get(lang, CONTINUE_LABEL["en"])
+        options = (PromptOption(1, label, tuple(START_WORDS.get(lang, ())), None),)
+        return Prompt(t, "message", "rest", text, text, lang, options, speech_rate=state.speech_rate())
 
     def to_explanation(self, t: float) -> None:
         """Go on to the explanation (after the practice questions, or at once)."""

@@ -84,12 +84,17 @@ class Outputs:
         self._qos_results: list[Any] = []
         #: time of the latest batch the engine ran on its own (timers, time windows)
         self._timed_t = -1.0
-        if engine is not None:
-            engine.subscribe(self._qos_results.append)
+        self._unsubscribe_engine: Callable[[], object] = (
+            engine.subscribe(self._qos_results.append) if engine is not None else lambda: None
+        )
         self._listeners: list[Listener] = []
         self._queue: list[SessionEvent] = []
         self._depth = 0
         self._dispatching = False
+
+    def let_go_of_engine(self) -> None:
+        """Stop hearing the QoS engine: the next instrument of a battery's session uses it now."""
+        self._unsubscribe_engine()
 
     def operation(self, fire: Fire, inclusive: bool = False) -> Operation:
         """Bracket one public call (see :class:`Operation`); ``fire`` acts on each due time-out."""

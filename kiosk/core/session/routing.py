@@ -69,7 +69,7 @@ class Router:
             self.opening.start_by_number(t, event)
         elif self.timers.halted:
             self.incidents.doctor_reply(t, event)
-        elif phase is Phase.EXPLANATION and not self.timers.paused:
+        elif phase in (Phase.EXPLANATION, Phase.REST) and not self.timers.paused:
             self.opening.acknowledge(t)
         else:
             self._answer(t, event)

@@ -48,6 +48,37 @@ class OpenQuestion:
     feedback: str | None = None
 
 
+@dataclass(frozen=True)
+class BatteryPlace:
+    """Where a session stands in a visit's battery: the visit's id, its instrument's index and every
+    instrument's id, in order. Logged at the start (``battery`` entry) so a continued test knows
+    what comes after it."""
+
+    visit_id: str
+    index: int
+    instruments: tuple[str, ...]
+
+    def detail(self) -> str:
+        """The ``battery`` log entry: ``<visit id> <index+1>/<count> <id>,<id>,...``."""
+        return f"{self.visit_id} {self.index + 1}/{len(self.instruments)} {','.join(self.instruments)}"
+
+    @classmethod
+    def parse(cls, detail: str) -> BatteryPlace | None:
+        """The place a ``battery`` log entry names (None for anything else)."""
+        parts = detail.split(" ")
+        if len(parts) != 3 or "/" not in parts[1]:
+            return None
+        number, _, count = parts[1].partition("/")
+        ids = tuple(parts[2].split(","))
+        if not (number.isdigit() and count.isdigit()) or int(count) != len(ids) or not 1 <= int(number) <= len(ids):
+            return None
+        return cls(parts[0], int(number) - 1, ids)
+
+    @property
+    def last(self) -> bool:
+        return self.index == len(self.instruments) - 1
+
+
 @dataclass
 class SessionState:
     """One administration's state. The first fields are fixed when the session is made."""
@@ -67,6 +98,8 @@ class SessionState:
     resuming: bool
     #: the session exists in the store (the log is written from then on)
     stored: bool
+    #: a battery's later instrument: the start shows the rest screen before its explanation
+    rest: bool = False
     answers: dict[str, Answer] = field(default_factory=dict)
     not_answered: list[str] = field(default_factory=list)
     phase: Phase = Phase.WELCOME

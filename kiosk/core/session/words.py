@@ -34,3 +34,9 @@ START_LABEL: Mapping[str, str] = Table(lambda words: words.screen["start"])
 
 #: what a patient says to start, in each language
 START_WORDS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.prompts["start_words"])
+
+#: the rest screen between two instruments of a battery ("{title}": the next instrument's)
+REST_TEXT: Mapping[str, str] = Table(lambda words: words.screen["rest"])
+
+#: the rest screen's one option
+CONTINUE_LABEL: Mapping[str, str] = Table(lambda words: words.screen["rest_continue"])

@@ -52,7 +52,8 @@ def test_orders_the_kiosk_cannot_run_are_left_out_with_why():
 
 def test_the_welcome_is_held_for_ordered_visits_and_where_walk_ups_are_not_allowed():
     made = []
-    desk = VisitDesk(lambda *args: made.append(args) or args, walk_up=True)
+    # the desk's make_session: (patient, language, answered_by, visit) and an order's instruments
+    desk = VisitDesk(lambda *args, **kw: made.append(args) or (*args, kw.get("instruments")), walk_up=True)
     assert not desk.holds_welcome()
     order = Order("order-1", "NHC-1", ("barthel",), "es", "relative")
     assert desk.set_orders([order]) and desk.holds_welcome()
@@ -60,8 +61,8 @@ def test_the_welcome_is_held_for_ordered_visits_and_where_walk_ups_are_not_allow
     assert desk.choose_walk_up() and not desk.holds_welcome()
     desk.next_visit()
     assert desk.holds_welcome()
-    assert desk.for_order(order) == ("NHC-1", "es", "relative", "order order-1") and desk.ready == ()
+    assert desk.for_order(order) == ("NHC-1", "es", "relative", "order order-1", ("barthel",)) and desk.ready == ()
     assert desk.for_staff("Maria Lopez", "en", False)[0] is None
-    assert desk.for_staff(" NHC-2 ", "en", True)[0] == ("NHC-2", "en", "relative", "staff")
+    assert desk.for_staff(" NHC-2 ", "en", True)[0] == ("NHC-2", "en", "relative", "staff", None)
     closed = VisitDesk(lambda *args: args, walk_up=False)
     assert closed.holds_welcome() and not closed.choose_walk_up() and closed.holds_welcome()

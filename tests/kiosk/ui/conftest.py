@@ -51,6 +51,7 @@ class UiKiosk:
         model: str = MODEL,
         questionnaire: str | Path | None = None,
         pin_on_disk: bool = False,
+        instruments: tuple = (),
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -61,6 +62,7 @@ class UiKiosk:
             next_patient_after_s=next_patient_after_s,
             show_score_to_patient=show_score,
             **({"clinician_pin": UI_PIN} if pin_on_disk else {}),
+            instruments=instruments,  # a battery (kiosk.config.InstrumentChoice), else the Barthel
         )
         parts = KioskParts.load(self.config)
         self.questionnaire, self.model = parts.questionnaire, parts.model
@@ -119,7 +121,7 @@ class UiKiosk:
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
     voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model,
-    questionnaire, pin_on_disk)."""
+    questionnaire, pin_on_disk, instruments)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
