@@ -56,7 +56,6 @@ class ReplayResult:
             "patient": self.script.patient,
             "language": self.script.language,
             "answered_by": self.script.answered_by,
-            "instrument": self.session.questionnaire.id,
             "score": {
                 "total": score.total,
                 "complete": score.complete,
