@@ -18,7 +18,7 @@ class RestScreen(ExplanationScreen):
     def compose(self) -> ComposeResult:
         """Bars, the rest sentence naming the next instrument, Continue, and the controls."""
         yield from self.compose_bars()
-        title = self.view.questionnaire.title.get(self.language) or self.view.questionnaire.id
+        title = self.view.questionnaire.title_for_patient(self.language) or self.view.questionnaire.id
         yield Static(ui_text(self.language, "rest", title=title), classes="heading", id="rest")
         yield Button(ui_text(self.language, "rest_continue"), id="understood", classes="big-action")
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)
