@@ -11,7 +11,7 @@ import yaml
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.questionnaire.loading import bundled_path
 
-MINI_TITLE = {"en": "Two questions", "es": "Dos preguntas", "fr": "Deux questions"}
+MINI_TITLE = {"en": "Two questions", "es": "Dos preguntas", "fr": "Deux questions", "de": "Zwei Fragen"}
 
 
 def write_mini(directory: Path, *, id: str = "mini", title: str | None = None) -> Path:

@@ -245,7 +245,7 @@ def test_a_site_language_that_is_unvalidated_and_not_accepted_is_refused_where_i
 
 
 def test_kiosk_run_refuses_an_unaccepted_translation_in_one_line_and_runs_an_accepted_one(tmp_path, capsys):
-    from kiosk.ui import app as kiosk_app
+    from kiosk.commands import run as kiosk_app
 
     path = _site(tmp_path, "language: de\n")
     assert kiosk_app.main(["--config", str(path)]) == 2

@@ -7,7 +7,10 @@ from __future__ import annotations
 import pytest
 from textual.widgets import Button
 
-from kiosk.ui.app import KIOSK_SIZE, build_app
+from kiosk.commands.run import build_app
+from kiosk.ui.app import KIOSK_SIZE
+
+from .helpers import settle
 
 
 @pytest.mark.parametrize(
@@ -24,12 +27,13 @@ async def test_the_welcome_offers_validated_and_accepted_languages(tmp_path, set
     app, close = build_app(config_path=config, voice=False, remote=False)
     try:
         async with app.run_test(size=KIOSK_SIZE) as pilot:
-            await pilot.pause()
-            assert type(app.screen).__name__ == "WelcomeScreen"
+            await settle(
+                pilot, lambda: type(app.screen).__name__ == "WelcomeScreen" and app.screen.query("#languages Button")
+            )
             labels = [str(b.label).strip() for b in app.screen.query("#languages Button").results(Button)]
             assert labels == buttons
             await pilot.press(str(len(buttons)))  # the last language offered, by its number
-            await pilot.pause()
+            await settle(pilot, lambda: type(app.screen).__name__ != "WelcomeScreen")
             assert app.session.language == ("de" if len(buttons) > 1 and "Deutsch" in buttons[-1] else "en")
     finally:
         close()
