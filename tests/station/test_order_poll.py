@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import asyncio
 import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 import sqlalchemy as sa
@@ -40,7 +41,10 @@ def test_the_bus_hands_a_kiosks_poll_only_its_kinds_and_a_page_everything():
         await page.get()
         return on_page, polled, commanded, orders.empty()
 
-    on_page, polled, commanded, left_alone = asyncio.run(run())
+    # a loop of its own on a thread of its own: the station tests' Chromium (Playwright's sync API)
+    # keeps an event loop running on this thread for the whole session
+    with ThreadPoolExecutor(1) as thread:
+        on_page, polled, commanded, left_alone = thread.submit(asyncio.run, run()).result()
     bus.stop()
     assert on_page == sent
     assert polled == [{"type": "order", "kiosk": "bed1"}, {"type": "resync"}]
