@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from textual import events
 from textual.app import App
@@ -29,17 +29,18 @@ from kiosk.store.lease import LEASE_TTL_S
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.controller import KioskController
 from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView
-from kiosk.ui.screens.doctor_called import DoctorCalledScreen
-from kiosk.ui.screens.explanation import ExplanationScreen
-from kiosk.ui.screens.pin import PinScreen
-from kiosk.ui.screens.visit_ready import VisitReadyScreen
 from kiosk.ui.screens.welcome import WelcomeScreen
 from kiosk.ui.stage import PatientStage, patient_view
-from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar, VoiceAgainButton
-from kiosk.ui.widgets.change_answer import ChangeAnswerButton
 from kiosk.ui.widgets.channel_board import VOICE_IN, VOICE_OUT
 from kiosk.ui.widgets.waiting_sign import WaitingSign
+
+if TYPE_CHECKING:  # message types of screens loaded when first shown (kiosk.ui.stage), not before the welcome
+    from kiosk.ui.screens.doctor_called import DoctorCalledScreen
+    from kiosk.ui.screens.explanation import ExplanationScreen
+    from kiosk.ui.screens.visit_ready import VisitReadyScreen
+    from kiosk.ui.widgets.answer_button import AnswerButton
+    from kiosk.ui.widgets.change_answer import ChangeAnswerButton
 
 #: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
 KIOSK_SIZE = (100, 32)
@@ -256,6 +257,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self.run_worker(ask, thread=True, name="start an order", group="orders")
 
     def _order_refused(self, why: str) -> None:
+        from kiosk.ui.screens.visit_ready import VisitReadyScreen  # loaded: it asked for the order
+
         if isinstance(self.screen, VisitReadyScreen):
             self.screen.refused(why if why.endswith(".") else f"The ward station cannot be reached ({why}).")
 
@@ -333,6 +336,8 @@ class KioskApp(App[int], inherit_bindings=False):
             else:
                 self.controller.release()
 
+        from kiosk.ui.screens.pin import PinScreen  # the PIN pad loads when staff first ask for it
+
         self._staff_seen = self.session.now()
         self.push_screen(PinScreen(self.pin_guard), unlocked)
         self.controller.hold()
@@ -342,6 +347,8 @@ class KioskApp(App[int], inherit_bindings=False):
         (the session's clock: a simulated one in tests and replays)."""
         if not self.clinician_open:
             return
+        from kiosk.ui.screens.pin import PinScreen  # loaded: the clinician screens are open
+
         idle = PIN_IDLE_S if isinstance(self.screen, PinScreen) else CLINICIAN_IDLE_S
         if self.session.now() - self._staff_seen >= idle:
             self.close_clinician()

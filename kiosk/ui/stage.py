@@ -7,6 +7,8 @@ rebuilt only when its :meth:`PatientScreen.key` changes (a rebuild loses focus a
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from textual.app import App
@@ -15,27 +17,49 @@ from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Phase, Session
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.screens.base import PatientScreen, PatientView
-from kiosk.ui.screens.doctor_called import DoctorCalledScreen
-from kiosk.ui.screens.explanation import ExplanationScreen
-from kiosk.ui.screens.familiarisation import FamiliarisationScreen
-from kiosk.ui.screens.out_of_order import OutOfOrderScreen
-from kiosk.ui.screens.paused import PausedScreen
-from kiosk.ui.screens.question import QuestionScreen
-from kiosk.ui.screens.rest import RestScreen
-from kiosk.ui.screens.summary import SummaryScreen
-from kiosk.ui.screens.visit_ready import VisitReadyScreen
 from kiosk.ui.screens.welcome import WelcomeScreen
 from kiosk.ui.widgets.channel_board import VOICE_IN
 
-#: the screen of each phase of a session
-PHASE_SCREENS: dict[Phase, type[PatientScreen]] = {
-    Phase.WELCOME: WelcomeScreen,
-    Phase.FAMILIARISATION: FamiliarisationScreen,
-    Phase.EXPLANATION: ExplanationScreen,
-    Phase.REST: RestScreen,
-    Phase.QUESTIONS: QuestionScreen,
-    Phase.SUMMARY: SummaryScreen,
-}
+
+def phase_screen(phase: Phase) -> type[PatientScreen]:
+    """The screen of each phase of a session. Each but the welcome is imported when first shown:
+    the first screen does not wait for the others' modules (issue 24, start-up)."""
+    if phase is Phase.WELCOME:
+        return WelcomeScreen
+    if phase is Phase.FAMILIARISATION:
+        from kiosk.ui.screens.familiarisation import FamiliarisationScreen
+
+        return FamiliarisationScreen
+    if phase is Phase.EXPLANATION:
+        from kiosk.ui.screens.explanation import ExplanationScreen
+
+        return ExplanationScreen
+    if phase is Phase.REST:
+        from kiosk.ui.screens.rest import RestScreen
+
+        return RestScreen
+    if phase is Phase.QUESTIONS:
+        from kiosk.ui.screens.question import QuestionScreen
+
+        return QuestionScreen
+    if phase is Phase.SUMMARY:
+        from kiosk.ui.screens.summary import SummaryScreen
+
+        return SummaryScreen
+    raise ValueError(f"no screen for the phase {phase!r}")
+
+
+def _overlay_screen(halted: bool, paused: bool) -> type[PatientScreen] | None:
+    """The screen over the phase's one: the doctor called, or paused (imported when first shown)."""
+    if halted:
+        from kiosk.ui.screens.doctor_called import DoctorCalledScreen
+
+        return DoctorCalledScreen
+    if paused:
+        from kiosk.ui.screens.paused import PausedScreen
+
+        return PausedScreen
+    return None
 
 
 class PatientStage:
@@ -54,24 +78,26 @@ class PatientStage:
         """Show the screens ``view`` calls for, or refresh the ones shown. ``out_of_order``: one
         calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff."""
         app, snap = self.app, view.snapshot
-        base_cls = PHASE_SCREENS[snap.phase]
-        overlay_cls = DoctorCalledScreen if snap.halted else PausedScreen if snap.paused else None
+        base_cls = phase_screen(snap.phase)
+        overlay_cls = _overlay_screen(snap.halted, snap.paused)
         if out_of_order:
+            from kiosk.ui.screens.out_of_order import OutOfOrderScreen
+
             base_cls, overlay_cls = OutOfOrderScreen, None
         shown = [s for s in app.screen_stack if isinstance(s, PatientScreen)]
         base, overlay = (shown + [None, None])[:2]
         key = (base_cls, base_cls.key(view))
+        make: Callable[[], PatientScreen] = partial(base_cls, view)
         if base_cls is WelcomeScreen and held_visits is not None:  # kiosk.core.visits: staff confirm first
+            from kiosk.ui.screens.visit_ready import VisitReadyScreen
+
             base_cls, key = VisitReadyScreen, (VisitReadyScreen, held_visits.ready)
+            make = partial(VisitReadyScreen, view, held_visits.ready, held_visits.walk_up)
         if overlay is not None and (type(overlay) is not overlay_cls or key != self.key):
             app.pop_screen()
             overlay = None
         if base is None or key != self.key:
-            screen = (
-                VisitReadyScreen(view, held_visits.ready, held_visits.walk_up)
-                if base_cls is VisitReadyScreen
-                else base_cls(view)
-            )
+            screen = make()
             (app.push_screen if base is None else app.switch_screen)(screen)
         else:
             base.show(view)
