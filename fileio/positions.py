@@ -114,6 +114,9 @@ def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add
             add(path, f"{where} is missing {missing!r}")
         elif error.validator == "minItems" and error.validator_value == 1 and error.instance == []:
             add(path, f"{where} is empty: list at least one")
+        elif error.validator in ("minItems", "maxItems") and isinstance(error.instance, list):
+            bound = "at least" if error.validator == "minItems" else "at most"
+            add(path, f"{where} has {len(error.instance)}: {bound} {error.validator_value} are allowed")
         elif error.validator == "multipleOf":
             add(path, f"{where}: must be a multiple of {error.validator_value}, got {error.instance!r}")
         else:

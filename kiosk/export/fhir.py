@@ -47,6 +47,10 @@ Choices, each from the R4 specification:
 - **Test data**: a session stored by ``kiosk replay`` (a scripted patient) is labelled ``HTEST``
   (``meta.security``, "test health data") on its response and total, so no EHR takes it for a
   patient's result.
+- **Format v2** (:mod:`kiosk.export.calculated`): the total item's ``calculatedExpression`` is
+  the instrument's FHIRPath formula when it has one; subscales are calculated items and
+  components of the total Observation; staff items carry the ``answered-by`` extension, and a
+  number staff enter is an ``integer``/``decimal`` item with its range and unit.
 - **Bundle** (transaction, :mod:`kiosk.export.bundle`): the Questionnaires used and the kiosk
   Device are conditional creates (``ifNoneExist`` on url+version / identifier). Results not yet
   signed off are conditional creates on their identifier, so re-sending never duplicates and never
@@ -65,6 +69,17 @@ from kiosk.core.questionnaire import Code, Questionnaire
 from kiosk.core.review import Review, ReviewState
 from kiosk.core.visits import visit_of
 from kiosk.core.words import Table
+from kiosk.export.calculated import (
+    calculated,
+    entry_answer,
+    entry_fields,
+    staff_mark,
+    subscale_code,
+    subscale_components,
+    subscale_expression,
+    subscale_items,
+    total_expression,
+)
 from kiosk.export.result import (
     TOTAL_LINK,
     ExportError,
@@ -79,7 +94,6 @@ ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
 ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
 TRANSLATION = "http://hl7.org/fhir/StructureDefinition/translation"
 SIGNATURE = "http://hl7.org/fhir/StructureDefinition/questionnaireresponse-signature"
-CALCULATED = "http://hl7.org/fhir/uv/sdc/StructureDefinition/sdc-questionnaire-calculatedExpression"
 #: ASTM E1762-95 "Verification Signature": the signer checked the content is complete and correct
 VERIFICATION = {
     "system": "urn:iso-astm:E1762-95:2013",
@@ -156,12 +170,6 @@ def wording(
     return {"url": WORDING, "extension": [{"url": name, "valueString": text} for name, text in parts]}
 
 
-def _total_expression(q: Questionnaire) -> str:
-    """The total as FHIRPath: the sum of the answers' weights, and nothing while an item is unanswered."""
-    answered = f"%resource.item.where(linkId != '{TOTAL_LINK}' and answer.exists())"
-    return f"iif({answered}.count() = {len(q.items)}, {answered}.answer.value.weight().sum(), {{}})"
-
-
 def _computable_name(title: str) -> str:
     """A title as R4 wants a computable name (invariant que-0): letters and digits, a capital first."""
     name = "".join(word[:1].upper() + word[1:] for word in re.findall(r"[A-Za-z0-9]+", title)).lstrip("0123456789")
@@ -176,7 +184,10 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
     items = []
     for item in q.items:
         entry: dict[str, Any] = {
-            "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+            "extension": [
+                wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken),
+                *staff_mark(item),
+            ],
             "linkId": item.id,
             **_text("text", item.text, language),
             "type": "choice",
@@ -184,6 +195,11 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
         }
         if item.code:
             entry["code"] = [_coding(item.code)]
+        if item.entry is not None:
+            fields = entry_fields(item)
+            entry |= {"type": fields["type"], "extension": entry["extension"] + fields["extension"]}
+            items.append(entry)
+            continue
         entry["answerOption"] = [
             {
                 "extension": [
@@ -196,10 +212,19 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
             for option in item.options
         ]
         items.append(entry)
+    for subscale in q.subscales:
+        items.append(
+            {
+                "extension": [calculated(subscale_expression(subscale))],
+                "linkId": subscale.id,
+                **_text("text", subscale.label, language),
+                "code": [subscale_code(q, subscale)],
+                "type": "integer",
+                "readOnly": True,
+            }
+        )
     total: dict[str, Any] = {
-        "extension": [
-            {"url": CALCULATED, "valueExpression": {"language": "text/fhirpath", "expression": _total_expression(q)}}
-        ],
+        "extension": [calculated(total_expression(q))],
         "linkId": TOTAL_LINK,
         **_text("text", {lang: TOTAL_TEXT.get(lang, TOTAL_TEXT["en"]) for lang in q.languages}, language),
         "type": "integer",
@@ -267,10 +292,15 @@ def _authored(r: Result) -> str:
 
 
 def fhir_response(
-    q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
+    q: Questionnaire,
+    stored: StoredSession,
+    review: Review | None = None,
+    site: ExportSite | None = None,
+    values: Mapping[str, float] | None = None,
 ) -> dict[str, Any]:
-    """A stored session (with its clinician's review, if any) as an R4 QuestionnaireResponse."""
-    return response_of(q, result(q, stored, review), site or ExportSite())
+    """A stored session (with its clinician's review, if any, and the numbers staff entered for
+    its ``input`` items, ``values``) as an R4 QuestionnaireResponse."""
+    return response_of(q, result(q, stored, review, values), site or ExportSite())
 
 
 def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]:
@@ -279,8 +309,17 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
     changed = {c.item_id for c in r.review.corrections}
     items = []
     for item in q.items:
+        if item.entry is not None and item.id in r.values:
+            items.append(
+                {
+                    "extension": [wording(language, clinical=item.text, patient=item.patient, spoken=item.spoken)],
+                    "linkId": item.id,
+                    "text": item.text[language],
+                    "answer": [entry_answer(item, r.values[item.id])],
+                }
+            )
         if item.id not in r.options:
-            continue  # unanswered: left out, as SDC does
+            continue  # unanswered (or a number, above): left out, as SDC does
         option = item.option(r.options[item.id])
         entry: dict[str, Any] = {"id": item.id} if item.id in changed else {}  # a Provenance's targetElement
         entry |= {
@@ -295,6 +334,7 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
             ],
         }
         items.append(entry)
+    items += subscale_items(q, r, language)
     if r.complete:
         items.append(
             {
@@ -359,7 +399,11 @@ def observation_status(r: Result) -> str:
 
 
 def fhir_total(
-    q: Questionnaire, stored: StoredSession, review: Review | None = None, site: ExportSite | None = None
+    q: Questionnaire,
+    stored: StoredSession,
+    review: Review | None = None,
+    site: ExportSite | None = None,
+    values: Mapping[str, float] | None = None,
 ) -> dict[str, Any] | None:
     """The total as an R4 Observation (LOINC 96761-2) derived from the response; None when the
     result is incomplete, so a partial sum is never charted as a Barthel total."""
@@ -368,7 +412,7 @@ def fhir_total(
         "type": "QuestionnaireResponse",
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
     }
-    return total_of(q, result(q, stored, review), site, response)
+    return total_of(q, result(q, stored, review, values), site, response)
 
 
 def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
@@ -398,6 +442,9 @@ def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, 
             "code": "{score}",
         },
     }
+    components = subscale_components(q, r, language)
+    if components:
+        observation["component"] = components
     band_set = q.bands_named(r.score.band_set)
     if r.score.band is not None:
         observation["interpretation"] = [

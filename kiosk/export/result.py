@@ -85,9 +85,18 @@ def questionnaire_version(q: Questionnaire) -> str:
     return f"{q.version}-{q.digest[:12]}" if q.version else q.digest[:12]
 
 
-def rescore(q: Questionnaire, stored: StoredSession) -> Score:
-    """The score recomputed from the stored option numbers (ExportError if they do not fit)."""
-    points = {}
+def _score(q: Questionnaire, session_id: str, options: Mapping[str, int], values: Mapping[str, float]) -> Score:
+    """The instrument's own scoring (sum or formula, subscales) of option numbers and entered values."""
+    try:
+        return q.score_answers(options, values=values)
+    except ValueError as exc:
+        raise ExportError(f"session {session_id}: {exc}") from None
+
+
+def rescore(q: Questionnaire, stored: StoredSession, values: Mapping[str, float] | None = None) -> Score:
+    """The score recomputed from the stored option numbers (and the numbers staff entered for
+    ``input`` items, ``values``); ExportError if they do not fit."""
+    options = {}
     for answer in stored.answers:
         try:
             option = q.item(answer.item_id).option(answer.option)
@@ -98,9 +107,8 @@ def rescore(q: Questionnaire, stored: StoredSession) -> Score:
                 f"session {stored.id}: {answer.item_id} option {answer.option} is worth "
                 f"{option.points} points in {q.id}, but {answer.points} were stored"
             )
-        assert option.points is not None
-        points[answer.item_id] = option.points
-    return q.score(points)
+        options[answer.item_id] = answer.option
+    return _score(q, stored.id, options, values or {})
 
 
 @dataclass(frozen=True)
@@ -113,6 +121,25 @@ class Result:
     options: dict[str, int]
     #: the score of ``options`` (complete, total and band only when every item has an answer)
     score: Score
+    #: item id -> the number staff entered, for the instrument's ``input`` items
+    values: Mapping[str, float] = field(default_factory=dict)
+
+    @property
+    def awaiting_staff(self) -> tuple[str, ...]:
+        """Staff items still unanswered: the result is incomplete until staff answer them."""
+        return self.score.awaiting_staff
+
+    @property
+    def pending(self) -> str:
+        """Why the result is incomplete, in a clinician's words ('' when complete)."""
+        if self.complete:
+            return ""
+        staff = self.awaiting_staff
+        patient = [i for i in self.score.missing if i not in staff]
+        parts = [f"not answered: {', '.join(patient)}"] if patient else []
+        if staff:
+            parts.append(f"incomplete until staff answer {', '.join(staff)}")
+        return "; ".join(parts)
 
     @property
     def complete(self) -> bool:
@@ -155,25 +182,27 @@ class Result:
         return self.score.total
 
 
-def result(q: Questionnaire, stored: StoredSession, review: Review | None = None) -> Result:
-    """A stored session with its review applied (ExportError if either does not fit ``q``)."""
+def result(
+    q: Questionnaire, stored: StoredSession, review: Review | None = None, values: Mapping[str, float] | None = None
+) -> Result:
+    """A stored session with its review applied (ExportError if either does not fit ``q``), scored
+    as the instrument says (sum or formula, subscales); ``values`` are the numbers staff entered
+    for its ``input`` items."""
     review = review or Review.unreviewed()
     if stored.questionnaire_id != q.id:
         raise ExportError(
             f"session {stored.id} was answered on questionnaire {stored.questionnaire_id!r}, "
             f"not on {q.id!r} ({q.source}): export it with that questionnaire"
         )
-    rescore(q, stored)  # the stored answers must fit the questionnaire before anything is said about them
+    values = dict(values or {})
+    rescore(q, stored, values)  # the stored answers must fit the questionnaire before anything is said about them
     options = review.options({a.item_id: a.option for a in stored.answers})
-    points = {}
     for item_id, number in options.items():
         try:
-            option = q.item(item_id).option(number)
+            q.item(item_id).option(number)
         except KeyError as exc:
             raise ExportError(f"session {stored.id}: review: {exc.args[0]}") from None
-        assert option.points is not None
-        points[item_id] = option.points
-    return Result(stored, review, options, q.score(points))
+    return Result(stored, review, options, _score(q, stored.id, options, values), values)
 
 
 def results(

@@ -1,8 +1,9 @@
 """The rules a questionnaire file must follow that its JSON Schema cannot say.
 
-Translations for the declared languages, unique ids, distinct points, one display per code, and
-band sets covering every reachable total. Every problem is collected with its ``file:line:col``
-position, so a clinician editing the file by hand fixes them all in one pass.
+Translations for the declared languages, unique ids, one display per code, what each kind of
+item needs (options, ``answers: yes_no`` or a staff ``input``), the scoring formula and subscales
+(:mod:`.rules`), and band sets covering every reachable total. Every problem is collected with
+its ``file:line:col`` position, so a clinician editing the file by hand fixes them all in one pass.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from collections.abc import Callable
 from typing import Any
 
 from fileio.positions import Positions, Problem, describe, schema_problems
+from kiosk.core.questionnaire.rules import check_items, check_scoring, reachable_totals
 from kiosk.core.words import languages
 
 #: the languages the kiosk's own screens are written in (a words file each, kiosk/core/words): a
@@ -33,11 +35,23 @@ def check(
         line, col = positions.of(path, key=key)
         problems.append(Problem(filename, line, col, message))
 
+    _yes_no_keys(data)
     schema_problems(data, schema, positions, add)
     if isinstance(data, dict):
         _check_semantics(data, add)
     problems.sort(key=lambda p: (p.line, p.column, p.message))
     return data, problems
+
+
+def _yes_no_keys(data: Any) -> None:
+    """Unquoted, YAML reads ``points: {yes: 1, no: 0}`` as true and false: read them as meant."""
+    items = data.get("items") if isinstance(data, dict) else None
+    for item in items if isinstance(items, list) else ():
+        points = item.get("points") if isinstance(item, dict) else None
+        if isinstance(points, dict) and any(isinstance(k, bool) for k in points):
+            item["points"] = {
+                ({True: "yes", False: "no"}.get(k, k) if isinstance(k, bool) else k): v for k, v in points.items()
+            }
 
 
 def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
@@ -81,8 +95,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
     for name, value in messages.items() if isinstance(messages, dict) else ():
         texts(("messages", name), value)
 
-    def options(path: tuple[Any, ...], value: Any, scored: bool) -> None:
-        seen: set[Any] = set()
+    def options(path: tuple[Any, ...], value: Any) -> None:
         codes: set[tuple[Any, Any]] = set()
         for i, option in dicts(value):
             texts(path + (i, "label"), option.get("label"))
@@ -100,11 +113,6 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                 if key in codes:
                     add(path + (i, "code"), f"two options of {describe(path[:-1])} have the answer code {key[1]!r}")
                 codes.add(key)
-            points = option.get("points")
-            if scored and isinstance(points, int):
-                if points in seen:
-                    add(path + (i, "points"), f"two options of {describe(path[:-1])} score {points} points")
-                seen.add(points)
 
     _check_displays(data, dicts, add)
     ids: dict[str, tuple[Any, ...]] = {}
@@ -128,7 +136,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                             f"{mark} would be said aloud: the only mark a spoken "
                             "text may hold is {ways} (how to answer)",
                         )
-            options(path + ("options",), entry.get("options"), scored=section == "items")
+            options(path + ("options",), entry.get("options"))
             expected, opts = entry.get("expected"), entry.get("options")
             if (
                 section == "familiarisation"
@@ -138,6 +146,13 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
             ):
                 add(path + ("expected",), f"expected option {expected} but there are only {len(opts)} options")
 
+    items = dicts(data.get("items"))
+    check_items(items, add)
+    translations = data.get("translations")
+    for lang in translations if isinstance(translations, dict) else ():
+        if languages and lang not in languages:
+            add(("translations", lang), f"a translation for {lang!r}, which is not in 'languages'", key=True)
+    check_scoring(data, items, texts, add)
     _check_bands(data, dicts, texts, add)
 
 
@@ -167,21 +182,6 @@ def _check_displays(
         first.setdefault(key, (code["display"], path))
 
 
-def _reachable_totals(items: list[tuple[int, dict[str, Any]]]) -> set[int] | None:
-    """Every total a patient can score (one option's points per item), or None when some points
-    are not whole multiples of 5: the schema reports those, and bands judged against totals that
-    the corrected file cannot reach would only bury that one mistake under others."""
-    totals = {0}
-    for _, item in items:
-        options = item.get("options")
-        points = {o.get("points") for o in options if isinstance(o, dict)} if isinstance(options, list) else set()
-        if not all(isinstance(p, int) and not isinstance(p, bool) and p >= 0 and p % 5 == 0 for p in points):
-            return None
-        if points:
-            totals = {t + p for t in totals for p in points}
-    return totals
-
-
 def _check_bands(
     data: dict[str, Any],
     dicts: Callable[[Any], list[tuple[int, dict[str, Any]]]],
@@ -192,18 +192,20 @@ def _check_bands(
     a patient can reach in a band, and the last band ending at the highest possible total; the
     default names one of the sets.
 
-    Gaps are judged on reachable totals: with points in steps of 5, "20-35, 40-55" (as published)
-    leaves no total out, so it is not a gap."""
+    Gaps are judged on reachable totals, computed from the points (a formula total: every whole
+    number of its declared range): with Barthel points in steps of 5, "20-35, 40-55" (as
+    published) leaves no total out, so it is not a gap."""
     block = data.get("bands")
     if not isinstance(block, dict):
         return
-    sets = block.get("sets") if isinstance(block.get("sets"), dict) else {}
+    found = block.get("sets")
+    sets: dict[str, Any] = found if isinstance(found, dict) else {}
     default = block.get("default")
     if isinstance(default, str) and sets and default not in sets:
         add(("bands", "default"), f"the default band set {default!r} is not one of the sets ({', '.join(sets)})")
     items = dicts(data.get("items"))
     # no items: the schema says so, and every band would only repeat it as "ends above 0"
-    reachable = _reachable_totals(items) if items else None
+    reachable = reachable_totals(data, items) if items else None
     for name, band_set in sets.items():
         path = ("bands", "sets", name, "ranges")
         bands = dicts(band_set.get("ranges")) if isinstance(band_set, dict) else []
@@ -226,7 +228,7 @@ def _check_bands(
                     f"band set {name!r}: band {band.get('id')!r} has min {band['min']} above max {band['max']}",
                 )
         ordered = sorted(bands, key=lambda ib: (ib[1]["min"], ib[1]["max"]))
-        below = -1  # the highest total covered so far
+        below = min(min(reachable), ordered[0][1]["min"]) - 1  # the highest total covered so far
         previous: dict[str, Any] | None = None
         for i, band in ordered:
             if previous is not None and band["min"] <= below:

@@ -21,14 +21,19 @@ from dataclasses import asdict
 from typing import Any
 
 from kiosk.core.questionnaire import (
+    PATIENT,
     Band,
     BandSet,
     Code,
+    Entry,
+    Formula,
     Item,
     Option,
     PracticeQuestion,
     Questionnaire,
+    Subscale,
     Timing,
+    Translation,
 )
 
 __all__ = ["FORMAT", "DefinitionError", "canonical", "canonical_json", "digest", "questionnaire_from"]
@@ -60,27 +65,52 @@ def _option(o: Option) -> dict[str, Any]:
     }
 
 
-def canonical(q: Questionnaire) -> dict[str, Any]:
-    """Everything ``q`` says, as plain JSON values (``source``, a file path, is not part of it)."""
+def _item(i: Item) -> dict[str, Any]:
+    """An item as captured; format v2's parts only where they differ from v1's meaning (a v1
+    instrument's definition, and so its digest, is what it was)."""
+    extra: dict[str, Any] = {}
+    if i.answered_by != PATIENT:
+        extra["answered_by"] = i.answered_by
+    if i.entry is not None:
+        extra["input"] = asdict(i.entry)
     return {
+        "id": i.id,
+        "number": i.number,
+        "text": dict(i.text),
+        "spoken": dict(i.spoken),
+        "patient": dict(i.patient),
+        "code": _code(i.code),
+        "options": [_option(o) for o in i.options],
+    } | extra
+
+
+def _v2(q: Questionnaire) -> dict[str, Any]:
+    """The instrument-level parts of format v2 that ``q`` uses (none for a v1 instrument)."""
+    extra: dict[str, Any] = {}
+    if q.reference:
+        extra["source"] = q.reference
+    if q.translations:
+        extra["translations"] = {lang: asdict(t) for lang, t in q.translations.items()}
+    if q.formula is not None:
+        extra["formula"] = asdict(q.formula)
+    if q.subscales:
+        extra["subscales"] = [
+            {"id": s.id, "label": dict(s.label), "items": list(s.items), "code": _code(s.code)} for s in q.subscales
+        ]
+    return extra
+
+
+def canonical(q: Questionnaire) -> dict[str, Any]:
+    """Everything ``q`` says, as plain JSON values (``source``, a file path, is not part of it;
+    ``reference``, the published source, is, as ``source``)."""
+    return _v2(q) | {
         "format": FORMAT,
         "id": q.id,
         "version": q.version,
         "digest": q.digest,
         "title": dict(q.title),
         "languages": list(q.languages),
-        "items": [
-            {
-                "id": i.id,
-                "number": i.number,
-                "text": dict(i.text),
-                "spoken": dict(i.spoken),
-                "patient": dict(i.patient),
-                "code": _code(i.code),
-                "options": [_option(o) for o in i.options],
-            }
-            for i in q.items
-        ],
+        "items": [_item(i) for i in q.items],
         "band_sets": [
             {
                 "id": s.id,
@@ -176,11 +206,15 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
             options=options(v["options"]),
             code=code(v["code"]),
             patient=texts(v["patient"]),
+            answered_by=str(v.get("answered_by", PATIENT)),
+            entry=Entry(**v["input"]) if v.get("input") else None,
         )
         for v in d["items"]
     )
-    if not items or any(not item.options or any(o.points is None for o in item.options) for item in items):
-        raise DefinitionError("every item of a captured definition needs scored options")
+    if not items or any(
+        (not item.options and item.entry is None) or any(o.points is None for o in item.options) for item in items
+    ):
+        raise DefinitionError("every item of a captured definition needs scored options or an input")
     band_sets = {
         str(s["id"]): BandSet(
             id=str(s["id"]),
@@ -219,4 +253,14 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
         total_code=code(d["total_code"]),
         source=source,
         digest=str(d["digest"]),
+        reference=str(d.get("source", "")),
+        translations={
+            str(lang): Translation(str(t["source"]), bool(t["validated"]))
+            for lang, t in d.get("translations", {}).items()
+        },
+        formula=Formula(**d["formula"]) if d.get("formula") else None,
+        subscales=tuple(
+            Subscale(id=str(s["id"]), label=texts(s["label"]), items=tuple(s["items"]), code=code(s["code"]))
+            for s in d.get("subscales", [])
+        ),
     )

@@ -17,15 +17,24 @@ from typing import Any
 from fileio.positions import Problem, parse, parse_file
 from kiosk.core.questionnaire.checks import check
 from kiosk.core.questionnaire.model import (
+    PATIENT,
     Band,
     BandSet,
     Code,
+    Entry,
     Item,
     Option,
     PracticeQuestion,
     Questionnaire,
     Timing,
+    Translation,
 )
+from kiosk.core.questionnaire.scoring import Formula, Subscale
+from kiosk.core.words import load_words
+
+#: the LOINC answers of a yes/no item (``answers: yes_no``): Yes is option 1, No option 2
+YES = Code("http://loinc.org", "LA33-6", "Yes")
+NO = Code("http://loinc.org", "LA32-8", "No")
 
 #: where the bundled questionnaire and its schema live
 _PACKAGE_DIR = "kiosk.core.questionnaire.instruments"
@@ -104,17 +113,32 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
             for i, v in enumerate(values, start=1)
         )
 
+    languages = tuple(data["languages"])
     items = tuple(
         Item(
             id=v["id"],
             number=n,
             text=dict(v["text"]),
-            spoken=dict(v["spoken"]),
-            options=opts(v["options"]),
+            spoken=dict(v.get("spoken", {})),
+            options=yes_no(v["points"], languages) if v.get("answers") == "yes_no" else opts(v.get("options", [])),
             code=code(v.get("code")),
             patient=dict(v.get("patient", {})),
+            answered_by=v.get("answered_by", PATIENT),
+            entry=Entry(**v["input"]) if "input" in v else None,
         )
         for n, v in enumerate(data["items"], start=1)
+    )
+    scoring = data.get("scoring", {})
+    total = scoring.get("total", "sum")
+    formula = Formula(total["fhirpath"], total["min"], total["max"]) if isinstance(total, dict) else None
+    subscales = tuple(
+        Subscale(
+            id=v["id"],
+            label=dict(v["label"]),
+            items=tuple(i.id for i in items if i.id in v["items"]),
+            code=code(v.get("code")),
+        )
+        for v in scoring.get("subscales", [])
     )
     practice = tuple(
         PracticeQuestion(
@@ -142,7 +166,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         id=data["id"],
         version=str(data.get("version", "")),
         title=dict(data["title"]),
-        languages=tuple(data["languages"]),
+        languages=languages,
         items=items,
         band_sets=band_sets,
         band_set=data["bands"]["default"],
@@ -153,4 +177,28 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         total_code=code(data.get("total_code")),
         source=source,
         digest=hashlib.sha256(json.dumps(data, sort_keys=True, ensure_ascii=False).encode()).hexdigest(),
+        reference=data.get("source", ""),
+        translations={
+            lang: Translation(v["source"], v["validated"]) for lang, v in data.get("translations", {}).items()
+        },
+        formula=formula,
+        subscales=subscales,
     )
+
+
+def yes_no(points: Mapping[str, int], languages: tuple[str, ...]) -> tuple[Option, ...]:
+    """The two options of a yes/no item: Yes (1) and No (2), worded from the kiosk's words files
+    (``answers``) in each of ``languages``, coded LOINC LA33-6 / LA32-8, scored by ``points``."""
+    words = load_words()
+
+    def option(number: int, name: str, code: Code) -> Option:
+        return Option(
+            number=number,
+            label={lang: words[lang].answers[f"{name}_label"] for lang in languages},
+            synonyms={lang: tuple(words[lang].answers[f"{name}_words"]) for lang in languages},
+            points=points[name],
+            patient={lang: words[lang].answers[f"{name}_patient"] for lang in languages},
+            code=code,
+        )
+
+    return option(1, "yes", YES), option(2, "no", NO)

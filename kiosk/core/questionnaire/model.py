@@ -1,7 +1,8 @@
 """The instrument model: immutable items, options, band sets, timing, and scoring.
 
 Built only by :func:`kiosk.core.questionnaire.load_questionnaire`, which has checked every rule,
-so the model trusts its data: a ``Questionnaire`` that exists is one the kiosk can run.
+so the model trusts its data: a ``Questionnaire`` that exists is one the kiosk can run. Scoring
+(the sum or a FHIRPath formula, subscales, bands) is :mod:`.scoring`'s.
 """
 
 from __future__ import annotations
@@ -9,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
+
+from kiosk.core.questionnaire.scoring import Formula, Score, Subscale, compute_score
 
 #: the longest a timing setting may be: a day (a longer wait is a typo, and no session lasts it)
 MAX_TIMING_S = 86400.0
@@ -51,19 +54,54 @@ class Option:
         return self.synonyms.get(language, ())
 
 
+#: who answers an item: the patient at the kiosk (default) or staff on the clinician screen or station
+PATIENT = "patient"
+STAFF = "staff"
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A number staff type in for an item (``input:``): years of education, weight in kg."""
+
+    #: "integer" or "decimal"
+    type: str
+    min: float
+    max: float
+    #: the unit shown beside the field and exported (UCUM-like text, "kg"); may be empty
+    unit: str = ""
+
+    def fits(self, value: Any) -> bool:
+        """Whether ``value`` is a number of this entry's type within its range."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return False
+        if self.type == "integer" and not float(value).is_integer():
+            return False
+        return self.min <= value <= self.max
+
+
 @dataclass(frozen=True)
 class Item:
-    """One scored Barthel item (feeding, bathing, ...)."""
+    """One item of an instrument: a question with options, or a number staff enter (``entry``)."""
 
     id: str
     #: 1-based position in the questionnaire
     number: int
     text: Mapping[str, str]
     spoken: Mapping[str, str]
+    #: the answer options (empty for an item answered by an ``entry``)
     options: tuple[Option, ...]
     code: Code | None = None
     #: the question as the patient's screen shows it, when it differs from ``text`` (clinical)
     patient: Mapping[str, str] = field(default_factory=dict)
+    #: :data:`PATIENT` (asked at the kiosk) or :data:`STAFF` (never shown or spoken to the patient)
+    answered_by: str = PATIENT
+    #: a number staff type in instead of choosing an option (staff items only)
+    entry: Entry | None = None
+
+    @property
+    def staff(self) -> bool:
+        """Answered by staff, never shown or spoken to the patient."""
+        return self.answered_by == STAFF
 
     def option(self, number: int) -> Option:
         """The option with this 1-based number; ``KeyError`` if there is none."""
@@ -77,13 +115,18 @@ class Item:
 
     @property
     def points(self) -> frozenset[int]:
-        """The points this item's options can score."""
+        """The points this item's options can score (empty for an entry)."""
         return frozenset(o.points for o in self.options if o.points is not None)
 
     @property
     def max_points(self) -> int:
-        """The most this item can score."""
-        return max(self.points)
+        """The most this item's options score (0 for an entry, which adds nothing to a sum)."""
+        return max(self.points, default=0)
+
+    @property
+    def min_points(self) -> int:
+        """The least this item's options score (0 for an entry)."""
+        return min(self.points, default=0)
 
 
 @dataclass(frozen=True)
@@ -178,23 +221,12 @@ class Timing:
 
 
 @dataclass(frozen=True)
-class Score:
-    """The result of scoring a set of item answers."""
+class Translation:
+    """Where one language's text of an instrument comes from, and whether it is a published,
+    validated translation (an unvalidated one needs the site's acceptance for clinical use)."""
 
-    #: sum of the points of the answered items
-    total: int
-    #: every item answered
-    complete: bool
-    #: the band of ``total`` when complete, else None (an incomplete total is not interpreted)
-    band: Band | None
-    #: item ids answered, in questionnaire order
-    answered: tuple[str, ...]
-    #: item ids not answered, in questionnaire order
-    missing: tuple[str, ...]
-    #: the highest possible total
-    max_total: int
-    #: the id of the band set ``band`` comes from
-    band_set: str = ""
+    source: str
+    validated: bool
 
 
 @dataclass(frozen=True)
@@ -220,6 +252,40 @@ class Questionnaire:
     #: SHA-256 of the file's content (as parsed: comments and layout do not count), so exports
     #: can tell two edits of the same questionnaire apart
     digest: str = ""
+    #: the published source of the instrument and its scoring (the file's ``source:``)
+    reference: str = ""
+    #: language -> its translation's source and status (the file's ``translations:``)
+    translations: Mapping[str, Translation] = field(default_factory=dict)
+    #: the total as a FHIRPath formula (None: the sum of the chosen options' points)
+    formula: Formula | None = None
+    #: sums of some items' points, reported beside the total
+    subscales: tuple[Subscale, ...] = ()
+
+    def validated(self, language: str) -> bool:
+        """Whether the text in ``language`` is a published, validated translation (a language
+        the file does not list under ``translations``, or lists unvalidated, is not)."""
+        entry = self.translations.get(language)
+        return entry is not None and entry.validated
+
+    @property
+    def patient_items(self) -> tuple[Item, ...]:
+        """The items the patient answers at the kiosk, in order (staff items left out)."""
+        return tuple(i for i in self.items if not i.staff)
+
+    @property
+    def staff_items(self) -> tuple[Item, ...]:
+        """The items staff answer (clinician screen or station), in order."""
+        return tuple(i for i in self.items if i.staff)
+
+    @property
+    def min_total(self) -> int:
+        """The lowest possible total."""
+        return self.formula.min if self.formula else sum(i.min_points for i in self.items)
+
+    @property
+    def max_total(self) -> int:
+        """The highest possible total."""
+        return self.formula.max if self.formula else sum(i.max_points for i in self.items)
 
     def item(self, item_id: str) -> Item:
         """The item with this id; ``KeyError`` if unknown."""
@@ -258,32 +324,54 @@ class Questionnaire:
         return self.bands_named(band_set).band_for(total)
 
     def score(self, points: Mapping[str, int], band_set: str | None = None) -> Score:
-        """Score answers given as item id -> points, interpreted with ``band_set`` (None: the set
-        scoring uses, normally the file's default).
+        """Score answers given as item id -> points (the form before option numbers were needed):
+        each points value stands for the first option scoring it. Prefer :meth:`score_answers`,
+        which a formula on answer codes needs when options share a score.
 
-        Raises ValueError for an unknown item or points that are not one of that item's options,
-        KeyError for an unknown band set. Missing items make the score incomplete (and leave it
-        without a band); they never count as 0 silently.
+        ValueError for an unknown item or points that are not one of that item's options.
         """
-        bands = self.bands_named(band_set)
-        known = {item.id: item for item in self.items}
+        options: dict[str, int] = {}
         for item_id, value in points.items():
-            if item_id not in known:
-                raise ValueError(f"unknown item {item_id!r}")
-            item = known[item_id]
-            if isinstance(value, bool) or value not in item.points:
+            item = self._known(item_id)
+            number = next((o.number for o in item.options if o.points == value and not isinstance(value, bool)), None)
+            if number is None:
                 allowed = ", ".join(str(p) for p in sorted(item.points))
                 raise ValueError(f"{value!r} points is not an option of item {item_id!r} (options: {allowed})")
-        answered = tuple(i.id for i in self.items if i.id in points)
-        missing = tuple(i.id for i in self.items if i.id not in points)
-        total = sum(int(points[i]) for i in answered)
-        complete = not missing
-        return Score(
-            total=total,
-            complete=complete,
-            band=bands.band_for(total) if complete else None,
-            answered=answered,
-            missing=missing,
-            max_total=sum(i.max_points for i in self.items),
-            band_set=bands.id,
-        )
+            options[item_id] = number
+        return self.score_answers(options, band_set)
+
+    def score_answers(
+        self, options: Mapping[str, int], band_set: str | None = None, *, values: Mapping[str, float] | None = None
+    ) -> Score:
+        """Score the answers: ``options`` item id -> option number (choice items), ``values`` item
+        id -> the number staff entered (entry items), interpreted with ``band_set`` (None: the set
+        scoring uses, normally the file's default).
+
+        ValueError for an unknown item, option or a value outside its entry's range (and for a
+        formula giving no whole number in its declared range); KeyError for an unknown band set.
+        A missing item makes the score incomplete, without a band, and a missing staff item is
+        named in ``awaiting_staff``: nothing ever counts as 0 silently.
+        """
+        bands = self.bands_named(band_set)
+        for item_id, number in options.items():
+            item = self._known(item_id)
+            if item.entry is not None or isinstance(number, bool) or not isinstance(number, int):
+                raise ValueError(f"item {item_id!r} takes {'an entered value' if item.entry else 'an option number'}")
+            if not 1 <= number <= len(item.options):
+                raise ValueError(f"item {item_id!r} has no option {number} (it has {len(item.options)})")
+        for item_id, value in (values or {}).items():
+            item = self._known(item_id)
+            if item.entry is None:
+                raise ValueError(f"item {item_id!r} has options, not an entered value")
+            if not item.entry.fits(value):
+                raise ValueError(
+                    f"{value!r} is not a{'n integer' if item.entry.type == 'integer' else ' number'} from "
+                    f"{item.entry.min:g} to {item.entry.max:g} for item {item_id!r}"
+                )
+        return compute_score(self, options, values or {}, bands)
+
+    def _known(self, item_id: str) -> Item:
+        for item in self.items:
+            if item.id == item_id:
+                return item
+        raise ValueError(f"unknown item {item_id!r}")

@@ -276,7 +276,7 @@ class Session:
 
     def score(self) -> Score:
         """The score of the answers recorded so far, recomputed from them."""
-        return self.questionnaire.score({i: a.points for i, a in self.state.answers.items()})
+        return self.questionnaire.score_answers({i: a.option for i, a in self.state.answers.items()})
 
     def snapshot(self) -> Snapshot:
         """A frozen picture of the session for a screen to render."""

@@ -194,7 +194,7 @@ class QuestionFlow:
     def finish(self, t: float) -> None:
         state = self.state
         self.out.context(t, {"TestState": "FINISHED"})
-        score = state.questionnaire.score({i: a.points for i, a in state.answers.items()})
+        score = state.questionnaire.score_answers({i: a.option for i, a in state.answers.items()})
         state.score = score
         if self.store is not None:
             self.store.finish_session(

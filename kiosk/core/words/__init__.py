@@ -16,7 +16,7 @@ from __future__ import annotations
 import re
 import string
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 from types import MappingProxyType
@@ -71,6 +71,14 @@ SHAPE: Mapping[str, Any] = {
         "fillers": WORDS_OR_NONE,
     },
     "export": {"total_score": TEXT},
+    "answers": {
+        "yes_label": TEXT,
+        "yes_patient": TEXT,
+        "yes_words": WORDS,
+        "no_label": TEXT,
+        "no_patient": TEXT,
+        "no_words": WORDS,
+    },
 }
 
 _KIND_WORDS = {
@@ -98,6 +106,8 @@ class Words:
     prompts: Mapping[str, Any]
     speech: Mapping[str, Any]
     export: Mapping[str, str]
+    #: the options of an instrument's yes/no items (``answers: yes_no``): label, patient's wording, synonyms
+    answers: Mapping[str, Any] = field(default_factory=dict)
 
 
 class WordsError(ValueError):
@@ -228,6 +238,7 @@ def _words(code: str, data: Mapping[str, Any]) -> Words:
         section("prompts"),
         MappingProxyType(speech),
         section("export"),
+        section("answers"),
     )
 
 

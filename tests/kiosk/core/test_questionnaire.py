@@ -216,16 +216,17 @@ def test_option_without_points(tmp_path):
     ]
 
 
-def test_points_not_a_multiple_of_five(tmp_path):
+def test_points_of_any_size_are_accepted_and_bands_judged_on_the_totals_they_reach(tmp_path):
+    """Format v2 drops the multiple-of-5 rule: 12 points for transfers is a valid option, and
+    the bands are then judged on the totals it gives (the highest is 97, not 100)."""
     path, text = broken(
         tmp_path,
         '      - points: 15\n        label: {en: "Independent"',
         '      - points: 12\n        label: {en: "Independent"',
     )
-    # one mistake, one message: bands are not judged against totals only the wrong points reach
-    assert [str(p) for p in check_questionnaire_file(path)] == [
-        f"{path}:{position(text, ' 12') + 1}: items[7].options[3].points: must be a multiple of 5, got 12"
-    ]
+    messages = [p.message for p in check_questionnaire_file(path)]
+    assert "band set 'shah': bands end at 100 but the highest possible total is 97" in messages
+    assert not any("multiple of 5" in m for m in messages)
 
 
 def test_unknown_keys(tmp_path):
@@ -303,7 +304,7 @@ def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path
         .replace("  - id: grooming\n", "  - id: grooming\n    colour: blue\n")
         .replace(
             '      - points: 5\n        label: {en: "Occasional accident"',
-            '      - points: 6\n        label: {en: "Occasional accident"',
+            '      - points: six\n        label: {en: "Occasional accident"',
             1,
         )
     )
@@ -313,7 +314,7 @@ def test_every_problem_is_reported_at_once_and_loading_refuses_the_file(tmp_path
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 3
     assert any("duplicate id" in line for line in lines) and any("colour" in line for line in lines)
-    assert any("multiple of 5" in line for line in lines)
+    assert any("'six' is not of type 'integer'" in line for line in lines)
     with pytest.raises(QuestionnaireError) as caught:
         load_questionnaire(path)
     assert len(caught.value.problems) == 3 and "and 2 more problems" in str(caught.value)

@@ -1,0 +1,213 @@
+"""The rules of format v2 a JSON Schema cannot say: what each kind of item needs, the scoring
+formula and subscales, and the totals an instrument can reach.
+
+Kept apart from :mod:`.checks` (texts, ids, codes, bands) so each reads in one sitting; both
+report through the same ``add(path, message, key=)`` so every problem is one ``file:line:col``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, TypeGuard
+
+from fileio.positions import describe
+from kiosk.core.questionnaire.scoring import ITEM_WEIGHT, local_code, run, syntax_problem
+
+Items = list[tuple[int, dict[str, Any]]]
+
+#: the codes of a yes/no item's options (as :mod:`.loading` expands them)
+YES_NO_CODES = {"yes": ("http://loinc.org", "LA33-6"), "no": ("http://loinc.org", "LA32-8")}
+#: the kinds of answer an item may have, one each
+KINDS = ("options", "answers", "input")
+
+
+def _integer(value: Any) -> TypeGuard[int]:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _number(value: Any) -> TypeGuard[float]:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def check_items(items: Items, add: Callable[..., None]) -> None:
+    """Each item has one kind of answer; yes/no points, staff inputs and spoken texts where due."""
+    for i, item in items:
+        path = ("items", i)
+        kinds = [k for k in KINDS if k in item]
+        if not kinds:
+            add(path, f"{describe(path)} needs 'options', 'answers: yes_no' or 'input' (a number staff enter)")
+        for extra in kinds[1:]:
+            add(path + (extra,), f"{describe(path)} has both {kinds[0]!r} and {extra!r}: give one", key=True)
+        if "points" in item and item.get("answers") != "yes_no":
+            add(
+                path + ("points",),
+                f"'points' on {describe(path)} is for 'answers: yes_no' items; give each option its own points",
+                key=True,
+            )
+        if item.get("answers") == "yes_no" and "points" not in item:
+            add(path, f'{describe(path)} has answers: yes_no but no points ({{"yes": N, "no": N}})')
+        staff = item.get("answered_by") == "staff"
+        if "input" in item and not staff:
+            add(path + ("input",), f"{describe(path)}: only staff enter numbers: add answered_by: staff", key=True)
+        if not staff and "spoken" not in item:
+            add(path, f"{describe(path)} is missing 'spoken' (what the kiosk says to the patient)")
+        entry = item.get("input")
+        if isinstance(entry, dict):
+            low, high = entry.get("min"), entry.get("max")
+            if _number(low) and _number(high) and low > high:
+                add(path + ("input", "min"), f"{describe(path + ('input',))}: min {low} is above max {high}")
+            if entry.get("type") == "integer":
+                for name in ("min", "max"):
+                    value = entry.get(name)
+                    if isinstance(value, float) and not value.is_integer():
+                        add(path + ("input", name), f"an integer input cannot have {name} {value}")
+
+
+def _choices(data: dict[str, Any], item: dict[str, Any]) -> list[tuple[tuple[str, str], int]] | None:
+    """((system, code), points) of an item's options in order; [] for an input; None if malformed."""
+    if item.get("answers") == "yes_no":
+        points = item.get("points")
+        if not isinstance(points, dict) or not all(_integer(points.get(k)) for k in YES_NO_CODES):
+            return None
+        return [(YES_NO_CODES[k], points[k]) for k in YES_NO_CODES]
+    if "input" in item:
+        return []
+    options = item.get("options")
+    if not isinstance(options, list) or not options:
+        return None
+    found: list[tuple[tuple[str, str], int]] = []
+    for n, option in enumerate(options, start=1):
+        if not isinstance(option, dict) or not _integer(option.get("points")):
+            return None
+        code = option.get("code")
+        if isinstance(code, dict) and isinstance(code.get("system"), str) and isinstance(code.get("code"), str):
+            key = (code["system"], code["code"])
+        else:
+            key = local_code(str(data.get("id")), str(item.get("id")), n)
+        found.append((key, option["points"]))
+    return found
+
+
+def _formula(data: dict[str, Any]) -> dict[str, Any] | None:
+    scoring = data.get("scoring")
+    total = scoring.get("total") if isinstance(scoring, dict) else None
+    return total if isinstance(total, dict) else None
+
+
+def reachable_totals(data: dict[str, Any], items: Items) -> set[int] | None:
+    """Every total the instrument can give: the sums of one option's points per item (no step
+    assumed), or every whole number of a formula's declared range; None when the points or the
+    range are malformed (the schema says so, and bands judged on them would bury that mistake)."""
+    formula = _formula(data)
+    if formula is not None:
+        low, high = formula.get("min"), formula.get("max")
+        return set(range(low, high + 1)) if _integer(low) and _integer(high) and low <= high else None
+    totals = {0}
+    for _, item in items:
+        choices = _choices(data, item)
+        if choices is None:
+            return None
+        if choices:
+            totals = {t + p for t in totals for _, p in choices}
+    return totals
+
+
+def _samples(data: dict[str, Any], items: Items) -> list[tuple[str, list[dict[str, Any]]]] | None:
+    """A few complete responses (described) to try a formula on: every item at its first option,
+    its last, its lowest and its highest points; inputs at their min, max and middle."""
+    per_item = []
+    for _, item in items:
+        choices, entry = _choices(data, item), item.get("input")
+        if choices is None or not isinstance(item.get("id"), str):
+            return None
+        if isinstance(entry, dict):
+            low, high = entry.get("min"), entry.get("max")
+            if not (_number(low) and _number(high)):
+                return None
+            key = "valueInteger" if entry.get("type") == "integer" else "valueDecimal"
+            middle = (low + high) / 2
+            values = [low, high, middle, middle]
+            per_item.append((item["id"], [{key: int(v) if key == "valueInteger" else v} for v in values]))
+        else:
+
+            def coded(choice: tuple[tuple[str, str], int]) -> dict[str, Any]:
+                (system, code), points = choice
+                ext = [{"url": ITEM_WEIGHT, "valueDecimal": points}]
+                return {"valueCoding": {"system": system, "code": code, "extension": ext}}
+
+            ranked = sorted(choices, key=lambda c: c[1])
+            per_item.append((item["id"], [coded(c) for c in (choices[0], choices[-1], ranked[0], ranked[-1])]))
+    names = ("at its first option", "at its last option", "at its lowest points", "at its highest points")
+    return [
+        (f"every item {name}", [{"linkId": link, "answer": [answers[k]]} for link, answers in per_item])
+        for k, name in enumerate(names)
+    ]
+
+
+def check_scoring(
+    data: dict[str, Any], items: Items, texts: Callable[[tuple[Any, ...], Any], None], add: Callable[..., None]
+) -> None:
+    """The formula parses and gives one whole number in its range on sample answers; subscales
+    name existing scored items once each, with ids of their own."""
+    formula = _formula(data)
+    scoring = data.get("scoring")
+    total = scoring.get("total") if isinstance(scoring, dict) else None
+    if isinstance(total, str) and total != "sum":
+        add(("scoring", "total"), f"scoring.total is 'sum' or a formula ({{fhirpath, min, max}}), not {total!r}")
+    path: tuple[Any, ...]
+    if formula is not None:
+        path = ("scoring", "total")
+        low, high = formula.get("min"), formula.get("max")
+        if _integer(low) and _integer(high) and low > high:
+            add(path + ("min",), f"scoring.total: min {low} is above max {high}")
+        expression = formula.get("fhirpath")
+        why = syntax_problem(expression) if isinstance(expression, str) and expression.strip() else None
+        if why is not None:
+            add(path + ("fhirpath",), f"scoring.total.fhirpath is not valid FHIRPath ({why})")
+        elif isinstance(expression, str) and _integer(low) and _integer(high) and low <= high:
+            _try_formula(expression, low, high, _samples(data, items) or [], add)
+    subscales = scoring.get("subscales") if isinstance(scoring, dict) else None
+    by_id = {item.get("id"): item for _, item in items}
+    seen: set[Any] = set()
+    for n, sub in enumerate(subscales if isinstance(subscales, list) else ()):
+        if not isinstance(sub, dict):
+            continue
+        path = ("scoring", "subscales", n)
+        texts(path + ("label",), sub.get("label"))
+        sub_id = sub.get("id")
+        if sub_id in seen or sub_id in by_id or sub_id == "total":
+            what = "another subscale" if sub_id in seen else "an item" if sub_id in by_id else "the total"
+            add(path + ("id",), f"subscale id {sub_id!r} is already {what}'s: give it its own")
+        seen.add(sub_id)
+        members = sub.get("items")
+        for k, item_id in enumerate(members if isinstance(members, list) else ()):
+            item = by_id.get(item_id)
+            if item is None:
+                add(path + ("items", k), f"subscale {sub_id!r}: there is no item {item_id!r}")
+            elif "input" in item:
+                add(path + ("items", k), f"subscale {sub_id!r}: item {item_id!r} is an input, with no points")
+            elif isinstance(members, list) and members.index(item_id) != k:
+                add(path + ("items", k), f"subscale {sub_id!r} lists item {item_id!r} twice")
+
+
+def _try_formula(
+    expression: str, low: int, high: int, samples: list[tuple[str, list[dict[str, Any]]]], add: Callable[..., None]
+) -> None:
+    """One problem for the first sample response the formula gives no whole number in range on."""
+    where = ("scoring", "total", "fhirpath")
+    for described, items in samples:
+        resource = {"resourceType": "QuestionnaireResponse", "item": items}
+        try:
+            result = run(expression, resource)
+        except Exception as exc:  # fhirpathpy raises bare Exceptions (unknown function, bad types)
+            add(where, f"scoring.total.fhirpath cannot be evaluated with {described}: {exc}")
+            return
+        value = result[0] if len(result) == 1 else None
+        if not (_number(value) and value == int(value) and low <= value <= high):
+            shown = value if len(result) == 1 else result
+            add(
+                where,
+                f"scoring.total.fhirpath gives {shown!r} with {described}: "
+                f"it must give one whole number from {low} to {high}",
+            )
+            return

@@ -1,0 +1,245 @@
+"""Scoring an instrument: its total, subscales and band, from the answers.
+
+The total is the sum of the chosen options' points unless the instrument declares a formula: a
+FHIRPath expression over the answers as a FHIR QuestionnaireResponse, evaluated with the
+maintained ``fhirpathpy`` library. FHIRPath because it is what FHIR SDC's
+``calculatedExpression`` holds, so the exported Questionnaire makes LHC-Forms compute the same
+total from the same words. The response the formula sees is :func:`response_items`' (the items'
+``linkId`` and answers: a ``valueCoding`` per chosen option, ``valueInteger``/``valueDecimal``
+per number staff entered), and ``weight()``/``ordinal()`` give a chosen option's points, as in
+SDC. Pure: no I/O, no clock.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from decimal import Decimal
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from kiosk.core.questionnaire.model import Band, BandSet, Code, Option, Questionnaire
+
+#: SDC/R5 extension giving an answer option its score (on answerOption or on the Coding)
+ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
+#: R4's older extension for the same (still read by ``weight()``)
+ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
+
+
+class ScoringError(ValueError):
+    """A total formula gave no whole number in its declared range for some answers."""
+
+
+@dataclass(frozen=True)
+class Formula:
+    """A total computed by a FHIRPath expression over the QuestionnaireResponse, whose results
+    lie from ``min`` to ``max`` (the range its bands must cover)."""
+
+    expression: str
+    min: int
+    max: int
+
+
+@dataclass(frozen=True)
+class Subscale:
+    """A sum of some items' points reported beside the total (exported with ``code`` when given)."""
+
+    id: str
+    label: Mapping[str, str]
+    #: item ids, in questionnaire order
+    items: tuple[str, ...]
+    code: Code | None = None
+
+
+@dataclass(frozen=True)
+class Score:
+    """The result of scoring a set of answers."""
+
+    #: the total: the formula's result when complete; otherwise (and for a sum) the sum of the
+    #: points of the answered items so far
+    total: int
+    #: every item answered (the patient's and the staff's)
+    complete: bool
+    #: the band of ``total`` when complete, else None (an incomplete total is not interpreted)
+    band: Band | None
+    #: item ids answered, in questionnaire order
+    answered: tuple[str, ...]
+    #: item ids not answered, in questionnaire order (staff items included)
+    missing: tuple[str, ...]
+    #: the highest possible total
+    max_total: int
+    #: the id of the band set ``band`` comes from
+    band_set: str = ""
+    #: the lowest possible total
+    min_total: int = 0
+    #: subscale id -> its sum, for each subscale whose items are all answered
+    subscales: Mapping[str, int] = field(default_factory=dict)
+    #: staff items still unanswered: the result stays incomplete until staff answer them
+    awaiting_staff: tuple[str, ...] = ()
+
+
+def local_code(questionnaire_id: str, item_id: str, number: int) -> tuple[str, str]:
+    """(system, code) of an option without a published code: the kiosk's own, per item."""
+    return f"urn:barthel-kiosk:option:{questionnaire_id}:{item_id}", str(number)
+
+
+def answer_code(questionnaire_id: str, item_id: str, option: Option) -> tuple[str, str]:
+    """(system, code) a chosen option is answered with: its published code, else a local one."""
+    if option.code is not None:
+        return option.code.system, option.code.code
+    return local_code(questionnaire_id, item_id, option.number)
+
+
+def response_items(q: Questionnaire, options: Mapping[str, int], values: Mapping[str, float]) -> list[dict[str, Any]]:
+    """The answered items as QuestionnaireResponse items (questionnaire order; unanswered left
+    out, as SDC does): what a formula sees, and the core of what the FHIR export says."""
+    items = []
+    for item in q.items:
+        if item.id in options:
+            system, code = answer_code(q.id, item.id, item.option(options[item.id]))
+            items.append({"linkId": item.id, "answer": [{"valueCoding": {"system": system, "code": code}}]})
+        elif item.id in values and item.entry is not None:
+            value = values[item.id]
+            answer = {"valueInteger": int(value)} if item.entry.type == "integer" else {"valueDecimal": value}
+            items.append({"linkId": item.id, "answer": [answer]})
+    return items
+
+
+def syntax_problem(expression: str) -> str | None:
+    """Why ``expression`` is not FHIRPath ("at character N: ..."), or None when it parses whole.
+
+    fhirpathpy's own parser recovers from errors silently, so this runs its grammar with a
+    listener that keeps them, and insists the whole text was read."""
+    from antlr4 import CommonTokenStream, InputStream, Token  # type: ignore[import-untyped]  # ships no hints
+    from antlr4.error.ErrorListener import ErrorListener  # type: ignore[import-untyped]
+    from fhirpathpy.parser.generated.FHIRPathLexer import FHIRPathLexer
+    from fhirpathpy.parser.generated.FHIRPathParser import FHIRPathParser
+
+    found: list[str] = []
+
+    class Keep(ErrorListener):  # type: ignore[misc]  # antlr4 ships no type hints
+        def syntaxError(self, recognizer: Any, symbol: Any, line: int, column: int, msg: str, e: Any) -> None:
+            found.append(f"at character {column + 1}: {msg}")
+
+    lexer = FHIRPathLexer(InputStream(expression))
+    lexer.removeErrorListeners()
+    lexer.addErrorListener(Keep())
+    tokens = CommonTokenStream(lexer)
+    parser = FHIRPathParser(tokens)
+    parser.removeErrorListeners()
+    parser.addErrorListener(Keep())
+    parser.expression()
+    if not found and tokens.LA(1) != Token.EOF:
+        found.append(f"at character {tokens.LT(1).start + 1}: {tokens.LT(1).text!r} is not part of the expression")
+    return found[0] if found else None
+
+
+def _number(value: Any) -> Any:
+    if isinstance(value, Decimal):
+        return int(value) if value == value.to_integral_value() else value
+    return value
+
+
+def _weights(values: list[Any]) -> list[Any]:
+    """``weight()``: the score of each chosen Coding (its itemWeight or ordinalValue extension)."""
+    found = []
+    for value in values:
+        if not isinstance(value, Mapping):
+            continue
+        for ext in value.get("extension", ()):
+            if isinstance(ext, Mapping) and ext.get("url") in (ITEM_WEIGHT, ORDINAL_VALUE):
+                weight = ext.get("valueDecimal", ext.get("valueInteger"))
+                if weight is not None:
+                    found.append(_number(Decimal(str(weight))))
+                    break
+    return found
+
+
+_FUNCTIONS = {name: {"fn": _weights, "arity": {0: []}} for name in ("weight", "ordinal")}
+
+
+@lru_cache(maxsize=64)
+def _compiled(expression: str) -> Any:
+    from fhirpathpy import compile
+    from fhirpathpy.models import models
+
+    return compile(expression, models["r4"], options={"userInvocationTable": _FUNCTIONS})
+
+
+def with_weights(q: Questionnaire, response: Mapping[str, Any]) -> dict[str, Any]:
+    """A copy of a QuestionnaireResponse whose chosen Codings carry their option's points
+    (itemWeight), looked up in ``q`` by item and code: what SDC's ``weight()`` reads from the
+    Questionnaire, so a response exported without them scores as the kiosk scored it."""
+    copied = copy.deepcopy(dict(response))
+    choice = {item.id: item for item in q.items if item.options}
+    for entry in copied.get("item", ()):
+        item = choice.get(str(entry.get("linkId"))) if isinstance(entry, dict) else None
+        if item is None:
+            continue
+        for answer in entry.get("answer", ()):
+            coding = answer.get("valueCoding") if isinstance(answer, dict) else None
+            if not isinstance(coding, dict):
+                continue
+            key = (coding.get("system"), coding.get("code"))
+            option = next((o for o in item.options if answer_code(q.id, item.id, o) == key), None)
+            if option is not None and option.points is not None:
+                coding["extension"] = [
+                    *coding.get("extension", []),
+                    {"url": ITEM_WEIGHT, "valueDecimal": option.points},
+                ]
+    return copied
+
+
+def evaluate(q: Questionnaire, expression: str, response: Mapping[str, Any]) -> list[Any]:
+    """``expression`` evaluated on a QuestionnaireResponse of ``q`` (``%resource`` is the response;
+    ``weight()`` gives a chosen option's points). Numbers come back as int where whole."""
+    return run(expression, with_weights(q, {"resourceType": "QuestionnaireResponse", **response}))
+
+
+def run(expression: str, resource: Mapping[str, Any]) -> list[Any]:
+    """``expression`` evaluated on a resource whose chosen Codings already carry their weights."""
+    return [_number(v) for v in _compiled(expression)(dict(resource), {"resource": resource})]
+
+
+def formula_total(q: Questionnaire, formula: Formula, response: Mapping[str, Any]) -> int:
+    """The formula's total on a response; ScoringError unless it is one whole number from
+    ``formula.min`` to ``formula.max``."""
+    try:
+        result = evaluate(q, formula.expression, response)
+    except Exception as exc:  # fhirpathpy raises bare Exceptions for unknown functions and types
+        raise ScoringError(f"the total formula of {q.id} cannot be evaluated: {exc}") from None
+    value = result[0] if len(result) == 1 else None
+    if isinstance(value, bool) or not isinstance(value, (int, float, Decimal)) or value != int(value):
+        raise ScoringError(f"the total formula of {q.id} gave {result!r}, not one whole number")
+    if not formula.min <= value <= formula.max:
+        raise ScoringError(
+            f"the total formula of {q.id} gave {int(value)}, outside its declared {formula.min} to {formula.max}"
+        )
+    return int(value)
+
+
+def compute_score(q: Questionnaire, options: Mapping[str, int], values: Mapping[str, float], bands: BandSet) -> Score:
+    """The score of checked answers (see :meth:`Questionnaire.score_answers`)."""
+    answered = tuple(i.id for i in q.items if i.id in options or i.id in values)
+    missing = tuple(i.id for i in q.items if i.id not in options and i.id not in values)
+    points = {i: q.item(i).option(n).points or 0 for i, n in options.items()}
+    complete = not missing
+    total = sum(points.values())
+    if complete and q.formula is not None:
+        total = formula_total(q, q.formula, {"item": response_items(q, options, values)})
+    subscales = {s.id: sum(points[i] for i in s.items) for s in q.subscales if all(i in points for i in s.items)}
+    staff = {i.id for i in q.items if i.staff}
+    return Score(
+        total=total,
+        complete=complete,
+        band=bands.band_for(total) if complete else None,
+        answered=answered,
+        missing=missing,
+        max_total=q.max_total,
+        band_set=bands.id,
+        min_total=q.min_total,
+        subscales=subscales,
+        awaiting_staff=tuple(i for i in missing if i in staff),
+    )
