@@ -198,7 +198,10 @@ class KioskApp(App[int], inherit_bindings=False):
         return True
 
     def on_answer_button_chosen(self, message: AnswerButton.Chosen) -> None:
-        """A touched answer is a touch input."""
+        """A touched answer is a touch input; the page button (no option) shows the other answers."""
+        if message.option is None:
+            self.controller.turn_page()
+            return
         self.controller.forward(ChannelInput(Channel.TOUCH, option=message.option, detail="screen"))
 
     def on_control_bar_commanded(self, message: ControlBar.Commanded) -> None:
@@ -292,7 +295,13 @@ class KioskApp(App[int], inherit_bindings=False):
     # -- drawing -------------------------------------------------------------------------------
 
     def _view(self) -> PatientView:
-        return patient_view(self.session, self.channels, self.questionnaire, show_score=self.show_score)
+        return patient_view(
+            self.session,
+            self.channels,
+            self.questionnaire,
+            show_score=self.show_score,
+            remote_page=self.controller.remote_page(),
+        )
 
     def _render(self) -> None:
         """Show the screens the session's state calls for (none over the clinician's)."""

@@ -48,6 +48,7 @@ class UiKiosk:
         show_score: bool = False,
         next_patient_after_s: float | None = None,
         model: str = MODEL,
+        questionnaire: Path | None = None,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -56,6 +57,7 @@ class UiKiosk:
             qos_model=model,  # loaded once, as `kiosk run` does
             next_patient_after_s=next_patient_after_s,
             show_score_to_patient=show_score,
+            questionnaire=questionnaire,
         )
         parts = KioskParts.load(self.config)
         self.questionnaire, self.model = parts.questionnaire, parts.model
@@ -112,7 +114,7 @@ class UiKiosk:
 @pytest.fixture
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
-    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model)."""
+    voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model, questionnaire)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
