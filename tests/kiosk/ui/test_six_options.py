@@ -17,7 +17,8 @@ from kiosk.ui.paging import RemotePager, shown
 from .fit import problems
 from .helpers import deliver_from_thread, drawn_text, screen_name, settle, until_drawn
 
-#: a walking item with six levels, a staff-measured weight between, and a five-answer item
+#: a walking item with six levels, a staff-measured weight between, a five-answer item and a
+#: staff choice
 STEPS = [
     "Cannot walk",
     "Walks with two people",
@@ -41,7 +42,7 @@ bands:
       source: test cut-offs
       ranges:
         - {{id: low, min: 0, max: 4, label: {{en: Low, es: Bajo, fr: Bas}}}}
-        - {{id: high, min: 5, max: 8, label: {{en: High, es: Alto, fr: Haut}}}}
+        - {{id: high, min: 5, max: 9, label: {{en: High, es: Alto, fr: Haut}}}}
 items:
   - id: steps
     text: {{en: "How do you walk?", es: "¿Cómo camina?", fr: "Comment marchez-vous ?"}}
@@ -56,7 +57,13 @@ items:
     text: {{en: "How do you climb stairs?", es: "¿Escaleras?", fr: "Escaliers ?"}}
     spoken: {{en: "How do you climb stairs?", es: "¿Escaleras?", fr: "Escaliers ?"}}
     options:
-{"".join(f'      - points: {min(n, 3)}{chr(10)}        label: {{en: "Stairs {n}", es: "Escaleras {n}", fr: "Escaliers {n}"}}{chr(10)}' for n in range(5))}\
+{"".join(f'      - points: {min(n, 3)}{chr(10)}        label: {{en: "Stairs {n}", es: "Escaleras {n}", fr: "Escaliers {n}"}}{chr(10)}' for n in range(5))}
+  - id: aid
+    answered_by: staff
+    text: {{en: "Uses a walking aid", es: "Usa ayuda", fr: "Utilise une aide"}}
+    options:
+      - {{points: 0, label: {{en: "No aid", es: "Sin ayuda", fr: "Sans aide"}}}}
+      - {{points: 1, label: {{en: "An aid", es: "Con ayuda", fr: "Avec aide"}}}}
 """
 
 SIZES = [(100, 32), (80, 24), (73, 18)]
