@@ -8,8 +8,8 @@ import json
 
 from textual.widgets import Input, Label, Select
 
-from kiosk.core.staff import STAFF_ANSWER
 from kiosk.core.session import Phase
+from kiosk.core.staff import STAFF_ANSWER
 from kiosk.export import fhir_response, result
 from kiosk.export.captured import questionnaire_of
 from kiosk.ui.app import CLINICIAN_CHORD
