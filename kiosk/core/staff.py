@@ -97,3 +97,34 @@ def waiting_line(waiting: Iterable[str]) -> str:
     """How a result with unanswered staff items says so: "waiting for staff: weight, height"."""
     names = list(waiting)
     return f"waiting for staff: {', '.join(names)}" if names else ""
+
+
+class EnteredStep(Protocol):
+    """A row of the station's audit trail as :func:`entered_at_station` reads it."""
+
+    @property
+    def action(self) -> str: ...
+    @property
+    def item_id(self) -> str | None: ...
+    @property
+    def reason(self) -> str: ...
+
+
+#: the station's audit action for a number staff entered there (its ``reason`` holds the number)
+ENTER = "enter"
+
+
+def entered_at_station(q: Questionnaire, steps: Iterable[EnteredStep]) -> dict[str, float]:
+    """The numbers staff entered at the station (audit rows :data:`ENTER`, oldest first; the
+    latest per item counts), for ``q``'s ``input`` items."""
+    values: dict[str, float] = {}
+    entries = {item.id: item for item in q.items if item.entry is not None}
+    for step in steps:
+        item = entries.get(step.item_id or "") if step.action == ENTER else None
+        if item is None:
+            continue
+        try:
+            values[item.id] = parse_entry(item, step.reason)
+        except ValueError:
+            continue
+    return values
