@@ -46,10 +46,11 @@ def check_items(items: Items, add: Callable[..., None]) -> None:
             )
         if item.get("answers") == "yes_no" and "points" not in item:
             add(path, f'{describe(path)} has answers: yes_no but no points ({{"yes": N, "no": N}})')
-        staff = item.get("answered_by") == "staff"
-        if "input" in item and not staff:
+        # an unknown answered_by is the schema's to report: judged as neither, it adds no more lines
+        patient = item.get("answered_by", "patient") == "patient"
+        if "input" in item and patient:
             add(path + ("input",), f"{describe(path)}: only staff enter numbers: add answered_by: staff", key=True)
-        if not staff and "spoken" not in item:
+        if patient and "spoken" not in item:
             add(path, f"{describe(path)} is missing 'spoken' (what the kiosk says to the patient)")
         entry = item.get("input")
         if isinstance(entry, dict):

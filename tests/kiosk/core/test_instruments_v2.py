@@ -13,6 +13,7 @@ from kiosk.core.questionnaire import (
 )
 from kiosk.core.questionnaire.definition import canonical, questionnaire_from
 from tests.kiosk.core.instruments_v2 import (
+    FORMULA,
     GDS,
     LAWTON,
     MIXED,
@@ -275,3 +276,18 @@ def test_staff_input_and_yes_no_helpers_build_valid_items(tmp_path):
     assert q.item("weight").entry.type == "decimal" and q.item("weight").entry.fits(72.4)
     assert q.score_answers({"q": 1}, values={"weight": 72.4}).total == 1
     assert texts("x") == '{en: "x", es: "x (es)"}'
+
+
+def test_validate_prints_each_v2_problem_as_one_line_and_fails(tmp_path, capsys):
+    judged = STAFFED.index("  - id: judged")
+    text = STAFFED[:judged] + STAFFED[judged:].replace("answered_by: staff", "answered_by: nurse", 1)
+    text = text.replace("answer.value < 9", "answer.value <* 9")
+    path = write(tmp_path, text)
+    assert validate_main([str(path)]) == 1
+    first, second = capsys.readouterr().out.splitlines()
+    character = FORMULA.index("< 9") + 2  # the stray "*" after "<", counted from 1
+    assert first.startswith(
+        f"{path}:{at(text, 'fhirpath:') + 10}: scoring.total.fhirpath is not valid FHIRPath "
+        f"(at character {character}: extraneous input '*' expecting "
+    )
+    assert second == f"{path}:{at(text, 'nurse')}: items[3].answered_by: 'nurse' is not one of ['patient', 'staff']"
