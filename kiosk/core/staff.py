@@ -83,8 +83,8 @@ def entered_values(q: Questionnaire, log: Iterable[LogLine]) -> dict[str, float]
         if data is None or (item := entries.get(data["item_id"])) is None or item.entry is None:
             continue
         value = data.get("value")
-        if item.entry.fits(value):
-            values[item.id] = value
+        if value is not None and item.entry.fits(value):
+            values[item.id] = float(value) if item.entry.type == "decimal" else int(value)
     return values
 
 
