@@ -39,7 +39,7 @@ from kiosk.ui.stage import PatientStage, patient_view
 from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar, VoiceAgainButton
 from kiosk.ui.widgets.change_answer import ChangeAnswerButton
-from kiosk.ui.widgets.channel_board import VOICE_IN, VOICE_OUT
+from kiosk.ui.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT
 from kiosk.ui.widgets.waiting_sign import WaitingSign
 
 #: the kiosk display's size in cells (columns, rows): snapshots and the bench use it
@@ -123,6 +123,7 @@ class KioskApp(App[int], inherit_bindings=False):
         #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
         self._staff_seen = 0.0
         controller.attach(self)
+        controller.remote_in_use = lambda: self.channels.on(REMOTE)  # 5-6 answers show pages then
         self.tell_channels()
 
     @property

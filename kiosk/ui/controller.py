@@ -28,7 +28,7 @@ from kiosk.core.session import NextPatient, Phase, Session, SessionEvent
 from kiosk.core.visits import Order, VisitDesk
 from kiosk.store.database import Store, StoredSession
 from kiosk.store.lease import SessionTaken
-from kiosk.ui.paging import RemotePager, needs_paging
+from kiosk.ui.paging import PAGE_BUTTON, RemotePager, needs_paging
 
 #: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
 #: patients again (a test's rows, its QoS trace and the WAL need room to grow)
@@ -100,6 +100,8 @@ class KioskController:
         self._dirty = False
         #: which page of a 5- or 6-answer item the remote's 1-3 stand for (:mod:`kiosk.ui.paging`)
         self.pager = RemotePager()
+        #: whether a remote is in use now, so such items show pages (the app says, from its channels)
+        self.remote_in_use: Callable[[], bool] = lambda: True
         self._unsubscribe: Callable[[], None] = lambda: None
 
     def attach(self, view: Screens) -> None:
@@ -159,13 +161,20 @@ class KioskController:
             return
         if self.session.phase is Phase.WELCOME and self.welcome_held():
             return
-        if item.channel is Channel.REMOTE and item.option is not None and (key := self.paged_item()) is not None:
+        if self._paged_input(item) and (key := self.paged_item()) is not None:
             option = self.pager.press(key, key[2], item.option)
             if option is None:  # the remote's 4 turned the page: nothing for the session
                 self._screens().redraw()
                 return
             item = dataclasses.replace(item, option=option)
         self.drive(self.session.handle, item)
+
+    def _paged_input(self, item: ChannelInput) -> bool:
+        """Whether ``item`` means what the paged screen shows: the remote's 1-4, and the keys 1-4
+        too (the number pressed is the number on screen; keys 5 and 6 stay options 5 and 6)."""
+        if item.option is None or not self.remote_in_use():
+            return False
+        return item.channel is Channel.REMOTE or (item.channel is Channel.KEYBOARD and item.option <= PAGE_BUTTON)
 
     def paged_item(self) -> tuple[str, int | None, int] | None:
         """The item on screen when a remote reaches its answers by pages (5 or 6 options, not

@@ -3,9 +3,9 @@
 On an item with more answers than the remote has answer buttons (5 or 6 options; remotes carry
 1-4), while a remote is in use, the screen shows options 1-3 numbered 1-3 and "4 More answers";
 pressing 4 shows options 4-6 numbered 1-3 and "4 Back". So the number the patient presses is
-always the number on the screen. Touch and the keyboard never page on their own: a touch on an
-answer on screen is that answer, a touch on the page button turns the page, keys 1-6 are the
-options' own numbers. Plain code (no Textual) so the controller owns the state and tests it
+always the number on the screen. A touch on an answer on screen is that answer, a touch on the page
+button turns the page; keys 1-4 press what the screen shows too (5 and 6 stay options 5 and 6),
+and the voice says the options' own numbers. Plain code (no Textual) so the controller owns the state and tests it
 without Pilot; the screen only draws :func:`shown`.
 """
 

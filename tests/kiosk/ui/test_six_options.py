@@ -66,7 +66,7 @@ items:
       - {{points: 1, label: {{en: "An aid", es: "Con ayuda", fr: "Avec aide"}}}}
 """
 
-SIZES = [(100, 32), (80, 24), (73, 18)]
+SIZES = [(100, 32), (80, 24), (73, 18), (60, 18)]
 
 
 def _kiosk(ui_kiosk, tmp_path: Path):
@@ -206,3 +206,26 @@ async def test_the_staff_item_is_never_asked_and_the_count_leaves_it_out(ui_kios
         await settle(pilot, lambda: kiosk.session.phase is Phase.SUMMARY)
         assert "weight" not in {a.item_id for a in kiosk.store.session(kiosk.session.id).answers}
         assert "Weight" not in drawn_text(kiosk.app)
+
+
+async def test_with_pages_shown_keys_1_to_4_press_what_the_screen_shows(ui_kiosk, tmp_path):
+    """While the pages are shown, the number pressed on the keyboard is the number on screen too:
+    4 turns the page, 2 is then option 5; 5 and 6 stay options 5 and 6."""
+    kiosk = _kiosk(ui_kiosk, tmp_path)
+    async with kiosk.app.run_test(size=(80, 24)) as pilot:
+        _remote_on(kiosk)
+        await _to_steps(kiosk, pilot)
+        await until_drawn(pilot, "More answers")
+        await pilot.press("4")
+        await until_drawn(pilot, STEPS[4], "Back")
+        await pilot.press("2")
+        await settle(pilot, lambda: _stored(kiosk, "steps") is not None)
+        assert _stored(kiosk, "steps").option == 5 and _stored(kiosk, "steps").channel == "keyboard"
+        kiosk.to_next_deadline()
+        await settle(
+            pilot, lambda: kiosk.session.current_item is not None and kiosk.session.current_item.id == "stairs"
+        )
+        await until_drawn(pilot, "Stairs 0", "More answers")
+        await pilot.press("5")
+        await settle(pilot, lambda: _stored(kiosk, "stairs") is not None)
+        assert _stored(kiosk, "stairs").option == 5
