@@ -161,7 +161,7 @@ class KioskController:
             return
         if self.session.phase is Phase.WELCOME and self.welcome_held():
             return
-        if self._paged_input(item) and (key := self.paged_item()) is not None:
+        if item.option is not None and self._paged_input(item) and (key := self.paged_item()) is not None:
             option = self.pager.press(key, key[2], item.option)
             if option is None:  # the remote's 4 turned the page: nothing for the session
                 self._screens().redraw()
