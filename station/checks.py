@@ -139,7 +139,9 @@ def check_definition(definition: Any, where: str) -> Questionnaire:
             # any integer an instrument scores, negative ones too (errors counted against a total)
             integer(option.points, f"{where}.items.{item.id}.points", -1000, 1000)
     maps: list[tuple[str, Mapping[str, str]]] = [("title", q.title)]
-    maps += [(f"items.{i.id}.{part}", getattr(i, part)) for i in q.items for part in ("text", "spoken")]
+    # staff items (answered_by: staff) are never spoken: they need no spoken text
+    spoken = {i.id: ("text",) if i.staff else ("text", "spoken") for i in q.items}
+    maps += [(f"items.{i.id}.{part}", getattr(i, part)) for i in q.items for part in spoken[i.id]]
     maps += [(f"items.{i.id}.options.{o.number}.label", o.label) for i in q.items for o in i.options]
     maps += [
         (f"familiarisation.{p.id}.{part}", getattr(p, part)) for p in q.familiarisation for part in ("text", "spoken")

@@ -10,7 +10,8 @@ not fit its questionnaire (rows stored before they were checked) is left out, ne
 from __future__ import annotations
 
 import json
-from typing import Any, cast
+from collections.abc import Mapping
+from typing import Any
 from urllib.parse import quote
 
 from starlette.applications import Starlette
@@ -21,10 +22,11 @@ from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import review_state, state_once_signed
+from kiosk.core.staff import waiting_line
 from kiosk.export import ExportError, practice_outcomes
 from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import StoredSession
-from station import db, exports, orders, validation, ward
+from station import db, exports, orders, staff_items, validation, ward
 from station.download import attachment
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
@@ -112,12 +114,13 @@ def _fits(item: Any, option: int | None) -> bool:
     return option is not None and 1 <= option <= len(item.options)
 
 
-def _score(q: Questionnaire, stored: StoredSession, review: Any) -> Score:
-    """The score of the answers (after corrections) that fit the questionnaire."""
+def _score(q: Questionnaire, stored: StoredSession, review: Any, values: Mapping[str, float] | None = None) -> Score:
+    """The score of the answers (after corrections) that fit the questionnaire, with the numbers
+    staff entered for its staff items (``values``, :mod:`station.staff_items`)."""
     items = {item.id: item for item in q.items}
     options = review.options({a.item_id: a.option for a in stored.answers})
-    points = {i: items[i].option(o).points for i, o in options.items() if i in items and _fits(items[i], o)}
-    return q.score(cast(dict[str, int], points))  # score() refuses a value without points
+    fitting = {i: o for i, o in options.items() if i in items and _fits(items[i], o)}
+    return q.score_answers(fitting, values=values or {})
 
 
 def _items(q: Questionnaire, stored: StoredSession, review: Any) -> list[dict[str, Any]]:
@@ -185,7 +188,8 @@ async def session_page(request: Request) -> Response:
     q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
-    score = _score(q, stored, current)
+    entered = staff_items.values(q, stored, entries)
+    score = _score(q, stored, current, entered)
     recorded = {a.item_id: a.option for a in stored.answers}
     state = review_state(current, recorded)
     return render(
@@ -200,6 +204,8 @@ async def session_page(request: Request) -> Response:
         q=q,
         items=_items(q, stored, current),
         score=score,
+        entered=entered,
+        waiting=waiting_line(score.awaiting_staff),
         practice=_practice(q, stored),
         plot=qos_svg(stored),
         incidents=[e for e in stored.log if e.kind in INCIDENTS],

@@ -28,7 +28,18 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
-from station import api, api_orders, auth, logins, order_pages, pages, result_pages, signoff_pages, throttle
+from station import (
+    api,
+    api_orders,
+    auth,
+    logins,
+    order_pages,
+    pages,
+    result_pages,
+    signoff_pages,
+    staff_items,
+    throttle,
+)
 from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
@@ -196,6 +207,7 @@ def create_app(
         *order_pages.routes,
         *result_pages.routes,
         *signoff_pages.routes,
+        *staff_items.routes,
         *api.routes,
         *api_orders.routes,
         Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),

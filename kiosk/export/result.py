@@ -15,6 +15,7 @@ from fileio.bounded import write_error, write_private  # the one owner-only writ
 from kiosk.config import Config, default_kiosk_id
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import Review, ReviewState, review_state
+from kiosk.core.staff import entered_values
 from kiosk.store.database import PracticeRecord, StoredSession
 
 TOTAL_LINK = "total"
@@ -95,7 +96,7 @@ def _score(q: Questionnaire, session_id: str, options: Mapping[str, int], values
 
 def rescore(q: Questionnaire, stored: StoredSession, values: Mapping[str, float] | None = None) -> Score:
     """The score recomputed from the stored option numbers (and the numbers staff entered for
-    ``input`` items, ``values``); ExportError if they do not fit."""
+    ``input`` items, ``values``; None: those in the session's log); ExportError if they do not fit."""
     options = {}
     for answer in stored.answers:
         try:
@@ -108,7 +109,7 @@ def rescore(q: Questionnaire, stored: StoredSession, values: Mapping[str, float]
                 f"{option.points} points in {q.id}, but {answer.points} were stored"
             )
         options[answer.item_id] = answer.option
-    return _score(q, stored.id, options, values or {})
+    return _score(q, stored.id, options, values if values is not None else entered_values(q, stored.log))
 
 
 @dataclass(frozen=True)
@@ -187,14 +188,14 @@ def result(
 ) -> Result:
     """A stored session with its review applied (ExportError if either does not fit ``q``), scored
     as the instrument says (sum or formula, subscales); ``values`` are the numbers staff entered
-    for its ``input`` items."""
+    for its ``input`` items (None: those in the session's log, :mod:`kiosk.core.staff`)."""
     review = review or Review.unreviewed()
     if stored.questionnaire_id != q.id:
         raise ExportError(
             f"session {stored.id} was answered on questionnaire {stored.questionnaire_id!r}, "
             f"not on {q.id!r} ({q.source}): export it with that questionnaire"
         )
-    values = dict(values or {})
+    values = dict(values if values is not None else entered_values(q, stored.log))  # staff's numbers, from the log
     rescore(q, stored, values)  # the stored answers must fit the questionnaire before anything is said about them
     options = review.options({a.item_id: a.option for a in stored.answers})
     for item_id, number in options.items():

@@ -53,6 +53,7 @@ from kiosk.store.records import (
     SessionSummary,
     StoredSession,
 )
+from kiosk.store.staff_answers import record_staff_answer
 from kiosk.store.transactions import ALERT_EVENTS, Transactions
 
 __all__ = [
@@ -289,6 +290,22 @@ class Store:
                     {"item": item_id, "withdrawn": withdrawn, "at": at, "reason": reason}, ensure_ascii=False
                 ),
             )
+
+    def record_staff_answer(
+        self,
+        session_id: str,
+        *,
+        item_id: str,
+        option: int | None,
+        points: int | None,
+        value: float | None,
+        by: str,
+        at: str | None = None,
+    ) -> None:
+        """Store what staff entered for a staff item, audited in the log (:mod:`kiosk.store.staff_answers`)."""
+        record_staff_answer(
+            self._tx, self.custody, session_id, item_id=item_id, option=option, points=points, value=value, at=at, by=by
+        )
 
     def record_not_answered(self, session_id: str, *, item_id: str, t: float, at: str) -> None:
         """Store that both attempts of a question timed out."""

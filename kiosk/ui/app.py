@@ -32,7 +32,7 @@ from kiosk.ui.screens.base import ClinicianScreen, PatientScreen, PatientView
 from kiosk.ui.screens.welcome import WelcomeScreen
 from kiosk.ui.stage import PatientStage, patient_view
 from kiosk.ui.widgets.bars import ControlBar, VoiceAgainButton
-from kiosk.ui.widgets.channel_board import VOICE_IN, VOICE_OUT
+from kiosk.ui.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT
 from kiosk.ui.widgets.waiting_sign import WaitingSign
 
 if TYPE_CHECKING:  # message types of screens loaded when first shown (kiosk.ui.stage), not before the welcome
@@ -125,6 +125,7 @@ class KioskApp(App[int], inherit_bindings=False):
         #: the app is unmounting: threads not started by now are never started
         self._unmounted = False
         controller.attach(self)
+        controller.remote_in_use = lambda: self.channels.on(REMOTE)  # 5-6 answers show pages then
         self.tell_channels()
 
     @property
@@ -211,7 +212,10 @@ class KioskApp(App[int], inherit_bindings=False):
         return True
 
     def on_answer_button_chosen(self, message: AnswerButton.Chosen) -> None:
-        """A touched answer is a touch input."""
+        """A touched answer is a touch input; the page button (no option) shows the other answers."""
+        if message.option is None:
+            self.controller.turn_page()
+            return
         self.controller.forward(ChannelInput(Channel.TOUCH, option=message.option, detail="screen"))
 
     def on_control_bar_commanded(self, message: ControlBar.Commanded) -> None:
@@ -308,7 +312,13 @@ class KioskApp(App[int], inherit_bindings=False):
 
     def _view(self) -> PatientView:
         # the running session's instrument: a battery's changes from one instrument to the next
-        return patient_view(self.session, self.channels, self.session.questionnaire, show_score=self.show_score)
+        return patient_view(
+            self.session,
+            self.channels,
+            self.session.questionnaire,
+            show_score=self.show_score,
+            remote_page=self.controller.remote_page(),
+        )
 
     def _render(self) -> None:
         """Show the screens the session's state calls for (none over the clinician's)."""

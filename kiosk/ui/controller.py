@@ -16,17 +16,19 @@ Everything here runs on the UI thread: threads reach it only through the app.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import sqlite3
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
-from kiosk.core.channels import ChannelInput
+from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.session import Finished, NextPatient, Phase, Session, SessionEvent
 from kiosk.core.visits import Order, VisitDesk
 from kiosk.store.database import Store, StoredSession
 from kiosk.store.lease import SessionTaken
+from kiosk.ui.paging import PAGE_BUTTON, RemotePager, needs_paging
 
 #: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
 #: patients again (a test's rows, its QoS trace and the WAL need room to grow)
@@ -99,6 +101,10 @@ class KioskController:
         self.view: Screens | None = None
         self._held: Session | None = None
         self._dirty = False
+        #: which page of a 5- or 6-answer item the remote's 1-3 stand for (:mod:`kiosk.ui.paging`)
+        self.pager = RemotePager()
+        #: whether a remote is in use now, so such items show pages (the app says, from its channels)
+        self.remote_in_use: Callable[[], bool] = lambda: True
         self._unsubscribe: Callable[[], None] = lambda: None
 
     def attach(self, view: Screens) -> None:
@@ -160,7 +166,40 @@ class KioskController:
             return
         if self.session.phase is Phase.WELCOME and self.welcome_held():
             return
+        if item.option is not None and self._paged_input(item) and (key := self.paged_item()) is not None:
+            option = self.pager.press(key, key[2], item.option)
+            if option is None:  # the remote's 4 turned the page: nothing for the session
+                self._screens().redraw()
+                return
+            item = dataclasses.replace(item, option=option)
         self.drive(self.session.handle, item)
+
+    def _paged_input(self, item: ChannelInput) -> bool:
+        """Whether ``item`` means what the paged screen shows: the remote's 1-4, and the keys 1-4
+        too (the number pressed is the number on screen; keys 5 and 6 stay options 5 and 6)."""
+        if item.option is None or not self.remote_in_use():
+            return False
+        return item.channel is Channel.REMOTE or (item.channel is Channel.KEYBOARD and item.option <= PAGE_BUTTON)
+
+    def paged_item(self) -> tuple[str, int | None, int] | None:
+        """The item on screen when a remote reaches its answers by pages (5 or 6 options, not
+        while "Is that right?" asks Yes or No), as the pager's key (id, attempt, option count)."""
+        snap = self.session.snapshot()
+        item = snap.item
+        if snap.phase is not Phase.QUESTIONS or item is None or snap.confirming is not None:
+            return None
+        return (item.id, snap.attempt, len(item.options)) if needs_paging(len(item.options)) else None
+
+    def remote_page(self) -> int:
+        """The page the remote's answers are on for the item on screen (0: options 1-3)."""
+        key = self.paged_item()
+        return self.pager.page(key) if key is not None else 0
+
+    def turn_page(self) -> None:
+        """The page button was touched on screen: the other three answers (as the remote's 4)."""
+        if (key := self.paged_item()) is not None:
+            self.pager.turn(key)
+            self._screens().redraw()
 
     def start_in(self, language: str) -> None:
         """The patient chose a language on the welcome: the test starts in it."""

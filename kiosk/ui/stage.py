@@ -109,7 +109,12 @@ class PatientStage:
 
 
 def patient_view(
-    session: Session, channels: KioskChannels, questionnaire: Questionnaire, *, show_score: bool = False
+    session: Session,
+    channels: KioskChannels,
+    questionnaire: Questionnaire,
+    *,
+    show_score: bool = False,
+    remote_page: int = 0,
 ) -> PatientView:
     """What the patient's screens show now: the session's snapshot and the ways to answer."""
     snap = session.snapshot()
@@ -126,4 +131,5 @@ def patient_view(
         hint_options=hint,
         now=session.now(),
         show_score=show_score,
+        remote_page=remote_page,
     )

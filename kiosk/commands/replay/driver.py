@@ -105,6 +105,9 @@ class _Driver:
         #: per question, the attempt an ``attempt: any`` answer was armed in (stale once it timed out)
         self.armed_in: list[int | None] = [None] * len(script.questions)
         self.events: list[SessionEvent] = []
+        #: item number -> the script's question for it (staff items are never asked, nor scripted)
+        asked = [item for item in session.questionnaire.items if not item.staff]
+        self._question_of = {item.number: i for i, item in enumerate(asked)}
         session.subscribe(self._on_event)
 
     def arm(self, due: float, action: Callable[[], None]) -> None:
@@ -125,11 +128,11 @@ class _Driver:
                 step = self.script.practice[event.number - 1]
                 self.arm(now + step.after, partial(self._give_answer, step, None))
         elif isinstance(event, AttemptOpened):
-            index = event.number - 1
+            index = self._question_of[event.number]
             self.opened[(index, event.attempt)] = now
             self._try_arm(index)
         elif isinstance(event, AttemptTimedOut) and not event.practice:
-            index = event.number - 1
+            index = self._question_of[event.number]
             question = self.script.questions[index]
             pending = question.steps[self.next_step[index] :]
             if pending and pending[0].attempt == ANY:  # too slow for this attempt: again on the next
@@ -142,7 +145,7 @@ class _Driver:
                     f"timed out at t={_num(event.t)} s under the session's rules"
                 )
         elif isinstance(event, (AnswerRecorded, QuestionNotAnswered)):
-            index = event.number - 1
+            index = self._question_of[event.number]
             question = self.script.questions[index]
             pending = question.steps[self.next_step[index] :]
             if (
@@ -228,7 +231,7 @@ class _Driver:
             if (
                 (attempt is None if step.attempt == ANY else attempt != step.attempt)
                 or item is None
-                or item.number != index + 1
+                or self._question_of.get(item.number) != index
             ):
                 state = (
                     f"question {item.number} attempt {self.session.current_attempt}"

@@ -249,10 +249,12 @@ def _build(
         questionnaire.timing.with_overrides(data.get("timing"))
     except ValueError as exc:
         add(("timing",), str(exc))
-    if len(data["questions"]) != len(questionnaire.items):
+    # staff items (answered_by: staff) are never asked: a script answers the patient's items only
+    asked = [item for item in questionnaire.items if not item.staff]
+    if len(data["questions"]) != len(asked):
         add(
             ("questions",),
-            f"the script has {len(data['questions'])} questions; the questionnaire has {len(questionnaire.items)}",
+            f"the script has {len(data['questions'])} questions; the questionnaire has {len(asked)}",
         )
     if problems:
         raise _script_error(problems)
@@ -365,7 +367,7 @@ def _build(
         practice = tuple(steps)
 
     questions = []
-    for i, (entry, item) in enumerate(zip(data["questions"], questionnaire.items)):
+    for i, (entry, item) in enumerate(zip(data["questions"], asked)):
         p = ("questions", i)
         if "item" in entry and entry["item"] != item.id:
             add(p + ("item",), f"question {i + 1} of the questionnaire is {item.id!r}, not {entry['item']!r}")

@@ -33,6 +33,8 @@ class AnsweredBy(str, Enum):
     PATIENT = "patient"
     RELATIVE = "relative"
     CAREGIVER = "caregiver"
+    #: staff, for the items an instrument marks ``answered_by: staff`` (never a whole session's)
+    STAFF = "staff"
 
 
 class IgnoreReason(str, Enum):

@@ -157,9 +157,15 @@ class SessionState:
         return item.id, item.number
 
     def next_item_index(self) -> int | None:
-        """The first item with neither an answer nor a "not answered" record."""
+        """The first item the patient answers with neither an answer nor a "not answered" record
+        (staff items, ``answered_by: staff``, are never asked: staff enter them afterwards)."""
         done = set(self.answers) | set(self.not_answered)
-        return next((i for i, item in enumerate(self.questionnaire.items) if item.id not in done), None)
+        items = self.questionnaire.items
+        return next((i for i, item in enumerate(items) if item.id not in done and not item.staff), None)
+
+    def patient_items(self) -> list[Item]:
+        """The items asked at the kiosk, in order ("Question k of n" counts only these)."""
+        return [item for item in self.questionnaire.items if not item.staff]
 
     def can_undo(self, timer_kind: str | None) -> bool:
         """The thank-you gap after a stored answer is running (``timer_kind``: the pending time-out)."""

@@ -89,6 +89,8 @@ class PatientView:
     now: float = 0.0
     #: the end screen shows the total and band (a site's choice; default: staff only)
     show_score: bool = False
+    #: the page of a 5- or 6-answer item a remote is on (0: options 1-3; :mod:`kiosk.ui.paging`)
+    remote_page: int = 0
 
     @property
     def waiting(self) -> bool:

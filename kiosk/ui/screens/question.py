@@ -9,6 +9,7 @@ from textual.widget import Widget
 from textual.widgets import Static
 
 from kiosk.core.questionnaire import Item
+from kiosk.ui.paging import needs_paging, shown
 from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar
@@ -41,6 +42,8 @@ class QuestionScreen(PatientScreen):
         self._item_id: str | None = None
         #: the option the Yes/No panel on screen asks about (None: the question's panel is shown)
         self._confirming: int | None = None
+        #: the remote's page of a 5- or 6-answer item on screen
+        self._page = 0
 
     @classmethod
     def key(cls, view: PatientView) -> Hashable:
@@ -70,14 +73,28 @@ class QuestionScreen(PatientScreen):
             explanation = view.questionnaire.message("explanation", self.language)
             return [thanks, Static(explanation, classes="notice", id="recap")] if explanation else [thanks]
         answer = view.snapshot.answers.get(item.id)
+        labels, buttons = self._answers(view, item)
         return [
             QuestionPanel(
                 item.patient_text_in(self.language),
-                [o.patient_label_in(self.language) for o in item.options],
+                labels,
                 chosen=answer.option if answer else None,
                 over_question=thanks,
+                buttons=buttons,
             )
         ]
+
+    def _answers(self, view: PatientView, item: Item) -> tuple[list[str], list[tuple[int, int | None]] | None]:
+        """The answer labels and, on a 5- or 6-answer item while a remote is in use, the page the
+        remote is on: three answers numbered 1-3 and "4 More answers" (or "4 Back"), so the
+        patient never sees a number the remote cannot press (:mod:`kiosk.ui.paging`)."""
+        self._page = view.remote_page
+        if not (view.ways.remote and needs_paging(len(item.options))):
+            return [o.patient_label_in(self.language) for o in item.options], None
+        page = shown(view.remote_page, len(item.options))
+        turn = ui_text(self.language, "more_answers" if view.remote_page == 0 else "back_answers")
+        labels = [item.option(b.option).patient_label_in(self.language) if b.option else turn for b in page]
+        return labels, [(b.number, b.option) for b in page]
 
     def _line(self, view: PatientView) -> str:
         """The between-questions line in the patient's language ("" outside a gap)."""
@@ -96,7 +113,11 @@ class QuestionScreen(PatientScreen):
             return
         item = view.snapshot.item
         confirming = view.snapshot.confirming
-        if (item.id if item else None) != self._item_id or confirming != self._confirming:
+        if (
+            (item.id if item else None) != self._item_id
+            or confirming != self._confirming
+            or view.remote_page != self._page
+        ):
             if (
                 item is not None
                 and self._item_id is not None
@@ -122,11 +143,13 @@ class QuestionScreen(PatientScreen):
         """Put ``item`` into the panel on screen when it has as many answers (no remount); False
         when it cannot, so the caller builds a new panel."""
         answer = view.snapshot.answers.get(item.id)
+        labels, buttons = self._answers(view, item)
         for panel in self.query(QuestionPanel):
             if panel.show_item(
                 item.patient_text_in(self.language),
-                [o.patient_label_in(self.language) for o in item.options],
+                labels,
                 chosen=answer.option if answer else None,
+                buttons=buttons,
             ):
                 self._item_id = item.id
                 if isinstance(self.focused, AnswerButton):  # it would look chosen on the new item

@@ -3,6 +3,7 @@ metrics over time, and exports (FHIR JSON, CSV, the plot as PNG)."""
 
 from __future__ import annotations
 
+import sqlite3
 from pathlib import Path
 
 from textual import on
@@ -10,11 +11,14 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static
 
+from kiosk.core.staff import entered_values, waiting_line
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.store.database import StoredSession
+from kiosk.store.lease import SessionTaken
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
 from kiosk.ui.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png
+from kiosk.ui.widgets.staff_items import StaffItems
 
 #: the session log's entries staff see as events, in their words
 EVENT_WORDS = {
@@ -68,6 +72,9 @@ class SessionDetailScreen(ClinicianScreen):
             )
             yield DataTable(id="answers-table", zebra_stripes=True, cursor_type="row")
             yield Label(self._total_line(), id="total")
+            if staff := [item for item in self.q.items if item.staff]:
+                answers = {a.item_id: a.option for a in s.answers}
+                yield StaffItems(staff, s.language, answers, entered_values(self.q, s.log))
             yield Label(self._practice_line(), id="practice")
             events = session_events(s)
             yield Label(
@@ -94,9 +101,13 @@ class SessionDetailScreen(ClinicianScreen):
         table = self.query_one("#answers-table", DataTable)
         table.add_columns("#", "item", "option", "answer", "points", "attempt", "channel")
         answers = {a.item_id: a for a in self.stored.answers}
+        values = entered_values(q, self.stored.log)
         for item in q.items:
             a = answers.get(item.id)
-            if a is None:
+            if a is None and item.id in values and item.entry is not None:
+                entered = f"{values[item.id]:g} {item.entry.unit}".strip()
+                table.add_row(str(item.number), item.id, "", entered, "", "", "staff")
+            elif a is None:
                 outcome = "not answered" if item.id in self.stored.not_answered else "-"
                 table.add_row(str(item.number), item.id, "", outcome, "", "", "")
             else:
@@ -121,6 +132,8 @@ class SessionDetailScreen(ClinicianScreen):
             score = rescore(q, self.stored)
         except ExportError as error:
             return f"Cannot score: {error}"
+        if score.awaiting_staff:  # a staff item unanswered: no total until staff answer it
+            return f"No total yet: {waiting_line(score.awaiting_staff)}"
         if not score.complete:  # a partial sum is no total: never shown as one
             return (
                 f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
@@ -190,6 +203,22 @@ class SessionDetailScreen(ClinicianScreen):
             self._done(f"Saving the plot failed: {error}")
             return
         self._done(f"Plot saved to {path}")
+
+    @on(StaffItems.Entered)
+    def _staff_entered(self, event: StaffItems.Entered) -> None:
+        """Store what staff entered (audited in the session's log), then show the session again."""
+        event.stop()
+        store = self.app.controller.store  # type: ignore[attr-defined]
+        item = self.q.item(event.item_id)
+        points = item.option(event.option).points if event.option is not None else None
+        try:
+            store.record_staff_answer(
+                self.stored.id, item_id=item.id, option=event.option, points=points, value=event.value, by="kiosk staff"
+            )
+        except (SessionTaken, KeyError, sqlite3.Error) as error:
+            self._done(f"{item.id} was not saved: {error}")
+            return
+        self.app.switch_screen(SessionDetailScreen(store.session(self.stored.id)))
 
     @on(Button.Pressed, "#back")
     def _back(self) -> None:

@@ -70,22 +70,26 @@ class AnswerButton(Widget, can_focus=True):
     class Chosen(Message):
         """The patient touched (or clicked) this answer."""
 
-        def __init__(self, option: int) -> None:
+        def __init__(self, option: int | None) -> None:
             self.option = option
-            """1-based option number, the same number as on the remote's button."""
+            """1-based option number of the item; None for the page button of a paged item
+            ("More answers" / "Back", :mod:`kiosk.ui.paging`)."""
             super().__init__()
 
-    def __init__(self, option: int, label: str, *, id: str | None = None) -> None:
-        """Show answer ``option`` (1-based) with its ``label`` in the session's language."""
+    def __init__(self, option: int | None, label: str, *, id: str | None = None, shows: int | None = None) -> None:
+        """Show answer ``option`` (1-based; None: the page button) with its ``label`` in the
+        session's language, numbered ``shows`` (default: the option's own number) -- on a paged
+        item, option 5 shows 2, the number the remote presses for it."""
         super().__init__(id=id, classes="answer")
         self.option = option
+        self.shows = shows if shows is not None else (option or 0)
         self.label = label
 
     def compose(self) -> ComposeResult:
         """The number -- in block digits when the button is tall enough, else in bold -- beside
         the answer text."""
-        yield BigNumber(self.option, classes="number")
-        yield Label(str(self.option), classes="small-number")
+        yield BigNumber(self.shows, classes="number")
+        yield Label(str(self.shows), classes="small-number")
         yield Label(self.label, classes="label")
 
     def relabel(self, label: str) -> None:

@@ -57,13 +57,22 @@ class QuestionPanel(Vertical):
     """
 
     def __init__(
-        self, question: str, options: Sequence[str], *, chosen: int | None = None, over_question: Widget | None = None
+        self,
+        question: str,
+        options: Sequence[str],
+        *,
+        chosen: int | None = None,
+        over_question: Widget | None = None,
+        buttons: Sequence[tuple[int, int | None]] | None = None,
     ) -> None:
         """Show ``question`` and the ``options`` labels (option 1 first); mark ``chosen`` if set.
-        ``over_question`` (the thank-you row) is laid over the question text's rows when shown."""
+        ``over_question`` (the thank-you row) is laid over the question text's rows when shown.
+        ``buttons`` (a remote's page, :mod:`kiosk.ui.paging`): the (number shown, option) of each
+        button, option None for the page button whose label is the last of ``options``."""
         super().__init__(classes="panel")
         self.question = question
         self.options = tuple(options)
+        self.buttons = tuple(buttons) if buttons is not None else tuple((n, n) for n in range(1, len(options) + 1))
         self.chosen = chosen
         self._over = over_question
 
@@ -74,24 +83,33 @@ class QuestionPanel(Vertical):
             if self._over is not None:
                 yield self._over
         with AnswerList(id="answers"):
-            for number, label in enumerate(self.options, start=1):
-                yield AnswerButton(number, label, id=f"answer-{number}")
+            for (shows, option), label in zip(self.buttons, self.options):
+                name = f"answer-{option}" if option is not None else "answer-page"
+                yield AnswerButton(option, label, id=name, shows=shows)
 
     def on_mount(self) -> None:
         """Show the chosen answer, if any, once the buttons exist."""
         self.mark_chosen(self.chosen)
 
-    def show_item(self, question: str, options: Sequence[str], *, chosen: int | None = None) -> bool:
-        """Show another question in place when it has as many options as this one (the usual next
+    def show_item(
+        self,
+        question: str,
+        options: Sequence[str],
+        *,
+        chosen: int | None = None,
+        buttons: Sequence[tuple[int, int | None]] | None = None,
+    ) -> bool:
+        """Show another question in place when it has the same buttons as this one (the usual next
         question), rewording the existing widgets instead of mounting new ones, which is most of
-        the cost of a question change; returns False, changing nothing, when the count differs."""
+        the cost of a question change; returns False, changing nothing, when they differ."""
         options = tuple(options)
-        if len(options) != len(self.options):
+        layout = tuple(buttons) if buttons is not None else tuple((n, n) for n in range(1, len(options) + 1))
+        if layout != self.buttons:
             return False
         self.question, self.options = question, options
         self.query_one("#question", Static).update(question)
-        for button in self.query(AnswerButton):
-            button.relabel(options[button.option - 1])
+        for button, label in zip(self.query(AnswerButton), options):
+            button.relabel(label)
         self.mark_chosen(chosen)
         return True
 
@@ -99,4 +117,4 @@ class QuestionPanel(Vertical):
         """Highlight the recorded answer (after an answer, until the next question opens)."""
         self.chosen = option
         for button in self.query(AnswerButton):
-            button.set_class(button.option == option, "-chosen")
+            button.set_class(option is not None and button.option == option, "-chosen")

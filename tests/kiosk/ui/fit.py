@@ -30,7 +30,7 @@ def problems(screen: Screen) -> list[str]:
             if not button.region.contains_region(label.region) or wanted > box.height:
                 found.append(f"answer {button.option}'s text ({wanted} lines) is cut by its button at {button.region}")
         for other in answers:
-            if other.option > button.option and button.region.overlaps(other.region):
+            if other.shows > button.shows and button.region.overlaps(other.region):
                 found.append(f"answers {button.option} and {other.option} overlap")
     if len({b.region.height for b in answers}) > 1:
         found.append(f"answers of unequal heights {[b.region.height for b in answers]}")
