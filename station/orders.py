@@ -31,8 +31,7 @@ from sqlalchemy.engine import Connection, Engine
 
 from kiosk.core.visits import HOSPITAL_ID
 from station import db
-from station.db import audit, code_failures, kiosks, orders, visits
-from station.sessions import LIFECYCLE
+from station.db import audit, code_failures, kiosks, orders
 
 #: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
 #: No spaces, dots or apostrophes, and a digit required, so "Maria Lopez", "O'Neill" or "LOPEZ"
@@ -133,7 +132,7 @@ def check_patient_id(value: str) -> str:
     return value
 
 
-def _audit(connection: Connection, order_id: str, author: str, action: str, reason: str) -> None:
+def audit_order(connection: Connection, order_id: str, author: str, action: str, reason: str) -> None:
     connection.execute(
         audit.insert().values(
             session_id=order_id, at=db.now_iso(), author=author[:64], action=action, reason=reason[:1000]
@@ -240,7 +239,7 @@ def create(
                 updated_at=now,
             )
         )
-        _audit(
+        audit_order(
             connection,
             order_id,
             by.name,
@@ -310,7 +309,7 @@ def cancel(engine: Engine, order_id: str, by: Any, reason: str) -> Order:
         connection.execute(
             orders.update().where(orders.c.id == order_id).values(state="cancelled", updated_at=db.now_iso())
         )
-        _audit(connection, order_id, by.name, "order_cancel", reason.strip() or "cancelled")
+        audit_order(connection, order_id, by.name, "order_cancel", reason.strip() or "cancelled")
         return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
 
 
@@ -343,7 +342,7 @@ def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
     connection.execute(
         orders.update().where(orders.c.id == row.id).values(state="in_progress", updated_at=db.now_iso())
     )
-    _audit(
+    audit_order(
         connection,
         row.id,
         f"kiosk {kiosk_id}",
@@ -351,145 +350,3 @@ def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
         f"staff confirmed patient {row.patient_id} at {kiosk_id} with the order's code",
     )
     return Order.of(connection.execute(sa.select(orders).where(orders.c.id == row.id)).one())
-
-
-def visit_of(detail: str) -> tuple[str, str | None]:
-    """The kind of visit and its order from a ``visit`` log entry's detail ("order order-…",
-    "staff", "walk-up")."""
-    kind, _, order_id = detail.partition(" ")
-    return (kind, order_id or None) if kind in ("order", "staff", "walk-up") else ("unknown", None)
-
-
-def on_rows(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[dict[str, Any]]:
-    """What the kiosk's new rows (``station.sync.Event``) mean for visits and orders, in the sync's
-    transaction: a session's ``visit`` entry records how it began and links its order (refused
-    when the order is another kiosk's or another patient's); a finished session is a result
-    waiting (its order awaits validation); an abandoned one puts its order back to ordered.
-    Returns the bus messages to publish."""
-    messages: list[dict[str, Any]] = []
-    if any(e.kind in LIFECYCLE for e in new):  # the Results lists show statuses: they follow live
-        messages.append({"type": "sessions", "kiosk": kiosk_id})
-    for event in sorted(new, key=lambda e: e.seq):
-        p = event.payload
-        if event.kind == "record_event" and p.get("kind") == "visit":
-            kind, order_id = visit_of(str(p.get("detail", "")))
-            if kind == "order":
-                _link(connection, kiosk_id, event, order_id)
-                messages.append({"type": "order", "kiosk": kiosk_id})
-            db.insert_ignore(
-                connection,
-                visits,
-                [{"session_id": event.session_id, "kind": kind, "order_id": order_id}],
-                ["session_id"],
-            )
-        elif event.kind == "finish_session":
-            messages.append({"type": "result", "kiosk": kiosk_id, "session": event.session_id, "finished": True})
-            _move(
-                connection,
-                event.session_id,
-                "in_progress",
-                "awaiting_validation",
-                "order_result",
-                f"session {event.session_id} finished on {kiosk_id}: the result waits for validation",
-            )
-        elif event.kind == "abandon":
-            if _move(
-                connection,
-                event.session_id,
-                "in_progress",
-                "ordered",
-                "order_ready",
-                f"session {event.session_id} ended without a result: the visit can be started again",
-            ):
-                messages.append({"type": "order", "kiosk": kiosk_id})
-        elif event.kind == "create_session":
-            linked = connection.execute(
-                sa.select(orders.c.id, orders.c.patient_id).where(orders.c.session_id == event.session_id)
-            ).first()
-            if linked is not None and linked.patient_id != p.get("patient_id"):
-                raise LinkRefused(
-                    f"seq {event.seq}: order {linked.id} is for patient {linked.patient_id}, "
-                    f"not {p.get('patient_id')}: the result is not filed under it"
-                )
-    return messages
-
-
-def _link(connection: Connection, kiosk_id: str, event: Any, order_id: str | None) -> None:
-    row = connection.execute(sa.select(orders).where(orders.c.id == (order_id or ""))).first()
-    if row is None or row.kiosk_id != kiosk_id:
-        raise LinkRefused(f"seq {event.seq}: no order {order_id} for kiosk {kiosk_id}")
-    patient = connection.execute(
-        sa.select(db.sessions.c.patient_id).where(db.sessions.c.id == event.session_id)
-    ).scalar()
-    if patient is not None and patient != row.patient_id:
-        raise LinkRefused(
-            f"seq {event.seq}: order {order_id} is for patient {row.patient_id}, "
-            f"not {patient}: the result is not filed under it"
-        )
-    if row.state == "ordered":
-        raise LinkRefused(f"seq {event.seq}: order {order_id} was not started with its code at the kiosk")
-    if row.state != "in_progress":
-        return  # cancelled (or done) meanwhile: the session is kept, the order stays as it is
-    if row.session_id not in (None, event.session_id):
-        raise LinkRefused(f"seq {event.seq}: order {order_id} is running as session {row.session_id}")
-    connection.execute(
-        orders.update().where(orders.c.id == row.id).values(session_id=event.session_id, updated_at=db.now_iso())
-    )
-    _audit(
-        connection,
-        row.id,
-        f"kiosk {kiosk_id}",
-        "order_session",
-        f"session {event.session_id} started for {row.patient_id} on {kiosk_id}",
-    )
-
-
-def _move(connection: Connection, session_id: str, source: str, target: str, action: str, reason: str) -> bool:
-    row = connection.execute(
-        sa.select(orders.c.id, orders.c.kiosk_id).where(orders.c.session_id == session_id, orders.c.state == source)
-    ).first()
-    if row is None:
-        return False
-    values: dict[str, Any] = {"state": target, "updated_at": db.now_iso()}
-    if target == "ordered":
-        values["session_id"] = None
-    connection.execute(orders.update().where(orders.c.id == row.id).values(**values))
-    _audit(connection, row.id, f"kiosk {row.kiosk_id}", action, reason)
-    return True
-
-
-def signed_off(engine: Engine, session_id: str, by: Any) -> None:
-    """The session's result was signed off: its order (if any) is done."""
-    with engine.begin() as connection:
-        _move(
-            connection,
-            session_id,
-            "awaiting_validation",
-            "signed_off",
-            "order_signed",
-            f"result of session {session_id} signed off by {by.name}",
-        )
-
-
-def reopened(engine: Engine, session_id: str, by: Any) -> None:
-    """A doctor reopened the session's signed-off result to amend it: its order (if any) awaits
-    validation again, so the order never says "signed off" of a result that is not."""
-    with engine.begin() as connection:
-        _move(
-            connection,
-            session_id,
-            "signed_off",
-            "awaiting_validation",
-            "order_reopened",
-            f"result of session {session_id} reopened to amend by {by.name}",
-        )
-
-
-def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:
-    """How each session began: (kind, order id); sessions without a ``visit`` entry are absent
-    (kiosks older than orders)."""
-    if not session_ids:
-        return {}
-    with engine.connect() as connection:
-        rows = connection.execute(sa.select(visits).where(visits.c.session_id.in_(list(session_ids))))
-        return {r.session_id: (r.kind, r.order_id) for r in rows}

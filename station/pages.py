@@ -26,7 +26,7 @@ from kiosk.core.staff import waiting_line
 from kiosk.export import ExportError, practice_outcomes
 from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import StoredSession
-from station import db, exports, orders, staff_items, validation, ward
+from station import db, exports, order_progress, staff_items, validation, ward
 from station.download import attachment
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
@@ -214,7 +214,7 @@ async def session_page(request: Request) -> Response:
         commands=await run_in_threadpool(ward.recent_commands, engine, session_id),
         reviewable=stored.status in validation.REVIEWABLE and not current.final,
         reopened=bool(current.reopenings) and not current.final,
-        visit=(await run_in_threadpool(orders.visit_kinds, engine, [session_id])).get(session_id),
+        visit=(await run_in_threadpool(order_progress.visit_kinds, engine, [session_id])).get(session_id),
         message=request.query_params.get("message"),
     )
 
@@ -259,7 +259,7 @@ async def sign_off(request: Request) -> Response:
         await run_in_threadpool(validation.sign_off, request.app.state.engine, session_id, request.state.user)
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
-    await run_in_threadpool(orders.signed_off, request.app.state.engine, session_id, request.state.user)
+    await run_in_threadpool(order_progress.signed_off, request.app.state.engine, session_id, request.state.user)
     await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Signed off.", to=page)
 
@@ -274,7 +274,7 @@ async def amend(request: Request) -> Response:
         )
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
-    await run_in_threadpool(orders.reopened, request.app.state.engine, session_id, request.state.user)
+    await run_in_threadpool(order_progress.reopened, request.app.state.engine, session_id, request.state.user)
     await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Reopened to amend: change the answers, then sign off again.", to=page)
 

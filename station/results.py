@@ -19,7 +19,7 @@ from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import review_state
 from kiosk.export import ExportError
 from kiosk.export.captured import questionnaire_of
-from station import orders, validation
+from station import order_progress, validation
 from station.db import audit, sessions
 from station.sessions import load
 
@@ -93,7 +93,7 @@ def results_of(engine: Engine, q: Questionnaire, rows: Sequence[Any]) -> list[Re
     """The results of these session rows (anything with an ``id``), in their order."""
     ids = [r.id for r in rows]
     reviews = validation.reviews(engine, ids)
-    kinds = orders.visit_kinds(engine, ids)
+    kinds = order_progress.visit_kinds(engine, ids)
     found = []
     with engine.connect() as connection:
         for row in rows:

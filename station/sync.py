@@ -25,7 +25,7 @@ from sqlalchemy.engine import Connection
 
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
-from station import alert_rules, db, orders
+from station import alert_rules, db, order_progress
 from station.checks import (
     ID_MAX,
     NEEDS_DEFINITION,
@@ -213,7 +213,7 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
     if new:
         messages += _alerts(connection, kiosk_id, new, received)
         messages += alert_rules.settle(connection, kiosk_id, new)  # staff's own doing, situations ended
-        messages += orders.on_rows(connection, kiosk_id, new)  # visits, orders, results waiting
+        messages += order_progress.on_rows(connection, kiosk_id, new)  # visits, orders, results waiting
     return seqs, messages
 
 

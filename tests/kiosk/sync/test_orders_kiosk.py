@@ -29,6 +29,8 @@ def config_for(tmp_path, station_url: str | None = None, token: str = "", walk_u
     text = (
         f"data_dir: {tmp_path / 'data'}\nfamiliarisation: false\ntiming: {{between_questions_s: 0.1}}\n"
         f'clinician_pin: "246813"\nwalk_up: {str(walk_up).lower()}\n'
+        # the orders below are in Spanish, a translation of the team's own this site accepts
+        "accept_unvalidated_translations: [es]\n"
     )
     if station_url:
         text += f"station: {{url: '{station_url}', token: '{token}', kiosk_id: ward3-bed2}}\n"

@@ -1,0 +1,228 @@
+"""How an order follows its visit (protocol §4): the rows a kiosk sends say which sessions run an
+order, when its results wait for validation and when they are signed off. A battery's order
+has a session per instrument; it awaits validation when every instrument has a finished
+session, and is signed off when every finished one is.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from typing import Any
+
+import sqlalchemy as sa
+from sqlalchemy.engine import Connection, Engine
+
+from station import db
+from station.db import orders, visits
+from station.orders import LinkRefused, audit_order
+from station.sessions import LIFECYCLE
+
+
+def visit_of(detail: str) -> tuple[str, str | None]:
+    """The kind of visit and its order from a ``visit`` log entry's detail ("order order-…",
+    "staff", "walk-up")."""
+    kind, _, order_id = detail.partition(" ")
+    return (kind, order_id or None) if kind in ("order", "staff", "walk-up") else ("unknown", None)
+
+
+def on_rows(connection: Connection, kiosk_id: str, new: Sequence[Any]) -> list[dict[str, Any]]:
+    """What the kiosk's new rows (``station.sync.Event``) mean for visits and orders, in the sync's
+    transaction: a session's ``visit`` entry records how it began and links its order (refused
+    when the order is another kiosk's or another patient's); a finished session is a result
+    waiting (its order awaits validation); an abandoned one puts its order back to ordered.
+    Returns the bus messages to publish."""
+    messages: list[dict[str, Any]] = []
+    if any(e.kind in LIFECYCLE for e in new):  # the Results lists show statuses: they follow live
+        messages.append({"type": "sessions", "kiosk": kiosk_id})
+    for event in sorted(new, key=lambda e: e.seq):
+        p = event.payload
+        if event.kind == "record_event" and p.get("kind") == "visit":
+            kind, order_id = visit_of(str(p.get("detail", "")))
+            if kind == "order":
+                _link(connection, kiosk_id, event, order_id)
+                messages.append({"type": "order", "kiosk": kiosk_id})
+            db.insert_ignore(
+                connection,
+                visits,
+                [{"session_id": event.session_id, "kind": kind, "order_id": order_id}],
+                ["session_id"],
+            )
+        elif event.kind == "finish_session":
+            messages.append({"type": "result", "kiosk": kiosk_id, "session": event.session_id, "finished": True})
+            _finished(connection, kiosk_id, event.session_id)
+        elif event.kind == "abandon":
+            if _abandoned(connection, kiosk_id, event.session_id):
+                messages.append({"type": "order", "kiosk": kiosk_id})
+        elif event.kind == "create_session":
+            linked = connection.execute(
+                sa.select(orders.c.id, orders.c.patient_id).where(orders.c.session_id == event.session_id)
+            ).first()
+            if linked is not None and linked.patient_id != p.get("patient_id"):
+                raise LinkRefused(
+                    f"seq {event.seq}: order {linked.id} is for patient {linked.patient_id}, "
+                    f"not {p.get('patient_id')}: the result is not filed under it"
+                )
+    return messages
+
+
+def _link(connection: Connection, kiosk_id: str, event: Any, order_id: str | None) -> None:
+    row = connection.execute(sa.select(orders).where(orders.c.id == (order_id or ""))).first()
+    if row is None or row.kiosk_id != kiosk_id:
+        raise LinkRefused(f"seq {event.seq}: no order {order_id} for kiosk {kiosk_id}")
+    patient = connection.execute(
+        sa.select(db.sessions.c.patient_id).where(db.sessions.c.id == event.session_id)
+    ).scalar()
+    if patient is not None and patient != row.patient_id:
+        raise LinkRefused(
+            f"seq {event.seq}: order {order_id} is for patient {row.patient_id}, "
+            f"not {patient}: the result is not filed under it"
+        )
+    if row.state == "ordered":
+        raise LinkRefused(f"seq {event.seq}: order {order_id} was not started with its code at the kiosk")
+    if row.state != "in_progress":
+        return  # cancelled (or done) meanwhile: the session is kept, the order stays as it is
+    if row.session_id not in (None, event.session_id) and not _is_finished(connection, row.session_id):
+        # the next instrument of a battery follows a finished one; two running at once never do
+        raise LinkRefused(f"seq {event.seq}: order {order_id} is running as session {row.session_id}")
+    connection.execute(
+        orders.update().where(orders.c.id == row.id).values(session_id=event.session_id, updated_at=db.now_iso())
+    )
+    audit_order(
+        connection,
+        row.id,
+        f"kiosk {kiosk_id}",
+        "order_session",
+        f"session {event.session_id} started for {row.patient_id} on {kiosk_id}",
+    )
+
+
+def _order_of(connection: Connection, session_id: str) -> Any:
+    """The order a session belongs to: through its visit entry (every instrument of a battery is
+    one session of the order), else the order's own link; None for a session of no order."""
+    order_id = connection.execute(sa.select(visits.c.order_id).where(visits.c.session_id == session_id)).scalar()
+    where = orders.c.id == order_id if order_id else orders.c.session_id == session_id
+    return connection.execute(sa.select(orders).where(where)).first()
+
+
+def _sessions_of(connection: Connection, order: Any) -> list[str]:
+    """The sessions of an order: one per instrument run so far, in the order they began."""
+    linked = connection.execute(sa.select(visits.c.session_id).where(visits.c.order_id == order.id)).scalars().all()
+    return list(dict.fromkeys([*linked, *([order.session_id] if order.session_id else [])]))
+
+
+def _is_finished(connection: Connection, session_id: str) -> bool:
+    status = connection.execute(sa.select(db.sessions.c.status).where(db.sessions.c.id == session_id)).scalar()
+    return status == "finished"
+
+
+def _finished(connection: Connection, kiosk_id: str, session_id: str) -> None:
+    """A session of an order finished: the order awaits validation once every instrument it
+    names has a finished session (a battery's earlier instruments leave it in progress)."""
+    order = _order_of(connection, session_id)
+    if order is None or order.state != "in_progress":
+        return
+    done = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+    wanted = len(json.loads(order.instruments))
+    if done < wanted:
+        audit_order(
+            connection,
+            order.id,
+            f"kiosk {kiosk_id}",
+            "order_instrument",
+            f"session {session_id} finished on {kiosk_id}: {done} of {wanted} instruments done",
+        )
+        return
+    _move(
+        connection,
+        session_id,
+        "in_progress",
+        "awaiting_validation",
+        "order_result",
+        f"session {session_id} finished on {kiosk_id}: the result waits for validation"
+        + (f" ({wanted} instruments)" if wanted > 1 else ""),
+    )
+
+
+def _abandoned(connection: Connection, kiosk_id: str, session_id: str) -> bool:
+    """A session of an order ended without a result: with nothing finished the visit can be
+    started again; after some of a battery's instruments, their results wait for validation."""
+    order = _order_of(connection, session_id)
+    if order is None or order.state != "in_progress":
+        return False
+    done = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+    if done:
+        return _move(
+            connection,
+            session_id,
+            "in_progress",
+            "awaiting_validation",
+            "order_result",
+            f"session {session_id} ended without a result on {kiosk_id}: the {done} finished "
+            f"instrument(s) of {len(json.loads(order.instruments))} wait for validation",
+        )
+    return _move(
+        connection,
+        session_id,
+        "in_progress",
+        "ordered",
+        "order_ready",
+        f"session {session_id} ended without a result: the visit can be started again",
+    )
+
+
+def _move(connection: Connection, session_id: str, source: str, target: str, action: str, reason: str) -> bool:
+    found = _order_of(connection, session_id)
+    row = found if found is not None and found.state == source else None
+    if row is None:
+        return False
+    values: dict[str, Any] = {"state": target, "updated_at": db.now_iso()}
+    if target == "ordered":
+        values["session_id"] = None
+    connection.execute(orders.update().where(orders.c.id == row.id).values(**values))
+    audit_order(connection, row.id, f"kiosk {row.kiosk_id}", action, reason)
+    return True
+
+
+def signed_off(engine: Engine, session_id: str, by: Any) -> None:
+    """The session's result was signed off: its order (if any) is done once every result of it
+    is (a battery's results are signed off one by one)."""
+    from station.validation import review_in
+
+    with engine.begin() as connection:
+        order = _order_of(connection, session_id)
+        others = [s for s in _sessions_of(connection, order) if s != session_id] if order is not None else []
+        if any(_is_finished(connection, s) and not review_in(connection, s).final for s in others):
+            return
+        _move(
+            connection,
+            session_id,
+            "awaiting_validation",
+            "signed_off",
+            "order_signed",
+            f"result of session {session_id} signed off by {by.name}",
+        )
+
+
+def reopened(engine: Engine, session_id: str, by: Any) -> None:
+    """A doctor reopened the session's signed-off result to amend it: its order (if any) awaits
+    validation again, so the order never says "signed off" of a result that is not."""
+    with engine.begin() as connection:
+        _move(
+            connection,
+            session_id,
+            "signed_off",
+            "awaiting_validation",
+            "order_reopened",
+            f"result of session {session_id} reopened to amend by {by.name}",
+        )
+
+
+def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:
+    """How each session began: (kind, order id); sessions without a ``visit`` entry are absent
+    (kiosks older than orders)."""
+    if not session_ids:
+        return {}
+    with engine.connect() as connection:
+        rows = connection.execute(sa.select(visits).where(visits.c.session_id.in_(list(session_ids))))
+        return {r.session_id: (r.kind, r.order_id) for r in rows}
