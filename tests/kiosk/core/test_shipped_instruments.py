@@ -35,10 +35,10 @@ def test_every_shipped_instrument_is_valid_and_names_its_translations(name):
     assert [lang for lang in q.languages if q.validated(lang)] == ["en"]
 
 
-@pytest.mark.parametrize("name", ("lawton", "gds15", "sarc_f"))
-def test_the_new_instruments_cite_their_published_source(name):
+@pytest.mark.parametrize("name", SHIPPED)
+def test_every_shipped_instrument_cites_its_published_source(name):
     q = instrument(name)
-    author = {"lawton": "Lawton", "gds15": "Sheikh", "sarc_f": "Malmstrom"}[name]
+    author = {"barthel": "Mahoney", "lawton": "Lawton", "gds15": "Sheikh", "sarc_f": "Malmstrom"}[name]
     assert author in q.reference and re.search(r"19\d\d|20\d\d", q.reference)
 
 
