@@ -61,3 +61,34 @@ def test_lhc_forms_computes_the_kiosks_total_and_subscales(
         assert rendered["shown"][item].endswith(f" - {option.points}"), (item, rendered["shown"][item])
     back = {i["linkId"]: i.get("answer") for i in rendered["back"]["item"]}
     assert {k: back.get(k) for k in computed} == {k: [{"valueInteger": v}] for k, v in computed.items()}
+
+
+@pytest.mark.parametrize(
+    ("name", "language", "pick"),
+    [
+        ("barthel", "en", 0),
+        ("lawton", "en", 1),
+        ("lawton", "fr", 3),
+        ("gds15", "en", 0),
+        ("gds15", "de", 1),
+        ("sarc_f", "es", 2),
+    ],
+)
+def test_lhc_forms_computes_each_shipped_instruments_total(lforms_page, name, language, pick):  # noqa: F811
+    """Each instrument the kiosk ships, exported with a response: LHC-Forms computes the total the
+    kiosk computed from the answers alone (``pick`` varies which option each item gets)."""
+    from kiosk.core.questionnaire import bundled_path, load_questionnaire
+
+    page, errors = lforms_page
+    q = load_questionnaire(bundled_path(f"{name}.yaml"))
+    options = {item.id: (n + pick) % len(item.options) + 1 for n, item in enumerate(q.patient_items)}
+    r = result(q, stored(q, options, language))
+    assert r.complete
+    questionnaire = fhir_questionnaire(q, language, SITE)
+    response = response_of(q, r, SITE)
+    (total_link,) = [i["linkId"] for i in questionnaire["item"] if i["linkId"] not in options]
+    answers_only = response | {"item": [i for i in response["item"] if i["linkId"] != total_link]}
+    page.set_default_timeout(PATIENCE_MS)
+    rendered = page.evaluate(RENDER, [questionnaire, answers_only])
+    assert not errors, errors
+    assert rendered["shown"][total_link] == str(r.score.total), (name, rendered["shown"][total_link])
