@@ -24,7 +24,7 @@ import re
 import sys
 from pathlib import Path
 
-from kiosk.config import ConfigError, configured_questionnaire, load_config
+from kiosk.config import ConfigError, configured_instruments, configured_questionnaire, load_config
 from kiosk.core.questionnaire import QuestionnaireError
 from kiosk.core.words import languages
 from kiosk.export import (
@@ -127,7 +127,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument(
         "--fhir-questionnaire",
         metavar="FILE",
-        help="write the FHIR R4 Questionnaire (with --language: that language's; else a Bundle of all)",
+        help="write the FHIR R4 Questionnaire (with --language: that language's; else a Bundle of all); "
+        "a battery (instruments: in the config): a Bundle of every instrument",
     )
     parser.add_argument("--language", choices=languages(), help="language of --fhir-questionnaire")
     parser.add_argument("--csv", metavar="FILE", help="write the sessions as CSV, rows per item")
@@ -148,11 +149,15 @@ def main(argv: list[str]) -> int:
         # today's questionnaire file is read only for what it describes: itself (--fhir-questionnaire)
         # and an export of no session; stored sessions are described by what they captured
         if args.fhir_questionnaire:
-            q = configured_questionnaire(config)
-            write_json(
-                args.fhir_questionnaire,
-                fhir_questionnaire(q, args.language, site) if args.language else questionnaire_bundle(q, site),
-            )
+            battery = [q for q, _ in configured_instruments(config)]
+            if len(battery) == 1 and args.language:
+                written: dict = fhir_questionnaire(battery[0], args.language, site)
+            else:  # several instruments (instruments: in the config) are a Bundle, one per language
+                missing = [q.id for q in battery if args.language and args.language not in q.languages]
+                if missing:
+                    raise ConfigError(f"--language {args.language}: {', '.join(missing)} has no such translation")
+                written = questionnaire_bundle(battery, site, args.language)
+            write_json(args.fhir_questionnaire, written)
         with open_store(args.data_dir, in_force=lambda: in_force_of(config), export=export_identity(site)) as store:
             refs = [ref.removeprefix(ID_TAGS["session"]) for ref in args.sessions]
             exporting = args.fhir or args.csv or args.csv_wide

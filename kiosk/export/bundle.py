@@ -131,11 +131,20 @@ def transaction_bundle(
     return bundle_of([Described(q, r, site) for r in results(q, sessions, reviews)])
 
 
-def questionnaire_bundle(q: Questionnaire, site: ExportSite | None = None) -> dict[str, Any]:
-    """The questionnaire in every language as a transaction Bundle of conditional creates."""
+def questionnaire_bundle(
+    q: Questionnaire | Sequence[Questionnaire], site: ExportSite | None = None, language: str | None = None
+) -> dict[str, Any]:
+    """The questionnaire (or each of a battery's instruments) in every language, or only in
+    ``language``, as a transaction Bundle of conditional creates."""
     site = site or ExportSite()
+    instruments = [q] if isinstance(q, Questionnaire) else list(q)
     return {
         "resourceType": "Bundle",
         "type": "transaction",
-        "entry": [_questionnaire_entry(q, site, language) for language in q.languages],
+        "entry": [
+            _questionnaire_entry(one, site, lang)
+            for one in instruments
+            for lang in one.languages
+            if language is None or lang == language
+        ],
     }

@@ -135,3 +135,25 @@ def test_an_empty_store_exports_an_empty_but_valid_bundle(tmp_path, monkeypatch,
     bundle = json.loads(out.read_text(encoding="utf-8"))
     check_fhir(bundle)
     assert bundle == {"resourceType": "Bundle", "type": "transaction"}
+
+
+def test_a_batterys_questionnaires_are_one_bundle_of_every_instrument(tmp_path, monkeypatch, capsys):
+    config = tmp_path / "battery.yaml"
+    from kiosk.store.database import Store
+
+    Store.open(tmp_path / "data").close()  # a kiosk's data directory, no session yet
+    config.write_text(f"data_dir: {tmp_path / 'data'}\ninstruments: [barthel, gds15, lawton]\n")
+    monkeypatch.setenv("KIOSK_CONFIG", str(config))
+    out = tmp_path / "questionnaires.json"
+    assert results_main(["--fhir-questionnaire", str(out)]) == 0
+    bundle = json.loads(out.read_text())
+    check_fhir(bundle)
+    urls = [e["resource"]["url"] for e in bundle["entry"]]
+    for instrument, languages in {"barthel": "en es fr de", "gds15": "en es fr de", "lawton": "en es fr"}.items():
+        assert sum(u.rsplit(":", 1)[1].startswith(f"{instrument}-") for u in urls) == len(languages.split()), urls
+    assert results_main(["--fhir-questionnaire", str(out), "--language", "fr"]) == 0
+    assert len(json.loads(out.read_text())["entry"]) == 3  # one French Questionnaire per instrument
+    # German: the Lawton has no German text, and nothing is written half
+    out.unlink()
+    assert results_main(["--fhir-questionnaire", str(out), "--language", "de"]) == 2
+    assert "lawton has no such translation" in capsys.readouterr().err and not out.exists()
