@@ -72,9 +72,7 @@ def test_the_shipped_battery_recording_replays():
     folder = ROOT / "recordings/patients/batteries"
     config = folder / "cga.config.yaml"
     needed = [line.strip("- \n") for line in config.read_text().splitlines() if line.startswith("  - ")]
-    missing = [name for name in needed if not bundled_path(f"{name}.yaml").is_file()]
-    if missing:  # the battery names instruments another branch ships (issue 26's shipped set)
-        pytest.skip(f"not shipped on this branch: {', '.join(missing)}")
+    assert all(bundled_path(f"{name}.yaml").is_file() for name in needed), needed  # shipped instruments
     script = load_battery_script(folder / "cga.yaml")
     assert [q.id for q in script.instruments] == needed
     assert main([str(folder / "cga.yaml"), "--config", str(config)]) == 0
