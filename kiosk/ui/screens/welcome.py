@@ -47,18 +47,12 @@ class LanguageList(Vertical):
         rows = self.content_region.height
         if not buttons or rows <= 0:
             return
-        count = len(buttons)
-        height, gap = max(1, (rows - count) // count), 1
-        if height < 3 and rows // count >= 3:
-            # four languages on a short panel: three rows each without the gap (a button's own
-            # shading still tells them apart) beat a label that cannot sit in the middle
-            height, gap = 3, 0
-        if height % 2 == 0:  # an odd height centres the label
+        height = max(1, (rows - len(buttons)) // len(buttons))
+        if height % 2 == 0 and height > 2:  # an odd height centres the label; two rows beat one
             height -= 1
         for button in buttons:
             button.styles.height = height
             button.styles.min_height = min(3, height)
-            button.styles.margin = (gap, 0, 0, 0)
 
 
 def language_labels(languages: list[str] | tuple[str, ...]) -> list[str]:

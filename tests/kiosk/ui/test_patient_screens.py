@@ -180,7 +180,9 @@ async def test_language_buttons_are_equal_with_their_labels_lined_up(ui_kiosk, s
         await until_drawn(pilot, "English", "Español", "Français")
         buttons = list(kiosk.app.screen.query("#languages Button").results(Button))
         assert len({(b.region.width, b.region.height) for b in buttons}) == 1
-        assert buttons[0].region.height % 2 == 1  # the label on the middle row
+        # the label on the middle row; four languages on the shortest panel get two rows each (no
+        # middle row: the label sits on the first of every button alike), never one
+        assert buttons[0].region.height % 2 == 1 or (size[1] < 20 and buttons[0].region.height == 2)
         shown = drawn_text(kiosk.app).splitlines()
         columns = {
             line.index(name[0]) - 3 for line in shown for name in ("English", "Español", "Français") if name in line
