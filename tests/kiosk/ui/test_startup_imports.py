@@ -3,7 +3,7 @@
 
 Each check runs a fresh interpreter, as `kiosk run` starts, so modules other tests loaded do not hide
 an import; it is the kiosk's second start, the first having filled its cache (the QoS grammar's
-tables, the parsed QoS model, the questionnaire's passed schema check: fileio.cache)."""
+tables, the parsed QoS model, the questionnaire's passed schema check, the parsed YAML files: fileio.cache)."""
 
 from __future__ import annotations
 
@@ -53,6 +53,9 @@ NOT_BEFORE_THE_WELCOME = (
     "qos.grammar",
     "lark",
     "jsonschema",
+    # the configuration, words, profiles and policy parsed at the last start are read back (fileio.positions)
+    "yaml",
+    "fileio.yamlfile",
     "plotext",
     "textual_plotext",
     "matplotlib",
