@@ -53,6 +53,8 @@ NOT_BEFORE_THE_WELCOME = (
     "qos.grammar",
     "lark",
     "jsonschema",
+    # the remotes' readers: build_app makes them (from a checked profile file), the app starts them
+    "serial",
     # the configuration, words, profiles and policy parsed at the last start are read back (fileio.positions)
     "yaml",
     "fileio.yamlfile",
@@ -65,7 +67,16 @@ NOT_BEFORE_THE_WELCOME = (
     "sqlalchemy",
 )
 #: the speech stack loads on the channels' own threads once the app runs, never while it is built
-NOT_WHILE_BUILDING = ("numpy", "sounddevice", "vosk", "pocketsphinx", "kiosk.speech.asr", "kiosk.speech.audio")
+NOT_WHILE_BUILDING = (
+    "numpy",
+    "sounddevice",
+    "vosk",
+    "pocketsphinx",
+    "kiosk.speech.asr",
+    "kiosk.speech.audio",
+    "serial",  # pyserial: on the serial remote's reader thread
+    "hid",  # hidapi
+)
 
 
 def _run(tmp_path, body: str) -> dict[str, Any]:
