@@ -65,18 +65,23 @@ def describe(path: tuple[Any, ...]) -> str:
     return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p)) for i, p in enumerate(path))
 
 
-def parse(text: str, filename: str) -> tuple[Any, Positions | None, list[Problem]]:
+def parse(
+    text: str, filename: str, *, keep: bool | Callable[[Any], bool] = False
+) -> tuple[Any, Positions | None, list[Problem]]:
     """Parse one YAML document under the shared reader's limits (``fileio.bounded``): (data, positions,
     problems).
 
     A document that cannot be read (syntax, duplicate keys, nesting, alias bombs, huge or
-    non-finite numbers) or is empty gives (None, None, [that problem]). A document that parsed is
-    kept (:func:`fileio.cache.keep`, keyed by its text, this package's code and the Python) and
-    read back without PyYAML, whose import and composing cost a kiosk's start about 0.015 s for its
-    configuration and profile files; one with a problem is parsed, and reported, every time.
+    non-finite numbers) or is empty gives (None, None, [that problem]).
+
+    With ``keep`` (True, or a test of the data: a file holding a secret is never copied into the
+    cache), a document that parsed is kept (:func:`fileio.cache.keep`, keyed by its text, this
+    package's code and the Python) and read back without PyYAML, whose import and composing cost a
+    kiosk's start about 0.015 s for its configuration, profile and policy files; one with a problem
+    is parsed, and reported, every time.
     """
-    key = cache.digest(PARSED, sys.version, _code(), text)
-    found = cache.kept(PARSED, key)
+    key = cache.digest(PARSED, sys.version, _code(), text) if keep else ""
+    found = cache.kept(PARSED, key) if key else None
     if isinstance(found, tuple) and len(found) == 2 and isinstance(found[1], Positions):
         return found[0], found[1], []
     from fileio.yamlfile import compose_yaml, construct_yaml
@@ -89,7 +94,8 @@ def parse(text: str, filename: str) -> tuple[Any, Positions | None, list[Problem
     except BadFile as exc:
         return None, None, [exc.problem]
     positions = Positions(node)
-    cache.keep(PARSED, key, (data, positions))
+    if key and (keep is True or (callable(keep) and keep(data))):
+        cache.keep(PARSED, key, (data, positions))
     return data, positions, []
 
 
@@ -103,15 +109,18 @@ def _code() -> str:
     return cache.code_digest(Path(__file__).parent)
 
 
-def parse_file(path: str | Path, name: str | None = None) -> tuple[Any, Positions | None, list[Problem]]:
-    """Read a YAML file through the shared bounded reader and :func:`parse` it; an unreadable file
-    (missing, too big, not UTF-8, binary) is one problem. ``name`` is how messages call the file."""
+def parse_file(
+    path: str | Path, name: str | None = None, *, keep: bool | Callable[[Any], bool] = False
+) -> tuple[Any, Positions | None, list[Problem]]:
+    """Read a YAML file through the shared bounded reader and :func:`parse` it (``keep``: as there);
+    an unreadable file (missing, too big, not UTF-8, binary) is one problem. ``name`` is how
+    messages call the file."""
     name = str(path) if name is None else name
     try:
         text = read_text(path, MAX_YAML_BYTES)
     except BadFile as exc:
         return None, None, [Problem(name, exc.problem.line, exc.problem.column, exc.problem.message)]
-    return parse(text, name)
+    return parse(text, name, keep=keep)
 
 
 def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add: Callable[..., None]) -> None:
