@@ -3,21 +3,25 @@
 Hand-edited files (questionnaires, scripted patients, the config) must report problems as
 ``file:line:col``. PyYAML's ``compose`` keeps the marks that ``safe_load`` throws away; this module
 keeps both the constructed data and a map from each path (keys and list indexes) to its mark. The
-file itself is read by ``fileio.bounded`` (size, encoding, nesting, aliases, duplicate keys, numbers),
-the one bounded reader every loader of the project shares.
+file itself is read by ``fileio.bounded`` and ``fileio.yamlfile`` (size, encoding, nesting, aliases,
+duplicate keys, numbers), the one bounded reader every loader of the project shares; PyYAML is
+imported when a document is first parsed.
 """
 
 from __future__ import annotations
 
+import functools
 import os
+import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
-
-import yaml
+from typing import TYPE_CHECKING, Any
 
 from fileio import cache
-from fileio.bounded import MAX_YAML_BYTES, BadFile, Problem, compose_yaml, construct_yaml, read_text
+from fileio.bounded import MAX_YAML_BYTES, BadFile, Problem, read_text
+
+if TYPE_CHECKING:
+    import yaml
 
 __all__ = ["Positions", "Problem", "describe", "parse", "parse_file", "schema_problems"]
 
@@ -35,6 +39,8 @@ class Positions:
         return node.start_mark.line + 1, node.start_mark.column + 1
 
     def _walk(self, node: yaml.Node, path: tuple[Any, ...]) -> None:
+        import yaml  # imported with the composer that made the node; PyYAML loads only when YAML is read
+
         self._marks[path] = self._mark(node)
         if isinstance(node, yaml.MappingNode):
             for key_node, value_node in node.value:
@@ -59,13 +65,27 @@ def describe(path: tuple[Any, ...]) -> str:
     return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p)) for i, p in enumerate(path))
 
 
-def parse(text: str, filename: str) -> tuple[Any, Positions | None, list[Problem]]:
+def parse(
+    text: str, filename: str, *, keep: bool | Callable[[Any], bool] = False
+) -> tuple[Any, Positions | None, list[Problem]]:
     """Parse one YAML document under the shared reader's limits (``fileio.bounded``): (data, positions,
     problems).
 
     A document that cannot be read (syntax, duplicate keys, nesting, alias bombs, huge or
     non-finite numbers) or is empty gives (None, None, [that problem]).
+
+    With ``keep`` (True, or a test of the data: a file holding a secret is never copied into the
+    cache), a document that parsed is kept (:func:`fileio.cache.keep`, keyed by its text, this
+    package's code and the Python) and read back without PyYAML, whose import and composing cost a
+    kiosk's start about 0.015 s for its configuration, profile and policy files; one with a problem
+    is parsed, and reported, every time.
     """
+    key = cache.digest(PARSED, sys.version, _code(), text) if keep else ""
+    found = cache.kept(PARSED, key) if key else None
+    if isinstance(found, tuple) and len(found) == 2 and isinstance(found[1], Positions):
+        return found[0], found[1], []
+    from fileio.yamlfile import compose_yaml, construct_yaml
+
     try:
         node = compose_yaml(text, filename)
         if node is None:
@@ -73,18 +93,34 @@ def parse(text: str, filename: str) -> tuple[Any, Positions | None, list[Problem
         data = construct_yaml(node, filename)
     except BadFile as exc:
         return None, None, [exc.problem]
-    return data, Positions(node), []
+    positions = Positions(node)
+    if key and (keep is True or (callable(keep) and keep(data))):
+        cache.keep(PARSED, key, (data, positions))
+    return data, positions, []
 
 
-def parse_file(path: str | Path, name: str | None = None) -> tuple[Any, Positions | None, list[Problem]]:
-    """Read a YAML file through the shared bounded reader and :func:`parse` it; an unreadable file
-    (missing, too big, not UTF-8, binary) is one problem. ``name`` is how messages call the file."""
+#: the cache folder's name under <user cache dir>/kiosk for parsed documents (:func:`parse`)
+PARSED = "parsed-yaml"
+
+
+@functools.cache
+def _code() -> str:
+    """The digest of this package's code: a document parsed by other code is parsed again."""
+    return cache.code_digest(Path(__file__).parent)
+
+
+def parse_file(
+    path: str | Path, name: str | None = None, *, keep: bool | Callable[[Any], bool] = False
+) -> tuple[Any, Positions | None, list[Problem]]:
+    """Read a YAML file through the shared bounded reader and :func:`parse` it (``keep``: as there);
+    an unreadable file (missing, too big, not UTF-8, binary) is one problem. ``name`` is how
+    messages call the file."""
     name = str(path) if name is None else name
     try:
         text = read_text(path, MAX_YAML_BYTES)
     except BadFile as exc:
         return None, None, [Problem(name, exc.problem.line, exc.problem.column, exc.problem.message)]
-    return parse(text, name)
+    return parse(text, name, keep=keep)
 
 
 def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add: Callable[..., None]) -> None:

@@ -259,9 +259,15 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     return Config(**values, source=Path(path) if path is not None else None)
 
 
+def _no_secret(data: Any) -> bool:
+    """Whether a configuration may be kept parsed in the user cache (:func:`fileio.positions.parse`):
+    not with a station's bearer token or the served page's key digest in it."""
+    return not (isinstance(data, dict) and {"station", "serve_token_sha256"} & set(data))
+
+
 def _read(path: Path) -> dict[str, Any]:
     name = str(path)
-    data, positions, problems = parse_file(path)
+    data, positions, problems = parse_file(path, keep=_no_secret)
     if problems and problems[0].message == "the file is empty":
         return {}  # a config file with every setting commented out means the defaults
     if problems:

@@ -25,7 +25,8 @@ from typing import Any
 
 import yaml
 
-from fileio.bounded import BadFile, load_data, write_private
+from fileio.bounded import BadFile, write_private
+from fileio.yamlfile import load_data
 from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
 from qos.errors import ContextError, ModelError, TraceError
 from qos.model import Model

@@ -73,12 +73,12 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
     """
     if path is None:
         data, positions, problems = parse_file(
-            str(resources.files("kiosk.core").joinpath("adaptation.yaml")), "adaptation.yaml"
+            str(resources.files("kiosk.core").joinpath("adaptation.yaml")), "adaptation.yaml", keep=True
         )
         name = "adaptation.yaml"
     else:
         name = str(path)
-        data, positions, problems = parse_file(path)
+        data, positions, problems = parse_file(path, keep=True)
     if problems or positions is None:
         raise PolicyError("\n".join(map(str, problems)))
 

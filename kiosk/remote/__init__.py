@@ -8,13 +8,15 @@ The app calls :func:`open_sources` once and starts every source with its sink, a
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from kiosk.core.channels import InputSource
-from kiosk.remote.hid import HidBackend, HidRemote
 from kiosk.remote.keymap import KeyboardRemote
 from kiosk.remote.profiles import ProfileError, load_profiles
-from kiosk.remote.reconnect import Backoff
-from kiosk.remote.serial import SerialRemote
+
+if TYPE_CHECKING:
+    from kiosk.remote.hid import HidBackend
+    from kiosk.remote.reconnect import Backoff
 
 __all__ = ["KeyboardRemote", "ProfileError", "keyboard_remote", "open_sources"]
 
@@ -28,6 +30,10 @@ def open_sources(
     Each source looks for its device until stopped, reporting what it finds as
     :class:`~kiosk.core.channels.ChannelStatus`. Raises :class:`ProfileError` for a bad profile file.
     """
+    # the readers load here, not with the package: the UI imports the buttons before the welcome
+    from kiosk.remote.hid import HidRemote
+    from kiosk.remote.serial import SerialRemote
+
     profiles = load_profiles(profiles_path)
     sources: list[InputSource] = [SerialRemote(p, backoff=backoff) for p in profiles.serial]
     sources += [HidRemote(p, backend=hid_backend, backoff=backoff) for p in profiles.hid]

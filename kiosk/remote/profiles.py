@@ -138,7 +138,7 @@ class _Where:
 
 
 def _read_file(path: Path) -> list[_Fields]:
-    document, positions, problems = parse_file(path)
+    document, positions, problems = parse_file(path, keep=True)  # kept: no PyYAML at a second start
     if problems:
         raise ProfileError(str(problems[0]))
     assert positions is not None

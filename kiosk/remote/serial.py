@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import glob
 import os
-
-import serial
+from typing import TYPE_CHECKING
 
 from kiosk.core.channels import ChannelState
 from kiosk.remote.decoders import LineDecoder, Press
 from kiosk.remote.profiles import SerialProfile
 from kiosk.remote.reconnect import Backoff, DeviceLost, DeviceUnavailable, ReconnectingReader, Wait, wait_or_stop
+
+if TYPE_CHECKING:
+    import serial
 
 #: how long one read waits for bytes; bounds how quickly stop() and a vanished port are noticed
 READ_TIMEOUT = 0.1
@@ -41,6 +43,8 @@ class SerialConnection:
 
     def read(self) -> list[Press]:
         """Read what arrived within :data:`READ_TIMEOUT`; raise DeviceLost if the port failed."""
+        import serial  # pyserial loads on the reader's thread, after the welcome is drawn
+
         try:
             data = self._device.read(max(1, self._device.in_waiting))
         except (serial.SerialException, OSError) as error:
@@ -52,6 +56,8 @@ class SerialConnection:
 
     def close(self) -> None:
         """Close the port, ignoring errors from a device that is already gone."""
+        import serial
+
         try:
             self._device.close()
         except (serial.SerialException, OSError):
@@ -67,6 +73,8 @@ class SerialRemote(ReconnectingReader):
 
     def connect(self) -> SerialConnection:
         """Open the first matching port, or raise DeviceUnavailable saying why none could be."""
+        import serial
+
         ports = matching_ports(self.profile.port)
         if not ports:
             raise DeviceUnavailable(ChannelState.OFF, f"no serial remote on {self.profile.port}")

@@ -7,7 +7,8 @@ import stat
 
 import pytest
 
-from fileio.bounded import MAX_DEPTH, BadFile, load_json, load_yaml, read_text, write_private
+from fileio.bounded import MAX_DEPTH, BadFile, load_json, read_text, write_private
+from fileio.yamlfile import load_yaml
 
 
 def world_readable(path):

@@ -86,3 +86,30 @@ def test_the_test_run_keeps_its_caches_out_of_the_users_home():
 
     folder = Path(platformdirs.user_cache_dir("kiosk")).resolve()
     assert not folder.is_relative_to(Path.home().resolve()), folder
+
+
+def test_a_parsed_document_asked_to_be_kept_is_read_back_without_yaml_one_with_a_problem_never(cache_home, monkeypatch):
+    from fileio import yamlfile
+
+    text = "points: 5\nwords: [a, b]\nwhen: 2026-11-26\n"
+    parse(text, "doc.yaml")  # kept only when asked
+    parse(text, "doc.yaml", keep=lambda data: "points" not in data)  # or when the data may be kept
+    assert not (cache_home.parent / "parsed-yaml").exists() or not list((cache_home.parent / "parsed-yaml").iterdir())
+    data, positions, problems = parse(text, "doc.yaml", keep=True)
+    assert problems == [] and positions is not None
+    (kept,) = (cache_home.parent / "parsed-yaml").glob("*.pickle")
+    assert stat.S_IMODE(kept.stat().st_mode) == 0o600
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("parsed again")
+
+    monkeypatch.setattr(yamlfile, "compose_yaml", refuse)
+    again, again_positions, again_problems = parse(text, "other.yaml", keep=True)
+    assert (again, again_problems) == (data, []) and again is not data
+    assert again_positions is not None and again_positions.of(("words", 1)) == positions.of(("words", 1)) == (2, 12)
+    monkeypatch.undo()
+    monkeypatch.setenv("XDG_CACHE_HOME", str(cache_home.parent.parent))
+    bad = "points: 5\npoints: 6\n"
+    for _ in range(2):  # the same problem every time: it is never kept
+        assert parse(bad, "doc.yaml", keep=True)[2][0].message == "duplicate key 'points'"
+    assert list(kept.parent.glob("*.pickle")) == [kept]

@@ -257,3 +257,21 @@ def test_kiosk_run_refuses_an_unaccepted_translation_in_one_line_and_runs_an_acc
         assert app.session.language == "de" and app.session.questionnaire.languages == ("en", "de")
     finally:
         close()
+
+
+def test_a_configuration_with_a_station_token_is_never_kept_parsed_in_the_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    parsed = tmp_path / "cache" / "kiosk" / "parsed-yaml"
+    plain = tmp_path / "plain.yaml"
+    plain.write_text(f"data_dir: {tmp_path / 'data'}\n", encoding="utf-8")
+    load_config(plain)
+    assert len(list(parsed.glob("*.pickle"))) == 1  # a configuration without a secret is kept
+    secret = tmp_path / "secret.yaml"
+    secret.write_text(
+        f"data_dir: {tmp_path / 'data'}\nstation:\n  url: http://127.0.0.1:9/\n  token: Zm9vYmFyYmF6cXV4\n",
+        encoding="utf-8",
+    )
+    secret.chmod(0o600)
+    assert load_config(secret).station is not None
+    assert len(list(parsed.glob("*.pickle"))) == 1
+    assert not any(b"Zm9vYmFyYmF6cXV4" in p.read_bytes() for p in parsed.glob("*.pickle"))

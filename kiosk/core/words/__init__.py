@@ -136,7 +136,12 @@ def check_words(directory: str | Path | None = None) -> tuple[dict[str, Words], 
     """Read every words file of ``directory`` (default: the kiosk's own): (words by language,
     problems, whether every file could be parsed as YAML). The words are those of the files
     without a problem."""
-    directory = Path(WORDS_DIR if directory is None else directory)
+    data, problems, readable = _check_files(Path(WORDS_DIR if directory is None else directory))
+    return {code: _words(code, one) for code, one in data.items()}, problems, readable
+
+
+def _check_files(directory: Path) -> tuple[dict[str, Any], list[Problem], bool]:
+    """:func:`check_words` with each good file's data as parsed (plain dicts and lists, picklable)."""
     problems: list[Problem] = []
     paths = language_files(directory)
     for path in sorted(set(directory.glob("*.yaml")) - set(paths.values())):
@@ -157,13 +162,13 @@ def check_words(directory: str | Path | None = None) -> tuple[dict[str, Words], 
     if TEMPLATE not in parsed:
         return {}, problems, readable
     template = parsed[TEMPLATE][0]
-    words = {}
+    good = {}
     for code, (data, positions) in parsed.items():
         found = _Check(str(paths[code]), positions, template, set(paths)).problems(data, code)
         problems += found
         if not found:
-            words[code] = _words(code, data)
-    return words, problems, readable
+            good[code] = data
+    return good, problems, readable
 
 
 def load_words(directory: str | Path | None = None) -> dict[str, Words]:
@@ -181,7 +186,38 @@ def load_words(directory: str | Path | None = None) -> dict[str, Words]:
 
 @cache
 def _kiosk_words() -> dict[str, Words]:
-    return load_words(WORDS_DIR)
+    return {code: _words(code, data) for code, data in kept_data(Path(WORDS_DIR)).items()}
+
+
+#: the cache folder's name under <user cache dir>/kiosk (see :func:`kept_data`)
+KEPT = "words"
+
+
+def kept_data(directory: Path) -> dict[str, Any]:
+    """The data of ``directory``'s words files, checked; kept between starts (:func:`fileio.cache.keep`,
+    keyed by every words file's content, this package's and :mod:`fileio`'s code and the Python),
+    since composing and checking seven YAML files is about 0.02 s of every start. Files with a
+    problem are never kept: they are read, and :class:`WordsError` raised, every time."""
+    import sys
+
+    import fileio
+    from fileio.cache import code_digest, digest, keep, kept
+
+    try:
+        files = sorted(directory.glob("*.yaml"))
+        code = [code_digest(folder) for folder in (Path(__file__).parent, Path(fileio.__file__).parent)]
+        key = digest(KEPT, str(directory), sys.version, *code, *map(str, files))
+    except OSError:  # what cannot be read is the check's to report
+        key, files = "", []
+    found = kept(KEPT, key) if key else None
+    if isinstance(found, dict):
+        return found
+    data, problems, _ = _check_files(directory)
+    if problems:
+        raise WordsError(problems)
+    if key:
+        keep(KEPT, key, data, files)
+    return data
 
 
 T = TypeVar("T")

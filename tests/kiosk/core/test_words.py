@@ -256,3 +256,24 @@ def test_a_new_words_file_is_all_a_new_language_needs(tmp_path):
     assert seen["instrument"] == []
     # the kiosk's own words have no such file, so the same instrument is refused there
     assert validate_main([str(instrument)]) == 1
+
+
+def test_checked_words_are_kept_and_read_back_without_parsing_a_problem_never(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    directory = words_dir(tmp_path)
+    first = words_module.kept_data(directory)
+    assert first == words_module._check_files(directory)[0]
+    (kept,) = (tmp_path / "cache" / "kiosk" / words_module.KEPT).glob("*.pickle")
+    parsed = []
+    monkeypatch.setattr(words_module, "parse_file", lambda *a: parsed.append(a))
+    assert words_module.kept_data(directory) == first and not parsed
+    monkeypatch.undo()
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    en = directory / "en.yaml"
+    en.write_text(en.read_text(encoding="utf-8").replace("language:", "langauge:", 1), encoding="utf-8")
+    expected = str(WordsError(check_words(directory)[1]))
+    for _ in range(2):  # the same message every time: a file with a problem is never kept
+        with pytest.raises(WordsError) as raised:
+            words_module.kept_data(directory)
+        assert str(raised.value) == expected
+    assert list(kept.parent.glob("*.pickle")) == [kept]

@@ -3,7 +3,7 @@
 
 Each check runs a fresh interpreter, as `kiosk run` starts, so modules other tests loaded do not hide
 an import; it is the kiosk's second start, the first having filled its cache (the QoS grammar's
-tables, the parsed QoS model, the questionnaire's passed schema check: fileio.cache)."""
+tables, the parsed QoS model, the questionnaire's passed schema check, the parsed YAML files: fileio.cache)."""
 
 from __future__ import annotations
 
@@ -53,6 +53,11 @@ NOT_BEFORE_THE_WELCOME = (
     "qos.grammar",
     "lark",
     "jsonschema",
+    # the remotes' readers: build_app makes them (from a checked profile file), the app starts them
+    "serial",
+    # the configuration, words, profiles and policy parsed at the last start are read back (fileio.positions)
+    "yaml",
+    "fileio.yamlfile",
     "plotext",
     "textual_plotext",
     "matplotlib",
@@ -62,7 +67,16 @@ NOT_BEFORE_THE_WELCOME = (
     "sqlalchemy",
 )
 #: the speech stack loads on the channels' own threads once the app runs, never while it is built
-NOT_WHILE_BUILDING = ("numpy", "sounddevice", "vosk", "pocketsphinx", "kiosk.speech.asr", "kiosk.speech.audio")
+NOT_WHILE_BUILDING = (
+    "numpy",
+    "sounddevice",
+    "vosk",
+    "pocketsphinx",
+    "kiosk.speech.asr",
+    "kiosk.speech.audio",
+    "serial",  # pyserial: on the serial remote's reader thread
+    "hid",  # hidapi
+)
 
 
 def _run(tmp_path, body: str) -> dict[str, Any]:
