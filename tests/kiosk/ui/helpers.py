@@ -16,12 +16,21 @@ from .conftest import UiKiosk
 
 #: event-loop turns to wait for something the app must do (a message from a thread, a new screen)
 TURNS = 200
+#: how long, at the least, before giving up on it: the channels' threads start after the first
+#: frame and may wait for a core on a busy machine, which no count of quick turns waits for
+PATIENCE_S = 30.0
 
 
 async def settle(pilot: Pilot, until: Callable[[], bool] = lambda: True) -> None:
-    """Let the app process its messages until ``until()`` holds (a bounded number of turns)."""
+    """Let the app process its messages until ``until()`` holds: quick turns first, then short
+    pauses that leave the machine to the app's threads, for at least :data:`PATIENCE_S`."""
     for _ in range(TURNS):
         await pilot.pause()
+        if until():
+            return
+    deadline = time.monotonic() + PATIENCE_S
+    while time.monotonic() < deadline:
+        await pilot.pause(0.02)
         if until():
             return
     raise AssertionError("the app never reached the expected state")
