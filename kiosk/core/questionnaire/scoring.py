@@ -110,6 +110,9 @@ class Score:
     subscales: Mapping[str, int] = field(default_factory=dict)
     #: staff items still unanswered: the result stays incomplete until staff answer them
     awaiting_staff: tuple[str, ...] = ()
+    #: why a complete set of answers has no total: its formula failed on them (``complete`` is
+    #: then False, and no total is reported rather than a wrong one)
+    problem: str = ""
 
 
 def local_code(questionnaire_id: str, item_id: str, number: int) -> tuple[str, str]:
@@ -259,8 +262,12 @@ def compute_score(q: Questionnaire, options: Mapping[str, int], values: Mapping[
     points = {i: q.item(i).option(n).points or 0 for i, n in options.items()}
     complete = not missing
     total = sum(points.values())
+    problem = ""
     if complete and q.formula is not None:
-        total = formula_total(q, q.formula, {"item": response_items(q, options, values)})
+        try:
+            total = formula_total(q, q.formula, {"item": response_items(q, options, values)})
+        except ScoringError as exc:  # answers the file's check did not try: no total, never a crash
+            complete, problem = False, str(exc)
     subscales = {s.id: sum(points[i] for i in s.items) for s in q.subscales if all(i in points for i in s.items)}
     staff = {i.id for i in q.items if i.staff}
     return Score(
@@ -274,4 +281,5 @@ def compute_score(q: Questionnaire, options: Mapping[str, int], values: Mapping[
         min_total=q.min_total,
         subscales=subscales,
         awaiting_staff=tuple(i for i in missing if i in staff),
+        problem=problem,
     )

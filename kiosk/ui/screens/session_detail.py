@@ -132,6 +132,8 @@ class SessionDetailScreen(ClinicianScreen):
             score = rescore(q, self.stored)
         except ExportError as error:
             return f"Cannot score: {error}"
+        if score.problem:  # the formula failed on these answers: no total rather than a wrong one
+            return f"No total: {score.problem}"
         if score.awaiting_staff:  # a staff item unanswered: no total until staff answer it
             return f"No total yet: {waiting_line(score.awaiting_staff)}"
         if not score.complete:  # a partial sum is no total: never shown as one

@@ -291,3 +291,19 @@ def test_validate_prints_each_v2_problem_as_one_line_and_fails(tmp_path, capsys)
         f"(at character {character}: extraneous input '*' expecting "
     )
     assert second == f"{path}:{at(text, 'nurse')}: items[3].answered_by: 'nurse' is not one of ['patient', 'staff']"
+
+
+def test_a_formula_that_fails_on_some_answers_gives_no_total_and_says_why(tmp_path):
+    # the file's check tries the formula on a few sample responses; answers it did not try may
+    # still take it outside its range: then the result has no total (never a wrong one, never a crash)
+    from dataclasses import replace
+
+    from kiosk.core.questionnaire import Formula
+
+    q = load(tmp_path, STAFFED)
+    narrow = replace(q, formula=Formula(q.formula.expression, -1, 2))
+    score = narrow.score_answers({"recall": 3, "orientation": 2, "judged": 2}, values={"education": 12})
+    assert (score.complete, score.band, score.missing) == (False, None, ())
+    assert "gave 4, outside its declared -1 to 2" in score.problem
+    fine = narrow.score_answers({"recall": 1, "orientation": 1, "judged": 1}, values={"education": 12})
+    assert (fine.complete, fine.total, fine.problem) == (True, 0, "")
