@@ -115,7 +115,10 @@ class Listening:
             commands = welcome_commands(language)
         elif self.undo_only and not self.paused:
             commands = undo_commands(language)
-        self.matcher = Matcher(options, language, self.min_confidence, paused=self.paused, commands=commands)
+        before_test = self.welcome and not self.paused  # a language or Start is said in words
+        self.matcher = Matcher(
+            options, language, self.min_confidence, paused=self.paused, commands=commands, numbers=not before_test
+        )
         phrases = self.matcher.phrases()
         if self.scored and not self.paused and self._declined:
             phrases = [p for p in phrases if self.matcher.meaning(p) not in self._declined]

@@ -185,9 +185,11 @@ class Matcher:
         min_confidence: float = DEFAULT_MIN_CONFIDENCE,
         paused: bool = False,
         commands: Mapping[Command, tuple[str, ...]] | None = None,
+        numbers: bool = True,
     ) -> None:
         """``commands`` (command → phrases) replaces the language's whole set of spoken commands
-        (:data:`COMMAND_PHRASES`), e.g. :func:`welcome_commands`."""
+        (:data:`COMMAND_PHRASES`), e.g. :func:`welcome_commands`; ``numbers=False`` leaves the
+        options' numbers out of the grammar (the welcome: a language is said by its name)."""
         if language not in LANGUAGES:
             raise ValueError(f"no speech vocabulary for language {language!r} (have {', '.join(LANGUAGES)})")
         if len(options) > len(CARDINALS[language]):
@@ -200,6 +202,9 @@ class Matcher:
         #: keys and the remote give 1 and 2 without the recogniser). With "number one" / "option
         #: one" in its grammar, "no, that's wrong" was heard as Yes on other voices in noise.
         self.yes_no = len(self.options) == 2 and _is_word(self.options[0].label, 0, language) and no_option == 2
+        #: whether an option may be said by its number (not on the welcome: a fan's hum was heard
+        #: as "four", a language, with 0.96 confidence once a fourth language came)
+        self.numbers = numbers
         #: every command phrase in play (a yes/no question's UNDO phrases mean "no")
         self._command_phrases = dict(COMMAND_PHRASES[language] if commands is None else commands)
         #: a short list of commands (before the test, in the thank-you gap): no "I need ..." either
@@ -244,7 +249,7 @@ class Matcher:
         out: list[str] = []
         for option in self.options:
             out += [spoken_label(option.label), *option.synonyms]
-        forms = NUMBER_FORMS[self.language] if not self.yes_no else ()
+        forms = NUMBER_FORMS[self.language] if not self.yes_no and self.numbers else ()
         for number in range(len(self.options)):
             for form in forms:
                 words = CARDINALS[self.language][number] if "{n}" in form else ORDINALS[self.language][number]
@@ -297,7 +302,7 @@ class Matcher:
         tokens = tuple(t for t in normalise(utterance).split() if t not in UNKNOWN_TOKENS)
         if not tokens:
             return Match(reason="nothing recognisable was said")
-        number = self._number(tokens) if not self.yes_no else None
+        number = self._number(tokens) if not self.yes_no and self.numbers else None
         if number is not None and number < 0:
             return Match(reason=f"there is no option {-number} on this question ({len(self.options)} options)")
         if number is not None:
