@@ -9,6 +9,7 @@ is one sentence and exit status 2.
 from __future__ import annotations
 
 import dataclasses
+import gc
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -120,9 +121,21 @@ def _voice_in(config: Any, wanted: bool, statuses: list[ChannelStatus]) -> Any:
     return VoiceChannel(config.language, vosk_model=config.vosk_model)
 
 
+def _collect_from_now_on() -> None:
+    """The welcome is drawn: what the start made is kept out of the collector's walks for good
+    (:func:`gc.freeze`), and collecting resumes."""
+    gc.freeze()
+    gc.enable()
+
+
 def main(argv: list[str]) -> int:
     """`kiosk run`: build the session and channels from the configuration and run the app."""
     args = run_parser().parse_args(argv)
+    # Every object the start makes (classes, words, questionnaire, stylesheet) stays alive, yet the
+    # cyclic collector would walk them over and over while the patient waits: about a tenth of the
+    # start (bench/startup.py). Paused until the welcome is drawn; then they are frozen out of its
+    # reach, so later collections do not walk them either.
+    gc.disable()
     try:
         app, close = build_app(
             config_path=args.config,
@@ -132,8 +145,10 @@ def main(argv: list[str]) -> int:
             remote=not args.no_remote,
         )
     except SetupError as error:
+        gc.enable()
         print(f"kiosk run: {error}", file=sys.stderr)
         return 2
+    app.after_first_frame.append(_collect_from_now_on)
     if (warning := app.pin_guard.warning) is not None:
         print(f"kiosk run: warning: {warning}", file=sys.stderr)
     try:

@@ -20,6 +20,7 @@ from textual import events
 from textual.app import App
 from textual.binding import Binding
 from textual.message import Message
+from textual.reactive import Reactive
 
 from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command
 from kiosk.core.pin import CornerTaps, PinGuard
@@ -88,6 +89,9 @@ class KioskApp(App[int], inherit_bindings=False):
     ALLOW_SELECT = False
     BINDINGS = [Binding(CLINICIAN_CHORD, "clinician", "Clinician", show=False, priority=True)]
     ENABLE_COMMAND_PALETTE = False
+    #: the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest.
+    #: A default, not set in ``__init__``: setting it there parses the whole stylesheet twice
+    theme: Reactive[str] = Reactive("textual-light")
 
     def __init__(
         self,
@@ -101,8 +105,6 @@ class KioskApp(App[int], inherit_bindings=False):
         show_score: bool = False,
     ) -> None:
         super().__init__()
-        # the clinician's widgets (tables, switches, the plot) follow the theme: light like the rest
-        self.theme = "textual-light"
         self.controller = controller
         self.questionnaire = controller.session.questionnaire
         #: checks the clinician PIN (a plain string: an in-memory guard, for tests and benches)
@@ -124,6 +126,9 @@ class KioskApp(App[int], inherit_bindings=False):
         self._staff_seen = 0.0
         #: the app is unmounting: threads not started by now are never started
         self._unmounted = False
+        #: called once the welcome is drawn, before the channels start (`kiosk run` resumes the
+        #: garbage collector it paused for the start)
+        self.after_first_frame: list[Callable[[], None]] = []
         controller.attach(self)
         controller.remote_in_use = lambda: self.channels.on(REMOTE)  # 5-6 answers show pages then
         self.tell_channels()
@@ -151,6 +156,8 @@ class KioskApp(App[int], inherit_bindings=False):
         patient waits for the welcome. What the session said before is queued for the speaker."""
         if self._unmounted:
             return
+        for call in self.after_first_frame:
+            call()
         if self.channels.speaker is not None:
             self.channels.speaker.start()
         for source in self.channels.input_sources():

@@ -89,3 +89,35 @@ def test_kiosk_serve_refuses_a_run_option_without_its_value(capsys):
     assert serve.main(["--data-dir"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["kiosk serve: argument --data-dir: expected one argument"]
+
+
+async def test_what_waits_for_the_first_frame_runs_once_the_welcome_is_drawn(tmp_path):
+    config = tmp_path / "config.yaml"
+    config.write_text("data_dir: data\n")
+    app, close = build_app(config_path=config, voice=False, remote=False)
+    seen: list[tuple[str, list[str]]] = []
+    app.after_first_frame.append(
+        lambda: seen.append((type(app.screen).__name__, [str(b.label) for b in app.screen.query("Button")]))
+    )
+    try:
+        async with app.run_test(size=KIOSK_SIZE) as pilot:
+            while not seen:
+                await pilot.pause()
+            await pilot.press("1")
+            await pilot.pause()
+    finally:
+        close()
+    assert len(seen) == 1  # once, not again for the next screens
+    screen, buttons = seen[0]
+    assert screen == "WelcomeScreen" and any("English" in label for label in buttons)
+
+
+def test_kiosk_run_collects_garbage_again_once_the_welcome_is_drawn():
+    kiosk_run.gc.disable()  # as kiosk run's main does before it builds the kiosk
+    try:
+        kiosk_run._collect_from_now_on()
+        assert kiosk_run.gc.isenabled()
+        assert kiosk_run.gc.get_freeze_count() > 0
+    finally:
+        kiosk_run.gc.unfreeze()
+        kiosk_run.gc.enable()
