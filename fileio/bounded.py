@@ -15,9 +15,10 @@ import re
 import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
+
+from basis import record
 
 
 @contextmanager
@@ -73,7 +74,7 @@ MAX_NODES = 200_000
 MAX_DIGITS = 15
 
 
-@dataclass(frozen=True)
+@record
 class Problem:
     """One thing wrong with a file, at a 1-based line and column."""
 

@@ -60,13 +60,14 @@ import os
 import re
 import socket
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import field, fields, replace
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
 import platformdirs
 
+from basis import record
 from fileio.bounded import BadFile, open_private, read_text
 from fileio.positions import Problem, parse_file
 from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
@@ -110,7 +111,7 @@ def default_kiosk_id() -> str:
     return name or "kiosk"
 
 
-@dataclass(frozen=True)
+@record
 class Station:
     """Where this kiosk reports (``station:`` in the configuration)."""
 
@@ -122,7 +123,7 @@ class Station:
     kiosk_id: str = field(default_factory=default_kiosk_id)
 
 
-@dataclass(frozen=True)
+@record
 class InstrumentChoice:
     """One instrument of the configured battery (``instruments:``): a shipped instrument's id or a
     file, and the RoQME model its QoS runs on (None: the kiosk's ``qos_model``)."""
@@ -135,7 +136,7 @@ class InstrumentChoice:
     qos_model: str | None = None
 
 
-@dataclass(frozen=True)
+@record
 class Config:
     """Settings of one kiosk. Build with :func:`load_config`."""
 

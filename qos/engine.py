@@ -11,8 +11,9 @@ exactly the update's time joins that update's batch. A caller with nothing to re
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from basis import record
 from qos.batches import check_batch, check_time, check_value
 from qos.errors import ContextError
 from qos.expressions import compile_expr, names_in
@@ -25,7 +26,7 @@ from qos.timers import TimerClock
 __all__ = ["Engine", "UpdateResult", "check_batch", "check_time", "check_value", "observation_sort_key"]
 
 
-@dataclass(frozen=True)
+@record
 class UpdateResult:
     """What one batch did: the metrics after it and the observations it fired."""
 

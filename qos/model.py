@@ -9,8 +9,9 @@ and the terms (expressions and patterns) in :mod:`qos.nodes`; this module re-exp
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from basis import record
 from qos.nodes import (
     Aggregate,
     AllOf,
@@ -99,7 +100,7 @@ SELF_BELIEF = "#belief"
 REFERENCE_CLAMP = (0.01, 0.99)
 
 
-@dataclass(frozen=True)
+@record
 class Context:
     """A context variable: what the kiosk tells the engine (``context NAME : TYPE``)."""
 
@@ -130,7 +131,7 @@ class Context:
         return self.type.literals if isinstance(self.type, EnumType) else ()
 
 
-@dataclass(frozen=True)
+@record
 class Property:
     """A QoS property: a hidden Boolean whose probability is the metric (``property NAME …``)."""
 
@@ -157,7 +158,7 @@ class Property:
 # ---- actions, variables, timers ------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@record
 class Evidence:
     """``reinforces | undermines BELIEF [strength] [survival T]``."""
 
@@ -174,7 +175,7 @@ class Evidence:
         return lr if self.reinforces else 1.0 / lr
 
 
-@dataclass(frozen=True)
+@record
 class SetVariable:
     """``sets v := expr``: the variable takes the expression's value after the batch."""
 
@@ -182,14 +183,14 @@ class SetVariable:
     expr: Expr
 
 
-@dataclass(frozen=True)
+@record
 class ClearEvidence:
     """``clears BELIEF``: forget every piece of evidence; the belief is its reference again."""
 
     target: str
 
 
-@dataclass(frozen=True)
+@record
 class TimerAction:
     """``starts | stops | resumes TIMER``."""
 
@@ -200,7 +201,7 @@ class TimerAction:
 Action = Evidence | SetVariable | ClearEvidence | TimerAction
 
 
-@dataclass(frozen=True)
+@record
 class Variable:
     """``var v : T := expr`` (recomputed every batch unless constant, set by ``sets``) or
     ``param p : T default value`` (a constant a caller may override)."""
@@ -216,7 +217,7 @@ class Variable:
     description: str | None = None
 
 
-@dataclass(frozen=True)
+@record
 class Schedule:
     """``schedule("minutes, hours, days, months, weekdays[, seconds]")`` (Esper ``timer:at``), read by
     :func:`qos.timers.parse_schedule`: each field holds the values at which the timer fires."""
@@ -230,7 +231,7 @@ class Schedule:
     seconds: frozenset[int]
 
 
-@dataclass(frozen=True)
+@record
 class Timer:
     """``timer T := interval | schedule(…) [offset d] [onetime] [paused]``; it occurs as a pattern."""
 
@@ -244,7 +245,7 @@ class Timer:
     description: str | None = None
 
 
-@dataclass(frozen=True)
+@record
 class Observation:
     """``observation NAME : PATTERN ACTION`` or ``… { ACTION… }``."""
 
@@ -271,7 +272,7 @@ class Observation:
 Stream = Context | Variable | Aggregate | Period
 
 
-@dataclass(frozen=True)
+@record
 class Model:
     """A loaded, checked RoQME model."""
 

@@ -3,12 +3,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from basis import record
 from qos.values import NUMBER, ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Var:
     """A context's current value in an expression."""
 
@@ -16,7 +15,7 @@ class Var:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Literal:
     """A constant: boolean, number or enum literal."""
 
@@ -24,7 +23,7 @@ class Literal:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Unary:
     """``!e`` (boolean not) or ``-e`` (numeric negation)."""
 
@@ -33,7 +32,7 @@ class Unary:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Binary:
     """``& | = != < <= > >= + - * /``."""
 
@@ -43,7 +42,7 @@ class Binary:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Conditional:
     """``condition ? then : otherwise``; undefined when the condition is."""
 
@@ -53,7 +52,7 @@ class Conditional:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Call:
     """A function of values: ``pow sqrt exp abs`` (numbers) or ``size isEmpty first last at includes``
     (arrays); ``X'f(a)`` is ``f(X, a)``."""
@@ -63,7 +62,7 @@ class Call:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Aggregate:
     """``avg min max count sum increasing decreasing stable`` over the updates of one context.
 
@@ -79,7 +78,7 @@ class Aggregate:
     type: ValueType
 
 
-@dataclass(frozen=True)
+@record
 class Period:
     """``period(X)``: at an update that changes X, the seconds since X's previous update;
     ``period(a -> b)``: at each ``b`` after an ``a``, the seconds since the latest ``a``."""
@@ -93,7 +92,7 @@ class Period:
 Expr = Var | Literal | Unary | Binary | Conditional | Call
 
 
-@dataclass(frozen=True)
+@record
 class Updated:
     """Occurs on every update of a context in a batch (``update(var)``, a bare non-boolean
     variable, or an eventtype occurring); with ``when_true``, only when the new value is true
@@ -103,7 +102,7 @@ class Updated:
     when_true: bool = False
 
 
-@dataclass(frozen=True)
+@record
 class Changed:
     """Occurs when an expression's value changes (``update(expr)``); with ``when_true``, only when
     it changes to true (``eventWhen(expr)``, or a bare boolean expression)."""
@@ -112,7 +111,7 @@ class Changed:
     when_true: bool = False
 
 
-@dataclass(frozen=True)
+@record
 class AnyOf:
     """``a or b``."""
 
@@ -120,7 +119,7 @@ class AnyOf:
     right: Pattern
 
 
-@dataclass(frozen=True)
+@record
 class AllOf:
     """``a and b``."""
 
@@ -128,7 +127,7 @@ class AllOf:
     right: Pattern
 
 
-@dataclass(frozen=True)
+@record
 class FollowedBy:
     """``a -> b``."""
 
@@ -136,14 +135,14 @@ class FollowedBy:
     then: Pattern
 
 
-@dataclass(frozen=True)
+@record
 class Once:
     """``once p``."""
 
     pattern: Pattern
 
 
-@dataclass(frozen=True)
+@record
 class While:
     """``p while(cond)``."""
 
@@ -151,7 +150,7 @@ class While:
     condition: Expr
 
 
-@dataclass(frozen=True)
+@record
 class Repeat:
     """``p repeat(n)``."""
 
@@ -159,7 +158,7 @@ class Repeat:
     times: int
 
 
-@dataclass(frozen=True)
+@record
 class AndNot:
     """``a and not b``: ``a`` occurs before ``b`` has occurred since the pattern was (re-)armed; an
     occurrence of ``b`` ends the attempt and the pattern starts again (Esper ``every (a and not b)``)."""
@@ -168,7 +167,7 @@ class AndNot:
     excluded: Pattern
 
 
-@dataclass(frozen=True)
+@record
 class Range:
     """``p range(a, b)``: occurs on the a-th to the b-th occurrence of ``p`` in the engine's life."""
 

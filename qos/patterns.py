@@ -69,8 +69,8 @@ a timer ``T``
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 
+from basis import record
 from qos.expressions import Evaluator, compile_expr, variables_of
 from qos.model import (
     AllOf,
@@ -88,7 +88,7 @@ from qos.model import (
 )
 
 
-@dataclass(frozen=True)
+@record
 class Batch:
     """What the matcher sees of one batch: values after it, and which names it updated (contexts set
     or emitted, derived contexts and aggregates recomputed, timers fired)."""

@@ -18,13 +18,14 @@ import json
 import math
 import statistics
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from basis import record
 from fileio.bounded import BadFile, write_private
 from fileio.yamlfile import load_data
 from qos.engine import MAX_TIMED_BATCHES, Engine, UpdateResult, check_batch
@@ -40,7 +41,7 @@ def seconds(t: float) -> float | int:
     return int(t) if float(t).is_integer() else t
 
 
-@dataclass
+@record(frozen=False)
 class TraceEvent:
     """One entry of a trace: at time ``t`` (seconds), set these contexts and emit these eventtypes."""
 
@@ -58,7 +59,7 @@ class TraceEvent:
         return data
 
 
-@dataclass
+@record(frozen=False)
 class Trace:
     """A context trace: the model it was recorded with and its events (in file order)."""
 
@@ -294,7 +295,7 @@ def _statistics(samples: list[float]) -> dict[str, float]:
     }
 
 
-@dataclass
+@record(frozen=False)
 class ReplaySamples:
     """A replayed trace: every property sampled over time, and what fired in which batch."""
 

@@ -3,10 +3,10 @@ declared type's bounds and unit. Shared by the model, its terms and the engine's
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from basis import record
 
 
-@dataclass(frozen=True)
+@record
 class EnumType:
     """An enumeration: a named type (``type T : enum {…}``) or the inline type of one context."""
 
@@ -17,7 +17,7 @@ class EnumType:
         return f"enum {self.name} {{{', '.join(self.literals)}}}"
 
 
-@dataclass(frozen=True)
+@record
 class ArrayType:
     """An array of at most ``size`` values of one scalar type (``number[3]``, ``enum[2] {…}``)."""
 
@@ -43,7 +43,7 @@ def type_name(value_type: ValueType) -> str:
     return f"enum {value_type.name}" if isinstance(value_type, EnumType) else value_type
 
 
-@dataclass(frozen=True)
+@record
 class TypeSpec:
     """A declared data type with its constraints: what ``type T : …`` names and a context or
     variable declares. Bounds and units apply to numbers (and to the elements of number arrays)."""

@@ -14,13 +14,13 @@ import hashlib
 import hmac
 import re
 import secrets
-from dataclasses import dataclass
 
 import sqlalchemy as sa
 from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
 from sqlalchemy.engine import Connection, Engine
 
+from basis import record
 from station import db, throttle
 from station.db import kiosks, settings, staff_sessions, users
 
@@ -42,7 +42,7 @@ class AuthError(ValueError):
     """An administrative request that cannot be done (message says why)."""
 
 
-@dataclass(frozen=True)
+@record
 class User:
     name: str
     role: str

@@ -22,13 +22,13 @@ from __future__ import annotations
 import json
 import secrets
 from collections.abc import Sequence
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
+from basis import record
 from kiosk.core.visits import HOSPITAL_ID
 from station import db
 from station.db import audit, code_failures, kiosks, orders
@@ -77,7 +77,7 @@ class LinkRefused(OrderError):
     status = 422
 
 
-@dataclass(frozen=True)
+@record
 class Order:
     id: str
     kiosk_id: str
@@ -140,7 +140,7 @@ def audit_order(connection: Connection, order_id: str, author: str, action: str,
     )
 
 
-@dataclass(frozen=True)
+@record
 class Instrument:
     """An instrument staff may order: its id, title (English, else any) and languages."""
 

@@ -9,12 +9,12 @@ corrected answers), never a stored copy.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 
+from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import review_state
 from kiosk.export import ExportError
@@ -29,7 +29,7 @@ INBOX_LIMIT = 100
 VISIT_WORDS = {"order": "ordered", "staff": "started by staff", "walk-up": "walk-up"}
 
 
-@dataclass(frozen=True)
+@record
 class Result:
     """One session's result as a row of the inbox or of a patient's course."""
 

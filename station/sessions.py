@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
+from basis import record
 from kiosk.core.channels import Channel
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Answer, AnsweredBy
@@ -34,7 +35,7 @@ from station.db import definitions, inbox, sessions
 LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted", "continue_session")
 
 
-@dataclass(frozen=True)
+@record
 class Row:
     """One outbox row as the kiosk sent it."""
 

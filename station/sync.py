@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, cast
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection
 
+from basis import record
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
 from station import alert_rules, db, order_progress
@@ -87,7 +87,7 @@ class Refused(SyncError):
     status = 422
 
 
-@dataclass(frozen=True)
+@record
 class Event:
     seq: int
     kind: str

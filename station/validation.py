@@ -8,12 +8,12 @@ always be traced to who did it and why.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, cast
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
+from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review, review_from_steps
 from kiosk.store.database import StoredSession
@@ -30,7 +30,7 @@ class ValidationError(ValueError):
     """A change the station refuses (message says why)."""
 
 
-@dataclass(frozen=True)
+@record
 class AuditEntry:
     at: str
     author: str

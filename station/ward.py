@@ -7,12 +7,13 @@ Every staff action is also written to the audit trail (who, when, what), in the 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 
+from basis import record
 from station import db
 from station.db import alerts, audit, commands, kiosks
 
@@ -48,7 +49,7 @@ class WardError(ValueError):
     """A staff action that cannot be done (message says why)."""
 
 
-@dataclass(frozen=True)
+@record
 class Alert:
     id: int
     kiosk_id: str
@@ -64,7 +65,7 @@ class Alert:
         return ALERT_TEXT.get(self.kind, self.kind)
 
 
-@dataclass(frozen=True)
+@record
 class KioskView:
     name: str
     last_seen: float | None

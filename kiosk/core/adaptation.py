@@ -9,11 +9,11 @@ changes the kiosk's behaviour, never the contexts sent to the QoS engine.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from basis import record
 from fileio.positions import Problem, parse_file
 from qos import Model, load_model
 
@@ -31,7 +31,7 @@ class PolicyError(ValueError):
     """An adaptation policy file is unusable; the message names file, line and column."""
 
 
-@dataclass(frozen=True)
+@record
 class Rule:
     """Switch ``name`` on after ``count`` consecutive readings of ``metric`` below ``below``;
     off once it rises above ``recover_above``."""
@@ -49,14 +49,14 @@ class Rule:
     attempt_factor: float = 1.0
 
 
-@dataclass(frozen=True)
+@record
 class Policy:
     """A validated set of rules."""
 
     rules: tuple[Rule, ...]
 
 
-@dataclass(frozen=True)
+@record
 class AdaptationChange:
     """An adaptation switched on or off, and why (one sentence a clinician can read)."""
 

@@ -12,9 +12,10 @@ and the session core, so it stays small, pure Python and free of Textual.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from enum import Enum
 from typing import Protocol
+
+from basis import record
 
 
 class Channel(str, Enum):
@@ -40,7 +41,7 @@ class Command(str, Enum):
     UNDO = "undo"
 
 
-@dataclass(frozen=True)
+@record
 class ChannelInput:
     """One thing the patient did: chose an answer option, or gave a command.
 
@@ -76,7 +77,7 @@ class ChannelState(str, Enum):
     LOST = "lost"  # was working and went away (unplugged, read error)
 
 
-@dataclass(frozen=True)
+@record
 class ChannelStatus:
     """A change in a channel's availability, e.g. the serial remote was unplugged."""
 

@@ -33,9 +33,9 @@ import os
 import secrets
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
+from basis import record
 from fileio.bounded import BadFile, load_json, open_private, read_text
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
@@ -109,7 +109,7 @@ def matches(secret: str, pin: str) -> bool:
     return hmac.compare_digest(hashlib.scrypt(pin.encode(), salt=salt, n=n, r=r, p=p, dklen=len(digest)), digest)
 
 
-@dataclass(frozen=True)
+@record
 class Verdict:
     """What one attempt at the PIN pad gave."""
 

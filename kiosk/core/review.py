@@ -11,9 +11,11 @@ result stands, from its review and the kiosk's answers). Pure data, no I/O.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from enum import Enum
 from typing import Protocol
+
+from basis import record
 
 #: the default system of staff account names (the signer's and corrector's Practitioner identifier)
 STAFF_SYSTEM = "urn:barthel-kiosk:station:staff"
@@ -32,7 +34,7 @@ class ReviewState(str, Enum):
     AMENDED = "amended"
 
 
-@dataclass(frozen=True)
+@record
 class Correction:
     """One clinician change to an item: a corrected answer, or an unanswered item filled."""
 
@@ -48,7 +50,7 @@ class Correction:
     at: str
 
 
-@dataclass(frozen=True)
+@record
 class Reopening:
     """A doctor reopened a signed-off result to amend it (it is final again once signed again)."""
 
@@ -60,7 +62,7 @@ class Reopening:
     signed_at: str
 
 
-@dataclass(frozen=True)
+@record
 class Review:
     """The review of one session: its state, corrections (oldest first) and sign-off."""
 

@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
+
+from basis import record
 
 WALK_UP = "walk-up"
 STAFF = "staff"
@@ -22,7 +23,7 @@ STAFF = "staff"
 HOSPITAL_ID = re.compile(r"^(?=.*[0-9])[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
 
 
-@dataclass(frozen=True)
+@record
 class Order:
     """A visit ordered for this kiosk, as the station describes it (protocol §4)."""
 

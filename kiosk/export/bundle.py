@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import uuid
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 from urllib.parse import quote
 
+from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review
 from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of, total_of
@@ -29,7 +29,7 @@ from kiosk.export.result import ExportSite, Result, questionnaire_version, resul
 from kiosk.store.database import StoredSession
 
 
-@dataclass(frozen=True)
+@record
 class Described:
     """One result with what describes it: the questionnaire it was answered on and the identity
     (site, kiosk, FHIR systems) it was recorded under."""

@@ -7,8 +7,7 @@ metric has the same colour on the kiosk's screen, its PNG and the station's page
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from basis import record
 from kiosk.store.records import StoredSession
 
 #: the metrics of the CLARC model, in the order they are drawn
@@ -47,7 +46,7 @@ def metric_colour(name: str, index: int = 0) -> str:
     return METRIC_COLOURS.get(name) or OTHER_COLOURS[index % len(OTHER_COLOURS)]
 
 
-@dataclass(frozen=True)
+@record
 class Mark:
     """A vertical mark on the plot: an incident or an adaptation switching on or off."""
 

@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import field, fields
 from pathlib import Path
 from typing import Any
 
+from basis import record
 from fileio.bounded import write_error, write_private  # the one owner-only writer; exports use it from here too
 from kiosk.config import Config, default_kiosk_id
 from kiosk.core.questionnaire import Questionnaire, Score
@@ -26,7 +27,7 @@ class ExportError(ValueError):
     review does not fit the session, or an export cannot be written."""
 
 
-@dataclass(frozen=True)
+@record
 class ExportSite:
     """Who exports: the site and the kiosk, and the FHIR systems and URLs the site owns.
 
@@ -112,7 +113,7 @@ def rescore(q: Questionnaire, stored: StoredSession, values: Mapping[str, float]
     return _score(q, stored.id, options, values if values is not None else entered_values(q, stored.log))
 
 
-@dataclass(frozen=True)
+@record
 class Result:
     """A stored session as exports state it: answers after review, their score, where it stands."""
 
@@ -219,7 +220,7 @@ def results(
 PRACTICE_CHECKS = {"hear": "hearing", "read": "reading", "select": "selecting"}
 
 
-@dataclass(frozen=True)
+@record
 class PracticeOutcome:
     """How one practice question went, in a clinician's words: "hearing: wrong (chose Chair)"."""
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import NamedTuple
 
+from basis import record
 from kiosk.remote.buttons import Button
 
 log = logging.getLogger("kiosk.remote")
@@ -95,7 +95,7 @@ class LineDecoder:
         return Press(button, text)
 
 
-@dataclass(frozen=True)
+@record
 class ReportMatch:
     """When a HID input report shows a button held: ``report[byte]`` has all bits of ``mask``
     set, or equals ``value`` (for remotes that send one key code per report). Exactly one of

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Protocol
 
+from basis import record
 from kiosk.core.channels import ChannelState
 from kiosk.remote.decoders import Press, ReportDecoder
 from kiosk.remote.profiles import HidProfile, usb_id
@@ -23,7 +23,7 @@ READ_TIMEOUT = 0.1
 MAX_REPORT = 64
 
 
-@dataclass(frozen=True)
+@record
 class HidDeviceInfo:
     """One HID interface as enumeration reports it."""
 

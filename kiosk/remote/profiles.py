@@ -11,10 +11,11 @@ and the field.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
+from basis import record
 from fileio.positions import Positions, Problem, parse_file
 from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
 from kiosk.remote.decoders import ReportMatch
@@ -36,7 +37,7 @@ class ProfileError(ValueError):
     """A device profile file cannot be used; the message names the file, profile and field."""
 
 
-@dataclass(frozen=True)
+@record
 class SerialProfile:
     """A remote on a serial port that sends one text line per press, e.g. ``BTN 3``."""
 
@@ -51,7 +52,7 @@ class SerialProfile:
     description: str = ""
 
 
-@dataclass(frozen=True)
+@record
 class HidProfile:
     """A USB HID remote, found by vendor and product id, whose input reports encode buttons."""
 
@@ -76,7 +77,7 @@ def usb_id(vendor_id: int, product_id: int) -> str:
     return f"{vendor_id:04x}:{product_id:04x}"
 
 
-@dataclass(frozen=True)
+@record
 class KeyboardProfile:
     """A remote that presents itself as a keyboard; ``keys`` maps Textual key names to buttons."""
 
@@ -89,7 +90,7 @@ class KeyboardProfile:
 Profile = SerialProfile | HidProfile | KeyboardProfile
 
 
-@dataclass(frozen=True)
+@record
 class Profiles:
     """All known profiles, in file order (built-in first, then the site's additions)."""
 

@@ -11,9 +11,9 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from typing import Protocol
 
+from basis import record
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
 from kiosk.remote.buttons import to_input
 from kiosk.remote.decoders import Press
@@ -30,7 +30,7 @@ def wait_or_stop(delay: float, stopping: threading.Event) -> None:
     stopping.wait(delay)
 
 
-@dataclass(frozen=True)
+@record
 class Backoff:
     """Delays between reconnect attempts: ``initial``, then times ``factor``, at most ``maximum``."""
 

@@ -13,7 +13,8 @@ import json
 import logging
 import re
 from collections.abc import Callable, Hashable, Sequence
-from dataclasses import dataclass
+
+from basis import record
 
 log = logging.getLogger(__name__)
 
@@ -23,7 +24,7 @@ def recogniser_words(phrase: str) -> list[str]:
     return re.sub(r"[^\w' -]+", " ", phrase.lower()).replace("-", " ").split()
 
 
-@dataclass(frozen=True)
+@record
 class Grammar:
     """The phrases a recogniser will listen for, and those left out (phrase, why).
 

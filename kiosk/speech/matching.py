@@ -17,8 +17,8 @@ from __future__ import annotations
 import re
 import unicodedata
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
+from basis import record
 from kiosk.core.channels import Command
 from kiosk.core.words import Table, languages
 
@@ -114,7 +114,7 @@ def spoken_label(label: str) -> str:
     return " ".join(re.sub(r"\([^)]*\)", " ", label).split()).strip(" ,;:.")
 
 
-@dataclass(frozen=True)
+@record
 class OptionWords:
     """What may be said to choose one answer option, in one language."""
 
@@ -122,7 +122,7 @@ class OptionWords:
     synonyms: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True)
+@record
 class Match:
     """The outcome of matching one utterance: an option, a command, or neither and why."""
 

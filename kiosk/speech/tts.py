@@ -42,10 +42,10 @@ import tempfile
 import threading
 import wave
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
+from basis import record
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.words import Table
 
@@ -77,7 +77,7 @@ class TtsUnavailable(RuntimeError):
 _BOUNDARY = re.compile(r"([.?!;:,])(\s+)(?=\S)")
 
 
-@dataclass(frozen=True)
+@record
 class Delivery:
     """How espeak-ng says one phrase for a requested rate (see the module docstring)."""
 
@@ -198,7 +198,7 @@ class PortAudioPlayer:
         self._sd.stop()
 
 
-@dataclass
+@record(frozen=False)
 class _Job:
     text: str
     language: str

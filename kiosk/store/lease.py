@@ -13,7 +13,9 @@ from __future__ import annotations
 import os
 import secrets
 import socket
-from dataclasses import dataclass, field
+from dataclasses import field
+
+from basis import record
 
 #: a lease not renewed for this long has lapsed; the kiosk renews every third of it
 LEASE_TTL_S = 30.0
@@ -23,7 +25,7 @@ class SessionTaken(RuntimeError):
     """The session is held by another running kiosk (or was taken over from this one)."""
 
 
-@dataclass(frozen=True)
+@record
 class Owner:
     """A running kiosk process."""
 

@@ -15,10 +15,10 @@ from __future__ import annotations
 import json
 import sqlite3
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
+from basis import record
 from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
 
@@ -184,7 +184,7 @@ MIGRATIONS: tuple[tuple[int, str], ...] = ((1, V1), (2, V2), (3, V3))
 LATEST = MIGRATIONS[-1][0]
 
 
-@dataclass(frozen=True)
+@record
 class InForce:
     """What describes sessions recorded before definitions were captured: the definition (canonical
     JSON, :func:`kiosk.core.questionnaire.definition.canonical`) and identity (site, kiosk id, FHIR systems) in force

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
+from basis import record
 from kiosk.core.channels import Channel
 from kiosk.core.session import Answer, AnsweredBy
 
 
-@dataclass(frozen=True)
+@record
 class SessionSummary:
     """One line of the session list (``status``: running, finished, abandoned or interrupted)."""
 
@@ -35,7 +36,7 @@ class SessionSummary:
         return self.status + (", simulated" if self.simulated else "")
 
 
-@dataclass(frozen=True)
+@record
 class MetricSample:
     """The QoS metrics after one update, and what fired."""
 
@@ -44,7 +45,7 @@ class MetricSample:
     fired: tuple[str, ...]
 
 
-@dataclass(frozen=True)
+@record
 class AdaptationRecord:
     """An adaptation switched on or off during a session."""
 
@@ -54,7 +55,7 @@ class AdaptationRecord:
     reason: str
 
 
-@dataclass(frozen=True)
+@record
 class PracticeRecord:
     """How one familiarisation question went: it checks whether the patient can hear, read or choose."""
 
@@ -71,7 +72,7 @@ class PracticeRecord:
     detail: str = ""
 
 
-@dataclass(frozen=True)
+@record
 class LogEntry:
     """A line of the session log (start, pause, ignored input, ...)."""
 
@@ -80,7 +81,7 @@ class LogEntry:
     detail: str
 
 
-@dataclass(frozen=True)
+@record
 class StoredSession:
     """Everything stored about one session."""
 

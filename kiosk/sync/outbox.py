@@ -10,15 +10,16 @@ from __future__ import annotations
 
 import json
 import sqlite3
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from basis import record
 
 #: how long a delete waits for the kiosk's own write transaction (they are short)
 BUSY_TIMEOUT_S = 10.0
 
 
-@dataclass(frozen=True)
+@record
 class Row:
     """One stored change waiting for the station."""
 

@@ -10,9 +10,10 @@ has (:class:`~kiosk.ui.channels.KioskChannels`).
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TYPE_CHECKING, Any
 
+from basis import record
 from kiosk.core.adaptation import Adaptation, Policy, load_policy
 from kiosk.core.clock import Clock
 from kiosk.core.pin import PinGuard
@@ -33,7 +34,7 @@ if TYPE_CHECKING:
     from qos import Model
 
 
-@dataclass(frozen=True)
+@record
 class KioskParts:
     """What a configuration names and every session shares: the questionnaire (a battery's
     first instrument), the QoS model and the adaptation policy (None: adaptation off); and the

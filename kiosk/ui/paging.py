@@ -12,7 +12,8 @@ without Pilot; the screen only draws :func:`shown`.
 from __future__ import annotations
 
 from collections.abc import Hashable
-from dataclasses import dataclass
+
+from basis import record
 
 #: the answer buttons a remote carries (:data:`kiosk.remote.buttons.ANSWER_BUTTONS`)
 REMOTE_ANSWERS = 4
@@ -22,7 +23,7 @@ PER_PAGE = REMOTE_ANSWERS - 1
 PAGE_BUTTON = REMOTE_ANSWERS
 
 
-@dataclass(frozen=True)
+@record
 class Shown:
     """One button on a paged screen: the ``number`` it shows (the remote's), and the ``option`` it
     stands for (None: the page button, "More answers" on the first page, "Back" on the second)."""

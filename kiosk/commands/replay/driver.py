@@ -7,10 +7,11 @@ script declared really happened under the session's rules.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from functools import partial
 from typing import Any
 
+from basis import record
 from fileio.bounded import BadFile
 from kiosk.commands.replay.script import ANY, COMMANDS, UNSURE_CONFIDENCE, BatteryScript, Script, ScriptError, Step
 from kiosk.core.channels import ChannelInput, Command
@@ -33,7 +34,7 @@ from qos.errors import QosError
 from qos.trace import seconds
 
 
-@dataclass
+@record(frozen=False)
 class ReplayResult:
     """What a replay produced: the finished session, its context trace and the QoS statistics."""
 

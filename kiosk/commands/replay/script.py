@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from functools import cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from basis import record
 from fileio.positions import Problem, describe, parse_file, schema_problems
 from kiosk.core.channels import Channel, Command
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, load_questionnaire
@@ -48,7 +49,7 @@ def _schema() -> dict[str, Any]:
     return json.loads(resources.files("kiosk.commands").joinpath("patient.schema.json").read_text(encoding="utf-8"))
 
 
-@dataclass(frozen=True)
+@record
 class Step:
     """One timed action of a script: an answer, an incident, or a practice answer."""
 
@@ -68,7 +69,7 @@ class Step:
     where: str = ""
 
 
-@dataclass(frozen=True)
+@record
 class Question:
     """What the patient does on one question: incidents, then an answer (or none)."""
 
@@ -79,7 +80,7 @@ class Question:
     where: str
 
 
-@dataclass(frozen=True)
+@record
 class Script:
     """A validated scripted patient."""
 
@@ -98,7 +99,7 @@ class Script:
     rest_after: float = 0.0
 
 
-@dataclass(frozen=True)
+@record
 class BatteryScript:
     """A scripted patient answering a battery: one :class:`Script` per instrument, in order."""
 

@@ -8,9 +8,10 @@ so the model trusts its data: a ``Questionnaire`` that exists is one the kiosk c
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import field, fields, replace
 from typing import Any
 
+from basis import record
 from kiosk.core.questionnaire.parts import PATIENT, STAFF, Band, BandSet, Code, Entry, Option
 from kiosk.core.questionnaire.scoring import Formula, Score, Subscale, compute_score
 
@@ -18,7 +19,7 @@ from kiosk.core.questionnaire.scoring import Formula, Score, Subscale, compute_s
 MAX_TIMING_S = 86400.0
 
 
-@dataclass(frozen=True)
+@record
 class Item:
     """One item of an instrument: a question with options, or a number staff enter (``entry``)."""
 
@@ -68,7 +69,7 @@ class Item:
         return min(self.points, default=0)
 
 
-@dataclass(frozen=True)
+@record
 class PracticeQuestion:
     """A familiarisation question checking the patient can hear, read or select. Not scored."""
 
@@ -92,7 +93,7 @@ class PracticeQuestion:
         raise KeyError(f"practice question {self.id!r} has no option {number}")
 
 
-@dataclass(frozen=True)
+@record
 class Timing:
     """How long the session waits, in seconds. Defaults come from the questionnaire file."""
 
@@ -131,7 +132,7 @@ class Timing:
         return replace(self, **changes)
 
 
-@dataclass(frozen=True)
+@record
 class Translation:
     """Where one language's text of an instrument comes from, and whether it is a published,
     validated translation (an unvalidated one needs the site's acceptance for clinical use)."""
@@ -140,7 +141,7 @@ class Translation:
     validated: bool
 
 
-@dataclass(frozen=True)
+@record
 class Questionnaire:
     """A validated questionnaire. Build it with :func:`load_questionnaire`."""
 

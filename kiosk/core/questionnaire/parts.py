@@ -6,13 +6,15 @@ them and :mod:`.scoring` scores with them, so neither imports the other's module
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
+
+from basis import record
 
 __all__ = ["PATIENT", "STAFF", "Band", "BandSet", "Code", "Entry", "Option"]
 
 
-@dataclass(frozen=True)
+@record
 class Code:
     """A coding for export, e.g. a LOINC code."""
 
@@ -22,7 +24,7 @@ class Code:
     display: str = ""
 
 
-@dataclass(frozen=True)
+@record
 class Option:
     """One answer option of a question. ``number`` is its 1-based position (button and remote)."""
 
@@ -54,7 +56,7 @@ PATIENT = "patient"
 STAFF = "staff"
 
 
-@dataclass(frozen=True)
+@record
 class Entry:
     """A number staff type in for an item (``input:``): years of education, weight in kg."""
 
@@ -74,7 +76,7 @@ class Entry:
         return self.min <= value <= self.max
 
 
-@dataclass(frozen=True)
+@record
 class Band:
     """An interpretation band: totals from ``min`` to ``max`` inclusive."""
 
@@ -84,7 +86,7 @@ class Band:
     label: Mapping[str, str]
 
 
-@dataclass(frozen=True)
+@record
 class BandSet:
     """A named set of interpretation bands covering every possible total, with its source."""
 

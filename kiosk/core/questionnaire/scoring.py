@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from decimal import Decimal
 from functools import lru_cache
 from typing import Any, Protocol
 
+from basis import record
 from kiosk.core.questionnaire.parts import Band, BandSet, Code, Entry, Option
 
 #: SDC/R5 extension giving an answer option its score (on answerOption or on the Coding)
@@ -64,7 +65,7 @@ class Questionnaire(Protocol):
     def item(self, item_id: str) -> ScoredItem: ...
 
 
-@dataclass(frozen=True)
+@record
 class Formula:
     """A total computed by a FHIRPath expression over the QuestionnaireResponse, whose results
     lie from ``min`` to ``max`` (the range its bands must cover)."""
@@ -74,7 +75,7 @@ class Formula:
     max: int
 
 
-@dataclass(frozen=True)
+@record
 class Subscale:
     """A sum of some items' points reported beside the total (exported with ``code`` when given)."""
 
@@ -85,7 +86,7 @@ class Subscale:
     code: Code | None = None
 
 
-@dataclass(frozen=True)
+@record
 class Score:
     """The result of scoring a set of answers."""
 

@@ -22,16 +22,17 @@ from __future__ import annotations
 
 import uuid
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
+from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session.core import Session
 from kiosk.core.session.ports import QosEngine
 from kiosk.core.session.state import BatteryPlace
 
 
-@dataclass(frozen=True)
+@record
 class Instrument:
     """One instrument of a battery: its questionnaire and the RoQME model its QoS runs on (None:
     the kiosk's model). ``model`` is whatever ``make_engine`` takes."""
@@ -40,7 +41,7 @@ class Instrument:
     model: Hashable | None = None
 
 
-@dataclass
+@record(frozen=False)
 class _Qos:
     engine: QosEngine | None
     trace: list[dict[str, Any]] = field(default_factory=list)

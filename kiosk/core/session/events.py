@@ -5,11 +5,10 @@ created, the QoS time)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
 from enum import Enum
-from reprlib import recursive_repr
 from typing import Any
 
+from basis import record
 from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.questionnaire import Score
 
@@ -67,46 +66,14 @@ ATTEMPTS = 2
 # Events published to listeners. ``t`` is seconds since the session was created (the QoS time).
 
 
-# Events are frozen dataclasses that generate only their ``__init__`` (and the frozen
-# ``__setattr__``/``__delattr__``): ``__repr__``, ``__eq__`` and ``__hash__`` are
-# :class:`SessionEvent`'s, written once and behaving as the generated ones would. Generating all six
-# methods for 27 classes cost about 0.005 s of every start (each is compiled with ``exec``).
-
-#: an event class -> the names of its fields, in order (filled on first use)
-_FIELDS: dict[type, tuple[str, ...]] = {}
-
-
-def _field_names(cls: type) -> tuple[str, ...]:
-    names = _FIELDS.get(cls)
-    if names is None:
-        names = _FIELDS[cls] = tuple(f.name for f in fields(cls))
-    return names
-
-
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class SessionEvent:
     """Base of everything a session publishes."""
 
     t: float
 
-    def _values(self) -> tuple[Any, ...]:
-        return tuple(getattr(self, name) for name in _field_names(type(self)))
 
-    @recursive_repr()
-    def __repr__(self) -> str:
-        shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in _field_names(type(self)))
-        return f"{type(self).__qualname__}({shown})"
-
-    def __eq__(self, other: object) -> bool:
-        if other.__class__ is self.__class__:
-            return self._values() == other._values()
-        return NotImplemented
-
-    def __hash__(self) -> int:
-        return hash(self._values())
-
-
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class PhaseChanged(SessionEvent):
     """The session moved to another phase (the UI shows another screen)."""
 
@@ -114,14 +81,14 @@ class PhaseChanged(SessionEvent):
     previous: Phase
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class LanguageChanged(SessionEvent):
     """The patient chose another language; prompts from now on use it."""
 
     language: str
 
 
-@dataclass(frozen=True)
+@record
 class PromptOption:
     """An answer option as a prompt presents it: the voice grammar is built from these."""
 
@@ -133,7 +100,7 @@ class PromptOption:
     points: int | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class Prompt(SessionEvent):
     """Something to show and say now: a question, a practice question or a message.
 
@@ -156,7 +123,7 @@ class Prompt(SessionEvent):
     speech_rate: float = 1.0
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class AttemptOpened(SessionEvent):
     """An attempt at a question is open for answers until ``deadline`` (session time)."""
 
@@ -168,7 +135,7 @@ class AttemptOpened(SessionEvent):
     practice: bool = False
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class AnswerRecorded(SessionEvent):
     """An answer was accepted (and, with a store, committed) for a scored item."""
 
@@ -182,7 +149,7 @@ class AnswerRecorded(SessionEvent):
     detail: str = ""
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class PracticeAnswered(SessionEvent):
     """A familiarisation question got an answer (``option`` None: it got none)."""
 
@@ -192,7 +159,7 @@ class PracticeAnswered(SessionEvent):
     channel: Channel | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class PracticeSkipped(SessionEvent):
     """A familiarisation question was not asked, e.g. a hearing check while voice out is off."""
 
@@ -202,7 +169,7 @@ class PracticeSkipped(SessionEvent):
     reason: str
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class AttemptTimedOut(SessionEvent):
     """An attempt's window ended without an answer."""
 
@@ -212,7 +179,7 @@ class AttemptTimedOut(SessionEvent):
     practice: bool = False
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class QuestionNotAnswered(SessionEvent):
     """Both attempts timed out; the session goes on to the next question."""
 
@@ -220,47 +187,47 @@ class QuestionNotAnswered(SessionEvent):
     number: int
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class Paused(SessionEvent):
     """The patient paused the session; the attempt clock is frozen."""
 
     channel: Channel | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class Resumed(SessionEvent):
     """The session goes on after a pause; ``deadline`` is the open attempt's new deadline, if any."""
 
     deadline: float | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class DoctorCalled(SessionEvent):
     """The patient called the doctor; the session is halted until a clinician continues it."""
 
     channel: Channel | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class DoctorContinued(SessionEvent):
     """A clinician continued a halted session."""
 
     deadline: float | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class PersonLost(SessionEvent):
     """The patient is no longer in front of the kiosk; the attempt clock is frozen."""
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class PersonBack(SessionEvent):
     """The patient is back; ``deadline`` is the open attempt's new deadline, if any."""
 
     deadline: float | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class InputIgnored(SessionEvent):
     """An input changed nothing; logged so a clinician can see what happened."""
 
@@ -270,21 +237,21 @@ class InputIgnored(SessionEvent):
     action: str = ""
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class ListeningChanged(SessionEvent):
     """Whether the voice channel should listen for answers now."""
 
     listening: bool
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class VolumeChanged(SessionEvent):
     """The patient asked for louder (+1) or quieter (-1) speech."""
 
     step: int
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class AdaptationChanged(SessionEvent):
     """Live adaptation switched something on or off (e.g. "voice_off", "slow_speech")."""
 
@@ -293,7 +260,7 @@ class AdaptationChanged(SessionEvent):
     reason: str
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class MetricsUpdated(SessionEvent):
     """The QoS engine took a batch of contexts, or ran one on its own as time passed (the model's
     timers and time windows: ``set`` and ``emit`` empty); its metrics and fired observations after it."""
@@ -306,7 +273,7 @@ class MetricsUpdated(SessionEvent):
     timers: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class ConfirmationAsked(SessionEvent):
     """An answer the channel was not sure of is not stored yet: the patient is asked "I heard:
     <option>. Is that right?" (the prompt that follows has the Yes/No options)."""
@@ -321,7 +288,7 @@ class ConfirmationAsked(SessionEvent):
     deadline: float
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class AnswerNotConfirmed(SessionEvent):
     """An answer waiting for confirmation was not stored: ``why`` is "declined" (No), "undone"
     (the undo command) or "timed_out" (no reply: the attempt ends unanswered)."""
@@ -333,7 +300,7 @@ class AnswerNotConfirmed(SessionEvent):
     why: str
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class AnswerWithdrawn(SessionEvent):
     """A stored answer was taken back ("Change my answer") and its question is asked again until
     ``deadline``; ``by`` is the channel the undo came through."""
@@ -348,7 +315,7 @@ class AnswerWithdrawn(SessionEvent):
     deadline: float
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class DoctorCallCancelled(SessionEvent):
     """The patient said "I'm fine, carry on" after calling the doctor; the test goes on."""
 
@@ -356,13 +323,13 @@ class DoctorCallCancelled(SessionEvent):
     deadline: float | None
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class NextPatient(SessionEvent):
     """The end screen has been shown long enough: the kiosk goes back to the welcome for the next
     patient (the finished session's result stays stored for staff)."""
 
 
-@dataclass(frozen=True, repr=False, eq=False)
+@record
 class Finished(SessionEvent):
     """The questionnaire is over; the score is recomputed from the recorded answers."""
 

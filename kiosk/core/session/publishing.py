@@ -9,10 +9,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
-from dataclasses import dataclass, field
+from dataclasses import field
 from datetime import timedelta
 from typing import Any
 
+from basis import record
 from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.session.events import IgnoreReason, InputIgnored, MetricsUpdated, SessionEvent
 from kiosk.core.session.ports import QosEngine, SessionStore
@@ -40,7 +41,7 @@ QUESTION_ASKED = "QuestionAsked"
 Listener = Callable[[SessionEvent], None]
 
 
-@dataclass
+@record(frozen=False)
 class Batch:
     """The context changes of one instant, sent to the QoS engine as one update."""
 

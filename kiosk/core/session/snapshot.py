@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 
+from basis import record
 from kiosk.core.channels import Channel
 from kiosk.core.questionnaire import Item, PracticeQuestion, Score
 from kiosk.core.session.events import AnsweredBy, Phase, Prompt
 
 
-@dataclass(frozen=True)
+@record
 class Answer:
     """A recorded answer to a scored item."""
 
@@ -24,7 +24,7 @@ class Answer:
     detail: str = ""
 
 
-@dataclass(frozen=True)
+@record
 class Snapshot:
     """Everything a screen needs to draw the session at one moment."""
 

@@ -7,16 +7,17 @@ constructor: the state lives in one place, so no collaborator needs to know the 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
+from basis import record
 from kiosk.core.channels import Channel
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, Score, Timing
 from kiosk.core.session.events import AnsweredBy, Phase, Prompt
 from kiosk.core.session.snapshot import Answer
 
 
-@dataclass
+@record(frozen=False)
 class Unconfirmed:
     """An answer heard but not stored yet, waiting for Yes or No."""
 
@@ -30,7 +31,7 @@ class Unconfirmed:
     press: bool = False
 
 
-@dataclass
+@record(frozen=False)
 class OpenQuestion:
     """The question currently on screen: a scored item or a practice question."""
 
@@ -48,7 +49,7 @@ class OpenQuestion:
     feedback: str | None = None
 
 
-@dataclass(frozen=True)
+@record
 class BatteryPlace:
     """Where a session stands in a visit's battery: the visit's id, its instrument's index and every
     instrument's id, in order. Logged at the start (``battery`` entry) so a continued test knows
@@ -79,7 +80,7 @@ class BatteryPlace:
         return self.index == len(self.instruments) - 1
 
 
-@dataclass
+@record(frozen=False)
 class SessionState:
     """One administration's state. The first fields are fixed when the session is made."""
 

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from collections.abc import Set as AbstractSet
-from dataclasses import dataclass
 
+from basis import record
 from kiosk.core.clock import Clock
 
 
-@dataclass
+@record(frozen=False)
 class Timer:
     """The one pending time-out: ``due`` (clock time) while running, ``remaining`` while frozen."""
 

@@ -16,12 +16,13 @@ from __future__ import annotations
 import re
 import string
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import cache
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, TypeVar
 
+from basis import record
 from fileio.positions import Positions, Problem, describe, parse_file
 
 #: where the kiosk's words files are
@@ -92,7 +93,7 @@ _KIND_WORDS = {
 }
 
 
-@dataclass(frozen=True)
+@record
 class Words:
     """One language's words, as its file holds them (lists as tuples, sections as read-only maps).
 

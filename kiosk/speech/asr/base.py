@@ -4,9 +4,9 @@ the one error that turns voice in off (:class:`AsrUnavailable`)."""
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable, Sequence
-from dataclasses import dataclass
 from typing import Protocol
 
+from basis import record
 from kiosk.speech.grammar import Grammar
 
 
@@ -21,7 +21,7 @@ class NoModelForLanguage(AsrUnavailable):
     reason_key = "voice_no_model"
 
 
-@dataclass(frozen=True)
+@record
 class Recognition:
     """What a recogniser made of (part of) an utterance."""
 

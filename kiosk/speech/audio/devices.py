@@ -9,9 +9,9 @@ import logging
 import queue
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
+from basis import record
 from kiosk.speech.audio.pcm import FRAME_SAMPLES, SAMPLE_RATE, PcmConsumer
 
 log = logging.getLogger(__name__)
@@ -21,7 +21,7 @@ class AudioUnavailable(RuntimeError):
     """Audio input cannot work on this machine; the message is one sentence for the UI."""
 
 
-@dataclass(frozen=True)
+@record
 class InputDevice:
     """One audio input as `kiosk devices` shows it."""
 

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass
 
 import numpy as np
 
+from basis import record
 from kiosk.speech.audio.pcm import FRAME_SAMPLES, SAMPLE_RATE, frame_level_db
 
 
-@dataclass(frozen=True)
+@record
 class EndpointerSettings:
     """How the endpointer decides where speech starts and ends."""
 

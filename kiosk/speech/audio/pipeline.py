@@ -6,11 +6,11 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
+from basis import record
 from kiosk.speech.audio.endpointer import Endpointer, EndpointerSettings
 from kiosk.speech.audio.pcm import FRAME_SAMPLES, SAMPLE_RATE
 
@@ -29,7 +29,7 @@ class StreamingRecogniser(Protocol):
         """End the utterance and return the final result."""
 
 
-@dataclass(frozen=True)
+@record
 class Utterance:
     """One stretch of speech and what the recogniser made of it."""
 

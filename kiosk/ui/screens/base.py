@@ -4,7 +4,6 @@ forwards keys, and the sizes it adapts its layout to."""
 from __future__ import annotations
 
 from collections.abc import Hashable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol, cast
 
 from textual import events, on
@@ -13,6 +12,7 @@ from textual.containers import Horizontal
 from textual.screen import Screen
 from textual.widgets import Button, Label
 
+from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import ATTEMPTS, Snapshot
 from kiosk.ui.widgets.bars import AdaptationBanner, VoiceAgainButton
@@ -53,7 +53,7 @@ ROOMY_ROWS = 28
 WIDE_COLUMNS = 90
 
 
-@dataclass(frozen=True)
+@record
 class Ways:
     """The ways the patient can act right now, as the channels are: what instructions may promise.
 
@@ -72,7 +72,7 @@ class Ways:
         return ("touch",) + (("remote",) if self.remote else ()) + (("voice",) if self.voice else ())
 
 
-@dataclass(frozen=True)
+@record
 class PatientView:
     """Everything a patient screen draws: the session's snapshot plus what the app knows around it."""
 

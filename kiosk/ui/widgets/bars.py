@@ -2,18 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.message import Message
 from textual.widgets import Button, Static
 
+from basis import record
 from kiosk.core.channels import Command
 from kiosk.ui.widgets.text import ui_text
 
 
-@dataclass(frozen=True)
+@record
 class ChannelLine:
     """How one channel is shown: its name, a word for its state, and whether it takes input now."""
 

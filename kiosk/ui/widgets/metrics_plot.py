@@ -11,13 +11,13 @@ its legend below the axes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from rich.text import Text
 from textual_plotext import PlotextPlot
 
+from basis import record
 from fileio.bounded import open_private
 from kiosk.export.qos_plot import MARK_COLOURS, METRICS, Mark, metric_colour, plot_marks
 from kiosk.store.database import StoredSession
@@ -42,7 +42,7 @@ def _rgb(colour: str) -> tuple[int, int, int]:
     return int(colour[1:3], 16), int(colour[3:5], 16), int(colour[5:7], 16)
 
 
-@dataclass(frozen=True)
+@record
 class PlotData:
     """What a metrics plot draws: one time series per metric, and the marks."""
 

@@ -1,0 +1,6 @@
+"""What every layer of the project builds on and that imports nothing of ours: :func:`record`,
+the dataclass the project declares its values with."""
+
+from basis.records import record
+
+__all__ = ["record"]

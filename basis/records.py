@@ -1,0 +1,100 @@
+"""``@record``: a dataclass whose ``__repr__``, ``__eq__`` and ``__hash__`` are written once here.
+
+On Python 3.11 :func:`dataclasses.dataclass` compiles every method it generates with ``exec``:
+six for a frozen class (``__init__``, ``__repr__``, ``__eq__``, ``__hash__``, ``__setattr__``,
+``__delattr__``). The kiosk declares about 130 value classes before its welcome, and making them
+was about a tenth of its start (docs/startup.md). A record generates only ``__init__`` (and, frozen,
+``__setattr__``/``__delattr__``); the other three are these shared functions, which behave as the
+generated ones: the same repr (fields with ``repr=True``, recursion shown as ``...``), equality
+only between instances of the very same class over the fields with ``compare=True``, and the same
+hash (a frozen record hashes the tuple of its hashed fields; a mutable one is unhashable). A class
+that writes one of them itself keeps its own, as with ``dataclass``. Everything else is a plain
+dataclass: :func:`dataclasses.fields`, :func:`~dataclasses.replace`, :func:`~dataclasses.asdict`,
+``field(...)``, ``__match_args__``, pickling.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from operator import attrgetter
+from reprlib import recursive_repr
+from typing import Any, TypeVar, cast, dataclass_transform, overload
+
+_T = TypeVar("_T", bound=type)
+
+
+class _Shape:
+    """What the shared methods read of one record class, worked out on first use."""
+
+    __slots__ = ("compared", "hashed", "shown")
+
+    def __init__(self, cls: type) -> None:
+        fields = dataclasses.fields(cls)
+        self.compared = _tuple_of([f.name for f in fields if f.compare])
+        self.hashed = _tuple_of([f.name for f in fields if (f.compare if f.hash is None else f.hash)])
+        self.shown = tuple(f.name for f in fields if f.repr)
+
+
+#: a record class -> its shape
+_SHAPES: dict[type, _Shape] = {}
+
+
+def _tuple_of(names: list[str]) -> Callable[[Any], tuple[Any, ...]]:
+    """A function giving an object's values of ``names`` as a tuple (the generated methods' tuple)."""
+    if not names:
+        return lambda obj: ()
+    if len(names) == 1:
+        one = attrgetter(names[0])
+        return lambda obj: (one(obj),)
+    return attrgetter(*names)
+
+
+def _shape(cls: type) -> _Shape:
+    shape = _SHAPES.get(cls)
+    if shape is None:
+        shape = _SHAPES[cls] = _Shape(cls)
+    return shape
+
+
+@recursive_repr()
+def _repr(self: Any) -> str:
+    shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in _shape(type(self)).shown)
+    return f"{type(self).__qualname__}({shown})"
+
+
+def _eq(self: Any, other: object) -> bool:
+    if other.__class__ is self.__class__:
+        values = _shape(type(self)).compared
+        return values(self) == values(other)
+    return NotImplemented
+
+
+def _hash(self: Any) -> int:
+    return hash(_shape(type(self)).hashed(self))
+
+
+def _make(cls: _T, frozen: bool, kw_only: bool) -> _T:
+    own = cls.__dict__
+    # as dataclass decides: a __hash__ the class wrote counts, the None that writing __eq__ leaves does not
+    explicit_hash = "__hash__" in own and not (own["__hash__"] is None and "__eq__" in own)
+    if "__repr__" not in own:
+        cls.__repr__ = _repr  # type: ignore[assignment]  # the shared method, set on the class
+    if "__eq__" not in own:
+        cls.__eq__ = _eq  # type: ignore[assignment]  # the shared method, set on the class
+    if not explicit_hash:
+        cls.__hash__ = _hash if frozen else None  # type: ignore[assignment]  # as dataclass(eq=True)
+    return cast(_T, dataclasses.dataclass(cls, frozen=frozen, kw_only=kw_only, repr=False, eq=False))
+
+
+@overload
+def record(cls: _T, /) -> _T: ...
+@overload
+def record(*, frozen: bool = True, kw_only: bool = False) -> Callable[[_T], _T]: ...
+@dataclass_transform(frozen_default=True, field_specifiers=(dataclasses.field, dataclasses.Field))
+def record(cls: _T | None = None, /, *, frozen: bool = True, kw_only: bool = False) -> Any:
+    """A dataclass, frozen unless ``frozen=False``, with the shared ``__repr__``, ``__eq__`` and
+    ``__hash__`` (see the module). ``@record`` and ``@record(frozen=False)``."""
+    if cls is None:
+        return lambda c: _make(c, frozen, kw_only)
+    return _make(cls, frozen, kw_only)
