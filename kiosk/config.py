@@ -58,7 +58,6 @@ from __future__ import annotations
 
 import os
 import re
-import socket
 from collections.abc import Mapping
 from dataclasses import field, fields, replace
 from pathlib import Path
@@ -74,6 +73,7 @@ from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing, load_questionnaire
 from kiosk.core.questionnaire.kept import load_questionnaire_kept
 from kiosk.core.questionnaire.loading import bundled_path
+from kiosk.core.site import ExportSite, default_kiosk_id
 from qos import bundled_models
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
@@ -103,12 +103,6 @@ class ConfigError(ValueError):
 #: a kiosk's name at the station, and a site's code: letters, digits, '.', '-' and '_' (both go
 #: into exported identifiers, so no spaces, '/' or '|')
 KIOSK_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")  # fullmatch: '$' would let a final newline in
-
-
-def default_kiosk_id() -> str:
-    """The host name made fit for an identifier (set ``kiosk_id`` so it never changes)."""
-    name = re.sub(r"[^A-Za-z0-9._-]", "-", socket.gethostname()).strip("-._")[:64]
-    return name or "kiosk"
 
 
 @record
@@ -218,6 +212,11 @@ _KEYS = {f.name for f in fields(Config)} - {"source"}
 def default_config_path() -> Path:
     """``<user config dir>/kiosk/config.yaml``."""
     return Path(platformdirs.user_config_dir("kiosk")) / "config.yaml"
+
+
+def site_from_config(config: Config) -> ExportSite:
+    """The export site of a configuration: its ``site``, ``kiosk_id`` and ``fhir:`` systems."""
+    return ExportSite(site=config.site, kiosk_id=config.kiosk_id, **dict(config.fhir))
 
 
 def load_config(path: str | Path | None = None, environ: Mapping[str, str] | None = None) -> Config:

@@ -37,12 +37,11 @@ def build_app(
 ) -> tuple[KioskApp, Callable[[], None]]:
     """The kiosk as configured, with whatever channels this machine has, and a function that
     closes what it opened. Raises :class:`SetupError` (one sentence) for a user's mistake."""
-    from kiosk.config import ConfigError, load_config
+    from kiosk.config import ConfigError, load_config, site_from_config
     from kiosk.core.adaptation import PolicyError
     from kiosk.core.clock import SystemClock
     from kiosk.core.questionnaire import QuestionnaireError
-    from kiosk.export import export_identity, site_from_config
-    from kiosk.export.opening import in_force_of
+    from kiosk.core.site import export_identity
     from kiosk.store.database import PATIENT_ID, StorageError, Store
     from kiosk.ui.channels import KioskChannels
     from kiosk.ui.compose import KioskParts, make_kiosk
@@ -63,7 +62,7 @@ def build_app(
             interrupt_after_s=config.interrupt_after_minutes * 60,
             outbox=config.station is not None,
             export=export_identity(site_from_config(config)),
-            in_force=lambda: in_force_of(config),
+            in_force=lambda: _in_force(config),
         )
     except QuestionnaireError as error:
         problems = getattr(error, "problems", None)
@@ -86,6 +85,14 @@ def build_app(
     # wired, so it hears of them): for staff, never a patient
     store.interrupt_stale()
     return app, store.close
+
+
+def _in_force(config: Any) -> Any:
+    """What an upgrade of an older database attaches to its sessions (only then are the exports'
+    modules needed)."""
+    from kiosk.export.opening import in_force_of
+
+    return in_force_of(config)
 
 
 def _remotes(

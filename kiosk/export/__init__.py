@@ -20,22 +20,20 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from kiosk.config import site_from_config
+from kiosk.core.site import ExportSite, export_identity, site_from_identity
 from kiosk.export.result import (  # eager: `result` is both this module and its function
     PRACTICE_CHECKS,
     TOTAL_LINK,
     ExportError,
-    ExportSite,
     PracticeOutcome,
     Result,
-    export_identity,
     practice_outcome,
     practice_outcomes,
     questionnaire_version,
     rescore,
     result,
     results,
-    site_from_config,
-    site_from_identity,
     write_export,
     write_json,
     write_private,

@@ -23,9 +23,10 @@ from urllib.parse import quote
 from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review
+from kiosk.core.site import ExportSite
 from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of, total_of
 from kiosk.export.provenance import fhir_provenances
-from kiosk.export.result import ExportSite, Result, questionnaire_version, results
+from kiosk.export.result import Result, questionnaire_version, results
 from kiosk.store.database import StoredSession
 
 

@@ -17,11 +17,11 @@ from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
-from kiosk.config import default_kiosk_id
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.questionnaire.definition import DefinitionError, canonical_json, questionnaire_from
 from kiosk.core.review import Review
-from kiosk.export.result import ExportError, ExportSite, site_from_identity
+from kiosk.core.site import ExportSite, default_kiosk_id, site_from_identity
+from kiosk.export.result import ExportError
 from kiosk.store.records import StoredSession
 
 __all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of", "wide_csv_tables"]

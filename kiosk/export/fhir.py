@@ -67,6 +67,7 @@ from typing import Any
 
 from kiosk.core.questionnaire import Code, Questionnaire
 from kiosk.core.review import Review, ReviewState
+from kiosk.core.site import ExportSite
 from kiosk.core.visits import visit_of
 from kiosk.core.words import Table
 from kiosk.export.calculated import (
@@ -83,7 +84,6 @@ from kiosk.export.calculated import (
 from kiosk.export.result import (
     TOTAL_LINK,
     ExportError,
-    ExportSite,
     Result,
     questionnaire_version,
     result,

@@ -26,8 +26,9 @@ import uuid
 from typing import Any
 
 from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.site import ExportSite
 from kiosk.export.fhir import device_reference, instant, option_coding, practitioner
-from kiosk.export.result import ExportSite, Result
+from kiosk.export.result import Result
 
 #: the answer a change replaced, as the response's Coding had it (on ``Provenance.entity``)
 REPLACED_ANSWER = "urn:barthel-kiosk:fhir:StructureDefinition:replaced-answer"

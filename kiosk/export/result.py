@@ -1,19 +1,19 @@
 """What every export of a stored session states: a :class:`Result` is the session's answers after
 a clinician's corrections (:class:`kiosk.core.review.Review`), their score recomputed from the option
 numbers (a stored total or stored points are never trusted), whether it is complete and whether a
-clinician signed it off; :class:`ExportSite` is who exports (site, kiosk, FHIR systems)."""
+clinician signed it off. Who exports (:class:`ExportSite`: site, kiosk, FHIR systems) is
+:mod:`kiosk.core.site`'s, named here too."""
 
 from __future__ import annotations
 
 import json
 from collections.abc import Mapping, Sequence
-from dataclasses import field, fields
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
 from basis import record
 from fileio.bounded import write_error, write_private  # the one owner-only writer; exports use it from here too
-from kiosk.config import Config, default_kiosk_id
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import Review, ReviewState, review_state
 from kiosk.core.staff import entered_values
@@ -25,60 +25,6 @@ TOTAL_LINK = "total"
 class ExportError(ValueError):
     """A stored session does not fit the questionnaire (unknown item, option or points), a
     review does not fit the session, or an export cannot be written."""
-
-
-@record
-class ExportSite:
-    """Who exports: the site and the kiosk, and the FHIR systems and URLs the site owns.
-
-    The defaults are URNs under ``urn:barthel-kiosk:`` with the site code in them; a hospital
-    sets its own (``site``, ``kiosk_id`` and ``fhir:`` in the kiosk's config,
-    :func:`site_from_config`).
-    """
-
-    site: str = "local"
-    kiosk_id: str = field(default_factory=default_kiosk_id)
-    #: the system of the patients' pseudonymous ids
-    patient_system: str = ""
-    #: the canonical URL of the questionnaire; one Questionnaire per language is ``URL-LANG``
-    #: (empty: ``urn:barthel-kiosk:SITE:questionnaire:ID``, ID the questionnaire file's id)
-    questionnaire_url: str = ""
-    #: the system of result identifiers: ``SITE/KIOSK/SESSION`` (+ ``/total`` for the Observation)
-    identifier_system: str = ""
-    #: the system of kiosk ids (the FHIR Device's identifier)
-    device_system: str = ""
-
-    def __post_init__(self) -> None:
-        defaults = {
-            "patient_system": f"urn:barthel-kiosk:{self.site}:patient",
-            "identifier_system": "urn:barthel-kiosk:result",
-            "device_system": f"urn:barthel-kiosk:{self.site}:kiosk",
-        }
-        for name, value in defaults.items():
-            if not getattr(self, name):
-                object.__setattr__(self, name, value)
-
-    def result_id(self, session_id: str) -> str:
-        """The stable business identifier of a session's result: site + kiosk + session."""
-        return f"{self.site}/{self.kiosk_id}/{session_id}"
-
-
-def site_from_config(config: Config) -> ExportSite:
-    """The export site of a :class:`kiosk.config.Config`."""
-    return ExportSite(site=config.site, kiosk_id=config.kiosk_id, **dict(config.fhir))
-
-
-def export_identity(site: ExportSite) -> dict[str, str]:
-    """``site`` as plain strings (what the kiosk sends the station with each session)."""
-    return {f.name: str(getattr(site, f.name)) for f in fields(site)}
-
-
-def site_from_identity(identity: Mapping[str, Any], kiosk_id: str) -> ExportSite:
-    """The :class:`ExportSite` a kiosk sent (:func:`export_identity`); its unknown or non-text
-    fields are ignored, and without one the station's default site for ``kiosk_id``."""
-    known = {f.name for f in fields(ExportSite)}
-    chosen = {k: v for k, v in identity.items() if k in known and isinstance(v, str) and v}
-    return ExportSite(**{"kiosk_id": kiosk_id, **chosen})
 
 
 def questionnaire_version(q: Questionnaire) -> str:

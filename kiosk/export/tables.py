@@ -18,10 +18,10 @@ from typing import Any
 
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review
+from kiosk.core.site import ExportSite
 from kiosk.core.visits import visit_of
 from kiosk.export.result import (
     TOTAL_LINK,
-    ExportSite,
     Result,
     practice_outcomes,
     questionnaire_version,

@@ -25,7 +25,7 @@ from textual.reactive import Reactive
 from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command
 from kiosk.core.pin import CornerTaps, PinGuard
 from kiosk.core.session import Session, SessionEvent
-from kiosk.export import ExportSite
+from kiosk.core.site import ExportSite
 from kiosk.store.lease import LEASE_TTL_S
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.controller import KioskController

@@ -14,6 +14,7 @@ from dataclasses import field
 from typing import TYPE_CHECKING, Any
 
 from basis import record
+from kiosk.config import site_from_config
 from kiosk.core.adaptation import Adaptation, Policy, load_policy
 from kiosk.core.clock import Clock
 from kiosk.core.pin import PinGuard
@@ -22,8 +23,6 @@ from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Session
 from kiosk.core.session.battery import Battery, Instrument
 from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
-from kiosk.export import site_from_config
-from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import Store, StoredSession, new_patient_id
 from kiosk.ui.app import POLL_INTERVAL, KioskApp
 from kiosk.ui.channels import KioskChannels
@@ -150,6 +149,8 @@ class SessionMaker:
         """The session continuing ``stored``, with the questionnaire it started with, whatever
         the file says now. Part of a battery, the visit goes on with its remaining instruments and
         the QoS trace of its earlier ones (found in the store)."""
+        from kiosk.export.captured import questionnaire_of  # a continued test only: not before the welcome
+
         questionnaire = questionnaire_of(stored, fallback=self.parts.questionnaire)
         place = Battery.place_of(stored)
         battery = self._battery(place.visit_id if place else None)
