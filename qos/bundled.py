@@ -5,7 +5,6 @@ without importing the package that lazily imports it.
 
 from __future__ import annotations
 
-from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,11 +13,14 @@ from qos.errors import ModelError
 if TYPE_CHECKING:
     from qos.model import Model
 
+#: the bundled models' folder (the package is installed as files, never zipped; importlib.resources
+#: would cost a start zipfile and its readers for nothing)
+MODELS = Path(__file__).parent / "models"
+
 
 def bundled_models() -> list[str]:
     """Names of the models shipped inside the package (``qos/models/NAME.roqme``)."""
-    folder = resources.files("qos") / "models"
-    return sorted(entry.name[: -len(".roqme")] for entry in folder.iterdir() if entry.name.endswith(".roqme"))
+    return sorted(entry.name[: -len(".roqme")] for entry in MODELS.iterdir() if entry.name.endswith(".roqme"))
 
 
 def load_model(name_or_path: str | Path) -> Model:
@@ -38,6 +40,5 @@ def load_model(name_or_path: str | Path) -> Model:
             f"no bundled model named {text!r} (bundled: {', '.join(bundled_models())}); "
             "give a path to a .roqme file instead"
         )
-    folder = resources.files("qos") / "models"
-    # bundled models may import each other (the package is installed as files, not zipped)
-    return parse_model((folder / f"{text}.roqme").read_text(encoding="utf-8"), f"{text}.roqme", Path(str(folder)))
+    # bundled models may import each other
+    return parse_model((MODELS / f"{text}.roqme").read_text(encoding="utf-8"), f"{text}.roqme", MODELS)

@@ -9,7 +9,6 @@ changes the kiosk's behaviour, never the contexts sent to the QoS engine.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -73,7 +72,7 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
     """
     if path is None:
         data, positions, problems = parse_file(
-            str(resources.files("kiosk.core").joinpath("adaptation.yaml")), "adaptation.yaml", keep=True
+            str(Path(__file__).with_name("adaptation.yaml")), "adaptation.yaml", keep=True
         )
         name = "adaptation.yaml"
     else:

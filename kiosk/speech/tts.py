@@ -31,7 +31,6 @@ A rate of 150 wpm or more is spoken as asked, with espeak-ng's own pauses.
 from __future__ import annotations
 
 import contextlib
-import html
 import logging
 import os
 import queue
@@ -40,7 +39,6 @@ import shutil
 import subprocess
 import tempfile
 import threading
-import wave
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
@@ -73,6 +71,12 @@ class TtsUnavailable(RuntimeError):
     """Voice out cannot work here; the message is one sentence for the UI."""
 
 
+def _xml_text(text: str) -> str:
+    """``text`` as SSML character data: ``&``, ``<`` and ``>`` escaped (html.escape without quotes,
+    whose module brings the whole HTML entity table to a start)."""
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
 #: a sentence end or a comma followed by more words: where a slowed prompt pauses longer
 _BOUNDARY = re.compile(r"([.?!;:,])(\s+)(?=\S)")
 
@@ -93,12 +97,12 @@ class Delivery:
         for m in _BOUNDARY.finditer(text):
             ms = self.comma_break_ms if m.group(1) == "," else self.sentence_break_ms
             out += [
-                html.escape(text[done : m.end(1)], quote=False),
+                _xml_text(text[done : m.end(1)]),
                 f'<break time="{ms}ms"/>' if ms else "",
                 m.group(2),
             ]
             done = m.end()
-        return f"<speak>{''.join(out)}{html.escape(text[done:], quote=False)}</speak>"
+        return f"<speak>{''.join(out)}{_xml_text(text[done:])}</speak>"
 
 
 def delivery(rate: int, text: str) -> Delivery:
@@ -145,7 +149,7 @@ class Synthesiser:
         """Say ``text`` with any espeak-ng voice ("en-us+f3", "en+croak", "roa/es+klatt") at
         exactly ``rate`` words per minute, slow or not, into ``path``: the many patients whose
         answers the tests and ``bench/asr.py`` feed to voice in, never the kiosk's own voice."""
-        return self._run(text, voice, rate, "100", path, html.escape(text, quote=False))
+        return self._run(text, voice, rate, "100", path, _xml_text(text))
 
     def _run(self, text: str, voice: str, rate: int, amplitude: str, path: str | Path, markup: str) -> Path:
         subprocess.run(
@@ -362,6 +366,8 @@ class Speaker:
         fd, name = tempfile.mkstemp(suffix=".wav", prefix="kiosk-tts-")
         os.close(fd)
         try:
+            import wave  # here, on the speaker's thread: never before the welcome
+
             import numpy as np
 
             synth.synthesise(job.text, job.language, name, self.rate, self.volume)

@@ -10,7 +10,6 @@ import hashlib
 import json
 from collections.abc import Mapping
 from functools import cache
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +30,9 @@ from kiosk.core.words import load_words
 YES = Code("http://loinc.org", "LA33-6", "Yes")
 NO = Code("http://loinc.org", "LA32-8", "No")
 
-#: where the bundled questionnaire and its schema live
-_PACKAGE_DIR = "kiosk.core.questionnaire.instruments"
+#: where the bundled questionnaires and their schema live (the package is installed as files,
+#: never zipped)
+_INSTRUMENTS = Path(__file__).parent / "instruments"
 DEFAULT_FILE = "barthel.yaml"
 SCHEMA_FILE = "questionnaire.schema.json"
 
@@ -52,7 +52,7 @@ class QuestionnaireError(ValueError):
 
 def bundled_path(name: str = DEFAULT_FILE) -> Path:
     """Path of a file shipped in ``kiosk/core/questionnaire/instruments``."""
-    return Path(str(resources.files(_PACKAGE_DIR).joinpath(name)))
+    return _INSTRUMENTS / name
 
 
 @cache

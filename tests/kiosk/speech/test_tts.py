@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import html
 import subprocess
 import threading
 import wave
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.questionnaire import load_questionnaire
@@ -144,6 +147,12 @@ def test_delivery_maps_slow_rates_to_pauses():
         f'<speak>Fish &amp; chips,<break time="{slow.comma_break_ms}ms"/> &lt;now&gt;.'
         f'<break time="{slow.sentence_break_ms}ms"/> Yes</speak>'
     )
+
+
+@given(st.text(alphabet=st.sampled_from("ab &<>\"'\u00e9#x"), max_size=30))
+def test_a_slowed_prompt_escapes_its_text_as_html_would(text):
+    slow = delivery(100, text)
+    assert slow.markup(text) == f"<speak>{html.escape(text, quote=False)}</speak>"
 
 
 def test_volume_steps_stay_in_range():
