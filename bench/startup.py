@@ -99,6 +99,62 @@ print(json.dumps({n: [b[0] - a[0], b[1] - a[1]] for n, a, b in zip(names, marks,
 """
 
 
+#: runs ``python -m MODULE`` (argv[1]) as it is, exiting (status 0) after the first display that shows a
+#: button labelled "English": Textual's App.post_display_hook is set the moment textual.app is
+#: imported, so neither app imports anything earlier or in another order than it would alone
+TO_THE_WELCOME = """
+import importlib.abc, importlib.machinery, os, runpy, sys
+
+def shown(app):
+    from textual.widgets import Button
+    try:
+        if any("English" in str(button.label) for button in app.screen.query(Button)):
+            os._exit(0)
+    except Exception:  # no screen yet
+        pass
+
+class Hook(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path, target=None):
+        if name != "textual.app":
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        run = spec.loader.exec_module
+        def exec_module(module):
+            run(module)
+            module.App.post_display_hook = shown
+        spec.loader.exec_module = exec_module
+        return spec
+
+sys.meta_path.insert(0, Hook())
+runpy.run_module(sys.argv.pop(1), run_name="__main__", alter_sys=True)  # argv as `python -m` gives it
+"""
+
+
+def instructions(env: dict[str, str], module: str) -> int:
+    """Instructions (valgrind's callgrind) ``python -m module`` runs from launch to its welcome on a
+    100x32 pseudo-terminal: a count the machine's load does not move."""
+    out = os.path.join(tempfile.mkdtemp(), "callgrind.out")
+    pid, fd = pty.fork()
+    if pid == 0:  # pragma: no cover - the child
+        argv = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", sys.executable, "-c", TO_THE_WELCOME]
+        os.execvpe("valgrind", [*argv, module], env)
+    fcntl.ioctl(fd, termios.TIOCSWINSZ, struct.pack("HHHH", 32, 100, 0, 0))
+    while True:  # the terminal must be read, or the app blocks writing to it
+        try:
+            if not os.read(fd, 65536):
+                break
+        except OSError:
+            break
+    _, status = os.waitpid(pid, 0)
+    os.close(fd)
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise RuntimeError(f"{module} under callgrind exited with {os.waitstatus_to_exitcode(status)}")
+    with open(out, encoding="utf-8") as f:
+        totals = [line for line in f if line.startswith("totals:")]
+    return int(totals[0].split()[1])
+
+
 def phases(env: dict[str, str], rounds: int) -> dict[str, dict[str, float]]:
     """Median wall and CPU seconds of each phase of PHASES over ``rounds`` fresh processes (CPU
     counts every thread: the channels start theirs when the app mounts)."""
@@ -133,6 +189,11 @@ def heaviest_imports(n: int = 8) -> list[dict[str, object]]:
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=7)
+    parser.add_argument(
+        "--instructions",
+        action="store_true",
+        help="also count instructions to the welcome with valgrind (about two minutes; needs valgrind)",
+    )
     args = parser.parse_args(argv)
     load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
@@ -154,6 +215,11 @@ def main(argv: list[str]) -> int:
             for name, command in apps.items():
                 runs[name].append(time_to_marker(command, env))
         kiosk_phases = phases(env, max(3, args.rounds // 2))
+        counted = (
+            {name: instructions(env, module) for name, module in (("two_widget", "two_widgets"), ("kiosk", "kiosk"))}
+            if args.instructions
+            else None
+        )
     wall = {name: [w for w, _ in found] for name, found in runs.items()}
     cpu = {name: [c for _, c in found] for name, found in runs.items()}
     two, kiosk = wall["two_widget"], wall["kiosk"]
@@ -173,6 +239,14 @@ def main(argv: list[str]) -> int:
                 "kiosk_cpu_s_median": round(statistics.median(cpu["kiosk"]), 3),
                 "cpu_ratio_median": round(cpu_ratio, 2),
                 "kiosk_phases": kiosk_phases,
+                **(
+                    {
+                        "instructions_M": {name: round(n / 1e6) for name, n in counted.items()},
+                        "instructions_ratio": round(counted["kiosk"] / counted["two_widget"], 2),
+                    }
+                    if counted
+                    else {}
+                ),
                 "load_average_before_after": [round(load_before[0], 2), round(os.getloadavg()[0], 2)],
                 "heaviest_imports_ms": heaviest_imports(),
             },
