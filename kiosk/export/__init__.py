@@ -17,9 +17,9 @@ its own exports results as unreviewed. Every function takes the questionnaire an
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from basis.lazy import lazy_names
 from kiosk.config import site_from_config
 from kiosk.core.site import ExportSite, export_identity, site_from_identity
 from kiosk.export.result import (  # eager: `result` is both this module and its function
@@ -134,14 +134,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """The public name ``name`` from the module that defines it (PEP 562)."""
-    if name not in _MODULES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_MODULES[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names(globals(), _MODULES, __all__)
