@@ -4,6 +4,7 @@ once in basis.records."""
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import importlib
 import pickle
@@ -20,7 +21,7 @@ import kiosk
 import qos
 import station
 from basis import record
-from basis.records import _eq
+from basis.records import _eq, is_frozen
 
 
 def _record_classes() -> list[type]:
@@ -43,7 +44,7 @@ RECORDS = _record_classes()
 def _twin(cls: type) -> type:
     """The stdlib dataclass with ``cls``'s fields and options: what ``cls`` was before."""
     specs = [(f.name, object, field(compare=f.compare, repr=f.repr, hash=f.hash)) for f in dataclasses.fields(cls)]
-    twin = dataclasses.make_dataclass(cls.__name__, specs, frozen=cls.__dataclass_params__.frozen)
+    twin = dataclasses.make_dataclass(cls.__name__, specs, frozen=is_frozen(cls))
     twin.__qualname__ = cls.__qualname__
     return twin
 
@@ -72,7 +73,7 @@ def test_a_record_class_behaves_as_the_dataclass_it_was(cls):
     for name in names:  # a field that takes part in comparing makes two records differ
         changed = _made(cls, {**values, name: "other"})
         assert (one == changed) == (ref == _made(twin, {**values, name: "other"}))
-    if cls.__dataclass_params__.frozen:
+    if is_frozen(cls):
         assert hash(one) == hash(same) == hash(ref)
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(one, names[0] if names else "x", "changed")
@@ -158,3 +159,52 @@ def test_a_record_is_still_a_dataclass_for_replace_match_and_pickle():
     assert pickle.loads(pickle.dumps(p)) == p and pickle.loads(pickle.dumps(p)).label == "a"
     with pytest.raises(dataclasses.FrozenInstanceError):
         del p.x
+
+
+@record
+class Defaults:
+    a: int
+    b: list[int] = field(default_factory=list)
+    c: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.c:
+            object.__setattr__(self, "c", f"c{self.a}")  # as a frozen dataclass's __post_init__ does
+
+
+class Plain(Defaults):
+    """A plain subclass: it may carry attributes of its own, never change the record's fields."""
+
+
+def test_a_frozen_record_refuses_every_change_once_made_as_a_frozen_dataclass_does():
+    d = Defaults(1)
+    assert (d.a, d.b, d.c) == (1, [], "c1")
+    for change in (
+        lambda: setattr(d, "a", 2),
+        lambda: setattr(d, "c", "x"),
+        lambda: setattr(d, "new", 1),
+        lambda: delattr(d, "a"),
+        lambda: delattr(d, "new"),
+    ):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            change()
+    assert (d.a, d.c, hasattr(d, "new")) == (1, "c1", False)
+    p = Plain(2)
+    p.note = "mine"  # type: ignore[attr-defined]  # a plain subclass's own attribute, as with dataclass
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.a = 3  # type: ignore[misc]  # the record's field stays frozen
+    for twin in (copy.copy(d), copy.deepcopy(d), pickle.loads(pickle.dumps(d)), dataclasses.replace(d)):
+        assert twin == d and twin is not d
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            twin.a = 5  # type: ignore[misc]  # a copy is as frozen as the original
+
+
+def test_a_frozen_record_that_writes_its_own_setattr_is_refused_as_dataclass_refuses_it():
+    class Mine:
+        a: int
+
+        def __setattr__(self, name: str, value: object) -> None:
+            object.__setattr__(self, name, value)
+
+    with pytest.raises(TypeError, match="__setattr__"):
+        record(Mine)
