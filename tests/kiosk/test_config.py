@@ -9,6 +9,7 @@ import pytest
 
 from kiosk.config import DEFAULT_PIN, Config, ConfigError, configured_questionnaire, load_config, offered_to_patients
 from kiosk.core.clock import SimClock, SystemClock
+from tests.kiosk.configs import refusal
 
 
 def test_defaults_without_a_file(tmp_path, monkeypatch):
@@ -55,10 +56,7 @@ def test_file_and_environment(tmp_path):
 )
 def test_a_bad_config_is_one_message_naming_file_line_and_column(tmp_path, text, message):
     path = tmp_path / "config.yaml"
-    path.write_text(text)
-    with pytest.raises(ConfigError) as caught:
-        load_config(path, environ={})
-    assert str(caught.value).startswith(f"{path}{message}")
+    assert refusal(path, text).startswith(f"{path}{message}")
 
 
 def test_bad_environment(tmp_path, monkeypatch):
@@ -173,10 +171,7 @@ def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypa
 )
 def test_bad_station_settings_say_where(tmp_path, text, message):
     path = tmp_path / "config.yaml"
-    path.write_text(text)
-    with pytest.raises(ConfigError) as caught:
-        load_config(path, environ={})
-    assert str(caught.value).startswith(f"{path}{message}")
+    assert refusal(path, text).startswith(f"{path}{message}")
 
 
 # --- accept_unvalidated_translations: which translations a site uses clinically -------------------
@@ -201,9 +196,7 @@ def _site(tmp_path: Path, text: str) -> Path:
 )
 def test_a_bad_accept_unvalidated_translations_says_where(tmp_path, text, message):
     path = _site(tmp_path, text)
-    with pytest.raises(ConfigError) as caught:
-        load_config(path, environ={})
-    assert str(caught.value).startswith(f"{path}{message}")
+    assert refusal(path).startswith(f"{path}{message}")
 
 
 @pytest.mark.parametrize(

@@ -7,6 +7,7 @@ import pytest
 
 from kiosk.config import ConfigError, InstrumentChoice, configured_instruments, load_config
 from tests.kiosk.battery_instruments import write_mini
+from tests.kiosk.configs import refusal
 
 
 def test_a_battery_of_a_shipped_id_and_a_file_with_its_own_model(tmp_path):
@@ -41,11 +42,7 @@ def test_without_instruments_the_questionnaire_is_a_battery_of_one(tmp_path):
     ],
 )
 def test_a_bad_battery_is_one_message_naming_file_line_and_column(tmp_path, text, message):
-    path = tmp_path / "config.yaml"
-    path.write_text(text)
-    with pytest.raises(ConfigError) as raised:
-        load_config(path, environ={})
-    assert str(raised.value).startswith(f"{tmp_path}/{message}")
+    assert refusal(tmp_path / "config.yaml", text).startswith(f"{tmp_path}/{message}")
 
 
 def test_an_instrument_given_twice_is_refused(tmp_path):

@@ -6,45 +6,12 @@ command that reads them; no traceback."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
 from kiosk.core.questionnaire import bundled_path
+from tests.kiosk.command_line import ROOT, kiosk, kiosk_run, one_line, write
 
-ROOT = Path(__file__).resolve().parents[2]
-#: a guard against a hang, not a timing assertion
-HANG_S = 120
 SCRIPT = ROOT / "recordings/patients/barthel6.yaml"
-
-
-def kiosk(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
-    """A real `kiosk` process with a clean environment (no user configuration)."""
-    return subprocess.run(
-        [sys.executable, "-m", "kiosk", *args],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=HANG_S,
-        check=False,
-        env={"PATH": "/usr/bin:/bin", "HOME": str(cwd), **(env or {})},
-    )
-
-
-def one_line(done: subprocess.CompletedProcess, where: str, stream: str = "stderr") -> str:
-    text = getattr(done, stream)
-    assert done.returncode == 2, (done.returncode, done.stderr, done.stdout)
-    assert "Traceback" not in done.stderr and text.count("\n") == 1, text
-    assert where in text, text
-    return text
-
-
-def write(tmp_path: Path, name: str, text: str) -> Path:
-    path = tmp_path / name
-    path.write_text(text, encoding="utf-8")
-    return path
 
 
 #: every command that reads the configuration, as a user would start it
@@ -138,19 +105,7 @@ def test_validate_and_run_refuse_invalid_unicode_written_as_an_escape(tmp_path, 
     validated = kiosk("validate", str(questionnaire), cwd=tmp_path)
     one_line(validated, f"{questionnaire}{where}", stream="stdout")
     config = write(tmp_path, "config.yaml", f"questionnaire: {questionnaire}\n")
-    one_line(
-        kiosk(
-            "run",
-            "--config",
-            str(config),
-            "--data-dir",
-            str(tmp_path / "data"),
-            "--no-voice",
-            "--no-remote",
-            cwd=tmp_path,
-        ),
-        f"{questionnaire}{where}",
-    )
+    one_line(kiosk_run(config, tmp_path, "--no-remote"), f"{questionnaire}{where}")
 
 
 @pytest.mark.slow  # a subprocess
@@ -196,10 +151,7 @@ def test_a_port_glob_over_the_file_system_is_refused_at_once(tmp_path, port, whe
     profiles = write(tmp_path, "site.yaml", f"profiles:\n  - name: serial-usb\n    port: '{port}'\n")
     one_line(kiosk("devices", "--profiles", str(profiles), cwd=tmp_path), f"{profiles}{where}")
     config = write(tmp_path, "config.yaml", f"remote_profiles: {profiles}\n")
-    one_line(
-        kiosk("run", "--config", str(config), "--data-dir", str(tmp_path / "data"), "--no-voice", cwd=tmp_path),
-        f"{profiles}{where}",
-    )
+    one_line(kiosk_run(config, tmp_path), f"{profiles}{where}")
 
 
 @pytest.mark.slow  # a subprocess

@@ -11,18 +11,12 @@ import math
 
 from textual import events, on
 from textual.app import ComposeResult
-from textual.containers import Grid, Horizontal, Vertical
+from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Label, Static
 
 from kiosk.core.pin import MAX_DIGITS, PinGuard
 from kiosk.ui.screens.base import ClinicianScreen
-
-#: the pad's keys, in reading order: ids are key-<label> except delete and OK
-_KEYS = ("1", "2", "3", "4", "5", "6", "7", "8", "9", "⌫", "0", "OK")
-
-
-def _key_id(label: str) -> str:
-    return {"⌫": "key-delete", "OK": "key-ok"}.get(label, f"key-{label}")
+from kiosk.ui.widgets.keypad import Keypad, keyboard_key, press
 
 
 class PinScreen(ClinicianScreen):
@@ -47,9 +41,7 @@ class PinScreen(ClinicianScreen):
                 yield Static("", id="pin")
                 yield Label("", id="pin-error")
                 yield Button("Back to the patient", id="pin-back")
-            with Grid(id="pin-keys"):
-                for label in _KEYS:
-                    yield Button(label, id=_key_id(label), variant="primary" if label == "OK" else "default")
+            yield Keypad(self, id="pin-keys")
 
     def on_mount(self) -> None:
         """Say at once when the pad is still waiting after earlier failures."""
@@ -94,17 +86,6 @@ class PinScreen(ClinicianScreen):
         else:
             self.query_one("#pin-error", Label).update("Wrong PIN.")
 
-    @on(Button.Pressed, "#pin-keys Button")
-    def _pad(self, event: Button.Pressed) -> None:
-        event.stop()
-        label = str(event.button.label)
-        if label == "OK":
-            self.submit()
-        elif label == "⌫":
-            self.delete()
-        else:
-            self.type_digit(label)
-
     @on(Button.Pressed, "#pin-back")
     def _back(self, event: Button.Pressed) -> None:
         event.stop()
@@ -112,13 +93,8 @@ class PinScreen(ClinicianScreen):
 
     def on_key(self, event: events.Key) -> None:
         """Digits, Backspace and Enter from a keyboard; Escape is the base screen's "back"."""
-        if event.character is not None and event.character.isdigit() and event.character.isascii():
-            self.type_digit(event.character)
-        elif event.key == "backspace":
-            self.delete()
-        elif event.key == "enter":
-            self.submit()
-        else:
+        if (key := keyboard_key(event)) is None:
             return
+        press(self, key)
         event.stop()
         event.prevent_default()

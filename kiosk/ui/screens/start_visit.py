@@ -9,7 +9,7 @@ from textual.containers import Grid, Horizontal, Vertical
 from textual.widgets import Button, Label, Static, Switch
 
 from kiosk.ui.screens.base import ClinicianScreen
-from kiosk.ui.screens.visit_ready import pad_key
+from kiosk.ui.widgets.keypad import pad_key
 from kiosk.ui.widgets.text import language_name
 
 _KEYS = tuple("1234567890ABCDEFGHIJKLMNOPQRSTUVWXYZ-_") + ("⌫",)

@@ -10,23 +10,16 @@ from __future__ import annotations
 
 from textual import events, on
 from textual.app import ComposeResult
-from textual.containers import Grid, Vertical
+from textual.containers import Vertical
 from textual.message import Message
 from textual.widgets import Button, Label, Static
 
 from kiosk.core.visits import Order
 from kiosk.ui.screens.base import PatientScreen, PatientView
+from kiosk.ui.widgets.keypad import Keypad, keyboard_key, press
 from kiosk.ui.widgets.text import language_name
 
-_KEYS = ("1", "2", "3", "4", "5", "6", "7", "8", "9", "⌫", "0", "OK")
 CODE_DIGITS = 4
-
-
-def pad_key(button: Button) -> Button:
-    """A pad key that takes every tap: a Button ignores a press within its 0.2 s press effect, so
-    "0000" typed quickly would lose digits."""
-    button.active_effect_duration = 0
-    return button
 
 
 def order_line(order: Order) -> str:
@@ -75,10 +68,7 @@ class VisitReadyScreen(PatientScreen):
                 yield Static("Staff: with the patient here, type the code the ward station shows for this visit.")
                 yield Static(" ", id="visit-code")
                 yield Label("", id="visit-error")
-                with Grid(id="visit-keys"):
-                    for label in _KEYS:
-                        key_id = {"⌫": "visit-key-delete", "OK": "visit-key-ok"}.get(label, f"visit-key-{label}")
-                        yield pad_key(Button(label, id=key_id, variant="primary" if label == "OK" else "default"))
+                yield Keypad(self, id="visit-keys", prefix="visit-", every_tap=True)
             else:
                 yield Static("No visit is ready on this kiosk", classes="visit-heading", id="visit-heading")
                 yield Static("Staff: order a visit on the ward station, or start one on the clinician screen.")
@@ -97,6 +87,10 @@ class VisitReadyScreen(PatientScreen):
             self._typed += digit
             self._show_code()
 
+    def delete(self) -> None:
+        self._typed = self._typed[:-1]
+        self._show_code()
+
     def submit(self) -> None:
         if len(self._typed) == CODE_DIGITS:
             self.post_message(self.CodeEntered(self._typed))
@@ -111,18 +105,6 @@ class VisitReadyScreen(PatientScreen):
         for error in self.query("#visit-error").results(Label):
             error.update(why)
 
-    @on(Button.Pressed, "#visit-keys Button")
-    def _pad(self, event: Button.Pressed) -> None:
-        event.stop()
-        label = str(event.button.label)
-        if label == "OK":
-            self.submit()
-        elif label == "⌫":
-            self._typed = self._typed[:-1]
-            self._show_code()
-        else:
-            self.type_digit(label)
-
     @on(Button.Pressed, "#walk-up")
     def _walk_up(self, event: Button.Pressed) -> None:
         event.stop()
@@ -130,16 +112,8 @@ class VisitReadyScreen(PatientScreen):
 
     def on_key(self, event: events.Key) -> None:
         """Digits type the code (never a remote's answer: nothing starts here without staff)."""
-        if not self.orders:
+        if not self.orders or (key := keyboard_key(event)) is None:
             return
-        if event.character is not None and event.character.isdigit() and event.character.isascii():
-            self.type_digit(event.character)
-        elif event.key == "backspace":
-            self._typed = self._typed[:-1]
-            self._show_code()
-        elif event.key == "enter":
-            self.submit()
-        else:
-            return
+        press(self, key)
         event.stop()
         event.prevent_default()

@@ -4,37 +4,13 @@ line on stderr and exit status 2 (no traceback, no hang, nothing half-loaded); `
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 import yaml
 
 from kiosk.core.questionnaire import bundled_path
+from tests.kiosk.command_line import ROOT, kiosk, kiosk_run, one_line, write
 
-ROOT = Path(__file__).resolve().parents[3]
-#: a guard against a hang, not a timing assertion: the reader's caps are what bound the work
-HANG_S = 120
 BOMB = "".join(f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 9) if i else 'lol'}]\n" for i in range(10))
-
-
-def kiosk(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "kiosk", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=HANG_S,
-        env={"PATH": "/usr/bin:/bin", "HOME": str(cwd)},
-    )
-
-
-def one_line(done: subprocess.CompletedProcess, where: str) -> str:
-    assert done.returncode == 2, (done.returncode, done.stderr)
-    assert "Traceback" not in done.stderr and done.stderr.count("\n") == 1, done.stderr
-    assert where in done.stderr, done.stderr
-    return done.stderr
 
 
 def portuguese_only() -> str:
@@ -54,12 +30,6 @@ def portuguese_only() -> str:
     return yaml.safe_dump(data, allow_unicode=True, sort_keys=False)
 
 
-def write(tmp_path: Path, name: str, content: str | bytes) -> Path:
-    path = tmp_path / name
-    path.write_bytes(content if isinstance(content, bytes) else content.encode())
-    return path
-
-
 @pytest.mark.slow  # a subprocess
 @pytest.mark.parametrize(
     ("name", "content", "where"),
@@ -74,9 +44,7 @@ def write(tmp_path: Path, name: str, content: str | bytes) -> Path:
 def test_kiosk_run_and_validate_refuse_the_same_questionnaires(tmp_path, name, content, where):
     questionnaire = write(tmp_path, name, content)
     config = write(tmp_path, "config.yaml", f"questionnaire: {questionnaire}\n")
-    run = kiosk(
-        "run", "--config", str(config), "--data-dir", str(tmp_path / "data"), "--no-voice", "--no-remote", cwd=tmp_path
-    )
+    run = kiosk_run(config, tmp_path, "--no-remote")
     assert one_line(run, f"kiosk run: {questionnaire}:").count(where) == 1
     validated = kiosk("validate", str(questionnaire), cwd=tmp_path)
     assert validated.returncode in (1, 2) and where in validated.stdout, validated.stdout
@@ -137,19 +105,7 @@ def test_kiosk_replay_refuses_bad_scripts(tmp_path, change, where):
 def test_a_policy_that_is_not_utf8_stops_kiosk_run_with_one_line(tmp_path):
     policy = write(tmp_path, "policy.yaml", "rules: []\n# réglée\n".encode("latin-1"))
     config = write(tmp_path, "config.yaml", f"adaptation_policy: {policy}\n")
-    one_line(
-        kiosk(
-            "run",
-            "--config",
-            str(config),
-            "--data-dir",
-            str(tmp_path / "data"),
-            "--no-voice",
-            "--no-remote",
-            cwd=tmp_path,
-        ),
-        f"{policy}:2:4: not UTF-8 text (byte 0xe9)",
-    )
+    one_line(kiosk_run(config, tmp_path, "--no-remote"), f"{policy}:2:4: not UTF-8 text (byte 0xe9)")
 
 
 @pytest.mark.slow  # a subprocess

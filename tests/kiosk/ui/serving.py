@@ -5,13 +5,16 @@ from __future__ import annotations
 import io
 import os
 import socket
+import sqlite3
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import AsyncIterator, Callable, Iterator
+from contextlib import asynccontextmanager, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+
+import pytest
 
 from kiosk.ui.serve.guard import token_digest
 
@@ -30,6 +33,11 @@ CHROMIUM_ARGS = [
 PATIENCE_S = 30.0
 #: the device key the served kiosks of the tests are set up with
 TOKEN = "test-device-key-0123456789abcdefghijklmnop"
+#: the marks of a test module that drives the served page in Chromium
+NEEDS_CHROMIUM = [
+    pytest.mark.slow,
+    pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="Debian's chromium is not installed (.ci/run installs it)"),
+]
 
 
 def free_port() -> int:
@@ -111,6 +119,10 @@ class Painted:
         """The server has sent the page ``text`` to draw: that screen is up in the app."""
         return lambda: text.encode() in self.data
 
+    def since(self, offset: int, *texts: str) -> Callable[[], bool]:
+        """The server has sent the page each of ``texts`` to draw after its first ``offset`` bytes."""
+        return lambda: all(text.encode() in self.data[offset:] for text in texts)
+
 
 async def wait_until(page, check: Callable[[], bool], what: str) -> None:
     """Let Playwright deliver frames until ``check()`` holds, at most :data:`PATIENCE_S`."""
@@ -152,3 +164,80 @@ async def wait_until_drawn(
     while not await drawn(page, *box, cell_h, rgb):
         assert time.monotonic() < deadline, f"never saw {what} drawn where the headless layout put it"
         await page.wait_for_timeout(50)  # lets the page draw; bounded by PATIENCE_S
+
+
+class KioskPage:
+    """A served kiosk open in Chromium: the page, what it was sent to draw, the terminal's size in
+    cells as the page reported it to the server, and where that terminal lies on the page."""
+
+    def __init__(self, page, painted: Painted, size: tuple[int, int], box: dict, requested: list[str]) -> None:
+        self.page = page
+        self.painted = painted
+        self.size = size
+        self.box = box
+        #: every address the page asked for, in order
+        self.requested = requested
+        self.cell_w, self.cell_h = box["width"] / size[0], box["height"] / size[1]
+
+    def pixels(self, region) -> tuple[float, float, float, float]:
+        """Where a region of the terminal (in cells) is on the page: left, top, right, bottom px."""
+        box = self.box
+        return (
+            box["x"] + region.x * self.cell_w,
+            box["y"] + region.y * self.cell_h,
+            box["x"] + region.right * self.cell_w,
+            box["y"] + region.bottom * self.cell_h,
+        )
+
+    async def tap(self, region) -> int:
+        """A tap on the middle of ``region``; returns how much the page had been sent to draw before it."""
+        left, top, right, bottom = self.pixels(region)
+        offset = len(self.painted.data)
+        await self.page.mouse.click((left + right) / 2, (top + bottom) / 2)
+        return offset
+
+    async def tap_drawn(self, region, rgb: tuple[int, int, int], what: str) -> int:
+        """:meth:`tap` once the page draws ``region`` as a button of colour ``rgb``, as a patient sees it."""
+        await wait_until_drawn(self.page, self.pixels(region), self.cell_h, rgb, what)
+        return await self.tap(region)
+
+
+@asynccontextmanager
+async def open_page(served: Served, viewport: tuple[int, int], fontsize: int | None) -> AsyncIterator[KioskPage]:
+    """The served kiosk in Debian's Chromium at ``viewport`` (width, height px) and ``?fontsize=``
+    (None: the page's default), once the page has drawn its first bytes."""
+    from playwright.async_api import async_playwright
+
+    async with async_playwright() as pw:
+        browser = await pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        try:
+            page = await browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
+            requested: list[str] = []
+            page.on("request", lambda request: requested.append(request.url))
+            painted = Painted(page)
+            # the device key once (as staff set the screen up), then the cookie opens the kiosk
+            await page.goto(served.url(f"/?token={TOKEN}" + (f"&fontsize={fontsize}" if fontsize else "")))
+            screen = page.locator(".xterm-screen")
+            await screen.wait_for(timeout=PATIENCE_S * 1000)
+            await page.wait_for_function("document.body.classList.contains('-first-byte')", timeout=PATIENCE_S * 1000)
+            query = dict(part.split("=") for part in painted.sockets[0].url.split("?", 1)[1].split("&"))
+            size = (int(query["width"]), int(query["height"]))
+            yield KioskPage(page, painted, size, await screen.bounding_box(), requested)
+        finally:
+            await browser.close()
+
+
+def rows(database: Path, sql: str) -> list[tuple]:
+    """What ``sql`` reads from the served kiosk's database now: nothing before it has its schema."""
+    if not database.exists():
+        return []
+    with sqlite3.connect(f"file:{database}?mode=ro", uri=True) as db:
+        try:
+            return db.execute(sql).fetchall()
+        except sqlite3.OperationalError:  # the schema is not there yet
+            return []
+
+
+def answers(database: Path) -> list[tuple]:
+    """The stored answers: item, option and channel."""
+    return rows(database, "SELECT item_id, option, channel FROM answers")

@@ -15,27 +15,14 @@ from kiosk.ui.widgets.text import language_name
 from .conftest import UiKiosk
 from .fit import problems
 from .helpers import screen_name, settle
-from .serving import (
-    ACTION_RGB,
-    ANSWER_RGB,
-    CHROMIUM,
-    CHROMIUM_ARGS,
-    PATIENCE_S,
-    TOKEN,
-    Painted,
-    serve,
-    wait_until,
-    wait_until_drawn,
-)
-from .test_served import _answers
+from .serving import ACTION_RGB, ANSWER_RGB, NEEDS_CHROMIUM, answers, open_page, serve, wait_until
 
 #: the smallest text the page may draw (px): what an 85-year-old can still read on the panel
 MIN_TEXT_PX = 24
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(not __import__("pathlib").Path(CHROMIUM).exists(), reason="no Debian chromium"),
-]
+pytestmark = NEEDS_CHROMIUM
+#: what the page may fetch: this machine only
+LOCAL = ("http://127.0.0.1", "ws://127.0.0.1", "data:")
 
 
 async def _layout(folder, size: tuple[int, int], language: str) -> list:
@@ -91,86 +78,44 @@ def served_kiosk(tmp_path):
 )
 @pytest.mark.parametrize("language", ["en", "es", "fr"])
 async def test_every_question_fits_the_served_page(served_kiosk, tmp_path_factory, viewport, fontsize, language):
-    from playwright.async_api import async_playwright
-
     database = served_kiosk.database
     width, height = viewport
-    async with async_playwright() as pw:
-        browser = await pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        try:
-            page = await browser.new_page(viewport={"width": width, "height": height})
-            outside = []
-            page.on(
-                "request",
-                lambda r: (
-                    outside.append(r.url)
-                    if not r.url.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:"))
-                    else None
-                ),
-            )
-            painted = Painted(page)
-            sockets = painted.sockets
+    async with open_page(served_kiosk, viewport, fontsize) as kiosk_page:
+        page, since, box = kiosk_page.page, kiosk_page.painted.since, kiosk_page.box
+        tapped_at = 0
+        # the size the page gave xterm.js (it may shrink the asked size, never below the floor)
+        font_px = float(await page.evaluate("document.getElementById('terminal').dataset.fontSize"))
+        assert font_px >= MIN_TEXT_PX
+        if fontsize is None:
+            assert font_px >= 28, "without ?fontsize the page should still draw large text"
+        assert box["x"] >= 0 and box["y"] >= 0
+        assert box["x"] + box["width"] <= width and box["y"] + box["height"] <= height
+        cell_h = kiosk_page.cell_h
+        assert cell_h >= MIN_TEXT_PX, f"rows of {cell_h:.1f} px cannot hold {MIN_TEXT_PX} px text"
+        steps = await _layout(tmp_path_factory.mktemp("layout"), kiosk_page.size, language)
 
-            def shown_since(text: str, offset: int):
-                """The server sent the page ``text`` to draw after ``offset`` bytes."""
-                return lambda: text.encode() in painted.data[offset:]
-
-            tapped_at = 0
-            # the device key once (as staff set the screen up), then the cookie opens the kiosk
-            await page.goto(served_kiosk.url(f"/?token={TOKEN}" + (f"&fontsize={fontsize}" if fontsize else "")))
-            screen = page.locator(".xterm-screen")
-            await screen.wait_for(timeout=PATIENCE_S * 1000)
-            await page.wait_for_function("document.body.classList.contains('-first-byte')", timeout=PATIENCE_S * 1000)
-            # the size the page gave xterm.js (it may shrink the asked size, never below the floor)
-            font_px = float(await page.evaluate("document.getElementById('terminal').dataset.fontSize"))
-            assert font_px >= MIN_TEXT_PX
-            if fontsize is None:
-                assert font_px >= 28, "without ?fontsize the page should still draw large text"
-            query = dict(part.split("=") for part in sockets[0].url.split("?", 1)[1].split("&"))
-            size = (int(query["width"]), int(query["height"]))
-            box = await screen.bounding_box()
-            assert box["x"] >= 0 and box["y"] >= 0
-            assert box["x"] + box["width"] <= width and box["y"] + box["height"] <= height
-            cell_w, cell_h = box["width"] / size[0], box["height"] / size[1]
-            assert cell_h >= MIN_TEXT_PX, f"rows of {cell_h:.1f} px cannot hold {MIN_TEXT_PX} px text"
-            steps = await _layout(tmp_path_factory.mktemp("layout"), size, language)
-
-            def pixels(region) -> tuple[float, float, float, float]:
-                return (
-                    box["x"] + region.x * cell_w,
-                    box["y"] + region.y * cell_h,
-                    box["x"] + region.right * cell_w,
-                    box["y"] + region.bottom * cell_h,
+        questionnaire = load_questionnaire()
+        explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
+        answered = 0
+        for name, target, regions in steps:
+            for region in regions:
+                left, top, right, bottom = kiosk_page.pixels(region)
+                assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
+                    f"{name}: an answer at {left:.0f},{top:.0f}-{right:.0f},{bottom:.0f} px is not "
+                    f"inside the {width}x{height} viewport"
                 )
-
-            questionnaire = load_questionnaire()
-            explanation = " ".join(questionnaire.message("explanation", language).split()[:3])
-            answered = 0
-            for name, target, regions in steps:
-                for region in regions:
-                    left, top, right, bottom = pixels(region)
-                    assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
-                        f"{name}: an answer at {left:.0f},{top:.0f}-{right:.0f},{bottom:.0f} px is not "
-                        f"inside the {width}x{height} viewport"
-                    )
-                if name == "language":  # the welcome is on the page
-                    await wait_until(page, shown_since(language_name(language), 0), "the welcome")
-                elif name == "start":  # the explanation is on the page
-                    await wait_until(page, shown_since(explanation, tapped_at), "the explanation")
-                elif regions:  # this question is open on the page: its text replaced the last one's
-                    text = _opening(questionnaire.item(name).patient_text_in(language))
-                    await wait_until(page, shown_since(text, tapped_at), f"{name} on the page")
-                left, top, right, bottom = pixels(target)
-                # and what is tapped drawn where the headless app put it, as the patient sees it
-                await wait_until_drawn(
-                    page, (left, top, right, bottom), cell_h, ANSWER_RGB if regions else ACTION_RGB, f"{name}'s button"
-                )
-                tapped_at = len(painted.data)
-                await page.mouse.click((left + right) / 2, (top + bottom) / 2)
-                if regions:
-                    answered += 1
-                    await wait_until(page, lambda: len(_answers(database)) == answered, f"{name} stored")
-            assert [a[0] for a in _answers(database)] == [s[0] for s in steps[2:]]
-            assert outside == [], f"the page fetched from outside this machine: {outside}"
-        finally:
-            await browser.close()
+            if name == "language":  # the welcome is on the page
+                await wait_until(page, since(0, language_name(language)), "the welcome")
+            elif name == "start":  # the explanation is on the page
+                await wait_until(page, since(tapped_at, explanation), "the explanation")
+            elif regions:  # this question is open on the page: its text replaced the last one's
+                text = _opening(questionnaire.item(name).patient_text_in(language))
+                await wait_until(page, since(tapped_at, text), f"{name} on the page")
+            # and what is tapped drawn where the headless app put it, as the patient sees it
+            tapped_at = await kiosk_page.tap_drawn(target, ANSWER_RGB if regions else ACTION_RGB, f"{name}'s button")
+            if regions:
+                answered += 1
+                await wait_until(page, lambda: len(answers(database)) == answered, f"{name} stored")
+        assert [a[0] for a in answers(database)] == [s[0] for s in steps[2:]]
+        outside = [url for url in kiosk_page.requested if not url.startswith(LOCAL)]
+        assert outside == [], f"the page fetched from outside this machine: {outside}"

@@ -19,21 +19,16 @@ from .helpers import screen_name, settle, until_drawn
 from .serving import (
     ACTION_RGB,
     ANSWER_RGB,
-    CHROMIUM,
-    CHROMIUM_ARGS,
+    NEEDS_CHROMIUM,
     PATIENCE_S,
-    TOKEN,
-    Painted,
+    answers,
+    open_page,
     serve,
     wait_until,
     wait_until_drawn,
 )
-from .test_served import _answers
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="Debian's chromium is not installed (.ci/run installs it)"),
-]
+pytestmark = NEEDS_CHROMIUM
 
 #: the served kiosk's PIN (tests/kiosk/ui/serving.py writes it into its configuration)
 SERVED_PIN = "246813"
@@ -120,107 +115,77 @@ async def test_the_gap_keeps_the_answer_in_view_and_staff_reach_everything_by_to
     tmp_path, tmp_path_factory, viewport, fontsize
 ):
     from PIL import Image
-    from playwright.async_api import async_playwright
 
     width, height = viewport
     with serve(tmp_path, between_questions_s=GAP_S) as served:
-        async with async_playwright() as pw:
-            browser = await pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-            try:
-                page = await browser.new_page(viewport={"width": width, "height": height})
-                painted = Painted(page)
-                await page.goto(served.url(f"/?token={TOKEN}" + (f"&fontsize={fontsize}" if fontsize else "")))
-                screen = page.locator(".xterm-screen")
-                await screen.wait_for(timeout=PATIENCE_S * 1000)
-                await page.wait_for_function(
-                    "document.body.classList.contains('-first-byte')", timeout=PATIENCE_S * 1000
+        async with open_page(served, viewport, fontsize) as kiosk_page:
+            page, painted, pixels = kiosk_page.page, kiosk_page.painted, kiosk_page.pixels
+            box, cell_w, cell_h = kiosk_page.box, kiosk_page.cell_w, kiosk_page.cell_h
+            since = painted.since
+            where = await _twin(tmp_path_factory.mktemp("twin"), kiosk_page.size)
+
+            async def tap(region, rgb: tuple[int, int, int] | None = None, what: str = "") -> int:
+                """A tap wholly inside the viewport (once drawn in ``rgb``, when given)."""
+                left, top, right, bottom = pixels(region)
+                assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
+                    f"{region} is not wholly inside the {width}x{height} viewport"
                 )
-                query = dict(p.split("=") for p in painted.sockets[0].url.split("?", 1)[1].split("&"))
-                size = (int(query["width"]), int(query["height"]))
-                box = await screen.bounding_box()
-                cell_w, cell_h = box["width"] / size[0], box["height"] / size[1]
-                where = await _twin(tmp_path_factory.mktemp("twin"), size)
+                return await (kiosk_page.tap(region) if rgb is None else kiosk_page.tap_drawn(region, rgb, what))
 
-                def pixels(region) -> tuple[float, float, float, float]:
-                    return (
-                        box["x"] + region.x * cell_w,
-                        box["y"] + region.y * cell_h,
-                        box["x"] + region.right * cell_w,
-                        box["y"] + region.bottom * cell_h,
-                    )
+            # the patient: Spanish, Start, an answer; its words stay drawn through the gap
+            await wait_until(page, painted.shows("Español"), "the welcome")
+            await tap(where["language"], ACTION_RGB, "Español")
+            await wait_until(page, painted.shows("Empezar"), "the explanation")
+            await tap(where["start"], ACTION_RGB, "Empezar")
+            await wait_until(page, painted.shows("Tienen que darme"), "the first question")
+            tapped = await tap(where["answer"], ANSWER_RGB, "answer 2")
+            await wait_until(
+                page,
+                since(tapped, "Gracias. Siguiente pregunta", "Cambiar mi respuesta", "cortar o untar"),
+                "the gap with the chosen answer",
+            )
+            await page.mouse.move(1, 1)
+            shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
+            label = pixels(where["chosen_label"])
+            green, white = _share(shot, label, CHOSEN_RGB), _share(shot, label, (255, 255, 255))
+            # mostly the chosen green, with the words' white strokes in it (a few per cent of a
+            # wide label's box at 1920 px), never the thanks' pale green or the button's purple
+            assert green > 0.5 and white > 0.003, (
+                f"the chosen answer's words are not drawn green and white at {label}: {green:.2f} {white:.2f}"
+            )
+            assert answers(served.database) == [("feeding", 2, "touch")]
 
-                async def tap(region) -> int:
-                    left, top, right, bottom = pixels(region)
-                    assert 0 <= left and right <= width and 0 <= top and bottom <= height, (
-                        f"{region} is not wholly inside the {width}x{height} viewport"
-                    )
-                    offset = len(painted.data)
-                    await page.mouse.click((left + right) / 2, (top + bottom) / 2)
-                    return offset
-
-                def since(offset: int, *texts: str):
-                    return lambda: all(t.encode() in painted.data[offset:] for t in texts)
-
-                # the patient: Spanish, Start, an answer; its words stay drawn through the gap
-                await wait_until(page, painted.shows("Español"), "the welcome")
-                await wait_until_drawn(page, pixels(where["language"]), cell_h, ACTION_RGB, "Español")
-                await tap(where["language"])
-                await wait_until(page, painted.shows("Empezar"), "the explanation")
-                await wait_until_drawn(page, pixels(where["start"]), cell_h, ACTION_RGB, "Empezar")
-                await tap(where["start"])
-                await wait_until(page, painted.shows("Tienen que darme"), "the first question")
-                await wait_until_drawn(page, pixels(where["answer"]), cell_h, ANSWER_RGB, "answer 2")
-                tapped = await tap(where["answer"])
-                await wait_until(
-                    page,
-                    since(tapped, "Gracias. Siguiente pregunta", "Cambiar mi respuesta", "cortar o untar"),
-                    "the gap with the chosen answer",
-                )
-                await page.mouse.move(1, 1)
-                shot = Image.open(io.BytesIO(await page.screenshot())).convert("RGB")
-                label = pixels(where["chosen_label"])
-                green, white = _share(shot, label, CHOSEN_RGB), _share(shot, label, (255, 255, 255))
-                # mostly the chosen green, with the words' white strokes in it (a few per cent of a
-                # wide label's box at 1920 px), never the thanks' pale green or the button's purple
-                assert green > 0.5 and white > 0.003, (
-                    f"the chosen answer's words are not drawn green and white at {label}: {green:.2f} {white:.2f}"
-                )
-                assert _answers(served.database) == [("feeding", 2, "touch")]
-
-                # staff: five taps on the corner, the PIN on the pad's keys, a stored session
-                for _ in range(5):
-                    await page.mouse.click(box["x"] + cell_w / 2, box["y"] + cell_h / 2)
-                await wait_until(page, painted.shows("Clinician access"), "the PIN pad")
-                await wait_until_drawn(page, pixels(where["pin_back"]), cell_h, ACTION_RGB, "Back to the patient")
-                for key in where["keys"].values():
-                    left, top, right, bottom = pixels(key)
-                    assert 0 <= left and right <= width and 0 <= top and bottom <= height, key
-                for digit in SERVED_PIN:
-                    await tap(where["keys"][f"key-{digit}"])
-                home = await tap(where["keys"]["key-ok"])
-                await wait_until(page, since(home, "Stored sessions", "Back to the patient"), "the clinician home")
-                for _ in range(8):  # Down to the end of the page: the stored sessions are last
-                    await tap(where["home_down"])
-                # the cursor row is highlighted across its columns (the session id first): tap there
-                first_row = where["sessions"]._replace(y=where["sessions"].y + 1, height=1, width=10)
-                await wait_until_drawn(page, pixels(first_row), cell_h, ACTION_RGB, "the stored session's row")
-                detail = await tap(first_row)
-                await wait_until(page, since(detail, "Plot PNG", "feeding"), "the session's page")
-                exported = await tap(where["fhir"])
-                await wait_until(page, since(exported, "FHIR QuestionnaireResponse written"), "the export")
-                plot = since(exported, "VoiceInteractionQuality", "1.00", "0.50")  # its key and axis
-                # the scrolling body only (above the export's result line and the buttons)
-                body = pixels(where["fhir"]._replace(x=0, y=0, width=size[0], height=where["fhir"].y - 1))
-                for _ in range(12):  # page down to the plot, each page drawn before the next tap
-                    if plot():
-                        break
-                    before = await _body_shot(page, body)
-                    await tap(where["down"])
-                    await _until_changed(page, body, before)
-                assert plot(), "the plot was never paged into view"
-                back = await tap(where["detail_back"])
-                await wait_until(page, since(back, "Stored sessions"), "back on the clinician home")
-                patient = await tap(where["back_to_patient"])
-                await wait_until(page, since(patient, "Pregunta 1 de 10"), "back on the patient's screen")
-            finally:
-                await browser.close()
+            # staff: five taps on the corner, the PIN on the pad's keys, a stored session
+            for _ in range(5):
+                await page.mouse.click(box["x"] + cell_w / 2, box["y"] + cell_h / 2)
+            await wait_until(page, painted.shows("Clinician access"), "the PIN pad")
+            await wait_until_drawn(page, pixels(where["pin_back"]), cell_h, ACTION_RGB, "Back to the patient")
+            for key in where["keys"].values():
+                left, top, right, bottom = pixels(key)
+                assert 0 <= left and right <= width and 0 <= top and bottom <= height, key
+            for digit in SERVED_PIN:
+                await tap(where["keys"][f"key-{digit}"])
+            home = await tap(where["keys"]["key-ok"])
+            await wait_until(page, since(home, "Stored sessions", "Back to the patient"), "the clinician home")
+            for _ in range(8):  # Down to the end of the page: the stored sessions are last
+                await tap(where["home_down"])
+            # the cursor row is highlighted across its columns (the session id first): tap there
+            first_row = where["sessions"]._replace(y=where["sessions"].y + 1, height=1, width=10)
+            detail = await tap(first_row, ACTION_RGB, "the stored session's row")
+            await wait_until(page, since(detail, "Plot PNG", "feeding"), "the session's page")
+            exported = await tap(where["fhir"])
+            await wait_until(page, since(exported, "FHIR QuestionnaireResponse written"), "the export")
+            plot = since(exported, "VoiceInteractionQuality", "1.00", "0.50")  # its key and axis
+            # the scrolling body only (above the export's result line and the buttons)
+            body = pixels(where["fhir"]._replace(x=0, y=0, width=kiosk_page.size[0], height=where["fhir"].y - 1))
+            for _ in range(12):  # page down to the plot, each page drawn before the next tap
+                if plot():
+                    break
+                before = await _body_shot(page, body)
+                await tap(where["down"])
+                await _until_changed(page, body, before)
+            assert plot(), "the plot was never paged into view"
+            back = await tap(where["detail_back"])
+            await wait_until(page, since(back, "Stored sessions"), "back on the clinician home")
+            patient = await tap(where["back_to_patient"])
+            await wait_until(page, since(patient, "Pregunta 1 de 10"), "back on the patient's screen")

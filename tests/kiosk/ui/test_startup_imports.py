@@ -37,6 +37,7 @@ NOT_BEFORE_THE_WELCOME = (
     "kiosk.ui.screens.out_of_order",
     "kiosk.ui.screens.visit_ready",
     "kiosk.ui.screens.pin",  # when staff ask for the PIN pad
+    "kiosk.ui.widgets.keypad",  # with the PIN pad or the visit code pad
     "kiosk.ui.widgets.answer_button",
     "kiosk.ui.widgets.change_answer",
     "kiosk.ui.widgets.confirm_panel",
