@@ -265,6 +265,8 @@ class ClinicianScreen(KioskScreen):
     """Base of the screens behind the PIN; the patient's screen waits underneath until they close.
     A screen with :func:`staff_nav` pages its ``.staff-body`` with Up and Down."""
 
+    #: their rules, read when the first of them is shown (beside this module): not at the welcome
+    CSS_PATH = "staff.tcss"
     BINDINGS = [("escape", "close", "Back")]
 
     @on(Button.Pressed, "#page-up")
