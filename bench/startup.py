@@ -10,8 +10,11 @@ so machine load hits both alike; the medians' ratio is the figure. The CPU secon
 to the welcome (its rusage when killed there) are reported too: they move less with machine load
 than the wall clock. ``kiosk_phases`` splits the kiosk's start (imports, build_app, the first frame
 drawn headless) in one process, to show where the time goes. Also reports ``python -X importtime``
-of ``kiosk.ui.app``'s heaviest imports and the load average before and after. Prints JSON.
-Run: uv run python bench/startup.py [--rounds N]
+of ``kiosk.ui.app``'s heaviest imports and the load average before and after. ``--instructions``
+also counts the instructions each app runs to its welcome under valgrind's callgrind (same
+pseudo-terminal; about two minutes): a figure the machine's load does not move, unlike the others
+(on a 2-core machine their medians move by a fifth between runs). Prints JSON.
+Run: uv run python bench/startup.py [--rounds N] [--instructions]
 """
 
 from __future__ import annotations
