@@ -149,7 +149,7 @@ def syntax_problem(expression: str) -> str | None:
     fhirpathpy's own parser recovers from errors silently, so this runs its grammar with a
     listener that keeps them, and insists the whole text was read."""
     from antlr4 import CommonTokenStream, InputStream, Token  # type: ignore[import-untyped]  # ships no hints
-    from antlr4.error.ErrorListener import ErrorListener  # type: ignore[import-untyped]
+    from antlr4.error.ErrorListener import ErrorListener  # type: ignore[import-untyped]  # ships no hints
     from fhirpathpy.parser.generated.FHIRPathLexer import FHIRPathLexer
     from fhirpathpy.parser.generated.FHIRPathParser import FHIRPathParser
 

@@ -210,7 +210,7 @@ class SessionDetailScreen(ClinicianScreen):
     def _staff_entered(self, event: StaffItems.Entered) -> None:
         """Store what staff entered (audited in the session's log), then show the session again."""
         event.stop()
-        store = self.app.controller.store  # type: ignore[attr-defined]
+        store = self.app.controller.store  # type: ignore[attr-defined]  # self.app is typed as Textual's App; it is the KioskApp
         item = self.q.item(event.item_id)
         points = item.option(event.option).points if event.option is not None else None
         try:
