@@ -150,13 +150,16 @@ class SessionMaker:
         the file says now. Part of a battery, the visit goes on with its remaining instruments and
         the QoS trace of its earlier ones (found in the store)."""
         from kiosk.export.captured import questionnaire_of  # a continued test only: not before the welcome
+        from qos import Engine
 
         questionnaire = questionnaire_of(stored, fallback=self.parts.questionnaire)
         place = Battery.place_of(stored)
         battery = self._battery(place.visit_id if place else None)
         if place is None or place.instruments != battery.ids or self.store is None:
-            self.battery = None  # not a battery this kiosk gives (any more): this test alone
-            engine, _ = battery.qos(0)
+            self.battery = None  # not a battery this kiosk gives (any more): this test alone, on the
+            # QoS model this kiosk runs its instrument on (the kiosk's own for one it does not give)
+            index = next((i for i, given in enumerate(battery.ids) if given == questionnaire.id), None)
+            engine = battery.qos(index)[0] if index is not None else Engine(self.parts.model)
             return Session.from_stored(questionnaire, stored, engine=engine, **battery.shared)
         before = []
         for summary in self.store.sessions():

@@ -24,13 +24,13 @@ from .test_controller import Drawn
 class BatteryKiosk:
     """A controller wired as make_kiosk wires it, configured with the Barthel then a short one."""
 
-    def __init__(self, tmp_path: Path, **store: Any) -> None:
+    def __init__(self, tmp_path: Path, mini_model: str | None = None, **store: Any) -> None:
         mini = write_mini(tmp_path)
         self.clock = SimClock()
         self.config = Config(
             data_dir=tmp_path / "data",
             familiarisation=False,
-            instruments=(InstrumentChoice("barthel"), InstrumentChoice(str(mini), mini)),
+            instruments=(InstrumentChoice("barthel"), InstrumentChoice(str(mini), mini, mini_model)),
         )
         self.store = Store.open(self.config.data_dir, **store)
         self.maker = SessionMaker(self.config, KioskParts.load(self.config), clock=self.clock, store=self.store)
@@ -112,3 +112,21 @@ def test_a_test_interrupted_in_the_first_instrument_continues_then_the_next_foll
     assert nxt is not resumed and (nxt.questionnaire.id, nxt.phase) == ("mini", Phase.REST)
     assert nxt.patient_id == resumed.patient_id and nxt.trace is resumed.trace
     assert again.store.session(first.id).status == "finished" and len(again.store.session(first.id).answers) == 10
+
+
+def test_a_test_of_a_visit_this_kiosk_no_longer_gives_continues_on_its_instruments_own_qos_model(tmp_path):
+    kiosk = BatteryKiosk(tmp_path, mini_model="kiosk_pace")
+    kiosk.controller.order_started(Order("O-2", "PAT-0043", ("mini",), "en", "patient"))  # mini alone
+    started = kiosk.controller.session
+    assert started.engine.model.name == "KioskPace"  # kiosk_pace.roqme
+    kiosk.key(1)
+    kiosk.next_deadline()
+    kiosk.key(2)
+    kiosk.store.release(started.id, "the kiosk stopped")
+    kiosk.store.close()
+
+    again = BatteryKiosk(tmp_path, mini_model="kiosk_pace")  # gives barthel then mini: not that visit
+    assert again.controller.continue_test(started.id) is None
+    resumed = again.controller.session
+    assert (resumed.id, resumed.questionnaire.id) == (started.id, "mini")
+    assert resumed.engine.model.name == "KioskPace"  # not the battery's first instrument's (clarc)
