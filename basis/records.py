@@ -115,6 +115,10 @@ def _make(cls: _T, frozen: bool, kw_only: bool) -> _T:
         cls.__eq__ = _eq  # type: ignore[assignment]  # the shared method, set on the class
     if not explicit_hash:
         cls.__hash__ = _hash if frozen else None  # type: ignore[assignment]  # as dataclass(eq=True)
+    for base in cls.__mro__[1:-1]:  # as dataclass refuses mixing frozen and mutable along a hierarchy
+        if "__record_fields__" in base.__dict__ and (base in _FROZEN) != frozen:
+            kind = "frozen" if frozen else "non-frozen"
+            raise TypeError(f"cannot inherit {kind} record {cls.__name__} from {base.__name__}")
     if frozen:
         if "__setattr__" in own or "__delattr__" in own:  # as dataclass(frozen=True) refuses
             raise TypeError(f"cannot overwrite __setattr__ or __delattr__ of frozen record {cls.__name__}")

@@ -19,7 +19,9 @@ from kiosk.core.channels import Channel, ChannelState, ChannelStatus, InputSourc
 from kiosk.ui.options import run_parser
 
 if TYPE_CHECKING:
+    from kiosk.config import Config
     from kiosk.store.database import Store
+    from kiosk.store.migrations import InForce
     from kiosk.ui.app import KioskApp
 
 
@@ -87,7 +89,7 @@ def build_app(
     return app, store.close
 
 
-def _in_force(config: Any) -> Any:
+def _in_force(config: Config) -> InForce:
     """What an upgrade of an older database attaches to its sessions (only then are the exports'
     modules needed)."""
     from kiosk.export.opening import in_force_of

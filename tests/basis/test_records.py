@@ -203,3 +203,17 @@ def test_a_frozen_record_that_writes_its_own_setattr_is_refused_as_dataclass_ref
 
     with pytest.raises(TypeError, match="__setattr__"):
         record(Mine)
+
+
+def test_frozen_and_mutable_records_do_not_mix_in_one_hierarchy_as_with_dataclass():
+    class Mutable(Point):  # a mutable record under a frozen one
+        z: int = 0
+
+    with pytest.raises(TypeError, match="non-frozen record Mutable from Point"):
+        record(frozen=False)(Mutable)
+
+    class Frozen(Box):  # a frozen record under a mutable one
+        z: int = 0
+
+    with pytest.raises(TypeError, match="frozen record Frozen from Box"):
+        record(Frozen)
