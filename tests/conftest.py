@@ -1,5 +1,6 @@
 """Fixtures every test package may use: the set-up the test run does itself (see
-:mod:`tests.prerequisites`), so ``uv run pytest`` passes on a fresh clone."""
+:mod:`tests.prerequisites`), so ``uv run pytest`` passes on a fresh clone, and the seal that keeps
+the run away from the developer's own kiosk (issue 32)."""
 
 from __future__ import annotations
 
@@ -10,27 +11,44 @@ from pathlib import Path
 
 import pytest
 
-from tests.prerequisites import ensure_npm_packages, require_debian
+from tests.prerequisites import DEVELOPER_HOME, ensure_npm_packages, require_debian
 
-#: the test run's own user cache directory and the XDG_CACHE_HOME it replaced
-_CACHE_HOME = pytest.StashKey[tuple[str, str | None]]()
+#: the variables the kiosk, the station, their libraries and libpq read from the environment:
+#: a developer's own (a data directory, a station, a Vosk model, a database) must not reach a test
+SEALED_PREFIXES = ("KIOSK_", "TEXTUAL", "PG")
+#: the tests' own switches, which a developer sets on purpose
+KEPT = frozenset({"KIOSK_E2E_SCREENSHOT"})
+#: the user directories platformdirs (data, configuration, cache, models) and Chromium derive from
+USER_DIRS = ("HOME", "XDG_CACHE_HOME", "XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_STATE_HOME")
+
+#: the test run's own home folder (removed when the run ends) and the environment it replaced
+_SEAL = pytest.StashKey[tuple[str, pytest.MonkeyPatch]]()
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """What the code keeps in the user's cache (the QoS grammar's tables, parsed models, passed
-    schema checks) goes to a directory of this test run, inherited by the processes tests start,
-    never to the user's home; it is removed when the run ends."""
-    folder = tempfile.mkdtemp(prefix="kiosk-tests-cache-")
-    config.stash[_CACHE_HOME] = (folder, os.environ.get("XDG_CACHE_HOME"))
-    os.environ["XDG_CACHE_HOME"] = folder
+    """Seal the run: every ``KIOSK_*``, ``TEXTUAL*`` and ``PG*`` variable is cleared, and HOME and
+    the XDG user directories point into one folder of this run, inherited by the processes tests
+    start; what the code keeps in the user's cache (the QoS grammar's tables, parsed models, passed
+    schema checks) goes there too, never to the user's home. Done here rather than in a fixture
+    because collection imports the code before any fixture runs."""
+    folder = tempfile.mkdtemp(prefix="kiosk-tests-home-")
+    seal = pytest.MonkeyPatch()
+    seal.setenv(DEVELOPER_HOME, os.environ.get(DEVELOPER_HOME) or str(Path.home()))  # xdist's workers inherit it
+    for name in list(os.environ):
+        if name.startswith(SEALED_PREFIXES) and name not in KEPT:
+            seal.delenv(name)
+    seal.delenv("XDG_RUNTIME_DIR", raising=False)
+    for name in USER_DIRS:
+        path = Path(folder) if name == "HOME" else Path(folder) / name.lower()
+        path.mkdir(mode=0o700, exist_ok=True)
+        seal.setenv(name, str(path))
+    seal.setenv("HYPOTHESIS_STORAGE_DIRECTORY", str(Path(folder) / "hypothesis"))  # not ./.hypothesis
+    config.stash[_SEAL] = (folder, seal)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    folder, before = config.stash[_CACHE_HOME]
-    if before is None:
-        os.environ.pop("XDG_CACHE_HOME", None)
-    else:
-        os.environ["XDG_CACHE_HOME"] = before
+    folder, seal = config.stash[_SEAL]
+    seal.undo()
     shutil.rmtree(folder, ignore_errors=True)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import fcntl
 import hashlib
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -20,6 +21,10 @@ JS = Path(__file__).parent / "kiosk" / "export" / "js"
 STAMP = JS / "node_modules" / ".installed-from-lock"
 #: serialises installs between test processes sharing this checkout
 LOCK = JS / ".npm-install.lock"
+
+#: names the developer's own home once the test run has pointed HOME at a folder of its own
+#: (tests/conftest.py): npm keeps its package cache and reads its .npmrc there
+DEVELOPER_HOME = "TESTS_DEVELOPER_HOME"
 
 _installed: set[Path] = set()
 
@@ -52,7 +57,12 @@ def ensure_npm_packages(js: Path = JS) -> Path:
                         pytrace=False,
                     )
                 done = subprocess.run(
-                    [npm, "ci", "--no-audit", "--no-fund"], cwd=js, capture_output=True, text=True, check=False
+                    [npm, "ci", "--no-audit", "--no-fund"],
+                    cwd=js,
+                    env=os.environ | {"HOME": os.environ.get(DEVELOPER_HOME) or str(Path.home())},
+                    capture_output=True,
+                    text=True,
+                    check=False,
                 )
                 if done.returncode != 0:
                     last = (done.stderr.strip() or done.stdout.strip()).splitlines()[-1:] or ["(no output)"]

@@ -109,7 +109,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self.questionnaire = controller.session.questionnaire
         #: checks the clinician PIN (a plain string: an in-memory guard, for tests and benches)
         self.pin_guard = clinician_pin if isinstance(clinician_pin, PinGuard) else PinGuard(clinician_pin)
-        self._corner = CornerTaps()
+        #: on the kiosk's own clock, so the taps' gaps are the kiosk's time, not a loaded machine's
+        self._corner = CornerTaps(now=lambda: self.session.clock.now())
         self.channels = channels = channels or KioskChannels()
         #: the latest status of every channel (the channel bar and the clinician screen show it)
         self.board = channels.board

@@ -8,12 +8,14 @@ import os
 import stat
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
 
 from fileio import cache
 from fileio.positions import parse, schema_problems
+from tests.prerequisites import DEVELOPER_HOME
 
 SCHEMA = {
     "type": "object",
@@ -85,7 +87,8 @@ def test_the_test_run_keeps_its_caches_out_of_the_users_home():
     import platformdirs
 
     folder = Path(platformdirs.user_cache_dir("kiosk")).resolve()
-    assert not folder.is_relative_to(Path.home().resolve()), folder
+    assert not folder.is_relative_to(Path(os.environ[DEVELOPER_HOME]).resolve()), folder
+    assert folder.is_relative_to(Path(tempfile.gettempdir()).resolve()), folder
 
 
 def test_a_parsed_document_asked_to_be_kept_is_read_back_without_yaml_one_with_a_problem_never(cache_home, monkeypatch):
