@@ -20,13 +20,16 @@ REMEMBERED = 32
 
 
 def private_dir(name: str) -> Path | None:
-    """``<user cache dir>/kiosk/<name>``, created 0700; None when it cannot be had, or is not this
+    """``<user cache dir>/kiosk/<name>``, both created 0700; None when it cannot be had, or is not this
     user's own or is open to others."""
     import platformdirs
 
-    folder = Path(platformdirs.user_cache_dir("kiosk")) / name
+    top = Path(platformdirs.user_cache_dir("kiosk"))
+    folder = top / name
     try:
-        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        top.parent.mkdir(parents=True, exist_ok=True)  # ~/.cache, as any program makes it
+        for level in (top, folder):  # 0700 like the data directory (issue 32: the top was 0755)
+            level.mkdir(mode=0o700, exist_ok=True)
         status = folder.stat()
     except OSError:
         return None

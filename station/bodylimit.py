@@ -5,12 +5,18 @@ A declared ``Content-Length`` over the cap is refused before a byte is read; a b
 one (chunked) is counted as it arrives and refused once past the cap, so an unauthenticated
 client can never make the station hold more than :data:`MAX_FORM` bytes of it. The answer is
 413 with one sentence, and the connection is closed (the rest of the body is never read).
+
+A client that leaves before its whole body has arrived (a phone losing the ward's Wi-Fi, a tab
+closed mid-upload) is answered by nobody and logged by nobody: there is no one to tell, and the
+ASGI traceback it used to leave in the log hid real faults (issue 32). That holds on every path,
+the kiosk API's included.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+from starlette.requests import ClientDisconnect
 from starlette.responses import PlainTextResponse
 
 #: the station's forms are a name, a password, a reason, a CSRF token: a few hundred bytes
@@ -29,7 +35,16 @@ class BodyLimit:
         self.app, self.limit, self.skip = app, limit, skip
 
     async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
-        if scope["type"] != "http" or scope["path"].startswith(self.skip):
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        try:
+            await self._limited(scope, receive, send)
+        except ClientDisconnect:
+            pass  # the client left mid-body: nobody is there to answer, nothing was stored
+
+    async def _limited(self, scope: Any, receive: Any, send: Any) -> None:
+        if scope["path"].startswith(self.skip):
             await self.app(scope, receive, send)
             return
         declared = dict(scope["headers"]).get(b"content-length", b"")
@@ -37,12 +52,15 @@ class BodyLimit:
             await self._refuse(scope, receive, send)
             return
         seen = 0
-        started = False
+        started = whole = False
 
         async def counted() -> Any:
-            nonlocal seen
+            nonlocal seen, whole
             message = await receive()
+            if message["type"] == "http.disconnect" and not whole:  # mid-body: the route stops here
+                raise ClientDisconnect  # (after the body, a disconnect is a stream's normal end)
             if message["type"] == "http.request":
+                whole = not message.get("more_body", False)
                 seen += len(message.get("body", b""))
                 if seen > self.limit:
                     raise _TooLarge

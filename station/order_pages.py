@@ -17,6 +17,7 @@ from starlette.routing import Route
 
 from station import orders, validation, ward
 from station.api_orders import ORDER_LANE
+from station.redirects import see_other
 from station.rendering import checked_form, render
 
 
@@ -80,8 +81,8 @@ async def create_order(request: Request) -> Response:
         # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
         order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
     except orders.OrderError as exc:
-        keep = "&".join(f"{k}={quote(form.get(k, ''))}" for k in ("kiosk", "patient_id", "language"))
-        return RedirectResponse(f"/orders?error={quote(str(exc))}&{keep}", status_code=303)
+        keep = {k: str(form.get(k, "")) for k in ("kiosk", "patient_id", "language")}
+        return see_other("/orders", error=str(exc), fields=keep)
     return RedirectResponse(f"/orders/{order.id}", status_code=303)
 
 
@@ -100,7 +101,7 @@ async def cancel_order(request: Request) -> Response:
     try:
         order = await run_in_threadpool(orders.cancel, engine, order_id, request.state.user, form.get("reason", ""))
     except orders.OrderError as exc:
-        return RedirectResponse(f"/orders/{quote(order_id)}?message={quote(str(exc))}", status_code=303)
+        return see_other(f"/orders/{quote(order_id)}", message=str(exc))
     await run_in_threadpool(request.app.state.bus.publish, {"type": "order", "kiosk": order.kiosk_id})
     return RedirectResponse(f"/orders/{quote(order_id)}?message={quote('Cancelled.')}", status_code=303)
 

@@ -12,12 +12,11 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 from typing import Any
-from urllib.parse import quote
 
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
-from starlette.responses import PlainTextResponse, RedirectResponse, Response
+from starlette.responses import PlainTextResponse, Response
 from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire, Score
@@ -29,6 +28,7 @@ from kiosk.store.database import StoredSession
 from station import db, exports, order_progress, staff_items, validation, ward
 from station.download import attachment
 from station.plot import INCIDENTS, qos_svg
+from station.redirects import see_other
 from station.rendering import checked_form, render, templates
 from station.result_pages import ward_results
 from station.sessions import NotFound, load
@@ -79,7 +79,7 @@ async def ward_page(request: Request) -> Response:
 
 
 def _back(request: Request, message: str | None = None, to: str = "/") -> Response:
-    return RedirectResponse(f"{to}?message={quote(message)}" if message else to, status_code=303)
+    return see_other(to, message=message) if message else see_other(to)
 
 
 async def acknowledge(request: Request) -> Response:

@@ -16,7 +16,7 @@ from urllib.parse import quote
 from sqlalchemy.engine import Engine
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
-from starlette.responses import RedirectResponse, Response
+from starlette.responses import Response
 from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire
@@ -25,6 +25,7 @@ from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import StoredSession
 from station import db
 from station.auth import User
+from station.redirects import see_other
 from station.rendering import checked_form
 from station.sessions import NotFound, load
 from station.validation import ValidationError, _check_open, _locked, review_of
@@ -81,7 +82,7 @@ async def enter_page(request: Request) -> Response:
         message = f"{item_id} entered."
     except (ValidationError, NotFound) as exc:
         message = str(exc)
-    return RedirectResponse(f"/sessions/{session_id}?message={quote(message)}", status_code=303)
+    return see_other(f"/sessions/{quote(session_id)}", message=message)
 
 
 routes = [Route("/sessions/{session_id}/staff/{item_id}", enter_page, methods=["POST"])]

@@ -15,6 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 import anyio.to_thread
 from sqlalchemy.engine import Engine
@@ -50,6 +51,8 @@ ROUTINE_WORKERS = 12
 #: threads for staff's login check alone: a nurse's order or sign-off never waits for it behind the
 #: kiosks' routine rows in the shared workers (measured: up to 375 ms there, bench/station.py)
 STAFF_LANE = ThreadPoolExecutor(max_workers=2, thread_name_prefix="station-staff")
+#: the longest page address a login sends the browser back to (a longer one goes to the ward view)
+MAX_NEXT = 512
 SECURITY_HEADERS = {
     # no inline script or style, nothing from elsewhere: the pages work with the network cut
     "content-security-policy": "default-src 'self'; img-src 'self' data:; frame-ancestors 'none'; form-action 'self'",
@@ -160,7 +163,8 @@ class LoginRequired:
         request = Request(scope, receive)
         found = await asyncio.get_running_loop().run_in_executor(STAFF_LANE, current_user, request)
         if found is None:
-            response: Response = RedirectResponse(f"/login?next={scope['path']}", status_code=303)
+            back = scope["path"] if len(scope["path"]) <= MAX_NEXT else "/"  # never a huge Location
+            response: Response = RedirectResponse(f"/login?next={quote(back)}", status_code=303)
             await response(scope, receive, send)
             return
         scope.setdefault("state", {})["user"] = found

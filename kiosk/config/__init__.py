@@ -146,6 +146,24 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     return Config(**values, source=Path(path) if path is not None else None)
 
 
+def _block_lines(text: str) -> list[str]:
+    """The file's lines, with a mapping written in flow style (``{}``, ``{language: en}``) turned
+    into block style first, so that a ``key: value`` line can be added after it (issue 32: after
+    ``{}`` it was a YAML error at line 2). A file that is not YAML is left to :func:`load_config`."""
+    import yaml
+
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        return text.splitlines()
+    if not isinstance(root, yaml.MappingNode) or not root.flow_style:
+        return text.splitlines()
+    data = yaml.safe_load(text)
+    comments = [line for line in text.splitlines() if line.lstrip().startswith("#")]
+    block = yaml.safe_dump(data, default_flow_style=False, sort_keys=False, allow_unicode=True) if data else ""
+    return comments + block.splitlines()
+
+
 def write_settings(path: Path, changes: Mapping[str, str | None]) -> None:
     """Set (or, with None, remove) top-level settings of a configuration file, keeping its other
     lines and comments; the file is created if missing, and always left owner-only (0600).
@@ -154,7 +172,7 @@ def write_settings(path: Path, changes: Mapping[str, str | None]) -> None:
     leaves the old file as it was. Raises :class:`ConfigError`.
     """
     try:
-        lines = read_text(path).splitlines() if path.exists() else []
+        lines = _block_lines(read_text(path)) if path.exists() else []
     except BadFile as exc:
         raise ConfigError(str(exc)) from None
     for key, value in changes.items():

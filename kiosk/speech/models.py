@@ -178,7 +178,9 @@ def install(language: str, url: str | None = None, sha256: str | None = None, in
     expected = expected.strip().lower()
 
     parent = models_dir() / "vosk"
-    parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+    parent.parent.parent.mkdir(mode=0o700, parents=True, exist_ok=True)  # the app's own folder too
+    for level in (parent.parent, parent):
+        level.mkdir(mode=0o700, exist_ok=True)
     archive, got_sha256, got_md5 = _download(url, parent)
     unpacked: Path | None = None
     try:

@@ -116,3 +116,11 @@ def test_a_parsed_document_asked_to_be_kept_is_read_back_without_yaml_one_with_a
     for _ in range(2):  # the same problem every time: it is never kept
         assert parse(bad, "doc.yaml", keep=True)[2][0].message == "duplicate key 'points'"
     assert list(kept.parent.glob("*.pickle")) == [kept]
+
+
+def test_the_cache_folder_and_the_kiosks_folder_above_it_are_owner_only(tmp_path, monkeypatch):
+    """Issue 32: ``<cache>/kiosk`` was made 0755 (only the folder below it was 0700)."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "fresh"))
+    folder = cache.private_dir("checked")
+    assert folder is not None
+    assert [oct(stat.S_IMODE(p.stat().st_mode)) for p in (folder.parent, folder)] == ["0o700", "0o700"]

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.ui.serve.guard import COOKIE
+from kiosk.config import load_config
+from kiosk.ui.serve.guard import COOKIE, token_digest
 from kiosk.ui.widgets.text import ui_text
 
 from .serving import CHROMIUM, CHROMIUM_ARGS, PATIENCE_S, TOKEN, Painted, free_port, serve, wait_until
@@ -194,3 +195,23 @@ def test_serving_without_a_device_key_is_refused_with_the_way_to_set_one_up(tmp_
     token = made.stdout.split("?token=")[1].split("&")[0]
     assert token not in config.read_text() and "language: en" in config.read_text()
     assert oct(config.stat().st_mode & 0o777) == "0o600"
+
+
+@pytest.mark.parametrize(
+    ("text", "show_score"), [("{}\n", False), ("# bed 2\n{show_score_to_patient: true}\n", True)], ids=["empty", "flow"]
+)
+def test_a_new_device_key_is_written_into_a_configuration_in_flow_style(tmp_path, text, show_score):
+    """Issue 32: after ``{}`` the added key was a YAML error at line 2."""
+    config = tmp_path / "config.yaml"
+    config.write_text(text)
+    made = subprocess.run(
+        [sys.executable, "-m", "kiosk", "serve", "--new-token", "--config", str(config)],
+        capture_output=True,
+        text=True,
+        timeout=PATIENCE_S,
+    )
+    assert made.returncode == 0 and "?token=" in made.stdout and made.stderr == "", made.stderr
+    token = made.stdout.split("?token=")[1].split("&")[0]
+    loaded = load_config(config, environ={})
+    assert loaded.serve_token_sha256 == token_digest(token)
+    assert loaded.show_score_to_patient is show_score and text.count("#") == config.read_text().count("#")
