@@ -68,7 +68,8 @@ async def get_orders(request: Request) -> Response:
 
 async def post_start(request: Request) -> Response:
     """``{"code": "1234"}``: 200 with the order started, 404 when no waiting visit of this kiosk
-    has that code, 429 after too many wrong codes."""
+    has that code, 429 when the code came before its slot after wrong codes (``Retry-After`` and
+    ``retry_after_s`` say when any code, the right one included, will be checked)."""
     if request.headers.get("authorization") is None:
         return _unauthorised()
     try:
@@ -89,7 +90,11 @@ async def post_start(request: Request) -> Response:
     except _Unauthorised:
         return _unauthorised()
     except orders.TooManyCodes as exc:
-        return _error(429, str(exc))
+        return JSONResponse(
+            {"error": str(exc), "retry_after_s": exc.retry_after_s},
+            status_code=429,
+            headers={"retry-after": str(exc.retry_after_s)},
+        )
     if started is None:
         return _error(404, "no visit ordered for this kiosk has that code")
     return JSONResponse({"order": started})

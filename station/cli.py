@@ -26,6 +26,7 @@ import sys
 from pathlib import Path
 
 from fileio.bounded import BadFile, read_text
+from kiosk.core.visits import DEFAULT_ID_PATTERN, pattern_problem
 from station import auth, db, roles, throttle
 
 ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate")
@@ -73,6 +74,13 @@ def _parser() -> argparse.ArgumentParser:
         metavar="ADDRESS",
         help="a reverse proxy (address or network) whose X-Forwarded-For names the client; "
         "repeat for each (default: none, the peer's own address counts)",
+    )
+    parser.add_argument(
+        "--patient-id-pattern",
+        metavar="REGEX",
+        default=DEFAULT_ID_PATTERN,
+        help="the site's patient identifiers, matched whole (default: digits with at most four letters "
+        "in front, such as NHC-0012345); the kiosks' patient_id_pattern should say the same",
     )
     parser.add_argument(
         "--insecure-lan",
@@ -197,6 +205,8 @@ def _serve(argv: list[str]) -> int:
         proxies = throttle.parse_proxies(args.trusted_proxy)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    if (problem := pattern_problem(args.patient_id_pattern)) is not None:
+        raise UsageError(problem.replace("patient_id_pattern", "--patient-id-pattern", 1))
     import uvicorn
 
     from station.web import create_app
@@ -206,7 +216,7 @@ def _serve(argv: list[str]) -> int:
     warning = roles.guard_warning(engine)
     if warning:
         print(warning, file=sys.stderr, flush=True)
-    app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies)
+    app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies, id_pattern=args.patient_id_pattern)
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})", flush=True)
     # failed and refused logins are logged here (station.security), one line each

@@ -67,6 +67,7 @@ async def create_order(request: Request) -> Response:
             engine,
             kiosk_id=form.get("kiosk", ""),
             patient_id=form.get("patient_id", ""),
+            id_pattern=request.app.state.id_pattern,
             instruments=chosen,
             language=form.get("language", ""),
             relative=form.get("relative") == "yes",

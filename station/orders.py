@@ -20,6 +20,7 @@ order's id (``order-…``), so an order's history reads like a session's.
 from __future__ import annotations
 
 import json
+import math
 import secrets
 from collections.abc import Sequence
 from datetime import UTC, datetime
@@ -29,14 +30,16 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
 from basis import record
-from kiosk.core.visits import HOSPITAL_ID
+from kiosk.core.visits import DEFAULT_ID_PATTERN, HOSPITAL_ID
+from kiosk.core.visits import check_patient_id as identifier_problem
 from station import db
 from station.db import audit, code_failures, kiosks, orders
 
-#: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit.
-#: No spaces, dots or apostrophes, and a digit required, so "Maria Lopez", "O'Neill" or "LOPEZ"
-#: are refused: identifiers such as "NHC-0012345" or "12345678" are what a ward types. The kiosk's
-#: clinician screen checks the same rule (one definition, in kiosk.core.visits).
+#: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit,
+#: and, where staff type one, the site's pattern (digit-dominant by default), so "Maria Lopez",
+#: "LOPEZ" or "MariaLopez19450312" are refused: identifiers such as "NHC-0012345" or "12345678"
+#: are what a ward types. The kiosk's clinician screen checks the same rule (one definition, in
+#: kiosk.core.visits: check_patient_id).
 PATIENT_ID = HOSPITAL_ID
 STATES = ("ordered", "in_progress", "awaiting_validation", "signed_off", "cancelled")
 WORDS = {
@@ -49,9 +52,13 @@ WORDS = {
 OPEN = ("ordered", "in_progress")
 #: digits of the confirmation code typed at the kiosk
 CODE_DIGITS = 4
-#: wrong codes a kiosk may send within the window before the station stops checking them
-MAX_CODE_FAILURES = 5
+#: wrong codes are throttled by spacing the kiosk's checks, never by refusing its right code
+#: (issue 32; docs/visit-code.md): with n wrong codes in the last CODE_WINDOW_S, the next check
+#: waits CODE_GAPS_S[n] (the last entry beyond) after the latest one. A typo costs nothing, a
+#: second 15 s; a guesser settles at one check per 120 s, the 5 per 10 minutes of the lockout
+#: this replaces, and staff with the right code wait at most 120 s, whatever was typed before.
 CODE_WINDOW_S = 10 * 60
+CODE_GAPS_S = (0, 0, 15, 60, 120)
 #: who may order (every staff role) and who signs off (doctors: station.validation)
 ORDER_ROLES = ("nurse", "doctor")
 #: orders one member of staff may place within the window (a ward round is a few dozen at most:
@@ -65,9 +72,13 @@ class OrderError(ValueError):
 
 
 class TooManyCodes(OrderError):
-    """The kiosk sent too many wrong codes lately."""
+    """The kiosk's next code cannot be checked yet: :attr:`retry_after_s` says when it can."""
 
     status = 429
+
+    def __init__(self, retry_after_s: int) -> None:
+        self.retry_after_s = retry_after_s
+        super().__init__(f"after wrong codes the station checks the next one in {retry_after_s} seconds")
 
 
 class LinkRefused(OrderError):
@@ -119,16 +130,15 @@ class Order:
         }
 
 
-def check_patient_id(value: str) -> str:
-    """The identifier, stripped, if it is pseudonymous (:data:`PATIENT_ID`); else OrderError."""
+def check_patient_id(value: str, pattern: str = DEFAULT_ID_PATTERN) -> str:
+    """The identifier, stripped, if it is pseudonymous (:data:`PATIENT_ID`) and matches the site's
+    ``pattern``; else OrderError."""
     value = value.strip()
     if not value:
         raise OrderError("patient identifier: give the identifier the hospital uses (e.g. NHC-0012345)")
-    if not PATIENT_ID.match(value):
-        raise OrderError(
-            f"patient identifier {value[:64]!r}: use the hospital's identifier, 2-64 letters, digits, "
-            "'-' or '_' with at least one digit, never a name"
-        )
+    problem = identifier_problem(value, pattern)
+    if problem is not None:
+        raise OrderError(f"patient identifier: {problem}")
     return value
 
 
@@ -186,11 +196,13 @@ def create(
     by: Any,
     known_instruments: Sequence[str],
     languages: Sequence[str],
+    id_pattern: str = DEFAULT_ID_PATTERN,
 ) -> Order:
-    """Order a visit (a nurse or a doctor); returns it with its confirmation code."""
+    """Order a visit (a nurse or a doctor) for a patient whose identifier ``id_pattern`` (the
+    site's rule) matches; returns it with its confirmation code."""
     if by.role not in ORDER_ROLES:
         raise OrderError("only nurses and doctors may order a visit")
-    patient_id = check_patient_id(patient_id)
+    patient_id = check_patient_id(patient_id, id_pattern)
     chosen = [i for i in dict.fromkeys(instruments) if i]
     if not chosen:
         raise OrderError("instruments: choose at least one")
@@ -313,20 +325,32 @@ def cancel(engine: Engine, order_id: str, by: Any, reason: str) -> Order:
         return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
 
 
+def next_check_in(connection: Connection, kiosk_id: str, now: float) -> float:
+    """Seconds until the station checks the kiosk's next code (0 or less: now): the gap of
+    :data:`CODE_GAPS_S` for its wrong codes in the window, counted from the latest of them."""
+    failures, latest = connection.execute(
+        sa.select(sa.func.count(), sa.func.max(code_failures.c.at)).where(
+            code_failures.c.kiosk_id == kiosk_id, code_failures.c.at > now - CODE_WINDOW_S
+        )
+    ).one()
+    if not failures:
+        return 0.0
+    return float(latest) + CODE_GAPS_S[min(failures, len(CODE_GAPS_S) - 1)] - now
+
+
 def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
     """The kiosk's staff typed ``code``: the kiosk's ordered visit with that code moves to in
     progress and is returned; None for a wrong code, which is counted (in the caller's
-    transaction, so commit it); after :data:`MAX_CODE_FAILURES` within
-    :data:`CODE_WINDOW_S` the kiosk gets :class:`TooManyCodes` until the window passes. Another
-    kiosk's order is never found: the code is looked up among this kiosk's orders only."""
-    since = db.now() - CODE_WINDOW_S
-    failures = connection.execute(
-        sa.select(sa.func.count())
-        .select_from(code_failures)
-        .where(code_failures.c.kiosk_id == kiosk_id, code_failures.c.at > since)
-    ).scalar_one()
-    if failures >= MAX_CODE_FAILURES:
-        raise TooManyCodes(f"too many wrong codes from this kiosk: wait {CODE_WINDOW_S // 60} minutes")
+    transaction, so commit it). A code sent before its slot (:func:`next_check_in`) is not looked
+    at: :class:`TooManyCodes` says when to send it again, and any code sent then, the right one
+    included, is checked. Callers hold the kiosk's row (``auth.touch_kiosk``), so concurrent
+    guesses take their slots one by one. Another kiosk's order is never found: the code is looked
+    up among this kiosk's orders only."""
+    now = db.now()
+    since = now - CODE_WINDOW_S
+    wait = next_check_in(connection, kiosk_id, now)
+    if wait > 0:
+        raise TooManyCodes(math.ceil(wait))
     code = str(code).strip()
     row = None
     if code.isdigit() and len(code) == CODE_DIGITS:
@@ -337,7 +361,7 @@ def start(connection: Connection, kiosk_id: str, code: str) -> Order | None:
         ).first()
     if row is None:
         connection.execute(code_failures.delete().where(code_failures.c.at < since))
-        connection.execute(code_failures.insert().values(kiosk_id=kiosk_id, at=db.now()))
+        connection.execute(code_failures.insert().values(kiosk_id=kiosk_id, at=now))
         return None
     connection.execute(
         orders.update().where(orders.c.id == row.id).values(state="in_progress", updated_at=db.now_iso())

@@ -29,6 +29,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
+from kiosk.core.visits import DEFAULT_ID_PATTERN
 from station import (
     api,
     api_orders,
@@ -184,9 +185,10 @@ def create_app(
     questionnaire: Questionnaire | None = None,
     https: bool = False,
     trusted_proxies: tuple[throttle.Network, ...] = (),
+    id_pattern: str = DEFAULT_ID_PATTERN,
 ) -> Starlette:
     """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
-    from ``trusted_proxies``."""
+    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole."""
     bus = Bus(engine)
     q = questionnaire or load_questionnaire()
 
@@ -232,6 +234,7 @@ def create_app(
     app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
+    app.state.id_pattern = id_pattern
     app.state.live = Live(
         bus,
         lambda name: pages.kiosk_event(app, name),

@@ -26,6 +26,7 @@ from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.core.questionnaire import SCREEN_LANGUAGES, Timing
 from kiosk.core.questionnaire.loading import bundled_path
 from kiosk.core.site import default_kiosk_id
+from kiosk.core.visits import pattern_problem
 from qos import bundled_models
 
 
@@ -105,6 +106,8 @@ def _read(path: Path) -> dict[str, Any]:
             raise fail((key,), f"language must be one of {', '.join(SCREEN_LANGUAGES)}")
         elif key in ("site", "kiosk_id") and (not isinstance(value, str) or not KIOSK_ID.fullmatch(value)):
             raise fail((key,), f"{key} must be 1-64 letters, digits, '.', '-' or '_' (it goes into identifiers)")
+        elif key == "patient_id_pattern" and (problem := pattern_problem(value)) is not None:
+            raise fail((key,), problem)
         elif key == "fhir":
             if not isinstance(value, dict):
                 raise fail((key,), "fhir must be a mapping such as {patient_system: https://example.org/sid/patient}")

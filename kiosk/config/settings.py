@@ -13,6 +13,7 @@ import platformdirs
 from basis import record
 from kiosk.core.pin import DEFAULT_PIN
 from kiosk.core.site import ExportSite, default_kiosk_id
+from kiosk.core.visits import DEFAULT_ID_PATTERN
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
@@ -125,6 +126,9 @@ class Config:
     #: an unordered test may be started at the welcome (stored and shown as a walk-up); false: only
     #: a visit ordered from the station or started by staff on the clinician screen
     walk_up: bool = True
+    #: the site's rule for the patient identifiers staff type (a regular expression matched whole;
+    #: kiosk.core.visits.DEFAULT_ID_PATTERN: digits with at most four letters in front)
+    patient_id_pattern: str = DEFAULT_ID_PATTERN
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)

@@ -18,9 +18,16 @@ from basis import record
 
 WALK_UP = "walk-up"
 STAFF = "staff"
-#: a patient identifier as a hospital gives it: 2-64 letters, digits, '-' or '_' and at least one
-#: digit, so that no name ("Maria Lopez", "LOPEZ") is ever taken for one (same rule as the station)
+#: what every patient identifier is, whatever the site: 2-64 letters, digits, '-' or '_' with at
+#: least one digit (what the store and the station's rows accept)
 HOSPITAL_ID = re.compile(r"^(?=.*[0-9])[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
+#: the identifier rule where staff type one (the station's order form, the kiosk's "Start a
+#: visit"), matched whole: digit-dominant, at most four letters and only in front, so a name with
+#: digits ("MariaLopez19450312", issue 32) is refused. A site sets its own (``patient_id_pattern``
+#: in the kiosk's configuration, ``--patient-id-pattern`` for the station), e.g. ``NHC-[0-9]{7}``.
+DEFAULT_ID_PATTERN = r"(?:[A-Za-z]{1,4}[-_]?)?[0-9][0-9_-]*"
+#: names a site's pattern must refuse, or it is not an identifier rule
+NAMES = ("MariaLopez19450312", "Maria Lopez", "LOPEZ", "Jose.Garcia", "ONeill1950")
 
 
 @record
@@ -48,8 +55,10 @@ def order_visit(order_id: str) -> str:
     return f"order {order_id}"
 
 
-def check_patient_id(value: str) -> str | None:
-    """Why ``value`` is not a hospital's patient identifier (one sentence), or None."""
+def check_patient_id(value: str, pattern: str | None = DEFAULT_ID_PATTERN) -> str | None:
+    """Why ``value`` is not a hospital's patient identifier (one sentence), or None: it must be
+    one (:data:`HOSPITAL_ID`) and match ``pattern`` whole (None: the first rule only, for an
+    identifier the station already checked)."""
     if not value:
         return "type the patient's identifier"
     if not HOSPITAL_ID.match(value):
@@ -57,6 +66,28 @@ def check_patient_id(value: str) -> str | None:
             f"{value[:64]!r} is not a patient identifier: 2 to 64 letters, digits, '-' or '_', "
             "with at least one digit, never a name"
         )
+    if pattern is not None and not re.fullmatch(pattern, value):
+        rule = (
+            "at most four letters in front, then digits ('-' or '_' between)"
+            if pattern == DEFAULT_ID_PATTERN
+            else f"the site's identifiers match {pattern}"
+        )
+        return f"{value[:64]!r} is not a patient identifier here: {rule}, never a name"
+    return None
+
+
+def pattern_problem(pattern: object) -> str | None:
+    """Why ``pattern`` cannot be a site's identifier rule (one sentence), or None: it must be a
+    regular expression that refuses every name of :data:`NAMES`."""
+    if not isinstance(pattern, str) or not pattern or len(pattern) > 200:
+        return "patient_id_pattern must be a regular expression of 1 to 200 characters, in quotes"
+    try:
+        compiled = re.compile(pattern)
+    except re.error as exc:
+        return f"patient_id_pattern is not a regular expression: {exc}"
+    accepted = [name for name in NAMES if compiled.fullmatch(name)]
+    if accepted:
+        return f"patient_id_pattern accepts the name {accepted[0]!r}: an identifier rule must refuse names"
     return None
 
 
@@ -79,8 +110,8 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
         language, answered_by = entry.get("language"), entry.get("answered_by", "patient")
         if not isinstance(order_id, str) or not order_id or not isinstance(patient, str):
             problems.append(f"{where}: without an id or a patient identifier")
-        elif check_patient_id(patient):
-            problems.append(f"{where} ({order_id}): {check_patient_id(patient)}")
+        elif check_patient_id(patient, None):  # the station's own rule was applied where it was typed
+            problems.append(f"{where} ({order_id}): {check_patient_id(patient, None)}")
         elif not isinstance(wanted, list) or not wanted or any(i not in instruments for i in wanted):
             problems.append(f"{where} ({order_id}): instruments {wanted!r}: this kiosk gives {', '.join(instruments)}")
         elif language not in known_languages:
@@ -110,9 +141,11 @@ class VisitDesk:
     (:meth:`holds_welcome`) and which session to start.
     """
 
-    def __init__(self, make_session: Any, *, walk_up: bool = True) -> None:
+    def __init__(self, make_session: Any, *, walk_up: bool = True, id_pattern: str = DEFAULT_ID_PATTERN) -> None:
         self._make = make_session
         self.walk_up = walk_up
+        #: the site's identifier rule (:func:`check_patient_id`)
+        self.id_pattern = id_pattern
         #: the visits ordered for this kiosk, oldest first
         self.ready: tuple[Order, ...] = ()
         #: the station's entries this kiosk cannot run, for the clinician screen
@@ -152,7 +185,7 @@ class VisitDesk:
         """The session of a visit staff start by typing the identifier: (session, None), or
         (None, why not)."""
         patient_id = patient_id.strip()
-        why = check_patient_id(patient_id)
+        why = check_patient_id(patient_id, self.id_pattern)
         if why:
             return None, why
         return self._make(patient_id, language, "relative" if relative else "patient", STAFF), None

@@ -85,7 +85,9 @@ def start_order(station: Station, code: str, *, instruments: Sequence[str], lang
     if status == 404:
         raise OrderRefused("That code is not one of this kiosk's visits: check it on the ward station.")
     if status == 429:
-        raise OrderRefused(f"Too many wrong codes: {error or 'wait a few minutes'}.")
+        wait = body.get("retry_after_s") if isinstance(body, dict) else None
+        when = f"in {wait} seconds" if isinstance(wait, int) and 0 < wait <= 3600 else "in a few minutes"
+        raise OrderRefused(f"After wrong codes the ward station checks the next one {when}: type it again then.")
     if status != 200 or not isinstance(body, dict):
         raise OrderRefused(f"The ward station answered {status}{': ' + error if error else ''}.")
     found, problems = parse_orders({"orders": [body.get("order")]}, instruments, languages)

@@ -201,7 +201,7 @@ def make_kiosk(
         fresh=maker.fresh,
         resume=maker.resume,
         after=maker.after,
-        visits=VisitDesk(maker.fresh, walk_up=config.walk_up) if visits else None,
+        visits=VisitDesk(maker.fresh, walk_up=config.walk_up, id_pattern=config.patient_id_pattern) if visits else None,
         sync=sync,
         orders=orders,
         start_order=start_order,

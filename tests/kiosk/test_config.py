@@ -9,6 +9,7 @@ import pytest
 
 from kiosk.config import DEFAULT_PIN, Config, ConfigError, configured_questionnaire, load_config, offered_to_patients
 from kiosk.core.clock import SimClock, SystemClock
+from kiosk.core.visits import DEFAULT_ID_PATTERN
 from tests.kiosk.configs import refusal
 
 
@@ -52,6 +53,9 @@ def test_file_and_environment(tmp_path):
         ("data_dir: [1]\n", ":1:1: data_dir must be a path"),
         ("language: en\nlanguage: es\n", ":2:1: duplicate key 'language'"),
         ("language: [\n", ":2:1: YAML syntax"),
+        ("language: en\npatient_id_pattern: '[A-Za-z0-9]+'\n", ":2:1: patient_id_pattern accepts the name"),
+        ("patient_id_pattern: 'NHC-[0-9'\n", ":1:1: patient_id_pattern is not a regular expression"),
+        ("patient_id_pattern: 7\n", ":1:1: patient_id_pattern must be a regular expression"),
     ],
 )
 def test_a_bad_config_is_one_message_naming_file_line_and_column(tmp_path, text, message):
@@ -268,3 +272,10 @@ def test_a_configuration_with_a_station_token_is_never_kept_parsed_in_the_cache(
     assert load_config(secret).station is not None
     assert len(list(parsed.glob("*.pickle"))) == 1
     assert not any(b"Zm9vYmFyYmF6cXV4" in p.read_bytes() for p in parsed.glob("*.pickle"))
+
+
+def test_a_sites_identifier_pattern_is_read_and_the_default_refuses_names(tmp_path):
+    path = tmp_path / "config.yaml"
+    path.write_text("patient_id_pattern: 'NHC-[0-9]{7}'\n")
+    assert load_config(path, environ={}).patient_id_pattern == "NHC-[0-9]{7}"
+    assert load_config(environ={}).patient_id_pattern == DEFAULT_ID_PATTERN

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 import json
 import re
+import subprocess
+import sys
 
 import pytest
 import sqlalchemy as sa
 
 from station import db
 from station.orders import orders as orders_table
-from tests.station.conftest import make_ward, new_kiosk
+from tests.station.conftest import PATIENCE_S, make_ward, new_kiosk
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 
 pytestmark = pytest.mark.slow
@@ -97,7 +99,7 @@ def test_an_order_goes_from_ordered_to_signed_off_on_its_own_kiosk_only(database
 def test_a_name_is_never_taken_for_a_patient_identifier(shared_station):
     station, ward = shared_station
     nurse = Staff(station.url, "nurse.kim", "nurse")
-    for name in ("Maria Lopez", "LOPEZ", "O'Neill", "x" * 65):
+    for name in ("Maria Lopez", "LOPEZ", "O'Neill", "x" * 65, "MariaLopez19450312"):
         refused = order(nurse, ward.kiosk_id, patient=name)
         assert refused.status_code == 303 and refused.headers["location"].startswith("/orders?error=")
         page = nurse.http.get(refused.headers["location"]).text
@@ -128,8 +130,9 @@ def test_guessing_codes_is_stopped_and_staff_forms_need_their_token(shared_stati
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)
     kiosk = KioskClient(station.url, token, name)
-    answers = [kiosk.start_order(f"{n:04d}").status_code for n in range(9000, 9006)]
-    assert answers == [404] * 5 + [429]
+    answers = [kiosk.start_order(f"{n:04d}") for n in range(9000, 9003)]
+    assert [a.status_code for a in answers] == [404, 404, 429]  # two typos are free; then a slot
+    assert answers[2].headers["retry-after"] == str(answers[2].json()["retry_after_s"])
     nurse = Staff(station.url, "nurse.kim", "nurse")
     forged = nurse.http.post(
         "/orders", data={"patient_id": "NHC-1", "kiosk": name, "instrument": "barthel", "language": "en"}
@@ -157,3 +160,22 @@ def test_staff_order_at_most_thirty_visits_in_ten_minutes_and_a_nurse_never_sign
     assert "only a doctor can sign off" in nurse.post(f"/sessions/{rows[0].session_id}/sign-off").headers[
         "location"
     ].replace("%20", " ")
+
+
+def test_a_sites_identifier_pattern_is_the_stations_rule_and_a_pattern_taking_names_is_refused(
+    tmp_path, station_factory
+):
+    ward = make_ward(db.sqlite_url(tmp_path / "data"))
+    station = station_factory(ward.db_url, args=("--patient-id-pattern", "NHC-[0-9]{7}"))
+    nurse = Staff(station.url, "nurse.kim", "nurse")
+    assert order(nurse, ward.kiosk_id, patient="NHC-0012345").headers["location"].startswith("/orders/order-")
+    refused = order(nurse, ward.kiosk_id, patient="12345678")
+    assert "the site&#39;s identifiers match NHC-[0-9]{7}" in nurse.http.get(refused.headers["location"]).text
+    started = subprocess.run(
+        [sys.executable, "-m", "kiosk", "station", "--db", ward.db_url, "--patient-id-pattern", "[A-Za-z0-9]+"],
+        capture_output=True,
+        text=True,
+        timeout=PATIENCE_S,
+    )
+    assert started.returncode == 2 and started.stderr.count("\n") == 1
+    assert "--patient-id-pattern accepts the name 'MariaLopez19450312'" in started.stderr

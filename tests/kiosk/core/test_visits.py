@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from kiosk.core.visits import Order, VisitDesk, check_patient_id, parse_orders
+from kiosk.core.visits import DEFAULT_ID_PATTERN, Order, VisitDesk, check_patient_id, parse_orders, pattern_problem
 
 
 @pytest.mark.parametrize("identifier", ["NHC-0012345", "12345678", "MRN_77", "p2"])
@@ -14,10 +14,25 @@ def test_hospital_identifiers_are_taken(identifier):
     assert check_patient_id(identifier) is None
 
 
-@pytest.mark.parametrize("name", ["Maria Lopez", "LOPEZ", "O'Neill", "Jose.Garcia", "-123", "x" * 65, ""])
+@pytest.mark.parametrize(
+    "name", ["Maria Lopez", "LOPEZ", "O'Neill", "Jose.Garcia", "-123", "x" * 65, "", "MariaLopez19450312", "Lopez1945"]
+)
 def test_names_and_malformed_identifiers_are_refused(name):
     why = check_patient_id(name)
     assert why is not None and ("never a name" in why or "type the patient" in why)
+
+
+def test_a_sites_own_pattern_is_the_rule_and_must_refuse_names():
+    assert check_patient_id("NHC-0012345", r"NHC-[0-9]{7}") is None
+    assert "the site's identifiers match NHC-[0-9]{7}" in check_patient_id("12345678", r"NHC-[0-9]{7}")
+    assert check_patient_id("AB12CD34", r"[A-Z]{2}[0-9]{2}[A-Z]{2}[0-9]{2}") is None  # a looser site rule
+    assert check_patient_id("AB 12", r".*") is not None  # never beyond what an identifier is
+    assert pattern_problem(r"NHC-[0-9]{7}") is None and pattern_problem(DEFAULT_ID_PATTERN) is None
+    assert "accepts the name 'MariaLopez19450312'" in pattern_problem(r"[A-Za-z0-9]+")
+    assert "not a regular expression" in pattern_problem("NHC-[0-9")
+    desk = VisitDesk(lambda *a, **k: a, id_pattern=r"NHC-[0-9]{7}")
+    assert desk.for_staff("12345678", "en", False)[0] is None
+    assert desk.for_staff("NHC-0012345", "en", False)[0] == ("NHC-0012345", "en", "patient", "staff")
 
 
 def test_orders_the_kiosk_cannot_run_are_left_out_with_why():
