@@ -54,7 +54,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _asr_cases import (  # noqa: E402
+from _asr_cases import (
     BABBLE_TALKERS,
     BABBLE_TEXT,
     CONDITIONS,
@@ -66,16 +66,16 @@ from _asr_cases import (  # noqa: E402
     Condition,
     patient_cases,
 )
-from _vads import endpointer_factory  # noqa: E402
+from _vads import endpointer_factory
 
-from kiosk.core.channels import ChannelInput, Command  # noqa: E402
-from kiosk.core.questionnaire import load_questionnaire  # noqa: E402
-from kiosk.speech import rooms  # noqa: E402
-from kiosk.speech.asr import PocketSphinxRecogniser  # noqa: E402
-from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav  # noqa: E402
-from kiosk.speech.matching import OptionWords  # noqa: E402
-from kiosk.speech.tts import Synthesiser  # noqa: E402
-from kiosk.speech.voice import VoiceChannel  # noqa: E402
+from kiosk.core.channels import ChannelInput, Command
+from kiosk.core.questionnaire import load_questionnaire
+from kiosk.speech import rooms
+from kiosk.speech.asr import PocketSphinxRecogniser
+from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav
+from kiosk.speech.matching import OptionWords
+from kiosk.speech.tts import Synthesiser
+from kiosk.speech.voice import VoiceChannel
 
 
 class Audio:

@@ -15,9 +15,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _qos_sessions import back_to_back  # noqa: E402
+from _qos_sessions import back_to_back
 
-from qos import Engine, load_model  # noqa: E402
+from qos import Engine, load_model
 
 SESSIONS = 200
 

@@ -22,9 +22,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _qos_sessions import back_to_back  # noqa: E402
+from _qos_sessions import back_to_back
 
-from qos import Engine, Model, load_model, parse_model  # noqa: E402
+from qos import Engine, Model, load_model, parse_model
 
 DAY = 10 * 3600.0
 HOUR = 3600.0

@@ -103,7 +103,7 @@ def kept(kind: str, key: str) -> object | None:
             stored_key, files, value = pickle.load(file)
         if stored_key != key or any(_file_digest(Path(path)) != sha for path, sha in files):
             return None
-    except Exception:  # noqa: BLE001 - whatever is wrong with a kept file, the work is done again
+    except Exception:  # whatever is wrong with a kept file, the work is done again
         return None
     return value
 

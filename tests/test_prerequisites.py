@@ -44,7 +44,7 @@ def test_npm_ci_runs_when_the_lock_is_new_or_changed_and_not_otherwise(tmp_path,
     monkeypatch.undo()
     monkeypatch.setattr(prerequisites, "_installed", set())
     ensure_npm_packages(js)  # with npm again: installed from the new lock
-    assert stamp.read_text().strip() == prerequisites._lock_hash(js)  # noqa: SLF001
+    assert stamp.read_text().strip() == prerequisites._lock_hash(js)
 
 
 def test_a_missing_debian_package_is_one_line_naming_it(tmp_path):

@@ -240,7 +240,7 @@ class SyncClient:
                     break
                 try:
                     outcome = self._on_command(command)
-                except Exception:  # noqa: BLE001 - the kiosk is closing: not acked, so re-delivered
+                except Exception:  # the kiosk is closing: not acked, so re-delivered
                     continue
                 if outcome is None:
                     continue

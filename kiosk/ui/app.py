@@ -261,7 +261,7 @@ class KioskApp(App[int], inherit_bindings=False):
         def ask() -> None:
             try:
                 order = starter(message.code)
-            except Exception as refused:  # noqa: BLE001 - OrderRefused or Unreachable: said to staff
+            except Exception as refused:  # OrderRefused or Unreachable: said to staff
                 self.call_from_thread(self._order_refused, str(refused) or type(refused).__name__)
                 return
             self.call_from_thread(self.controller.order_started, order)

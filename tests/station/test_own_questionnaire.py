@@ -19,7 +19,7 @@ KEPT = ("feeding", "bathing", "grooming")
 OWN_TEXT = "Can you eat a meal on your own? (site wording)"
 
 
-def test_a_sites_own_questionnaire_is_shown_and_exported_with_its_own_definition(shared_station):  # noqa: F811
+def test_a_sites_own_questionnaire_is_shown_and_exported_with_its_own_definition(shared_station):
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)
     rows = [r for r in record_patient(PATIENTS / "barthel1.yaml") if r.payload.get("item_id", KEPT[0]) in KEPT]

@@ -63,7 +63,7 @@ def _badge(html: str, element_id: str) -> str:
     return found.group(1).strip()
 
 
-def test_every_page_of_a_result_uses_the_questionnaire_the_session_ran(shared_station):  # noqa: F811
+def test_every_page_of_a_result_uses_the_questionnaire_the_session_ran(shared_station):
     station, ward = shared_station
     session_id, patient_id, answers = _own_session(station, ward)
     total = sum(a["points"] for a in answers)
@@ -82,7 +82,7 @@ def test_every_page_of_a_result_uses_the_questionnaire_the_session_ran(shared_st
         staff.http.close()
 
 
-def test_changes_that_come_back_to_the_kiosks_answer_are_signed_off_as_recorded(shared_station):  # noqa: F811
+def test_changes_that_come_back_to_the_kiosks_answer_are_signed_off_as_recorded(shared_station):
     """The confirmation, the page's badge, the inbox and the CSV name one state: the review-state
     function's (a change undone is no change)."""
     station, ward = shared_station
@@ -119,7 +119,7 @@ def _row_state(html: str, session_id: str) -> str | None:
     return found.group(1) if found else None
 
 
-def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_station):  # noqa: F811
+def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_station):
     """Reopened, a result is ``corrected`` on its page, in CSV and FHIR: the inbox lists it as
     waiting (and counts it), not as signed; signed again it is ``amended`` everywhere."""
     station, ward = shared_station
@@ -157,7 +157,7 @@ def test_a_result_reopened_to_amend_waits_again_until_signed_again(shared_statio
         staff.http.close()
 
 
-def test_staff_order_a_visit_of_the_sites_own_questionnaire(shared_station):  # noqa: F811
+def test_staff_order_a_visit_of_the_sites_own_questionnaire(shared_station):
     """A site whose kiosk runs its own questionnaire can order it: the station offers every
     instrument a kiosk has run here, and the kiosk is sent an order it can take."""
     station, ward = shared_station

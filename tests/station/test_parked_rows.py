@@ -43,7 +43,7 @@ def _hostile(store: Store, session_id: str) -> list[int]:
         ({"t": 2.0, "kind": "note", "detail": ""}, "2026-01-01T00:00:02.000000000000000+00:00:00Z"),
     ):
         kind = "record_answer" if "item_id" in payload else "record_event"
-        cursor = store._db.execute(  # noqa: SLF001 - a row no real session writes
+        cursor = store._db.execute(  # a row no real session writes
             "INSERT INTO outbox (kind, session_id, payload, at) VALUES (?, ?, ?, ?)",
             (kind, session_id, json.dumps(payload), at),
         )

@@ -42,7 +42,7 @@ def _sync_long_session(station, ward) -> tuple[str, str]:
     return rows[0].session_id, name
 
 
-def test_no_station_page_scrolls_sideways_on_a_phone(browser, shared_station):  # noqa: F811
+def test_no_station_page_scrolls_sideways_on_a_phone(browser, shared_station):
     station, ward = shared_station
     session_id, kiosk = _sync_long_session(station, ward)
     staff = Staff(station.url)

@@ -66,7 +66,7 @@ def _total(html: str) -> str:
     return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", "", found.group(1))).strip()
 
 
-def test_a_nurse_enters_the_weight_and_the_aid_and_the_total_appears(shared_station, tmp_path):  # noqa: F811
+def test_a_nurse_enters_the_weight_and_the_aid_and_the_total_appears(shared_station, tmp_path):
     _a_nurse_completes_the_staff_items(*shared_station, tmp_path)
 
 
@@ -97,7 +97,7 @@ def _a_nurse_completes_the_staff_items(station, ward, tmp_path: Path) -> None:
     assert "P-STAFF1" in page.text
 
 
-def test_a_weight_entered_at_the_kiosk_reaches_the_station(shared_station, tmp_path):  # noqa: F811
+def test_a_weight_entered_at_the_kiosk_reaches_the_station(shared_station, tmp_path):
     station, ward = shared_station
     session_id = _sync(station, ward, _rows(tmp_path, kiosk_weight=64.0))
     staff = Staff(station.url, name="nurse.kim", role="nurse")

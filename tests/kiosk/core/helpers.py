@@ -36,7 +36,7 @@ class Rig:
 
     def at(self, t: float) -> None:
         """Move to session time ``t``, firing every time-out due strictly before it."""
-        target = self.session._origin + t  # noqa: SLF001 - clock time of session time t
+        target = self.session._origin + t  # clock time of session time t
         while (d := self.session.next_deadline()) is not None and d < target:
             self.clock.set(d)
             self.session.poll()

@@ -259,7 +259,7 @@ def test_the_last_answer_can_be_changed_before_the_summary_and_a_restart_asks_it
     store = Store.open(tmp_path / "data")
     rig = started(store=store)
     for _ in QUESTIONNAIRE.items:
-        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # noqa: SLF001 - open the next item
+        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # open the next item
         rig.answer(1)
     assert rig.session.snapshot().interlude == "last_question" and rig.session.snapshot().can_undo
     rig.command(Command.UNDO)

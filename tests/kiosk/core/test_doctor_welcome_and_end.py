@@ -88,7 +88,7 @@ def test_after_the_end_screen_the_kiosk_is_ready_for_the_next_patient(tmp_path):
     store = Store.open(tmp_path / "data")
     rig = started(store=store, next_patient_after_s=90)
     for _ in QUESTIONNAIRE.items:
-        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # noqa: SLF001 - open the next item
+        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # open the next item
         rig.answer(2)
     rig.run_until(rig.session.now() + TIMING["closing_s"])
     assert rig.session.finished and not rig.of(NextPatient)
@@ -106,7 +106,7 @@ def test_after_the_end_screen_the_kiosk_is_ready_for_the_next_patient(tmp_path):
 def test_without_a_next_patient_delay_the_end_screen_stays():
     rig = started()
     for _ in QUESTIONNAIRE.items:
-        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # noqa: SLF001 - open the next item
+        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # open the next item
         rig.answer(1)
     rig.run_until(rig.session.now() + TIMING["closing_s"])
     assert rig.session.finished and rig.session.next_deadline() is None

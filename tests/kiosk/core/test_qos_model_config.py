@@ -49,7 +49,7 @@ def test_kiosk_replay_of_a_slow_patient_fires_the_inactivity_timer_at_its_time(t
     assert {"t": due, "observations": ["Silent"]} in printed["qos"]["fired"]
 
     with Store.open(data, create=False) as store:
-        (session_id,) = [row[0] for row in store._db.execute("SELECT id FROM sessions")]  # noqa: SLF001
+        (session_id,) = [row[0] for row in store._db.execute("SELECT id FROM sessions")]
         stored = store.session(session_id)
     assert (due, ("Silent",)) in [(m.t, m.fired) for m in stored.metrics]
 

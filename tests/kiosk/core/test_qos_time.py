@@ -71,7 +71,7 @@ def test_the_inactivity_timer_fires_through_poll_while_nothing_happens(tmp_path)
     rig.at(asked + 5)
     rig.session.person_lost()  # the attempt clock stops: only the model's timer is left running
     due = asked + SILENCE_S
-    assert rig.session.next_deadline() == rig.session._origin + due  # noqa: SLF001 - clock time of `due`
+    assert rig.session.next_deadline() == rig.session._origin + due  # clock time of `due`
     published, metrics_before = len(rig.session.trace), len(rig.of(MetricsUpdated))
 
     rig.clock.set(rig.session.next_deadline())

@@ -96,7 +96,7 @@ def test_two_time_outs_make_the_question_not_answered_and_the_next_opens_after_t
 
 def test_a_late_poll_fires_time_outs_at_their_due_time():
     rig = started()
-    rig.clock.set(rig.session._origin + 200)  # noqa: SLF001 - the UI's timer was starved
+    rig.clock.set(rig.session._origin + 200)  # the UI's timer was starved
     rig.session.poll()
     assert [e.t for e in rig.of(AttemptTimedOut)][:2] == [55, 85]
     assert [e["t"] for e in rig.session.trace[1:4]] == [55, 85, 130]
@@ -402,7 +402,7 @@ def test_abandon_leaves_a_session_on_the_welcome_screen_or_finished_as_it_is(tmp
     assert store.sessions() == []  # never started, so never stored
     rig = started(store=store)
     for _ in QUESTIONNAIRE.items:
-        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # noqa: SLF001 - open the next item
+        rig.run_until(rig.session.next_deadline() - rig.session._origin)  # open the next item
         rig.answer(1)
     rig.run_until(rig.session.now() + 20)
     assert rig.session.finished

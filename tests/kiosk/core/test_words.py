@@ -153,13 +153,13 @@ def test_a_bad_words_file_stops_the_configuration_with_its_position(tmp_path, mo
     directory = words_dir(tmp_path)
     edit(directory / "es.yaml", "  paused_title: En pausa\n", "")
     monkeypatch.setattr(words_module, "WORDS_DIR", directory)
-    words_module._kiosk_words.cache_clear()  # noqa: SLF001 - read the kiosk's words again, from the copy
+    words_module._kiosk_words.cache_clear()  # read the kiosk's words again, from the copy
     try:
         with pytest.raises(ConfigError, match=re.escape(position(directory / "es.yaml", "screen:"))):
             load_config(environ={})
     finally:
         monkeypatch.undo()
-        words_module._kiosk_words.cache_clear()  # noqa: SLF001
+        words_module._kiosk_words.cache_clear()
     assert list(load_words()) == ["de", "en", "es", "fr"]
 
 

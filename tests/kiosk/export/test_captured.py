@@ -57,7 +57,7 @@ def test_sessions_share_one_stored_definition_and_keep_their_identity(tmp_path):
     identity = {"site": "sitea", "kiosk_id": "kiosk-a", "patient_system": "https://sitea.example/sid/patient"}
     with Store.open(tmp_path, export=identity) as store:
         ids = [at_first_question(store, patient_id=f"P-SHARE{n}").session.id for n in range(2)]
-        rows = store._db.execute("SELECT sha256, body FROM definitions").fetchall()  # noqa: SLF001
+        rows = store._db.execute("SELECT sha256, body FROM definitions").fetchall()
         sessions = [store.session(i) for i in ids]
     assert len(rows) == 1 and rows[0][0] == digest(canonical(QUESTIONNAIRE)) == sessions[0].definition_sha256
     for stored in sessions:
@@ -72,7 +72,7 @@ def _v2_database(data) -> None:
     """A version-2 database (v1 upgraded as a v2 kiosk did) with a create_session waiting in its outbox."""
     path = v1_database(data)
     db = sqlite3.connect(path, isolation_level=None)
-    for statement in schema._statements(schema.V2):  # noqa: SLF001 - the shipped v2 script
+    for statement in schema._statements(schema.V2):  # the shipped v2 script
         db.execute(statement)
     db.execute("PRAGMA user_version = 2")
     db.execute(
@@ -96,10 +96,10 @@ def test_an_upgrade_attaches_the_definition_and_identity_in_force_marked_attache
     monkeypatch.setenv("KIOSK_CONFIG", str(_config(tmp_path / "a.yaml", "sitea", "kiosk-a")))
     assert results_main(["--data-dir", str(data), "--csv", str(tmp_path / "a.csv")]) == 0  # upgrades
     with Store.open(data, create=False) as store:
-        assert schema.version(store._db) == schema.LATEST  # noqa: SLF001
+        assert schema.version(store._db) == schema.LATEST
         stored = [store.session(s.id) for s in store.sessions()]
-        (payload,) = [json.loads(p) for (p,) in store._db.execute("SELECT payload FROM outbox")]  # noqa: SLF001
-        assert store._db.execute("SELECT COUNT(*) FROM definitions").fetchone() == (1,)  # noqa: SLF001
+        (payload,) = [json.loads(p) for (p,) in store._db.execute("SELECT payload FROM outbox")]
+        assert store._db.execute("SELECT COUNT(*) FROM definitions").fetchone() == (1,)
     assert len(stored) == 4
     for session in stored:
         assert session.definition_attached_later and session.identity_attached_later

@@ -40,7 +40,7 @@ def apply(*bundles) -> dict:
 
 def test_the_hospital_ends_with_one_result_per_session_the_amended_one_with_its_history(
     shared_station, tmp_path, monkeypatch, capsys
-):  # noqa: F811
+):
     station, ward = shared_station
     name, token = new_kiosk(ward.db_url)
     site = ExportSite(site="hosp-north", kiosk_id=name)

@@ -119,7 +119,7 @@ def test_lhc_forms_shows_every_answer_and_the_same_total(lforms_page, replayed, 
     assert back.get("total") == ours.get("total")
 
 
-def test_lhc_forms_shows_a_station_bundles_corrected_and_signed_result(lforms_page, shared_station):  # noqa: F811
+def test_lhc_forms_shows_a_station_bundles_corrected_and_signed_result(lforms_page, shared_station):
     """The station's own export (a real station process): the response of its Bundle, on the
     Questionnaire of that Bundle, shows the corrected answers and the corrected total."""
     from tests.station.conftest import new_kiosk

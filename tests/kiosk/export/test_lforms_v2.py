@@ -29,7 +29,7 @@ pytestmark = pytest.mark.slow
     ],
 )
 def test_lhc_forms_computes_the_kiosks_total_and_subscales(
-    lforms_page,  # noqa: F811
+    lforms_page,
     tmp_path,
     text,
     options,
@@ -74,7 +74,7 @@ def test_lhc_forms_computes_the_kiosks_total_and_subscales(
         ("sarc_f", "es", 2),
     ],
 )
-def test_lhc_forms_computes_each_shipped_instruments_total(lforms_page, name, language, pick):  # noqa: F811
+def test_lhc_forms_computes_each_shipped_instruments_total(lforms_page, name, language, pick):
     """Each instrument the kiosk ships, exported with a response: LHC-Forms computes the total the
     kiosk computed from the answers alone (``pick`` varies which option each item gets)."""
     from kiosk.core.questionnaire import bundled_path, load_questionnaire

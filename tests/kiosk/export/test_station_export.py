@@ -56,7 +56,7 @@ def csv_state(staff: Staff, session_id: str) -> set[str]:
     return {row["review_state"] for row in rows}
 
 
-def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_final(shared_station):  # noqa: F811
+def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_final(shared_station):
     station, ward = shared_station
     session_id = synced(station, ward, "barthel4.yaml")  # grooming and bladder unanswered: 65 from 8 items
     doctor = Staff(station.url)
@@ -95,7 +95,7 @@ def test_a_result_completed_and_signed_off_at_the_station_exports_amended_and_fi
     assert csv_state(doctor, session_id) == {"amended"}
 
 
-def test_a_corrected_result_says_the_same_in_csv_and_fhir_and_keeps_the_kiosks_answer(shared_station):  # noqa: F811
+def test_a_corrected_result_says_the_same_in_csv_and_fhir_and_keeps_the_kiosks_answer(shared_station):
     station, ward = shared_station
     session_id = synced(station, ward, "barthel1.yaml")  # 100: feeding independent (10)
     nurse, doctor = Staff(station.url, "nurse.kim", "nurse"), Staff(station.url)
@@ -134,7 +134,7 @@ def test_a_corrected_result_says_the_same_in_csv_and_fhir_and_keeps_the_kiosks_a
     assert entity["agent"][0]["who"]["reference"] == of(signed, "Device")[0]["fullUrl"]  # the kiosk's answer
 
 
-def test_a_doctor_amends_a_signed_result_and_signs_it_again(shared_station):  # noqa: F811
+def test_a_doctor_amends_a_signed_result_and_signs_it_again(shared_station):
     station, ward = shared_station
     session_id = synced(station, ward, "barthel1.yaml")
     page = f"/sessions/{session_id}"

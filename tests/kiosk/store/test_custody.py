@@ -135,7 +135,7 @@ def test_closing_the_kiosk_interrupts_its_running_session_and_leaves_finished_on
     with Store.open(tmp_path) as again:
         statuses = {s.id: (s.status, s.interrupted_reason) for s in again.sessions()}
         assert statuses == {"s1": ("interrupted", "its kiosk was closed"), "s2": ("finished", None)}
-        assert again._db.execute("SELECT COUNT(*) FROM leases").fetchone() == (0,)  # noqa: SLF001
+        assert again._db.execute("SELECT COUNT(*) FROM leases").fetchone() == (0,)
 
 
 def test_simulated_sessions_are_marked_and_never_offered(tmp_path):

@@ -64,7 +64,7 @@ def v1_database(data: Path) -> Path:
 def test_a_database_from_before_schema_versions_upgrades_and_keeps_every_row(tmp_path):
     path = v1_database(tmp_path / "data")
     with Store.open(tmp_path / "data") as store:
-        assert schema.version(store._db) == schema.LATEST  # noqa: SLF001
+        assert schema.version(store._db) == schema.LATEST
         sessions = {s.id: s for s in store.sessions()}
         assert set(sessions) == {"aaaa00000001", "bbbb00000002", "cccc00000003", "dddd00000004"}
         finished = store.session("aaaa00000001")
@@ -90,8 +90,8 @@ def test_a_database_from_before_schema_versions_upgrades_and_keeps_every_row(tmp
 
 def test_a_fresh_database_is_created_at_the_latest_version(tmp_path):
     with Store.open(tmp_path / "data") as store:
-        assert schema.version(store._db) == schema.LATEST  # noqa: SLF001
-        tables = {r[0] for r in store._db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}  # noqa: SLF001
+        assert schema.version(store._db) == schema.LATEST
+        tables = {r[0] for r in store._db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
     assert {"sessions", "answers", "leases", "outbox"} <= tables
 
 
@@ -138,8 +138,8 @@ def test_a_damaged_database_is_one_message_naming_the_file_and_what_to_do(tmp_pa
     data = tmp_path / "data"
     with Store.open(data) as store:
         for n in range(300):  # enough rows for a file of several pages
-            store._db.execute("INSERT INTO patients VALUES (?, ?)", (f"P-{n:06d}", "x" * 200))  # noqa: SLF001
-        store._db.execute("PRAGMA wal_checkpoint(TRUNCATE)")  # noqa: SLF001
+            store._db.execute("INSERT INTO patients VALUES (?, ?)", (f"P-{n:06d}", "x" * 200))
+        store._db.execute("PRAGMA wal_checkpoint(TRUNCATE)")
     path = data / DB_NAME
     if how == "garbage":
         path.write_bytes(random.Random(8).randbytes(8192))

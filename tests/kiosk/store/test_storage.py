@@ -69,8 +69,8 @@ def test_an_existing_open_directory_is_tightened(tmp_path):
 
 def test_wal_and_full_sync_are_on(tmp_path):
     store = Store.open(tmp_path)
-    assert store._db.execute("PRAGMA journal_mode").fetchone()[0] == "wal"  # noqa: SLF001
-    assert store._db.execute("PRAGMA synchronous").fetchone()[0] == 2  # FULL  # noqa: SLF001
+    assert store._db.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+    assert store._db.execute("PRAGMA synchronous").fetchone()[0] == 2  # FULL
 
 
 def test_each_answer_is_visible_to_another_connection_as_soon_as_it_is_recorded(tmp_path):

@@ -21,10 +21,7 @@ KIOSK = "ward3-bed2"
 
 def outbox_rows(store: Store) -> list[tuple[int, str, str]]:
     return [
-        (seq, kind, json)
-        for seq, kind, json in store._db.execute(  # noqa: SLF001
-            "SELECT seq, kind, payload FROM outbox ORDER BY seq"
-        )
+        (seq, kind, json) for seq, kind, json in store._db.execute("SELECT seq, kind, payload FROM outbox ORDER BY seq")
     ]
 
 

@@ -55,7 +55,7 @@ async def test_a_kiosk_without_a_station_starts_no_sync_thread_and_queues_nothin
             await until_thread(lambda: app.session.phase is Phase.QUESTIONS, "the questions")
             assert app.controller.sync is None
             assert not [t for t in threading.enumerate() if t.name.startswith("station")]
-            assert app.controller.store._db.execute("SELECT COUNT(*) FROM outbox").fetchone() == (0,)  # noqa: SLF001
+            assert app.controller.store._db.execute("SELECT COUNT(*) FROM outbox").fetchone() == (0,)
     finally:
         close()
 

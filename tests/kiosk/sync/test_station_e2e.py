@@ -88,7 +88,7 @@ def test_replays_reach_the_real_station_even_after_it_was_down(tmp_path):
     assert "within 2 s" in message
     assert "kept in" in message and "connection refused" in message
     with Store.open(data) as store:
-        kept = store._db.execute("SELECT COUNT(*) FROM outbox").fetchone()[0]  # noqa: SLF001
+        kept = store._db.execute("SELECT COUNT(*) FROM outbox").fetchone()[0]
     assert kept > 0
 
     station = start_station(db_url, port, tmp_path / "station.log")
@@ -99,7 +99,7 @@ def test_replays_reach_the_real_station_even_after_it_was_down(tmp_path):
         station.terminate()
         station.wait(timeout=PATIENCE_S)
     with Store.open(data) as store:
-        assert store._db.execute("SELECT COUNT(*) FROM outbox").fetchone() == (0,)  # noqa: SLF001
+        assert store._db.execute("SELECT COUNT(*) FROM outbox").fetchone() == (0,)
         sessions = {s.id: s for s in store.sessions()}
     with engine.connect() as connection:
         seqs = [r.seq for r in connection.execute(sa.select(db.inbox.c.seq).where(db.inbox.c.kiosk_id == "ward3-bed2"))]

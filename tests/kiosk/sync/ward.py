@@ -98,7 +98,7 @@ class Handler(BaseHTTPRequestHandler):
             return False
         return True
 
-    def do_POST(self) -> None:  # noqa: N802 - http.server's name
+    def do_POST(self) -> None:  # http.server's name
         if not self._authorised():
             return
         body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
@@ -118,7 +118,7 @@ class Handler(BaseHTTPRequestHandler):
         else:
             self._reply(404, {"error": "no such endpoint"})
 
-    def do_GET(self) -> None:  # noqa: N802
+    def do_GET(self) -> None:
         if not self._authorised():
             return
         wait = float(parse_qs(urlsplit(self.path).query).get("wait", ["0"])[0])

@@ -72,14 +72,14 @@ async def _the_out_of_order_kiosk_and_its_recovery(kiosk: UiKiosk, pilot, free_s
     first = kiosk.session
     shown = await until_drawn(pilot, OUT_OF_ORDER, "Este quiosco no funciona", "Cette borne ne fonctionne pas")
     assert screen_name(kiosk) == "OutOfOrderScreen"
-    assert "P-TEST" not in shown and not kiosk.app._notifications  # noqa: SLF001 - no notice, no pseudonym
+    assert "P-TEST" not in shown and not kiosk.app._notifications  # no notice, no pseudonym
     sessions_before = len(kiosk.store.sessions())
     for key in ("1", "2", "enter", "d"):  # taps and keys start nothing
         await pilot.press(key)
     await pilot.click(offset=(50, 16))
     await settle(pilot)
     assert screen_name(kiosk) == "OutOfOrderScreen" and kiosk.app.session.phase is Phase.WELCOME
-    assert len(kiosk.store.sessions()) == sessions_before and not kiosk.app._notifications  # noqa: SLF001
+    assert len(kiosk.store.sessions()) == sessions_before and not kiosk.app._notifications
 
     await pilot.press(CLINICIAN_CHORD, *"0000", "enter")  # a slip: counted, though not writable
     await until_drawn(pilot, "Wrong PIN.")

@@ -24,7 +24,7 @@ async def test_the_inactivity_timer_fires_through_the_apps_poll_with_no_input(ui
         before = kiosk.session.metrics["Interaction"]
         published = len(kiosk.session.trace)
         # the attempt clock is stopped: the next thing due is the model's timer
-        assert kiosk.session.next_deadline() == kiosk.session._origin + asked[0] + silence_s  # noqa: SLF001
+        assert kiosk.session.next_deadline() == kiosk.session._origin + asked[0] + silence_s
 
         kiosk.to_next_deadline()  # the app's poll, and nothing else
         await settle(pilot)

@@ -24,7 +24,7 @@ async def test_a_write_the_database_refuses_drops_the_test_plainly_and_staff_get
         kiosk.to_next_deadline()
         await settle(pilot, lambda: kiosk.session.current_attempt == 1)
         session = kiosk.session
-        kiosk.store._db.execute("PRAGMA busy_timeout = 0")  # noqa: SLF001 - do not wait 10 s for the lock here
+        kiosk.store._db.execute("PRAGMA busy_timeout = 0")  # do not wait 10 s for the lock here
         other = sqlite3.connect(kiosk.store.path, isolation_level=None)
         other.execute("BEGIN IMMEDIATE")  # another process writing, for longer than the kiosk waits
         try:
