@@ -14,7 +14,6 @@ file and :func:`load_words` loads none. Pure (``fileio`` only), so every layer r
 from __future__ import annotations
 
 import re
-import string
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import field
 from functools import cache
@@ -24,6 +23,8 @@ from typing import Any, TypeVar
 
 from basis import record
 from fileio.positions import Positions, Problem, describe, parse_file
+from kiosk.core.words.placeholders import fill as fill  # the one way words are filled in
+from kiosk.core.words.placeholders import placeholders
 
 #: where the kiosk's words files are
 WORDS_DIR = Path(__file__).resolve().parent
@@ -280,13 +281,12 @@ def _words(code: str, data: Mapping[str, Any]) -> Words:
 
 
 def _placeholders(text: Any) -> set[str] | None:
-    """The ``{names}`` in ``text``, or None when it is no text or its braces are not a format string's."""
+    """The ``{names}`` in ``text``, or None when it is no text or holds a brace that is not a
+    ``{name}`` mark or a doubled brace (a format spec, an index, a lone brace)."""
     if not isinstance(text, str):
         return None
-    try:
-        return {name for _, name, _, _ in string.Formatter().parse(text) if name is not None}
-    except ValueError:
-        return None
+    names, wrong = placeholders(text)
+    return None if wrong else names
 
 
 class _Check:
@@ -364,7 +364,14 @@ class _Check:
         if kind == SCREEN_TEXT:
             mine, theirs = _placeholders(value), _placeholders(self.in_template(path))
             if mine is None:
-                self.add(path, f"{describe(path)}: a brace without its pair (write {{{{ or }}}} for a brace)")
+                wrong = placeholders(value)[1]
+                unpaired = [w for w in wrong if not (w.startswith("{") and w.endswith("}"))]
+                what = "a brace without its pair" if unpaired else f"{', '.join(wrong)} is not a placeholder"
+                self.add(
+                    path,
+                    f"{describe(path)}: {what}: a placeholder is a name in braces, like {{ways}}, with no "
+                    "format, index or attribute (write {{ or }} for a brace)",
+                )
             elif theirs is not None and mine != theirs:
                 want = ", ".join(f"{{{p}}}" for p in sorted(theirs)) or "none"
                 self.add(path, f"{describe(path)} must have the placeholders of en.yaml ({want})")

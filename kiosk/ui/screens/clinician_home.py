@@ -8,11 +8,12 @@ from __future__ import annotations
 from textual import on
 from textual.app import ComposeResult
 from textual.containers import Horizontal, VerticalScroll
-from textual.widgets import Button, DataTable, Label, Static, Switch
+from textual.widgets import DataTable, Switch
 
 from kiosk.core.session import Phase
 from kiosk.export.captured import questionnaire_of
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.ui.widgets.literal import Button, Label, Static, cell
 
 #: how often the running session's line is redrawn (seconds)
 REFRESH_S = 1.0
@@ -72,14 +73,9 @@ class ClinicianHomeScreen(ClinicianScreen):
             progress = f"{len(test.answers)} of {count} answered" + (
                 f", {len(test.not_answered)} not answered" if test.not_answered else ""
             )
-            interrupted.add_row(
-                test.patient_id,
-                test.started_at[:16].replace("T", " "),
-                progress,
-                test.interrupted_reason or "",
-                test.id,
-                key=test.id,
-            )
+            started = test.started_at[:16].replace("T", " ")
+            row = (test.patient_id, started, progress, test.interrupted_reason or "", test.id)
+            interrupted.add_row(*map(cell, row), key=test.id)
         # "Continue this test" only when there is one to continue
         some = bool(interrupted.row_count)
         interrupted.display = some
@@ -104,9 +100,9 @@ class ClinicianHomeScreen(ClinicianScreen):
             )
             if s.id in table.rows:
                 for column, value in zip(table.columns, row):
-                    table.update_cell(s.id, column, value)
+                    table.update_cell(s.id, column, cell(value))
             else:
-                table.add_row(*row, key=s.id)
+                table.add_row(*map(cell, row), key=s.id)
 
     def refresh_session(self) -> None:
         """Redraw what a running session changes: its line, the channels, which actions apply,
