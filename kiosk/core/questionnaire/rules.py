@@ -14,6 +14,7 @@ from typing import Any, TypeGuard
 from fileio.positions import describe
 from kiosk.core.questionnaire.formula import ItemAnswers, prove
 from kiosk.core.questionnaire.scoring import local_code
+from kiosk.core.questionnaire.ucum import unit_problem
 
 Items = list[tuple[int, dict[str, Any]]]
 
@@ -62,6 +63,10 @@ def check_items(items: Items, add: Callable[..., None]) -> None:
             low, high = entry.get("min"), entry.get("max")
             if _number(low) and _number(high) and low > high:
                 add(path + ("input", "min"), f"{describe(path + ('input',))}: min {low} is above max {high}")
+            unit = entry.get("unit")
+            why = unit_problem(unit) if isinstance(unit, str) and unit else None
+            if why is not None:
+                add(path + ("input", "unit"), f"{describe(path + ('input', 'unit'))}: {why}")
             if entry.get("type") == "integer":
                 for name in ("min", "max"):
                     value = entry.get(name)

@@ -11,7 +11,8 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable
 
-from kiosk.core.staff import entered_values, waiting_line
+from kiosk.core.questionnaire import result_words
+from kiosk.core.staff import entered_values
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.store.database import StoredSession
@@ -127,15 +128,10 @@ class SessionDetailScreen(ClinicianScreen):
             score = rescore(q, self.stored)
         except ExportError as error:
             return f"Cannot score: {error}"
-        if score.problem:  # the formula failed on these answers: no total rather than a wrong one
-            return f"No total: {score.problem}"
-        if score.awaiting_staff:  # a staff item unanswered: no total until staff answer it
-            return f"No total yet: {waiting_line(score.awaiting_staff)}"
         if not score.complete:  # a partial sum is no total: never shown as one
-            return (
-                f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
-                f"(the answered ones add up to {score.total})"
-            )
+            patient_missing = set(score.missing) - set(score.awaiting_staff)
+            partial = f" (the answered ones add up to {score.total})" if patient_missing and not score.problem else ""
+            return result_words(q, score) + partial
         band = score.band.label["en"] if score.band else "no band"
         return f"Total {score.total} of {score.max_total} (complete); {band}"
 

@@ -282,3 +282,51 @@ def test_the_kiosk_computes_what_fhirpathpy_computes(expression):
 def test_the_formulas_of_the_test_instruments_still_validate(tmp_path):
     for text in (STAFFED, MEASURED):
         assert problems(tmp_path, text) == []
+
+
+# ---------------------------------------------------------------- units
+
+
+@pytest.mark.parametrize(
+    ("unit", "why"),
+    [
+        ("kilos", "'kilos' is not a UCUM unit: write 'kg'"),
+        ("years", "'years' is not a UCUM unit: write 'a'"),
+        ("Kg", "'Kg' is not a UCUM unit: 'Kg' is not a unit the kiosk knows (did you mean 'kg'?)"),
+        ("kg//m2", "'kg//m2' is not a UCUM unit: '/' needs a unit on each side (did you mean 'kg/m2'?)"),
+        ("(cm", "'(cm' is not a UCUM unit: it does not follow UCUM's grammar (did you mean 'cm'?)"),
+    ],
+)
+def test_a_unit_that_is_not_ucum_is_refused_with_what_to_write(tmp_path, unit, why):
+    from tests.kiosk.core.instruments_v2 import staff_input
+
+    body = choice("intake", [0, 1]) + staff_input("weight", "decimal", 20, 250, f"'{unit}'")
+    text = with_formula(summed("intake"), 0, 1, body)
+    assert problems(tmp_path, text) == [f"{at(text, 'unit: ') + 6}: items[1].input.unit: {why}"]
+
+
+@pytest.mark.parametrize("unit", ["kg", "cm", "s", "a", "{score}", "kg/m2", "mm[Hg]", "{beats}/min", "10*3/uL", "mL"])
+def test_ucum_units_and_compositions_are_accepted(tmp_path, unit):
+    from tests.kiosk.core.instruments_v2 import staff_input
+
+    body = choice("intake", [0, 1]) + staff_input("weight", "decimal", 20, 250, f"'{unit}'")
+    assert problems(tmp_path, with_formula(summed("intake"), 0, 1, body)) == []
+
+
+# ---------------------------------------------------------------- incomplete results in words
+
+
+def test_an_incomplete_result_says_what_it_waits_for_in_the_items_words(tmp_path):
+    from kiosk.core.questionnaire import result_words
+
+    q = load(tmp_path, MEASURED)
+    waiting = q.score_answers({"intake": 2})
+    assert result_words(q, waiting) == "No total yet: waiting for staff: weight? (kg), height? (cm)"
+    nothing = q.score_answers({}, values={"weight": 70.0})
+    assert result_words(q, nothing) == "No total: not answered: intake?; waiting for staff: height? (cm)"
+    done = q.score_answers({"intake": 3}, values={"weight": 70.0, "height": 170.0})
+    assert result_words(q, done) == "Total 5 of 5; normal"
+    broken = replace(q, formula=Formula("today().count()", 0, 5)).score_answers(
+        {"intake": 3}, values={"weight": 70.0, "height": 170.0}
+    )
+    assert result_words(q, broken).startswith("No total: the total formula of measured cannot be evaluated: ")

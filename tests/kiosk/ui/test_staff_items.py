@@ -57,7 +57,7 @@ async def test_staff_enter_the_weight_and_the_aid_and_the_result_completes(ui_ki
         await _finish_visit(kiosk, pilot)
         assert not kiosk.session.snapshot().score.complete
         await _open_detail(kiosk, pilot)
-        assert _total(kiosk) == "No total yet: waiting for staff: weight, aid"
+        assert _total(kiosk) == "No total yet: waiting for staff: Weight (kg), Uses a walking aid"
         # a weight out of range is refused in one sentence, and nothing is stored
         await _click(pilot, "#staff-value-weight")
         await pilot.press(*"300")
@@ -71,7 +71,7 @@ async def test_staff_enter_the_weight_and_the_aid_and_the_result_completes(ui_ki
         await pilot.press(*"72,5")
         await _click(pilot, "#staff-save-weight")
         await settle(pilot, lambda: "72.5 kg" in text_of(kiosk.app.screen.query_one("#staff-now-weight", Label)))
-        assert _total(kiosk) == "No total yet: waiting for staff: aid"
+        assert _total(kiosk) == "No total yet: waiting for staff: Uses a walking aid"
         select = kiosk.app.screen.query_one("#staff-choice-aid", Select)
         select.focus()
         await pilot.press("enter", "down", "down", "enter")
