@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 from kiosk.config import ConfigError, configured_instruments, configured_questionnaire, load_config
-from kiosk.core.questionnaire import QuestionnaireError, pending_words, result_words
+from kiosk.core.questionnaire import QuestionnaireError, result_words
 from kiosk.core.words import languages
 from kiosk.export import (
     ID_TAGS,
@@ -39,25 +39,9 @@ from kiosk.export import (
     write_export,
     write_json,
 )
-from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, wide_csv_tables
+from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, result_line, wide_csv_tables
 from kiosk.export.opening import in_force_of, open_store
 from kiosk.store.database import StorageError, StoredSession
-
-
-def _result(stored: StoredSession) -> str:
-    """A stored session's result in one line of the list ("Total 85 of 100; ...", "No total yet:
-    waiting for staff: Weight (kg)"), or why it cannot be scored."""
-    try:
-        q = questionnaire_of(stored)
-        score = rescore(q, stored)
-    except ExportError as error:
-        return f"cannot be scored: {error}"
-    patient = [i for i in score.missing if i not in score.awaiting_staff]
-    if patient and not score.problem:  # the list stays one short line: the detail names them
-        return f"No total: {len(patient)} of {len(q.items)} questions not answered" + (
-            f"; {pending_words(q, score).split('; ')[-1]}" if score.awaiting_staff else ""
-        )
-    return result_words(q, score)
 
 
 def _show(stored: StoredSession) -> None:
@@ -209,7 +193,7 @@ def main(argv: list[str]) -> int:
                 for s in summaries:
                     print(
                         f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "
-                        f"{s.language}  {_result(store.session(s.id))}"
+                        f"{s.language}  {result_line(store.session(s.id))}"
                     )
                 waiting, parked = store.outbox_waiting()
                 if waiting or parked:
