@@ -13,7 +13,7 @@ from collections.abc import Callable
 from typing import Any
 
 from fileio.positions import Positions, Problem, describe, schema_problems
-from kiosk.core.questionnaire.rules import check_items, check_scoring, reachable_totals
+from kiosk.core.questionnaire.rules import check_items, check_scoring, check_stand_ins, reachable_totals
 from kiosk.core.words import languages
 
 #: the languages the kiosk's own screens are written in (a words file each, kiosk/core/words): a
@@ -150,6 +150,7 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
 
     items = dicts(data.get("items"))
     check_items(items, add)
+    check_stand_ins(data, items, add)
     translations = data.get("translations")
     for lang in translations if isinstance(translations, dict) else ():
         if languages and lang not in languages:

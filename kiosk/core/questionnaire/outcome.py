@@ -39,8 +39,24 @@ def pending_words(q: Questionnaire, score: Score, language: str = "en") -> str:
     patient = [names.get(i, i) for i in score.missing if i not in staff]
     parts = [f"not answered: {', '.join(patient)}"] if patient else []
     if staff:
-        parts.append(f"waiting for staff: {', '.join(names.get(i, i) for i in score.awaiting_staff)}")
+        parts.append(f"waiting for staff: {', '.join(_either(q, score.awaiting_staff, names))}")
     return "; ".join(parts)
+
+
+def _either(q: Questionnaire, waiting: tuple[str, ...], names: dict[str, str]) -> list[str]:
+    """The names of ``waiting``, an item answered instead of others joined to their last with
+    "or" ("Weight (kg), Height (cm) or Calf circumference (cm)")."""
+    stand_ins = {i.id: i.instead_of for i in q.items if i.instead_of and i.id in waiting}
+    listed = [i for i in waiting if i not in stand_ins]
+    shown = [names.get(i, i) for i in listed]
+    for stand_in, others in stand_ins.items():
+        last = max((listed.index(o) for o in others if o in listed), default=None)
+        if last is None:
+            listed.append(stand_in)
+            shown.append(names.get(stand_in, stand_in))
+        else:
+            shown[last] += f" or {names.get(stand_in, stand_in)}"
+    return shown
 
 
 def result_words(q: Questionnaire, score: Score, language: str = "en") -> str:

@@ -7,6 +7,7 @@ report through the same ``add(path, message, key=)`` so every problem is one ``f
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections.abc import Callable
 from typing import Any, TypeGuard
@@ -22,6 +23,8 @@ Items = list[tuple[int, dict[str, Any]]]
 YES_NO_CODES = {"yes": ("http://loinc.org", "LA33-6"), "no": ("http://loinc.org", "LA32-8")}
 #: the kinds of answer an item may have, one each
 KINDS = ("options", "answers", "input")
+#: the most items that may stand in for others (each multiplies the answers a formula is proved on by 3)
+MAX_STAND_INS = 3
 #: the largest total (either sign) a formula may declare: clinical scores are far smaller, and
 #: bands are checked against every whole number of the range
 MAX_TOTAL = 10_000
@@ -142,6 +145,67 @@ def _answers(data: dict[str, Any], items: Items) -> list[ItemAnswers] | None:
     return found
 
 
+def stand_ins(items: Items) -> dict[str, list[str]]:
+    """Each well-formed ``instead_of``: the standing-in item's id -> the ids it stands in for."""
+    return {
+        item["id"]: [i for i in item["instead_of"] if isinstance(i, str)]
+        for _, item in items
+        if isinstance(item.get("id"), str) and isinstance(item.get("instead_of"), list)
+    }
+
+
+def check_stand_ins(data: dict[str, Any], items: Items, add: Callable[..., None]) -> None:
+    """``instead_of`` names other existing items, each in one list only, none itself standing in
+    for others; the instrument's total is a formula (which says how either side scores); at most
+    :data:`MAX_STAND_INS` items stand in for others (every combination is proved)."""
+    ids = {item.get("id") for _, item in items}
+    groups = stand_ins(items)
+    taken: dict[str, str] = {}
+    for i, item in items:
+        listed = item.get("instead_of")
+        if not isinstance(listed, list):
+            continue
+        path = ("items", i, "instead_of")
+        if _formula(data) is None:
+            add(
+                path,
+                f"{describe(path)}: an item answered instead of others needs a formula total, "
+                "which says how either is scored",
+                key=True,
+            )
+        for k, other in enumerate(listed):
+            if other == item.get("id") or other not in ids:
+                what = "itself" if other == item.get("id") else f"{other!r}, which is not an item"
+                add(path + (k,), f"{describe(path)} names {what}")
+            elif other in groups:
+                add(path + (k,), f"{describe(path)} names {other!r}, which stands in for others itself")
+            elif other in taken and taken[other] != item.get("id"):
+                add(path + (k,), f"{describe(path)}: {other!r} is already stood in for by {taken[other]!r}")
+            else:
+                taken[other] = str(item.get("id"))
+    if len(groups) > MAX_STAND_INS:
+        add(("items",), f"at most {MAX_STAND_INS} items may stand in for others ({len(groups)} do)")
+
+
+def _scenarios(groups: dict[str, list[str]], answers: list[ItemAnswers]) -> list[tuple[str, list[ItemAnswers]]]:
+    """The sets of items a complete result may have answered, described: every item; and for
+    each stand-in, either it or the items it stands in for left out."""
+    choices = [[("", set[str]())]]
+    for stand_in, others in list(groups.items())[:MAX_STAND_INS]:
+        choices.append(
+            [
+                ("", set()),
+                (f" (with {stand_in} answered instead of {', '.join(others)})", set(others)),
+                (f" (with {', '.join(others)} answered, not {stand_in})", {stand_in}),
+            ]
+        )
+    found = []
+    for combination in itertools.product(*choices):
+        left_out = set().union(*(c[1] for c in combination))
+        found.append(("".join(c[0] for c in combination), [a for a in answers if a.id not in left_out]))
+    return found
+
+
 def check_scoring(
     data: dict[str, Any], items: Items, texts: Callable[[tuple[Any, ...], Any], None], add: Callable[..., None]
 ) -> None:
@@ -166,7 +230,13 @@ def check_scoring(
         answers = _answers(data, items)
         if isinstance(expression, str) and answers is not None and _integer(low) and _integer(high):
             bounded = low <= high and abs(low) <= MAX_TOTAL and abs(high) <= MAX_TOTAL
-            for at, why in prove(expression, low, high, answers) if bounded else ():
+            found: list[tuple[int, str]] = []
+            for described, scenario in _scenarios(stand_ins(items), answers) if bounded else ():
+                proved = prove(expression, low, high, scenario, [a.id for a in answers])
+                found = [(at, why + (described if not at else "")) for at, why in proved]
+                if found:
+                    break
+            for at, why in found:
                 if at:
                     add(path + ("fhirpath",), f"scoring.total.fhirpath, at character {at}: {why}")
                 else:

@@ -38,6 +38,8 @@ class ScoredItem(Protocol):
     def entry(self) -> Entry | None: ...
     @property
     def staff(self) -> bool: ...
+    @property
+    def instead_of(self) -> tuple[str, ...]: ...
     def option(self, number: int) -> Option: ...
 
 
@@ -191,10 +193,25 @@ def formula_total(q: Questionnaire, formula: Formula, response: Mapping[str, Any
     return int(value)
 
 
+def excused_items(q: Questionnaire, answered: set[str]) -> set[str]:
+    """The unanswered items a complete result does without: those an answered item stands in for
+    (``instead_of``), and an item standing in for others that were all answered."""
+    excused: set[str] = set()
+    for item in q.items:
+        if not item.instead_of:
+            continue
+        if item.id in answered:
+            excused.update(item.instead_of)
+        elif all(i in answered for i in item.instead_of):
+            excused.add(item.id)
+    return excused - answered
+
+
 def compute_score(q: Questionnaire, options: Mapping[str, int], values: Mapping[str, float], bands: BandSet) -> Score:
     """The score of checked answers (see :meth:`Questionnaire.score_answers`)."""
     answered = tuple(i.id for i in q.items if i.id in options or i.id in values)
-    missing = tuple(i.id for i in q.items if i.id not in options and i.id not in values)
+    excused = excused_items(q, set(answered))
+    missing = tuple(i.id for i in q.items if i.id not in answered and i.id not in excused)
     points = {i: q.item(i).option(n).points or 0 for i, n in options.items()}
     complete = not missing
     total = sum(points.values())

@@ -66,15 +66,18 @@ class ItemAnswers:
         return {key: Interval(Decimal(str(low)), Decimal(str(high)), kind == "integer")}
 
 
-def prove(expression: str, low: int, high: int, items: Sequence[ItemAnswers]) -> list[tuple[int, str]]:
+def prove(
+    expression: str, low: int, high: int, items: Sequence[ItemAnswers], known: Sequence[str] = ()
+) -> list[tuple[int, str]]:
     """Every problem of a total formula ranging ``low``..``high`` over ``items``, as
     (character, message), character 0 for the formula as a whole; empty when every complete set
-    of answers gives one whole number in range."""
+    of answers gives one whole number in range. ``known``: the instrument's item ids, when
+    ``items`` are those a complete result may have answered (some left out)."""
     try:
         tree = parse(expression)
     except FormulaError as exc:
         return [(exc.at, exc.message)]
-    ids = [i.id for i in items]
+    ids = list(known) or [i.id for i in items]
     wrong = [(at, _no_item(name, ids)) for name, at in named_items(tree) if name not in ids]
     if wrong:
         return wrong
