@@ -303,10 +303,39 @@ class _Check:
 
     def problems(self, data: Any, code: str) -> list[Problem]:
         self.mapping((), data, SHAPE)
+        if isinstance(data, dict):
+            self.overlaps(data)
         declared = data.get("language", {}).get("code") if isinstance(data, dict) else None
         if isinstance(declared, str) and declared != code:
             self.add(("language", "code"), f"language.code is {declared!r} but the file is {code}.yaml")
         return self.found
+
+    def overlaps(self, data: dict[str, Any]) -> None:
+        """Words that would mean two things: a yes word that is also a no word, or a command
+        ("pause") that is also a yes or no word (the patient saying it would do the other)."""
+
+        def said(path: tuple[str, ...]) -> dict[str, int]:
+            value: Any = data
+            for key in path:
+                value = value.get(key) if isinstance(value, dict) else None
+            words = value if isinstance(value, list) else []
+            return {w.strip().casefold(): n for n, w in enumerate(words) if isinstance(w, str)}
+
+        answers: dict[str, str] = {}
+        for section in ("prompts", "speech", "answers"):
+            yes, no = said((section, "yes_words")), said((section, "no_words"))
+            for word in sorted(yes.keys() & no.keys()):
+                self.add((section, "no_words", no[word]), f"{section}.no_words: {word!r} is also one of the yes_words")
+            if section != "prompts":
+                answers |= dict.fromkeys(yes.keys() | no.keys(), section)
+        commands = data.get("speech", {}).get("commands") if isinstance(data.get("speech"), dict) else None
+        for command in commands if isinstance(commands, dict) else ():
+            for word, n in said(("speech", "commands", command)).items():
+                if word in answers:
+                    self.add(
+                        ("speech", "commands", command, n),
+                        f"speech.commands.{command}: {word!r} is also one of {answers[word]}'s yes or no words",
+                    )
 
     def mapping(self, path: tuple[Any, ...], value: Any, shape: Mapping[str, Any]) -> None:
         where = describe(path) or "the file"

@@ -318,3 +318,15 @@ def test_a_formula_that_fails_on_some_answers_gives_no_total_and_says_why(tmp_pa
     assert "gave 4, outside its declared -1 to 2" in score.problem
     fine = narrow.score_answers({"recall": 1, "orientation": 1, "judged": 1}, values={"education": 12})
     assert (fine.complete, fine.total, fine.problem) == (True, 0, "")
+
+
+def test_a_synonym_that_is_a_voice_command_is_refused(tmp_path):
+    # "wait" pauses the session in English: as an answer's synonym the patient saying it would pause
+    text = LAWTON.replace(
+        '        label: {en: "telephone 1", es: "telephone 1 (es)"}\n',
+        '        label: {en: "telephone 1", es: "telephone 1 (es)"}\n        synonyms: {en: [on my own, Wait]}\n',
+    )
+    assert problems(tmp_path, text) == [
+        f"{at(text, 'Wait')}: the synonym 'Wait' is the kiosk's 'pause' command in 'en': "
+        "a patient saying it would pause instead of answering"
+    ]

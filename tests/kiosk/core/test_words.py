@@ -113,6 +113,13 @@ def test_a_file_missing_a_key_is_refused_naming_where_and_the_key(tmp_path, caps
             "no words file for 'pt'",
         ),
         ("  code: xx", "  code: en", "code:", "language.code is 'en' but the file is xx.yaml"),
+        (
+            'no_words: ["no", nope, no that\'s wrong',
+            'no_words: ["no", yeah, no that\'s wrong',
+            'no_words: ["no", yeah',
+            "prompts.no_words: 'yeah' is also one of the yes_words",
+        ),
+        ("pause: [pause, wait, stop]", "pause: [pause, wait, nope]", "pause: [pause", "'nope' is also one of"),
         ("  start: Go\n", "  start: Go\n  start: Went\n", "start: Went", "duplicate key 'start'"),
     ],
 )
