@@ -165,12 +165,30 @@ def _check_files(directory: Path) -> tuple[dict[str, Any], list[Problem], bool]:
         return {}, problems, readable
     template = parsed[TEMPLATE][0]
     good = {}
+    checked = {}
     for code, (data, positions) in parsed.items():
-        found = _Check(str(paths[code]), positions, template, set(paths)).problems(data, code)
+        checked[code] = _Check(str(paths[code]), positions, template, set(paths)).problems(data, code)
+    _blame_the_template(checked, parsed[TEMPLATE][1], str(paths[TEMPLATE]))
+    for code, found in checked.items():
         problems += found
         if not found:
-            good[code] = data
+            good[code] = parsed[code][0]
     return good, problems, readable
+
+
+def _blame_the_template(checked: dict[str, list[Problem]], positions: Positions, template: str) -> None:
+    """A screen key every other language has but en.yaml lacks was deleted from en.yaml: one
+    problem there, not an "unknown key" in each of the others."""
+    others = [code for code in checked if code != TEMPLATE]
+    unknown = re.compile(r"unknown key '(screen\.[^']+)' \(en\.yaml has no such key\)")
+    keys = [{m.group(1) for p in checked[code] if (m := unknown.fullmatch(p.message))} for code in others]
+    for key in sorted(set.intersection(*keys) if len(others) > 1 else set()):
+        for code in others:
+            checked[code] = [p for p in checked[code] if p.message != f"unknown key {key!r} (en.yaml has no such key)"]
+        line, column = positions.of(("screen",), key=True)
+        checked[TEMPLATE].append(
+            Problem(template, line, column, f"missing {key!r} (every other language has it, and the screens need it)")
+        )
 
 
 def load_words(directory: str | Path | None = None) -> dict[str, Words]:

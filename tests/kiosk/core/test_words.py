@@ -151,6 +151,17 @@ def test_a_format_spec_in_the_template_is_refused_by_validate_and_never_formatte
     )
 
 
+def test_a_key_deleted_from_the_template_is_reported_there_not_in_every_other_file(tmp_path):
+    directory = words_dir(tmp_path)
+    template = directory / "en.yaml"
+    edit(template, "  paused_title: Paused\n", "")
+    _, problems, readable = check_words(directory)
+    assert readable and [str(p) for p in problems] == [
+        f"{position(template, 'screen:')}: missing 'screen.paused_title' (every other language has it, "
+        "and the screens need it)"
+    ]
+
+
 def test_a_broken_template_is_reported_in_the_template_only(tmp_path):
     directory = words_dir(tmp_path)
     template = directory / "en.yaml"
