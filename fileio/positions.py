@@ -155,8 +155,32 @@ def schema_problems(data: Any, schema: dict[str, Any], positions: Positions, add
             add(path, f"{where} has {len(error.instance)}: {bound} {error.validator_value} are allowed")
         elif error.validator == "multipleOf":
             add(path, f"{where}: must be a multiple of {error.validator_value}, got {error.instance!r}")
+        elif error.validator == "type" and (not path or len(repr(error.instance)) > MAX_ECHO):
+            # never echo a whole file (kiosk validate /etc/passwd) or a long value back
+            wanted = "a mapping of keys (key: value lines)" if error.validator_value == "object" else None
+            add(
+                path,
+                f"{where} must be {wanted or f'of type {error.validator_value!r}'}, not {_kind_of(error.instance)}",
+            )
         else:
-            add(path, f"{where}: {error.message}")
+            shown = repr(error.instance)
+            message = (
+                error.message if len(shown) <= MAX_ECHO else error.message.replace(shown, _kind_of(error.instance))
+            )
+            add(path, f"{where}: {message}")
+
+
+#: the longest value a problem repeats back as written
+MAX_ECHO = 60
+
+
+def _kind_of(value: Any) -> str:
+    """What a value is, without its content: "a text of 1,234 characters", "a list of 3 values"."""
+    if isinstance(value, str):
+        return f"a text of {len(value):,} characters"
+    if isinstance(value, (list, dict)):
+        return f"a {'list' if isinstance(value, list) else 'mapping'} of {len(value):,} values"
+    return f"a {type(value).__name__}"
 
 
 def _schema_key(data: Any, schema: dict[str, Any]) -> str | None:

@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 from kiosk.config import ConfigError, configured_instruments, configured_questionnaire, load_config
-from kiosk.core.questionnaire import QuestionnaireError
+from kiosk.core.questionnaire import QuestionnaireError, result_words
 from kiosk.core.words import languages
 from kiosk.export import (
     ID_TAGS,
@@ -39,7 +39,7 @@ from kiosk.export import (
     write_export,
     write_json,
 )
-from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, wide_csv_tables
+from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, result_line, wide_csv_tables
 from kiosk.export.opening import in_force_of, open_store
 from kiosk.store.database import StorageError, StoredSession
 
@@ -88,9 +88,12 @@ def _show(stored: StoredSession) -> None:
                 f"{a.channel.value:<8} {label}"
             )
     source = q.bands_named(score.band_set).source
-    band = f"{score.band.label['en']} (bands: {score.band_set}, {source})" if score.band else "no band (incomplete)"
-    completeness = "complete" if score.complete else f"incomplete, missing {', '.join(score.missing)}"
-    print(f"total {score.total}/{score.max_total} ({completeness}); {band}")
+    if score.complete:
+        band = f"{score.band.label['en']} (bands: {score.band_set}, {source})" if score.band else "no band"
+        print(f"total {score.total}/{score.max_total} (complete); {band}")
+    else:  # a partial sum is no total: say what the result waits for, by the items' words
+        partial = set(score.missing) - set(score.awaiting_staff) and not score.problem
+        print(result_words(q, score) + (f" (the answered ones add up to {score.total})" if partial else ""))
     for record in stored.adaptations:
         print(f"  adaptation {record.name} {'on' if record.active else 'off'} at t={record.t:g}: {record.reason}")
     if stored.metrics:
@@ -190,7 +193,7 @@ def main(argv: list[str]) -> int:
                 for s in summaries:
                     print(
                         f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "
-                        f"{s.language}  {s.answered} answered, {s.not_answered} not answered"
+                        f"{s.language}  {result_line(store.session(s.id))}"
                     )
                 waiting, parked = store.outbox_waiting()
                 if waiting or parked:

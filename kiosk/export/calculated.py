@@ -45,7 +45,27 @@ def total_expression(q: Questionnaire) -> str:
     value = f"({q.formula.expression})" if q.formula else f"{_answered([i.id for i in q.items if i.options])}"
     if q.formula is None:
         value += ".answer.value.weight().sum()"
+    if any(i.instead_of for i in q.items):
+        return f"iif({_complete(q)}, {value}, {{}})"
     return f"iif({every}.count() = {len(q.items)}, {value}, {{}})"
+
+
+def _complete(q: Questionnaire) -> str:
+    """Every item answered, an item answered ``instead_of`` others counting for them (and they
+    for it), as FHIRPath."""
+
+    def has(item_id: str) -> str:
+        return f"%resource.item.where(linkId = {_quoted(item_id)} and answer.exists()).exists()"
+
+    covered = {other for i in q.items for other in i.instead_of}
+    clauses = []
+    for item in q.items:
+        if item.instead_of:
+            others = " and ".join(has(o) for o in item.instead_of)
+            clauses.append(f"({has(item.id)} or ({others}))")
+        elif item.id not in covered:
+            clauses.append(has(item.id))
+    return " and ".join(clauses)
 
 
 def subscale_expression(subscale: Subscale) -> str:

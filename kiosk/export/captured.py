@@ -17,14 +17,31 @@ from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
-from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.questionnaire import Questionnaire, pending_words, result_words
 from kiosk.core.questionnaire.definition import DefinitionError, canonical_json, questionnaire_from
 from kiosk.core.review import Review
 from kiosk.core.site import ExportSite, default_kiosk_id, site_from_identity
-from kiosk.export.result import ExportError
+from kiosk.export.result import ExportError, rescore
 from kiosk.store.records import StoredSession
 
-__all__ = ["bundle_of", "csv_of", "questionnaire_of", "site_of", "wide_csv_of", "wide_csv_tables"]
+__all__ = ["bundle_of", "csv_of", "questionnaire_of", "result_line", "site_of", "wide_csv_of", "wide_csv_tables"]
+
+
+def result_line(stored: StoredSession) -> str:
+    """A stored session's result in one short line of a list ("Total 85 of 100; Mild
+    dependence", "No total yet: waiting for staff: Weight (kg)", "No total: 2 of 10 questions
+    not answered"), or why it cannot be scored: what the clinician's list and ``kiosk results``
+    show beside each session (the detail names every missing item)."""
+    try:
+        q = questionnaire_of(stored)
+        score = rescore(q, stored)
+    except ExportError as error:
+        return f"cannot be scored: {error}"
+    patient = [i for i in score.missing if i not in score.awaiting_staff]
+    if patient and not score.problem:
+        staff = pending_words(q, score).split("; ")[-1] if score.awaiting_staff else ""
+        return f"No total: {len(patient)} of {len(q.items)} questions not answered" + (f"; {staff}" if staff else "")
+    return result_words(q, score)
 
 
 @lru_cache(maxsize=64)

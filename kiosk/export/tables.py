@@ -16,7 +16,7 @@ import io
 from collections.abc import Sequence
 from typing import Any
 
-from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.questionnaire import Questionnaire, result_words
 from kiosk.core.review import Review
 from kiosk.core.site import ExportSite
 from kiosk.core.visits import visit_of
@@ -37,7 +37,8 @@ ID_TAGS = {"session": "S:", "patient": "P:", "kiosk_id": "K:"}
 #: order asked; ``checks`` says what it checks; never scored), "item" (one per questionnaire item, in
 #: order: the option after review; ``recorded_option`` the kiosk's own when a clinician changed it,
 #: ``corrected_by`` who did) and "total" (last: ``points`` the total, blank when incomplete, with
-#: ``label`` "incomplete (N points from K of M items)"; its band and ``band_set``, the set that
+#: ``label`` saying what it waits for, "No total: not answered: Grooming (N points from K of M
+#: items)" or "No total yet: waiting for staff: Weight (kg) (...)"; its band and ``band_set``, the set that
 #: gave it: "severe" is 21-60 in Shah's set but 20-35 in the Spanish one). Every row carries the
 #: session's columns (ids tagged, see the module docstring); ``review_state`` is
 #: :func:`kiosk.core.review.review_state`'s (unreviewed, corrected, signed_off, amended), as in FHIR.
@@ -164,7 +165,7 @@ def csv_text(
         label = (
             _band(q, r)
             if score.complete
-            else (f"incomplete ({score.total} points from {len(score.answered)} of {len(q.items)} items)")
+            else f"{result_words(q, score)} ({score.total} points from {len(score.answered)} of {len(q.items)} items)"
         )
         writer.writerow(
             common

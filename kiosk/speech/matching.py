@@ -20,7 +20,7 @@ from collections.abc import Mapping, Sequence
 
 from basis import record
 from kiosk.core.channels import Command
-from kiosk.core.words import Table, languages
+from kiosk.core.words import Table, fill, languages
 
 #: the languages with speech words: every language with a words file
 LANGUAGES = languages()
@@ -253,7 +253,7 @@ class Matcher:
         for number in range(len(self.options)):
             for form in forms:
                 words = CARDINALS[self.language][number] if "{n}" in form else ORDINALS[self.language][number]
-                out += [form.format(n=w, o=w) for w in words]
+                out += [fill(form, n=w, o=w) for w in words]
         for command, phrases in self._command_phrases.items():
             if command in self.commands or command is Command.UNDO:
                 out += phrases

@@ -310,6 +310,7 @@ class KioskApp(App[int], inherit_bindings=False):
             f"This test was stopped: {reason}. Staff can see it on the clinician screen.",
             title="Test stopped",
             severity="warning",
+            markup=False,
             timeout=60,
         )
 

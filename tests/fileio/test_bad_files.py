@@ -150,3 +150,21 @@ def test_the_real_files_still_load(tmp_path, loader):
     good, name, load = LOADERS[loader]
     (tmp_path / name).write_bytes(good)
     load(tmp_path / name)
+
+
+def test_a_refused_file_is_never_echoed_back(tmp_path):
+    # `kiosk validate /etc/passwd` printed the file's first line (and the rest) back: a value is
+    # repeated only when short, and a whole file never
+    secret = "root:x:0:0:root:/root:/bin/bash\n" * 30
+    path = tmp_path / "passwd"
+    path.write_text(secret, encoding="utf-8")
+    (problem,) = check_questionnaire_file(path)
+    assert str(problem) == (
+        f"{path}:1:1: the file must be a mapping of keys (key: value lines), not a text of {len(secret) - 1:,} characters"
+    )
+    long_title = bundled_path().read_text(encoding="utf-8").replace("id: barthel", "id: [" + "x, " * 40 + "x]", 1)
+    other = tmp_path / "long.yaml"
+    other.write_text(long_title, encoding="utf-8")
+    found = [str(p) for p in check_questionnaire_file(other)]
+    assert any("id must be of type 'string', not a list of 41 values" in line for line in found), found
+    assert not any("x, x, x" in line for line in found)

@@ -42,6 +42,7 @@ from kiosk.core.questionnaire.model import (
     Timing,
     Translation,
 )
+from kiosk.core.questionnaire.outcome import item_name, pending_words, result_words
 from kiosk.core.questionnaire.parts import PATIENT, STAFF, Band, BandSet, Code, Entry, Option
 from kiosk.core.questionnaire.scoring import (
     ITEM_WEIGHT,
@@ -81,6 +82,9 @@ __all__ = [
     "check_questionnaire_file",
     "check_questionnaire_text",
     "evaluate",
+    "item_name",
     "load_questionnaire",
+    "pending_words",
     "response_items",
+    "result_words",
 ]

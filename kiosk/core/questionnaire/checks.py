@@ -13,8 +13,8 @@ from collections.abc import Callable
 from typing import Any
 
 from fileio.positions import Positions, Problem, describe, schema_problems
-from kiosk.core.questionnaire.rules import check_items, check_scoring, reachable_totals
-from kiosk.core.words import languages
+from kiosk.core.questionnaire.rules import check_items, check_scoring, check_stand_ins, reachable_totals
+from kiosk.core.words import languages, load_words
 
 #: the languages the kiosk's own screens are written in (a words file each, kiosk/core/words): a
 #: questionnaire in another language would start a session its screens cannot show
@@ -109,6 +109,12 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
                 for n, word in enumerate(words if isinstance(words, list) else ()):
                     if isinstance(word, str) and word and not word.strip():
                         add(path + (i, "synonyms", lang, n), f"a synonym in {lang!r} is blank: write the words")
+                    elif isinstance(word, str) and (command := _commands(lang).get(word.strip().casefold())):
+                        add(
+                            path + (i, "synonyms", lang, n),
+                            f"the synonym {word!r} is the kiosk's {command!r} command in {lang!r}: "
+                            f"a patient saying it would {command} instead of answering",
+                        )
             answer_code = option.get("code")
             if isinstance(answer_code, dict):
                 key = (answer_code.get("system"), answer_code.get("code"))
@@ -150,12 +156,22 @@ def _check_semantics(data: dict[str, Any], add: Callable[..., None]) -> None:
 
     items = dicts(data.get("items"))
     check_items(items, add)
+    check_stand_ins(data, items, add)
     translations = data.get("translations")
     for lang in translations if isinstance(translations, dict) else ():
         if languages and lang not in languages:
             add(("translations", lang), f"a translation for {lang!r}, which is not in 'languages'", key=True)
     check_scoring(data, items, texts, add)
     _check_bands(data, dicts, texts, add)
+
+
+def _commands(language: str) -> dict[str, str]:
+    """The voice commands' phrases in ``language`` (casefolded) -> the command ({} for a language
+    without a words file)."""
+    words = load_words().get(language)
+    if words is None:
+        return {}
+    return {p.strip().casefold(): c for c, phrases in words.speech["commands"].items() for p in phrases}
 
 
 def _check_displays(

@@ -73,6 +73,8 @@ def _item(i: Item) -> dict[str, Any]:
         extra["answered_by"] = i.answered_by
     if i.entry is not None:
         extra["input"] = asdict(i.entry)
+    if i.instead_of:
+        extra["instead_of"] = list(i.instead_of)
     return {
         "id": i.id,
         "number": i.number,
@@ -210,6 +212,7 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
             patient=texts(v["patient"]),
             answered_by=str(v.get("answered_by", PATIENT)),
             entry=Entry(**v["input"]) if v.get("input") else None,
+            instead_of=tuple(str(i) for i in v.get("instead_of", ())),
         )
         for v in d["items"]
     )

@@ -120,6 +120,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
             patient=dict(v.get("patient", {})),
             answered_by=v.get("answered_by", PATIENT),
             entry=Entry(**v["input"]) if "input" in v else None,
+            instead_of=tuple(v.get("instead_of", ())),
         )
         for n, v in enumerate(data["items"], start=1)
     )

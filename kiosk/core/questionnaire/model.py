@@ -37,6 +37,9 @@ class Item:
     answered_by: str = PATIENT
     #: a number staff type in instead of choosing an option (staff items only)
     entry: Entry | None = None
+    #: items this one is answered instead of, when they cannot be (empty: none): the result
+    #: is complete with either this item or all of those answered
+    instead_of: tuple[str, ...] = ()
 
     @property
     def staff(self) -> bool:

@@ -7,11 +7,15 @@ report through the same ``add(path, message, key=)`` so every problem is one ``f
 
 from __future__ import annotations
 
+import itertools
+import re
 from collections.abc import Callable
 from typing import Any, TypeGuard
 
 from fileio.positions import describe
-from kiosk.core.questionnaire.scoring import ITEM_WEIGHT, local_code, run, syntax_problem
+from kiosk.core.questionnaire.formula import ItemAnswers, prove
+from kiosk.core.questionnaire.scoring import local_code
+from kiosk.core.questionnaire.ucum import unit_problem
 
 Items = list[tuple[int, dict[str, Any]]]
 
@@ -19,6 +23,11 @@ Items = list[tuple[int, dict[str, Any]]]
 YES_NO_CODES = {"yes": ("http://loinc.org", "LA33-6"), "no": ("http://loinc.org", "LA32-8")}
 #: the kinds of answer an item may have, one each
 KINDS = ("options", "answers", "input")
+#: the most items that may stand in for others (each multiplies the answers a formula is proved on by 3)
+MAX_STAND_INS = 3
+#: the largest total (either sign) a formula may declare: clinical scores are far smaller, and
+#: bands are checked against every whole number of the range
+MAX_TOTAL = 10_000
 
 
 def _integer(value: Any) -> TypeGuard[int]:
@@ -57,6 +66,10 @@ def check_items(items: Items, add: Callable[..., None]) -> None:
             low, high = entry.get("min"), entry.get("max")
             if _number(low) and _number(high) and low > high:
                 add(path + ("input", "min"), f"{describe(path + ('input',))}: min {low} is above max {high}")
+            unit = entry.get("unit")
+            why = unit_problem(unit) if isinstance(unit, str) and unit else None
+            if why is not None:
+                add(path + ("input", "unit"), f"{describe(path + ('input', 'unit'))}: {why}")
             if entry.get("type") == "integer":
                 for name in ("min", "max"):
                     value = entry.get(name)
@@ -102,7 +115,9 @@ def reachable_totals(data: dict[str, Any], items: Items) -> set[int] | None:
     formula = _formula(data)
     if formula is not None:
         low, high = formula.get("min"), formula.get("max")
-        return set(range(low, high + 1)) if _integer(low) and _integer(high) and low <= high else None
+        if _integer(low) and _integer(high) and -MAX_TOTAL <= low <= high <= MAX_TOTAL:
+            return set(range(low, high + 1))
+        return None
     totals = {0}
     for _, item in items:
         choices = _choices(data, item)
@@ -113,43 +128,90 @@ def reachable_totals(data: dict[str, Any], items: Items) -> set[int] | None:
     return totals
 
 
-def _samples(data: dict[str, Any], items: Items) -> list[tuple[str, list[dict[str, Any]]]] | None:
-    """A few complete responses (described) to try a formula on: every item at its first option,
-    its last, its lowest and its highest points; inputs at their min, max and middle."""
-    per_item = []
+def _answers(data: dict[str, Any], items: Items) -> list[ItemAnswers] | None:
+    """What each item may be answered with, for the formula's proof; None if malformed."""
+    found = []
     for _, item in items:
         choices, entry = _choices(data, item), item.get("input")
         if choices is None or not isinstance(item.get("id"), str):
             return None
         if isinstance(entry, dict):
             low, high = entry.get("min"), entry.get("max")
-            if not (_number(low) and _number(high)):
+            if not (_number(low) and _number(high)) or low > high:
                 return None
-            key = "valueInteger" if entry.get("type") == "integer" else "valueDecimal"
-            middle = (low + high) / 2
-            values = [low, high, middle, middle]
-            per_item.append((item["id"], [{key: int(v) if key == "valueInteger" else v} for v in values]))
+            found.append(ItemAnswers(item["id"], entry=(str(entry.get("type")), low, high)))
         else:
+            found.append(ItemAnswers(item["id"], options=tuple((s, c, p) for (s, c), p in choices)))
+    return found
 
-            def coded(choice: tuple[tuple[str, str], int]) -> dict[str, Any]:
-                (system, code), points = choice
-                ext = [{"url": ITEM_WEIGHT, "valueDecimal": points}]
-                return {"valueCoding": {"system": system, "code": code, "extension": ext}}
 
-            ranked = sorted(choices, key=lambda c: c[1])
-            per_item.append((item["id"], [coded(c) for c in (choices[0], choices[-1], ranked[0], ranked[-1])]))
-    names = ("at its first option", "at its last option", "at its lowest points", "at its highest points")
-    return [
-        (f"every item {name}", [{"linkId": link, "answer": [answers[k]]} for link, answers in per_item])
-        for k, name in enumerate(names)
-    ]
+def stand_ins(items: Items) -> dict[str, list[str]]:
+    """Each well-formed ``instead_of``: the standing-in item's id -> the ids it stands in for."""
+    return {
+        item["id"]: [i for i in item["instead_of"] if isinstance(i, str)]
+        for _, item in items
+        if isinstance(item.get("id"), str) and isinstance(item.get("instead_of"), list)
+    }
+
+
+def check_stand_ins(data: dict[str, Any], items: Items, add: Callable[..., None]) -> None:
+    """``instead_of`` names other existing items, each in one list only, none itself standing in
+    for others; the instrument's total is a formula (which says how either side scores); at most
+    :data:`MAX_STAND_INS` items stand in for others (every combination is proved)."""
+    ids = {item.get("id") for _, item in items}
+    groups = stand_ins(items)
+    taken: dict[str, str] = {}
+    for i, item in items:
+        listed = item.get("instead_of")
+        if not isinstance(listed, list):
+            continue
+        path = ("items", i, "instead_of")
+        if _formula(data) is None:
+            add(
+                path,
+                f"{describe(path)}: an item answered instead of others needs a formula total, "
+                "which says how either is scored",
+                key=True,
+            )
+        for k, other in enumerate(listed):
+            if other == item.get("id") or other not in ids:
+                what = "itself" if other == item.get("id") else f"{other!r}, which is not an item"
+                add(path + (k,), f"{describe(path)} names {what}")
+            elif other in groups:
+                add(path + (k,), f"{describe(path)} names {other!r}, which stands in for others itself")
+            elif other in taken and taken[other] != item.get("id"):
+                add(path + (k,), f"{describe(path)}: {other!r} is already stood in for by {taken[other]!r}")
+            else:
+                taken[other] = str(item.get("id"))
+    if len(groups) > MAX_STAND_INS:
+        add(("items",), f"at most {MAX_STAND_INS} items may stand in for others ({len(groups)} do)")
+
+
+def _scenarios(groups: dict[str, list[str]], answers: list[ItemAnswers]) -> list[tuple[str, list[ItemAnswers]]]:
+    """The sets of items a complete result may have answered, described: every item; and for
+    each stand-in, either it or the items it stands in for left out."""
+    choices = [[("", set[str]())]]
+    for stand_in, others in list(groups.items())[:MAX_STAND_INS]:
+        choices.append(
+            [
+                ("", set()),
+                (f" (with {stand_in} answered instead of {', '.join(others)})", set(others)),
+                (f" (with {', '.join(others)} answered, not {stand_in})", {stand_in}),
+            ]
+        )
+    found = []
+    for combination in itertools.product(*choices):
+        left_out = set().union(*(c[1] for c in combination))
+        found.append(("".join(c[0] for c in combination), [a for a in answers if a.id not in left_out]))
+    return found
 
 
 def check_scoring(
     data: dict[str, Any], items: Items, texts: Callable[[tuple[Any, ...], Any], None], add: Callable[..., None]
 ) -> None:
-    """The formula parses and gives one whole number in its range on sample answers; subscales
-    name existing scored items once each, with ids of their own."""
+    """The formula is in the kiosk's formula language, names existing items, and gives one whole
+    number in its range for every complete set of answers (:func:`prove`); subscales name
+    existing scored items once each, with ids of their own."""
     formula = _formula(data)
     scoring = data.get("scoring")
     total = scoring.get("total") if isinstance(scoring, dict) else None
@@ -161,12 +223,29 @@ def check_scoring(
         low, high = formula.get("min"), formula.get("max")
         if _integer(low) and _integer(high) and low > high:
             add(path + ("min",), f"scoring.total: min {low} is above max {high}")
+        for name, value in (("min", low), ("max", high)):
+            if _integer(value) and abs(value) > MAX_TOTAL:
+                add(path + (name,), f"scoring.total: {name} {value} is beyond ±{MAX_TOTAL:,}, no score's range")
         expression = formula.get("fhirpath")
-        why = syntax_problem(expression) if isinstance(expression, str) and expression.strip() else None
-        if why is not None:
-            add(path + ("fhirpath",), f"scoring.total.fhirpath is not valid FHIRPath ({why})")
-        elif isinstance(expression, str) and _integer(low) and _integer(high) and low <= high:
-            _try_formula(expression, low, high, _samples(data, items) or [], add)
+        answers = _answers(data, items)
+        if isinstance(expression, str) and answers is not None and _integer(low) and _integer(high):
+            bounded = low <= high and abs(low) <= MAX_TOTAL and abs(high) <= MAX_TOTAL
+            found: list[tuple[int, str]] = []
+            for described, scenario in _scenarios(stand_ins(items), answers) if bounded else ():
+                proved = prove(expression, low, high, scenario, [a.id for a in answers])
+                found = [(at, why + (described if not at else "")) for at, why in proved]
+                if found:
+                    break
+            for at, why in found:
+                if at:
+                    add(path + ("fhirpath",), f"scoring.total.fhirpath, at character {at}: {why}")
+                else:
+                    whole = "not whole" in why or re.search(r"gives -?\d+\.\d", why)
+                    hint = " (round(), floor() or div make one)" if whole else ""
+                    add(
+                        path + ("fhirpath",),
+                        f"scoring.total.fhirpath: {why}; it must give one whole number from {low} to {high}{hint}",
+                    )
     subscales = scoring.get("subscales") if isinstance(scoring, dict) else None
     by_id = {item.get("id"): item for _, item in items}
     seen: set[Any] = set()
@@ -189,26 +268,3 @@ def check_scoring(
                 add(path + ("items", k), f"subscale {sub_id!r}: item {item_id!r} is an input, with no points")
             elif isinstance(members, list) and members.index(item_id) != k:
                 add(path + ("items", k), f"subscale {sub_id!r} lists item {item_id!r} twice")
-
-
-def _try_formula(
-    expression: str, low: int, high: int, samples: list[tuple[str, list[dict[str, Any]]]], add: Callable[..., None]
-) -> None:
-    """One problem for the first sample response the formula gives no whole number in range on."""
-    where = ("scoring", "total", "fhirpath")
-    for described, items in samples:
-        resource = {"resourceType": "QuestionnaireResponse", "item": items}
-        try:
-            result = run(expression, resource)
-        except Exception as exc:  # fhirpathpy raises bare Exceptions (unknown function, bad types)
-            add(where, f"scoring.total.fhirpath cannot be evaluated with {described}: {exc}")
-            return
-        value = result[0] if len(result) == 1 else None
-        if not (_number(value) and value == int(value) and low <= value <= high):
-            shown = value if len(result) == 1 else result
-            add(
-                where,
-                f"scoring.total.fhirpath gives {shown!r} with {described}: "
-                f"it must give one whole number from {low} to {high}",
-            )
-            return

@@ -1,8 +1,8 @@
 """Scoring an instrument: its total, subscales and band, from the answers.
 
 The total is the sum of the chosen options' points unless the instrument declares a formula: a
-FHIRPath expression over the answers as a FHIR QuestionnaireResponse, evaluated with the
-maintained ``fhirpathpy`` library. FHIRPath because it is what FHIR SDC's
+FHIRPath expression over the answers as a FHIR QuestionnaireResponse, in the kiosk's bounded
+subset of it (:mod:`.formula`, ``docs/formulas.md``). FHIRPath because it is what FHIR SDC's
 ``calculatedExpression`` holds, so the exported Questionnaire makes LHC-Forms compute the same
 total from the same words. The response the formula sees is :func:`response_items`' (the items'
 ``linkId`` and answers: a ``valueCoding`` per chosen option, ``valueInteger``/``valueDecimal``
@@ -16,16 +16,11 @@ import copy
 from collections.abc import Mapping
 from dataclasses import field
 from decimal import Decimal
-from functools import lru_cache
 from typing import Any, Protocol
 
 from basis import record
+from kiosk.core.questionnaire.formula import ITEM_WEIGHT, EvaluationError, compute
 from kiosk.core.questionnaire.parts import Band, BandSet, Code, Entry, Option
-
-#: SDC/R5 extension giving an answer option its score (on answerOption or on the Coding)
-ITEM_WEIGHT = "http://hl7.org/fhir/StructureDefinition/itemWeight"
-#: R4's older extension for the same (still read by ``weight()``)
-ORDINAL_VALUE = "http://hl7.org/fhir/StructureDefinition/ordinalValue"
 
 
 class ScoringError(ValueError):
@@ -43,6 +38,8 @@ class ScoredItem(Protocol):
     def entry(self) -> Entry | None: ...
     @property
     def staff(self) -> bool: ...
+    @property
+    def instead_of(self) -> tuple[str, ...]: ...
     def option(self, number: int) -> Option: ...
 
 
@@ -143,67 +140,6 @@ def response_items(q: Questionnaire, options: Mapping[str, int], values: Mapping
     return items
 
 
-def syntax_problem(expression: str) -> str | None:
-    """Why ``expression`` is not FHIRPath ("at character N: ..."), or None when it parses whole.
-
-    fhirpathpy's own parser recovers from errors silently, so this runs its grammar with a
-    listener that keeps them, and insists the whole text was read."""
-    from antlr4 import CommonTokenStream, InputStream, Token  # type: ignore[import-untyped]  # ships no hints
-    from antlr4.error.ErrorListener import ErrorListener  # type: ignore[import-untyped]  # ships no hints
-    from fhirpathpy.parser.generated.FHIRPathLexer import FHIRPathLexer
-    from fhirpathpy.parser.generated.FHIRPathParser import FHIRPathParser
-
-    found: list[str] = []
-
-    class Keep(ErrorListener):
-        def syntaxError(self, recognizer: Any, symbol: Any, line: int, column: int, msg: str, e: Any) -> None:
-            found.append(f"at character {column + 1}: {msg}")
-
-    lexer = FHIRPathLexer(InputStream(expression))
-    lexer.removeErrorListeners()
-    lexer.addErrorListener(Keep())
-    tokens = CommonTokenStream(lexer)
-    parser = FHIRPathParser(tokens)
-    parser.removeErrorListeners()
-    parser.addErrorListener(Keep())
-    parser.expression()
-    if not found and tokens.LA(1) != Token.EOF:
-        found.append(f"at character {tokens.LT(1).start + 1}: {tokens.LT(1).text!r} is not part of the expression")
-    return found[0] if found else None
-
-
-def _number(value: Any) -> Any:
-    if isinstance(value, Decimal):
-        return int(value) if value == value.to_integral_value() else value
-    return value
-
-
-def _weights(values: list[Any]) -> list[Any]:
-    """``weight()``: the score of each chosen Coding (its itemWeight or ordinalValue extension)."""
-    found = []
-    for value in values:
-        if not isinstance(value, Mapping):
-            continue
-        for ext in value.get("extension", ()):
-            if isinstance(ext, Mapping) and ext.get("url") in (ITEM_WEIGHT, ORDINAL_VALUE):
-                weight = ext.get("valueDecimal", ext.get("valueInteger"))
-                if weight is not None:
-                    found.append(_number(Decimal(str(weight))))
-                    break
-    return found
-
-
-_FUNCTIONS = {name: {"fn": _weights, "arity": {0: []}} for name in ("weight", "ordinal")}
-
-
-@lru_cache(maxsize=64)
-def _compiled(expression: str) -> Any:
-    from fhirpathpy import compile
-    from fhirpathpy.models import models
-
-    return compile(expression, models["r4"], options={"userInvocationTable": _FUNCTIONS})
-
-
 def with_weights(q: Questionnaire, response: Mapping[str, Any]) -> dict[str, Any]:
     """A copy of a QuestionnaireResponse whose chosen Codings carry their option's points
     (itemWeight), looked up in ``q`` by item and code: what SDC's ``weight()`` reads from the
@@ -235,8 +171,9 @@ def evaluate(q: Questionnaire, expression: str, response: Mapping[str, Any]) -> 
 
 
 def run(expression: str, resource: Mapping[str, Any]) -> list[Any]:
-    """``expression`` evaluated on a resource whose chosen Codings already carry their weights."""
-    return [_number(v) for v in _compiled(expression)(dict(resource), {"resource": resource})]
+    """``expression`` evaluated on a resource whose chosen Codings already carry their weights,
+    by :func:`~kiosk.core.questionnaire.formula.compute` (bounded; EvaluationError says why not)."""
+    return compute(expression, resource)
 
 
 def formula_total(q: Questionnaire, formula: Formula, response: Mapping[str, Any]) -> int:
@@ -244,7 +181,7 @@ def formula_total(q: Questionnaire, formula: Formula, response: Mapping[str, Any
     ``formula.min`` to ``formula.max``."""
     try:
         result = evaluate(q, formula.expression, response)
-    except Exception as exc:  # fhirpathpy raises bare Exceptions for unknown functions and types
+    except EvaluationError as exc:
         raise ScoringError(f"the total formula of {q.id} cannot be evaluated: {exc}") from None
     value = result[0] if len(result) == 1 else None
     if isinstance(value, bool) or not isinstance(value, (int, float, Decimal)) or value != int(value):
@@ -256,10 +193,25 @@ def formula_total(q: Questionnaire, formula: Formula, response: Mapping[str, Any
     return int(value)
 
 
+def excused_items(q: Questionnaire, answered: set[str]) -> set[str]:
+    """The unanswered items a complete result does without: those an answered item stands in for
+    (``instead_of``), and an item standing in for others that were all answered."""
+    excused: set[str] = set()
+    for item in q.items:
+        if not item.instead_of:
+            continue
+        if item.id in answered:
+            excused.update(item.instead_of)
+        elif all(i in answered for i in item.instead_of):
+            excused.add(item.id)
+    return excused - answered
+
+
 def compute_score(q: Questionnaire, options: Mapping[str, int], values: Mapping[str, float], bands: BandSet) -> Score:
     """The score of checked answers (see :meth:`Questionnaire.score_answers`)."""
     answered = tuple(i.id for i in q.items if i.id in options or i.id in values)
-    missing = tuple(i.id for i in q.items if i.id not in options and i.id not in values)
+    excused = excused_items(q, set(answered))
+    missing = tuple(i.id for i in q.items if i.id not in answered and i.id not in excused)
     points = {i: q.item(i).option(n).points or 0 for i, n in options.items()}
     complete = not missing
     total = sum(points.values())

@@ -21,6 +21,7 @@ from kiosk.core.session.words import (
     START_LABEL,
     START_WORDS,
 )
+from kiosk.core.words import fill
 
 
 class Prompts:
@@ -128,7 +129,7 @@ class Prompts:
         state = self.state
         lang = state.language
         title = state.questionnaire.title.get(lang) or state.questionnaire.id
-        text = REST_TEXT.get(lang, REST_TEXT["en"]).format(title=title)
+        text = fill(REST_TEXT.get(lang, REST_TEXT["en"]), title=title)
         label = CONTINUE_LABEL.get(lang, CONTINUE_LABEL["en"])
         options = (PromptOption(1, label, tuple(START_WORDS.get(lang, ())), None),)
         return Prompt(t, "message", "rest", text, text, lang, options, speech_rate=state.speech_rate())

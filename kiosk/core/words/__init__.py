@@ -14,7 +14,6 @@ file and :func:`load_words` loads none. Pure (``fileio`` only), so every layer r
 from __future__ import annotations
 
 import re
-import string
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import field
 from functools import cache
@@ -24,6 +23,8 @@ from typing import Any, TypeVar
 
 from basis import record
 from fileio.positions import Positions, Problem, describe, parse_file
+from kiosk.core.words.placeholders import fill as fill  # the one way words are filled in
+from kiosk.core.words.placeholders import placeholders
 
 #: where the kiosk's words files are
 WORDS_DIR = Path(__file__).resolve().parent
@@ -164,12 +165,30 @@ def _check_files(directory: Path) -> tuple[dict[str, Any], list[Problem], bool]:
         return {}, problems, readable
     template = parsed[TEMPLATE][0]
     good = {}
+    checked = {}
     for code, (data, positions) in parsed.items():
-        found = _Check(str(paths[code]), positions, template, set(paths)).problems(data, code)
+        checked[code] = _Check(str(paths[code]), positions, template, set(paths)).problems(data, code)
+    _blame_the_template(checked, parsed[TEMPLATE][1], str(paths[TEMPLATE]))
+    for code, found in checked.items():
         problems += found
         if not found:
-            good[code] = data
+            good[code] = parsed[code][0]
     return good, problems, readable
+
+
+def _blame_the_template(checked: dict[str, list[Problem]], positions: Positions, template: str) -> None:
+    """A screen key every other language has but en.yaml lacks was deleted from en.yaml: one
+    problem there, not an "unknown key" in each of the others."""
+    others = [code for code in checked if code != TEMPLATE]
+    unknown = re.compile(r"unknown key '(screen\.[^']+)' \(en\.yaml has no such key\)")
+    keys = [{m.group(1) for p in checked[code] if (m := unknown.fullmatch(p.message))} for code in others]
+    for key in sorted(set.intersection(*keys) if len(others) > 1 else set()):
+        for code in others:
+            checked[code] = [p for p in checked[code] if p.message != f"unknown key {key!r} (en.yaml has no such key)"]
+        line, column = positions.of(("screen",), key=True)
+        checked[TEMPLATE].append(
+            Problem(template, line, column, f"missing {key!r} (every other language has it, and the screens need it)")
+        )
 
 
 def load_words(directory: str | Path | None = None) -> dict[str, Words]:
@@ -280,13 +299,12 @@ def _words(code: str, data: Mapping[str, Any]) -> Words:
 
 
 def _placeholders(text: Any) -> set[str] | None:
-    """The ``{names}`` in ``text``, or None when it is no text or its braces are not a format string's."""
+    """The ``{names}`` in ``text``, or None when it is no text or holds a brace that is not a
+    ``{name}`` mark or a doubled brace (a format spec, an index, a lone brace)."""
     if not isinstance(text, str):
         return None
-    try:
-        return {name for _, name, _, _ in string.Formatter().parse(text) if name is not None}
-    except ValueError:
-        return None
+    names, wrong = placeholders(text)
+    return None if wrong else names
 
 
 class _Check:
@@ -303,10 +321,39 @@ class _Check:
 
     def problems(self, data: Any, code: str) -> list[Problem]:
         self.mapping((), data, SHAPE)
+        if isinstance(data, dict):
+            self.overlaps(data)
         declared = data.get("language", {}).get("code") if isinstance(data, dict) else None
         if isinstance(declared, str) and declared != code:
             self.add(("language", "code"), f"language.code is {declared!r} but the file is {code}.yaml")
         return self.found
+
+    def overlaps(self, data: dict[str, Any]) -> None:
+        """Words that would mean two things: a yes word that is also a no word, or a command
+        ("pause") that is also a yes or no word (the patient saying it would do the other)."""
+
+        def said(path: tuple[str, ...]) -> dict[str, int]:
+            value: Any = data
+            for key in path:
+                value = value.get(key) if isinstance(value, dict) else None
+            words = value if isinstance(value, list) else []
+            return {w.strip().casefold(): n for n, w in enumerate(words) if isinstance(w, str)}
+
+        answers: dict[str, str] = {}
+        for section in ("prompts", "speech", "answers"):
+            yes, no = said((section, "yes_words")), said((section, "no_words"))
+            for word in sorted(yes.keys() & no.keys()):
+                self.add((section, "no_words", no[word]), f"{section}.no_words: {word!r} is also one of the yes_words")
+            if section != "prompts":
+                answers |= dict.fromkeys(yes.keys() | no.keys(), section)
+        commands = data.get("speech", {}).get("commands") if isinstance(data.get("speech"), dict) else None
+        for command in commands if isinstance(commands, dict) else ():
+            for word, n in said(("speech", "commands", command)).items():
+                if word in answers:
+                    self.add(
+                        ("speech", "commands", command, n),
+                        f"speech.commands.{command}: {word!r} is also one of {answers[word]}'s yes or no words",
+                    )
 
     def mapping(self, path: tuple[Any, ...], value: Any, shape: Mapping[str, Any]) -> None:
         where = describe(path) or "the file"
@@ -364,7 +411,14 @@ class _Check:
         if kind == SCREEN_TEXT:
             mine, theirs = _placeholders(value), _placeholders(self.in_template(path))
             if mine is None:
-                self.add(path, f"{describe(path)}: a brace without its pair (write {{{{ or }}}} for a brace)")
+                wrong = placeholders(value)[1]
+                unpaired = [w for w in wrong if not (w.startswith("{") and w.endswith("}"))]
+                what = "a brace without its pair" if unpaired else f"{', '.join(wrong)} is not a placeholder"
+                self.add(
+                    path,
+                    f"{describe(path)}: {what}: a placeholder is a name in braces, like {{ways}}, with no "
+                    "format, index or attribute (write {{ or }} for a brace)",
+                )
             elif theirs is not None and mine != theirs:
                 want = ", ".join(f"{{{p}}}" for p in sorted(theirs)) or "none"
                 self.add(path, f"{describe(path)} must have the placeholders of en.yaml ({want})")

@@ -10,12 +10,12 @@ from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.screen import Screen
-from textual.widgets import Button, Label
 
 from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import ATTEMPTS, Snapshot
 from kiosk.ui.widgets.bars import AdaptationBanner, VoiceAgainButton
+from kiosk.ui.widgets.literal import Button, Label
 from kiosk.ui.widgets.text import join_or, ui_text, ways_sentence
 from kiosk.ui.widgets.waiting_sign import WaitingSign
 

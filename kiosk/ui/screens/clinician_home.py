@@ -5,14 +5,18 @@ touch display), with "Back to the patient" always at the bottom."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from textual import on
 from textual.app import ComposeResult
 from textual.containers import Horizontal, VerticalScroll
-from textual.widgets import Button, DataTable, Label, Static, Switch
+from textual.widgets import DataTable, Switch
 
 from kiosk.core.session import Phase
-from kiosk.export.captured import questionnaire_of
+from kiosk.export.captured import questionnaire_of, result_line
+from kiosk.store.records import SessionSummary
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.ui.widgets.literal import Button, Label, Static, cell
 
 #: how often the running session's line is redrawn (seconds)
 REFRESH_S = 1.0
@@ -23,6 +27,11 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     #: the session list has the keys: arrows pick a session, Enter opens it
     AUTO_FOCUS = "#sessions"
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        #: (session, answered, not answered, status) -> its result line
+        self._results: dict[tuple[str, int, int, str], str] = {}
 
     def compose(self) -> ComposeResult:
         """The running session, channels, stored sessions, and the way back."""
@@ -72,14 +81,9 @@ class ClinicianHomeScreen(ClinicianScreen):
             progress = f"{len(test.answers)} of {count} answered" + (
                 f", {len(test.not_answered)} not answered" if test.not_answered else ""
             )
-            interrupted.add_row(
-                test.patient_id,
-                test.started_at[:16].replace("T", " "),
-                progress,
-                test.interrupted_reason or "",
-                test.id,
-                key=test.id,
-            )
+            started = test.started_at[:16].replace("T", " ")
+            row = (test.patient_id, started, progress, test.interrupted_reason or "", test.id)
+            interrupted.add_row(*map(cell, row), key=test.id)
         # "Continue this test" only when there is one to continue
         some = bool(interrupted.row_count)
         interrupted.display = some
@@ -89,24 +93,41 @@ class ClinicianHomeScreen(ClinicianScreen):
                 "Interrupted tests (continue one only with that patient in front of the kiosk):"
             )
         table = self.query_one("#sessions", DataTable)
-        table.add_columns("session", "patient", "started", "status", "lang", "answered", "not answered", "instrument")
+        table.add_columns(
+            "session", "patient", "started", "status", "result", "lang", "answered", "not answered", "instrument"
+        )
         self._fill_sessions()
         self.refresh_session()
         self.set_interval(REFRESH_S, self.refresh_session)
+
+    def on_screen_resume(self) -> None:
+        """Back from a session's detail, where staff may have entered its staff items: every
+        result is read again."""
+        self._results.clear()
+
+    def _result(self, s: SessionSummary) -> str:
+        """A session's result line, read from the store only when its answers or status changed."""
+        if s.status == "running":
+            return "in progress: no total yet"
+        key = (s.id, s.answered, s.not_answered, s.status)
+        store = self.kiosk.controller.store
+        if key not in self._results and store is not None:
+            self._results[key] = result_line(store.session(s.id))
+        return self._results.get(key, "")
 
     def _fill_sessions(self) -> None:
         table = self.query_one("#sessions", DataTable)
         store = self.kiosk.controller.store
         for s in store.sessions() if store is not None else []:
             row = (
-                *(s.id, s.patient_id, s.started_at[:19], s.label, s.language),
+                *(s.id, s.patient_id, s.started_at[:19], s.label, self._result(s), s.language),
                 *(str(s.answered), str(s.not_answered), s.questionnaire_id),
             )
             if s.id in table.rows:
                 for column, value in zip(table.columns, row):
-                    table.update_cell(s.id, column, value)
+                    table.update_cell(s.id, column, cell(value))
             else:
-                table.add_row(*row, key=s.id)
+                table.add_row(*map(cell, row), key=s.id)
 
     def refresh_session(self) -> None:
         """Redraw what a running session changes: its line, the channels, which actions apply,

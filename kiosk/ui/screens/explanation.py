@@ -5,10 +5,10 @@ from __future__ import annotations
 from textual import on
 from textual.app import ComposeResult
 from textual.message import Message
-from textual.widgets import Button, Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.widgets.bars import ControlBar
+from kiosk.ui.widgets.literal import Button, Static
 from kiosk.ui.widgets.text import ui_text, ways_sentence
 
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Hashable
 
 from textual.app import ComposeResult
-from textual.widgets import Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.widgets.bars import ControlBar
+from kiosk.ui.widgets.literal import Static
 from kiosk.ui.widgets.question_panel import QuestionPanel
 from kiosk.ui.widgets.text import ui_text
 from kiosk.ui.widgets.waiting_sign import WaitingSign

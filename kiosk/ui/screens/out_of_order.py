@@ -6,9 +6,9 @@ from collections.abc import Hashable
 
 from textual.app import ComposeResult
 from textual.containers import Vertical
-from textual.widgets import Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView
+from kiosk.ui.widgets.literal import Static
 from kiosk.ui.widgets.text import ui_text
 
 

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from textual.app import ComposeResult
-from textual.widgets import Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.widgets.bars import ControlBar
+from kiosk.ui.widgets.literal import Static
 from kiosk.ui.widgets.text import ui_text, ways_sentence
 
 

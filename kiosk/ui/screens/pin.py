@@ -12,11 +12,11 @@ import math
 from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
-from textual.widgets import Button, Label, Static
 
 from kiosk.core.pin import MAX_DIGITS, PinGuard
 from kiosk.ui.screens.base import ClinicianScreen
 from kiosk.ui.widgets.keypad import Keypad, keyboard_key, press
+from kiosk.ui.widgets.literal import Button, Label, Static
 
 
 class PinScreen(ClinicianScreen):

@@ -6,7 +6,6 @@ from collections.abc import Hashable
 
 from textual.app import ComposeResult
 from textual.widget import Widget
-from textual.widgets import Static
 
 from kiosk.core.questionnaire import Item
 from kiosk.ui.paging import needs_paging, shown
@@ -15,6 +14,7 @@ from kiosk.ui.widgets.answer_button import AnswerButton
 from kiosk.ui.widgets.bars import ControlBar
 from kiosk.ui.widgets.change_answer import ThanksRow
 from kiosk.ui.widgets.confirm_panel import ConfirmPanel
+from kiosk.ui.widgets.literal import Static
 from kiosk.ui.widgets.question_panel import QuestionPanel
 from kiosk.ui.widgets.text import ui_text
 from kiosk.ui.widgets.waiting_sign import WaitingSign

@@ -4,10 +4,10 @@ Continue, which shows the next instrument's explanation (any answer key or remot
 from __future__ import annotations
 
 from textual.app import ComposeResult
-from textual.widgets import Button, Static
 
 from kiosk.ui.screens.explanation import ExplanationScreen
 from kiosk.ui.widgets.bars import ControlBar
+from kiosk.ui.widgets.literal import Button, Static
 from kiosk.ui.widgets.text import ui_text
 
 

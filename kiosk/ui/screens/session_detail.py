@@ -9,14 +9,16 @@ from pathlib import Path
 from textual import on
 from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
-from textual.widgets import Button, DataTable, Label, Static
+from textual.widgets import DataTable
 
-from kiosk.core.staff import entered_values, waiting_line
+from kiosk.core.questionnaire import result_words
+from kiosk.core.staff import entered_values
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.store.database import StoredSession
 from kiosk.store.lease import SessionTaken
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.ui.widgets.literal import Button, Label, Static, cell
 from kiosk.ui.widgets.metrics_plot import MetricsPlot, metrics_key, plot_data, save_png
 from kiosk.ui.widgets.staff_items import StaffItems
 
@@ -96,7 +98,7 @@ class SessionDetailScreen(ClinicianScreen):
         events = self.query_one("#events", DataTable)
         events.add_columns("when", "what")
         for when, what in session_events(self.stored):
-            events.add_row(when, what)
+            events.add_row(cell(when), cell(what))
         q = self.q
         table = self.query_one("#answers-table", DataTable)
         table.add_columns("#", "item", "option", "answer", "points", "attempt", "channel")
@@ -106,20 +108,14 @@ class SessionDetailScreen(ClinicianScreen):
             a = answers.get(item.id)
             if a is None and item.id in values and item.entry is not None:
                 entered = f"{values[item.id]:g} {item.entry.unit}".strip()
-                table.add_row(str(item.number), item.id, "", entered, "", "", "staff")
+                table.add_row(*map(cell, (item.number, item.id, "", entered, "", "", "staff")))
             elif a is None:
                 outcome = "not answered" if item.id in self.stored.not_answered else "-"
-                table.add_row(str(item.number), item.id, "", outcome, "", "", "")
+                table.add_row(*map(cell, (item.number, item.id, "", outcome, "", "", "")))
             else:
-                table.add_row(
-                    str(item.number),
-                    item.id,
-                    str(a.option),
-                    item.option(a.option).label_in(self.stored.language),
-                    str(a.points),
-                    str(a.attempt),
-                    a.channel.value,
-                )
+                label = item.option(a.option).label_in(self.stored.language)
+                row = (item.number, item.id, a.option, label, a.points, a.attempt, a.channel.value)
+                table.add_row(*map(cell, row))
 
     def _title(self) -> str:
         """The instrument's own title (the session's captured one), so no line assumes the Barthel."""
@@ -132,15 +128,10 @@ class SessionDetailScreen(ClinicianScreen):
             score = rescore(q, self.stored)
         except ExportError as error:
             return f"Cannot score: {error}"
-        if score.problem:  # the formula failed on these answers: no total rather than a wrong one
-            return f"No total: {score.problem}"
-        if score.awaiting_staff:  # a staff item unanswered: no total until staff answer it
-            return f"No total yet: {waiting_line(score.awaiting_staff)}"
         if not score.complete:  # a partial sum is no total: never shown as one
-            return (
-                f"No total: {len(score.missing)} of {len(q.items)} questions not answered "
-                f"(the answered ones add up to {score.total})"
-            )
+            patient_missing = set(score.missing) - set(score.awaiting_staff)
+            partial = f" (the answered ones add up to {score.total})" if patient_missing and not score.problem else ""
+            return result_words(q, score) + partial
         band = score.band.label["en"] if score.band else "no band"
         return f"Total {score.total} of {score.max_total} (complete); {band}"
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 from textual import on
 from textual.app import ComposeResult
 from textual.containers import Grid, Horizontal, Vertical
-from textual.widgets import Button, Label, Static, Switch
+from textual.widgets import Switch
 
 from kiosk.ui.screens.base import ClinicianScreen
 from kiosk.ui.widgets.keypad import pad_key
+from kiosk.ui.widgets.literal import Button, Label, Static
 from kiosk.ui.widgets.text import language_name
 
 _KEYS = tuple("1234567890ABCDEFGHIJKLMNOPQRSTUVWXYZ-_") + ("⌫",)

@@ -5,9 +5,9 @@ kiosk goes back to the welcome for the next patient after ``next_patient_after_s
 from __future__ import annotations
 
 from textual.app import ComposeResult
-from textual.widgets import Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView
+from kiosk.ui.widgets.literal import Static
 from kiosk.ui.widgets.text import ui_text
 
 

@@ -12,11 +12,11 @@ from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.message import Message
-from textual.widgets import Button, Label, Static
 
 from kiosk.core.visits import Order
 from kiosk.ui.screens.base import PatientScreen, PatientView
 from kiosk.ui.widgets.keypad import Keypad, keyboard_key, press
+from kiosk.ui.widgets.literal import Button, Label, Static
 from kiosk.ui.widgets.text import language_name
 
 CODE_DIGITS = 4

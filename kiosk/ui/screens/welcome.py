@@ -8,9 +8,9 @@ from textual import events, on
 from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.message import Message
-from textual.widgets import Button, Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView, Ways
+from kiosk.ui.widgets.literal import Button, Static
 from kiosk.ui.widgets.text import language_name, ui_text, ways_sentence
 
 

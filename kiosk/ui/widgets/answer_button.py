@@ -7,7 +7,8 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.message import Message
 from textual.widget import Widget
-from textual.widgets import Label
+
+from kiosk.ui.widgets.literal import Label
 
 #: each digit as 3x5 pixels: solid strokes, not Textual's box-drawing Digits, which read as
 #: brackets from a metre away

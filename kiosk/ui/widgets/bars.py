@@ -5,10 +5,10 @@ from __future__ import annotations
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.message import Message
-from textual.widgets import Button, Static
 
 from basis import record
 from kiosk.core.channels import Command
+from kiosk.ui.widgets.literal import Button, Static
 from kiosk.ui.widgets.text import ui_text
 
 

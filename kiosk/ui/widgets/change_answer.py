@@ -5,8 +5,8 @@ from __future__ import annotations
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.message import Message
-from textual.widgets import Button, Static
 
+from kiosk.ui.widgets.literal import Button, Static
 from kiosk.ui.widgets.text import ui_text
 
 

@@ -6,9 +6,9 @@ from collections.abc import Sequence
 
 from textual.app import ComposeResult
 from textual.containers import Vertical
-from textual.widgets import Static
 
 from kiosk.ui.widgets.answer_button import AnswerButton
+from kiosk.ui.widgets.literal import Static
 
 
 class ConfirmPanel(Vertical):

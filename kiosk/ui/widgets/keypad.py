@@ -8,7 +8,8 @@ from typing import Protocol
 
 from textual import events, on
 from textual.containers import Grid
-from textual.widgets import Button
+
+from kiosk.ui.widgets.literal import Button
 
 DELETE = "⌫"
 OK = "OK"

@@ -129,7 +129,7 @@ def metrics_figure(data: PlotData, title: str) -> Any:
         axes.axvline(mark.t, color=MARK_COLOURS[mark.kind], linestyle="--", linewidth=1)
     axes.set_xlabel("session time (s)")
     axes.set_ylabel("metric")
-    axes.set_title(title)
+    axes.set_title(title.replace("$", r"\$"))  # a '$' pair would be read as mathtext
     handles, _ = axes.get_legend_handles_labels()
     kinds = {m.kind for m in data.marks}
     handles += [

@@ -8,9 +8,9 @@ from textual import events
 from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.widget import Widget
-from textual.widgets import Static
 
 from kiosk.ui.widgets.answer_button import AnswerButton
+from kiosk.ui.widgets.literal import Static
 
 #: rows between two answers (stacked or two-by-two)
 GAP = 1

@@ -14,10 +14,11 @@ from textual import on
 from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
-from textual.widgets import Button, Input, Label, Select
+from textual.widgets import Input, Select
 
 from kiosk.core.questionnaire import Item
 from kiosk.core.staff import entry_hint, parse_entry
+from kiosk.ui.widgets.literal import Button, Label, literal
 
 
 class StaffItems(Vertical):
@@ -57,7 +58,7 @@ class StaffItems(Vertical):
                 if item.entry is not None:
                     yield Input(placeholder=entry_hint(item), id=f"staff-value-{item.id}")
                 else:
-                    choices = [(f"{o.number} {o.label_in(self.language)}", o.number) for o in item.options]
+                    choices = [(literal(f"{o.number} {o.label_in(self.language)}"), o.number) for o in item.options]
                     yield Select(choices, prompt="choose", id=f"staff-choice-{item.id}")
                 yield Button("Save", id=f"staff-save-{item.id}", classes="staff-save")
             yield Label("", id=f"staff-problem-{item.id}", classes="staff-problem")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from kiosk.core.words import TEMPLATE, Table
+from kiosk.core.words import TEMPLATE, Table, fill
 
 #: the language whose words every other language falls back to
 FALLBACK = TEMPLATE
@@ -31,7 +31,7 @@ def ui_text(language: str, key: str, default: str | None = None, **values: objec
     words = table.get(language, {}).get(key) or table[FALLBACK].get(key, default)
     if words is None:
         raise KeyError(f"no screen text {key!r}")
-    return words.format(**values) if values else words
+    return fill(words, **values) if values else words
 
 
 def language_name(language: str) -> str:

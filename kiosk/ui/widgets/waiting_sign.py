@@ -7,8 +7,7 @@ listens. The dot moves once a second with the session's clock (the app's poll ti
 
 from __future__ import annotations
 
-from textual.widgets import Static
-
+from kiosk.ui.widgets.literal import Static
 from kiosk.ui.widgets.text import ui_text
 
 #: positions of the moving dot

@@ -137,3 +137,23 @@ def write(tmp_path: Path, text: str, name: str = "instrument.yaml") -> Path:
 
 def load(tmp_path: Path, text: str, name: str = "instrument.yaml") -> Questionnaire:
     return load_questionnaire(write(tmp_path, text, name))
+
+
+#: MNA-SF-like: the calf circumference is measured instead of the weight and height of the BMI
+#: when the patient cannot be weighed (bed-bound): either side completes the result
+CALF = "%resource.item.where(linkId = 'calf').answer.value"
+STAND_IN_FORMULA = (
+    "%resource.item.where(linkId = 'intake').answer.value.weight().sum() + "
+    f"iif({CALF}.exists(), iif({CALF} < 31, 0, 3), "
+    f"iif({BMI} < 19, 0, iif({BMI} < 21, 1, iif({BMI} < 23, 2, 3))))"
+)
+STOOD_IN = instrument(
+    "standin",
+    choice("intake", [0, 1, 2])
+    + staff_input("weight", "decimal", 20, 250, "kg")
+    + staff_input("height", "decimal", 100, 220, "cm")
+    + staff_input("calf", "decimal", 10, 60, "cm")
+    + "    instead_of: [weight, height]\n",
+    bands(("malnourished", 0, 1), ("at_risk", 2, 3), ("normal", 4, 5)),
+    f'scoring:\n  total:\n    fhirpath: "{STAND_IN_FORMULA}"\n    min: 0\n    max: 5\n',
+)

@@ -158,16 +158,27 @@ def test_seven_options_and_one_option_are_refused(tmp_path):
 def test_a_formula_that_is_not_fhirpath_is_refused_where_it_is(tmp_path):
     text = STAFFED.replace("answer.value < 9", "answer.value <* 9")
     (problem,) = problems(tmp_path, text)
-    assert problem.startswith(f"{at(text, 'fhirpath:') + 10}: scoring.total.fhirpath is not valid FHIRPath (at ")
+    character = FORMULA.index("< 9") + 2  # the stray "*" after "<", counted from 1
+    assert problem == (
+        f"{at(text, 'fhirpath:') + 10}: scoring.total.fhirpath, at character {character}: "
+        "expected a value but found '*'"
+    )
 
 
 def test_a_formula_with_an_unknown_function_or_out_of_its_range_is_refused(tmp_path):
     text = STAFFED.replace(".weight().sum()", ".weight().total()")
     (problem,) = problems(tmp_path, text)
-    assert "scoring.total.fhirpath cannot be evaluated with every item at its first option" in problem
+    assert problem.endswith(
+        f"scoring.total.fhirpath, at character {FORMULA.index('sum()') + 1}: total() is not in the kiosk's "
+        "formula language (it has abs, ceiling, count, empty, exists, first, floor, iif, last, max, min, not, "
+        "ordinal, round, sum, truncate, weight, where)"
+    )
     text = STAFFED.replace("max: 5\n", "max: 3\n").replace("impaired, min: 2, max: 5", "impaired, min: 2, max: 3")
     (problem,) = problems(tmp_path, text)
-    assert problem.endswith("gives 5 with every item at its last option: it must give one whole number from -1 to 3")
+    assert problem.endswith(
+        "scoring.total.fhirpath: it gives 4 when recall is option 2, orientation is option 3, education is 9, "
+        "judged is option 2; it must give one whole number from -1 to 3"
+    )
 
 
 def test_a_formula_total_needs_its_range(tmp_path):
@@ -286,9 +297,9 @@ def test_validate_prints_each_v2_problem_as_one_line_and_fails(tmp_path, capsys)
     assert validate_main([str(path)]) == 1
     first, second = capsys.readouterr().out.splitlines()
     character = FORMULA.index("< 9") + 2  # the stray "*" after "<", counted from 1
-    assert first.startswith(
-        f"{path}:{at(text, 'fhirpath:') + 10}: scoring.total.fhirpath is not valid FHIRPath "
-        f"(at character {character}: extraneous input '*' expecting "
+    assert first == (
+        f"{path}:{at(text, 'fhirpath:') + 10}: scoring.total.fhirpath, at character {character}: "
+        "expected a value but found '*'"
     )
     assert second == f"{path}:{at(text, 'nurse')}: items[3].answered_by: 'nurse' is not one of ['patient', 'staff']"
 
@@ -307,3 +318,15 @@ def test_a_formula_that_fails_on_some_answers_gives_no_total_and_says_why(tmp_pa
     assert "gave 4, outside its declared -1 to 2" in score.problem
     fine = narrow.score_answers({"recall": 1, "orientation": 1, "judged": 1}, values={"education": 12})
     assert (fine.complete, fine.total, fine.problem) == (True, 0, "")
+
+
+def test_a_synonym_that_is_a_voice_command_is_refused(tmp_path):
+    # "wait" pauses the session in English: as an answer's synonym the patient saying it would pause
+    text = LAWTON.replace(
+        '        label: {en: "telephone 1", es: "telephone 1 (es)"}\n',
+        '        label: {en: "telephone 1", es: "telephone 1 (es)"}\n        synonyms: {en: [on my own, Wait]}\n',
+    )
+    assert problems(tmp_path, text) == [
+        f"{at(text, 'Wait')}: the synonym 'Wait' is the kiosk's 'pause' command in 'en': "
+        "a patient saying it would pause instead of answering"
+    ]

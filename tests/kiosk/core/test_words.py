@@ -98,6 +98,9 @@ def test_a_file_missing_a_key_is_refused_naming_where_and_the_key(tmp_path, caps
         ("  paused_text:", "  paused_txt: x\n  paused_text:", "paused_txt", "unknown key 'screen.paused_txt'"),
         ("{total} of {maximum}", "{total} of {max}", "summary_total", "must have the placeholders of en.yaml"),
         ("Question {number} of", "Question {number of", "question_of", "a brace without its pair"),
+        ("Answer by {ways}.", "Answer by {ways:>999999999}.", "answer_by", "{ways:>999999999} is not a placeholder"),
+        ("Answer by {ways}.", "Answer by {0.__class__}.", "answer_by", "{0.__class__} is not a placeholder"),
+        ("Answer by {ways}.", "Answer by {ways!r}.", "answer_by", "{ways!r} is not a placeholder"),
         ("  title: Barthel questionnaire", "  title: [Barthel]", "title:", "screen.title must be text"),
         ('  yes_label: "Yes"', "  yes_label: yes", "yes_label", "prompts.yes_label must be text"),
         ("[[one], [two],", "[[one],", "cardinals", "speech.cardinals must have the words for 10 numbers"),
@@ -110,6 +113,13 @@ def test_a_file_missing_a_key_is_refused_naming_where_and_the_key(tmp_path, caps
             "no words file for 'pt'",
         ),
         ("  code: xx", "  code: en", "code:", "language.code is 'en' but the file is xx.yaml"),
+        (
+            'no_words: ["no", nope, no that\'s wrong',
+            'no_words: ["no", yeah, no that\'s wrong',
+            'no_words: ["no", yeah',
+            "prompts.no_words: 'yeah' is also one of the yes_words",
+        ),
+        ("pause: [pause, wait, stop]", "pause: [pause, wait, nope]", "pause: [pause", "'nope' is also one of"),
         ("  start: Go\n", "  start: Go\n  start: Went\n", "start: Went", "duplicate key 'start'"),
     ],
 )
@@ -120,6 +130,36 @@ def test_each_difference_from_en_yaml_is_one_positioned_problem(tmp_path, old, n
     _, problems, _ = check_words(directory)
     assert len(problems) == 1, problems
     assert str(problems[0]).startswith(position(path, at).rsplit(":", 1)[0] + ":") and message in problems[0].message
+
+
+def test_a_format_spec_in_the_template_is_refused_by_validate_and_never_formatted(tmp_path, capsys):
+    directory = words_dir(tmp_path)
+    template = directory / "en.yaml"
+    edit(template, "Answer by {ways}.", "Answer by {ways:>999999999}.")
+    assert validate_main(["--words", str(directory)]) == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == (
+        f"{position(template, 'answer_by').rsplit(':', 1)[0]}:14: screen.answer_by: {{ways:>999999999}} is not a "
+        "placeholder: a placeholder is a name in braces, like {ways}, with no format, index or attribute "
+        "(write {{ or }} for a brace)"
+    )
+    # and were such a text ever filled, only {name} marks are: the spec stays as written
+    from kiosk.core.words import fill
+
+    assert fill("Answer by {ways:>999999999}, {ways} {{x}} {0.__class__}", ways="touch") == (
+        "Answer by {ways:>999999999}, touch {x} {0.__class__}"
+    )
+
+
+def test_a_key_deleted_from_the_template_is_reported_there_not_in_every_other_file(tmp_path):
+    directory = words_dir(tmp_path)
+    template = directory / "en.yaml"
+    edit(template, "  paused_title: Paused\n", "")
+    _, problems, readable = check_words(directory)
+    assert readable and [str(p) for p in problems] == [
+        f"{position(template, 'screen:')}: missing 'screen.paused_title' (every other language has it, "
+        "and the screens need it)"
+    ]
 
 
 def test_a_broken_template_is_reported_in_the_template_only(tmp_path):

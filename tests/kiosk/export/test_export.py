@@ -80,7 +80,9 @@ def test_csv_has_a_row_per_item_and_a_recomputed_total(export_store):
     assert [r["item"] for r in rows] == [i.id for i in QUESTIONNAIRE.items] + ["total"]
     grooming = rows[2]
     assert (grooming["option"], grooming["label"]) == ("", "not answered")
-    assert (rows[-1]["points"], rows[-1]["label"]) == ("", "incomplete (65 points from 8 of 10 items)")
+    label = rows[-1]["label"]
+    assert rows[-1]["points"] == "" and label.startswith("No total: not answered: Grooming")
+    assert ", Bladder" in label and label.endswith(" (65 points from 8 of 10 items)")
     assert rows[0]["channel"] == "voice" and rows[0]["attempt"] == "1"
 
 
@@ -89,13 +91,16 @@ def test_kiosk_results_lists_shows_and_exports_owner_only(export_store, tmp_path
     assert results_main(["--data-dir", data]) == 0
     listing = capsys.readouterr().out.splitlines()
     assert len(listing) == 2 and all("finished" in line for line in listing)
+    assert any(line.endswith("No total: 2 of 10 questions not answered") for line in listing), listing
     session_id = by_patient(export_store, "TB-0004").id
     fhir, table = tmp_path / "r.json", tmp_path / "r.csv"
     table.write_text("old export\n")
     table.chmod(0o644)  # an export written over an old world-readable file becomes owner-only
     assert results_main([session_id[:6], "--data-dir", data, "--fhir", str(fhir), "--csv", str(table)]) == 0
     shown = capsys.readouterr().out
-    assert "total 65/100 (incomplete, missing grooming, bladder)" in shown
+    (line,) = [x for x in shown.splitlines() if x.startswith("No total")]
+    assert line.startswith("No total: not answered: Grooming") and ", Bladder" in line
+    assert line.endswith("(the answered ones add up to 65)")
     bundle = json.loads(fhir.read_text())
     check_fhir(bundle)
     assert [e["resource"]["resourceType"] for e in bundle["entry"]] == [
@@ -172,8 +177,8 @@ def test_practice_outcomes_are_in_kiosk_results_and_the_csv_but_not_in_fhir(tmp_
         ("practice_select", "select", "", "not answered", "", ""),
     ]
     assert [r["kind"] for r in rows] == ["practice"] * 3 + ["item"] * 10 + ["total"]
-    assert (
-        rows[-1]["points"] == "" and rows[-1]["label"] == "incomplete (0 points from 0 of 10 items)"
+    assert rows[-1]["points"] == "" and rows[-1]["label"].endswith(
+        " (0 points from 0 of 10 items)"
     )  # practice never scores
 
     with Store.open(tmp_path / "data") as reopened:

@@ -19,7 +19,7 @@ from kiosk.export import ExportSite, fhir_questionnaire, result
 from kiosk.export.calculated import ANSWERED_BY, CALCULATED, MAX_VALUE, MIN_VALUE, UNIT
 from kiosk.export.fhir import response_of, total_of
 from kiosk.store.records import StoredSession
-from tests.kiosk.core.instruments_v2 import GDS, MEASURED, MIXED, STAFFED, load
+from tests.kiosk.core.instruments_v2 import GDS, MEASURED, MIXED, STAFFED, STOOD_IN, load
 from tests.prerequisites import JS, ensure_npm_packages
 
 from .standard import check_fhir
@@ -186,3 +186,18 @@ def test_a_formula_over_decimals_staff_measured_agrees_everywhere(tmp_path, weig
     expression = expressions(questionnaire)["total"]
     assert fhirpath_js([expression], response, questionnaire) == [[total]]
     assert evaluate(q, expression, response) == [total]
+
+
+@pytest.mark.parametrize(
+    ("values", "total"),
+    [({"calf": 33.0}, [5]), ({"weight": 50.0, "height": 170.0}, [2]), ({"weight": 50.0}, [])],
+)
+def test_a_stand_in_item_completes_the_total_everywhere(tmp_path, values, total):
+    """The calf circumference instead of the weight and height (MNA-SF F2): the exported total is
+    computed once either side is answered, by fhirpath.js as by the kiosk."""
+    q = load(tmp_path, STOOD_IN)
+    questionnaire, response, observation, r = exported(q, {"intake": 3}, values)
+    assert r.complete == bool(total) and (r.score.total if r.complete else None) == (total or [None])[0]
+    expression = expressions(questionnaire)["total"]
+    assert fhirpath_js([expression], response, questionnaire) == [total]
+    assert evaluate(q, expression, response) == total

@@ -208,4 +208,4 @@ async def test_an_incomplete_test_shows_no_total_to_the_patient_or_the_clinician
         await pilot.press("enter")
         await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
         line = text_of(kiosk.app.screen.query_one("#total", Label))
-        assert line == "No total: 1 of 10 questions not answered (the answered ones add up to 90)"
+        assert line == "No total: not answered: Feeding: how do you manage eating? (the answered ones add up to 90)"

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 
-from textual.widgets import Input, Label, Select
+from textual.widgets import DataTable, Input, Label, Select
 
 from kiosk.core.session import Phase
 from kiosk.core.staff import STAFF_ANSWER
@@ -57,7 +57,13 @@ async def test_staff_enter_the_weight_and_the_aid_and_the_result_completes(ui_ki
         await _finish_visit(kiosk, pilot)
         assert not kiosk.session.snapshot().score.complete
         await _open_detail(kiosk, pilot)
-        assert _total(kiosk) == "No total yet: waiting for staff: weight, aid"
+        assert _total(kiosk) == "No total yet: waiting for staff: Weight (kg), Uses a walking aid"
+        await pilot.press("escape")  # the list says it too, in the same words
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        row = kiosk.app.screen.query_one("#sessions", DataTable).get_row_at(0)
+        assert row[4] == "No total yet: waiting for staff: Weight (kg), Uses a walking aid", row
+        await pilot.press("enter")
+        await settle(pilot, lambda: screen_name(kiosk) == "SessionDetailScreen")
         # a weight out of range is refused in one sentence, and nothing is stored
         await _click(pilot, "#staff-value-weight")
         await pilot.press(*"300")
@@ -71,7 +77,7 @@ async def test_staff_enter_the_weight_and_the_aid_and_the_result_completes(ui_ki
         await pilot.press(*"72,5")
         await _click(pilot, "#staff-save-weight")
         await settle(pilot, lambda: "72.5 kg" in text_of(kiosk.app.screen.query_one("#staff-now-weight", Label)))
-        assert _total(kiosk) == "No total yet: waiting for staff: aid"
+        assert _total(kiosk) == "No total yet: waiting for staff: Uses a walking aid"
         select = kiosk.app.screen.query_one("#staff-choice-aid", Select)
         select.focus()
         await pilot.press("enter", "down", "down", "enter")
@@ -80,6 +86,10 @@ async def test_staff_enter_the_weight_and_the_aid_and_the_result_completes(ui_ki
         await settle(pilot, lambda: "An aid" in text_of(kiosk.app.screen.query_one("#staff-now-aid", Label)))
         # steps option 3 = 2 points, stairs option 5 = 3 points, aid 1 point
         assert _total(kiosk).startswith("Total 6 of 9 (complete)")
+        await pilot.press("escape")
+        await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
+        row = kiosk.app.screen.query_one("#sessions", DataTable).get_row_at(0)
+        assert row[4].startswith("Total 6 of 9"), row
 
     stored = kiosk.store.session(kiosk.session.id)
     aid = _stored(kiosk, "aid")
