@@ -22,7 +22,7 @@ from textual.binding import Binding
 from textual.message import Message
 from textual.reactive import Reactive
 
-from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command
+from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command, Presence
 from kiosk.core.pin import CornerTaps, PinGuard
 from kiosk.core.session import Session, SessionEvent
 from kiosk.core.site import ExportSite
@@ -60,7 +60,7 @@ CLINICIAN_IDLE_S = 300.0
 class ChannelReceived(Message):
     """A channel thread delivered an input or a status change (posted, never handled on that thread)."""
 
-    item: ChannelInput | ChannelStatus
+    item: ChannelInput | ChannelStatus | Presence
 
 
 @dataclass
@@ -176,9 +176,9 @@ class KioskApp(App[int], inherit_bindings=False):
 
     # -- from other threads -----------------------------------------------------------------------
 
-    def channel_sink(self, item: ChannelInput | ChannelStatus) -> None:
+    def channel_sink(self, item: ChannelInput | ChannelStatus | Presence) -> None:
         """The sink every channel (and the speaker's status) delivers to, from its own thread:
-        posts to the UI thread."""
+        posts to the UI thread. The camera delivers its presence reports here too."""
         self.post_message(ChannelReceived(item))
 
     def speaker_activity(self, speaking: bool) -> None:
