@@ -39,6 +39,7 @@ from kiosk.ui.widgets.waiting_sign import WaitingSign
 if TYPE_CHECKING:  # message types of screens loaded when first shown (kiosk.ui.stage), not before the welcome
     from kiosk.ui.screens.doctor_called import DoctorCalledScreen
     from kiosk.ui.screens.explanation import ExplanationScreen
+    from kiosk.ui.screens.unattended import UnattendedScreen
     from kiosk.ui.screens.visit_ready import VisitReadyScreen
     from kiosk.ui.widgets.answer_button import AnswerButton
     from kiosk.ui.widgets.change_answer import ChangeAnswerButton
@@ -244,6 +245,10 @@ class KioskApp(App[int], inherit_bindings=False):
     def on_doctor_called_screen_carry_on(self, message: DoctorCalledScreen.CarryOn) -> None:
         """The patient touched "I'm fine, carry on" after calling the doctor."""
         self.controller.drive(self.session.cancel_doctor_call, Channel.TOUCH)
+
+    def on_unattended_screen_go_on(self, message: UnattendedScreen.GoOn) -> None:
+        """Someone touched the screen while the kiosk waited for a touch: the test goes on."""
+        self.controller.forward(ChannelInput(Channel.TOUCH, option=1, detail="screen"))
 
     def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
         """The patient touched Start under the explanation."""

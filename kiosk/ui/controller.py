@@ -326,13 +326,13 @@ class KioskController:
         """A clinician continues a session halted by call-doctor (or paused)."""
         self.drive(self.session.clinician_continue)
 
-    def person_lost(self) -> None:
-        """A clinician says the patient left the kiosk (it has no presence sensor)."""
-        self.drive(self.session.person_lost)
+    def person_lost(self, detail: str = "clinician screen") -> None:
+        """Staff say the patient left the kiosk ("Patient away": here, or from the ward station)."""
+        self.drive(self.session.person_lost, detail)
 
-    def person_back(self) -> None:
-        """A clinician says the patient is back in front of the kiosk."""
-        self.drive(self.session.person_back)
+    def person_back(self, detail: str = "clinician screen") -> None:
+        """Staff say the patient is back in front of the kiosk."""
+        self.drive(self.session.person_back, detail)
 
     def set_adaptation(self, enabled: bool) -> None:
         """A clinician switches live adaptation on or off for this session."""
