@@ -16,7 +16,10 @@ from typing import Any
 
 import httpx
 
-ALERT_KINDS = {"doctor_called", "doctor_continued", "person_lost", "person_back"}
+from kiosk.store.transactions import ALERT_EVENTS
+
+#: the protocol's names of the rows a kiosk sends first (kiosk.store.transactions.ALERT_EVENTS)
+ALERT_KINDS = set(ALERT_EVENTS.values())
 PATIENTS = Path(__file__).resolve().parent.parent / "recordings" / "patients"
 
 

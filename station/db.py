@@ -119,7 +119,7 @@ alerts = sa.Table(
     sa.Column("kiosk_id", sa.String(64), nullable=False),
     sa.Column("seq", sa.BigInteger, nullable=False),
     sa.Column("session_id", sa.String(64), nullable=False),
-    #: "doctor_called" or "person_lost"
+    #: "doctor_called", "person_lost" (away as long as the kiosk's site says) or "unattended"
     sa.Column("kind", sa.String(32), nullable=False),
     sa.Column("raised_at", sa.String(40), nullable=False),
     sa.Column("received_at", sa.Float, nullable=False),

@@ -56,14 +56,28 @@ REQUIRED: dict[str, tuple[str, ...]] = {
     "abandon": (),
 }
 #: session-log kinds that raise an alert, and the kinds that end one. The protocol names them
-#: doctor_called/doctor_continued; today's session log says call_doctor/clinician_continue.
-RAISES = {"doctor_called": "doctor_called", "call_doctor": "doctor_called", "person_lost": "person_lost"}
-ENDS = {"doctor_continued": "doctor_called", "clinician_continue": "doctor_called", "person_back": "person_lost"}
+#: doctor_called/doctor_continued; today's session log says call_doctor/clinician_continue. A
+#: patient away raises the alert only once away as long as the kiosk's site says (away_alert; the
+#: person_lost that came before it raises none); no answer to questions in a row raises unattended.
+RAISES = {
+    "doctor_called": "doctor_called",
+    "call_doctor": "doctor_called",
+    "away_alert": "person_lost",
+    "unattended": "unattended",
+}
+ENDS = {
+    "doctor_continued": "doctor_called",
+    "clinician_continue": "doctor_called",
+    "person_back": "person_lost",
+    "unattended_ended": "unattended",
+}
+#: the rows sent first that neither raise nor end an alert: the patient left (the alert may follow)
+URGENT = {"person_lost"}
 
 
 def is_alert(event: Event) -> bool:
-    """A row the protocol sends first: a doctor call, a patient leaving, and their ends."""
-    return event.kind == "record_event" and event.payload.get("kind") in RAISES.keys() | ENDS.keys()
+    """A row the protocol sends first: a doctor call, a patient leaving, no answer, and their ends."""
+    return event.kind == "record_event" and event.payload.get("kind") in RAISES.keys() | ENDS.keys() | URGENT
 
 
 class SyncError(ValueError):

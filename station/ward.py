@@ -7,6 +7,7 @@ Every staff action is also written to the audit trail (who, when, what), in the 
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import field
 from typing import Any
 
@@ -15,7 +16,7 @@ from sqlalchemy.engine import Engine
 
 from basis import record
 from station import db
-from station.db import alerts, audit, commands, kiosks
+from station.db import alerts, audit, commands, inbox, kiosks
 
 #: a kiosk without a heartbeat for this long shows offline (the kiosk sends one at least every 10 s)
 OFFLINE_AFTER_S = 30.0
@@ -27,7 +28,38 @@ COMMAND_WORDS = {
     "person_back": "Told {kiosk} the patient is back.",
     "end": "Asked {kiosk} to end the session.",
 }
-ALERT_TEXT = {"doctor_called": "Doctor called", "person_lost": "Patient left the kiosk"}
+ALERT_TEXT = {
+    "doctor_called": "Doctor called",
+    "person_lost": "Patient away from the kiosk",
+    "unattended": "No answer to questions in a row; the kiosk waits for a touch",
+}
+#: small counts in words, for an alert staff read at a glance ("no answer to two questions in a row")
+_COUNTS = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six", 7: "seven", 8: "eight", 9: "nine", 10: "ten"}
+
+
+def alert_text(kind: str, detail: str = "") -> str:
+    """What staff read about an alert; ``detail`` is what the kiosk said with it (the seconds away,
+    the questions unanswered), when it said it."""
+    number = _number(detail)
+    if kind == "person_lost" and number is not None and number > 0:
+        span = f"{number / 60:g} min" if number % 60 == 0 else f"{number:g} s"
+        return f"Patient away from the kiosk for {span}"
+    if kind == "unattended" and number is not None and number >= 1 and number == int(number):
+        count = int(number)
+        if count == 1:
+            return "No answer to the last question; the kiosk waits for a touch"
+        return f"No answer to {_COUNTS.get(count, str(count))} questions in a row; the kiosk waits for a touch"
+    return ALERT_TEXT.get(kind, kind)
+
+
+def _number(detail: str) -> float | None:
+    try:
+        number = float(detail)
+    except ValueError:
+        return None
+    return number if math.isfinite(number) else None
+
+
 #: the fields of a status report the ward view shows, with their types
 STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
     "session_id": (str, type(None)),
@@ -38,6 +70,8 @@ STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
     "paused": bool,
     "person_away": bool,
     "doctor_called": bool,
+    # no answer to questions in a row: the kiosk waits for the patient's touch
+    "unattended": bool,
     "simulated": bool,
     "at": (str, type(None)),
     # why the kiosk takes no patient (its store failed: a full disk); None while it works
@@ -59,10 +93,12 @@ class Alert:
     resolved_at: str | None
     ack_by: str | None
     ack_at: str | None
+    #: what the kiosk said with it (the row's ``detail``: seconds away, questions unanswered)
+    detail: str = ""
 
     @property
     def text(self) -> str:
-        return ALERT_TEXT.get(self.kind, self.kind)
+        return alert_text(self.kind, self.detail)
 
 
 @record
@@ -98,12 +134,26 @@ def seen(engine: Engine, kiosk_id: str) -> None:
 
 
 def _alert(row: Any) -> Alert:
-    return Alert(row.id, row.kiosk_id, row.session_id, row.kind, row.raised_at, row.resolved_at, row.ack_by, row.ack_at)
+    detail = ""
+    if row.payload:
+        try:
+            detail = str(json.loads(row.payload).get("detail") or "")
+        except (ValueError, AttributeError):
+            detail = ""
+    return Alert(
+        row.id, row.kiosk_id, row.session_id, row.kind, row.raised_at, row.resolved_at, row.ack_by, row.ack_at, detail
+    )
 
 
 def open_alerts(engine: Engine, kiosk_id: str | None = None) -> list[Alert]:
-    """Alerts nobody has acknowledged yet, oldest first."""
-    query = sa.select(alerts).where(alerts.c.ack_at.is_(None)).order_by(alerts.c.id)
+    """Alerts nobody has acknowledged yet, oldest first, with what the kiosk said with each."""
+    raised_by = sa.and_(inbox.c.kiosk_id == alerts.c.kiosk_id, inbox.c.seq == alerts.c.seq)
+    query = (
+        sa.select(alerts, inbox.c.payload)
+        .select_from(alerts.outerjoin(inbox, raised_by))
+        .where(alerts.c.ack_at.is_(None))
+        .order_by(alerts.c.id)
+    )
     if kiosk_id is not None:
         query = query.where(alerts.c.kiosk_id == kiosk_id)
     with engine.connect() as connection:
@@ -148,7 +198,7 @@ def acknowledge(engine: Engine, alert_id: int, by: str) -> str:
                 at=at,
                 author=by,
                 action="acknowledge",
-                reason=f"{ALERT_TEXT.get(row.kind, row.kind)} on {row.kiosk_id}",
+                reason=f"{alert_text(row.kind)} on {row.kiosk_id}",
             )
         )
     return row.kiosk_id
@@ -156,7 +206,8 @@ def acknowledge(engine: Engine, alert_id: int, by: str) -> str:
 
 def queue_command(engine: Engine, kiosk_id: str, session_id: str, kind: str, by: str) -> int:
     """Queue a command for the kiosk (it obeys only if the session is still its running one).
-    A ``continue`` also acknowledges the session's open doctor call."""
+    A ``continue`` also acknowledges the session's open doctor call, or its open "no answer" alert
+    (the kiosk then waits for the patient's touch: it never asks on with nobody there)."""
     if kind not in COMMAND_KINDS:
         raise WardError(f"unknown command {kind!r}")
     at = db.now_iso()
@@ -180,7 +231,11 @@ def queue_command(engine: Engine, kiosk_id: str, session_id: str, kind: str, by:
         if kind == "continue":
             connection.execute(
                 alerts.update()
-                .where(alerts.c.session_id == session_id, alerts.c.kind == "doctor_called", alerts.c.ack_at.is_(None))
+                .where(
+                    alerts.c.session_id == session_id,
+                    alerts.c.kind.in_(("doctor_called", "unattended")),
+                    alerts.c.ack_at.is_(None),
+                )
                 .values(ack_by=by, ack_at=at)
             )
     return int(command_id)

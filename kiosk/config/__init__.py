@@ -34,6 +34,9 @@ Example ``config.yaml`` (every key optional)::
       device_system: https://hosp-north.example/sid/kiosk
     interrupt_after_minutes: 120      # a test running longer is interrupted: staff may continue it
     next_patient_after_s: 90          # the end screen stays this long, then the welcome for the next patient
+    away_alert_after_s: 60            # a patient away this long (camera or "Patient away") alerts the ward
+    unattended_after: 2               # this many questions in a row unanswered: the ward is alerted and
+                                      # the kiosk waits for a touch instead of asking on
     show_score_to_patient: false      # the end screen shows the patient their total and band
     walk_up: true                     # anyone may start a test at the welcome (marked walk-up); false:
                                       # only ordered visits and visits staff start on the clinician screen

@@ -121,6 +121,12 @@ class Config:
     #: kiosk goes back to the welcome for the next patient; the result stays stored for staff (None,
     #: never from a file: the end screen stays until staff start over, as in the UI tests)
     next_patient_after_s: float | None = 90.0
+    #: seconds a patient may be away (camera, or staff's "Patient away") before the ward is alerted
+    #: (None, never from a file: no alert)
+    away_alert_after_s: float | None = 60.0
+    #: unanswered questions in a row after which the ward is alerted and the kiosk waits for a touch
+    #: (None, never from a file: it asks on, as the UI tests written before it expect)
+    unattended_after: int | None = 2
     #: the end screen shows the patient their total and band (default: only staff see them)
     show_score_to_patient: bool = False
     #: an unordered test may be started at the welcome (stored and shown as a walk-up); false: only

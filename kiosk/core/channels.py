@@ -68,6 +68,30 @@ class ChannelInput:
             raise ValueError(f"answer options are numbered from 1, got {self.option}")
 
 
+class PresenceSource(str, Enum):
+    """Who says whether the patient is in front of the kiosk."""
+
+    #: the camera channel (``kiosk.camera``): a person found in its frames, or none
+    CAMERA = "camera"
+    #: staff: "Patient away" / "Patient back" on the clinician screen or from the ward station
+    STAFF = "staff"
+
+
+@record
+class Presence:
+    """A presence source's report: whether a person is in front of the kiosk now.
+
+    Handed to the session like a :class:`ChannelInput` (``Session.handle``): a person not seen
+    stops the question clock; seen again, the test goes on where it was. A source reports on
+    change; the session ignores a report that changes nothing (and logs it).
+    """
+
+    seen: bool
+    source: PresenceSource
+    #: what the source saw or who pressed, for the session log ("ward station", "no person in 15 frames")
+    detail: str = ""
+
+
 class ChannelState(str, Enum):
     """Whether a channel can currently take input, as the UI shows it."""
 
@@ -93,7 +117,7 @@ class ChannelStatus:
 
 
 #: Where a channel delivers what it receives. Called from the channel's own thread.
-Sink = Callable[[ChannelInput | ChannelStatus], None]
+Sink = Callable[[ChannelInput | ChannelStatus | Presence], None]
 
 
 class InputSource(Protocol):

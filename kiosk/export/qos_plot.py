@@ -29,6 +29,8 @@ INCIDENT_WORDS = {
     "doctor_continued": "continued by staff",
     "person_lost": "patient left",
     "person_back": "patient back",
+    "away_alert": "ward alerted: away",
+    "unattended": "ward alerted: no answer",
     "attempt_timed_out": "no answer in time",
     "repeat": "asked to repeat",
     "abandoned": "abandoned",

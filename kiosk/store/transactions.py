@@ -14,12 +14,17 @@ from collections.abc import Callable, Iterator
 from datetime import UTC, datetime
 from typing import Any
 
-#: session-log kinds that are alerts for the ward, with the name the station protocol gives them
+#: session-log kinds that are alerts for the ward (or end one), with the name the station protocol
+#: gives them; sent before any other row. A patient leaving (person_lost) is sent first too, but
+#: the ward is alerted only by away_alert, once they have been away as long as the site says.
 ALERT_EVENTS = {
     "call_doctor": "doctor_called",
     "clinician_continue": "doctor_continued",
     "person_lost": "person_lost",
     "person_back": "person_back",
+    "away_alert": "away_alert",
+    "unattended": "unattended",
+    "unattended_ended": "unattended_ended",
 }
 
 

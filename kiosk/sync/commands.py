@@ -21,8 +21,8 @@ class Kiosk(Protocol):
     store: Any
 
     def clinician_continue(self) -> None: ...
-    def person_lost(self) -> None: ...
-    def person_back(self) -> None: ...
+    def person_lost(self, detail: str = ...) -> None: ...
+    def person_back(self, detail: str = ...) -> None: ...
     def end_session(self, reason: str) -> None: ...
 
 
@@ -38,6 +38,7 @@ def live_status(session: Session) -> dict[str, Any]:
         "of": snap.count,
         "paused": snap.paused,
         "person_away": not snap.person_present,
+        "unattended": snap.unattended,
         "doctor_called": snap.halted,
         "simulated": False,
     }
@@ -58,18 +59,19 @@ def apply_command(kiosk: Kiosk, command: Mapping[str, Any]) -> Outcome | None:
     if session.finished:
         return "refused", f"session {session.id} is finished"
     snap = session.snapshot()
+    by = f"ward station, {command.get('by') or 'staff'}"
     if kind == "continue":
-        if not (snap.halted or snap.paused):
+        if not (snap.halted or snap.paused or snap.unattended):
             return "refused", "the session is not waiting for a doctor"
-        kiosk.clinician_continue()
+        kiosk.clinician_continue()  # unattended: logged; the kiosk still waits for the patient's touch
     elif kind == "person_away":
         if not snap.person_present:
             return "refused", "the patient is already marked away"
-        kiosk.person_lost()
+        kiosk.person_lost(by)
     elif kind == "person_back":
         if snap.person_present:
             return "refused", "the patient is not marked away"
-        kiosk.person_back()
+        kiosk.person_back(by)
     elif kind == "end":
         kiosk.end_session(f"ended from the ward station by {command.get('by') or 'staff'}")
     else:

@@ -22,7 +22,7 @@ from textual.binding import Binding
 from textual.message import Message
 from textual.reactive import Reactive
 
-from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command
+from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command, Presence
 from kiosk.core.pin import CornerTaps, PinGuard
 from kiosk.core.session import Session, SessionEvent
 from kiosk.core.site import ExportSite
@@ -39,6 +39,7 @@ from kiosk.ui.widgets.waiting_sign import WaitingSign
 if TYPE_CHECKING:  # message types of screens loaded when first shown (kiosk.ui.stage), not before the welcome
     from kiosk.ui.screens.doctor_called import DoctorCalledScreen
     from kiosk.ui.screens.explanation import ExplanationScreen
+    from kiosk.ui.screens.unattended import UnattendedScreen
     from kiosk.ui.screens.visit_ready import VisitReadyScreen
     from kiosk.ui.widgets.answer_button import AnswerButton
     from kiosk.ui.widgets.change_answer import ChangeAnswerButton
@@ -60,7 +61,7 @@ CLINICIAN_IDLE_S = 300.0
 class ChannelReceived(Message):
     """A channel thread delivered an input or a status change (posted, never handled on that thread)."""
 
-    item: ChannelInput | ChannelStatus
+    item: ChannelInput | ChannelStatus | Presence
 
 
 @dataclass
@@ -177,9 +178,9 @@ class KioskApp(App[int], inherit_bindings=False):
 
     # -- from other threads -----------------------------------------------------------------------
 
-    def channel_sink(self, item: ChannelInput | ChannelStatus) -> None:
+    def channel_sink(self, item: ChannelInput | ChannelStatus | Presence) -> None:
         """The sink every channel (and the speaker's status) delivers to, from its own thread:
-        posts to the UI thread."""
+        posts to the UI thread. The camera delivers its presence reports here too."""
         self.post_message(ChannelReceived(item))
 
     def speaker_activity(self, speaking: bool) -> None:
@@ -245,6 +246,10 @@ class KioskApp(App[int], inherit_bindings=False):
     def on_doctor_called_screen_carry_on(self, message: DoctorCalledScreen.CarryOn) -> None:
         """The patient touched "I'm fine, carry on" after calling the doctor."""
         self.controller.drive(self.session.cancel_doctor_call, Channel.TOUCH)
+
+    def on_unattended_screen_go_on(self, message: UnattendedScreen.GoOn) -> None:
+        """Someone touched the screen while the kiosk waited for a touch: the test goes on."""
+        self.controller.forward(ChannelInput(Channel.TOUCH, option=1, detail="screen"))
 
     def on_explanation_screen_understood(self, message: ExplanationScreen.Understood) -> None:
         """The patient touched Start under the explanation."""

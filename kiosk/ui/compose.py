@@ -20,7 +20,7 @@ from kiosk.core.clock import Clock
 from kiosk.core.pin import PinGuard
 from kiosk.core.qos_model import load_kiosk_model
 from kiosk.core.questionnaire import Questionnaire
-from kiosk.core.session import Session
+from kiosk.core.session import Session, Watching
 from kiosk.core.session.battery import Battery, Instrument
 from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
 from kiosk.store.database import Store, StoredSession, new_patient_id
@@ -115,6 +115,7 @@ class SessionMaker:
                 "timing": config.timing,
                 "adaptation": Adaptation(policy) if policy else None,
                 "next_patient_after_s": config.next_patient_after_s,
+                "watching": Watching(config.away_alert_after_s, config.unattended_after),
             },
             visit_id=visit_id,
         )

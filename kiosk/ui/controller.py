@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
-from kiosk.core.channels import Channel, ChannelInput
+from kiosk.core.channels import Channel, ChannelInput, Presence
 from kiosk.core.session import Finished, NextPatient, Phase, Session, SessionEvent
 from kiosk.core.visits import Order, VisitDesk
 from kiosk.store.database import Store, StoredSession
@@ -158,11 +158,14 @@ class KioskController:
         if isinstance(event, NextPatient):
             self._screens().later(self.next_patient)
 
-    def forward(self, item: ChannelInput) -> None:
+    def forward(self, item: ChannelInput | Presence) -> None:
         """Hand an input to the session (what a number means on each screen is the session's call);
         nothing while the kiosk is out of order, and none starts a test while the welcome waits for
-        staff (an ordered visit, no walk-ups)."""
+        staff (an ordered visit, no walk-ups). A presence report (the camera's) goes straight on."""
         if self.out_of_order is not None:
+            return
+        if isinstance(item, Presence):
+            self.drive(self.session.handle, item)
             return
         if self.session.phase is Phase.WELCOME and self.welcome_held():
             return
@@ -323,13 +326,13 @@ class KioskController:
         """A clinician continues a session halted by call-doctor (or paused)."""
         self.drive(self.session.clinician_continue)
 
-    def person_lost(self) -> None:
-        """A clinician says the patient left the kiosk (it has no presence sensor)."""
-        self.drive(self.session.person_lost)
+    def person_lost(self, detail: str = "clinician screen") -> None:
+        """Staff say the patient left the kiosk ("Patient away": here, or from the ward station)."""
+        self.drive(self.session.person_lost, detail)
 
-    def person_back(self) -> None:
-        """A clinician says the patient is back in front of the kiosk."""
-        self.drive(self.session.person_back)
+    def person_back(self, detail: str = "clinician screen") -> None:
+        """Staff say the patient is back in front of the kiosk."""
+        self.drive(self.session.person_back, detail)
 
     def set_adaptation(self, enabled: bool) -> None:
         """A clinician switches live adaptation on or off for this session."""

@@ -49,8 +49,9 @@ def phase_screen(phase: Phase) -> type[PatientScreen]:
     raise ValueError(f"no screen for the phase {phase!r}")
 
 
-def _overlay_screen(halted: bool, paused: bool) -> type[PatientScreen] | None:
-    """The screen over the phase's one: the doctor called, or paused (imported when first shown)."""
+def _overlay_screen(halted: bool, paused: bool, unattended: bool = False) -> type[PatientScreen] | None:
+    """The screen over the phase's one: the doctor called, paused, or waiting for a touch after
+    questions in a row went unanswered (imported when first shown)."""
     if halted:
         from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 
@@ -59,6 +60,10 @@ def _overlay_screen(halted: bool, paused: bool) -> type[PatientScreen] | None:
         from kiosk.ui.screens.paused import PausedScreen
 
         return PausedScreen
+    if unattended:
+        from kiosk.ui.screens.unattended import UnattendedScreen
+
+        return UnattendedScreen
     return None
 
 
@@ -79,7 +84,7 @@ class PatientStage:
         calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff."""
         app, snap = self.app, view.snapshot
         base_cls = phase_screen(snap.phase)
-        overlay_cls = _overlay_screen(snap.halted, snap.paused)
+        overlay_cls = _overlay_screen(snap.halted, snap.paused, snap.unattended)
         if out_of_order:
             from kiosk.ui.screens.out_of_order import OutOfOrderScreen
 

@@ -127,6 +127,7 @@ def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypa
         "ward3-bed2",
     )
     assert config.interrupt_after_minutes == 45
+    assert (config.away_alert_after_s, config.unattended_after) == (60.0, 2)  # the defaults
     env = {"KIOSK_STATION_URL": "http://127.0.0.1:9000", "KIOSK_STATION_TOKEN": "xyz"}
     config = load_config(path, environ=env)
     assert (config.station.url, config.station.token, config.station.kiosk_id) == (
@@ -146,6 +147,10 @@ def test_the_station_settings_and_their_environment_overrides(tmp_path, monkeypa
         ("station: {url: 'http://x:1', token: a, kiosk_id: 'bed 2'}\n", ":1:50: station: kiosk_id 'bed 2' must be"),
         ("station: {url: 'http://x:1', tokn: a}\n", ":1:1: station must be a mapping"),
         ("interrupt_after_minutes: 0\n", ":1:1: interrupt_after_minutes must be a number of minutes"),
+        ("away_alert_after_s: 5\n", ":1:1: away_alert_after_s must be a number of seconds, 10 to 3600"),
+        ("away_alert_after_s: soon\n", ":1:1: away_alert_after_s must be a number of seconds"),
+        ("unattended_after: 0\n", ":1:1: unattended_after must be a whole number of questions, 1 to 10"),
+        ("unattended_after: 2.5\n", ":1:1: unattended_after must be a whole number"),
         # ports out of range, no host, control characters in the url, the token or an id (real
         # processes: tests/kiosk/test_hostile_config.py)
         ("station: {url: 'http://127.0.0.1:99999', token: a}\n", ":1:16: station: url 'http://127.0.0.1:99999' needs"),

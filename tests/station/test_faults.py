@@ -15,6 +15,7 @@ import sqlalchemy as sa
 
 from station import db
 from station.sessions import load
+from station.sync import RAISES as RAISING
 from tests.station.conftest import PATIENCE_S, free_port, make_ward
 from tests.station.helpers import PATIENTS, KioskClient, record_patient
 
@@ -67,7 +68,7 @@ def _check_exactly_once(db_url: str, kiosk_id: str, rows) -> None:
             assert stored.status == "finished"
             assert len(stored.trace) == sum(r.kind == "record_context" for r in own)
         alerts = connection.execute(sa.select(sa.func.count()).select_from(db.alerts)).scalar_one()
-        assert alerts == sum(r.alert and r.payload["kind"] in ("doctor_called", "person_lost") for r in rows)
+        assert alerts == sum(r.alert and r.payload["kind"] in RAISING for r in rows)
     engine.dispose()
 
 

@@ -14,6 +14,7 @@ import pytest
 import sqlalchemy as sa
 
 from station import db
+from station.sync import RAISES as RAISING
 from tests.station.conftest import PASSWORDS, PATIENCE_S, new_kiosk
 from tests.station.helpers import PATIENTS, KioskClient, record_patient
 
@@ -65,7 +66,7 @@ def _wait_for_beeps(page) -> None:
 def test_an_alert_sounds_and_notifies_until_acknowledged(browser, ward, viewport):
     station, ward, kiosk = ward
     rows = record_patient(PATIENTS / "barthel6.yaml")
-    alert = next(r for r in rows if r.alert and r.payload["kind"] in ("doctor_called", "person_lost"))
+    alert = next(r for r in rows if r.alert and r.payload["kind"] in RAISING)
     context, page = open_page(browser, station, "nurse.kim", "nurse", viewport)
     page.click("#enable-sound")
     page.wait_for_selector("body[data-live='1']", state="attached")

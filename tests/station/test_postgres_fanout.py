@@ -10,6 +10,7 @@ import threading
 
 import pytest
 
+from station.sync import RAISES as RAISING
 from tests.station.conftest import PATIENCE_S, make_ward
 from tests.station.helpers import PATIENTS, KioskClient, Staff, record_patient
 
@@ -39,7 +40,7 @@ def test_an_alert_posted_to_one_station_appears_on_a_page_of_another(pg_url, sta
     name, initial = events.get(timeout=PATIENCE_S)
     assert name == "alerts" and initial["ids"] == []
     rows = record_patient(PATIENTS / "barthel6.yaml")
-    alert = next(r for r in rows if r.alert and r.payload["kind"] in ("person_lost", "doctor_called"))
+    alert = next(r for r in rows if r.alert and r.payload["kind"] in RAISING)
     kiosk = KioskClient(first.url, ward.token, ward.kiosk_id)
     assert kiosk.sync([alert]).status_code == 200
     while True:
@@ -47,7 +48,7 @@ def test_an_alert_posted_to_one_station_appears_on_a_page_of_another(pg_url, sta
         if name == "alerts" and data["ids"]:
             break
     (text,) = [a["text"] for a in data["alerts"]]
-    assert ward.kiosk_id in text and ("Doctor called" in text or "Patient left" in text)
+    assert ward.kiosk_id in text and ("Doctor called" in text or "Patient away" in text)
     assert f'href="#kiosk-{ward.kiosk_id}"' in data["html"]
 
     # a command queued on the second station answers a long poll held by the first

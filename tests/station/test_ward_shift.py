@@ -89,16 +89,21 @@ def test_sound_stays_on_own_actions_are_quiet_and_alerts_close_themselves(browse
     assert kiosk.sync([event(finish.seq + 1, session, "person_lost", 300.0)]).status_code == 200
     kiosk.status(session_id=session, patient_id="NHC-5150", phase="questions", question=4, of=10, person_away=True)
     tile.locator(".badge:has-text('patient away')").wait_for()
+    assert alert_rows(ward.db_url, name) == []  # leaving alerts no one until away as long as the site says
+    away = replace(
+        event(finish.seq + 2, session, "away_alert", 360.0), payload={"t": 360.0, "kind": "away_alert", "detail": "60"}
+    )
+    assert kiosk.sync([away]).status_code == 200
     assert alert_rows(ward.db_url, name) == [("person_lost", "nurse.kim")]  # stored, closed by its sender
     assert page.locator("#alerts li").count() == 0
     assert page.evaluate("window.__same_page") is True  # no reload: the audio stayed on
     assert page.get_attribute("body", "data-sound") == "on"
 
     # a doctor call rings; it closes by itself when the doctor's call is answered at the kiosk
-    assert kiosk.sync([event(finish.seq + 2, session, "doctor_called", 310.0)]).status_code == 200
+    assert kiosk.sync([event(finish.seq + 3, session, "doctor_called", 370.0)]).status_code == 200
     page.locator(f"#alerts li:has-text('{name}')").wait_for()
     page.wait_for_selector("body[data-audible]", state="attached")
-    assert kiosk.sync([event(finish.seq + 3, session, "doctor_continued", 330.0)]).status_code == 200
+    assert kiosk.sync([event(finish.seq + 4, session, "doctor_continued", 390.0)]).status_code == 200
     page.wait_for_selector(f"#alerts li:has-text('{name}')", state="detached")
     page.wait_for_selector("body[data-sounding='0']", state="attached")
     assert alert_rows(ward.db_url, name)[1] == ("doctor_called", "closed: situation ended")
@@ -111,7 +116,7 @@ def test_sound_stays_on_own_actions_are_quiet_and_alerts_close_themselves(browse
     page.wait_for_selector("body[data-live='1']", state="attached")
     page.mouse.click(200, 600)  # a touch anywhere on the page
     page.wait_for_selector("body[data-sound='on']", state="attached")
-    assert kiosk.sync([replace(finish, seq=finish.seq + 4)]).status_code == 200
+    assert kiosk.sync([replace(finish, seq=finish.seq + 5)]).status_code == 200
     page.wait_for_selector("body[data-audible]", state="attached")
     page.wait_for_selector("#inbox li.result:has-text('NHC-5150')")
     context.close()

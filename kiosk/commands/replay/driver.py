@@ -14,7 +14,7 @@ from typing import Any
 from basis import record
 from fileio.bounded import BadFile
 from kiosk.commands.replay.script import ANY, COMMANDS, UNSURE_CONFIDENCE, BatteryScript, Script, ScriptError, Step
-from kiosk.core.channels import ChannelInput, Command
+from kiosk.core.channels import Channel, ChannelInput, Command, Presence
 from kiosk.core.clock import SimClock
 from kiosk.core.qos_model import DEFAULT_MODEL
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
@@ -23,12 +23,14 @@ from kiosk.core.session import (
     AnswerRecorded,
     AttemptOpened,
     AttemptTimedOut,
+    AwayAlert,
     InputIgnored,
     Phase,
     PhaseChanged,
     QuestionNotAnswered,
     Session,
     SessionEvent,
+    Unattended,
 )
 from qos.errors import QosError
 from qos.trace import seconds
@@ -80,6 +82,11 @@ class ReplayResult:
                 for e in self.events
                 if isinstance(e, AdaptationChanged)
             ],
+            "alerts": [
+                {"t": _num(e.t), "kind": "away" if isinstance(e, AwayAlert) else "unattended"}
+                for e in self.events
+                if isinstance(e, (AwayAlert, Unattended))
+            ],
             "qos": self.qos,
             "simulated_s": _num(self.simulated_s),
         }
@@ -106,6 +113,10 @@ class _Driver:
         #: per question, the attempt an ``attempt: any`` answer was armed in (stale once it timed out)
         self.armed_in: list[int | None] = [None] * len(script.questions)
         self.events: list[SessionEvent] = []
+        #: the questions whose go_on was used (the kiosk waited after them)
+        self.went_on: set[int] = set()
+        #: the question whose unanswered end made the kiosk wait for a touch
+        self._last_unanswered: int | None = None
         #: item number -> the script's question for it (staff items are never asked, nor scripted)
         asked = [item for item in session.questionnaire.items if not item.staff]
         self._question_of = {item.number: i for i, item in enumerate(asked)}
@@ -145,8 +156,12 @@ class _Driver:
                     f"({pending[0].after:g} s after it opened) never happened: attempt {event.attempt} "
                     f"timed out at t={_num(event.t)} s under the session's rules"
                 )
+        elif isinstance(event, Unattended) and self._last_unanswered is not None:
+            self._unattended(self._last_unanswered, now)
         elif isinstance(event, (AnswerRecorded, QuestionNotAnswered)):
             index = self._question_of[event.number]
+            if isinstance(event, QuestionNotAnswered):
+                self._last_unanswered = index
             question = self.script.questions[index]
             pending = question.steps[self.next_step[index] :]
             if (
@@ -166,6 +181,17 @@ class _Driver:
                     f"{question.where}: declared answered on attempt {question.attempt} "
                     f"but the question was not answered"
                 )
+
+    def _unattended(self, index: int, now: float) -> None:
+        """The kiosk waits for a touch after question ``index``: the script's go_on touches (a slow
+        patient's ``attempt: any`` question: at once, as they are there)."""
+        question = self.script.questions[index]
+        if question.go_on is not None and question.go_on.channel is not None:
+            self.went_on.add(index)
+            touch = ChannelInput(question.go_on.channel, option=1, detail="script")
+            self.arm(now + question.go_on.after, partial(self.session.handle, touch))
+        elif question.attempt == ANY:
+            self.arm(now, partial(self.session.handle, ChannelInput(Channel.TOUCH, option=1, detail="script")))
 
     def _try_arm(self, index: int) -> None:
         question = self.script.questions[index]
@@ -218,10 +244,8 @@ class _Driver:
             self.session.handle(ChannelInput(step.channel, command=COMMANDS[step.kind], detail="script"))
         elif step.kind == "continue":
             self.session.clinician_continue()
-        elif step.kind == "person_lost":
-            self.session.person_lost()
-        elif step.kind == "person_back":
-            self.session.person_back()
+        elif step.kind in ("person_lost", "person_back"):
+            self.session.handle(Presence(step.kind == "person_back", step.source, "script"))
         self._try_arm(index)
 
     def _give_answer(self, step: Step, index: int | None, check: bool = True) -> None:
@@ -267,6 +291,7 @@ class _Driver:
             if self.errors:
                 raise ScriptError(self.errors[0])
             if self.session.finished:
+                self._check_go_on()
                 return
             self.armed.sort()
             deadline = self.session.next_deadline()
@@ -285,8 +310,19 @@ class _Driver:
                 )
         raise ScriptError(f"{self.script.source}: the replay did not finish")
 
+    def _check_go_on(self) -> None:
+        for index, question in enumerate(self.script.questions):
+            if question.go_on is not None and index not in self.went_on:
+                raise ScriptError(
+                    f"{question.go_on.where}: the kiosk never waited for a touch after this question "
+                    "(go_on): fewer questions in a row went unanswered than unattended_after"
+                )
+
     def _waiting_for(self) -> str:
         s = self.session
+        if s.snapshot().unattended:
+            where = self.script.questions[self._last_unanswered].where if self._last_unanswered is not None else ""
+            return f"waiting for a touch after questions in a row went unanswered: give go_on at {where}"
         if s.halted:
             return "doctor called, no clinician continue"
         if s.paused:
@@ -331,6 +367,7 @@ def run_script(
         adaptation=Adaptation(policy or load_policy(model=loaded)) if script.adaptation else None,
         familiarisation=script.practice is not None,
         visit=visit,
+        watching=script.watching,
     )
     driver = _Driver(script, session, clock)
     try:
@@ -384,6 +421,7 @@ def run_battery(
             "store": store,
             "timing": first.timing,
             "adaptation": Adaptation(policy or load_policy(model=loaded[model])) if first.adaptation else None,
+            "watching": first.watching,
         },
     )
     results: list[ReplayResult] = []

@@ -15,8 +15,9 @@ from typing import Any
 
 from basis import record
 from fileio.positions import Problem, describe, parse_file, schema_problems
-from kiosk.core.channels import Channel, Command
+from kiosk.core.channels import Channel, Command, PresenceSource
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, load_questionnaire
+from kiosk.core.session import Watching
 
 #: ``attempt: any``: the patient answers ``after`` seconds into whichever attempt lets them (a slow
 #: patient: too slow for a window, they start again on the next); not answered if none does
@@ -67,6 +68,8 @@ class Step:
     unsure: bool = False
     #: where it is written, for messages: "file:line:col: questions[2].incidents[0]"
     where: str = ""
+    #: who reports a person_lost/person_back incident
+    source: PresenceSource = PresenceSource.CAMERA
 
 
 @record
@@ -78,6 +81,8 @@ class Question:
     attempt: int | None
     steps: tuple[Step, ...]
     where: str
+    #: the touch that goes on when the kiosk waits after this unanswered question (``go_on:``)
+    go_on: Step | None = None
 
 
 @record
@@ -97,6 +102,8 @@ class Script:
     questions: tuple[Question, ...]
     #: seconds on the rest screen before Continue (a battery's later instruments)
     rest_after: float = 0.0
+    #: the site's settings about a patient who is not there (the kiosk's defaults unless given)
+    watching: Watching = Watching()
 
 
 @record
@@ -378,19 +385,31 @@ def _build(
             ip = p + ("incidents", j)
             if "channel" in incident and incident["do"] not in COMMANDS:
                 add(ip + ("channel",), f"{incident['do']!r} is not given through a channel")
+            if "source" in incident and incident["do"] not in ("person_lost", "person_back"):
+                add(ip + ("source",), f"{incident['do']!r} has no presence source")
             anchor = incident.get("attempt", 1 if j == 0 else None)
             channel = Channel(incident.get("channel", "touch"))
-            steps.append(Step(incident["do"], anchor, float(incident.get("after", 0)), channel, where=where(ip)))
+            source = PresenceSource(incident.get("source", "camera"))
+            steps.append(
+                Step(incident["do"], anchor, float(incident.get("after", 0)), channel, where=where(ip), source=source)
+            )
+        go_on = None
         if attempt is None:
             for key in ("option", "say", "channel", "after", "unsure", "confirm", "undo", "then"):
                 if key in entry:
                     add(p + (key,), f"{describe(p)} is not answered (attempt: none) but gives {key!r}", key=True)
-        else:
+        elif "go_on" in entry and attempt != ANY:
+            add(p + ("go_on",), f"{describe(p)} is answered: the kiosk never waits after it", key=True)
+        if "go_on" in entry:
+            touch = entry["go_on"]
+            channel = Channel(touch.get("channel", "touch"))
+            go_on = Step("go_on", None, float(touch.get("after", 0)), channel, 1, where=where(p + ("go_on",)))
+        if attempt is not None:
             step = answer_step(p, entry, item, "answer", attempt)
             if step:
                 steps.append(step)
                 steps += corrections(p, entry, item, attempt)
-        questions.append(Question(item, attempt, tuple(steps), where(p)))
+        questions.append(Question(item, attempt, tuple(steps), where(p), go_on))
     if problems:
         raise _script_error(problems)
     return Script(
@@ -405,7 +424,16 @@ def _build(
         timing=dict(data.get("timing", {})),
         practice=practice,
         questions=tuple(questions),
+        watching=Watching(
+            _setting(data.get("away_alert_after_s", Watching().away_alert_after_s), float),
+            _setting(data.get("unattended_after", Watching().unattended_after), int),
+        ),
     )
+
+
+def _setting(value: Any, kind: type) -> Any:
+    """A watching setting as the session takes it: ``off`` is None."""
+    return None if value is False or value in ("off", None) else kind(value)
 
 
 def _match_reply(language: str, utterance: str) -> int | str:

@@ -6,8 +6,9 @@ in from outside:
 
 * time from a :class:`~kiosk.core.clock.Clock`; nothing happens on its own -- a driver calls
   :meth:`Session.poll` at (or after) :meth:`Session.next_deadline` to let time-outs happen;
-* patient input as :class:`~kiosk.core.channels.ChannelInput` through :meth:`Session.handle`, and the
-  other inputs (start, presence, clinician) as methods;
+* patient input as :class:`~kiosk.core.channels.ChannelInput` and presence reports as
+  :class:`~kiosk.core.channels.Presence` (camera or staff) through :meth:`Session.handle`, and the
+  other inputs (start, clinician) as methods;
 * the QoS engine (``qos.Engine``) it tells about contexts, exactly as the CLARC context table says;
 * an optional store (``kiosk.store.database.Store``) that commits every answer as it happens.
 
@@ -37,6 +38,9 @@ Timing rules (all values from :class:`~kiosk.core.questionnaire.Timing`):
   (:meth:`Session.set_voice_out_available`); practice outcomes are stored for the clinician.
 * An answer while the patient is reported lost is still taken (a touch proves someone is there);
   PersonDetected stays the presence source's business, and the next question waits for it.
+* Away for the site's ``away_alert_after_s`` (:class:`Watching`), the ward is alerted
+  (``away_alert``); after ``unattended_after`` unanswered questions in a row the ward is alerted
+  (``unattended``) and the kiosk waits for a touch instead of asking on (:mod:`.attendance`).
 
 QoS contexts (one batch per instant; practice answers are never published):
 start -> ``PersonDetected: true, TestState: STARTED``; answer on attempt 1 ->
@@ -55,12 +59,14 @@ screen renders), :mod:`.state` (the one shared state), :mod:`.timers` (the attem
 :mod:`.publishing` (QoS batches, log, listeners, the operation bracket), :mod:`.prompts` (what is
 shown and said), :mod:`.opening` (welcome, start, language, explanation), :mod:`.questions`
 (attempts, answers, time-outs, finish), :mod:`.corrections` (confirm an unsure answer, undo the
-last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor, presence),
+last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor), :mod:`.attendance`
+(presence, the away alert, the wait for a touch),
 :mod:`.live` (live adaptation), :mod:`.routing` (which step takes an input or a time-out),
 :mod:`.resume` (continuing a stored session), :mod:`.ports` (what it needs of the engine and the
 store) and :mod:`.core` (the :class:`Session` that owns them).
 """
 
+from kiosk.core.session.attendance import Watching
 from kiosk.core.session.core import Session
 from kiosk.core.session.events import (
     ATTEMPTS,
@@ -71,6 +77,7 @@ from kiosk.core.session.events import (
     AnswerWithdrawn,
     AttemptOpened,
     AttemptTimedOut,
+    AwayAlert,
     ConfirmationAsked,
     DoctorCallCancelled,
     DoctorCalled,
@@ -94,6 +101,8 @@ from kiosk.core.session.events import (
     QuestionNotAnswered,
     Resumed,
     SessionEvent,
+    Unattended,
+    UnattendedEnded,
     VolumeChanged,
 )
 from kiosk.core.session.ports import QosEngine, SessionStore
@@ -112,6 +121,7 @@ __all__ = [
     "AnswerWithdrawn",
     "AttemptOpened",
     "AttemptTimedOut",
+    "AwayAlert",
     "ConfirmationAsked",
     "DoctorCallCancelled",
     "DoctorCalled",
@@ -140,5 +150,8 @@ __all__ = [
     "SessionEvent",
     "SessionStore",
     "Snapshot",
+    "Unattended",
+    "UnattendedEnded",
     "VolumeChanged",
+    "Watching",
 ]

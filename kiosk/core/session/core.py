@@ -16,9 +16,10 @@ import uuid
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from kiosk.core.channels import Channel, ChannelInput
+from kiosk.core.channels import Channel, ChannelInput, Presence, PresenceSource
 from kiosk.core.clock import Clock
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
+from kiosk.core.session.attendance import Attendance, Watching
 from kiosk.core.session.corrections import Corrections
 from kiosk.core.session.events import AnsweredBy, Phase
 from kiosk.core.session.incidents import Incidents
@@ -51,6 +52,8 @@ class Session:
     :mod:`kiosk.core.session.battery`); a later instrument starts with the rest screen.
     ``visit`` says how the visit began (``kiosk.core.visits``: an order, staff, a walk-up); it is
     logged at the start, in the start's transaction, so the result is always marked.
+    ``watching`` is what the site sets about a patient who is not there (:class:`Watching`: the
+    away alert, the wait for a touch after unanswered questions); ``None``: neither.
     """
 
     def __init__(
@@ -73,6 +76,7 @@ class Session:
         resume_not_answered: tuple[str, ...] = (),
         visit: str | None = None,
         battery: BatteryPlace | None = None,
+        watching: Watching | None = None,
     ) -> None:
         if language not in questionnaire.languages:
             raise ValueError(f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
@@ -104,7 +108,7 @@ class Session:
         self.out = out = Outputs(state, timers, engine=engine, store=store, on_metrics=self._metrics_updated)
         self.prompts = prompts = Prompts(state, timers, out)
         self.live = LiveAdaptation(state, timers, out, prompts, store=store)
-        self.incidents = Incidents(state, timers, out, prompts)
+        self.incidents = incidents = Incidents(state, timers, out, prompts)
         self.flow = flow = QuestionFlow(
             state,
             timers,
@@ -113,6 +117,10 @@ class Session:
             store=store,
             next_patient_after_s=next_patient_after_s,
             practice_not_answered=self._practice_not_answered,
+            unattended=self._not_answered,
+        )
+        self.attendance = Attendance(
+            state, timers, out, prompts, watching=watching, go_on=flow.go_on, ask_again=incidents.ask_again
         )
         self.corrections = Corrections(
             state, timers, out, prompts, store=store, record_answer=flow.record_answer, time_out=flow.attempt_timed_out
@@ -139,6 +147,7 @@ class Session:
             corrections=self.corrections,
             practice=practice,
             incidents=self.incidents,
+            attendance=self.attendance,
         )
 
     # -- construction from a stored, unfinished session -----------------------------------------
@@ -314,6 +323,7 @@ class Session:
             **self.practice.progress(),
             confirming=open_.unconfirmed.option if open_ and open_.unconfirmed else None,
             can_undo=self.corrections.can_undo() and not self.timers.frozen,
+            unattended=state.unattended,
         )
 
     # -- inputs ------------------------------------------------------------------------------------
@@ -347,14 +357,16 @@ class Session:
         with self._operation() as t:
             self.opening.acknowledge(t)
 
-    def handle(self, event: ChannelInput) -> None:
-        """An input from a channel: an answer option or a command.
+    def handle(self, event: ChannelInput | Presence) -> None:
+        """An input from a channel: an answer option or a command, or a presence report
+        (:class:`~kiosk.core.channels.Presence`, from the camera or staff; see :mod:`.attendance`).
 
         An answer number means what the screen says: on the welcome screen option n starts in the
         questionnaire's n-th language (a higher number starts in the current language, as "press
         any button" promises); under the explanation any number acknowledges it (unless paused);
         after call-doctor 1 is "I'm fine, carry on"; while "Is that right?" is asked 1 is Yes and
-        2 is No.
+        2 is No. While the kiosk waits for a touch (questions in a row unanswered) a number by
+        touch, key or remote goes on to the next question.
         """
         with self._operation() as t:
             self.router.input(t, event)
@@ -406,9 +418,10 @@ class Session:
             self.incidents.call_doctor(t, channel)
 
     def clinician_continue(self) -> None:
-        """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left."""
+        """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left.
+        While the kiosk waits for a touch it is logged and the kiosk keeps waiting for it."""
         with self._operation() as t:
-            self.incidents.clinician_continue(t)
+            self.incidents.clinician_continue(t, self.attendance.staff_continue)
 
     def cancel_doctor_call(self, channel: Channel | None = None) -> None:
         """The patient says "I'm fine, carry on" after calling the doctor: the test goes on (a
@@ -416,15 +429,14 @@ class Session:
         with self._operation() as t:
             self.incidents.cancel_doctor(t, channel)
 
-    def person_lost(self) -> None:
-        """The presence source (or the clinician) says the patient left; the clock stops."""
-        with self._operation() as t:
-            self.incidents.person_lost(t)
+    def person_lost(self, detail: str = "") -> None:
+        """Staff say the patient left ("Patient away"): ``handle(Presence(False, STAFF, detail))``."""
+        self.handle(Presence(False, PresenceSource.STAFF, detail))
 
-    def person_back(self) -> None:
-        """The patient is back; the attempt has at least ``person_back_grace_s`` left."""
-        with self._operation() as t:
-            self.incidents.person_back(t)
+    def person_back(self, detail: str = "") -> None:
+        """Staff say the patient is back: ``handle(Presence(True, STAFF, detail))``; the attempt has
+        at least ``person_back_grace_s`` left."""
+        self.handle(Presence(True, PresenceSource.STAFF, detail))
 
     def skip_familiarisation(self) -> None:
         """Leave the practice questions (a clinician's or the patient's choice)."""
@@ -474,6 +486,9 @@ class Session:
 
     def _practice_not_answered(self, t: float) -> None:
         self.practice.not_answered(t)
+
+    def _not_answered(self, t: float) -> bool:
+        return self.attendance.not_answered(t)
 
     def _metrics_updated(self, t: float, metrics: Mapping[str, float], answered: bool) -> None:
         self.live.observe(t, metrics, answered)

@@ -9,7 +9,7 @@ from enum import Enum
 from typing import Any
 
 from basis import record
-from kiosk.core.channels import Channel, ChannelInput
+from kiosk.core.channels import Channel, ChannelInput, PresenceSource
 from kiosk.core.questionnaire import Score
 
 # Vocabulary
@@ -56,6 +56,7 @@ class IgnoreReason(str, Enum):
     UNKNOWN_LANGUAGE = "unknown_language"
     NOTHING_TO_UNDO = "nothing_to_undo"  # no answer can be taken back now
     UNSURE_REPLY = "unsure_reply"  # an unsure "yes" never confirms an unsure answer
+    WAITING_FOR_TOUCH = "waiting_for_touch"  # unattended: only a touch or a press goes on, not a voice
 
 
 #: attempts per question: the question is asked, then asked again, then it is not answered. Fixed
@@ -219,12 +220,40 @@ class DoctorContinued(SessionEvent):
 class PersonLost(SessionEvent):
     """The patient is no longer in front of the kiosk; the attempt clock is frozen."""
 
+    #: who said so (None: an older caller that did not say)
+    source: PresenceSource | None = None
+
 
 @record
 class PersonBack(SessionEvent):
     """The patient is back; ``deadline`` is the open attempt's new deadline, if any."""
 
     deadline: float | None
+    source: PresenceSource | None = None
+
+
+@record
+class AwayAlert(SessionEvent):
+    """The patient has been away for ``away_s`` (the site's ``away_alert_after_s``): the ward is
+    alerted (logged ``away_alert``, an alert row for the station)."""
+
+    away_s: float
+
+
+@record
+class Unattended(SessionEvent):
+    """``count`` questions in a row were not answered (the site's ``unattended_after``): the ward is
+    alerted and the kiosk waits for a touch before the next question."""
+
+    count: int
+
+
+@record
+class UnattendedEnded(SessionEvent):
+    """Someone touched the screen (or pressed a key or the remote) while the kiosk waited: the test
+    goes on with the next question."""
+
+    channel: Channel
 
 
 @record

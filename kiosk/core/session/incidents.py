@@ -6,12 +6,14 @@
   button, or 1 on the keys or the remote -- never by voice, as a misheard phrase must not call
   off help); then at least ``resume_grace_s`` is left. The cancel is logged
   (``doctor_call_cancelled``) and published, so staff see the call was called off.
-* Person lost freezes the clock; person back leaves at least ``person_back_grace_s``.
 
-After each, an open question is asked again.
+After each, an open question is asked again (or, while the kiosk waits for a touch after questions
+in a row went unanswered, that wait is said again). Presence is :mod:`.attendance`'s.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from kiosk.core.channels import Channel, ChannelInput
 from kiosk.core.session.events import (
@@ -20,8 +22,6 @@ from kiosk.core.session.events import (
     DoctorContinued,
     IgnoreReason,
     Paused,
-    PersonBack,
-    PersonLost,
     Phase,
     Resumed,
 )
@@ -40,9 +40,14 @@ class Incidents:
         self.out = out
         self.prompts = prompts
 
-    def clinician_continue(self, t: float) -> None:
-        """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left."""
+    def clinician_continue(self, t: float, waiting_for_touch: Callable[[float], None]) -> None:
+        """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left.
+        While the kiosk waits for a touch (and nothing else stops it) ``waiting_for_touch(t)``
+        is told instead: the test goes on only with someone at the screen."""
         timers, out = self.timers, self.out
+        if self.state.unattended and self.state.started() and not (timers.halted or timers.paused):
+            waiting_for_touch(t)
+            return
         if not self.state.started() or not (timers.halted or timers.paused):
             out.ignore(t, None, IgnoreReason.NOT_HALTED, "clinician_continue")
             return
@@ -52,35 +57,6 @@ class Incidents:
         self._unfreeze({"doctor", "paused"}, self.state.timing.resume_grace_s)
         deadline = timers.attempt_deadline()
         out.emit(DoctorContinued(t, deadline) if was_halted else Resumed(t, deadline))
-        self._ask_again(t)
-
-    def person_lost(self, t: float) -> None:
-        """The presence source (or the clinician) says the patient left; the clock stops."""
-        state = self.state
-        if not state.person_present:
-            self.out.ignore(t, None, IgnoreReason.PERSON_ALREADY_LOST, "person_lost")
-            return
-        state.person_present = False
-        if not state.started():
-            return
-        self.out.context(t, {"PersonDetected": False})
-        self.out.log(t, "person_lost")
-        self._freeze("away")
-        self.out.emit(PersonLost(t))
-
-    def person_back(self, t: float) -> None:
-        """The patient is back; the attempt has at least ``person_back_grace_s`` left."""
-        state = self.state
-        if state.person_present:
-            self.out.ignore(t, None, IgnoreReason.PERSON_NOT_LOST, "person_back")
-            return
-        state.person_present = True
-        if not state.started():
-            return
-        self.out.context(t, {"PersonDetected": True})
-        self.out.log(t, "person_back")
-        self._unfreeze({"away"}, state.timing.person_back_grace_s)
-        self.out.emit(PersonBack(t, self.timers.attempt_deadline()))
         self._ask_again(t)
 
     def _freeze(self, reason: str) -> None:
@@ -160,6 +136,14 @@ class Incidents:
             self._ask_again(t)
 
     def _ask_again(self, t: float) -> None:
-        """After a freeze ends, an open question is asked again."""
-        if not self.timers.frozen and self.state.current_attempt is not None:
+        """After a freeze ends, an open question is asked again (or the wait for a touch said again)."""
+        if self.timers.frozen:
+            return
+        if self.state.current_attempt is not None:
             self.prompts.ask(t, repeat=True)
+        elif self.state.unattended:
+            self.prompts.unattended(t)
+
+    def ask_again(self, t: float) -> None:
+        """Ask an open question again once nothing stops the clock (for the other steps)."""
+        self._ask_again(t)

@@ -15,11 +15,13 @@ from kiosk.core.session.timers import AttemptClock
 from kiosk.core.session.words import (
     CONFIRM_WORDS,
     CONTINUE_LABEL,
+    GO_ON_LABEL,
     LANGUAGE_NAMES,
     OWN_NAME,
     REST_TEXT,
     START_LABEL,
     START_WORDS,
+    UNATTENDED_TEXT,
 )
 from kiosk.core.words import fill
 
@@ -133,6 +135,15 @@ class Prompts:
         label = CONTINUE_LABEL.get(lang, CONTINUE_LABEL["en"])
         options = (PromptOption(1, label, tuple(START_WORDS.get(lang, ())), None),)
         return Prompt(t, "message", "rest", text, text, lang, options, speech_rate=state.speech_rate())
+
+    def unattended(self, t: float) -> None:
+        """Publish the wait for a touch after questions in a row went unanswered ("Are you still
+        there? Touch the screen to go on."), with one option: Go on. Nothing is listened for."""
+        state = self.state
+        lang = state.language
+        text = UNATTENDED_TEXT.get(lang, UNATTENDED_TEXT["en"])
+        options = (PromptOption(1, GO_ON_LABEL.get(lang, GO_ON_LABEL["en"]), (), None),)
+        self.publish(Prompt(t, "message", "unattended", text, text, lang, options, speech_rate=state.speech_rate()))
 
     def to_explanation(self, t: float) -> None:
         """Go on to the explanation (after the practice questions, or at once)."""

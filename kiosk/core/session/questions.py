@@ -47,6 +47,7 @@ class QuestionFlow:
         store: SessionStore | None,
         next_patient_after_s: float | None,
         practice_not_answered: Callable[[float], None],
+        unattended: Callable[[float], bool] = lambda t: False,
     ) -> None:
         self.state = state
         self.timers = timers
@@ -55,6 +56,7 @@ class QuestionFlow:
         self.store = store
         self.next_patient_after_s = next_patient_after_s
         self._practice_not_answered = practice_not_answered
+        self._unattended = unattended
 
     def schedule_next_item(self, t: float, after: float) -> None:
         """The next unanswered item opens ``after`` seconds from ``t``; with none left, the summary."""
@@ -62,6 +64,14 @@ class QuestionFlow:
             self.timers.set("open", t, after)
         else:
             self.timers.set("finish", t, self.state.timing.closing_s)
+
+    def go_on(self, t: float) -> None:
+        """Open the next question at once (with none left, the summary): someone touched the
+        screen while the kiosk waited for a touch."""
+        if self.state.next_item_index() is not None:
+            self.open_next_item(t)
+        else:
+            self.finish(t)
 
     def open_next_item(self, t: float) -> None:
         index = self.state.next_item_index()
@@ -107,6 +117,8 @@ class QuestionFlow:
         if self.store is not None:
             self.store.record_not_answered(state.id, item_id=key, t=t, at=out.wall(t))
         out.emit(QuestionNotAnswered(t, key, number))
+        if self._unattended(t):  # nobody answers: wait for a touch, say no "Let us go on"
+            return
         self.prompts.message(t, "not_answered")
         self.prompts.update_listening(t)
         self.schedule_next_item(t, state.timing.between_questions_s)
@@ -138,6 +150,7 @@ class QuestionFlow:
                 detail=detail,
             )
         state.answers[item.id] = answer
+        state.not_answered_run = 0
         contexts: dict[str, object] = {}
         if not open_.correcting:  # attempt contexts are once per question
             contexts["FirstAttemptAnswered" if attempt == 1 else "SecondAttemptAnswered"] = True

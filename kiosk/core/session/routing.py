@@ -5,7 +5,8 @@ inside an operation."""
 
 from __future__ import annotations
 
-from kiosk.core.channels import ChannelInput, Command
+from kiosk.core.channels import ChannelInput, Command, Presence
+from kiosk.core.session.attendance import AWAY_ALERT, Attendance
 from kiosk.core.session.corrections import Corrections
 from kiosk.core.session.events import Phase, VolumeChanged
 from kiosk.core.session.incidents import Incidents
@@ -33,6 +34,7 @@ class Router:
         corrections: Corrections,
         practice: Practice,
         incidents: Incidents,
+        attendance: Attendance,
     ) -> None:
         self.state = state
         self.timers = timers
@@ -43,6 +45,7 @@ class Router:
         self.corrections = corrections
         self.practice = practice
         self.incidents = incidents
+        self.attendance = attendance
 
     def fire(self, kind: str, t: float) -> None:
         """A time-out of ``kind`` fell due at session time ``t``."""
@@ -58,17 +61,23 @@ class Router:
             self.flow.finish(t)
         elif kind == "next_patient":
             self.flow.next_patient(t)
+        elif kind == AWAY_ALERT:
+            self.attendance.away_too_long(t)
         self.prompts.update_listening(t)  # a gap that ended stops listening for "No, that's wrong"
 
-    def input(self, t: float, event: ChannelInput) -> None:
+    def input(self, t: float, event: ChannelInput | Presence) -> None:
         """An input from a channel (see ``Session.handle`` for what each number means where)."""
         phase = self.state.phase
-        if event.command is not None:
+        if isinstance(event, Presence):
+            self.attendance.presence(t, event)
+        elif event.command is not None:
             self._command(t, event)
         elif phase is Phase.WELCOME:
             self.opening.start_by_number(t, event)
         elif self.timers.halted:
             self.incidents.doctor_reply(t, event)
+        elif self.state.unattended:
+            self.attendance.touched(t, event)
         elif phase in (Phase.EXPLANATION, Phase.REST) and not self.timers.paused:
             self.opening.acknowledge(t)
         else:

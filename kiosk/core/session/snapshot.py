@@ -65,3 +65,5 @@ class Snapshot:
     confirming: int | None = None
     #: "Change my answer" can be offered: the thank-you gap after an answer is running
     can_undo: bool = False
+    #: questions in a row went unanswered: the kiosk waits for a touch ("Touch the screen to go on")
+    unattended: bool = False

@@ -108,6 +108,10 @@ class SessionState:
     greeted: bool = False
     open: OpenQuestion | None = None
     person_present: bool = True
+    #: scored questions in a row that both attempts ran out on (an answer sets it back to 0)
+    not_answered_run: int = 0
+    #: that run reached the site's ``unattended_after``: the kiosk waits for a touch to go on
+    unattended: bool = False
     #: whether voice in works on this kiosk (see Session.set_voice_available)
     voice_available: bool = True
     #: whether voice out works on this kiosk (see Session.set_voice_out_available)
@@ -184,8 +188,8 @@ class SessionState:
         """What to show while the next question (or the summary) is being waited for."""
         if self.phase is Phase.FAMILIARISATION and timer_kind == "practice" and self.open is not None:
             return self.open.feedback  # "Well done." stays while the next practice question waits
-        if self.phase is not Phase.QUESTIONS or timer_kind is None:
-            return None
+        if self.phase is not Phase.QUESTIONS or timer_kind is None or not self.person_present:
+            return None  # nobody is there to go on with: the one message is the away notice
         if timer_kind == "finish":
             return "last_question"
         if timer_kind != "open":

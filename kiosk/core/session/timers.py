@@ -4,7 +4,7 @@ Nothing happens on its own: a driver calls ``Session.poll`` once the clock reach
 :meth:`AttemptClock.next_deadline`, and every operation first lets due time-outs fire (each at its
 own due time, not at the time of the call). Pause, call-doctor and person lost freeze the clock;
 once the last freeze is lifted an open attempt gets at least the largest grace any of them asked
-for.
+for. Beside it runs one *watch*, a time-out no freeze stops (how long the patient has been away).
 """
 
 from __future__ import annotations
@@ -37,6 +37,8 @@ class AttemptClock:
         #: why the clock is stopped ("paused", "doctor", "away", ...); empty while it runs
         self.freezes: set[str] = set()
         self._grace = 0.0
+        #: the watch: (kind, clock time due), a time-out that runs while the clock is frozen
+        self.watch: tuple[str, float] | None = None
 
     def t(self, clock_time: float) -> float:
         """Session time of a clock time."""
@@ -77,19 +79,38 @@ class AttemptClock:
         """Drop the pending time-out."""
         self.timer = None
 
+    def watch_for(self, kind: str, start_t: float, seconds: float) -> None:
+        """Set the watch: ``kind`` falls due ``seconds`` after session time ``start_t``, frozen or not."""
+        self.watch = (kind, self.origin + start_t + seconds)
+
+    def unwatch(self, kind: str) -> None:
+        """Drop the watch if it is of ``kind``."""
+        if self.watch is not None and self.watch[0] == kind:
+            self.watch = None
+
     def due(self, now: float, inclusive: bool) -> Iterator[tuple[str, float]]:
-        """Take the time-outs due by clock time ``now`` in order, as (kind, session time due).
+        """Take the time-outs due by clock time ``now`` in order, as (kind, session time due): the
+        pending time-out and the watch, the earlier first (the time-out first at one instant).
 
         The caller acts on each before the next is looked at (acting may set another timer).
         """
-        while (
-            self.timer is not None
-            and self.timer.due is not None
-            and (self.timer.due < now or (inclusive and self.timer.due == now))
-        ):
-            timer, self.timer = self.timer, None
-            assert timer.due is not None
-            yield timer.kind, self.t(timer.due)
+
+        def ripe(due: float) -> bool:
+            return due < now or (inclusive and due == now)
+
+        while True:
+            timer_due = self.timer.due if self.timer is not None else None
+            watch_due = self.watch[1] if self.watch is not None else None
+            if timer_due is not None and ripe(timer_due) and (watch_due is None or timer_due <= watch_due):
+                assert self.timer is not None
+                kind, self.timer = self.timer.kind, None
+                yield kind, self.t(timer_due)
+            elif watch_due is not None and ripe(watch_due):
+                assert self.watch is not None
+                kind, self.watch = self.watch[0], None
+                yield kind, self.t(watch_due)
+            else:
+                return
 
     def freeze(self, reason: str) -> None:
         """Stop the clock for ``reason`` (the first freeze keeps what was left)."""
@@ -136,5 +157,6 @@ class AttemptClock:
         return None
 
     def next_deadline(self) -> float | None:
-        """Clock time of the next time-out, or None if none is running."""
-        return self.timer.due if self.timer is not None else None
+        """Clock time of the next time-out (or the watch), or None if none is running."""
+        dues = [self.timer.due if self.timer is not None else None, self.watch[1] if self.watch is not None else None]
+        return min((d for d in dues if d is not None), default=None)

@@ -40,3 +40,9 @@ REST_TEXT: Mapping[str, str] = Table(lambda words: words.screen["rest"])
 
 #: the rest screen's one option
 CONTINUE_LABEL: Mapping[str, str] = Table(lambda words: words.screen["rest_continue"])
+
+#: the wait after questions in a row went unanswered ("Are you still there? Touch the screen to go on.")
+UNATTENDED_TEXT: Mapping[str, str] = Table(lambda words: words.screen["unattended"])
+
+#: that wait's one option
+GO_ON_LABEL: Mapping[str, str] = Table(lambda words: words.screen["go_on"])

@@ -112,12 +112,12 @@ def patient_notices(view: PatientView) -> str | None:
     """The notices the patient sees above the question, in their language, or None: only what is
     true with the channels on now (no "speaking more slowly" without a voice)."""
     snap, lang = view.snapshot, view.snapshot.language
+    if not snap.person_present:  # away: one calm message, nothing else
+        return ui_text(lang, "person_lost")
     notices = []
     if view.hint_options:
         options = [str(n) for n in range(1, view.hint_options + 1)]
         notices.append(ui_text(lang, "only_options", options=join_or(lang, options)))
-    if not snap.person_present:
-        notices.append(ui_text(lang, "person_lost"))
     for name in sorted(snap.adaptations):
         if name == "slow_speech" and not view.ways.voice_out:
             continue

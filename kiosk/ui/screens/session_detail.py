@@ -31,6 +31,10 @@ EVENT_WORDS = {
     "resume": "Continued after a pause",
     "person_lost": "Patient left the kiosk",
     "person_back": "Patient back",
+    "away_alert": "Ward alerted: patient away (seconds)",
+    "unattended": "Ward alerted: no answer (questions in a row); waited for a touch",
+    "unattended_ended": "Touched to go on",
+    "continue_waits_for_touch": "Continue from staff: waited for the patient's touch",
     "answer_withdrawn": "Answer taken back",
     "abandoned": "Ended by staff",
 }

@@ -52,6 +52,8 @@ class UiKiosk:
         questionnaire: str | Path | None = None,
         pin_on_disk: bool = False,
         instruments: tuple = (),
+        unattended_after: int | None = None,
+        away_alert_after_s: float | None = 60.0,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -63,6 +65,9 @@ class UiKiosk:
             show_score_to_patient=show_score,
             **({"clinician_pin": UI_PIN} if pin_on_disk else {}),
             instruments=instruments,  # a battery (kiosk.config.InstrumentChoice), else the Barthel
+            # None: every question may time out and the kiosk asks on (the tests from before issue 36)
+            unattended_after=unattended_after,
+            away_alert_after_s=away_alert_after_s,
         )
         parts = KioskParts.load(self.config)
         self.questionnaire, self.model = parts.questionnaire, parts.model
@@ -121,7 +126,7 @@ class UiKiosk:
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
     voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model,
-    questionnaire, pin_on_disk, instruments)."""
+    questionnaire, pin_on_disk, instruments, unattended_after, away_alert_after_s)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
