@@ -73,6 +73,7 @@ def build_app(
         raise SetupError(str(error)) from None
     statuses: list[ChannelStatus] = []
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
+    sources += _camera(statuses)
     channels = KioskChannels(
         speaker=_speaker() if voice else None,
         voice=_voice_in(config, voice, statuses),
@@ -95,6 +96,16 @@ def _in_force(config: Config) -> InForce:
     from kiosk.export.opening import in_force_of
 
     return in_force_of(config)
+
+
+def _camera(statuses: list[ChannelStatus]) -> list[InputSource]:
+    """The camera channel when this machine has a camera and the pose model, else its status off
+    with why (the kiosk runs as without it). It opens the camera after the first frame."""
+    from kiosk.camera import camera_channel, camera_status
+
+    statuses.append(camera_status())
+    channel = camera_channel()
+    return [channel] if channel is not None else []
 
 
 def _remotes(

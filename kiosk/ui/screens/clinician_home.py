@@ -10,9 +10,11 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import Button, DataTable, Label, Static, Switch
 
+from kiosk.core.channels import ChannelState
 from kiosk.core.session import Phase
 from kiosk.export.captured import questionnaire_of
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.ui.widgets.channel_board import CAMERA
 
 #: how often the running session's line is redrawn (seconds)
 REFRESH_S = 1.0
@@ -171,9 +173,17 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def _channels_text(self) -> str:
         lines = self.kiosk.board.lines("en", patient=False)
-        return "Channels: " + "; ".join(
-            f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
-            for line in lines
+        state, reason = self.kiosk.board.state(CAMERA)
+        camera = (
+            "camera on" if state is ChannelState.ON else f"camera {state.value}" + (f" ({reason})" if reason else "")
+        )
+        return (
+            "Channels: "
+            + "; ".join(
+                f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
+                for line in lines
+            )
+            + f"; {camera}"
         )
 
     @on(Button.Pressed, "#continue")
