@@ -59,8 +59,8 @@ class Pose:
 
 def axes(facing: float) -> tuple[np.ndarray, np.ndarray]:
     """(forward, left) unit vectors on the floor for a body facing ``facing``."""
-    forward = np.array([math.cos(facing), 0.0, math.sin(facing)])
-    return forward, np.cross(UP, forward)
+    cos, sin = math.cos(facing), math.sin(facing)
+    return np.array([cos, 0.0, sin]), np.array([sin, 0.0, -cos])  # left = UP x forward
 
 
 def skeleton(build: Build, pose: Pose) -> np.ndarray:
@@ -137,9 +137,15 @@ class Camera:
                 math.sin(self.yaw) * math.cos(self.pitch),
             ]
         )
-        right = np.cross(look, UP)
+        right = np.array([-look[2], 0.0, look[0]])  # look x UP
         right /= np.linalg.norm(right)
-        up = np.cross(right, look)
+        up = np.array(
+            [
+                right[1] * look[2] - right[2] * look[1],
+                right[2] * look[0] - right[0] * look[2],
+                right[0] * look[1] - right[1] * look[0],
+            ]
+        )
         rel = points - self.position
         xc, yc, zc = rel @ right, rel @ up, rel @ look
         focal = self.width / (2 * math.tan(self.fov / 2))
