@@ -6,7 +6,8 @@ standing figure of tests/kiosk/camera/data, scaled into a 640x480 and a 320x240 
 memory before the import and after ``--frames`` frames; ``cpu_ms_per_frame`` processor time per frame
 while tracking (video mode: the detector runs only when tracking is lost) and with the detector on
 every frame (still mode), median of ``--frames``. ``install_mb``: the files of the distributions
-the camera brings that the kiosk did not have before (:data:`ADDED`). The kiosk's start with the camera channel is measured by bench/startup.py.
+the camera brings that the kiosk did not have before (:data:`ADDED`). The kiosk's start with the
+camera channel is measured by bench/startup.py.
 Prints JSON. Run: uv run python bench/camera_cost.py [--frames 60]
 """
 
