@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from kiosk.core.channels import Channel, ChannelState, ChannelStatus, InputSource
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus, InputSource, Sink
 from kiosk.ui.options import run_parser
 
 if TYPE_CHECKING:
@@ -73,7 +73,7 @@ def build_app(
         raise SetupError(str(error)) from None
     statuses: list[ChannelStatus] = []
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
-    sources += _camera(statuses)
+    sources.append(_LateCamera())
     channels = KioskChannels(
         speaker=_speaker() if voice else None,
         voice=_voice_in(config, voice, statuses),
@@ -98,14 +98,31 @@ def _in_force(config: Config) -> InForce:
     return in_force_of(config)
 
 
-def _camera(statuses: list[ChannelStatus]) -> list[InputSource]:
-    """The camera channel when this machine has a camera and the pose model, else its status off
-    with why (the kiosk runs as without it). It opens the camera after the first frame."""
-    from kiosk.camera import camera_channel, camera_status
+class _LateCamera:
+    """The camera channel, looked for only when the app starts its channels (after the first frame):
+    nothing of :mod:`kiosk.camera` loads before the welcome. Without a camera or the pose model it
+    reports the camera off with why, and the kiosk runs as without it."""
 
-    statuses.append(camera_status())
-    channel = camera_channel()
-    return [channel] if channel is not None else []
+    name = "camera"
+
+    def __init__(self) -> None:
+        self._channel: Any = None
+        self._stopped = False
+
+    def start(self, sink: Sink) -> None:
+        from kiosk.camera import camera_channel, camera_status
+
+        status = camera_status()
+        sink(status)
+        if status.state is not ChannelState.OFF and not self._stopped:
+            self._channel = camera_channel()
+            if self._channel is not None:
+                self._channel.start(sink)
+
+    def stop(self) -> None:
+        self._stopped = True
+        if self._channel is not None:
+            self._channel.stop()
 
 
 def _remotes(
