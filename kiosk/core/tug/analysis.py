@@ -50,6 +50,7 @@ SEATED_LEVEL = 0.03
 #: seated again: the hips' height over the ankles at the end within this of the start (torso lengths;
 #: standing is about 0.65 higher)
 SAME_SEAT = 0.3
+LANDED_SPEED = 0.2
 #: pauses shorter than this between tries of a hesitant start belong to the movement
 HESITATION_S = 3.0
 #: a plausible total (seconds) and sit-to-stand (seconds)
@@ -162,7 +163,10 @@ def _measure(
     lift = smooth(fill_gaps(t, s.lift), max(3, round(0.2 * fps)) | 1)
     seen = np.flatnonzero(s.legs)
     first, last = int(seen[0]), int(seen[-1])
-    start = _posture(t, s, lift, first, index_at(t, t[first] + REST_S), 1, fps)
+    rest_until = t[first] + REST_S
+    if sequence.go_t is not None:  # no one rises within 0.2 s of Go: a short rest before it is rest
+        rest_until = max(t[first] + 0.3, min(rest_until, sequence.go_t + 0.2))
+    start = _posture(t, s, lift, first, index_at(t, rest_until), 1, fps)
     if start is None:
         raise _Refused("the patient never stands up")
     end = _posture(t, s, lift, max(first, index_at(t, t[last] - REST_S)), last, -1, fps)
@@ -184,7 +188,7 @@ def _measure(
     seated_t = crossing(t, end.level, max(3 * end.noise, SEATED_LEVEL), index_at(t, down), 1)
     if seated_t is None:
         raise _Refused("the patient does not sit still at the end")
-    found["seated_t"] = seated_t
+    found["seated_t"] = _landing(t, end.level, down, seated_t)
     stood = crossing(t, start.level, 0.85, index_at(t, up), 1)
     sat = crossing(t, end.level, 0.85, index_at(t, down), -1)
     found["stood_t"] = stood if stood is not None else up
@@ -223,6 +227,19 @@ def _posture(t: np.ndarray, s: Signals, lift: np.ndarray, a: int, b: int, way: i
     standing = float(np.max(rise[lo : hi + 1]))
     scale = standing - seated
     return _Posture(seated=seated, noise=noise / scale, level=(rise - seated) / scale, rest=(a, b), torso=torso)
+
+
+def _landing(t: np.ndarray, level: np.ndarray, down: float, near: float) -> float:
+    """When the hips stop on the seat: the descent's speed falling below :data:`LANDED_SPEED` of its
+    peak, within half a second of ``near`` (the hips near the seat's height; a slow descent gets
+    there before it lands, a noisy one crosses its wider band early)."""
+    speed = -np.gradient(level, t)
+    a, b = index_at(t, down - 1.0), index_at(t, near + 0.5)
+    peak = a + int(np.argmax(speed[a : b + 1]))
+    landed = crossing(t, speed, LANDED_SPEED * float(speed[peak]), peak, 1)
+    if landed is None or not near - 0.5 <= landed <= near + 0.5:
+        return near
+    return landed
 
 
 def _onset(t: np.ndarray, s: Signals, start: _Posture, first: int, up: float, fps: float) -> tuple[float, float | None]:
