@@ -93,7 +93,7 @@ CSV_COLUMNS = ("result_id", "patient_id", "effective", "method", "measure", "sec
 def tug_csv_rows(time: TugTime) -> list[tuple[str, ...]]:
     """Long-format rows (:data:`CSV_COLUMNS`): the total, then one row per phase."""
     base = (time.result_id, time.patient_id, time.effective, time.method)
-    rows = [(*base, "total", f"{time.total_s:.2f}", time.accepted_by)]
+    rows: list[tuple[str, ...]] = [(*base, "total", f"{time.total_s:.2f}", time.accepted_by)]
     rows += [(*base, p.name, f"{p.duration_s:.2f}", time.accepted_by) for p in time.phases]
     return rows
 
