@@ -41,8 +41,9 @@ MIN_RISE = 0.35
 ONSET_LEVEL = 0.12
 ONSET_MOVED = 0.08
 ONSET_LEAN = 0.2
-#: a movement this large (a share of the smallest that starts the test) before the start: unclear start
-STIRRED = 0.8
+#: a movement this large for half a second (a share of the smallest that starts the test) before
+#: the start: unclear start
+STIRRED = 0.35
 #: ...and where it began: back down to the rest's level plus this share of that smallest movement
 ONSET_FLOOR = 0.3
 #: seated again: the hips within this share of the rise (or three times the rest's noise) of the seat
@@ -280,7 +281,10 @@ def _onset(t: np.ndarray, s: Signals, start: _Posture, first: int, up: float, fp
     if onset is None:
         return float(t[first]), None
     # an earlier movement that did not lead to standing: the start cannot be told without Go
-    early = np.flatnonzero((motion > STIRRED) & (t > t[rest_end]) & (t < onset - 0.2))
+    # (held for half a second: a try a frontal view barely sees lasts that long, the rest's jitter
+    # does not; the smoothing spreads the rise itself back, hence a second clear of it)
+    sustained = smooth(motion, max(3, round(0.5 * fps)) | 1)
+    early = np.flatnonzero((sustained > STIRRED) & (t > t[rest_end] + 0.25) & (t < onset - 1.0))
     return onset, float(t[early[0]]) if len(early) else None
 
 
