@@ -23,6 +23,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "devices": ("kiosk.commands.devices", "list remotes (HID, serial) and audio inputs, and what the kiosk would use"),
     "pin": ("kiosk.commands.pin", "set the clinician PIN (`kiosk pin set`; stored hashed in the configuration)"),
     "models": ("kiosk.speech.models", "install and list speech-recognition models"),
+    "tug": ("kiosk.commands.tug", "Timed Up and Go from pose-landmarks files: analyse them, generate test ones"),
     "qos": ("kiosk.commands.qos", "QoS tools: replay a context trace, print a session's trace"),
     "station": ("station.cli", "the ward station web app (kiosks report to it; staff watch and validate)"),
 }

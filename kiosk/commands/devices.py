@@ -1,7 +1,8 @@
 """`kiosk devices`: what input hardware this machine has, and what the kiosk would use.
 
 Lists the remote profiles and, for each, the device the kiosk would take; every HID device
-(hidapi) and serial port (pyserial, plus anything a profile's glob matches); and the audio inputs.
+(hidapi) and serial port (pyserial, plus anything a profile's glob matches); the audio inputs; and
+the cameras (Video4Linux nodes, /dev/video*) with whether the pose model is installed.
 Only looks: no port or device is opened, so it is safe to run beside a running kiosk.
 """
 
@@ -30,7 +31,8 @@ from kiosk.remote.serial import matching_ports
 def main(argv: list[str]) -> int:
     """Print the devices report; exit status 2 if the profile file is unusable."""
     parser = argparse.ArgumentParser(
-        prog="kiosk devices", description="List remotes (HID, serial) and audio inputs, and what the kiosk would use."
+        prog="kiosk devices",
+        description="List remotes (HID, serial), audio inputs and cameras, and what the kiosk would use.",
     )
     parser.add_argument(
         "--profiles",
@@ -79,7 +81,25 @@ def main(argv: list[str]) -> int:
     print("\nAudio inputs:")
     for line in _audio_lines():
         print(f"  {line}")
+
+    print("\nCameras:")
+    for line in _camera_lines():
+        print(f"  {line}")
     return 0
+
+
+def _camera_lines() -> list[str]:
+    from kiosk.camera import list_cameras, model_problem
+
+    cameras = list_cameras()
+    problem = model_problem()
+    if not cameras:
+        return ["no camera (the kiosk runs without one; the Timed Up and Go needs one)"]
+    use = f"not used: {problem}" if problem else "would use, with MediaPipe Pose (full model)"
+    return [
+        f"{c.device} {c.name} -> " + (use if n == 0 else "not used (the first camera is)")
+        for n, c in enumerate(cameras)
+    ]
 
 
 def _hid_devices() -> tuple[list[HidDeviceInfo], str]:

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from kiosk.core.channels import Channel, ChannelState, ChannelStatus, InputSource
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus, InputSource, Sink
 from kiosk.ui.options import run_parser
 
 if TYPE_CHECKING:
@@ -73,6 +73,7 @@ def build_app(
         raise SetupError(str(error)) from None
     statuses: list[ChannelStatus] = []
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
+    sources.append(_LateCamera())
     channels = KioskChannels(
         speaker=_speaker() if voice else None,
         voice=_voice_in(config, voice, statuses),
@@ -95,6 +96,33 @@ def _in_force(config: Config) -> InForce:
     from kiosk.export.opening import in_force_of
 
     return in_force_of(config)
+
+
+class _LateCamera:
+    """The camera channel, looked for only when the app starts its channels (after the first frame):
+    nothing of :mod:`kiosk.camera` loads before the welcome. Without a camera or the pose model it
+    reports the camera off with why, and the kiosk runs as without it."""
+
+    name = "camera"
+
+    def __init__(self) -> None:
+        self._channel: Any = None
+        self._stopped = False
+
+    def start(self, sink: Sink) -> None:
+        from kiosk.camera import camera_channel, camera_status
+
+        status = camera_status()
+        sink(status)
+        if status.state is not ChannelState.OFF and not self._stopped:
+            self._channel = camera_channel()
+            if self._channel is not None:
+                self._channel.start(sink)
+
+    def stop(self) -> None:
+        self._stopped = True
+        if self._channel is not None:
+            self._channel.stop()
 
 
 def _remotes(

@@ -25,6 +25,8 @@ class Channel(str, Enum):
     TOUCH = "touch"
     REMOTE = "remote"
     KEYBOARD = "keyboard"
+    #: sees, gives no answers: pose landmarks and presence (kiosk.camera)
+    CAMERA = "camera"
 
 
 class Command(str, Enum):

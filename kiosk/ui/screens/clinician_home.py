@@ -12,10 +12,12 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import DataTable, Switch
 
+from kiosk.core.channels import ChannelState
 from kiosk.core.session import Phase
 from kiosk.export.captured import questionnaire_of, result_line
 from kiosk.store.records import SessionSummary
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
+from kiosk.ui.widgets.channel_board import CAMERA
 from kiosk.ui.widgets.literal import Button, Label, Static, cell
 
 #: how often the running session's line is redrawn (seconds)
@@ -192,9 +194,17 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def _channels_text(self) -> str:
         lines = self.kiosk.board.lines("en", patient=False)
-        return "Channels: " + "; ".join(
-            f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
-            for line in lines
+        state, reason = self.kiosk.board.state(CAMERA)
+        camera = (
+            "camera on" if state is ChannelState.ON else f"camera {state.value}" + (f" ({reason})" if reason else "")
+        )
+        return (
+            "Channels: "
+            + "; ".join(
+                f"{line.name} {line.state}" + (f" ({line.reason})" if line.reason and not line.live else "")
+                for line in lines
+            )
+            + f"; {camera}"
         )
 
     @on(Button.Pressed, "#continue")

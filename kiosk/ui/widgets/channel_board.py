@@ -14,6 +14,8 @@ from kiosk.ui.widgets.text import ui_text
 #: the indicators in display order: voice out, voice in, remote, touch
 VOICE_OUT, VOICE_IN, REMOTE, TOUCH = "voice_out", "voice_in", "remote", "touch"
 _ORDER = (VOICE_OUT, VOICE_IN, REMOTE, TOUCH)
+#: the camera: on the clinician screen only (it takes no answers, so the patient's bar leaves it out)
+CAMERA = "camera"
 #: when no source of a channel is on, the most hopeful state wins
 _PRIORITY = (ChannelState.CONNECTING, ChannelState.LOST, ChannelState.OFF)
 
@@ -25,7 +27,7 @@ class ChannelBoard:
         """``voice_out_source`` is the source name voice-out statuses carry (e.g. "espeak-ng");
         every other voice status is about voice in."""
         self._voice_out_source = voice_out_source
-        self._statuses: dict[str, dict[str, ChannelStatus]] = {name: {} for name in _ORDER}
+        self._statuses: dict[str, dict[str, ChannelStatus]] = {name: {} for name in (*_ORDER, CAMERA)}
         self._statuses[TOUCH]["screen"] = ChannelStatus(Channel.TOUCH, ChannelState.ON, "screen")
         self.speaking = False
         self.listening = False
@@ -34,7 +36,7 @@ class ChannelBoard:
         """Which indicator a status belongs to."""
         if status.channel is Channel.VOICE:
             return VOICE_OUT if status.source == self._voice_out_source else VOICE_IN
-        return {Channel.REMOTE: REMOTE, Channel.TOUCH: TOUCH}.get(status.channel, TOUCH)
+        return {Channel.REMOTE: REMOTE, Channel.TOUCH: TOUCH, Channel.CAMERA: CAMERA}.get(status.channel, TOUCH)
 
     def update(self, status: ChannelStatus) -> None:
         """Remember the latest status of its source."""

@@ -15,7 +15,7 @@ from kiosk.core.channels import ChannelState
 from kiosk.core.session import Phase
 from kiosk.ui.app import KIOSK_SIZE
 from kiosk.ui.serve import server as serve
-from kiosk.ui.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT
+from kiosk.ui.widgets.channel_board import CAMERA, REMOTE, VOICE_IN, VOICE_OUT
 
 #: real threads probe real devices and load a speech model: allow them this long
 PATIENCE_S = 30.0
@@ -31,10 +31,10 @@ async def test_a_fresh_kiosk_starts_a_session_with_whatever_channels_it_has(tmp_
             # every channel has said what it is (on, or off with a reason) -- whatever this machine has
             while time.monotonic() < deadline and not all(
                 app.board.state(name)[0] is ChannelState.ON or app.board.state(name)[1]
-                for name in (VOICE_OUT, VOICE_IN, REMOTE)
+                for name in (VOICE_OUT, VOICE_IN, REMOTE, CAMERA)
             ):
                 await asyncio.sleep(0.05)  # waiting on real device threads, bounded by PATIENCE_S
-            for name in (VOICE_OUT, VOICE_IN, REMOTE):
+            for name in (VOICE_OUT, VOICE_IN, REMOTE, CAMERA):
                 state, reason = app.board.state(name)
                 assert state is ChannelState.ON or reason, f"{name} is {state.value} without a reason"
             await pilot.press("1")
