@@ -16,7 +16,8 @@ from kiosk.camera.channel import CameraChannel, PoseReading, PoseRecorder
 from kiosk.camera.frames import CameraInfo, CameraUnavailable, Frame, FrameSource, OpenCvCamera, list_cameras
 from kiosk.camera.pose import MediapipePose, ModelUnavailable, PoseEstimator, model_problem
 from kiosk.camera.presence import Presence
-from kiosk.core.channels import Channel, ChannelState, ChannelStatus
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus, PresenceSource, Sink
+from kiosk.core.channels import Presence as PresenceReport
 
 __all__ = [
     "CameraChannel",
@@ -34,6 +35,7 @@ __all__ = [
     "camera_channel",
     "camera_status",
     "list_cameras",
+    "presence_reports",
 ]
 
 
@@ -58,3 +60,14 @@ def camera_channel(
         return None
     device = list_cameras()[0].device
     return CameraChannel(lambda: OpenCvCamera(device), MediapipePose, on_pose=on_pose, on_presence=on_presence)
+
+
+def presence_reports(sink: Sink) -> Callable[[bool], None]:
+    """An ``on_presence`` listener that hands each debounced change to the session's sink as the
+    core's presence report (called on the camera's thread; the sink posts to the UI thread)."""
+
+    def report(seen: bool) -> None:
+        detail = "in front of the camera" if seen else "nobody in front of the camera"
+        sink(PresenceReport(seen, PresenceSource.CAMERA, detail))
+
+    return report

@@ -110,12 +110,12 @@ class _LateCamera:
         self._stopped = False
 
     def start(self, sink: Sink) -> None:
-        from kiosk.camera import camera_channel, camera_status
+        from kiosk.camera import camera_channel, camera_status, presence_reports
 
         status = camera_status()
         sink(status)
         if status.state is not ChannelState.OFF and not self._stopped:
-            self._channel = camera_channel()
+            self._channel = camera_channel(on_presence=presence_reports(sink))
             if self._channel is not None:
                 self._channel.start(sink)
 

@@ -8,8 +8,17 @@ import queue
 
 import numpy as np
 
-from kiosk.camera import CameraChannel, CameraUnavailable, Frame, ModelUnavailable, PoseRecorder, Presence
-from kiosk.core.channels import Channel, ChannelState, ChannelStatus
+from kiosk.camera import (
+    CameraChannel,
+    CameraUnavailable,
+    Frame,
+    ModelUnavailable,
+    PoseRecorder,
+    Presence,
+    presence_reports,
+)
+from kiosk.core.channels import Channel, ChannelState, ChannelStatus, PresenceSource
+from kiosk.core.channels import Presence as PresenceReport
 from kiosk.core.tug.families import generate
 from kiosk.core.tug.landmarks import PoseFrame
 
@@ -105,3 +114,32 @@ def test_stop_ends_the_thread_between_frames():
     channel.stop()
     channel.join(WAIT_S)
     assert not channel._thread.is_alive()
+
+
+def test_a_patient_who_leaves_the_frame_reaches_the_session_as_away_then_back():
+    """What the kiosk's session receives from the camera: a core presence report per debounced
+    change, from the camera's thread, in the order the frames showed it."""
+    sequence, _ = generate("normal", 3)
+    person = sequence.frames[0].landmarks
+    frames = [PoseFrame(t=i / 10, landmarks=None if 20 <= i < 60 else person) for i in range(90)]
+    got: queue.Queue = queue.Queue()
+    sink = got.put
+    channel = CameraChannel(
+        lambda: Stills([f.t for f in frames]),
+        lambda: Replayed(frames),
+        on_presence=presence_reports(sink),
+        presence=Presence(away_s=1.0, back_s=0.5),
+    )
+    channel.start(sink)
+    channel.join(WAIT_S)
+    reports = []
+    while not got.empty():
+        item = got.get()
+        if isinstance(item, PresenceReport):
+            reports.append(item)
+    assert [(r.seen, r.source) for r in reports] == [
+        (True, PresenceSource.CAMERA),
+        (False, PresenceSource.CAMERA),
+        (True, PresenceSource.CAMERA),
+    ]
+    assert reports[1].detail == "nobody in front of the camera"
