@@ -95,6 +95,15 @@ LEAD_INS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["lead
 #: "I don't know" have somewhere to go other than the nearest answer; they match nothing
 FILLERS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["fillers"])
 
+#: words that turn a reply into a "no" wherever they are heard ("that's not what I said", "no I
+#: said two"): a "yes" to "Is that right?" whose hearing holds one is never taken as said
+NEGATIONS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["negations"])
+
+#: ways of asking for help that answer a question rather than call anyone ("I need a bit of
+#: help"): an option a patient chooses by saying "help" takes them all; on a question with no
+#: such option they are heard as no answer, never as "I need a doctor" (issue 33)
+HELP_WORDS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["help_words"])
+
 #: what recognisers emit for sounds outside their grammar
 UNKNOWN_TOKENS = frozenset({"[unk]", "<unk>"})
 
@@ -104,6 +113,12 @@ def normalise(text: str) -> str:
     decomposed = unicodedata.normalize("NFKD", text.casefold())
     plain = "".join(c for c in decomposed if not unicodedata.combining(c))
     return " ".join(re.sub(r"[^\w\[\]]+", " ", plain).split())
+
+
+def heard_negation(text: str, language: str) -> bool:
+    """Whether ``text`` holds one of ``language``'s negations as whole words ("isn't" too)."""
+    tokens = _tokens(text)
+    return any(_find(_tokens(word), tokens) >= 0 for word in NEGATIONS[language])
 
 
 def spoken_label(label: str) -> str:
@@ -153,9 +168,10 @@ def _is_word(label: str, which: int, language: str) -> bool:
 
 
 def _with_known_words(option: OptionWords, language: str) -> OptionWords:
-    """An option the kiosk itself offers, with the natural ways of saying it: Yes or No (a
-    confirmation; No also takes the "that's wrong" phrases), Start, or a language's name (the
-    welcome, where the option in the prompt's own language also takes "start")."""
+    """An option with the natural ways of saying it: Yes or No (a confirmation; No also takes
+    the "that's wrong" phrases), Start, a language's name (the welcome, where the option in the
+    prompt's own language also takes "start"), or an option chosen by saying "help", which takes
+    every way of asking for a bit of help (:data:`HELP_WORDS`)."""
     extra: tuple[str, ...] = ()
     label = normalise(spoken_label(option.label))
     for which in (0, 1):
@@ -163,6 +179,8 @@ def _with_known_words(option: OptionWords, language: str) -> OptionWords:
             extra = YES_NO[language][which] + (COMMAND_PHRASES[language][Command.UNDO] if which else ())
     if label in {normalise(w) for w in START_WORDS[language][:2]}:
         extra = START_WORDS[language]
+    if normalise(HELP_WORDS[language][0]) in {label, *map(normalise, option.synonyms)}:
+        extra += HELP_WORDS[language]  # "I need a bit of help" is this answer, not a call
     words = set(label.split())
     for named, names in LANGUAGE_NAMES.items():
         if words & {normalise(n) for n in names if " " not in n}:
@@ -270,9 +288,12 @@ class Matcher:
         return () if self.yes_no or self._few_commands else LEAD_INS[self.language]
 
     def fillers(self) -> tuple[str, ...]:
-        """Non-answers the grammar holds so they are not forced onto an answer (:data:`FILLERS`),
-        without any that would mean something here ("no" where no is an answer)."""
-        return tuple(f for f in FILLERS[self.language] if not self.match(f).matched)
+        """Non-answers the grammar holds so they are not forced onto an answer (:data:`FILLERS`,
+        and the ways of asking for help where no option is chosen by them, so that "I need a bit
+        of help" is not forced onto "I need a doctor"), without any that would mean something
+        here ("no" where no is an answer)."""
+        others = (*FILLERS[self.language], *HELP_WORDS[self.language])
+        return tuple(dict.fromkeys(f for f in others if not self.match(f).matched))
 
     def meaning(self, phrase: str) -> int | Command | str:
         """What saying ``phrase`` selects: an option number, a command, or else the phrase itself
