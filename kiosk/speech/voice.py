@@ -219,7 +219,8 @@ class VoiceChannel:
                 scored=scored,
                 welcome=getattr(prompt, "kind", "") in ("welcome", "message"),
                 key=getattr(prompt, "key", None),
-                confirming=getattr(prompt, "kind", "") == "confirm",
+                # "Is that right?", and "Shall I call the nurse?": the same rules for a spoken yes
+                confirming=getattr(prompt, "kind", "") in ("confirm", "call"),
             )
 
     def set_question(

@@ -49,12 +49,17 @@ def phase_screen(phase: Phase) -> type[PatientScreen]:
     raise ValueError(f"no screen for the phase {phase!r}")
 
 
-def _overlay_screen(halted: bool, paused: bool) -> type[PatientScreen] | None:
-    """The screen over the phase's one: the doctor called, or paused (imported when first shown)."""
+def _overlay_screen(halted: bool, paused: bool, calling: bool = False) -> type[PatientScreen] | None:
+    """The screen over the phase's one: the doctor called, "Shall I call the nurse?" after a call
+    heard by voice, or paused (imported when first shown)."""
     if halted:
         from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 
         return DoctorCalledScreen
+    if calling:
+        from kiosk.ui.screens.call_confirm import CallConfirmScreen
+
+        return CallConfirmScreen
     if paused:
         from kiosk.ui.screens.paused import PausedScreen
 
@@ -79,7 +84,7 @@ class PatientStage:
         calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff."""
         app, snap = self.app, view.snapshot
         base_cls = phase_screen(snap.phase)
-        overlay_cls = _overlay_screen(snap.halted, snap.paused)
+        overlay_cls = _overlay_screen(snap.halted, snap.paused, snap.calling is not None)
         if out_of_order:
             from kiosk.ui.screens.out_of_order import OutOfOrderScreen
 

@@ -56,6 +56,7 @@ screen renders), :mod:`.state` (the one shared state), :mod:`.timers` (the attem
 shown and said), :mod:`.opening` (welcome, start, language, explanation), :mod:`.questions`
 (attempts, answers, time-outs, finish), :mod:`.corrections` (confirm an unsure answer, undo the
 last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor, presence),
+:mod:`.calls` (a call heard by voice asked back: "Shall I call the nurse?"),
 :mod:`.live` (live adaptation), :mod:`.routing` (which step takes an input or a time-out),
 :mod:`.resume` (continuing a stored session), :mod:`.ports` (what it needs of the engine and the
 store) and :mod:`.core` (the :class:`Session` that owns them).
@@ -72,8 +73,10 @@ from kiosk.core.session.events import (
     AttemptOpened,
     AttemptTimedOut,
     ConfirmationAsked,
+    DoctorCallAsked,
     DoctorCallCancelled,
     DoctorCalled,
+    DoctorCallNotConfirmed,
     DoctorContinued,
     Finished,
     IgnoreReason,
@@ -113,8 +116,10 @@ __all__ = [
     "AttemptOpened",
     "AttemptTimedOut",
     "ConfirmationAsked",
+    "DoctorCallAsked",
     "DoctorCallCancelled",
     "DoctorCalled",
+    "DoctorCallNotConfirmed",
     "DoctorContinued",
     "Finished",
     "IgnoreReason",

@@ -16,9 +16,10 @@ import uuid
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from kiosk.core.channels import Channel, ChannelInput
+from kiosk.core.channels import Channel, ChannelInput, Command
 from kiosk.core.clock import Clock
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
+from kiosk.core.session.calls import CallConfirmation
 from kiosk.core.session.corrections import Corrections
 from kiosk.core.session.events import AnsweredBy, Phase
 from kiosk.core.session.incidents import Incidents
@@ -105,6 +106,7 @@ class Session:
         self.prompts = prompts = Prompts(state, timers, out)
         self.live = LiveAdaptation(state, timers, out, prompts, store=store)
         self.incidents = Incidents(state, timers, out, prompts)
+        self.calls = CallConfirmation(state, timers, out, prompts, call_doctor=self.incidents.call_doctor)
         self.flow = flow = QuestionFlow(
             state,
             timers,
@@ -139,6 +141,7 @@ class Session:
             corrections=self.corrections,
             practice=practice,
             incidents=self.incidents,
+            calls=self.calls,
         )
 
     # -- construction from a stored, unfinished session -----------------------------------------
@@ -313,7 +316,8 @@ class Session:
             interlude=state.interlude(self.timers.kind),
             **self.practice.progress(),
             confirming=open_.unconfirmed.option if open_ and open_.unconfirmed else None,
-            can_undo=self.corrections.can_undo() and not self.timers.frozen,
+            can_undo=self.corrections.can_undo() and not self.timers.frozen and state.call is None,
+            calling=state.call.text if state.call is not None else None,
         )
 
     # -- inputs ------------------------------------------------------------------------------------
@@ -401,9 +405,13 @@ class Session:
             self.incidents.resume(t)
 
     def call_doctor(self, channel: Channel | None = None) -> None:
-        """Call the doctor: the session halts until :meth:`clinician_continue`."""
+        """Call the doctor: the session halts until :meth:`clinician_continue` (a call by voice
+        comes through :meth:`handle`, and is asked back: :mod:`kiosk.core.session.calls`)."""
         with self._operation() as t:
-            self.incidents.call_doctor(t, channel)
+            if self.state.call is not None:  # pressed while "Shall I call the nurse?" is asked
+                self.calls.call(t, ChannelInput(channel or Channel.TOUCH, command=Command.CALL_DOCTOR))
+            else:
+                self.incidents.call_doctor(t, channel)
 
     def clinician_continue(self) -> None:
         """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left."""

@@ -87,6 +87,7 @@ class Prompts:
             or state.phase in (Phase.EXPLANATION, Phase.REST)
             or state.current_attempt is not None
             or state.can_undo(self.timers.kind)
+            or state.call is not None  # "Shall I call the nurse?" is answered by voice too
         )
         listening = wanted and not self.timers.frozen and "voice_off" not in state.active_adaptations()
         if listening != state.listening:

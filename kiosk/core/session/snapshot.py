@@ -65,3 +65,6 @@ class Snapshot:
     confirming: int | None = None
     #: "Change my answer" can be offered: the thank-you gap after an answer is running
     can_undo: bool = False
+    #: "Shall I call the nurse?" (its text) while a call heard by voice waits for Yes or No
+    #: (options 1 and 2); None otherwise
+    calling: str | None = None

@@ -32,6 +32,21 @@ class Unconfirmed:
 
 
 @record(frozen=False)
+class HeardCall:
+    """A call for the doctor heard by voice, waiting for "Shall I call the nurse?" Yes or No."""
+
+    #: what was heard, and how sure the recogniser was
+    detail: str
+    confidence: float | None
+    #: the time-out pending when it was heard (kind, seconds left): put back once it is answered
+    pending: tuple[str, float] | None
+    #: "Shall I call the nurse?" as asked (the prompt's text), in the patient's language
+    text: str = ""
+    #: a spoken "yes" came too unsure: the patient is asked to press Yes or No
+    press: bool = False
+
+
+@record(frozen=False)
 class OpenQuestion:
     """The question currently on screen: a scored item or a practice question."""
 
@@ -114,6 +129,8 @@ class SessionState:
     voice_out_available: bool = True
     #: ids of the practice questions skipped before they were shown
     practice_unasked: set[str] = field(default_factory=set)
+    #: a call for the doctor heard by voice, waiting for Yes or No (see kiosk.core.session.calls)
+    call: HeardCall | None = None
     #: the latest prompt published
     prompt: Prompt | None = None
     #: a repeated prompt is being given: TestState is REPEATING until anything else happens

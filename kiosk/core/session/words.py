@@ -40,3 +40,8 @@ REST_TEXT: Mapping[str, str] = Table(lambda words: words.screen["rest"])
 
 #: the rest screen's one option
 CONTINUE_LABEL: Mapping[str, str] = Table(lambda words: words.screen["rest_continue"])
+
+#: "Shall I call the nurse?" after a call heard by voice, and the same asking for a press
+CALL_CONFIRM: Mapping[str, tuple[str, str]] = Table(
+    lambda words: (words.screen["call_confirm"], words.screen["call_confirm_press"])
+)
