@@ -13,6 +13,7 @@ from typing import Any
 
 from textual.app import App
 
+from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Phase, Session
 from kiosk.ui.channels import KioskChannels
@@ -125,7 +126,7 @@ def patient_view(
     snap = session.snapshot()
     # the session lifts voice_off when voice in goes; checked here too so the button never
     # promises listening that cannot happen (and not over Continue while paused)
-    voice_again = "voice_off" in snap.adaptations and not (snap.paused or snap.halted) and channels.on(VOICE_IN)
+    voice_again = bool(VOICE_OFF & snap.adaptations) and not (snap.paused or snap.halted) and channels.on(VOICE_IN)
     question = snap.item or snap.practice
     hint = len(question.options) if channels.no_such_option and question is not None else None
     return PatientView(

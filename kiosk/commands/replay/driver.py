@@ -18,6 +18,7 @@ from kiosk.core.channels import ChannelInput, Command
 from kiosk.core.clock import SimClock
 from kiosk.core.qos_model import DEFAULT_MODEL
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
+from kiosk.core.room import RoomHearing
 from kiosk.core.session import (
     AdaptationChanged,
     AnswerRecorded,
@@ -220,6 +221,8 @@ class _Driver:
             self.session.clinician_continue()
         elif step.kind == "person_lost":
             self.session.person_lost()
+        elif step.kind == "unheard":
+            self.session.voice_unheard("the script: speech the voice channel could not take")
         elif step.kind == "person_back":
             self.session.person_back()
         self._try_arm(index)
@@ -331,6 +334,7 @@ def run_script(
         adaptation=Adaptation(policy or load_policy(model=loaded)) if script.adaptation else None,
         familiarisation=script.practice is not None,
         visit=visit,
+        room=RoomHearing(),  # a replay stands in a room of its own, heard from scratch
     )
     driver = _Driver(script, session, clock)
     try:
@@ -384,6 +388,7 @@ def run_battery(
             "store": store,
             "timing": first.timing,
             "adaptation": Adaptation(policy or load_policy(model=loaded[model])) if first.adaptation else None,
+            "room": RoomHearing(),
         },
     )
     results: list[ReplayResult] = []

@@ -49,12 +49,15 @@ class CallConfirmation:
         prompts: Prompts,
         *,
         call_doctor: Callable[[float, Channel | None, ChannelInput | None], None],
+        heard: Callable[[float, bool], None] = lambda t, worked: None,
     ) -> None:
         self.state = state
         self.timers = timers
         self.out = out
         self.prompts = prompts
         self._call_doctor = call_doctor
+        #: a voice hearing's outcome, for the room's measure (kiosk.core.room)
+        self._heard = heard
 
     def call(self, t: float, event: ChannelInput) -> None:
         """A call for the doctor: by voice asked back (the second hearing makes it); any other
@@ -72,7 +75,7 @@ class CallConfirmation:
         """An answer number while "Shall I call the nurse?" is asked: 1 Yes, 2 No."""
         call = self.state.call
         assert call is not None
-        if event.channel is Channel.VOICE and "voice_off" in self.state.active_adaptations():
+        if event.channel is Channel.VOICE and self.state.voice_off():
             self.out.ignore(t, event, IgnoreReason.VOICE_OFF)
         elif event.option == NO:
             self._not_made(t, "declined", event.channel)
@@ -115,7 +118,7 @@ class CallConfirmation:
         assert call is not None
         lang = state.language
         asking, pressing = CALL_CONFIRM.get(lang, CALL_CONFIRM["en"])
-        voice_failing = "voice_off" in state.active_adaptations() or not state.voice_available
+        voice_failing = state.voice_off() or not state.voice_available
         call.text = pressing if call.press or voice_failing else asking
         words = CONFIRM_WORDS.get(lang, CONFIRM_WORDS["en"])
         options = tuple(PromptOption(number, label, synonyms, None) for number, (label, synonyms) in words.items())
@@ -126,6 +129,7 @@ class CallConfirmation:
     def _make(self, t: float, event: ChannelInput, how: str) -> None:
         call = self._end(t)
         self.out.log(t, "doctor_call_confirmed", f"voice {call.detail!r}: {how}")
+        self._heard(t, True)
         self._call_doctor(t, Channel.VOICE, event)
 
     def _not_made(self, t: float, why: str, channel: Channel | None) -> None:
@@ -133,6 +137,7 @@ class CallConfirmation:
         by = f" by {channel.value}" if channel is not None else ""
         self.out.log(t, f"doctor_call_{why}", f"voice {call.detail!r}: not called{by}")
         self.out.emit(DoctorCallNotConfirmed(t, why, channel))
+        self._heard(t, False)
         if self.state.prompt is not None:  # what was on screen is asked again (the voice's grammar too)
             self.prompts.publish(replace(self.state.prompt, t=t, repeat=True))
         self.prompts.update_listening(t)

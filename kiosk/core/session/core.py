@@ -19,6 +19,7 @@ from typing import Any
 from kiosk.core.channels import Channel, ChannelInput, Command
 from kiosk.core.clock import Clock
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
+from kiosk.core.room import RoomHearing
 from kiosk.core.session.calls import CallConfirmation
 from kiosk.core.session.corrections import Corrections
 from kiosk.core.session.events import AnsweredBy, Phase
@@ -52,6 +53,8 @@ class Session:
     :mod:`kiosk.core.session.battery`); a later instrument starts with the rest screen.
     ``visit`` says how the visit began (``kiosk.core.visits``: an order, staff, a walk-up); it is
     logged at the start, in the start's transaction, so the result is always marked.
+    ``room`` (:class:`kiosk.core.room.RoomHearing`, shared by a kiosk's sessions) is how well voice
+    is heard where the kiosk stands; its voice hearings feed it (None: not measured).
     """
 
     def __init__(
@@ -74,6 +77,7 @@ class Session:
         resume_not_answered: tuple[str, ...] = (),
         visit: str | None = None,
         battery: BatteryPlace | None = None,
+        room: RoomHearing | None = None,
     ) -> None:
         if language not in questionnaire.languages:
             raise ValueError(f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
@@ -104,20 +108,19 @@ class Session:
         self.timers = timers = AttemptClock(clock, clock.now() - t_offset)
         self.out = out = Outputs(state, timers, engine=engine, store=store, on_metrics=self._metrics_updated)
         self.prompts = prompts = Prompts(state, timers, out)
-        self.live = LiveAdaptation(state, timers, out, prompts, store=store)
+        self.live = live = LiveAdaptation(state, timers, out, prompts, store=store, room=room)
         self.incidents = Incidents(state, timers, out, prompts)
-        self.calls = CallConfirmation(state, timers, out, prompts, call_doctor=self.incidents.call_doctor)
+        steps = (state, timers, out, prompts)
+        self.calls = CallConfirmation(*steps, call_doctor=self.incidents.call_doctor, heard=live.hearing)
         self.flow = flow = QuestionFlow(
-            state,
-            timers,
-            out,
-            prompts,
+            *steps,
             store=store,
             next_patient_after_s=next_patient_after_s,
             practice_not_answered=self._practice_not_answered,
+            heard=live.hearing,
         )
         self.corrections = Corrections(
-            state, timers, out, prompts, store=store, record_answer=flow.record_answer, time_out=flow.attempt_timed_out
+            *steps, store=store, record_answer=flow.record_answer, time_out=flow.attempt_timed_out, heard=live.hearing
         )
         self.practice = practice = Practice(state, timers, out, prompts, store=store, open_question=flow.open_question)
         self.opening = opening = Opening(
@@ -471,6 +474,13 @@ class Session:
         """
         with self._operation() as t:
             self.live.set_voice_available(t, available)
+
+    def voice_unheard(self, reason: str) -> None:
+        """The voice channel heard speech it could not take (``reason``, its words): counted
+        against how well voice is heard in this room (:mod:`kiosk.core.room`)."""
+        with self._operation() as t:
+            if self.state.started():
+                self.live.hearing(t, False)
 
     def set_adaptation_enabled(self, enabled: bool) -> None:
         """The clinician turns live adaptation on or off (off lifts every active adaptation)."""

@@ -89,7 +89,7 @@ class Prompts:
             or state.can_undo(self.timers.kind)
             or state.call is not None  # "Shall I call the nurse?" is answered by voice too
         )
-        listening = wanted and not self.timers.frozen and "voice_off" not in state.active_adaptations()
+        listening = wanted and not self.timers.frozen and not state.voice_off()
         if listening != state.listening:
             state.listening = listening
             self.out.emit(ListeningChanged(t, listening))

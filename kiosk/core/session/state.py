@@ -11,6 +11,7 @@ from dataclasses import field
 from typing import Any
 
 from basis import record
+from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.channels import Channel
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, Score, Timing
 from kiosk.core.session.events import AnsweredBy, Phase, Prompt
@@ -223,6 +224,10 @@ class SessionState:
 
     def active_adaptations(self) -> frozenset[str]:
         return frozenset(self.adaptation.active) if self.adaptation is not None else frozenset()
+
+    def voice_off(self) -> bool:
+        """Whether an adaptation stopped listening for speech (voice_off, voice_room)."""
+        return bool(VOICE_OFF & self.active_adaptations())
 
     def speech_rate(self) -> float:
         return self.adaptation.speech_rate if self.adaptation is not None else 1.0
