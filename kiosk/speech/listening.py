@@ -81,12 +81,20 @@ class Listening:
     # -- the prompt --------------------------------------------------------------------------
 
     def set_question(
-        self, options: Sequence[OptionWords], *, scored: bool, welcome: bool, key: str | None, confirming: bool
+        self,
+        options: Sequence[OptionWords],
+        *,
+        scored: bool,
+        welcome: bool,
+        key: str | None,
+        confirming: bool,
+        again: bool = False,
     ) -> None:
-        """A new prompt's options (see :meth:`kiosk.speech.voice.VoiceChannel.set_question`)."""
+        """A new prompt's options (see :meth:`kiosk.speech.voice.VoiceChannel.set_question`);
+        ``again``: the same prompt asked again ("Please press Yes or No")."""
         if scored:
             self._on_question(key)
-        if not confirming or key != self._key:
+        if not (confirming and again and key == self._key):
             self._yes_once = False  # a second hearing agrees with a first on the same confirmation only
         self._key = key
         self.options = list(options)

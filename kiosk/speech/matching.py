@@ -99,9 +99,11 @@ FILLERS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["fille
 #: said two"): a "yes" to "Is that right?" whose hearing holds one is never taken as said
 NEGATIONS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["negations"])
 
-#: ways of asking for help that answer a question rather than call anyone ("I need a bit of
-#: help"): an option a patient chooses by saying "help" takes them all; on a question with no
-#: such option they are heard as no answer, never as "I need a doctor" (issue 33)
+#: ways of asking for help that answer a question rather than call anyone ("a bit of help", also
+#: after a lead-in: "I need a bit of help"): where an option is chosen by saying "help" they
+#: choose it (the word is in them); on a question without one they are in the grammar as no
+#: answer, so they are never forced onto "I need a doctor" (issue 33). Not added to an option's
+#: own phrases: more phrases there moved where answers end in talk (tests/kiosk/speech/test_rooms.py)
 HELP_WORDS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["help_words"])
 
 #: what recognisers emit for sounds outside their grammar
@@ -168,10 +170,9 @@ def _is_word(label: str, which: int, language: str) -> bool:
 
 
 def _with_known_words(option: OptionWords, language: str) -> OptionWords:
-    """An option with the natural ways of saying it: Yes or No (a confirmation; No also takes
-    the "that's wrong" phrases), Start, a language's name (the welcome, where the option in the
-    prompt's own language also takes "start"), or an option chosen by saying "help", which takes
-    every way of asking for a bit of help (:data:`HELP_WORDS`)."""
+    """An option the kiosk itself offers, with the natural ways of saying it: Yes or No (a
+    confirmation; No also takes the "that's wrong" phrases), Start, or a language's name (the
+    welcome, where the option in the prompt's own language also takes "start")."""
     extra: tuple[str, ...] = ()
     label = normalise(spoken_label(option.label))
     for which in (0, 1):
@@ -179,8 +180,6 @@ def _with_known_words(option: OptionWords, language: str) -> OptionWords:
             extra = YES_NO[language][which] + (COMMAND_PHRASES[language][Command.UNDO] if which else ())
     if label in {normalise(w) for w in START_WORDS[language][:2]}:
         extra = START_WORDS[language]
-    if normalise(HELP_WORDS[language][0]) in {label, *map(normalise, option.synonyms)}:
-        extra += HELP_WORDS[language]  # "I need a bit of help" is this answer, not a call
     words = set(label.split())
     for named, names in LANGUAGE_NAMES.items():
         if words & {normalise(n) for n in names if " " not in n}:
@@ -292,7 +291,9 @@ class Matcher:
         and the ways of asking for help where no option is chosen by them, so that "I need a bit
         of help" is not forced onto "I need a doctor"), without any that would mean something
         here ("no" where no is an answer)."""
-        others = (*FILLERS[self.language], *HELP_WORDS[self.language])
+        helps = HELP_WORDS[self.language]
+        asked = [f"{lead} {words}" for lead in LEAD_INS[self.language] for words in helps]  # "i need some help"
+        others = (*FILLERS[self.language], *helps, *asked)
         return tuple(dict.fromkeys(f for f in others if not self.match(f).matched))
 
     def meaning(self, phrase: str) -> int | Command | str:

@@ -147,12 +147,17 @@ def test_a_no_between_two_unsure_yeses_means_they_do_not_agree():
 def test_a_second_hearing_counts_on_the_same_confirmation_only():
     listening = _listening("en", key="feeding")
     assert listening.hear(_heard("yes", 0.65)).needs_confirmation
-    listening.set_question(_confirm_options("en"), scored=False, welcome=False, key="feeding", confirming=True)
-    listening.grammar("en")  # "Is that right? Please press Yes or No": the same confirmation
+    listening.set_question(
+        _confirm_options("en"), scored=False, welcome=False, key="feeding", confirming=True, again=True
+    )
+    listening.grammar("en")  # "Is that right? Please press Yes or No": the same confirmation asked again
     assert not listening.hear(_heard("yes", 0.65)).needs_confirmation
     assert listening.hear(_heard("yes", 0.65)).needs_confirmation  # a fresh pair is needed again
     listening.set_question(_confirm_options("en"), scored=False, welcome=False, key="bathing", confirming=True)
     listening.grammar("en")
+    assert listening.hear(_heard("yes", 0.65)).needs_confirmation
+    listening.set_question(_confirm_options("en"), scored=False, welcome=False, key="bathing", confirming=True)
+    listening.grammar("en")  # a fresh "Is that right?" on the same question: a fresh pair is needed
     assert listening.hear(_heard("yes", 0.65)).needs_confirmation
 
 
