@@ -292,7 +292,8 @@ class Matcher:
         of help" is not forced onto "I need a doctor"), without any that would mean something
         here ("no" where no is an answer)."""
         helps = HELP_WORDS[self.language]
-        asked = [f"{lead} {words}" for lead in LEAD_INS[self.language] for words in helps]  # "i need some help"
+        # after the first lead-in ("i need some help"), the one that asks
+        asked = [f"{lead} {words}" for lead in LEAD_INS[self.language][:1] for words in helps]
         others = (*FILLERS[self.language], *helps, *asked)
         return tuple(dict.fromkeys(f for f in others if not self.match(f).matched))
 
