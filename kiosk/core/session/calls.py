@@ -122,9 +122,10 @@ class CallConfirmation:
         call.text = pressing if call.press or voice_failing else asking
         words = CONFIRM_WORDS.get(lang, CONFIRM_WORDS["en"])
         options = tuple(PromptOption(number, label, synonyms, None) for number, (label, synonyms) in words.items())
-        self.out.emit(
-            Prompt(t, "call", "call_doctor", call.text, call.text, lang, options, repeat, None, state.speech_rate())
+        call.prompt = Prompt(
+            t, "call", "call_doctor", call.text, call.text, lang, options, repeat, None, state.speech_rate()
         )
+        self.out.emit(call.prompt)
 
     def _make(self, t: float, event: ChannelInput, how: str) -> None:
         call = self._end(t)

@@ -45,6 +45,8 @@ class HeardCall:
     text: str = ""
     #: a spoken "yes" came too unsure: the patient is asked to press Yes or No
     press: bool = False
+    #: the question as last published (asked again after a pause or the patient's return)
+    prompt: Prompt | None = None
 
 
 @record(frozen=False)

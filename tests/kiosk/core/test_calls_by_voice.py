@@ -147,6 +147,16 @@ def test_a_call_heard_while_is_that_right_waits_leaves_the_answer_waiting():
     assert rig.session.answers["feeding"].option == 3
 
 
+def test_after_a_pause_the_call_question_is_asked_again_not_the_item():
+    rig = _asked()
+    rig.session.pause()  # the clinician opened the staff screens
+    rig.session.resume()
+    prompt = rig.of(Prompt)[-1]
+    assert (prompt.kind, prompt.repeat) == ("call", True) and rig.session.snapshot().calling
+    rig.session.handle(ChannelInput(Channel.TOUCH, option=1, detail="screen"))
+    assert rig.session.halted
+
+
 def test_a_call_before_the_test_is_not_asked_back_nor_made():
     rig = make_rig()
     rig.session.welcome()
