@@ -76,6 +76,8 @@ STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
     "at": (str, type(None)),
     # why the kiosk takes no patient (its store failed: a full disk); None while it works
     "out_of_order": (str, type(None)),
+    # the kiosk steers patients to touch: voice is not heard well in its room (a sentence for staff)
+    "voice_room": (str, type(None)),
 }
 
 

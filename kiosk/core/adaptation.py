@@ -14,13 +14,20 @@ from typing import Any
 
 from basis import record
 from fileio.positions import Problem, parse_file
+from kiosk.core.room import METRIC as ROOM_METRIC
 from qos import Model, load_model
 
 #: the QoS model the kiosk runs (sessions, replays, stored traces); the rules watch its properties
 MODEL = "clarc"
 
 #: adaptations the session knows how to carry out
-KNOWN = ("voice_off", "slow_speech", "longer_attempts")
+KNOWN = ("voice_off", "voice_room", "slow_speech", "longer_attempts")
+#: the adaptations that stop listening for speech and ask for touch or the remote: voice_off (this
+#: patient's voice answers fare badly: VoiceInteractionQuality) and voice_room (voice is not
+#: heard well in this room: :mod:`kiosk.core.room`)
+VOICE_OFF = frozenset({"voice_off", "voice_room"})
+#: metrics the kiosk measures itself, which rules may watch beside the model's properties
+KIOSK_METRICS = (ROOM_METRIC,)
 _RULE_KEYS = {"name", "metric", "below", "count", "count_on", "recover_above", "speech_rate", "attempt_factor"}
 #: keys a rule may leave out, with their defaults
 _OPTIONAL = {"speech_rate": 1.0, "attempt_factor": 1.0}
@@ -103,9 +110,11 @@ def load_policy(path: str | Path | None = None, model: Model | None = None) -> P
             raise fail(p + ("name",), f"unknown adaptation {raw['name']!r} (known: {', '.join(KNOWN)})")
         if any(rule.name == raw["name"] for rule in rules):
             raise fail(p + ("name",), f"a second rule for {raw['name']!r} (one rule per adaptation)")
-        if raw["metric"] not in properties:
+        if raw["metric"] not in (*properties, *KIOSK_METRICS):
             raise fail(
-                p + ("metric",), f"unknown metric {raw['metric']!r} (the model's properties: {', '.join(properties)})"
+                p + ("metric",),
+                f"unknown metric {raw['metric']!r} (the model's properties: {', '.join(properties)}; "
+                f"the kiosk's own: {', '.join(KIOSK_METRICS)})",
             )
         if raw["count_on"] not in ("answers", "updates"):
             raise fail(p + ("count_on",), "count_on is 'answers' or 'updates'")
@@ -218,12 +227,13 @@ class Adaptation:
         return [AdaptationChange(name, False, reason)]
 
     def patient_requests_voice(self) -> list[AdaptationChange]:
-        """The patient asked to answer by voice again: lift voice_off (it needs fresh evidence to return)."""
-        if "voice_off" not in self._active:
-            return []
-        self._active.discard("voice_off")
-        self._low["voice_off"] = 0
-        return [AdaptationChange("voice_off", False, "the patient asked to answer by voice")]
+        """The patient asked to answer by voice again: lift voice_off and voice_room (each needs
+        fresh evidence to return)."""
+        lifted = sorted(VOICE_OFF & self._active)
+        for name in lifted:
+            self._active.discard(name)
+            self._low[name] = 0
+        return [AdaptationChange(name, False, "the patient asked to answer by voice") for name in lifted]
 
     def restore(self, active: Iterable[str], enabled: bool) -> None:
         """Continue a stored session's state: these adaptations in force, adaptation on or off.

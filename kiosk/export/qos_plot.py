@@ -38,6 +38,7 @@ INCIDENT_WORDS = {
 #: adaptations in a clinician's words (a policy may name others: shown with spaces)
 ADAPTATION_WORDS = {
     "voice_off": "voice answers off",
+    "voice_room": "voice hard to hear in this room",
     "slow_speech": "slow speech",
     "longer_attempts": "longer attempts",
 }

@@ -14,7 +14,15 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, cast
 
 from kiosk.core.channels import Channel, ChannelInput
-from kiosk.speech.matching import Match, Matcher, OptionWords, undo_commands, welcome_commands
+from kiosk.speech.matching import (
+    NEGATIONS,
+    Match,
+    Matcher,
+    OptionWords,
+    heard_negation,
+    undo_commands,
+    welcome_commands,
+)
 
 if TYPE_CHECKING:  # the audio pipeline (numpy) loads on the channel's own threads
     from kiosk.speech.asr import Recognition
@@ -22,6 +30,11 @@ if TYPE_CHECKING:  # the audio pipeline (numpy) loads on the channel's own threa
 
 #: the voice channel's own log: what was heard and why it was not taken
 log = logging.getLogger("kiosk.speech.voice")
+
+#: a spoken "yes" to "Is that right?" is taken as said only this sure, or heard twice (a "no"
+#: declines at the matcher's own floor): on voices and rooms the kiosk had never heard, "no no" and
+#: "that's not what I said" were heard as "yes" at 0.64-0.65 and stored two wrong answers (issue 33)
+YES_MIN_CONFIDENCE = 0.8
 
 #: an answer heard with less than the matcher's minimum confidence, but at least this, twice in a
 #: row on the same question (the attempt and the patient's repeat), is asked back: two hearings
@@ -60,15 +73,30 @@ class Listening:
         #: the option the latest utterance on this scored question was unsure of (see
         #: :data:`AGREE_MIN_CONFIDENCE`)
         self._unsure: int | None = None
+        #: a "yes" was heard once already on this "Is that right?", not sure enough to take
+        #: alone: a second "yes" on it is the second hearing
+        self._yes_once = False
+        self._key: str | None = None
 
     # -- the prompt --------------------------------------------------------------------------
 
     def set_question(
-        self, options: Sequence[OptionWords], *, scored: bool, welcome: bool, key: str | None, confirming: bool
+        self,
+        options: Sequence[OptionWords],
+        *,
+        scored: bool,
+        welcome: bool,
+        key: str | None,
+        confirming: bool,
+        again: bool = False,
     ) -> None:
-        """A new prompt's options (see :meth:`kiosk.speech.voice.VoiceChannel.set_question`)."""
+        """A new prompt's options (see :meth:`kiosk.speech.voice.VoiceChannel.set_question`);
+        ``again``: the same prompt asked again ("Please press Yes or No")."""
         if scored:
             self._on_question(key)
+        if not (confirming and again and key == self._key):
+            self._yes_once = False  # a second hearing agrees with a first on the same confirmation only
+        self._key = key
         self.options = list(options)
         self.scored = scored
         self.welcome = welcome
@@ -152,6 +180,13 @@ class Listening:
         confirm = self.scored and match.option is not None and unsure
         if self.confirming and match.option is not None and self._too_loud(utterance):
             confirm = True
+        if self.confirming and match.option == 1 and not confirm:
+            doubt = self._yes_doubt(result)
+            if doubt:
+                log.info("voice: %r taken as an unsure yes: %s", result.text, doubt)
+                confirm = True
+        elif self.confirming and match.option is not None:
+            self._yes_once = False  # a "no" between two hearings of "yes": they do not agree
         self._unsure = None
         return ChannelInput(
             Channel.VOICE,
@@ -161,6 +196,31 @@ class Listening:
             confidence=round(result.confidence, 3),
             needs_confirmation=confirm,
         )
+
+    def _yes_doubt(self, result: Any) -> str:
+        """Why a "yes" to "Is that right?" is not taken as said (empty: it is).
+
+        Layered, each enough alone: a free transcript (a recogniser that also hears without the
+        grammar fills ``transcript``) holding a negation, or not meaning "yes" itself (two
+        hearings that do not agree); or the "yes" heard once below :data:`YES_MIN_CONFIDENCE`,
+        which waits for a second hearing (the patient says it again, or presses Yes).
+        """
+        assert self.matcher is not None  # called from hear(), which has one
+        language = self.matcher.language
+        transcript = getattr(result, "transcript", None)
+        for heard in (result.text, transcript):
+            if heard and heard_negation(heard, language):
+                self._yes_once = False
+                return f"{heard!r} holds a negation ({', '.join(NEGATIONS[language][:3])}, ...)"
+        if transcript is not None and self.matcher.match(transcript).option != 1:
+            return f"the free hearing {transcript!r} is not a yes"
+        if result.confidence >= YES_MIN_CONFIDENCE:
+            return ""
+        if self._yes_once:
+            self._yes_once = False
+            return ""  # heard twice on this "Is that right?": two hearings agree
+        self._yes_once = True
+        return f"heard once at {result.confidence:.2f} < {YES_MIN_CONFIDENCE:.2f}: a second hearing or a press"
 
     def _too_loud(self, utterance: Utterance) -> bool:
         """Whether the room was nearly as loud as the voice (see :attr:`reply_min_above_room_db`)."""

@@ -95,6 +95,17 @@ LEAD_INS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["lead
 #: "I don't know" have somewhere to go other than the nearest answer; they match nothing
 FILLERS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["fillers"])
 
+#: words that turn a reply into a "no" wherever they are heard ("that's not what I said", "no I
+#: said two"): a "yes" to "Is that right?" whose hearing holds one is never taken as said
+NEGATIONS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["negations"])
+
+#: ways of asking for help that answer a question rather than call anyone ("a bit of help", also
+#: after a lead-in: "I need a bit of help"): where an option is chosen by saying "help" they
+#: choose it (the word is in them); on a question without one they are in the grammar as no
+#: answer, so they are never forced onto "I need a doctor" (issue 33). Not added to an option's
+#: own phrases: more phrases there moved where answers end in talk (tests/kiosk/speech/test_rooms.py)
+HELP_WORDS: Mapping[str, tuple[str, ...]] = Table(lambda words: words.speech["help_words"])
+
 #: what recognisers emit for sounds outside their grammar
 UNKNOWN_TOKENS = frozenset({"[unk]", "<unk>"})
 
@@ -104,6 +115,12 @@ def normalise(text: str) -> str:
     decomposed = unicodedata.normalize("NFKD", text.casefold())
     plain = "".join(c for c in decomposed if not unicodedata.combining(c))
     return " ".join(re.sub(r"[^\w\[\]]+", " ", plain).split())
+
+
+def heard_negation(text: str, language: str) -> bool:
+    """Whether ``text`` holds one of ``language``'s negations as whole words ("isn't" too)."""
+    tokens = _tokens(text)
+    return any(_find(_tokens(word), tokens) >= 0 for word in NEGATIONS[language])
 
 
 def spoken_label(label: str) -> str:
@@ -270,9 +287,15 @@ class Matcher:
         return () if self.yes_no or self._few_commands else LEAD_INS[self.language]
 
     def fillers(self) -> tuple[str, ...]:
-        """Non-answers the grammar holds so they are not forced onto an answer (:data:`FILLERS`),
-        without any that would mean something here ("no" where no is an answer)."""
-        return tuple(f for f in FILLERS[self.language] if not self.match(f).matched)
+        """Non-answers the grammar holds so they are not forced onto an answer (:data:`FILLERS`,
+        and the ways of asking for help where no option is chosen by them, so that "I need a bit
+        of help" is not forced onto "I need a doctor"), without any that would mean something
+        here ("no" where no is an answer)."""
+        helps = HELP_WORDS[self.language]
+        # after the first lead-in ("i need some help"), the one that asks
+        asked = [f"{lead} {words}" for lead in LEAD_INS[self.language][:1] for words in helps]
+        others = (*FILLERS[self.language], *helps, *asked)
+        return tuple(dict.fromkeys(f for f in others if not self.match(f).matched))
 
     def meaning(self, phrase: str) -> int | Command | str:
         """What saying ``phrase`` selects: an option number, a command, or else the phrase itself

@@ -219,7 +219,9 @@ class VoiceChannel:
                 scored=scored,
                 welcome=getattr(prompt, "kind", "") in ("welcome", "message"),
                 key=getattr(prompt, "key", None),
-                confirming=getattr(prompt, "kind", "") == "confirm",
+                # "Is that right?", and "Shall I call the nurse?": the same rules for a spoken yes
+                confirming=getattr(prompt, "kind", "") in ("confirm", "call"),
+                again=bool(getattr(prompt, "repeat", False)),
             )
 
     def set_question(
@@ -230,6 +232,7 @@ class VoiceChannel:
         welcome: bool = False,
         key: str | None = None,
         confirming: bool = False,
+        again: bool = False,
     ) -> None:
         """Listen for this question's answers (and the commands) in ``language``; answers to a
         ``scored`` question are confirmed unless heard with confidence (see :data:`CONFIRM_BELOW`).
@@ -237,9 +240,12 @@ class VoiceChannel:
         loud as the voice is sent as unsure (see :data:`REPLY_MIN_ABOVE_ROOM_DB`).
         At the ``welcome`` (or the explanation) the only command is calling the doctor, in whole phrases.
         ``key`` names the question: asked again under the same key, the options the patient
-        declined on it are not listened for (see :meth:`declined`)."""
+        declined on it are not listened for (see :meth:`declined`). ``again``: the same prompt
+        asked again (a "yes" heard unsure on it before counts as a first hearing)."""
         with self._lock:
-            self._heard.set_question(options, scored=scored, welcome=welcome, key=key, confirming=confirming)
+            self._heard.set_question(
+                options, scored=scored, welcome=welcome, key=key, confirming=confirming, again=again
+            )
             if language != self.language:
                 self.language = language
                 # before start() the language is only noted; the model loads off the UI thread

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, Protocol
 
+from kiosk.core.room import STAFF_NOTICE
 from kiosk.core.session import Phase, Session
 from kiosk.sync.client import Outcome
 
@@ -40,6 +41,8 @@ def live_status(session: Session) -> dict[str, Any]:
         "person_away": not snap.person_present,
         "unattended": snap.unattended,
         "doctor_called": snap.halted,
+        # voice is not heard well in this room, and patients are steered to touch (kiosk.core.room)
+        "voice_room": STAFF_NOTICE if "voice_room" in snap.adaptations else None,
         "simulated": False,
     }
 

@@ -65,6 +65,13 @@ class ChannelReceived(Message):
 
 
 @dataclass
+class VoiceUnheard(Message):
+    """Voice in heard speech it could not take: not an answer or command, or too unsure."""
+
+    reason: str
+
+
+@dataclass
 class SpeechActivity(Message):
     """Voice out started (True) or stopped (False) talking."""
 
@@ -123,6 +130,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self.show_score = show_score
         if (speaker := channels.speaker) is not None:  # its worker thread reports through these
             speaker.on_status, speaker.on_speech = self.channel_sink, self.speaker_activity
+        if channels.voice is not None and hasattr(channels.voice, "on_unmatched"):
+            channels.voice.on_unmatched = self.voice_unheard  # counted for the room (kiosk.core.room)
         self.stage = PatientStage(self)
         #: session time of the last touch or key on a staff screen (their idle time-out counts from it)
         self._staff_seen = 0.0
@@ -182,6 +191,14 @@ class KioskApp(App[int], inherit_bindings=False):
         """The sink every channel (and the speaker's status) delivers to, from its own thread:
         posts to the UI thread. The camera delivers its presence reports here too."""
         self.post_message(ChannelReceived(item))
+
+    def voice_unheard(self, utterance: str, reason: str) -> None:
+        """Voice in heard speech it could not take (on its own thread): posted to the UI thread."""
+        self.post_message(VoiceUnheard(reason))
+
+    def on_voice_unheard(self, message: VoiceUnheard) -> None:
+        """The session counts it against how well voice is heard in this room."""
+        self.controller.drive(self.session.voice_unheard, message.reason)
 
     def speaker_activity(self, speaking: bool) -> None:
         """The speaker's speech start/end callback (worker thread). The recogniser is muted right

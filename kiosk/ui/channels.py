@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from typing import Any
 
+from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.channels import Channel, ChannelInput, ChannelState, ChannelStatus, Command, InputSource
 from kiosk.core.session import (
     AnswerRecorded,
@@ -81,7 +82,7 @@ class KioskChannels:
         voice_in = self.on(VOICE_IN)
         return Ways(
             remote=self.on(REMOTE),
-            voice=voice_in and "voice_off" not in snap.adaptations,
+            voice=voice_in and not VOICE_OFF & snap.adaptations,
             listening=voice_in and self.board.listening,
             voice_out=self.on(VOICE_OUT),
         )

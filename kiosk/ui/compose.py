@@ -20,6 +20,7 @@ from kiosk.core.clock import Clock
 from kiosk.core.pin import PinGuard
 from kiosk.core.qos_model import load_kiosk_model
 from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.room import RoomHearing
 from kiosk.core.session import Session, Watching
 from kiosk.core.session.battery import Battery, Instrument
 from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
@@ -101,6 +102,8 @@ class SessionMaker:
 
         #: the battery of the latest visit (its next instrument comes from it)
         self.battery: Battery | None = None
+        #: how well voice is heard in this kiosk's room, over all its patients (kiosk.core.room)
+        self.room = RoomHearing()
 
     def _battery(self, visit_id: str | None = None, ids: Sequence[str] | None = None) -> Battery:
         from qos import Engine
@@ -116,6 +119,7 @@ class SessionMaker:
                 "adaptation": Adaptation(policy) if policy else None,
                 "next_patient_after_s": config.next_patient_after_s,
                 "watching": Watching(config.away_alert_after_s, config.unattended_after),
+                "room": self.room,
             },
             visit_id=visit_id,
         )

@@ -13,6 +13,7 @@ from typing import Any
 
 from textual.app import App
 
+from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Phase, Session
 from kiosk.ui.channels import KioskChannels
@@ -49,13 +50,20 @@ def phase_screen(phase: Phase) -> type[PatientScreen]:
     raise ValueError(f"no screen for the phase {phase!r}")
 
 
-def _overlay_screen(halted: bool, paused: bool, unattended: bool = False) -> type[PatientScreen] | None:
-    """The screen over the phase's one: the doctor called, paused, or waiting for a touch after
-    questions in a row went unanswered (imported when first shown)."""
+def _overlay_screen(
+    halted: bool, paused: bool, unattended: bool = False, calling: bool = False
+) -> type[PatientScreen] | None:
+    """The screen over the phase's one: the doctor called, "Shall I call the nurse?" after a call
+    heard by voice, paused, or waiting for a touch after questions in a row went unanswered
+    (imported when first shown)."""
     if halted:
         from kiosk.ui.screens.doctor_called import DoctorCalledScreen
 
         return DoctorCalledScreen
+    if calling:
+        from kiosk.ui.screens.call_confirm import CallConfirmScreen
+
+        return CallConfirmScreen
     if paused:
         from kiosk.ui.screens.paused import PausedScreen
 
@@ -84,7 +92,7 @@ class PatientStage:
         calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff."""
         app, snap = self.app, view.snapshot
         base_cls = phase_screen(snap.phase)
-        overlay_cls = _overlay_screen(snap.halted, snap.paused, snap.unattended)
+        overlay_cls = _overlay_screen(snap.halted, snap.paused, snap.unattended, snap.calling is not None)
         if out_of_order:
             from kiosk.ui.screens.out_of_order import OutOfOrderScreen
 
@@ -125,7 +133,7 @@ def patient_view(
     snap = session.snapshot()
     # the session lifts voice_off when voice in goes; checked here too so the button never
     # promises listening that cannot happen (and not over Continue while paused)
-    voice_again = "voice_off" in snap.adaptations and not (snap.paused or snap.halted) and channels.on(VOICE_IN)
+    voice_again = bool(VOICE_OFF & snap.adaptations) and not (snap.paused or snap.halted) and channels.on(VOICE_IN)
     question = snap.item or snap.practice
     hint = len(question.options) if channels.no_such_option and question is not None else None
     return PatientView(

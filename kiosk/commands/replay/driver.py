@@ -18,6 +18,7 @@ from kiosk.core.channels import Channel, ChannelInput, Command, Presence
 from kiosk.core.clock import SimClock
 from kiosk.core.qos_model import DEFAULT_MODEL
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
+from kiosk.core.room import RoomHearing
 from kiosk.core.session import (
     AdaptationChanged,
     AnswerRecorded,
@@ -246,6 +247,8 @@ class _Driver:
             self.session.clinician_continue()
         elif step.kind in ("person_lost", "person_back"):
             self.session.handle(Presence(step.kind == "person_back", step.source, "script"))
+        elif step.kind == "unheard":
+            self.session.voice_unheard("the script: speech the voice channel could not take")
         self._try_arm(index)
 
     def _give_answer(self, step: Step, index: int | None, check: bool = True) -> None:
@@ -368,6 +371,7 @@ def run_script(
         familiarisation=script.practice is not None,
         visit=visit,
         watching=script.watching,
+        room=RoomHearing(),  # a replay stands in a room of its own, heard from scratch
     )
     driver = _Driver(script, session, clock)
     try:
@@ -422,6 +426,7 @@ def run_battery(
             "timing": first.timing,
             "adaptation": Adaptation(policy or load_policy(model=loaded[model])) if first.adaptation else None,
             "watching": first.watching,
+            "room": RoomHearing(),
         },
     )
     results: list[ReplayResult] = []

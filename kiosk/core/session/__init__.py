@@ -60,7 +60,8 @@ screen renders), :mod:`.state` (the one shared state), :mod:`.timers` (the attem
 shown and said), :mod:`.opening` (welcome, start, language, explanation), :mod:`.questions`
 (attempts, answers, time-outs, finish), :mod:`.corrections` (confirm an unsure answer, undo the
 last one), :mod:`.practice` (familiarisation), :mod:`.incidents` (pause, call-doctor), :mod:`.attendance`
-(presence, the away alert, the wait for a touch),
+(presence, the away alert, the wait for a touch), :mod:`.calls` (a call heard by voice asked back:
+"Shall I call the nurse?"),
 :mod:`.live` (live adaptation), :mod:`.routing` (which step takes an input or a time-out),
 :mod:`.resume` (continuing a stored session), :mod:`.ports` (what it needs of the engine and the
 store) and :mod:`.core` (the :class:`Session` that owns them).
@@ -79,8 +80,10 @@ from kiosk.core.session.events import (
     AttemptTimedOut,
     AwayAlert,
     ConfirmationAsked,
+    DoctorCallAsked,
     DoctorCallCancelled,
     DoctorCalled,
+    DoctorCallNotConfirmed,
     DoctorContinued,
     Finished,
     IgnoreReason,
@@ -123,8 +126,10 @@ __all__ = [
     "AttemptTimedOut",
     "AwayAlert",
     "ConfirmationAsked",
+    "DoctorCallAsked",
     "DoctorCallCancelled",
     "DoctorCalled",
+    "DoctorCallNotConfirmed",
     "DoctorContinued",
     "Finished",
     "IgnoreReason",

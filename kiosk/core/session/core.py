@@ -16,10 +16,12 @@ import uuid
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from kiosk.core.channels import Channel, ChannelInput, Presence, PresenceSource
+from kiosk.core.channels import Channel, ChannelInput, Command, Presence, PresenceSource
 from kiosk.core.clock import Clock
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
+from kiosk.core.room import RoomHearing
 from kiosk.core.session.attendance import Attendance, Watching
+from kiosk.core.session.calls import CallConfirmation
 from kiosk.core.session.corrections import Corrections
 from kiosk.core.session.events import AnsweredBy, Phase
 from kiosk.core.session.incidents import Incidents
@@ -54,6 +56,8 @@ class Session:
     logged at the start, in the start's transaction, so the result is always marked.
     ``watching`` is what the site sets about a patient who is not there (:class:`Watching`: the
     away alert, the wait for a touch after unanswered questions); ``None``: neither.
+    ``room`` (:class:`kiosk.core.room.RoomHearing`, shared by a kiosk's sessions) is how well voice
+    is heard where the kiosk stands; its voice hearings feed it (None: not measured).
     """
 
     def __init__(
@@ -77,6 +81,7 @@ class Session:
         visit: str | None = None,
         battery: BatteryPlace | None = None,
         watching: Watching | None = None,
+        room: RoomHearing | None = None,
     ) -> None:
         if language not in questionnaire.languages:
             raise ValueError(f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
@@ -107,23 +112,23 @@ class Session:
         self.timers = timers = AttemptClock(clock, clock.now() - t_offset)
         self.out = out = Outputs(state, timers, engine=engine, store=store, on_metrics=self._metrics_updated)
         self.prompts = prompts = Prompts(state, timers, out)
-        self.live = LiveAdaptation(state, timers, out, prompts, store=store)
+        self.live = live = LiveAdaptation(state, timers, out, prompts, store=store, room=room)
         self.incidents = incidents = Incidents(state, timers, out, prompts)
+        steps = (state, timers, out, prompts)
+        self.calls = CallConfirmation(*steps, call_doctor=self.incidents.call_doctor, heard=live.hearing)
         self.flow = flow = QuestionFlow(
-            state,
-            timers,
-            out,
-            prompts,
+            *steps,
             store=store,
             next_patient_after_s=next_patient_after_s,
             practice_not_answered=self._practice_not_answered,
             unattended=self._not_answered,
+            heard=live.hearing,
         )
         self.attendance = Attendance(
             state, timers, out, prompts, watching=watching, go_on=flow.go_on, ask_again=incidents.ask_again
         )
         self.corrections = Corrections(
-            state, timers, out, prompts, store=store, record_answer=flow.record_answer, time_out=flow.attempt_timed_out
+            *steps, store=store, record_answer=flow.record_answer, time_out=flow.attempt_timed_out, heard=live.hearing
         )
         self.practice = practice = Practice(state, timers, out, prompts, store=store, open_question=flow.open_question)
         self.opening = opening = Opening(
@@ -148,6 +153,7 @@ class Session:
             practice=practice,
             incidents=self.incidents,
             attendance=self.attendance,
+            calls=self.calls,
         )
 
     # -- construction from a stored, unfinished session -----------------------------------------
@@ -322,8 +328,9 @@ class Session:
             interlude=state.interlude(self.timers.kind),
             **self.practice.progress(),
             confirming=open_.unconfirmed.option if open_ and open_.unconfirmed else None,
-            can_undo=self.corrections.can_undo() and not self.timers.frozen,
+            can_undo=self.corrections.can_undo() and not self.timers.frozen and state.call is None,
             unattended=state.unattended,
+            calling=state.call.text if state.call is not None else None,
         )
 
     # -- inputs ------------------------------------------------------------------------------------
@@ -413,9 +420,13 @@ class Session:
             self.incidents.resume(t)
 
     def call_doctor(self, channel: Channel | None = None) -> None:
-        """Call the doctor: the session halts until :meth:`clinician_continue`."""
+        """Call the doctor: the session halts until :meth:`clinician_continue` (a call by voice
+        comes through :meth:`handle`, and is asked back: :mod:`kiosk.core.session.calls`)."""
         with self._operation() as t:
-            self.incidents.call_doctor(t, channel)
+            if self.state.call is not None:  # pressed while "Shall I call the nurse?" is asked
+                self.calls.call(t, ChannelInput(channel or Channel.TOUCH, command=Command.CALL_DOCTOR))
+            else:
+                self.incidents.call_doctor(t, channel)
 
     def clinician_continue(self) -> None:
         """A clinician continues a halted (or paused) session; at least ``resume_grace_s`` left.
@@ -475,6 +486,13 @@ class Session:
         """
         with self._operation() as t:
             self.live.set_voice_available(t, available)
+
+    def voice_unheard(self, reason: str) -> None:
+        """The voice channel heard speech it could not take (``reason``, its words): counted
+        against how well voice is heard in this room (:mod:`kiosk.core.room`)."""
+        with self._operation() as t:
+            if self.state.started():
+                self.live.hearing(t, False)
 
     def set_adaptation_enabled(self, enabled: bool) -> None:
         """The clinician turns live adaptation on or off (off lifts every active adaptation)."""

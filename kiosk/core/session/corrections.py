@@ -64,6 +64,7 @@ class Corrections:
         store: SessionStore | None,
         record_answer: Callable[[float, int, Channel, str], None],
         time_out: Callable[[float], None],
+        heard: Callable[[float, bool], None] = lambda t, worked: None,
     ) -> None:
         self.state = state
         self.timers = timers
@@ -72,6 +73,8 @@ class Corrections:
         self.store = store
         self._record_answer = record_answer
         self._time_out = time_out
+        #: a voice hearing's outcome, for the room's measure (kiosk.core.room)
+        self._heard = heard
 
     def can_undo(self) -> bool:
         """The thank-you gap after a stored answer is running (and nothing stops the clock)."""
@@ -110,6 +113,7 @@ class Corrections:
             return
         if event.needs_confirmation:
             self.out.ignore(t, event, IgnoreReason.UNSURE_REPLY)
+            self._heard(t, False)  # a "yes" too unsure to act on
             pending.press = True
             # finding and pressing the button takes longer than saying yes
             self.timers.at_least(state.timing.confirm_window_s)
@@ -131,6 +135,8 @@ class Corrections:
         item = state.questionnaire.items[open_.index]
         self.out.log(t, "answer_not_confirmed", f"{item.id} option {pending.option}: {why}")
         self.out.emit(AnswerNotConfirmed(t, item.id, item.number, pending.option, open_.attempt, why))
+        if pending.channel is Channel.VOICE:  # misheard, or nobody could answer what was heard
+            self._heard(t, False)
         if why == "timed_out":
             self._time_out(t)
             return
@@ -155,6 +161,8 @@ class Corrections:
         assert open_ is not None
         item = state.questionnaire.items[open_.index]
         answer = state.answers.pop(item.id)
+        if answer.channel is Channel.VOICE:  # a voice answer stored wrong
+            self._heard(t, False)
         if self.store is not None and state.stored:
             self.store.withdraw_answer(
                 state.id,

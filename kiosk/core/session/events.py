@@ -57,6 +57,7 @@ class IgnoreReason(str, Enum):
     NOTHING_TO_UNDO = "nothing_to_undo"  # no answer can be taken back now
     UNSURE_REPLY = "unsure_reply"  # an unsure "yes" never confirms an unsure answer
     WAITING_FOR_TOUCH = "waiting_for_touch"  # unattended: only a touch or a press goes on, not a voice
+    CALL_ASKED = "call_asked"  # "Shall I call the nurse?" waits for Yes or No
 
 
 #: attempts per question: the question is asked, then asked again, then it is not answered. Fixed
@@ -342,6 +343,26 @@ class AnswerWithdrawn(SessionEvent):
     channel: Channel
     by: Channel | None
     deadline: float
+
+
+@record
+class DoctorCallAsked(SessionEvent):
+    """A call for the doctor was heard by voice and is not made yet: "Shall I call the nurse?"
+    waits for Yes or No until ``deadline`` (None while the clock is stopped). Yes, a second
+    hearing of the call or the doctor's key makes it (:class:`DoctorCalled`)."""
+
+    detail: str
+    confidence: float | None
+    deadline: float | None
+
+
+@record
+class DoctorCallNotConfirmed(SessionEvent):
+    """The call heard by voice was not made: the patient said or pressed No (``why``
+    "declined", ``channel`` the one that said it) or nobody replied in time ("unanswered")."""
+
+    why: str
+    channel: Channel | None
 
 
 @record

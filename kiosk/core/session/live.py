@@ -7,6 +7,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from kiosk.core.adaptation import VOICE_OFF
+from kiosk.core.room import METRIC, RoomHearing
 from kiosk.core.session.events import AdaptationChanged
 from kiosk.core.session.ports import SessionStore
 from kiosk.core.session.prompts import Prompts
@@ -19,9 +21,18 @@ class LiveAdaptation:
     """Adaptation switches and their effects; the policy is ``state.adaptation`` (None: none)."""
 
     def __init__(
-        self, state: SessionState, timers: AttemptClock, out: Outputs, prompts: Prompts, *, store: SessionStore | None
+        self,
+        state: SessionState,
+        timers: AttemptClock,
+        out: Outputs,
+        prompts: Prompts,
+        *,
+        store: SessionStore | None,
+        room: RoomHearing | None = None,
     ) -> None:
         self.state = state
+        #: how well voice is heard in this kiosk's room (shared with its other sessions), or None
+        self.room = room
         self.timers = timers
         self.out = out
         self.prompts = prompts
@@ -31,6 +42,16 @@ class LiveAdaptation:
         """New QoS metrics at session time ``t`` (``answered``: they followed an answer)."""
         if self.state.adaptation is not None:
             for change in self.state.adaptation.observe(metrics, answered=answered):
+                self.apply(t, change)
+
+    def hearing(self, t: float, worked: bool) -> None:
+        """One voice hearing's outcome (see :mod:`kiosk.core.room`): the room's measure moves, and
+        the policy reads it (voice_room)."""
+        if self.room is None:
+            return
+        value = self.room.add(worked)
+        if self.state.adaptation is not None:
+            for change in self.state.adaptation.observe({METRIC: value}, answered=False):
                 self.apply(t, change)
 
     def request_voice(self, t: float) -> None:
@@ -51,8 +72,9 @@ class LiveAdaptation:
         state.voice_available = available
         self.out.log(t, "voice_in", "available" if available else "unavailable")
         if state.adaptation is not None:
-            for change in state.adaptation.hold("voice_off", not available, "voice in is unavailable"):
-                self.apply(t, change)
+            for name in sorted(VOICE_OFF):
+                for change in state.adaptation.hold(name, not available, "voice in is unavailable"):
+                    self.apply(t, change)
 
     def set_enabled(self, t: float, enabled: bool) -> None:
         """The clinician turns live adaptation on or off (off lifts every active adaptation)."""
@@ -67,8 +89,10 @@ class LiveAdaptation:
         if self.store is not None:
             self.store.record_adaptation(state.id, t=t, name=change.name, active=change.active, reason=change.reason)
         self.out.emit(AdaptationChanged(t, change.name, change.active, change.reason))
-        if change.name == "voice_off":
-            if state.voice_available:  # hearing the patient again means nothing without voice in
+        if change.name in VOICE_OFF:
+            # said when voice answers stop or come back, not when the other reason changes
+            others = VOICE_OFF & state.active_adaptations() - {change.name}
+            if state.voice_available and not others:  # hearing the patient again means nothing without voice in
                 self.prompts.message(t, "voice_off" if change.active else "voice_on")
             self.prompts.update_listening(t)
         elif change.name == "slow_speech" and change.active and state.current_attempt is not None:

@@ -7,6 +7,7 @@ what was last said."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 
 from kiosk.core.session.events import ListeningChanged, Phase, PhaseChanged, Prompt, PromptOption
 from kiosk.core.session.publishing import Outputs
@@ -50,6 +51,9 @@ class Prompts:
         """Ask the open question (or, while an answer waits for confirmation, "Is that right?")."""
         state = self.state
         assert state.open is not None
+        if state.call is not None and state.call.prompt is not None:  # "Shall I call the nurse?" waits
+            self.out.emit(replace(state.call.prompt, t=t, repeat=True))
+            return
         if state.open.unconfirmed is not None:
             self.publish(self._confirmation(t, repeat))
             return
@@ -90,8 +94,9 @@ class Prompts:
             or state.phase in (Phase.EXPLANATION, Phase.REST)
             or state.current_attempt is not None
             or state.can_undo(self.timers.kind)
+            or state.call is not None  # "Shall I call the nurse?" is answered by voice too
         )
-        listening = wanted and not self.timers.frozen and "voice_off" not in state.active_adaptations()
+        listening = wanted and not self.timers.frozen and not state.voice_off()
         if listening != state.listening:
             state.listening = listening
             self.out.emit(ListeningChanged(t, listening))

@@ -48,6 +48,7 @@ class QuestionFlow:
         next_patient_after_s: float | None,
         practice_not_answered: Callable[[float], None],
         unattended: Callable[[float], bool] = lambda t: False,
+        heard: Callable[[float, bool], None] = lambda t, worked: None,
     ) -> None:
         self.state = state
         self.timers = timers
@@ -57,6 +58,8 @@ class QuestionFlow:
         self.next_patient_after_s = next_patient_after_s
         self._practice_not_answered = practice_not_answered
         self._unattended = unattended
+        #: a voice hearing's outcome, for the room's measure (kiosk.core.room)
+        self._heard = heard
 
     def schedule_next_item(self, t: float, after: float) -> None:
         """The next unanswered item opens ``after`` seconds from ``t``; with none left, the summary."""
@@ -159,6 +162,8 @@ class QuestionFlow:
         self.out.emit(
             AnswerRecorded(t, item.id, item.number, option.number, option.points, attempt, channel, by, detail)
         )
+        if channel is Channel.VOICE:
+            self._heard(t, True)
         self.schedule_next_item(t, state.timing.between_questions_s)
         self.prompts.update_listening(t)  # on through the thank-you gap: "No, that's wrong" takes it back
 
@@ -177,7 +182,7 @@ class QuestionFlow:
             return IgnoreReason.ALREADY_ANSWERED
         if state.open.outcome is not None:
             return IgnoreReason.NO_OPEN_ATTEMPT
-        if event.channel is Channel.VOICE and "voice_off" in state.active_adaptations():
+        if event.channel is Channel.VOICE and state.voice_off():
             return IgnoreReason.VOICE_OFF
         choices = 2 if state.open.unconfirmed is not None else len(state.question().options)  # Yes/No
         if event.option is None or event.option > choices:

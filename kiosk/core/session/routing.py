@@ -7,8 +7,9 @@ from __future__ import annotations
 
 from kiosk.core.channels import ChannelInput, Command, Presence
 from kiosk.core.session.attendance import AWAY_ALERT, Attendance
+from kiosk.core.session.calls import CallConfirmation
 from kiosk.core.session.corrections import Corrections
-from kiosk.core.session.events import Phase, VolumeChanged
+from kiosk.core.session.events import IgnoreReason, Phase, VolumeChanged
 from kiosk.core.session.incidents import Incidents
 from kiosk.core.session.opening import Opening
 from kiosk.core.session.practice import Practice
@@ -35,6 +36,7 @@ class Router:
         practice: Practice,
         incidents: Incidents,
         attendance: Attendance,
+        calls: CallConfirmation,
     ) -> None:
         self.state = state
         self.timers = timers
@@ -46,6 +48,7 @@ class Router:
         self.practice = practice
         self.incidents = incidents
         self.attendance = attendance
+        self.calls = calls
 
     def fire(self, kind: str, t: float) -> None:
         """A time-out of ``kind`` fell due at session time ``t``."""
@@ -55,6 +58,8 @@ class Router:
             self.flow.attempt_timed_out(t)
         elif kind == "confirm":
             self.corrections.not_confirmed(t, "timed_out")
+        elif kind == "call":
+            self.calls.timed_out(t)
         elif kind == "practice":
             self.practice.next(t)
         elif kind == "finish":
@@ -70,6 +75,8 @@ class Router:
         phase = self.state.phase
         if isinstance(event, Presence):
             self.attendance.presence(t, event)
+        elif self.state.call is not None and event.command not in (Command.VOLUME_UP, Command.VOLUME_DOWN):
+            self._calling(t, event)
         elif event.command is not None:
             self._command(t, event)
         elif phase is Phase.WELCOME:
@@ -82,6 +89,18 @@ class Router:
             self.opening.acknowledge(t)
         else:
             self._answer(t, event)
+
+    def _calling(self, t: float, event: ChannelInput) -> None:
+        """An input while "Shall I call the nurse?" is asked: Yes or No, the call again, or
+        "repeat"; anything else waits until it is answered."""
+        if event.option is not None:
+            self.calls.reply(t, event)
+        elif event.command is Command.CALL_DOCTOR:
+            self.calls.call(t, event)
+        elif event.command is Command.REPEAT:
+            self.calls.repeat(t)
+        else:
+            self.out.ignore(t, event, IgnoreReason.CALL_ASKED)
 
     def _answer(self, t: float, event: ChannelInput) -> None:
         """An answer option while the questions (or practice) run."""
@@ -111,7 +130,7 @@ class Router:
         elif command is Command.RESUME:
             self.incidents.resume(t, event)
         elif command is Command.CALL_DOCTOR:
-            self.incidents.call_doctor(t, event.channel, event)
+            self.calls.call(t, event)  # by voice asked back first; pressed, at once
         elif command is Command.REPEAT:
             self.flow.repeat(t, event.channel, event)
         elif command is Command.UNDO:

@@ -67,3 +67,6 @@ class Snapshot:
     can_undo: bool = False
     #: questions in a row went unanswered: the kiosk waits for a touch ("Touch the screen to go on")
     unattended: bool = False
+    #: "Shall I call the nurse?" (its text) while a call heard by voice waits for Yes or No
+    #: (options 1 and 2); None otherwise
+    calling: str | None = None

@@ -11,6 +11,7 @@ from dataclasses import field
 from typing import Any
 
 from basis import record
+from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.channels import Channel
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, Score, Timing
 from kiosk.core.session.events import AnsweredBy, Phase, Prompt
@@ -29,6 +30,23 @@ class Unconfirmed:
     remaining: float
     #: a "yes" came too unsure to store the answer: the patient is asked to press Yes or No
     press: bool = False
+
+
+@record(frozen=False)
+class HeardCall:
+    """A call for the doctor heard by voice, waiting for "Shall I call the nurse?" Yes or No."""
+
+    #: what was heard, and how sure the recogniser was
+    detail: str
+    confidence: float | None
+    #: the time-out pending when it was heard (kind, seconds left): put back once it is answered
+    pending: tuple[str, float] | None
+    #: "Shall I call the nurse?" as asked (the prompt's text), in the patient's language
+    text: str = ""
+    #: a spoken "yes" came too unsure: the patient is asked to press Yes or No
+    press: bool = False
+    #: the question as last published (asked again after a pause or the patient's return)
+    prompt: Prompt | None = None
 
 
 @record(frozen=False)
@@ -118,6 +136,8 @@ class SessionState:
     voice_out_available: bool = True
     #: ids of the practice questions skipped before they were shown
     practice_unasked: set[str] = field(default_factory=set)
+    #: a call for the doctor heard by voice, waiting for Yes or No (see kiosk.core.session.calls)
+    call: HeardCall | None = None
     #: the latest prompt published
     prompt: Prompt | None = None
     #: a repeated prompt is being given: TestState is REPEATING until anything else happens
@@ -210,6 +230,10 @@ class SessionState:
 
     def active_adaptations(self) -> frozenset[str]:
         return frozenset(self.adaptation.active) if self.adaptation is not None else frozenset()
+
+    def voice_off(self) -> bool:
+        """Whether an adaptation stopped listening for speech (voice_off, voice_room)."""
+        return bool(VOICE_OFF & self.active_adaptations())
 
     def speech_rate(self) -> float:
         return self.adaptation.speech_rate if self.adaptation is not None else 1.0

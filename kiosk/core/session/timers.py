@@ -88,6 +88,14 @@ class AttemptClock:
         if self.watch is not None and self.watch[0] == kind:
             self.watch = None
 
+    def take(self) -> tuple[str, float] | None:
+        """Drop the pending time-out and return its kind and the seconds it had left, to be put
+        back with :meth:`set` (a question interrupted by "Shall I call the nurse?"); None if none."""
+        timer, self.timer = self.timer, None
+        if timer is None:
+            return None
+        return timer.kind, timer.remaining if timer.due is None else max(0.0, timer.due - self.clock.now())
+
     def due(self, now: float, inclusive: bool) -> Iterator[tuple[str, float]]:
         """Take the time-outs due by clock time ``now`` in order, as (kind, session time due): the
         pending time-out and the watch, the earlier first (the time-out first at one instant).

@@ -46,3 +46,8 @@ UNATTENDED_TEXT: Mapping[str, str] = Table(lambda words: words.screen["unattende
 
 #: that wait's one option
 GO_ON_LABEL: Mapping[str, str] = Table(lambda words: words.screen["go_on"])
+
+#: "Shall I call the nurse?" after a call heard by voice, and the same asking for a press
+CALL_CONFIRM: Mapping[str, tuple[str, str]] = Table(
+    lambda words: (words.screen["call_confirm"], words.screen["call_confirm_press"])
+)

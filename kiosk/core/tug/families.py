@@ -175,7 +175,7 @@ def _course(
             turn,
             {"facing": (facing + way + (math.pi if way < 0 else -math.pi), 0, 1), "step": (0.0, 0.5, 1.0)},
         )
-    )  # noqa: E501
+    )
 
 
 def _sit_down(timeline: Timeline, rng: np.random.Generator, seat_h: float, slow: bool, build: Build) -> None:

@@ -71,6 +71,8 @@ SHAPE: Mapping[str, Any] = {
         "start_words": WORDS,
         "lead_ins": WORDS_OR_NONE,
         "fillers": WORDS_OR_NONE,
+        "negations": WORDS,
+        "help_words": WORDS,
     },
     "export": {"total_score": TEXT},
     "answers": {

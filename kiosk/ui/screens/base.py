@@ -12,6 +12,7 @@ from textual.containers import Horizontal
 from textual.screen import Screen
 
 from basis import record
+from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import ATTEMPTS, Snapshot
 from kiosk.ui.widgets.bars import AdaptationBanner, VoiceAgainButton
@@ -121,7 +122,9 @@ def patient_notices(view: PatientView) -> str | None:
     for name in sorted(snap.adaptations):
         if name == "slow_speech" and not view.ways.voice_out:
             continue
-        if name == "voice_off":
+        if name in VOICE_OFF:  # this patient's voice, or this room: the patient reads the same
+            if name != min(VOICE_OFF & snap.adaptations):
+                continue  # said once when both are on
             ways = ("touch", "remote") if view.ways.remote else ("touch",)
             notices.append(ways_sentence(lang, "voice_off", ways, "_answer"))
             continue

@@ -13,6 +13,7 @@ from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import DataTable, Switch
 
 from kiosk.core.channels import ChannelState
+from kiosk.core.room import STAFF_NOTICE
 from kiosk.core.session import Phase
 from kiosk.export.captured import questionnaire_of, result_line
 from kiosk.store.records import SessionSummary
@@ -175,6 +176,8 @@ class ClinicianHomeScreen(ClinicianScreen):
             f"This kiosk: session {session.id}, patient {session.patient_id}, {state}, "
             f"{len(session.answers)} of {len(session.questionnaire.items)} answered."
         )
+        if "voice_room" in session.snapshot().adaptations:
+            line += f" {STAFF_NOTICE}."
         if session.metrics:
             line += " QoS now: " + ", ".join(f"{name} {value:.2f}" for name, value in session.metrics.items())
         return line

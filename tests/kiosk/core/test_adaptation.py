@@ -104,7 +104,7 @@ def test_disabled_adaptation_does_nothing_and_turning_it_off_lifts_everything():
             " recover_above: 0.4}\n",
             "VoiceInteractionQualty",
             "unknown metric 'VoiceInteractionQualty' (the model's "
-            "properties: Interaction, Performance, VoiceInteractionQuality)",
+            "properties: Interaction, Performance, VoiceInteractionQuality; the kiosk's own: VoiceHeard)",
         ),
         (
             "rules:\n  - {name: voice_off, metric: Interaction, below: 1.5, count: 3, count_on: answers, recover_above: 1.8}\n",
@@ -201,7 +201,10 @@ def test_the_metric_is_checked_against_the_model_given(tmp_path):
     )
     assert load_policy(path).rules[0].metric == "Interaction"
     other = parse_model("roqme Other\nproperty Calm reference 0.5\n", "other.roqme")
-    with pytest.raises(PolicyError, match=r":2:31: unknown metric 'Interaction' \(the model's properties: Calm\)"):
+    with pytest.raises(
+        PolicyError,
+        match=r":2:31: unknown metric 'Interaction' \(the model's properties: Calm; the kiosk's own: VoiceHeard\)",
+    ):
         load_policy(path, model=other)
 
 

@@ -20,6 +20,7 @@ from kiosk.speech import rooms
 from kiosk.speech.asr import PocketSphinxRecogniser
 from kiosk.speech.asr.levels import above_room, gate_talk, voiced_frames
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, frame_powers, read_wav
+from kiosk.speech.listening import YES_MIN_CONFIDENCE
 from kiosk.speech.matching import OptionWords
 from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel
@@ -310,8 +311,9 @@ def test_a_yes_said_among_talkers_nearly_as_loud_is_never_taken_as_said(voice_of
     """ "Is that right?" answered where people talk nearly as loud as the patient (SNR 3 dB):
     a reply heard as yes is sent as unsure (the session then asks for Yes or No to be pressed),
     never as a yes that stores the answer, however sure the recogniser: a "no" was now and then
-    heard as "yes" there. At 10 and 20 dB every yes heard is taken as said, and how far the
-    voice stood above the room is measured near the SNR it was mixed at."""
+    heard as "yes" there. At 10 and 20 dB every yes heard is taken as said, at once or (heard
+    below the stricter floor for a yes) when said again, and how far the voice stood above the
+    room is measured near the SNR it was mixed at."""
     sure_yes = 0
     for voice, rate in [("en-us", 160), *PATIENTS]:
         rng = np.random.default_rng(snr_db)
@@ -330,9 +332,16 @@ def test_a_yes_said_among_talkers_nearly_as_loud_is_never_taken_as_said(voice_of
             assert got.option == (1 if text.startswith("yes") else 2), (voice, text, got)
             if snr_db < 5:
                 assert got.needs_confirmation, (voice, text, measured)
-            else:
-                assert not got.needs_confirmation, (voice, text, measured)
-                sure_yes += got.option == 1
+                continue
+            if got.option == 1 and got.needs_confirmation:
+                # heard once below the stricter floor for a yes (issue 33): taken when said again
+                assert got.confidence < YES_MIN_CONFIDENCE, (voice, text, got)
+                ear.channel.set_question([OptionWords("Yes"), OptionWords("No")], "en", confirming=True, again=True)
+                got = ear.hear(_in_noise(speech, _babble(voice_of, len(speech) / SAMPLE_RATE + 3, rng), snr_db))
+                if got is None or got.option != 1:
+                    continue
+            assert not got.needs_confirmation, (voice, text, measured)
+            sure_yes += got.option == 1
     assert snr_db < 5 or sure_yes >= 6, "most yeses are heard in a room of 10 dB or more"
 
 

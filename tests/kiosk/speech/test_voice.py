@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 from kiosk.core.channels import Channel, ChannelInput, Command
-from kiosk.core.session import DoctorCalled, Paused, Phase, Prompt, Resumed
+from kiosk.core.session import DoctorCallAsked, DoctorCalled, Paused, Phase, Prompt, Resumed
 from kiosk.speech.asr import PocketSphinxRecogniser
 from kiosk.speech.audio import feed_wav
 from kiosk.speech.matching import OptionWords
@@ -81,7 +81,10 @@ def test_spoken_commands_reach_the_session(backend, spoken):
     assert "feeding" not in kiosk.session.answers
     kiosk.say(spoken("continue"))
     assert any(isinstance(e, Resumed) for e in kiosk.events)
-    kiosk.say(spoken("call the doctor"))
+    kiosk.say(spoken("call the doctor"))  # asked back first: "Shall I call the nurse?"
+    assert any(isinstance(e, DoctorCallAsked) for e in kiosk.events)
+    assert not any(isinstance(e, DoctorCalled) for e in kiosk.events)
+    kiosk.say(spoken("yes"))
     assert any(isinstance(e, DoctorCalled) and e.channel is Channel.VOICE for e in kiosk.events)
 
 
