@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import anyio.to_thread
+import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
@@ -32,6 +33,8 @@ from station import (
     api,
     api_orders,
     auth,
+    db,
+    errors,
     logins,
     order_pages,
     pages,
@@ -171,7 +174,35 @@ async def forbidden(request: Request, exc: Exception) -> Response:
     return PlainTextResponse(str(exc), status_code=403)
 
 
+#: one thread for the health check's write probe: it never queues behind pages or kiosks
+HEALTH_LANE = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-health")
+HEALTH_TIMEOUT_S = 5.0
+
+
+def write_probe(engine: Engine) -> None:
+    """Commit a heartbeat (the settings row ``heartbeat``: the time of this check): the database
+    takes writes now (raises the driver's error otherwise: read-only, disk full, server gone). A
+    commit, not a rolled-back write: SQLite only meets a full disk when it writes its log."""
+    with engine.begin() as connection:
+        now = db.now_iso()
+        changed = connection.execute(
+            db.settings.update().where(db.settings.c.key == "heartbeat").values(value=now)
+        ).rowcount
+        if not changed:
+            db.insert_ignore(connection, db.settings, [{"key": "heartbeat", "value": now}], ["key"])
+
+
 async def healthz(request: Request) -> Response:
+    """200 ``ok`` only when the database can be written now; else 503 naming why."""
+    loop = asyncio.get_running_loop()
+    try:
+        await asyncio.wait_for(
+            loop.run_in_executor(HEALTH_LANE, write_probe, request.app.state.engine), HEALTH_TIMEOUT_S
+        )
+    except TimeoutError:
+        return PlainTextResponse(f"database: a test write took longer than {HEALTH_TIMEOUT_S:g} s", status_code=503)
+    except sa.exc.SQLAlchemyError as exc:
+        return PlainTextResponse(f"database cannot be written: {errors.reason(exc)}", status_code=503)
     return PlainTextResponse("ok")
 
 
@@ -225,7 +256,12 @@ def create_app(
         ),
         Middleware(LoginRequired),
     ]
-    app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
+    app = Starlette(
+        routes=routes,
+        middleware=middleware,
+        lifespan=lifespan,
+        exception_handlers={Forbidden: forbidden, Exception: errors.station_error},
+    )
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
     app.state.live = Live(
