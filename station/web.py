@@ -39,6 +39,7 @@ from station import (
     order_pages,
     pages,
     result_pages,
+    results,
     signoff_pages,
     staff_items,
     throttle,
@@ -147,6 +148,15 @@ async def events(request: Request) -> Response:
     return StreamingResponse(live.stream(), media_type="text/event-stream", headers={"x-accel-buffering": "no"})
 
 
+def _user_and_count(request: Request) -> tuple[auth.User | None, int | None]:
+    """The login's user and, for a page, the navigation's count of results waiting: one hop off
+    the event loop for both (the count is an index range, :func:`station.results.waiting_count`)."""
+    found = current_user(request)
+    if found is None or request.method != "GET":
+        return found, None
+    return found, results.waiting_count(request.app.state.engine)
+
+
 class LoginRequired:
     """Page routes need a logged-in user; the kiosk API, login, events and static files do not
     (they check their own credentials)."""
@@ -161,12 +171,12 @@ class LoginRequired:
             await self.app(scope, receive, send)
             return
         request = Request(scope, receive)
-        found = await asyncio.get_running_loop().run_in_executor(STAFF_LANE, current_user, request)
+        found, waiting = await asyncio.get_running_loop().run_in_executor(STAFF_LANE, _user_and_count, request)
         if found is None:
             response: Response = RedirectResponse(f"/login?next={scope['path']}", status_code=303)
             await response(scope, receive, send)
             return
-        scope.setdefault("state", {})["user"] = found
+        scope.setdefault("state", {}).update(user=found, waiting=waiting)
         await self.app(scope, receive, send)
 
 
