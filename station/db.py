@@ -113,6 +113,9 @@ definitions = sa.Table(
     sa.Column("version", sa.Text, nullable=False),
     sa.Column("body", sa.Text, nullable=False),
     sa.Column("stored_at", sa.String(40), nullable=False),
+    #: who made the station know it (station.known): "shipped", "registered by NAME", a doctor
+    sa.Column("known_by", sa.String(64)),
+    sa.Column("known_at", sa.String(40)),
 )
 
 alerts = sa.Table(

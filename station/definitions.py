@@ -20,6 +20,8 @@ from kiosk.core.questionnaire.definition import DefinitionError, questionnaire_f
 from kiosk.export import ExportError
 from kiosk.store.records import StoredSession
 from station.db import definitions
+from station.formulas import guarded
+from station.known import known
 
 #: definitions kept parsed in this process (a site runs a handful)
 KEPT = 128
@@ -28,20 +30,33 @@ KEPT = 128
 class _Parsed:
     """A definition's body and the questionnaire it describes (or why it describes none)."""
 
-    __slots__ = ("body", "problem", "questionnaire", "sha")
+    __slots__ = ("body", "guarded", "problem", "questionnaire", "sha")
 
     def __init__(self, body: Mapping[str, Any], sha: str = "") -> None:
         self.body, self.sha = body, sha
         self.questionnaire: Questionnaire | None = None
         self.problem = ""
+        #: the questionnaire as the station scores it, unknown (False) and known (True)
+        self.guarded: dict[bool, Questionnaire] = {}
         try:
             self.questionnaire = questionnaire_from(body)
         except DefinitionError as exc:
             self.problem = str(exc)
 
+    def scored(self, is_known: bool) -> Questionnaire | None:
+        """The questionnaire whose formula runs only in the formula process, and only if known."""
+        if self.questionnaire is None:
+            return None
+        if is_known not in self.guarded:
+            self.guarded[is_known] = guarded(self.questionnaire, self.sha, self.body, is_known)
+        return self.guarded[is_known]
+
 
 _kept: OrderedDict[str, _Parsed] = OrderedDict()
 _lock = threading.Lock()
+#: the definitions this station knows, as far as this process has read (a definition, once
+#: known, stays known: station.known)
+_known: set[str] = set()
 
 
 def _keep(sha: str, parsed: _Parsed) -> _Parsed:
@@ -55,8 +70,11 @@ def _keep(sha: str, parsed: _Parsed) -> _Parsed:
 
 def parsed(connection: Connection, shas: Iterable[str]) -> dict[str, _Parsed]:
     """The parsed definitions of ``shas`` (those stored), reading only the ones not kept yet, in
-    one query."""
+    one query, and which of them the station knows (another)."""
     wanted = {s for s in shas if s}
+    unknown = wanted - _known
+    if unknown:
+        _known.update(known(connection, unknown))
     with _lock:
         found = {s: _kept[s] for s in wanted if s in _kept}
     missing = wanted - found.keys()
@@ -85,7 +103,9 @@ def questionnaire_for(stored: StoredSession, fallback: Questionnaire | None = No
     with _lock:
         kept = _kept.get(stored.definition_sha256)
     if kept is None or kept.body is not stored.definition:
-        kept = _Parsed(stored.definition, stored.definition_sha256)  # one this module did not read
-    if kept.questionnaire is None:
+        # a definition this module did not read: parsed here, and known only if read as known
+        kept = _Parsed(stored.definition, stored.definition_sha256)
+    scored = kept.scored(stored.definition_sha256 in _known)
+    if scored is None:
         raise ExportError(f"session {stored.id}: {kept.problem}")
-    return kept.questionnaire
+    return scored

@@ -29,6 +29,7 @@ from kiosk.store.database import StoredSession
 from station import db, exports, order_progress, staff_items, validation, ward
 from station.definitions import questionnaire_for
 from station.download import attachment
+from station.formulas import GuardedQuestionnaire
 from station.plot import INCIDENTS, qos_svg
 from station.rendering import checked_form, render, templates
 from station.result_pages import ward_results
@@ -216,6 +217,7 @@ async def session_page(request: Request) -> Response:
         reviewable=stored.status in validation.REVIEWABLE and not current.final,
         reopened=bool(current.reopenings) and not current.final,
         visit=(await run_in_threadpool(order_progress.visit_kinds, engine, [session_id])).get(session_id),
+        unknown_definition=isinstance(q, GuardedQuestionnaire) and not q.known,
         message=request.query_params.get("message"),
     )
 

@@ -34,7 +34,9 @@ from station import (
     api_orders,
     auth,
     db,
+    definition_pages,
     errors,
+    formulas,
     logins,
     order_pages,
     pages,
@@ -237,6 +239,7 @@ def create_app(
         yield
         await app.state.live.stop()
         bus.stop()
+        formulas.WORKER.stop()
 
     routes = [
         Route("/login", login_page, methods=["GET"]),
@@ -248,6 +251,7 @@ def create_app(
         *order_pages.routes,
         *result_pages.routes,
         *signoff_pages.routes,
+        *definition_pages.routes,
         *staff_items.routes,
         *api.routes,
         *api_orders.routes,
