@@ -25,7 +25,7 @@ from station.sessions import LIFECYCLE, RESULT_KINDS, load_many
 
 #: inbox filters: which review states each shows
 INBOX_STATES = {"waiting": ("unreviewed", "corrected"), "signed": ("signed_off", "amended"), "all": None}
-INBOX_LIMIT = 100
+INBOX_LIMIT = 50
 VISIT_WORDS = {"order": "ordered", "staff": "started by staff", "walk-up": "walk-up"}
 
 

@@ -132,17 +132,23 @@ def sign_off(engine: Engine, session_id: str, by: User) -> None:
     """A doctor makes the result final (as recorded, or with the corrections made): the audit
     row, the session's review state and its order change in one transaction, so a result and its
     order never disagree."""
+    with engine.begin() as connection:
+        sign_off_in(connection, session_id, by)
+
+
+def sign_off_in(connection: Connection, session_id: str, by: User, at: str | None = None) -> None:
+    """:func:`sign_off` in the caller's transaction (``at``: when, default now; a history loaded
+    in bulk signs many in one transaction, bench/_history.py)."""
     if not by.is_doctor:
         raise ValidationError("only a doctor can sign off a result")
-    with engine.begin() as connection:
-        stored, entries = _locked(connection, session_id)
-        _check_open(stored, review_of(entries))
-        at = db.now_iso()
-        connection.execute(
-            audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason="")
-        )
-        connection.execute(sessions.update().where(sessions.c.id == session_id).values(signed_at=at))
-        order_progress.signed_off(connection, session_id, by)
+    stored, entries = _locked(connection, session_id)
+    _check_open(stored, review_of(entries))
+    at = at or db.now_iso()
+    connection.execute(
+        audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason="")
+    )
+    connection.execute(sessions.update().where(sessions.c.id == session_id).values(signed_at=at))
+    order_progress.signed_off(connection, session_id, by)
 
 
 def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
