@@ -76,6 +76,13 @@ def _parser() -> argparse.ArgumentParser:
         "repeat for each (default: none, the peer's own address counts)",
     )
     parser.add_argument(
+        "--formula-timeout",
+        type=float,
+        default=2.0,
+        metavar="SECONDS",
+        help="the longest a known definition's total formula may run on one result (default 2)",
+    )
+    parser.add_argument(
         "--insecure-lan",
         action="store_true",
         help="allow a non-loopback --host without TLS (only on a network you trust)",
@@ -220,6 +227,9 @@ def _serve(argv: list[str]) -> int:
     warning = roles.guard_warning(engine)
     if warning:
         print(warning, file=sys.stderr, flush=True)
+    from station import formulas
+
+    formulas.TIMEOUT_S = max(0.1, args.formula_timeout)
     try:
         known.register_shipped(engine)
     except sa.exc.SQLAlchemyError as exc:  # a database that takes no write: /healthz says so too

@@ -34,7 +34,7 @@ from typing import Any
 from basis import record
 from kiosk.core.questionnaire import Questionnaire, Score
 
-#: the longest a formula may take on one response (seconds, wall clock)
+#: the longest a formula may take on one response (seconds, wall clock; ``--formula-timeout``)
 TIMEOUT_S = 2.0
 #: the longest formula the station runs (characters)
 EXPRESSION_MAX = 4096

@@ -15,12 +15,14 @@ import pytest
 
 from kiosk.core.questionnaire import bundled_path, load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, digest
-from station.formulas import TIMEOUT_S
 from tests.station.conftest import PATIENCE_S, make_ward
 from tests.station.helpers import KioskClient, Row, Staff
 
 pytestmark = pytest.mark.slow
 
+#: the formula budget the station is started with: long enough that /healthz is asked while the
+#: formula runs even on a loaded machine (the default is 2 s)
+BUDGET_S = 20
 #: exponential backtracking in Python's re: (a+)+$ against many a's and a final '!'
 EVIL = "iif('" + "a" * 34 + "!'.matches('^(a+)+$'), 1, 0)"
 
@@ -79,7 +81,7 @@ def formula_workers(pid: int) -> list[int]:
 @pytest.mark.parametrize("database", ["sqlite", "postgresql"])
 def test_a_kiosk_formula_never_runs_in_the_station(database: str, request, station_factory) -> None:
     ward = make_ward(request.getfixturevalue("sqlite_url" if database == "sqlite" else "pg_url"))
-    station = station_factory(ward.db_url)
+    station = station_factory(ward.db_url, args=("--formula-timeout", str(BUDGET_S)))
     kiosk = KioskClient(station.url, ward.token, ward.kiosk_id)
     evil = definition_with(EVIL)
     evil_session, rows = session_rows(evil, 1)
@@ -109,14 +111,15 @@ def test_a_kiosk_formula_never_runs_in_the_station(database: str, request, stati
         target=lambda: answered.append(doctor.http.get(f"/sessions/{evil_session}", timeout=PATIENCE_S))
     )
     page_thread.start()
-    health = []
+    health, during = [], []
     while page_thread.is_alive():
         health.append(httpx.get(station.url + "/healthz", timeout=PATIENCE_S))
+        during.append(page_thread.is_alive())  # answered while the page still waited
     page_thread.join()
     assert health and all(h.status_code == 200 for h in health)
-    assert len(health) > 1  # answered again and again while the formula ran
+    assert any(during)
     assert answered[0].status_code == 200
-    assert f"took longer than {TIMEOUT_S:g} s" in answered[0].text
+    assert f"took longer than {BUDGET_S:g} s" in answered[0].text
     # and it is not run again: its export answers at once, with no total
     exported = doctor.http.get(f"/sessions/{evil_session}/export.json")
     assert exported.status_code == 200
