@@ -4,33 +4,21 @@
 One recorded session (the real kiosk's outbox rows, :func:`bench._station_client.record_patient`)
 is cloned under new session ids, patients and days, and each clone is stored by
 :func:`station.sync.intake` (the kiosk API's own use case, many sessions per transaction) and
-signed off by :func:`station.validation.sign_off` (the doctor's), at the time it would have been:
-the station's clock (:func:`station.db.now_iso`) is set to that day while the loader signs.
+signed off by :func:`station.validation.sign_off_in` (the doctor's, many in one transaction), a
+day after each was taken.
 """
 
 from __future__ import annotations
 
 import contextlib
-import copy
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from datetime import UTC, datetime, timedelta
 from typing import Any
 
 from sqlalchemy.engine import Engine
 
 from bench._station_client import Row
-from station import auth, db, sync, validation
-
-
-@contextlib.contextmanager
-def clock_at(moment: datetime) -> Iterator[None]:
-    """The station's wall clock reads ``moment`` (this process only)."""
-    real = db.now_iso
-    db.now_iso = lambda: moment.isoformat(timespec="milliseconds")
-    try:
-        yield
-    finally:
-        db.now_iso = real
+from station import auth, sync, validation
 
 
 def clone(
@@ -42,11 +30,11 @@ def clone(
     events = []
     for n, row in enumerate(template):
         at = when + (datetime.fromisoformat(row.at.replace("Z", "+00:00")) - start)
-        payload = copy.deepcopy(row.payload)
+        payload = row.payload  # shared: intake never changes a payload it is given
         if row.kind == "create_session":
-            payload.update(session_id=session_id, patient_id=patient_id, started_at=when.isoformat())
+            payload = payload | {"session_id": session_id, "patient_id": patient_id, "started_at": when.isoformat()}
         elif row.kind == "finish_session":
-            payload["finished_at"] = at.isoformat()
+            payload = payload | {"finished_at": at.isoformat()}
         events.append(
             {"seq": first_seq + n, "kind": row.kind, "session_id": session_id, "at": at.isoformat(), "payload": payload}
         )
@@ -102,10 +90,11 @@ def load_history(
             progress(loaded)
     if pending:
         flush()
-    for session_id, at in to_sign:
-        with clock_at(at):
-            validation.sign_off(engine, session_id, by)
-        signed += 1
+    for start in range(0, len(to_sign), per_transaction):
+        with engine.begin() as connection:
+            for session_id, at in to_sign[start : start + per_transaction]:
+                validation.sign_off_in(connection, session_id, by, at.isoformat(timespec="milliseconds"))
+                signed += 1
     return {"results": loaded, "signed_off": signed, "patients": min(patients, results), "years": years}
 
 
@@ -174,15 +163,14 @@ def time_pages(http: Any, pages: dict[str, str], rounds: int) -> dict[str, dict[
     return out
 
 
-def month_export(http: Any, pid: int, month: datetime) -> dict[str, Any]:
-    """Download the month's signed-off Bundle (streamed); its time, size, entries and the station's
-    memory growth while it ran (resident memory sampled every 20 ms)."""
+def month_export(http: Any, pid: int, today: datetime) -> dict[str, Any]:
+    """Download the signed-off Bundle of the 30 days up to ``today`` (streamed); its time, size,
+    entries and the station's memory growth while it ran (resident memory sampled every 20 ms)."""
     import json
     import threading
     import time
 
-    first = month.replace(day=1)
-    last = (first + timedelta(days=32)).replace(day=1) - timedelta(days=1)
+    first, last = today - timedelta(days=30), today
     before = rss_mib(pid)
     peak = [before]
     done = threading.Event()
@@ -204,7 +192,7 @@ def month_export(http: Any, pid: int, month: datetime) -> dict[str, Any]:
     sampler.join()
     entries = json.loads(body).get("entry", []) if status == 200 else []
     return {
-        "month": f"{first:%Y-%m}",
+        "period": f"{first.date()} to {last.date()}",
         "status": status,
         "seconds": round(took, 2),
         "bytes": len(body),

@@ -15,7 +15,7 @@ import sqlalchemy as sa
 from alembic import command
 from alembic.config import Config
 
-from bench._history import clock_at, load_history
+from bench._history import load_history
 from kiosk.core.questionnaire import load_questionnaire
 from kiosk.export import bundle_of
 from station import auth, db, exports, results, validation
@@ -123,8 +123,7 @@ def test_results_waiting_on_every_page(sqlite_url, station_factory, template) ->
     """The navigation's count is the same on the ward, the inbox and a result's own page."""
     make_ward(sqlite_url)
     engine = db.make_engine(sqlite_url)
-    with clock_at(NOW):
-        _load(engine, template, count=5, signed=0.4)
+    _load(engine, template, count=5, signed=0.4)
     engine.dispose()
     station = station_factory(sqlite_url)
     staff = Staff(station.url)
