@@ -24,7 +24,7 @@ from kiosk.export.captured import site_of
 from station import validation
 from station.db import sessions
 from station.definitions import questionnaire_for
-from station.sessions import load, load_many
+from station.sessions import SAMPLE_KINDS, load, load_many
 
 
 class PeriodError(ValueError):
@@ -101,7 +101,7 @@ def _signed_batches(connection: Connection, first: date, last: date, size: int =
 
 
 def _described_batch(connection: Connection, fallback: Questionnaire, ids: list[str]) -> Iterator[Described]:
-    loaded = load_many(connection, ids)
+    loaded = load_many(connection, ids, without=SAMPLE_KINDS)
     reviews = validation.reviews_in(connection, ids)
     for session_id in ids:
         kiosk, stored = loaded[session_id]

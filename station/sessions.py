@@ -279,13 +279,21 @@ def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
 RESULT_KINDS = (*LIFECYCLE, "record_answer", "withdraw_answer", "record_not_answered")
 
 
+#: the rows no export reads (the QoS engine's samples and context, its adaptations): two thirds of
+#: a session's rows, left out of the month's export (station.exports)
+SAMPLE_KINDS = ("record_metrics", "record_context", "record_adaptation")
+
+
 def load_many(
-    connection: Connection, session_ids: Iterable[str], kinds: Iterable[str] | None = None
+    connection: Connection,
+    session_ids: Iterable[str],
+    kinds: Iterable[str] | None = None,
+    without: Iterable[str] = (),
 ) -> dict[str, tuple[str, StoredSession]]:
     """Several sessions as :func:`load` reads one, in three queries whatever their number (their
     heads, their rows, the definitions this process has not parsed yet); sessions that never
     arrived are absent. ``kinds`` reads only rows of those kinds (a list of results needs
-    :data:`RESULT_KINDS`, not every metric sample)."""
+    :data:`RESULT_KINDS`, not every metric sample), ``without`` all but those."""
     ids = list(dict.fromkeys(session_ids))
     if not ids:
         return {}
@@ -297,6 +305,8 @@ def load_many(
     )
     if kinds is not None:
         query = query.where(inbox.c.kind.in_(list(kinds)))
+    if without:
+        query = query.where(inbox.c.kind.not_in(list(without)))
     rows: dict[str, list[Row]] = {session_id: [] for session_id in heads}
     for session_id, seq, kind, payload, at in connection.execute(query):
         rows[session_id].append(Row(seq, kind, json.loads(payload), at))
