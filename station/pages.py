@@ -191,7 +191,8 @@ async def session_page(request: Request) -> Response:
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
     entered = staff_items.values(q, stored, entries)
-    score = _score(q, stored, current, entered)
+    # scored off the event loop: a formula may take its whole budget (station.formulas)
+    score = await run_in_threadpool(_score, q, stored, current, entered)
     recorded = {a.item_id: a.option for a in stored.answers}
     state = review_state(current, recorded)
     return render(

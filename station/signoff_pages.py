@@ -46,7 +46,7 @@ async def confirm_page(request: Request) -> Response:
         q = questionnaire_for(stored, fallback=q)
     except ExportError as exc:
         return PlainTextResponse(f"session {session_id} cannot be described: {exc}", status_code=422)
-    score = validation.corrected(stored, q, current)["score"]
+    score = (await run_in_threadpool(validation.corrected, stored, q, current))["score"]  # off the event loop
     language = stored.language
     labels = {item.id: item.text.get(language) or item.text.get("en") or item.id for item in q.items}
     # what the result will be called once signed: the one review-state function's answer, so the
