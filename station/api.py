@@ -13,6 +13,8 @@ from collections.abc import Awaitable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
+import anyio
+import anyio.to_thread
 from sqlalchemy.engine import Connection
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
@@ -53,6 +55,21 @@ async def _kiosk(request: Request) -> str | None:
     return await run_in_threadpool(auth.kiosk_for, request.app.state.engine, token) if token else None
 
 
+#: threads the kiosks' routine batches may hold at once: past a few they only wait for one
+#: another's writes, and a staff page's reads queued behind them took seconds (bench/station.py
+#: --history); the pages keep the shared workers
+ROUTINE_LANE_THREADS = 6
+_lanes: dict[int, anyio.CapacityLimiter] = {}
+
+
+def _routine_lane() -> anyio.CapacityLimiter:
+    """The routine batches' limiter (one per event loop: a limiter belongs to its loop)."""
+    loop = id(asyncio.get_running_loop())
+    if loop not in _lanes:
+        _lanes[loop] = anyio.CapacityLimiter(ROUTINE_LANE_THREADS)
+    return _lanes[loop]
+
+
 class _Unauthorised(Exception):
     pass
 
@@ -77,7 +94,7 @@ def _in_worker(request: Request, work: Any, urgent: bool = False, status: str | 
 
     if urgent:
         return asyncio.get_running_loop().run_in_executor(ALERT_LANE, run)
-    return run_in_threadpool(run)
+    return anyio.to_thread.run_sync(run, limiter=_routine_lane())
 
 
 class _TooLarge(ValueError):

@@ -27,9 +27,9 @@ from pathlib import Path
 
 from fileio.bounded import BadFile, read_text
 from kiosk.core.visits import DEFAULT_ID_PATTERN, pattern_problem
-from station import auth, db, roles, throttle
+from station import auth, db, known, roles, throttle
 
-ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate")
+ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate", "add-definition")
 
 
 class UsageError(Exception):
@@ -57,6 +57,7 @@ def _parser() -> argparse.ArgumentParser:
         "  kiosk station remove-user NAME                  ends NAME's logins too\n"
         "  kiosk station add-kiosk NAME      prints the kiosk's token (shown once)\n"
         "  kiosk station revoke-kiosk NAME\n"
+        "  kiosk station add-definition FILE.yaml   an instrument this site uses: its total formula may run\n"
         "  kiosk station migrate --db OWNER_URL --grant APP_ROLE   (PostgreSQL) migrate as the owner; the\n"
         "      station then runs as APP_ROLE, which cannot change or switch off the audit trail",
     )
@@ -83,6 +84,13 @@ def _parser() -> argparse.ArgumentParser:
         "in front, such as NHC-0012345); the kiosks' patient_id_pattern should say the same",
     )
     parser.add_argument(
+        "--formula-timeout",
+        type=float,
+        default=2.0,
+        metavar="SECONDS",
+        help="the longest a known definition's total formula may run on one result (default 2)",
+    )
+    parser.add_argument(
         "--insecure-lan",
         action="store_true",
         help="allow a non-loopback --host without TLS (only on a network you trust)",
@@ -102,6 +110,9 @@ def _admin_parser(command: str) -> argparse.ArgumentParser:
             help="PostgreSQL: let this role run the station (tables read and written, the audit "
             "trail only read and added to); repeat for several",
         )
+        return parser
+    if command == "add-definition":
+        parser.add_argument("file", type=Path, help="the instrument file (YAML), as the kiosks run it")
         return parser
     parser.add_argument("name", help="the user's or kiosk's name")
     if command == "add-user":
@@ -157,6 +168,14 @@ def _admin(command: str, argv: list[str]) -> int:
     elif command == "remove-user":
         ended = auth.remove_user(engine, args.name)
         print(f"user {args.name} removed; {ended} login(s) ended")
+    elif command == "add-definition":
+        from kiosk.core.questionnaire import QuestionnaireError
+
+        try:
+            found, sha = known.register_file(engine, args.file, getpass.getuser())
+        except QuestionnaireError as exc:
+            raise UsageError(f"{args.file}: {exc}") from None
+        print(f"definition {found} {sha} registered: the station runs its total formula")
     elif command == "add-kiosk":
         token = auth.add_kiosk(engine, args.name)
         print(f"kiosk {args.name} added; its token (shown only now; put it in the kiosk's config as station.token):")
@@ -207,8 +226,10 @@ def _serve(argv: list[str]) -> int:
         raise UsageError(str(exc)) from None
     if (problem := pattern_problem(args.patient_id_pattern)) is not None:
         raise UsageError(problem.replace("patient_id_pattern", "--patient-id-pattern", 1))
+    import sqlalchemy as sa
     import uvicorn
 
+    from station import errors
     from station.web import create_app
 
     engine = db.open_database(_url(args.db))
@@ -216,6 +237,13 @@ def _serve(argv: list[str]) -> int:
     warning = roles.guard_warning(engine)
     if warning:
         print(warning, file=sys.stderr, flush=True)
+    from station import formulas
+
+    formulas.TIMEOUT_S = max(0.1, args.formula_timeout)
+    try:
+        known.register_shipped(engine)
+    except sa.exc.SQLAlchemyError as exc:  # a database that takes no write: /healthz says so too
+        print(f"kiosk station: cannot register the shipped instruments: {errors.reason(exc)}", file=sys.stderr)
     app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies, id_pattern=args.patient_id_pattern)
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})", flush=True)

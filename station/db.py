@@ -99,6 +99,9 @@ sessions = sa.Table(
     sa.Column("definition_sha256", sa.String(64)),
     #: the definition was attached by the station (an upgrade, or a kiosk that sent none): the bundled one
     sa.Column("definition_attached_later", sa.Boolean, nullable=False, server_default=sa.false()),
+    #: when the sign-off the result stands under was made; NULL while it waits for validation
+    #: (never signed, or reopened to amend): written with the audit row that changes it
+    sa.Column("signed_at", sa.String(40)),
 )
 
 #: questionnaire definitions, stored once per content (kiosk.core.questionnaire.definition: canonical JSON, SHA-256)
@@ -110,6 +113,9 @@ definitions = sa.Table(
     sa.Column("version", sa.Text, nullable=False),
     sa.Column("body", sa.Text, nullable=False),
     sa.Column("stored_at", sa.String(40), nullable=False),
+    #: who made the station know it (station.known): "shipped", "registered by NAME", a doctor
+    sa.Column("known_by", sa.String(64)),
+    sa.Column("known_at", sa.String(40)),
 )
 
 alerts = sa.Table(

@@ -11,6 +11,8 @@ only stands in for a session that captured none.
 
 from __future__ import annotations
 
+import json
+from collections.abc import Iterator
 from datetime import date, timedelta
 
 import sqlalchemy as sa
@@ -18,10 +20,11 @@ from sqlalchemy.engine import Connection, Engine
 
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.export import Described, bundle_of, csv_text, result
-from kiosk.export.captured import questionnaire_of, site_of
+from kiosk.export.captured import site_of
 from station import validation
-from station.db import audit
-from station.sessions import load
+from station.db import sessions
+from station.definitions import questionnaire_for
+from station.sessions import SAMPLE_KINDS, load, load_many
 
 
 class PeriodError(ValueError):
@@ -31,7 +34,7 @@ class PeriodError(ValueError):
 def _described(connection: Connection, fallback: Questionnaire, session_id: str) -> Described:
     kiosk, stored = load(connection, session_id)
     review = validation.review_in(connection, session_id)
-    q = questionnaire_of(stored, fallback=fallback)
+    q = questionnaire_for(stored, fallback=fallback)
     return Described(q, result(q, stored, review), site_of(stored, kiosk))
 
 
@@ -61,29 +64,82 @@ def period(start: str, end: str) -> tuple[date, date]:
     return days[0], days[1]
 
 
+#: results read, described and sent at a time by the period's export
+BATCH = 200
+
+
 def signed_off_in(engine: Engine, first: date, last: date) -> list[str]:
     """The sessions whose result is signed off now, by a sign-off made from ``first`` to ``last``
     (UTC days, both included), oldest sign-off first. A result reopened for amendment and not
     signed again is left out: the hospital keeps its earlier signed version until then."""
-    start, end = first.isoformat(), (last + timedelta(days=1)).isoformat()
     with engine.connect() as connection:
-        candidates = list(
-            dict.fromkeys(
-                connection.execute(
-                    sa.select(audit.c.session_id)
-                    .where(audit.c.action == "sign_off", audit.c.at >= start, audit.c.at < end)
-                    .order_by(audit.c.id)
-                ).scalars()
-            )
+        return [sid for batch in _signed_batches(connection, first, last) for sid in batch]
+
+
+def _signed_batches(connection: Connection, first: date, last: date, size: int = BATCH) -> Iterator[list[str]]:
+    """:func:`signed_off_in`'s sessions, ``size`` at a time: keyset pages over the index on the
+    session's stored sign-off time (Alembic ``0006_history``), so a month's export reads the
+    month, never the years before it."""
+    start, end = first.isoformat(), (last + timedelta(days=1)).isoformat()
+    key = ("", "")
+    while True:
+        query = (
+            sa.select(sessions.c.signed_at, sessions.c.id)
+            .where(sessions.c.signed_at >= start, sessions.c.signed_at < end)
+            .order_by(sessions.c.signed_at, sessions.c.id)
+            .limit(size)
         )
-    reviews = validation.reviews(engine, candidates)
-    chosen = [s for s in candidates if reviews[s].final and start <= (reviews[s].signed_at or "") < end]
-    return sorted(chosen, key=lambda s: reviews[s].signed_at or "")
+        if key[0]:
+            query = query.where(sa.tuple_(sessions.c.signed_at, sessions.c.id) > sa.tuple_(*key))
+        rows = connection.execute(query).all()
+        if not rows:
+            return
+        yield [r.id for r in rows]
+        key = (rows[-1].signed_at, rows[-1].id)
+        if len(rows) < size:
+            return
+
+
+def _described_batch(connection: Connection, fallback: Questionnaire, ids: list[str]) -> Iterator[Described]:
+    loaded = load_many(connection, ids, without=SAMPLE_KINDS)
+    reviews = validation.reviews_in(connection, ids)
+    for session_id in ids:
+        kiosk, stored = loaded[session_id]
+        q = questionnaire_for(stored, fallback=fallback)
+        yield Described(q, result(q, stored, reviews[session_id]), site_of(stored, kiosk))
 
 
 def period_bundle(engine: Engine, q: Questionnaire, first: date, last: date) -> dict:
     """Every result signed off from ``first`` to ``last`` (:func:`signed_off_in`) in one
-    transaction Bundle (no entry when there is none)."""
-    sessions = signed_off_in(engine, first, last)
+    transaction Bundle (no entry when there is none): :func:`period_chunks`, read whole."""
+    return json.loads("".join(period_chunks(engine, q, first, last)))
+
+
+def period_chunks(engine: Engine, q: Questionnaire, first: date, last: date) -> Iterator[str]:
+    """:func:`period_bundle` as JSON text, a batch of results at a time, in constant memory:
+    each result's entries (:func:`kiosk.export.bundle_of` of that one result) as it is read,
+    its Questionnaire and Device the first time a result needs them, before that result's
+    entries (each once per Bundle, as ``bundle_of`` gives them; fullUrls are derived from
+    identifiers, so references resolve wherever they stand). The first batch is described
+    before the first byte, so what cannot be exported there is an ExportError the caller can
+    answer; a later one ends the stream unfinished (invalid JSON), never a Bundle silently short."""
+    seen: set[str] = set()
     with engine.connect() as connection:
-        return bundle_of([_described(connection, q, session_id) for session_id in sessions])
+        batches = _signed_batches(connection, first, last)
+        pending = list(_described_batch(connection, q, next(batches, [])))
+        if not pending:
+            yield json.dumps({"resourceType": "Bundle", "type": "transaction"})
+            return
+        yield '{"resourceType": "Bundle", "type": "transaction", "entry": [\n'
+        comma = ""
+        while pending:
+            for described in pending:
+                for entry in bundle_of([described]).get("entry", []):
+                    if entry["resource"]["resourceType"] in ("Questionnaire", "Device"):
+                        if entry["fullUrl"] in seen:
+                            continue
+                        seen.add(entry["fullUrl"])
+                    yield comma + json.dumps(entry, ensure_ascii=False)
+                    comma = ",\n"
+            pending = list(_described_batch(connection, q, next(batches, [])))
+        yield "\n]}"

@@ -53,7 +53,11 @@ class _Changed:
 
 
 class Live:
-    """Renders bus messages into page events and fans them out to the open pages."""
+    """Renders bus messages into page events and fans them out to the open pages.
+
+    Alerts have a path of their own: a task and a thread that render only the open alerts (an
+    index over the open ones, Alembic ``0006_history``), so a doctor call never waits behind a
+    kiosk's tile, the results count, or whatever else the station is rendering."""
 
     def __init__(
         self,
@@ -68,25 +72,50 @@ class Live:
         #: the results event: the count waiting and the results that just finished (they ring)
         self._render_results = render_results
         self._pages: set[asyncio.Queue[str]] = set()
-        self._task: asyncio.Task[None] | None = None
-        #: a thread of its own: rendering an alert never queues behind the kiosks' requests
+        self._tasks: list[asyncio.Task[None]] = []
+        #: a thread for alerts alone, and one for the rest (tiles, results)
+        self._alert_thread = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-alerts-live")
         self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-live")
 
     def start(self) -> None:
-        self._task = asyncio.get_running_loop().create_task(self._run())
+        loop = asyncio.get_running_loop()
+        self._tasks = [loop.create_task(self._run_alerts()), loop.create_task(self._run())]
 
     async def stop(self) -> None:
-        if self._task is not None:
-            self._task.cancel()
+        for task in self._tasks:
+            task.cancel()
         self._executor.shutdown(wait=False)
+        self._alert_thread.shutdown(wait=False)
 
     async def _render(self, render: Callable[..., dict[str, Any]], *args: Any) -> dict[str, Any]:
         return await asyncio.get_running_loop().run_in_executor(self._executor, render, *args)
 
+    async def _alerts_text(self) -> str:
+        return sse("alerts", await asyncio.get_running_loop().run_in_executor(self._alert_thread, self._render_alerts))
+
+    def _send(self, text: str) -> None:
+        for page in list(self._pages):
+            page.put_nowait(text)
+
+    async def _run_alerts(self) -> None:
+        """The alerts' own path: on any change of an alert, the open alerts, rendered once for
+        every page (the messages queued meanwhile taken together)."""
+        queue = self._bus.subscribe()
+        while True:
+            message = await queue.get()
+            wanted = message.get("type") in ("alert", "ack")
+            while not queue.empty():
+                wanted |= queue.get_nowait().get("type") in ("alert", "ack")
+            if not wanted or not self._pages:
+                continue
+            try:
+                self._send(await self._alerts_text())
+            except Exception:  # a page must keep its feed even if one render fails
+                log.exception("station: could not render the alerts for the live feed")
+
     async def _run(self) -> None:
-        """Render what changed, one piece at a time, alerts before tiles: after each render the
-        messages that arrived meanwhile are taken in, so a new alert never waits behind a burst
-        of status reports."""
+        """Render what else changed, one piece at a time: after each render the messages that
+        arrived meanwhile are taken in."""
         queue = self._bus.subscribe()
         changed = _Changed()
         while True:
@@ -94,16 +123,14 @@ class Live:
                 changed.take(await queue.get())
             while not queue.empty():
                 changed.take(queue.get_nowait())
-            if not self._pages:
+            changed.alerts = False  # the alerts' own path sends those
+            if not self._pages or not changed:
                 changed = _Changed()
                 continue
             try:
                 if changed.resync:
                     changed = _Changed()
                     text = sse("resync", {})
-                elif changed.alerts:
-                    changed.alerts = False
-                    text = sse("alerts", await self._render(self._render_alerts))
                 elif changed.results:
                     finished, changed.finished, changed.results = changed.finished, [], False
                     if self._render_results is None:
@@ -114,8 +141,7 @@ class Live:
             except Exception:  # a page must keep its feed even if one render fails
                 log.exception("station: could not render a live update")
                 continue
-            for page in list(self._pages):
-                page.put_nowait(text)
+            self._send(text)
 
     async def stream(self) -> AsyncIterator[str]:
         """The event stream of one open page (ends when the page goes away)."""
@@ -123,7 +149,7 @@ class Live:
         self._pages.add(page)
         try:
             yield "retry: 1000\n\n"
-            yield sse("alerts", await self._render(self._render_alerts))
+            yield await self._alerts_text()
             while True:
                 try:
                     yield await asyncio.wait_for(page.get(), timeout=KEEPALIVE_S)

@@ -184,38 +184,38 @@ def _move(connection: Connection, session_id: str, source: str, target: str, act
     return True
 
 
-def signed_off(engine: Engine, session_id: str, by: Any) -> None:
-    """The session's result was signed off: its order (if any) is done once every result of it
-    is (a battery's results are signed off one by one)."""
+def signed_off(connection: Connection, session_id: str, by: Any) -> None:
+    """The session's result was signed off (in the caller's transaction, the sign-off's own): its
+    order (if any) is done once every result of it is (a battery's results are signed off one by
+    one)."""
     from station.validation import review_in
 
-    with engine.begin() as connection:
-        order = _order_of(connection, session_id)
-        others = [s for s in _sessions_of(connection, order) if s != session_id] if order is not None else []
-        if any(_is_finished(connection, s) and not review_in(connection, s).final for s in others):
-            return
-        _move(
-            connection,
-            session_id,
-            "awaiting_validation",
-            "signed_off",
-            "order_signed",
-            f"result of session {session_id} signed off by {by.name}",
-        )
+    order = _order_of(connection, session_id)
+    others = [s for s in _sessions_of(connection, order) if s != session_id] if order is not None else []
+    if any(_is_finished(connection, s) and not review_in(connection, s).final for s in others):
+        return
+    _move(
+        connection,
+        session_id,
+        "awaiting_validation",
+        "signed_off",
+        "order_signed",
+        f"result of session {session_id} signed off by {by.name}",
+    )
 
 
-def reopened(engine: Engine, session_id: str, by: Any) -> None:
-    """A doctor reopened the session's signed-off result to amend it: its order (if any) awaits
-    validation again, so the order never says "signed off" of a result that is not."""
-    with engine.begin() as connection:
-        _move(
-            connection,
-            session_id,
-            "signed_off",
-            "awaiting_validation",
-            "order_reopened",
-            f"result of session {session_id} reopened to amend by {by.name}",
-        )
+def reopened(connection: Connection, session_id: str, by: Any) -> None:
+    """A doctor reopened the session's signed-off result to amend it (in the caller's
+    transaction): its order (if any) awaits validation again, so the order never says "signed
+    off" of a result that is not."""
+    _move(
+        connection,
+        session_id,
+        "signed_off",
+        "awaiting_validation",
+        "order_reopened",
+        f"result of session {session_id} reopened to amend by {by.name}",
+    )
 
 
 def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[str, str | None]]:

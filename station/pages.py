@@ -9,24 +9,26 @@ not fit its questionnaire (rows stored before they were checked) is left out, ne
 
 from __future__ import annotations
 
+import itertools
 import json
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
-from starlette.responses import PlainTextResponse, Response
+from starlette.responses import PlainTextResponse, Response, StreamingResponse
 from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import review_state, state_once_signed
 from kiosk.core.staff import waiting_line
 from kiosk.export import ExportError, practice_outcomes
-from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import StoredSession
 from station import db, exports, order_progress, staff_items, validation, ward
+from station.definitions import questionnaire_for
 from station.download import attachment
+from station.formulas import GuardedQuestionnaire
 from station.plot import INCIDENTS, qos_svg
 from station.redirects import see_other
 from station.rendering import checked_form, render, templates
@@ -185,11 +187,12 @@ async def session_page(request: Request) -> Response:
         kiosk, stored = await run_in_threadpool(_load, engine, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
-    q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
+    q = questionnaire_for(stored, fallback=request.app.state.questionnaire)
     entries = await run_in_threadpool(validation.trail, engine, session_id)
     current = validation.review_of(entries)
     entered = staff_items.values(q, stored, entries)
-    score = _score(q, stored, current, entered)
+    # scored off the event loop: a formula may take its whole budget (station.formulas)
+    score = await run_in_threadpool(_score, q, stored, current, entered)
     recorded = {a.item_id: a.option for a in stored.answers}
     state = review_state(current, recorded)
     return render(
@@ -205,7 +208,7 @@ async def session_page(request: Request) -> Response:
         items=_items(q, stored, current),
         score=score,
         entered=entered,
-        waiting=waiting_line(score.awaiting_staff),
+        awaiting=waiting_line(score.awaiting_staff),
         practice=_practice(q, stored),
         plot=qos_svg(stored),
         incidents=[e for e in stored.log if e.kind in INCIDENTS],
@@ -215,6 +218,7 @@ async def session_page(request: Request) -> Response:
         reviewable=stored.status in validation.REVIEWABLE and not current.final,
         reopened=bool(current.reopenings) and not current.final,
         visit=(await run_in_threadpool(order_progress.visit_kinds, engine, [session_id])).get(session_id),
+        unknown_definition=isinstance(q, GuardedQuestionnaire) and not q.known,
         message=request.query_params.get("message"),
     )
 
@@ -235,7 +239,7 @@ async def change_item(request: Request) -> Response:
         return _back(request, "Choose the new answer.", to=page)
     try:
         _, stored = await run_in_threadpool(_load, engine, session_id)
-        q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
+        q = questionnaire_for(stored, fallback=request.app.state.questionnaire)
         await run_in_threadpool(
             validation.change_item,
             engine,
@@ -259,7 +263,6 @@ async def sign_off(request: Request) -> Response:
         await run_in_threadpool(validation.sign_off, request.app.state.engine, session_id, request.state.user)
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
-    await run_in_threadpool(order_progress.signed_off, request.app.state.engine, session_id, request.state.user)
     await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Signed off.", to=page)
 
@@ -274,7 +277,6 @@ async def amend(request: Request) -> Response:
         )
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
-    await run_in_threadpool(order_progress.reopened, request.app.state.engine, session_id, request.state.user)
     await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
     return _back(request, "Reopened to amend: change the answers, then sign off again.", to=page)
 
@@ -306,26 +308,43 @@ async def export(request: Request) -> Response:
     return _attachment(body, "text/csv", session_id, ".csv")
 
 
+def _joined(chunks: Iterator[str], size: int = 1 << 16) -> Iterator[str]:
+    """``chunks`` joined into pieces of about ``size`` characters: one worker-thread hop per
+    piece, not per FHIR entry."""
+    piece: list[str] = []
+    length = 0
+    for chunk in chunks:
+        piece.append(chunk)
+        length += len(chunk)
+        if length >= size:
+            yield "".join(piece)
+            piece, length = [], 0
+    if piece:
+        yield "".join(piece)
+
+
 async def period_export(request: Request) -> Response:
     """Every result signed off in a period (``?from=YYYY-MM-DD&to=YYYY-MM-DD``, UTC days, both
-    included) as one FHIR transaction Bundle."""
+    included) as one FHIR transaction Bundle, streamed as it is read (constant memory, however
+    many results: :func:`station.exports.period_chunks`)."""
     engine, q = request.app.state.engine, request.app.state.questionnaire
     start, end = request.query_params.get("from", ""), request.query_params.get("to", "")
     try:
         first, last = exports.period(start, end)
     except exports.PeriodError as exc:
         return PlainTextResponse(str(exc), status_code=400)
+    pieces = _joined(exports.period_chunks(engine, q, first, last))
     try:
-        bundle = await run_in_threadpool(exports.period_bundle, engine, q, first, last)
+        head = await run_in_threadpool(next, pieces, "")
     except ExportError as exc:
         return PlainTextResponse(
             f"the results signed off from {first} to {last} cannot be exported: {exc}", status_code=422
         )
-    return _attachment(
-        json.dumps(bundle, indent=2, ensure_ascii=False),
-        "application/fhir+json",
-        f"signed-off-{first}-{last}",
-        ".fhir.json",
+    stem = f"signed-off-{first}-{last}"
+    return StreamingResponse(
+        itertools.chain([head], pieces),
+        media_type="application/fhir+json",
+        headers={"content-disposition": attachment(stem, ".fhir.json")},
     )
 
 

@@ -58,8 +58,10 @@ async def checked_form(request: Request) -> dict[str, str]:
 def render(request: Request, name: str, status: int = 200, **context: Any) -> Response:
     context.setdefault("user", getattr(request.state, "user", None))
     if context["user"] is not None and "waiting" not in context:  # the navigation's count
-        from station.results import waiting_count
+        context["waiting"] = getattr(request.state, "waiting", None)
+        if context["waiting"] is None:  # read with the login, in the staff lane (station.web)
+            from station.results import waiting_count
 
-        context["waiting"] = waiting_count(request.app.state.engine)
+            context["waiting"] = waiting_count(request.app.state.engine)
     context["csrf"] = csrf_token(request)
     return templates.TemplateResponse(request, name, context, status_code=status)

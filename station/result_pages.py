@@ -13,12 +13,17 @@ from starlette.requests import Request
 from starlette.responses import HTMLResponse, PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from station import db, orders, results, ward
+from station import db, orders, results
 from station.course_plot import course_svg
 from station.rendering import render, templates
 
 #: sessions in the ward page's Results list
 RECENT = 50
+
+
+def _kiosk_names(engine: Any) -> list[str]:
+    with engine.connect() as connection:
+        return list(connection.execute(sa.select(db.kiosks.c.name).order_by(db.kiosks.c.name)).scalars())
 
 
 async def inbox_page(request: Request) -> Response:
@@ -27,9 +32,19 @@ async def inbox_page(request: Request) -> Response:
     if state not in results.INBOX_STATES:
         state = "waiting"
     kiosk = request.query_params.get("kiosk") or ""
-    found = await run_in_threadpool(lambda: results.inbox(engine, q, state=state, kiosk_id=kiosk or None))
-    names = await run_in_threadpool(lambda: [k.name for k in ward.kiosk_views(engine)])
-    return render(request, "inbox.html", results=found, state=state, kiosk=kiosk, kiosks=names)
+    after = request.query_params.get("after") or ""
+    found = await run_in_threadpool(lambda: results.inbox(engine, q, state=state, kiosk_id=kiosk or None, after=after))
+    names = await run_in_threadpool(_kiosk_names, engine)
+    return render(
+        request,
+        "inbox.html",
+        results=found.results,
+        more=found.after,
+        after=after,
+        state=state,
+        kiosk=kiosk,
+        kiosks=names,
+    )
 
 
 async def patients_page(request: Request) -> Response:
@@ -72,8 +87,8 @@ routes = [
 
 def results_event(app: Any, finished: list[str]) -> dict[str, Any]:
     """The count of results waiting, and the ones that just finished (the pages ring for them).
-    Cheap on purpose (two small queries, no session folded): it is rendered on the live feed's
-    one thread, which alerts share."""
+    Cheap on purpose (two small indexed queries, no session folded); alerts never wait for it
+    (:mod:`station.live` renders them on a thread of their own)."""
     engine = app.state.engine
     rung = []
     if finished:
@@ -97,11 +112,16 @@ async def inbox_rows(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     state = request.query_params.get("state", "waiting")
     kiosk = request.query_params.get("kiosk") or None
+    after = request.query_params.get("after") or ""
     found = await run_in_threadpool(
-        lambda: results.inbox(engine, q, state=state if state in results.INBOX_STATES else "waiting", kiosk_id=kiosk)
+        lambda: results.inbox(
+            engine, q, state=state if state in results.INBOX_STATES else "waiting", kiosk_id=kiosk, after=after
+        )
     )
     template = templates.get_template("_result_row.html")
-    html = "".join(template.render(r=r) for r in found) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
+    html = (
+        "".join(template.render(r=r) for r in found.results) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
+    )
     return HTMLResponse(html)
 
 

@@ -12,20 +12,20 @@ from collections.abc import Sequence
 from typing import Any
 
 import sqlalchemy as sa
-from sqlalchemy.engine import Engine
+from sqlalchemy.engine import Connection, Engine
 
 from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import review_state
 from kiosk.export import ExportError
-from kiosk.export.captured import questionnaire_of
 from station import order_progress, validation
-from station.db import audit, sessions
-from station.sessions import load
+from station.db import sessions
+from station.definitions import questionnaire_for
+from station.sessions import LIFECYCLE, RESULT_KINDS, load_many
 
 #: inbox filters: which review states each shows
 INBOX_STATES = {"waiting": ("unreviewed", "corrected"), "signed": ("signed_off", "amended"), "all": None}
-INBOX_LIMIT = 100
+INBOX_LIMIT = 50
 VISIT_WORDS = {"order": "ordered", "staff": "started by staff", "walk-up": "walk-up"}
 
 
@@ -65,92 +65,118 @@ class Result:
         return VISIT_WORDS.get(self.visit, "not recorded")
 
 
-def _signed(engine: Engine) -> Any:
-    """Sessions whose latest sign-off or reopening is a sign-off: a result a doctor reopened to
-    amend waits for validation again, as :func:`kiosk.core.review.review_from_steps` says."""
-    latest = (
-        sa.select(audit.c.session_id, sa.func.max(audit.c.id).label("last"))
-        .where(audit.c.action.in_(("sign_off", "amend")))
-        .group_by(audit.c.session_id)
-        .subquery()
-    )
-    return sa.select(latest.c.session_id).join(audit, audit.c.id == latest.c.last).where(audit.c.action == "sign_off")
+def _signed() -> Any:
+    """Whether a result stands signed off: its latest sign-off or reopening is a sign-off (a
+    result a doctor reopened to amend waits for validation again, as
+    :func:`kiosk.core.review.review_from_steps` says), stored on the session by the transaction
+    that changed it (:mod:`station.validation`), never recomputed over the trail."""
+    return sessions.c.signed_at.is_not(None)
 
 
 def waiting_count(engine: Engine) -> int:
-    """Finished results no doctor has signed off yet (the count in the navigation)."""
+    """Finished results no doctor has signed off yet (the count in the navigation): an index
+    range over the results waiting, whatever the years of signed ones."""
     with engine.connect() as connection:
-        return int(
-            connection.execute(
-                sa.select(sa.func.count())
-                .select_from(sessions)
-                .where(sessions.c.status == "finished", sessions.c.id.not_in(_signed(engine)))
-            ).scalar_one()
-        )
+        return waiting_in(connection)
+
+
+def waiting_in(connection: Connection) -> int:
+    return int(
+        connection.execute(
+            sa.select(sa.func.count())
+            .select_from(sessions)
+            .where(sessions.c.status == "finished", sessions.c.signed_at.is_(None))
+        ).scalar_one()
+    )
 
 
 def results_of(engine: Engine, q: Questionnaire, rows: Sequence[Any]) -> list[Result]:
-    """The results of these session rows (anything with an ``id``), in their order."""
+    """The results of these session rows (anything with an ``id``), in their order: a handful of
+    queries for the whole list (:func:`station.sessions.load_many`), each definition parsed once."""
     ids = [r.id for r in rows]
     reviews = validation.reviews(engine, ids)
     kinds = order_progress.visit_kinds(engine, ids)
     found = []
     with engine.connect() as connection:
-        for row in rows:
-            kiosk, stored = load(connection, row.id)
-            review = reviews[row.id]
-            try:  # scored on the questionnaire the session ran, not the one the station bundles
-                ran = questionnaire_of(stored, fallback=q)
-            except ExportError:
-                ran = None
-            score = (
-                validation.corrected(stored, ran, review)["score"]
-                if ran and stored.questionnaire_id == ran.id
-                else None
+        loaded = load_many(connection, ids, RESULT_KINDS)
+    for session_id in ids:
+        if session_id not in loaded:
+            continue
+        kiosk, stored = loaded[session_id]
+        review = reviews[session_id]
+        try:  # scored on the questionnaire the session ran, not the one the station bundles
+            ran = questionnaire_for(stored, fallback=q)
+        except ExportError:
+            ran = None
+        score = (
+            validation.corrected(stored, ran, review)["score"] if ran and stored.questionnaire_id == ran.id else None
+        )
+        state = review_state(review, {a.item_id: a.option for a in stored.answers})
+        kind, order_id = kinds.get(session_id, ("", None))
+        found.append(
+            Result(
+                session_id,
+                kiosk,
+                stored.patient_id,
+                stored.questionnaire_id,
+                stored.started_at,
+                stored.finished_at,
+                stored.status,
+                score.total if score and score.complete else None,
+                score.max_total if score else 0,
+                bool(score and score.complete),
+                score.band.id if score and score.band else None,
+                state.value,
+                stored.simulated,
+                kind,
+                order_id,
+                (ran.title.get(stored.language) or ran.title.get("en") or "") if ran else "",
             )
-            state = review_state(review, {a.item_id: a.option for a in stored.answers})
-            kind, order_id = kinds.get(row.id, ("", None))
-            found.append(
-                Result(
-                    row.id,
-                    kiosk,
-                    stored.patient_id,
-                    stored.questionnaire_id,
-                    stored.started_at,
-                    stored.finished_at,
-                    stored.status,
-                    score.total if score and score.complete else None,
-                    score.max_total if score else 0,
-                    bool(score and score.complete),
-                    score.band.id if score and score.band else None,
-                    state.value,
-                    stored.simulated,
-                    kind,
-                    order_id,
-                    (ran.title.get(stored.language) or ran.title.get("en") or "") if ran else "",
-                )
-            )
+        )
     return found
 
 
-def inbox(engine: Engine, q: Questionnaire, *, state: str = "waiting", kiosk_id: str | None = None) -> list[Result]:
+@record
+class Page:
+    """One page of a long list, newest first, and where the next (older) one starts."""
+
+    results: list[Result]
+    #: the ``after`` of the next page ("" when this is the last)
+    after: str = ""
+
+
+def inbox(
+    engine: Engine,
+    q: Questionnaire,
+    *,
+    state: str = "waiting",
+    kiosk_id: str | None = None,
+    after: str = "",
+    limit: int = INBOX_LIMIT,
+) -> Page:
     """Finished results, newest first, in the review states of ``state`` (:data:`INBOX_STATES`),
-    of one kiosk or all."""
+    of one kiosk or all. Keyset pages: ``after`` is the previous page's last (finish time, id), so
+    the hundredth page costs what the first does (an index range, never an OFFSET)."""
     query = (
-        sa.select(sessions.c.id)
+        sa.select(sessions.c.id, sessions.c.finished_at)
         .where(sessions.c.status == "finished")
-        .order_by(sessions.c.finished_at.desc())
-        .limit(INBOX_LIMIT)
+        .order_by(sessions.c.finished_at.desc(), sessions.c.id.desc())
+        .limit(limit + 1)
     )
     if kiosk_id:
         query = query.where(sessions.c.kiosk_id == kiosk_id)
     if state == "waiting":
-        query = query.where(sessions.c.id.not_in(_signed(engine)))
+        query = query.where(sa.not_(_signed()))
     elif state == "signed":
-        query = query.where(sessions.c.id.in_(_signed(engine)))
+        query = query.where(_signed())
+    finished_at, _, session_id = after.partition("|")
+    if finished_at:
+        query = query.where(sa.tuple_(sessions.c.finished_at, sessions.c.id) < sa.tuple_(finished_at, session_id))
     with engine.connect() as connection:
         rows = connection.execute(query).all()
-    return results_of(engine, q, rows)
+    more = len(rows) > limit
+    rows = rows[:limit]
+    return Page(results_of(engine, q, rows), f"{rows[-1].finished_at}|{rows[-1].id}" if more else "")
 
 
 def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
@@ -174,26 +200,46 @@ def instruments(engine: Engine, q: Questionnaire, visits: list[Result]) -> list[
         latest[visit.questionnaire_id] = visit.session_id
     found: list[Questionnaire] = []
     with engine.connect() as connection:
-        for questionnaire_id, session_id in latest.items():
-            _, stored = load(connection, session_id)
-            try:
-                ran = questionnaire_of(stored, fallback=q if questionnaire_id == q.id else None)
-            except ExportError:  # nothing to plot it against: its rows still list the visit
-                continue
-            if ran.id == questionnaire_id:
-                found.append(ran)
+        loaded = load_many(connection, latest.values(), LIFECYCLE)
+    for questionnaire_id, session_id in latest.items():
+        if session_id not in loaded:
+            continue
+        _, stored = loaded[session_id]
+        try:
+            ran = questionnaire_for(stored, fallback=q if questionnaire_id == q.id else None)
+        except ExportError:  # nothing to plot it against: its rows still list the visit
+            continue
+        if ran.id == questionnaire_id:
+            found.append(ran)
     return found or [q]
 
 
+def prefix_range(text: str) -> tuple[str, str]:
+    """The identifiers starting with ``text`` as a range [low, high) in code-point order: what an
+    index on the identifier answers without reading the rest (a contains-search reads them all)."""
+    return text, text[:-1] + chr(ord(text[-1]) + 1)
+
+
+def _starts_with(text: str, postgres: bool) -> Any:
+    column = sessions.c.patient_id
+    if postgres:  # the text_pattern_ops index answers LIKE 'prefix%' (Alembic 0006_history)
+        escaped = text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
+        return column.like(escaped + "%", escape="\\")
+    low, high = prefix_range(text)
+    return sa.and_(column >= low, column < high)
+
+
 def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, str]]:
-    """Patients whose identifier contains ``text`` (case-insensitive): (id, visits, last visit)."""
+    """Patients whose identifier starts with ``text`` as typed or in capitals (hospital numbers
+    are written in capitals, staff type in either): (id, visits, last visit), latest first."""
     text = text.strip()
     if not text:
         return []
-    pattern = "%" + text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_") + "%"
+    postgres = engine.dialect.name == "postgresql"
+    prefixes = list(dict.fromkeys((text, text.upper())))
     query = (
         sa.select(sessions.c.patient_id, sa.func.count(), sa.func.max(sessions.c.started_at))
-        .where(sessions.c.patient_id.ilike(pattern, escape="\\"), sessions.c.status != "pending")
+        .where(sa.or_(*(_starts_with(p, postgres) for p in prefixes)), sessions.c.status != "pending")
         .group_by(sessions.c.patient_id)
         .order_by(sa.func.max(sessions.c.started_at).desc())
         .limit(limit)

@@ -21,7 +21,6 @@ from kiosk.core.channels import Channel
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.session import Answer, AnsweredBy
 from kiosk.export import ExportError
-from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import (
     AdaptationRecord,
     LogEntry,
@@ -29,7 +28,9 @@ from kiosk.store.database import (
     PracticeRecord,
     StoredSession,
 )
-from station.db import definitions, inbox, sessions
+from station import definitions
+from station.db import inbox, sessions
+from station.definitions import questionnaire_for
 
 #: the outbox kinds that change a session's status (they refresh the session list)
 LIFECYCLE = ("create_session", "finish_session", "abandon", "mark_interrupted", "continue_session")
@@ -202,31 +203,26 @@ def _apply(
         log.append(LogEntry(float(p.get("t", 0.0)), f"unrecognised:{row.kind}", json.dumps(p)[:200]))
 
 
-def _kiosk_and_rows(connection: Connection, session_id: str) -> tuple[str, list[Row]]:
-    kiosk = connection.execute(sa.select(sessions.c.kiosk_id).where(sessions.c.id == session_id)).scalar()
-    if kiosk is None:
-        raise NotFound(session_id)
-    return kiosk, rows_of(connection, session_id)
+def _heads(connection: Connection, session_ids: list[str]) -> dict[str, Any]:
+    """The sessions' rows of ``sessions`` (kiosk and definition), by id, in one query."""
+    columns = (sessions.c.id, sessions.c.kiosk_id, sessions.c.definition_sha256, sessions.c.definition_attached_later)
+    return {r.id: r for r in connection.execute(sa.select(*columns).where(sessions.c.id.in_(session_ids)))}
 
 
-def _with_definition(connection: Connection, stored: StoredSession) -> StoredSession:
+def _with_definition(stored: StoredSession, head: Any, kept: dict[str, Any]) -> StoredSession:
     """``stored`` with the definition it runs (None if its create_session never arrived), and only
     what fits it (see :func:`fitted`)."""
-    row = connection.execute(
-        sa.select(sessions.c.definition_sha256, sessions.c.definition_attached_later, definitions.c.body)
-        .select_from(sessions.outerjoin(definitions, definitions.c.sha256 == sessions.c.definition_sha256))
-        .where(sessions.c.id == stored.id)
-    ).first()
-    if row is None or row.body is None:
+    found = kept.get(head.definition_sha256) if head.definition_sha256 else None
+    if found is None:
         return stored
     stored = replace(
         stored,
-        definition=json.loads(row.body),
-        definition_sha256=row.definition_sha256,
-        definition_attached_later=bool(row.definition_attached_later),
+        definition=found.body,
+        definition_sha256=head.definition_sha256,
+        definition_attached_later=bool(head.definition_attached_later),
     )
     try:
-        return fitted(stored, questionnaire_of(stored))
+        return fitted(stored, questionnaire_for(stored))
     except ExportError:
         return stored
 
@@ -273,5 +269,53 @@ def fitted(stored: StoredSession, q: Questionnaire) -> StoredSession:
 def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
     """The kiosk a session came from, and the session with its definition and identity (NotFound
     if it never arrived)."""
-    kiosk, rows = _kiosk_and_rows(connection, session_id)
-    return kiosk, _with_definition(connection, fold(session_id, rows))
+    found = load_many(connection, [session_id])
+    if session_id not in found:
+        raise NotFound(session_id)
+    return found[session_id]
+
+
+#: the rows a result's score, state and list entry need (no metrics, contexts or log)
+RESULT_KINDS = (*LIFECYCLE, "record_answer", "withdraw_answer", "record_not_answered")
+
+
+#: the rows no export reads (the QoS engine's samples and context, its adaptations): two thirds of
+#: a session's rows, left out of the month's export (station.exports)
+SAMPLE_KINDS = ("record_metrics", "record_context", "record_adaptation")
+
+
+def load_many(
+    connection: Connection,
+    session_ids: Iterable[str],
+    kinds: Iterable[str] | None = None,
+    without: Iterable[str] = (),
+) -> dict[str, tuple[str, StoredSession]]:
+    """Several sessions as :func:`load` reads one, in three queries whatever their number (their
+    heads, their rows, the definitions this process has not parsed yet); sessions that never
+    arrived are absent. ``kinds`` reads only rows of those kinds (a list of results needs
+    :data:`RESULT_KINDS`, not every metric sample), ``without`` all but those."""
+    ids = list(dict.fromkeys(session_ids))
+    if not ids:
+        return {}
+    heads = _heads(connection, ids)
+    query = (
+        sa.select(inbox.c.session_id, inbox.c.seq, inbox.c.kind, inbox.c.payload, inbox.c.at)
+        .where(inbox.c.session_id.in_(list(heads)))
+        .order_by(inbox.c.session_id, inbox.c.seq)
+    )
+    if kinds is not None:
+        query = query.where(inbox.c.kind.in_(list(kinds)))
+    if without:
+        query = query.where(inbox.c.kind.not_in(list(without)))
+    rows: dict[str, list[Row]] = {session_id: [] for session_id in heads}
+    for session_id, seq, kind, payload, at in connection.execute(query):
+        rows[session_id].append(Row(seq, kind, json.loads(payload), at))
+    kept = definitions.parsed(connection, [h.definition_sha256 for h in heads.values()])
+    return {
+        session_id: (
+            heads[session_id].kiosk_id,
+            _with_definition(fold(session_id, rows[session_id]), heads[session_id], kept),
+        )
+        for session_id in ids
+        if session_id in heads
+    }

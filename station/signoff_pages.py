@@ -16,9 +16,9 @@ from starlette.routing import Route
 
 from kiosk.core.review import state_once_signed
 from kiosk.export import ExportError
-from kiosk.export.captured import questionnaire_of
 from kiosk.store.records import StoredSession
 from station import validation
+from station.definitions import questionnaire_for
 from station.rendering import render
 from station.sessions import NotFound, load
 
@@ -43,10 +43,10 @@ async def confirm_page(request: Request) -> Response:
             f"/sessions/{session_id}?message={quote('Only a doctor can sign off.')}", status_code=303
         )
     try:  # the questionnaire the session ran, not the one the station bundles
-        q = questionnaire_of(stored, fallback=q)
+        q = questionnaire_for(stored, fallback=q)
     except ExportError as exc:
         return PlainTextResponse(f"session {session_id} cannot be described: {exc}", status_code=422)
-    score = validation.corrected(stored, q, current)["score"]
+    score = (await run_in_threadpool(validation.corrected, stored, q, current))["score"]  # off the event loop
     language = stored.language
     labels = {item.id: item.text.get(language) or item.text.get("en") or item.id for item in q.items}
     # what the result will be called once signed: the one review-state function's answer, so the

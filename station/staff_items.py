@@ -21,10 +21,10 @@ from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.staff import ENTER, EnteredStep, entered_at_station, entered_values, parse_entry
-from kiosk.export.captured import questionnaire_of
 from kiosk.store.database import StoredSession
 from station import db
 from station.auth import User
+from station.definitions import questionnaire_for
 from station.redirects import see_other
 from station.rendering import checked_form
 from station.sessions import NotFound, load
@@ -76,7 +76,7 @@ async def enter_page(request: Request) -> Response:
     session_id, item_id = request.path_params["session_id"], request.path_params["item_id"]
     try:
         stored = await run_in_threadpool(_load, engine, session_id)
-        q = questionnaire_of(stored, fallback=request.app.state.questionnaire)
+        q = questionnaire_for(stored, fallback=request.app.state.questionnaire)
         user = request.state.user
         await run_in_threadpool(enter_value, engine, q, session_id, item_id, str(form.get("value", "")), user)
         message = f"{item_id} entered."

@@ -17,9 +17,9 @@ from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review, review_from_steps
 from kiosk.store.database import StoredSession
-from station import db
+from station import db, order_progress
 from station.auth import User
-from station.db import audit
+from station.db import audit, sessions
 from station.sessions import load
 
 #: a session that is over (only these can be validated)
@@ -81,9 +81,16 @@ def review(engine: Engine, session_id: str) -> Review:
 
 def reviews(engine: Engine, session_ids: list[str]) -> dict[str, Review]:
     """The reviews of several sessions, read in one query (the ward page's result list)."""
-    entries: dict[str, list[AuditEntry]] = {session_id: [] for session_id in session_ids}
     with engine.connect() as connection:
-        for r in connection.execute(sa.select(audit).where(audit.c.session_id.in_(session_ids)).order_by(audit.c.id)):
+        return reviews_in(connection, session_ids)
+
+
+def reviews_in(connection: Connection, session_ids: list[str]) -> dict[str, Review]:
+    """:func:`reviews` on an open connection."""
+    entries: dict[str, list[AuditEntry]] = {session_id: [] for session_id in session_ids}
+    if session_ids:
+        query = sa.select(audit).where(audit.c.session_id.in_(session_ids)).order_by(audit.c.id)
+        for r in connection.execute(query):
             entries[r.session_id].append(AuditEntry.of(r))
     return {session_id: review_of(found) for session_id, found in entries.items()}
 
@@ -122,20 +129,32 @@ def change_item(
 
 
 def sign_off(engine: Engine, session_id: str, by: User) -> None:
-    """A doctor makes the result final (as recorded, or with the corrections made)."""
+    """A doctor makes the result final (as recorded, or with the corrections made): the audit
+    row, the session's review state and its order change in one transaction, so a result and its
+    order never disagree."""
+    with engine.begin() as connection:
+        sign_off_in(connection, session_id, by)
+
+
+def sign_off_in(connection: Connection, session_id: str, by: User, at: str | None = None) -> None:
+    """:func:`sign_off` in the caller's transaction (``at``: when, default now; a history loaded
+    in bulk signs many in one transaction, bench/_history.py)."""
     if not by.is_doctor:
         raise ValidationError("only a doctor can sign off a result")
-    with engine.begin() as connection:
-        stored, entries = _locked(connection, session_id)
-        _check_open(stored, review_of(entries))
-        connection.execute(
-            audit.insert().values(session_id=session_id, at=db.now_iso(), author=by.name, action="sign_off", reason="")
-        )
+    stored, entries = _locked(connection, session_id)
+    _check_open(stored, review_of(entries))
+    at = at or db.now_iso()
+    connection.execute(
+        audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason="")
+    )
+    connection.execute(sessions.update().where(sessions.c.id == session_id).values(signed_at=at))
+    order_progress.signed_off(connection, session_id, by)
 
 
 def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
     """A doctor reopens a signed-off result to amend it: it can be changed again, and is final
-    once a doctor signs it off again (the earlier sign-off stays in the trail)."""
+    once a doctor signs it off again (the earlier sign-off stays in the trail). The audit row,
+    the session's review state (waiting again) and its order change in one transaction."""
     if not by.is_doctor:
         raise ValidationError("only a doctor can amend a signed-off result")
     reason = reason.strip()
@@ -152,6 +171,8 @@ def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
                 session_id=session_id, at=db.now_iso(), author=by.name, action="amend", reason=reason[:1000]
             )
         )
+        connection.execute(sessions.update().where(sessions.c.id == session_id).values(signed_at=None))
+        order_progress.reopened(connection, session_id, by)
 
 
 def _check_open(stored: StoredSession, current: Review) -> None:

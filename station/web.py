@@ -18,6 +18,7 @@ from typing import Any
 from urllib.parse import quote
 
 import anyio.to_thread
+import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
@@ -34,10 +35,15 @@ from station import (
     api,
     api_orders,
     auth,
+    db,
+    definition_pages,
+    errors,
+    formulas,
     logins,
     order_pages,
     pages,
     result_pages,
+    results,
     signoff_pages,
     staff_items,
     throttle,
@@ -148,6 +154,15 @@ async def events(request: Request) -> Response:
     return StreamingResponse(live.stream(), media_type="text/event-stream", headers={"x-accel-buffering": "no"})
 
 
+def _user_and_count(request: Request) -> tuple[auth.User | None, int | None]:
+    """The login's user and, for a page, the navigation's count of results waiting: one hop off
+    the event loop for both (the count is an index range, :func:`station.results.waiting_count`)."""
+    found = current_user(request)
+    if found is None or request.method != "GET":
+        return found, None
+    return found, results.waiting_count(request.app.state.engine)
+
+
 class LoginRequired:
     """Page routes need a logged-in user; the kiosk API, login, events and static files do not
     (they check their own credentials)."""
@@ -162,13 +177,13 @@ class LoginRequired:
             await self.app(scope, receive, send)
             return
         request = Request(scope, receive)
-        found = await asyncio.get_running_loop().run_in_executor(STAFF_LANE, current_user, request)
+        found, waiting = await asyncio.get_running_loop().run_in_executor(STAFF_LANE, _user_and_count, request)
         if found is None:
             back = scope["path"] if len(scope["path"]) <= MAX_NEXT else "/"  # never a huge Location
             response: Response = RedirectResponse(f"/login?next={quote(back)}", status_code=303)
             await response(scope, receive, send)
             return
-        scope.setdefault("state", {})["user"] = found
+        scope.setdefault("state", {}).update(user=found, waiting=waiting)
         await self.app(scope, receive, send)
 
 
@@ -176,7 +191,35 @@ async def forbidden(request: Request, exc: Exception) -> Response:
     return PlainTextResponse(str(exc), status_code=403)
 
 
+#: one thread for the health check's write probe: it never queues behind pages or kiosks
+HEALTH_LANE = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-health")
+HEALTH_TIMEOUT_S = 5.0
+
+
+def write_probe(engine: Engine) -> None:
+    """Commit a heartbeat (the settings row ``heartbeat``: the time of this check): the database
+    takes writes now (raises the driver's error otherwise: read-only, disk full, server gone). A
+    commit, not a rolled-back write: SQLite only meets a full disk when it writes its log."""
+    with engine.begin() as connection:
+        now = db.now_iso()
+        changed = connection.execute(
+            db.settings.update().where(db.settings.c.key == "heartbeat").values(value=now)
+        ).rowcount
+        if not changed:
+            db.insert_ignore(connection, db.settings, [{"key": "heartbeat", "value": now}], ["key"])
+
+
 async def healthz(request: Request) -> Response:
+    """200 ``ok`` only when the database can be written now; else 503 naming why."""
+    loop = asyncio.get_running_loop()
+    try:
+        await asyncio.wait_for(
+            loop.run_in_executor(HEALTH_LANE, write_probe, request.app.state.engine), HEALTH_TIMEOUT_S
+        )
+    except TimeoutError:
+        return PlainTextResponse(f"database: a test write took longer than {HEALTH_TIMEOUT_S:g} s", status_code=503)
+    except sa.exc.SQLAlchemyError as exc:
+        return PlainTextResponse(f"database cannot be written: {errors.reason(exc)}", status_code=503)
     return PlainTextResponse("ok")
 
 
@@ -202,6 +245,7 @@ def create_app(
         yield
         await app.state.live.stop()
         bus.stop()
+        formulas.WORKER.stop()
 
     routes = [
         Route("/login", login_page, methods=["GET"]),
@@ -213,6 +257,7 @@ def create_app(
         *order_pages.routes,
         *result_pages.routes,
         *signoff_pages.routes,
+        *definition_pages.routes,
         *staff_items.routes,
         *api.routes,
         *api_orders.routes,
@@ -231,7 +276,12 @@ def create_app(
         ),
         Middleware(LoginRequired),
     ]
-    app = Starlette(routes=routes, middleware=middleware, lifespan=lifespan, exception_handlers={Forbidden: forbidden})
+    app = Starlette(
+        routes=routes,
+        middleware=middleware,
+        lifespan=lifespan,
+        exception_handlers={Forbidden: forbidden, Exception: errors.station_error},
+    )
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
     app.state.id_pattern = id_pattern

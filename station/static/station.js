@@ -194,7 +194,7 @@
     for (const part of document.querySelectorAll("[data-refresh]")) refresh(part);
     const inbox = document.getElementById("inbox");
     if (inbox) {
-      refill("inbox", "/fragments/inbox?" + new URLSearchParams({ state: inbox.dataset.state, kiosk: inbox.dataset.kiosk }));
+      refill("inbox", "/fragments/inbox?" + new URLSearchParams({ state: inbox.dataset.state, kiosk: inbox.dataset.kiosk, after: inbox.dataset.after || "" }));
     }
   }
 

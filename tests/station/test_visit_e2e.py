@@ -154,7 +154,7 @@ def test_order_greet_confirm_answer_ring_sign_off_course(
 
     # the patient's course shows the visit: total, band, review state, ordered, and the plot's point
     doctor.goto(station.url + "/patients")
-    doctor.fill("input[name=q]", "0042")  # search by part of the identifier
+    doctor.fill("input[name=q]", "nhc-004")  # by the identifier's start, typed in lower case
     doctor.click("form[role=search] button")
     fits(doctor, viewport)
     doctor.click("#patients a:has-text('NHC-0042')")
