@@ -58,6 +58,7 @@ class IgnoreReason(str, Enum):
     UNSURE_REPLY = "unsure_reply"  # an unsure "yes" never confirms an unsure answer
     WAITING_FOR_TOUCH = "waiting_for_touch"  # unattended: only a touch or a press goes on, not a voice
     CALL_ASKED = "call_asked"  # "Shall I call the nurse?" waits for Yes or No
+    NOT_AN_INPUT_CHANNEL = "not_an_input_channel"  # the camera sees; it gives no answers or commands
 
 
 #: attempts per question: the question is asked, then asked again, then it is not answered. Fixed

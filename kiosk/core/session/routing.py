@@ -14,7 +14,7 @@ from kiosk.core.session.incidents import Incidents
 from kiosk.core.session.opening import Opening
 from kiosk.core.session.practice import Practice
 from kiosk.core.session.prompts import Prompts
-from kiosk.core.session.publishing import Outputs
+from kiosk.core.session.publishing import USER_INTERACTION, Outputs
 from kiosk.core.session.questions import QuestionFlow
 from kiosk.core.session.state import SessionState
 from kiosk.core.session.timers import AttemptClock
@@ -75,6 +75,8 @@ class Router:
         phase = self.state.phase
         if isinstance(event, Presence):
             self.attendance.presence(t, event)
+        elif event.channel not in USER_INTERACTION:
+            self.out.ignore(t, event, IgnoreReason.NOT_AN_INPUT_CHANNEL)
         elif self.state.call is not None and event.command not in (Command.VOLUME_UP, Command.VOLUME_DOWN):
             self._calling(t, event)
         elif event.command is not None:
