@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 
 from textual import events
@@ -66,12 +67,14 @@ class AnswerList(Vertical):
         buttons = self.answers()
         if rows <= 0 or width <= 0 or not buttons:
             return
-        more = self.query_one(MoreAnswers)
-        labels = [b.query_one(".label", Label) for b in [*buttons, more]]
+        more = next(iter(self.query(MoreAnswers)), None)
+        labels = [b.query_one(".label", Label) for b in buttons]
         size = Size(width, rows)
 
         def lines(index: int | None, text_width: int) -> int:
-            return labels[-1 if index is None else index].get_content_height(size, size, text_width)
+            if index is None:  # the page button's words, wrapped as a label wraps them
+                return max(len(textwrap.wrap(words, text_width)) for words in self.turn)
+            return labels[index].get_content_height(size, size, text_width)
 
         roomy = self.screen.has_class("-roomy")
         self.plan = plan_ = plan(len(buttons), rows, width, lines, roomy=roomy)
@@ -80,14 +83,18 @@ class AnswerList(Vertical):
             page = page_of(plan_, index) if index is not None else None
         self._wanted = None
         self.page = min(self.page if page is None else page, len(plan_.pages) - 1)
+        if plan_.paged and more is None:  # mounted the first time the answers need pages
+            self.mount(MoreAnswers(self.turn[0]))
+            self.call_after_refresh(self.lay_out)
+        elif more is not None:
+            more.display = plan_.paged
+            more.relabel(self.turn[self.page == len(plan_.pages) - 1])
         shown = set(plan_.pages[self.page])
         self.set_class(plan_.columns == 2, "-two-by-two")
         self.styles.grid_rows = str(plan_.height)
-        visible = [b for i, b in enumerate(buttons) if i in shown] + ([more] if plan_.paged else [])
+        visible = [b for i, b in enumerate(buttons) if i in shown] + ([more] if plan_.paged and more else [])
         for index, button in enumerate(buttons):
             button.display = index in shown
-        more.display = plan_.paged
-        more.relabel(self.turn[self.page == len(plan_.pages) - 1])
         for n, button in enumerate(visible):
             button.styles.height = plan_.height
             last = n == len(visible) - 1
@@ -151,9 +158,6 @@ class QuestionPanel(Vertical):
             for (shows, option), label in zip(self.buttons, self.options):
                 name = f"answer-{option}" if option is not None else "answer-page"
                 yield AnswerButton(option, label, id=name, shows=shows)
-            more = MoreAnswers(self.turn[0])
-            more.display = False
-            yield more
 
     def on_mount(self) -> None:
         """Show the chosen answer, if any, once the buttons exist."""

@@ -36,8 +36,8 @@ async def _walk(folder, size: tuple[int, int]) -> list:
             await settle(pilot)
             opening = " ".join(item.patient_text_in("en").split()[:3])
             taps.append((f"{item.id} shown", None, opening))
-            more = kiosk.app.screen.query("#answer-more").first()
-            if more.display:
+            more = next(iter(kiosk.app.screen.query("#answer-more")), None)
+            if more is not None and more.display:
                 taps.append((item.id, more.region, ANSWER_RGB))
                 await pilot.click("#answer-more")
                 last = kiosk.app.screen.query_one(f"#answer-{len(item.options)}")
