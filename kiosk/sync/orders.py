@@ -10,6 +10,7 @@ from __future__ import annotations
 import sqlite3
 import threading
 from collections.abc import Callable, Sequence
+from contextlib import closing
 from pathlib import Path
 from urllib.parse import quote
 
@@ -37,7 +38,7 @@ def held_orders(path: Path) -> list[str]:
     of its own (the poll's thread shares none). A database not made yet holds none."""
     if not Path(path).exists():
         return []
-    with sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=10.0) as db:
+    with closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=10.0)) as db:
         rows = db.execute(HELD, (MOST_HELD,)).fetchall()
     return list(dict.fromkeys(detail.partition(" ")[2] for (detail,) in rows))
 
