@@ -8,7 +8,6 @@ Every request carries ``Authorization: Bearer <kiosk token>``; an unknown or rev
 from __future__ import annotations
 
 import asyncio
-import json
 from collections.abc import Awaitable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -171,10 +170,11 @@ async def post_status(request: Request) -> Response:
 
     def work(connection: Connection, kiosk: str) -> tuple[None, list[dict[str, Any]]]:
         _check_kiosk_id(body, kiosk)  # raising rolls the status back
+        ward.report_status(connection, kiosk, status)
         return None, [{"type": "kiosk", "kiosk": kiosk}]
 
     try:
-        await _in_worker(request, work, status=json.dumps(status))
+        await _in_worker(request, work)
     except _Unauthorised:
         return _unauthorised()
     except ValueError as exc:

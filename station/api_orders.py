@@ -20,7 +20,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
-from station import auth, orders
+from station import auth, order_progress, orders
 from station.api import MAX_WAIT_S, _error, _in_worker, _json, _refused, _token, _Unauthorised, _unauthorised
 from station.bus import long_poll
 
@@ -37,10 +37,18 @@ def _ready(engine: Any, kiosk: str) -> dict[str, Any]:
     return {"version": version, "orders": ready}
 
 
+def _release(bus: Any, kiosk: str, held: set[str]) -> None:
+    """The kiosk's orders in progress that it no longer holds heal (:func:`order_progress.release_unheld`)."""
+    with bus.transaction() as (connection, messages):
+        if order_progress.release_unheld(connection, kiosk, held):
+            messages.append({"type": "order", "kiosk": kiosk})
+
+
 async def get_orders(request: Request) -> Response:
     """Long poll: the list at once when its version differs from ``version`` (or none was given),
     else when an order of this kiosk changes (by any station process) or ``wait`` seconds pass.
-    Subscribing before looking means a change in between is not missed."""
+    Subscribing before looking means a change in between is not missed. ``held`` (comma-separated
+    order ids): the orders the kiosk still runs; its other orders in progress are released first."""
     token = _token(request)
     loop = asyncio.get_running_loop()
     # the whole poll on the urgent lane (cheap reads): a waiting visit never queues behind the
@@ -54,6 +62,8 @@ async def get_orders(request: Request) -> Response:
         return _error(400, "'wait' must be a number of seconds")
     known = request.query_params.get("version")
     engine, bus = request.app.state.engine, request.app.state.bus
+    if (held := request.query_params.get("held")) is not None:
+        await loop.run_in_executor(ORDER_LANE, _release, bus, kiosk, {h for h in held.split(",") if h})
     queue = bus.subscribe(kiosk, ("order", "resync"))
     try:
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
+from datetime import UTC, datetime
 from typing import Any
 
 import sqlalchemy as sa
@@ -226,3 +227,50 @@ def visit_kinds(engine: Engine, session_ids: Sequence[str]) -> dict[str, tuple[s
     with engine.connect() as connection:
         rows = connection.execute(sa.select(visits).where(visits.c.session_id.in_(list(session_ids))))
         return {r.session_id: (r.kind, r.order_id) for r in rows}
+
+
+#: an order that went in progress this recently is never released: its kiosk may not have stored
+#: the session yet (the code's answer and the session's first row are moments apart, but a held
+#: report can be on its way meanwhile, from this process or another tab on the same kiosk)
+RELEASE_GRACE_S = 60.0
+
+
+def release_unheld(connection: Connection, kiosk_id: str, held: set[str]) -> list[str]:
+    """The kiosk reports the orders it holds (a running or interrupted session of them, or rows of
+    one still to send): its other orders in progress have nothing left to finish them (it stopped
+    after the code was accepted and before a session was stored, or between two instruments of a
+    battery), so each heals as an abandoned visit does: back to ordered, or, with some
+    instruments finished, their results wait for validation. Returns the orders released."""
+    since = datetime.fromtimestamp(db.now() - RELEASE_GRACE_S, UTC).isoformat(timespec="milliseconds")
+    stuck = connection.execute(
+        sa.select(orders).where(
+            orders.c.kiosk_id == kiosk_id, orders.c.state == "in_progress", orders.c.updated_at < since
+        )
+    ).all()
+    released = []
+    for order in stuck:
+        if order.id in held:
+            continue
+        done = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+        wanted = len(json.loads(order.instruments))
+        target = "awaiting_validation" if done else "ordered"
+        values: dict[str, Any] = {"state": target, "updated_at": db.now_iso()}
+        if target == "ordered":
+            values["session_id"] = None
+        moved = connection.execute(
+            orders.update().where(orders.c.id == order.id, orders.c.state == "in_progress").values(**values)
+        ).rowcount
+        if not moved:
+            continue
+        why = f"kiosk {kiosk_id} runs no session of this visit (it stopped before the visit could go on)"
+        audit_order(
+            connection,
+            order.id,
+            f"kiosk {kiosk_id}",
+            "order_result" if done else "order_ready",
+            f"{why}: the {done} finished instrument(s) of {wanted} wait for validation"
+            if done
+            else f"{why}: the visit can be started again with its code",
+        )
+        released.append(order.id)
+    return released

@@ -78,7 +78,11 @@ STATUS_FIELDS: dict[str, type | tuple[type, ...]] = {
     "out_of_order": (str, type(None)),
     # the kiosk steers patients to touch: voice is not heard well in its room (a sentence for staff)
     "voice_room": (str, type(None)),
+    # the kiosk process that reports (two browser tabs on one kiosk are two processes)
+    "instance": (str, type(None)),
 }
+#: the most kiosk processes whose reports a kiosk's row keeps (the newest)
+MOST_INSTANCES = 8
 
 
 class WardError(ValueError):
@@ -130,6 +134,43 @@ def parse_status(body: Any) -> dict[str, Any]:
     return status
 
 
+def merge_status(stored: str | None, status: dict[str, Any], now: float) -> str:
+    """The kiosk's stored reports with ``status`` in, as stored: one report per kiosk process
+    (its ``instance``; none: a kiosk from before, one process), each with when it came."""
+    reports = _reports(stored)
+    reports[status.get("instance") or ""] = {**status, "received": now}
+    newest = sorted(reports.items(), key=lambda kv: kv[1].get("received", 0.0))[-MOST_INSTANCES:]
+    return json.dumps({"reports": dict(newest)})
+
+
+def _reports(stored: str | None) -> dict[str, dict[str, Any]]:
+    """The stored reports by process (a row written before processes were told apart: one)."""
+    value = json.loads(stored) if stored else {}
+    if not isinstance(value, dict):
+        return {}
+    if "reports" in value:
+        return dict(value["reports"])
+    return {"": value} if value else {}
+
+
+def shown_status(stored: str | None, now: float) -> dict[str, Any]:
+    """What the kiosk's tile shows: the live session of a process that reported within
+    :data:`OFFLINE_AFTER_S` (two tabs on one kiosk: the one running a test, not the other's
+    welcome; the newest if both run one), else the newest report. Staff see the test that runs."""
+    reports = sorted(_reports(stored).values(), key=lambda r: r.get("received", 0.0))
+    live = [r for r in reports if r.get("session_id") and now - r.get("received", 0.0) <= OFFLINE_AFTER_S]
+    shown = (live or reports or [{}])[-1]
+    return {k: v for k, v in shown.items() if k != "received"}
+
+
+def report_status(connection: Any, kiosk_id: str, status: dict[str, Any]) -> None:
+    """Keep a process's status report beside the others of its kiosk (read under a row lock on
+    PostgreSQL, so two processes reporting at once both count)."""
+    stored = connection.execute(sa.select(kiosks.c.status).where(kiosks.c.name == kiosk_id).with_for_update()).scalar()
+    merged = merge_status(stored, status, db.now())
+    connection.execute(kiosks.update().where(kiosks.c.name == kiosk_id).values(status=merged))
+
+
 def seen(engine: Engine, kiosk_id: str) -> None:
     with engine.begin() as connection:
         connection.execute(kiosks.update().where(kiosks.c.name == kiosk_id).values(last_seen=db.now()))
@@ -170,12 +211,13 @@ def kiosk_views(engine: Engine, name: str | None = None) -> list[KioskView]:
     with engine.connect() as connection:
         rows = connection.execute(query).all()
     pending = open_alerts(engine, name)
+    now = db.now()
     return [
         KioskView(
             r.name,
             r.last_seen,
             r.revoked_at is not None,
-            json.loads(r.status) if r.status else {},
+            shown_status(r.status, now),
             tuple(a for a in pending if a.kiosk_id == r.name),
         )
         for r in rows

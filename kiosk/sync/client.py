@@ -18,6 +18,7 @@ outbox, and they go when it is back.
 from __future__ import annotations
 
 import random
+import secrets
 import sqlite3
 import threading
 import time
@@ -94,6 +95,9 @@ class SyncClient:
         self._stopping = threading.Event()
         self._lock = threading.Lock()
         self._status: dict[str, Any] = {"session_id": None, "phase": "welcome"}
+        #: this process among the kiosk's (two browser tabs are two): the station shows the one
+        #: running a test, not the other's welcome (station.ward.shown_status)
+        self.instance = secrets.token_hex(6)
         self._status_changed = True
         self._batch = BATCH
         self._threads: list[threading.Thread] = []
@@ -208,7 +212,7 @@ class SyncClient:
             code, body = self.station.request(
                 "POST",
                 "/api/v1/status",
-                {**status, "kiosk_id": self.kiosk_id, "at": datetime.now(UTC).isoformat()},
+                {**status, "kiosk_id": self.kiosk_id, "instance": self.instance, "at": datetime.now(UTC).isoformat()},
             )
         except Unreachable:
             with self._lock:

@@ -7,8 +7,12 @@ which the app runs on its own thread (``app.call_from_thread``).
 
 from __future__ import annotations
 
+import sqlite3
 import threading
 from collections.abc import Callable, Sequence
+from contextlib import closing
+from pathlib import Path
+from urllib.parse import quote
 
 from kiosk.core.visits import Order, parse_orders
 from kiosk.sync.client import Backoff
@@ -16,6 +20,27 @@ from kiosk.sync.http import Station, Unreachable
 
 #: how long one long poll for orders may wait at the station
 POLL_WAIT_S = 20.0
+#: the most orders a poll reports as held (the newest sessions')
+MOST_HELD = 200
+#: the orders whose visit a kiosk can still go on with: a session of them running or interrupted
+#: (staff continue it), or with rows the station has not had yet (it cannot judge the visit yet)
+HELD = """
+SELECT e.detail FROM events e JOIN sessions s ON s.id = e.session_id
+WHERE e.kind = 'visit' AND e.detail LIKE 'order %'
+  AND (s.status IN ('running', 'interrupted')
+       OR EXISTS (SELECT 1 FROM outbox o WHERE o.session_id = s.id AND o.parked IS NULL))
+ORDER BY s.started_at DESC LIMIT ?
+"""
+
+
+def held_orders(path: Path) -> list[str]:
+    """The orders the kiosk database at ``path`` holds (:data:`HELD`), read through a connection
+    of its own (the poll's thread shares none). A database not made yet holds none."""
+    if not Path(path).exists():
+        return []
+    with closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=10.0)) as db:
+        rows = db.execute(HELD, (MOST_HELD,)).fetchall()
+    return list(dict.fromkeys(detail.partition(" ")[2] for (detail,) in rows))
 
 
 class OrderRefused(Exception):
@@ -34,8 +59,12 @@ class OrderWatcher:
         on_orders: Callable[[list[Order], list[str]], None],
         poll_wait_s: float = POLL_WAIT_S,
         backoff: tuple[float, float] = (0.5, 30.0),
+        held: Callable[[], list[str]] | None = None,
     ) -> None:
+        """``held()``: the orders this kiosk can still go on with (:func:`held_orders`), told to
+        the station on every poll so an order whose kiosk stopped mid-visit heals (None: not told)."""
         self.station = station
+        self._held = held
         self._instruments, self._languages = list(instruments), list(languages)
         self._on_orders = on_orders
         self._poll_wait_s = poll_wait_s
@@ -61,8 +90,10 @@ class OrderWatcher:
         while not self._stopping.is_set():
             query = f"/api/v1/orders?wait={self._poll_wait_s:g}" + (f"&version={version}" if version else "")
             try:
+                if self._held is not None:
+                    query += "&held=" + quote(",".join(self._held()), safe=",")
                 status, body = self.station.request("GET", query, timeout=self._poll_wait_s + 15)
-            except Unreachable as exc:
+            except (Unreachable, sqlite3.Error) as exc:
                 self.problem = str(exc)
                 self._stopping.wait(backoff.next())
                 continue

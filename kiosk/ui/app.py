@@ -158,8 +158,13 @@ class KioskApp(App[int], inherit_bindings=False):
         if self.controller.store is not None:
             self.set_interval(LEASE_TTL_S / 3, self.controller.keep_session)
         self.controller.greet()
+        self.controller.display_size(*self.size)
         self._render()
         self.call_after_refresh(self._start_threads)
+
+    def on_resize(self, event: events.Resize) -> None:
+        """The display changed size: below the kiosk's floor it takes no patient, and says why."""
+        self.controller.display_size(event.size.width, event.size.height)
 
     def _start_threads(self) -> None:
         """Start the speaker, the input sources and the station's client, after the first frame:

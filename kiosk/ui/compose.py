@@ -232,7 +232,7 @@ def _station(config: Config, parts: KioskParts, store: Store, app: Callable[[], 
         return None, None, None
     from kiosk.sync import SyncClient
     from kiosk.sync.http import Station
-    from kiosk.sync.orders import OrderWatcher, start_order
+    from kiosk.sync.orders import OrderWatcher, held_orders, start_order
 
     client = SyncClient(
         store.path,
@@ -248,6 +248,7 @@ def _station(config: Config, parts: KioskParts, store: Store, app: Callable[[], 
         instruments=instruments,
         languages=languages,
         on_orders=lambda *found: app().call_from_thread(app().controller.orders_changed, *found),
+        held=lambda: held_orders(store.path),
     )
     starter = Station(station.url, station.token)
     return client, watcher, lambda code: start_order(starter, code, instruments=instruments, languages=languages)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import logging
 import os
 import sqlite3
 from collections.abc import Callable, Sequence
@@ -33,6 +34,7 @@ from kiosk.ui.paging import PAGE_BUTTON, RemotePager, needs_paging
 #: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
 #: patients again (a test's rows, its QoS trace and the WAL need room to grow)
 PROBE_BYTES = 256 * 1024
+log = logging.getLogger(__name__)
 #: what staff read when they try to replace a test that is still going
 IN_PROGRESS = "a test is in progress on this kiosk: finish it, or start a new patient, first"
 #: the phases a clinician's visit pauses (the welcome and the end have nothing to time out)
@@ -96,8 +98,10 @@ class KioskController:
         self.start_order = start_order
         #: every session event received, in order (the clinician screens and tests read it)
         self.events: list[SessionEvent] = []
-        #: why the kiosk takes no patient now (the store failed), for staff; None while it works
-        self.out_of_order: str | None = None
+        #: why the kiosk cannot store (a full disk, a failing drive); None while it can
+        self.store_fault: str | None = None
+        #: why the display cannot show a test (:func:`kiosk.ui.floor.too_small`); None while it can
+        self.display_fault: str | None = None
         self.view: Screens | None = None
         self._held: Session | None = None
         self._dirty = False
@@ -106,6 +110,29 @@ class KioskController:
         #: whether a remote is in use now, so such items show pages (the app says, from its channels)
         self.remote_in_use: Callable[[], bool] = lambda: True
         self._unsubscribe: Callable[[], None] = lambda: None
+
+    @property
+    def out_of_order(self) -> str | None:
+        """Why the kiosk takes no patient now, for staff; None while it works."""
+        return self.store_fault or self.display_fault
+
+    def display_size(self, columns: int, rows: int) -> None:
+        """The display is now ``columns`` x ``rows``: below :data:`kiosk.ui.floor.FLOOR` the
+        kiosk takes no patient (a running test is interrupted, for staff to continue) and tells
+        staff why; back above it, the welcome returns by itself."""
+        from kiosk.ui.floor import too_small
+
+        reason = too_small(columns, rows)
+        if reason == self.display_fault:
+            return
+        self.display_fault = reason
+        if reason is not None:
+            log.warning("out of order: %s", reason)
+            if self._busy():
+                self.session_lost(reason, tell_patient=False)
+        if self.view is not None:
+            self._screens().redraw(rebuild=True)
+        self.report_status()
 
     def attach(self, view: Screens) -> None:
         """Draw on ``view`` and follow the session's events from now on."""
@@ -427,8 +454,8 @@ class KioskController:
             return  # the database is busy or failing: the next round tries again
         if why is not None:
             self.session_lost(why)
-        elif self.out_of_order is not None and self._can_write():
-            self.out_of_order = None  # space was freed (or the lock let go): the welcome is back
+        elif self.store_fault is not None and self._can_write():
+            self.store_fault = None  # space was freed (or the lock let go): the welcome is back
             self._screens().redraw(rebuild=True)
             self.report_status()
 
@@ -437,8 +464,8 @@ class KioskController:
         refused was rolled back, what was stored stays for staff to continue). The kiosk takes no
         patient until it can write again: the patient sees one calm out-of-order screen, staff
         the reason on the clinician screen and the station (:meth:`keep_session` recovers)."""
-        self.out_of_order = f"the kiosk could not store its last step ({failed})"
-        self.session_lost(self.out_of_order, tell_patient=False)
+        self.store_fault = f"the kiosk could not store its last step ({failed})"
+        self.session_lost(self.store_fault, tell_patient=False)
         self.report_status()
 
     def _can_write(self) -> bool:

@@ -142,9 +142,14 @@ class ClinicianHomeScreen(ClinicianScreen):
         line = self.query_one("#out-of-order-reason", Static)
         line.display = reason is not None
         if reason is not None:
+            remedy = (
+                "the display is large enough again"
+                if app.controller.store_fault is None
+                else "the data directory can be written again (free disk space)"
+            )
             line.update(
                 f'Out of order: {reason}. The patient sees "This kiosk is not working"; the welcome '
-                "comes back by itself once the data directory can be written again (free disk space)."
+                f"comes back by itself once {remedy}."
             )
         self.query_one("#channel-reasons", Static).update(self._channels_text())
         # Continue is for a session halted by call-doctor or paused by the patient, not for the

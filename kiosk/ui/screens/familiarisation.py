@@ -35,7 +35,11 @@ class FamiliarisationScreen(PatientScreen):
         else:
             # in the flow above the question, as on the question screen
             yield Static("", id="interlude", classes="interlude")
-            yield QuestionPanel(practice.text[self.language], [o.label_in(self.language) for o in practice.options])
+            yield QuestionPanel(
+                practice.text[self.language],
+                [o.label_in(self.language) for o in practice.options],
+                turn=(ui_text(self.language, "more_answers"), ui_text(self.language, "back_answers")),
+            )
         yield WaitingSign(self.language)
         yield ControlBar(self.language, repeat=self.view.ways.voice_out)
 

@@ -81,6 +81,7 @@ class QuestionScreen(PatientScreen):
                 chosen=answer.option if answer else None,
                 over_question=thanks,
                 buttons=buttons,
+                turn=(ui_text(self.language, "more_answers"), ui_text(self.language, "back_answers")),
             )
         ]
 

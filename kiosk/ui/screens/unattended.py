@@ -6,9 +6,9 @@ from __future__ import annotations
 from textual import events, on
 from textual.app import ComposeResult
 from textual.message import Message
-from textual.widgets import Button, Static
 
 from kiosk.ui.screens.base import PatientScreen, PatientView
+from kiosk.ui.widgets.literal import Button, Static
 from kiosk.ui.widgets.text import ui_text
 
 

@@ -2,58 +2,126 @@
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 
 from textual import events
 from textual.app import ComposeResult
 from textual.containers import Vertical
+from textual.geometry import Size
+from textual.message import Message
 from textual.widget import Widget
 
+from kiosk.ui.answer_pages import GAP, MIN_ROWS, Plan, page_of, plan
 from kiosk.ui.widgets.answer_button import AnswerButton
-from kiosk.ui.widgets.literal import Static
-
-#: rows between two answers (stacked or two-by-two)
-GAP = 1
-#: the fewest rows an answer gets before the answers go two-by-two; at 3 rows and wide enough, the
-#: number is drawn in big block digits
-MIN_ROWS = 3
+from kiosk.ui.widgets.literal import Label, Static
 
 
-def arrangement(count: int, rows: int) -> tuple[int, int]:
-    """How ``count`` answers share ``rows`` rows: (columns, height of each answer). One column
-    while each answer still gets :data:`MIN_ROWS`, else two-by-two; every answer the same height
-    (spare rows stay below the last), and never less than one row."""
-    columns = 1 if (rows - GAP * (count - 1)) // count >= MIN_ROWS else 2
-    lines = -(-count // columns)
-    return columns, max(1, (rows - GAP * (lines - 1)) // lines)
+class MoreAnswers(AnswerButton):
+    """The page button of answers that do not all fit the display (:mod:`kiosk.ui.answer_pages`):
+    "More answers", or "Back" on the last page. A touch turns the page; it chooses nothing."""
+
+    class Turned(Message):
+        """The patient touched the page button."""
+
+    def __init__(self, label: str) -> None:
+        super().__init__(None, label, id="answer-more", shows=0)
+
+    def compose(self) -> ComposeResult:
+        """A quiet arrow where the number goes (no number: no key or remote button means it)."""
+        yield Label("»", classes="small-number")
+        yield Label(self.label, classes="label")
+
+    def action_choose(self) -> None:
+        """Ask the answer list for its next page."""
+        self.post_message(self.Turned())
 
 
 class AnswerList(Vertical):
-    """The answer buttons, laid out again whenever the height left for them changes."""
+    """The answer buttons, laid out again whenever the height left for them, or their texts,
+    change: every answer's whole text on screen, on pages when the display is too small for all
+    of them at once (:func:`kiosk.ui.answer_pages.plan`)."""
+
+    def __init__(self, *, turn: tuple[str, str] = ("»", "«"), id: str | None = None) -> None:
+        """``turn``: the page button's label on every page but the last, and on the last."""
+        super().__init__(id=id)
+        self.turn = turn
+        self.plan: Plan | None = None
+        #: the page shown (0: the first answers)
+        self.page = 0
+        #: the option whose page to show at the next layout (the chosen answer stays in view)
+        self._wanted: int | None = None
 
     def on_resize(self, event: events.Resize) -> None:
         """The question above took more or fewer rows, or the display changed."""
         self.lay_out()
 
-    def lay_out(self) -> None:
-        """Stack the answers, or put them two-by-two, all equally tall (:func:`arrangement`)."""
-        rows = self.content_region.height
-        buttons = list(self.query(AnswerButton))
-        if rows <= 0 or not buttons:
+    def answers(self) -> list[AnswerButton]:
+        """The item's answer buttons, in order (not the page button)."""
+        return [b for b in self.query(AnswerButton) if not isinstance(b, MoreAnswers)]
+
+    def lay_out(self, page: int | None = None) -> None:
+        """Stack the answers, or put them two-by-two, all equally tall, on as many pages as their
+        texts need; show ``page`` (default: the one shown, or the first if it is gone)."""
+        rows, width = self.content_region.height, self.content_region.width
+        buttons = self.answers()
+        if rows <= 0 or width <= 0 or not buttons:
             return
-        columns, height = arrangement(len(buttons), rows)
-        self.set_class(columns == 2, "-two-by-two")
-        self.styles.grid_rows = str(height)
-        for button in buttons:
-            button.styles.height = height
-            button.set_class(height >= MIN_ROWS, "-big")
+        more = next(iter(self.query(MoreAnswers)), None)
+        labels = [b.query_one(".label", Label) for b in buttons]
+        size = Size(width, rows)
+
+        def lines(index: int | None, text_width: int) -> int:
+            if index is None:  # the page button's words, wrapped as a label wraps them
+                return max(len(textwrap.wrap(words, text_width)) for words in self.turn)
+            return labels[index].get_content_height(size, size, text_width)
+
+        roomy = self.screen.has_class("-roomy")
+        self.plan = plan_ = plan(len(buttons), rows, width, lines, roomy=roomy)
+        if page is None and self._wanted is not None:
+            index = next((i for i, b in enumerate(buttons) if b.option == self._wanted), None)
+            page = page_of(plan_, index) if index is not None else None
+        self._wanted = None
+        self.page = min(self.page if page is None else page, len(plan_.pages) - 1)
+        if plan_.paged and more is None:  # mounted the first time the answers need pages
+            self.mount(MoreAnswers(self.turn[0]))
+            self.call_after_refresh(self.lay_out)
+        elif more is not None:
+            more.display = plan_.paged
+            more.relabel(self.turn[self.page == len(plan_.pages) - 1])
+        shown = set(plan_.pages[self.page])
+        self.set_class(plan_.columns == 2, "-two-by-two")
+        self.styles.grid_rows = str(plan_.height)
+        visible = [b for i, b in enumerate(buttons) if i in shown] + ([more] if plan_.paged and more else [])
+        for index, button in enumerate(buttons):
+            button.display = index in shown
+        for n, button in enumerate(visible):
+            button.styles.height = plan_.height
+            last = n == len(visible) - 1
+            button.styles.margin = (0, 0, 0 if plan_.columns == 2 or last else GAP, 0)
+            button.set_class(plan_.height >= MIN_ROWS, "-big")
+
+    def show_option(self, option: int | None) -> None:
+        """Turn to the page with ``option`` on it (the chosen answer stays in view)."""
+        if option is None:
+            return
+        self._wanted = option
+        if self.plan is not None:
+            self.lay_out()
+
+    def on_more_answers_turned(self, message: MoreAnswers.Turned) -> None:
+        """The next page, or the first after the last."""
+        message.stop()
+        if self.plan is not None:
+            self.lay_out((self.page + 1) % len(self.plan.pages))
 
 
 class QuestionPanel(Vertical):
     """The question in large bold text above one button per option, numbered from 1.
 
     The answers share the height the question leaves, all equally tall, stacked or -- when the
-    display is short -- two-by-two, so every answer is on screen whatever its size.
+    display is short -- two-by-two, and on pages when even that cuts a text, so every answer shown
+    is whole whatever the display's size.
     """
 
     def __init__(
@@ -64,12 +132,16 @@ class QuestionPanel(Vertical):
         chosen: int | None = None,
         over_question: Widget | None = None,
         buttons: Sequence[tuple[int, int | None]] | None = None,
+        turn: tuple[str, str] = ("»", "«"),
     ) -> None:
         """Show ``question`` and the ``options`` labels (option 1 first); mark ``chosen`` if set.
         ``over_question`` (the thank-you row) is laid over the question text's rows when shown.
         ``buttons`` (a remote's page, :mod:`kiosk.ui.paging`): the (number shown, option) of each
-        button, option None for the page button whose label is the last of ``options``."""
+        button, option None for the page button whose label is the last of ``options``.
+        ``turn``: the words of the display's page button, "More answers" and "Back", shown when
+        the answers do not all fit the display at once (:class:`AnswerList`)."""
         super().__init__(classes="panel")
+        self.turn = turn
         self.question = question
         self.options = tuple(options)
         self.buttons = tuple(buttons) if buttons is not None else tuple((n, n) for n in range(1, len(options) + 1))
@@ -82,7 +154,7 @@ class QuestionPanel(Vertical):
             yield Static(self.question, id="question")
             if self._over is not None:
                 yield self._over
-        with AnswerList(id="answers"):
+        with AnswerList(turn=self.turn, id="answers"):
             for (shows, option), label in zip(self.buttons, self.options):
                 name = f"answer-{option}" if option is not None else "answer-page"
                 yield AnswerButton(option, label, id=name, shows=shows)
@@ -108,8 +180,10 @@ class QuestionPanel(Vertical):
             return False
         self.question, self.options = question, options
         self.query_one("#question", Static).update(question)
-        for button, label in zip(self.query(AnswerButton), options):
+        answers = self.query_one(AnswerList)
+        for button, label in zip(answers.answers(), options):
             button.relabel(label)
+        answers.lay_out(page=0)  # the new texts may wrap to other heights
         self.mark_chosen(chosen)
         return True
 
@@ -118,3 +192,4 @@ class QuestionPanel(Vertical):
         self.chosen = option
         for button in self.query(AnswerButton):
             button.set_class(option is not None and button.option == option, "-chosen")
+        self.query_one(AnswerList).show_option(option)

@@ -164,6 +164,9 @@ def test_the_live_status_goes_on_each_change(tmp_path):
         server.until(lambda w: any(s.get("doctor_called") for s in w.statuses), "the doctor call in the status")
         status = next(s for s in server.ward.statuses if s.get("doctor_called"))
         assert (status["kiosk_id"], status["question"], status["session_id"]) == (KIOSK, 3, "abc")
+        # this process among the kiosk's (two browser tabs are two processes: station.ward)
+        other = SyncClient(store.path, url=server.url, token=TOKEN, kiosk_id=KIOSK)
+        assert status["instance"] == sync.instance and sync.instance != other.instance
     finally:
         sync.stop()
         server.stop()
