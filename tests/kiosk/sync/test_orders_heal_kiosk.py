@@ -100,6 +100,6 @@ def test_the_poll_holds_the_orders_of_running_and_unsent_sessions(tmp_path):
     ended = visit("order-ended")
     ended.abandon()
     assert "order-ended" in held_orders(store.path)  # its rows are not at the station yet
-    store._db.execute("DELETE FROM outbox")  # noqa: SLF001 - as the sync client does once delivered
+    store._db.execute("DELETE FROM outbox")  # as the sync client does once delivered
     assert held_orders(store.path) == ["order-running"]
     store.close()
