@@ -70,6 +70,8 @@ WHISPER_MIN_FRAMES = 1000
 WHISPER_THREADS = 1
 #: at most this many prompt tokens (Whisper's own limit is 223)
 WHISPER_PROMPT_TOKENS = 120
+#: words that turn a reply around ("not right"), refusing the detector's second hearing of it
+NEGATIONS = frozenset({"no", "not", "nope", "wrong", "incorrect", "isn", "don", "never", "nothing"})
 #: what Whisper says over silence and noise, learnt from subtitled video (normalised)
 HALLUCINATIONS = frozenset(
     {
@@ -196,13 +198,40 @@ class WhisperRecogniser:
         """Decode the utterance and check the transcript (see the module docstring)."""
         pcm = bytes(self._pcm)
         self._pcm.clear()
-        if self._detector is not None:
-            self._detector.close()
         if self._grammar is None or len(pcm) < 2 * SAMPLE_RATE // 10:
+            if self._detector is not None:
+                self._detector.close()
             return Recognition("", 0.0)
         encoded, frames = self._encode(pcm)
         text, logprob, no_speech = self._generate(encoded, len(pcm) / 2 / SAMPLE_RATE)
-        return self._judge(pcm, encoded, frames, text, logprob, no_speech)
+        result = self._judge(pcm, encoded, frames, text, logprob, no_speech)
+        if self._detector is None:
+            return result
+        if result.confidence > 0 and not isinstance(self._meaning(result.text), str):
+            self._detector.close()
+            return result
+        return self._second_hearing(result, normalise(text))
+
+    def _second_hearing(self, result: Recognition, heard: str) -> Recognition:
+        """Where Whisper heard no answer, the detector's own hearing of an option (PocketSphinx,
+        with its own checks), unless Whisper's transcript holds a word only another option's
+        phrases have, or, for a reply taken at once, a negation (:data:`NEGATIONS`: "yes not right"
+        is no yes). tiny.en hears espeak-ng's "that's right" as "next slide"."""
+        assert self._grammar is not None and self._detector is not None
+        second = self._detector.finish()
+        option = self._meaning(second.text) if second.confidence > 0 else None
+        if not isinstance(option, int) or isinstance(option, bool):
+            return result
+        mine = {w for p in self._grammar.phrases if self._meaning(p) == option for w in normalise(p).split()}
+        others = {w for p in self._grammar.phrases if self._meaning(p) != option for w in normalise(p).split()}
+        if self._taken_as_heard:  # a reply acted on at once: any negation refuses it
+            others |= NEGATIONS
+        others -= mine
+        if others & set(heard.split()):
+            log.debug("whisper: %r contradicts the detector's %r", heard, second.text)
+            return result
+        log.debug("whisper: %r; the detector heard %r (%.2f)", heard, second.text, second.confidence)
+        return second
 
     def transcribe(self, pcm: bytes) -> tuple[str, float, float]:
         """Whisper's transcript of 16 kHz int16 audio, its mean token log-probability and its
