@@ -34,14 +34,11 @@ this machine's sources do not carry; where they are installed, pass e.g. ``--voi
                                [--recogniser pocketsphinx|whisper] [--languages en es fr de]
                                [--hard] [--voices-per-language N]
 
-``--hard`` runs issue 33's rooms (quiet, steady noise at 20 dB, RT60 1 s and 1.5 s, people
-talking at 7 and 5 dB); ``--languages es fr de`` (Whisper only) plays 4 espeak-ng voices per
-language (:data:`_asr_cases.OTHER_VOICES`) saying that language's labels, synonyms and numbers
-from the kiosk's own words; ``--voices-per-language N`` keeps the first N voices of each split (a
-bounded, quicker run). Also per condition: ``right_option_stored`` (option answers stored right,
-issue 33's figure), ``false_calls``, ``cpu_ms_per_utterance`` (the recogniser's processor time),
-``speech_end_to_answer_wall_ms`` (the final decode's wall time instead of its processor time:
-the machine's other work included); ``max_rss_mb`` for the whole run.
+``--hard``: issue 33's rooms (quiet, 20 dB noise, RT60 1 and 1.5 s, talk at 7 and 5 dB);
+``--languages es fr de`` (Whisper): 4 espeak-ng voices each (``_asr_cases.OTHER_VOICES``);
+``--voices-per-language N``: the first N voices per split (a bounded run). Also reported:
+``right_option_stored``, ``false_calls``, ``cpu_ms_per_utterance``, ``max_rss_mb`` and
+``speech_end_to_answer_wall_ms`` (the final decode's wall time, the machine's other work in it).
 
 ``--vad webrtc`` needs ``uv pip install webrtcvad-wheels``; ``--vad silero`` needs onnxruntime and
 silero-vad's ONNX model (see ``bench/_vads.py``): neither is a kiosk dependency.
