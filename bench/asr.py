@@ -55,7 +55,6 @@ import random
 import resource
 import sys
 import tempfile
-import time
 import zlib
 from pathlib import Path
 
@@ -77,6 +76,7 @@ from _asr_cases import (  # noqa: E402
     patient_cases,
     yes_no,
 )
+from _timed import Timed  # noqa: E402
 from _vads import endpointer_factory  # noqa: E402
 
 from kiosk.core.channels import ChannelInput, Command  # noqa: E402
@@ -145,44 +145,6 @@ class Room:
         return np.clip(np.round(out), -32768, 32767).astype(np.int16)
 
 
-class _Timed:
-    """Adds up the processor time a recogniser spends (process time, not wall time: the bench
-    shares its cores with other work, which would otherwise count as the recogniser's)."""
-
-    def __init__(self, inner) -> None:
-        self.inner, self.seconds, self.name, self.language = inner, 0.0, inner.name, inner.language
-        #: processor seconds of the latest finish(): the endpoint → result part of the latency
-        self.last_finish = 0.0
-        #: utterances finished
-        self.finished = 0
-
-    def set_grammar(self, *args, **kwargs):
-        """Forward."""
-        return self.inner.set_grammar(*args, **kwargs)
-
-    def reset(self) -> None:
-        """Forward."""
-        self.inner.reset()
-
-    def accept(self, pcm: bytes):
-        """Forward, timed."""
-        began = time.process_time()
-        try:
-            return self.inner.accept(pcm)
-        finally:
-            self.seconds += time.process_time() - began
-
-    def finish(self):
-        """Forward, timed."""
-        began = time.process_time()
-        try:
-            return self.inner.finish()
-        finally:
-            self.last_finish = time.process_time() - began
-            self.seconds += self.last_finish
-            self.finished += 1
-
-
 class Patient:
     """One voice in one room, answering through a real :class:`VoiceChannel`."""
 
@@ -206,16 +168,16 @@ class Patient:
         self.latency: list[float] = []
         #: the same with the final decode's wall time (the machine's other work included)
         self.latency_wall: list[float] = []
-        self.timed: list[_Timed] = []
+        self.timed: list[Timed] = []
         self.audio_seconds = 0.0
         #: spoken yeses the channel sent as unsure (see VoiceChannel.reply_min_above_room_db)
         self.asked_to_press = 0
         #: ... of which the option heard was the one meant (pressing Yes would have stored it)
         self.asked_to_press_right = 0
 
-        def recogniser(language: str) -> _Timed:
+        def recogniser(language: str) -> Timed:
             inner = open_whisper(language) if recogniser_name == "whisper" else PocketSphinxRecogniser(language)
-            self.timed.append(_Timed(inner))
+            self.timed.append(Timed(inner))
             return self.timed[-1]
 
         self.channel = VoiceChannel(
