@@ -207,10 +207,26 @@ class WhisperRecogniser:
         result = self._judge(pcm, encoded, frames, text, logprob, no_speech)
         if self._detector is None:
             return result
-        if result.confidence > 0 and not isinstance(self._meaning(result.text), str):
+        meaning = self._meaning(result.text)
+        if result.confidence > 0 and isinstance(meaning, int) and self._taken_as_heard:
+            return self._agreed(result, meaning)
+        if result.confidence > 0 and not isinstance(meaning, str):
             self._detector.close()
             return result
         return self._second_hearing(result, normalise(text))
+
+    def _agreed(self, result: Recognition, option: int) -> Recognition:
+        """A reply acted on at once (English): Whisper's hearing stands only where the detector
+        heard the same option, unless that option is itself a refusal (its phrases hold a
+        negation: declining stores nothing). The kiosk's own voice saying "not right" came out
+        of Whisper as "That's right." (0.94); PocketSphinx heard "wrong"."""
+        assert self._grammar is not None and self._detector is not None
+        second = self._detector.finish()
+        mine = {w for p in self._grammar.phrases if self._meaning(p) == option for w in normalise(p).split()}
+        if mine & NEGATIONS or (second.confidence > 0 and self._meaning(second.text) == option):
+            return result
+        log.debug("whisper: %r, but the detector heard %r", result.text, second.text)
+        return Recognition(result.text, 0.0)
 
     def _second_hearing(self, result: Recognition, heard: str) -> Recognition:
         """Where Whisper heard no answer, the detector's own hearing of an option (PocketSphinx,

@@ -202,3 +202,20 @@ def test_whisper_off_gives_the_reason(monkeypatch):
     assert whisper_status("en") == (None, "turned off (KIOSK_WHISPER=off)")
     with pytest.raises(AsrUnavailable, match="turned off"):
         WhisperRecogniser("en")
+
+
+@pytest.mark.slow  # real audio (espeak-ng)
+@pytest.mark.parametrize("reply", ["not right", "that's not right", "no that's not what I said"])
+def test_a_spoken_no_is_never_taken_as_yes(spoken, reply, monkeypatch):
+    """Whisper hears the kiosk's own "not right" as "That's right." (0.94); PocketSphinx hears
+    "that's not right" as "that's right" (0.74): neither hearing alone may store it."""
+    monkeypatch.delenv("KIOSK_WHISPER", raising=False)
+    from kiosk.speech.audio import read_wav
+
+    recogniser = open_recogniser("en")
+    matcher = Matcher([OptionWords("Yes"), OptionWords("No")], "en")
+    recogniser.set_grammar(matcher.phrases(), matcher.meaning, matcher.lead_ins(), matcher.fillers(), True)
+    silence = b"\0" * 9600
+    recogniser.accept(silence + read_wav(spoken(reply)).tobytes() + silence)
+    result = recogniser.finish()
+    assert matcher.match(result.text, result.confidence).option != 1
