@@ -32,6 +32,7 @@ import logging
 import math
 import re
 from collections.abc import Callable, Hashable, Sequence
+from enum import Enum
 from typing import Any
 
 import numpy as np
@@ -208,17 +209,18 @@ class WhisperRecogniser:
         if self._detector is None:
             return result
         meaning = self._meaning(result.text)
-        if result.confidence > 0 and isinstance(meaning, int) and self._taken_as_heard:
-            return self._agreed(result, meaning)
-        if result.confidence > 0 and not isinstance(meaning, str):
+        if result.confidence > 0 and (_is_command(meaning) or self._taken_as_heard and _is_option(meaning)):
+            return self._agreed(result, meaning)  # acted on at once
+        if result.confidence > 0 and _is_option(meaning):
             self._detector.close()
             return result
         return self._second_hearing(result, normalise(text))
 
-    def _agreed(self, result: Recognition, option: int) -> Recognition:
-        """A reply acted on at once (English): Whisper's hearing stands only where the detector
-        heard the same option, unless that option is itself a refusal (its phrases hold a
-        negation: declining stores nothing). The kiosk's own voice saying "not right" came out
+    def _agreed(self, result: Recognition, option: Hashable) -> Recognition:
+        """A command or a reply acted on at once (English): Whisper's hearing stands only where
+        the detector heard the same, unless it is itself a refusal (its phrases hold a negation:
+        declining stores nothing). Whisper prompted with the commands heard "I need help" in
+        white noise as "I need a doctor". The kiosk's own voice saying "not right" came out
         of Whisper as "That's right." (0.94); PocketSphinx heard "wrong"."""
         assert self._grammar is not None and self._detector is not None
         second = self._detector.finish()
@@ -236,7 +238,7 @@ class WhisperRecogniser:
         assert self._grammar is not None and self._detector is not None
         second = self._detector.finish()
         option = self._meaning(second.text) if second.confidence > 0 else None
-        if not isinstance(option, int) or isinstance(option, bool):
+        if not _is_option(option):
             return result
         mine = {w for p in self._grammar.phrases if self._meaning(p) == option for w in normalise(p).split()}
         others = {w for p in self._grammar.phrases if self._meaning(p) != option for w in normalise(p).split()}
@@ -292,9 +294,9 @@ class WhisperRecogniser:
         if whole is not None:
             return Recognition(plain, sure)
         meaning = self._meaning(plain)
-        if self._taken_as_heard or not isinstance(meaning, int | str):
+        if self._taken_as_heard or _is_command(meaning):
             return Recognition(plain, 0.0)  # a command or a reply taken at once: whole phrases only
-        if isinstance(meaning, int):
+        if _is_option(meaning):
             return Recognition(plain, sure)  # an option inside a sentence: asked back
         best, best_logprob = self._rescore(encoded, frames, plain)
         if best is not None:
@@ -338,6 +340,17 @@ class WhisperRecogniser:
         voiced = int(voiced_frames(pcm).sum())
         seconds = max(voiced / 100, 0.25)
         return len(plain.split()) > WHISPER_MAX_WORDS_PER_S * seconds + 1
+
+
+def _is_option(meaning: Hashable) -> bool:
+    """Whether a phrase's meaning is an option number (see ``Matcher.meaning``)."""
+    return isinstance(meaning, int) and not isinstance(meaning, bool)
+
+
+def _is_command(meaning: Hashable) -> bool:
+    """Whether a phrase's meaning is a command (an enum member; options are numbers, anything
+    else is the phrase itself)."""
+    return isinstance(meaning, Enum)
 
 
 def _collapse(plain: str) -> str:
