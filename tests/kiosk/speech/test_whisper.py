@@ -143,6 +143,18 @@ def test_the_multilingual_model_is_joined_once_privately_and_a_damaged_copy_is_j
     assert sha256_of(folder / "model.bin") == BASE_SHA256
 
 
+@pytest.fixture(scope="module")
+def private_cache(tmp_path_factory):
+    """The joined base model goes to a private cache, not the user's (joined once per module)."""
+    before = os.environ.get("KIOSK_CACHE_DIR")
+    os.environ["KIOSK_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
+    yield
+    if before is None:
+        del os.environ["KIOSK_CACHE_DIR"]
+    else:
+        os.environ["KIOSK_CACHE_DIR"] = before
+
+
 def _options(item_id: str, language: str) -> list[OptionWords]:
     item = next(i for i in QUESTIONNAIRE.items if i.id == item_id)
     return [OptionWords(o.label_in(language), tuple(o.synonyms_in(language))) for o in item.options]
@@ -158,7 +170,9 @@ def _options(item_id: str, language: str) -> list[OptionWords]:
         ("de", None, None, "ja", True),
     ],
 )
-def test_spoken_answers_and_replies_in_four_languages(spoken, language, answer, option, reply, yes, monkeypatch):
+def test_spoken_answers_and_replies_in_four_languages(
+    spoken, private_cache, language, answer, option, reply, yes, monkeypatch
+):
     """The kiosk's own voice in each language, through Whisper with the matcher's grammar."""
     monkeypatch.delenv("KIOSK_WHISPER", raising=False)
     from kiosk.speech.audio import read_wav
