@@ -56,6 +56,8 @@ class Condition:
     noise: str = ""  # "", "white", "babble"
     snr_db: float = 0.0
     effect: str = ""  # "", "reverb", "telephone", "quiet", "leading_silence"
+    #: the reverberant room's RT60 (s)
+    rt60: float = 0.7
     #: steady noise: utterances must never reach the cut-off here
     steady: bool = False
 
@@ -69,11 +71,18 @@ CONDITIONS = {
     "babble_10": Condition("babble", 10),
     "babble_5": Condition("babble", 5),
     "reverb": Condition(effect="reverb"),
+    # a tiled day room and a corridor: reverberation of 1 s and more (issue 33)
+    "reverb_1s": Condition(effect="reverb", rt60=1.0),
+    "reverb_1.5s": Condition(effect="reverb", rt60=1.5),
+    # people talking nearby, about as loud as the patient (issue 33: 5-10 dB)
+    "talk_7": Condition("babble", 7),
     "telephone": Condition(effect="telephone"),
     "quiet_-20dB": Condition(effect="quiet"),
     "leading_silence": Condition(effect="leading_silence"),
 }
 QUICK_CONDITIONS = ["clean", "white_10", "babble_10", "reverb"]
+#: issue 33's rooms: quiet, steady noise (20 dB), reverberant (RT60 1 s and 1.5 s), talk nearby
+HARD_CONDITIONS = ["clean", "white_20", "reverb_1s", "reverb_1.5s", "talk_7", "babble_5"]
 
 #: answers in a patient's own words (item, text, option)
 NATURAL_EN = [
@@ -138,3 +147,46 @@ def patient_cases(questionnaire) -> list[tuple[str, str, object]]:
         cases += [(item.id, text, command) for text, command in COMMANDS_EN]
     cases += [(item, text, option) for item, text, option in NATURAL_EN]
     return list(dict.fromkeys(cases))
+
+
+#: patients' voices in the kiosk's other languages (espeak-ng voice+variant, words per minute):
+#: different variants, speeds and so pitches; none is the kiosk's own voice at its own rate
+OTHER_VOICES = {
+    "es": [("es+m3", 130), ("es-419+f2", 165), ("es+klatt", 145), ("es-419+croak", 120)],
+    "fr": [("fr+m3", 135), ("fr-be+f2", 160), ("fr+klatt", 145), ("fr+croak", 120)],
+    "de": [("de+m3", 130), ("de+f2", 165), ("de+klatt", 145), ("de+croak", 120)],
+}
+#: non-answers in the other languages ("<cough>" is a cough)
+OTHER_NON_ANSWERS = {
+    "es": ["eh", "¿qué?", "<cough>", "no lo sé", "¿ya es la hora de comer?", "mi hija viene luego"],
+    "fr": ["euh", "quoi ?", "<cough>", "je ne sais pas", "c'est l'heure du déjeuner ?", "ma fille vient plus tard"],
+    "de": ["äh", "was?", "<cough>", "ich weiß nicht", "ist es zeit zum mittagessen", "meine tochter kommt später"],
+}
+
+
+def language_cases(questionnaire, language: str) -> list[tuple[str, str, object]]:
+    """:func:`patient_cases` in another language: each option's label and synonyms, its number
+    said two ways, non-answers, and the commands repeat and call the doctor, from the kiosk's own
+    words file for that language."""
+    from kiosk.speech.matching import CARDINALS, COMMAND_PHRASES, NUMBER_FORMS
+
+    cases = []
+    forms = [f for f in NUMBER_FORMS[language] if "{n}" in f][:2]
+    for item in questionnaire.items:
+        for option in item.options:
+            cases.append((item.id, spoken_label(option.label_in(language)), option.number))
+            cases += [(item.id, s, option.number) for s in option.synonyms_in(language)]
+            cases += [(item.id, f.format(n=CARDINALS[language][option.number - 1][0]), option.number) for f in forms]
+        cases += [(item.id, text, None) for text in OTHER_NON_ANSWERS[language]]
+        cases += [(item.id, COMMAND_PHRASES[language][c][0], c) for c in (Command.REPEAT, Command.CALL_DOCTOR)]
+    return list(dict.fromkeys(cases))
+
+
+def yes_no(language: str) -> tuple[list[str], list[str]]:
+    """The replies a patient gives to "Is that right?" in ``language`` (four ways each)."""
+    if language == "en":
+        return YES_EN, NO_EN
+    from kiosk.speech.matching import YES_NO
+
+    yes, no = YES_NO[language]
+    return [yes[i % len(yes)] for i in (0, 2, 3, 0)], [no[i % len(no)] for i in (0, 1, 2, 0)]

@@ -1,4 +1,4 @@
-"""`kiosk models`: install and list Vosk speech-recognition models.
+"""`kiosk models`: install Vosk speech-recognition models; list which recogniser each language uses.
 
     kiosk models install LANG [--url URL --sha256 HEX]
     kiosk models list
@@ -208,15 +208,25 @@ def install(language: str, url: str | None = None, sha256: str | None = None, in
 
 
 def _list() -> list[str]:
+    """One line per language: the recogniser :func:`kiosk.speech.asr.open_recogniser` would
+    open for it, and why (decided from what is installed, without loading a model)."""
+    from kiosk.speech.asr.whisper_files import whisper_status
+
     lines = []
     for language in OFFICIAL_MODELS:
+        whisper, why = whisper_status(language)
         path = find_model(language)
-        if path is not None:
-            lines.append(f"{language}  vosk          {path}")
+        if whisper is not None:
+            detail = "PocketSphinx ends the turn" if language == "en" else "the endpointer ends the turn"
+            lines.append(f"{language}  whisper       Whisper {whisper}, installed ({detail})")
+        elif path is not None:
+            lines.append(f"{language}  vosk          {path} (fallback: Whisper {why})")
         elif language == "en":
-            lines.append(f"{language}  pocketsphinx  (bundled English model; `kiosk models install en` for vosk)")
+            lines.append(f"{language}  pocketsphinx  bundled English model (fallback: Whisper {why})")
         else:
-            lines.append(f"{language}  none          voice answers off; `kiosk models install {language}`")
+            lines.append(
+                f"{language}  none          voice answers off (Whisper {why}); `kiosk models install {language}`"
+            )
     return lines
 
 
@@ -228,7 +238,7 @@ def main(argv: Sequence[str]) -> int:
     add.add_argument("language", help="en, es or fr")
     add.add_argument("--url", help="a model zip from another address (needs --sha256)")
     add.add_argument("--sha256", help="the archive's SHA-256, hex")
-    sub.add_parser("list", help="which recogniser each language would use")
+    sub.add_parser("list", help="which recogniser each language would use, and why")
     args = parser.parse_args(list(argv))
     if args.action == "list":
         print("\n".join(_list()))

@@ -344,7 +344,8 @@ class VoiceChannel:
             self._pipeline.recogniser = recogniser
         self._apply_grammar()
         self._gate()
-        self._status(ChannelState.ON, f"voice answers on: {recogniser.name}")
+        fallback = getattr(recogniser, "fallback", "")
+        self._status(ChannelState.ON, f"voice answers on: {recogniser.name}" + (f" ({fallback})" if fallback else ""))
 
     def _apply_grammar(self) -> None:
         """(Lock held.) Give the recogniser the current prompt's grammar, once there is one."""

@@ -20,6 +20,8 @@ class VoskRecogniser:
     """Vosk (Kaldi) with a model directory and a JSON phrase-list grammar per question."""
 
     name = "vosk"
+    #: why a better recogniser is not used ("" when none would be)
+    fallback = ""
 
     def __init__(self, model_path: str | Path, language: str) -> None:
         try:

@@ -85,6 +85,8 @@ class PocketSphinxRecogniser:
     """PocketSphinx with the wheel's US-English model and a JSGF grammar per question."""
 
     name = "pocketsphinx"
+    #: why a better recogniser is not used ("" when none would be)
+    fallback = ""
 
     def __init__(self, language: str = "en") -> None:
         if language != "en":
@@ -183,6 +185,13 @@ class PocketSphinxRecogniser:
     def reset(self) -> None:
         """Drop any utterance in progress."""
         self._end()
+
+    def close(self) -> None:
+        """End the utterance without scoring it (another recogniser decodes it, see
+        :mod:`kiosk.speech.asr.whisper`): the cepstral mean has heard the voice, so later partial
+        results may end a turn early."""
+        self._end()
+        self._settled = True
 
     def accept(self, pcm: bytes) -> Recognition | None:
         """Decode more audio; returns the best partial hypothesis so far (if any)."""

@@ -27,6 +27,7 @@ def models_served(tmp_path, monkeypatch):
     served = tmp_path / "www"
     served.mkdir()
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path / "models"))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     handler = partial(_QuietHandler, directory=str(served))
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
@@ -151,6 +152,7 @@ def test_list_and_recogniser_choice_follow_what_is_installed(models_served, tmp_
 
 def test_kiosk_vosk_model_points_at_a_model_or_a_folder_of_models(tmp_path, monkeypatch):
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path / "none"))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     shelf = tmp_path / "shelf"
     for name in ("vosk-model-small-fr-0.22", "vosk-model-small-en-us-0.15"):
         (shelf / name / "am").mkdir(parents=True)
@@ -167,6 +169,7 @@ def test_kiosk_vosk_model_points_at_a_model_or_a_folder_of_models(tmp_path, monk
 
 def test_configured_model_is_only_used_for_its_own_language(tmp_path, monkeypatch):
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path / "none"))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     spanish = tmp_path / "vosk-model-small-es-0.42"
     (spanish / "am").mkdir(parents=True)

@@ -24,6 +24,7 @@ from .voice_kiosk import QUESTIONNAIRE, VoiceKiosk
 
 def test_no_recogniser_for_the_language_turns_voice_off_and_the_session_goes_on(monkeypatch, tmp_path):
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     kiosk = VoiceKiosk(open_recogniser, language="es")
     assert not kiosk.available
@@ -46,6 +47,7 @@ def test_no_model_reason_is_shown_in_the_patients_language(monkeypatch, tmp_path
     """The patient's screen says why voice is off in their language; the clinician still sees
     the technical reason with the command that fixes it."""
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     kiosk = VoiceKiosk(open_recogniser, language=language)
     board = ChannelBoard("espeak-ng")
@@ -56,7 +58,8 @@ def test_no_model_reason_is_shown_in_the_patients_language(monkeypatch, tmp_path
     clinician = [line.reason for line in board.lines("en", patient=False) if "kiosk models install" in line.reason]
     assert clinician == [
         f"voice answers off: no speech model for language {language!r}: pocketsphinx only "
-        f"ships English; install one with `kiosk models install {language}`"
+        f"ships English; install one with `kiosk models install {language}` "
+        "(Whisper: turned off (KIOSK_WHISPER=off))"
     ]
 
 
@@ -146,6 +149,7 @@ class _WavMicrophone:
 
 def test_started_channel_hears_its_microphone_thread_and_follows_language_changes(spoken, monkeypatch, tmp_path):
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
     microphones: list[_WavMicrophone] = []
     kiosk = VoiceKiosk(
@@ -161,7 +165,11 @@ def test_started_channel_hears_its_microphone_thread_and_follows_language_change
     assert kiosk.voice.wait_loaded()
     assert [(s.state, s.source, s.reason) for s in kiosk.statuses[2:]] == [
         (ChannelState.CONNECTING, "voice", "loading the speech model for 'en'"),
-        (ChannelState.ON, "voice", "voice answers on: pocketsphinx"),
+        (
+            ChannelState.ON,
+            "voice",
+            "voice answers on: pocketsphinx (Whisper unavailable: turned off (KIOSK_WHISPER=off))",
+        ),
     ]
     (microphone,) = microphones
     microphone.files += [spoken("independent"), spoken("yes")]  # the answer, and yes to "Is that right?"
@@ -174,6 +182,7 @@ def test_started_channel_hears_its_microphone_thread_and_follows_language_change
 def _no_models(monkeypatch, tmp_path) -> None:
     """A kiosk with no vosk model: English has pocketsphinx, Spanish nothing."""
     monkeypatch.setenv("KIOSK_MODELS_DIR", str(tmp_path))
+    monkeypatch.setenv("KIOSK_WHISPER", "off")
     monkeypatch.delenv("KIOSK_VOSK_MODEL", raising=False)
 
 
