@@ -15,7 +15,7 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
 from station import db
-from station.db import orders, visits
+from station.db import orders, sessions, visits
 from station.orders import LinkRefused, audit_order
 from station.sessions import LIFECYCLE
 
@@ -189,11 +189,9 @@ def signed_off(connection: Connection, session_id: str, by: Any) -> None:
     """The session's result was signed off (in the caller's transaction, the sign-off's own): its
     order (if any) is done once every result of it is (a battery's results are signed off one by
     one)."""
-    from station.validation import review_in
-
     order = _order_of(connection, session_id)
     others = [s for s in _sessions_of(connection, order) if s != session_id] if order is not None else []
-    if any(_is_finished(connection, s) and not review_in(connection, s).final for s in others):
+    if any(_is_finished(connection, s) and not _is_signed(connection, s) for s in others):
         return
     _move(
         connection,
@@ -203,6 +201,13 @@ def signed_off(connection: Connection, session_id: str, by: Any) -> None:
         "order_signed",
         f"result of session {session_id} signed off by {by.name}",
     )
+
+
+def _is_signed(connection: Connection, session_id: str) -> bool:
+    """The session's result is final: signed off, and not reopened since (the review state the
+    sign-off and the amend store on the session, in their own transactions)."""
+    signed = connection.execute(sa.select(sessions.c.signed_at).where(sessions.c.id == session_id)).scalar()
+    return signed is not None
 
 
 def reopened(connection: Connection, session_id: str, by: Any) -> None:
