@@ -137,7 +137,7 @@ def _index(run: list[str], questionnaire_id: str) -> int:
     return run.index(questionnaire_id) if questionnaire_id in run else len(run)
 
 
-def _visits_of(connection: Connection, q: Questionnaire, ids: Sequence[str], zone: tzinfo | None) -> list[PrintedVisit]:
+def visits_of(connection: Connection, q: Questionnaire, ids: Sequence[str], zone: tzinfo | None) -> list[PrintedVisit]:
     """The visits of these sessions (grouped by order, else one each), oldest first."""
     ids = list(dict.fromkeys(ids))
     loaded = load_many(connection, ids, RESULT_KINDS)
@@ -182,7 +182,7 @@ def visit(engine: Engine, q: Questionnaire, session_id: str, zone: tzinfo | None
         ids = [session_id]
         if order_id:
             ids += connection.execute(sa.select(visits.c.session_id).where(visits.c.order_id == order_id)).scalars()
-        found = _visits_of(connection, q, ids, zone)
+        found = visits_of(connection, q, ids, zone)
     if not found:
         raise NotFound(session_id)
     return next(v for v in found if session_id in {r.session_id for r in v.results})
@@ -196,4 +196,4 @@ def course(engine: Engine, q: Questionnaire, patient_id: str, zone: tzinfo | Non
             .where(sessions.c.patient_id == patient_id, sessions.c.status != "pending")
             .order_by(sessions.c.started_at)
         ).scalars()
-        return _visits_of(connection, q, list(ids), zone)
+        return visits_of(connection, q, list(ids), zone)

@@ -8,11 +8,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from datetime import UTC, datetime
 
+import sqlalchemy as sa
 from sqlalchemy.engine import Engine
 
 from bench._history import clone
 from kiosk.core.questionnaire import load_questionnaire
-from station import auth, orders, sync, validation
+from station import auth, db, orders, sync, validation
 from tests.instruments import MOOD4, MOOD4_PATIENT
 from tests.station.helpers import PATIENTS, Row, record_patient
 
@@ -63,3 +64,12 @@ def store_visits(engine: Engine) -> Visits:
     _take(engine, second, "print-mood", ORDERED_AT.replace(minute=25), seq)
     validation.sign_off(engine, "print-barthel", auth.User("dr.lopez", "doctor"))
     return Visits("print-walk-up", order.id, "print-barthel", "print-mood")
+
+
+def raise_alert(engine: Engine, session_id: str, seq: int, kind: str, at: datetime) -> int:
+    """The kiosk reports alert ``kind`` in ``session_id`` at ``at`` (its row numbered ``seq``);
+    returns the alert's id."""
+    row = Row(seq, "record_event", session_id, {"t": 1.0, "kind": kind, "detail": ""}, 1.0, at.isoformat())
+    with engine.begin() as connection:
+        sync.intake(connection, KIOSK, sync.parse({"events": [row.event()]}))
+        return int(connection.execute(sa.select(db.alerts.c.id).where(db.alerts.c.seq == seq)).scalar_one())
