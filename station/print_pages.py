@@ -12,9 +12,13 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, Response
 from starlette.routing import Route
 
-from station import printing
+from station import db, printing
 from station.rendering import render
 from station.sessions import NotFound
+
+
+def _now() -> str:
+    return printing.shown_time(db.now_iso())
 
 
 async def visit_print(request: Request) -> Response:
@@ -24,7 +28,9 @@ async def visit_print(request: Request) -> Response:
         found = await run_in_threadpool(printing.visit, engine, q, session_id)
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
-    return render(request, "print_visit.html", visits=[found], patient_id=found.patient_id, course=False)
+    return render(
+        request, "print_visit.html", visits=[found], patient_id=found.patient_id, course=False, printed_at=_now()
+    )
 
 
 async def course_print(request: Request) -> Response:
@@ -33,7 +39,7 @@ async def course_print(request: Request) -> Response:
     found = await run_in_threadpool(printing.course, engine, q, patient_id)
     if not found:
         return PlainTextResponse(f"no visit of patient {patient_id} has reached this station", status_code=404)
-    return render(request, "print_visit.html", visits=found, patient_id=patient_id, course=True)
+    return render(request, "print_visit.html", visits=found, patient_id=patient_id, course=True, printed_at=_now())
 
 
 routes = [
