@@ -118,5 +118,9 @@ def test_print_view_and_its_pdf_in_chromium(browser, sqlite_url, station_factory
         page.wait_for_selector(".print-visit")
         text = " ".join(p.extract_text() for p in PdfReader(io.BytesIO(page.pdf(format="A4"))).pages)
         assert "2026-10-02 11:30 CEST" in text and "2026-11-20 11:15 CET" in text
+        for missing in ("/sessions/no-such-session/print", "/patients/NHC-9999999/print"):
+            answer = page.goto(station.url + missing)
+            assert answer is not None and answer.status == 404, missing
+            assert "has reached this station" in page.inner_text("body")
     finally:
         context.close()
