@@ -18,6 +18,12 @@
   let audio = null;
   let timer = null;
 
+  // -- the print views: their button opens the browser's print dialog (print or save as PDF) --
+  document.addEventListener("click", (event) => {
+    const target = event.target instanceof Element ? event.target.closest("[data-print]") : null;
+    if (target) window.print();
+  });
+
   // -- confirmations and actions that stay on the page ---------------------------------------
   document.addEventListener("submit", (event) => {
     const button = event.submitter;
