@@ -46,3 +46,6 @@ UNATTENDED_TEXT: Mapping[str, str] = Table(lambda words: words.screen["unattende
 
 #: that wait's one option
 GO_ON_LABEL: Mapping[str, str] = Table(lambda words: words.screen["go_on"])
+
+#: a walk-up patient's start of an instrument their caregiver answers: who it is for, calmly
+CAREGIVER_ONLY_TEXT: Mapping[str, str] = Table(lambda words: words.screen["caregiver_only"])
