@@ -15,6 +15,7 @@ from kiosk.core.clock import SimClock
 from kiosk.export import csv_text, fhir_response, wide_csv_text
 from kiosk.store.database import Store
 from tests.kiosk.core.answerer_instruments import caregiver_instrument, session_of
+from tests.kiosk.export.standard import check_fhir
 
 
 def _answered(tmp_path, answerer: Answerer | None):
@@ -57,6 +58,7 @@ def _answered(tmp_path, answerer: Answerer | None):
 def test_the_answerer_is_a_related_person_and_a_csv_column(tmp_path, answerer, relationship):
     q, stored = _answered(tmp_path, answerer)
     response = fhir_response(q, stored)
+    check_fhir(response)  # valid R4 for the official schema and fhir.resources
     (related,) = response["contained"]
     assert related["resourceType"] == "RelatedPerson" and related["patient"] == response["subject"]
     assert related["relationship"] == [relationship]
@@ -70,6 +72,7 @@ def test_the_answerer_is_a_related_person_and_a_csv_column(tmp_path, answerer, r
 def test_without_a_recorded_relationship_the_related_person_says_none(tmp_path):
     q, stored = _answered(tmp_path, None)
     response = fhir_response(q, stored)
+    check_fhir(response)
     assert response["contained"] == [
         {"resourceType": "RelatedPerson", "id": "answerer", "patient": response["subject"]}
     ]
