@@ -14,6 +14,7 @@ from typing import cast
 
 from lark import Token, Tree
 
+from qos.bundled import MODELS
 from qos.errors import ModelError
 from qos.grammar import SyntaxProblem, children, parse_text
 from qos.model import (
@@ -50,7 +51,8 @@ _STRENGTHS = "verylow, low, medium, high, veryhigh"
 def parse_model(text: str, filename: str = "<string>", folder: str | Path | None = None) -> Model:
     """Parse and check a model; raise :class:`ModelError` naming file, line and column.
 
-    ``folder`` is where ``import`` looks for other models (default: the current directory).
+    ``folder`` is where ``import`` looks for other models (default: the current directory), then
+    the shipped models' folder (``import "clarc.roqme"`` from anywhere).
     """
     source = Source(text, filename, Path(folder) if folder is not None else Path("."))
     return _Checker(source).model(source)
@@ -150,6 +152,8 @@ class _Checker(TermChecker):
         if self.source.folder is None:
             raise self.error(target, f"cannot import {relative}: this model was not read from a file")
         path = (self.source.folder / relative).resolve()
+        if not path.is_file() and "/" not in relative and (MODELS / relative).is_file():
+            path = (MODELS / relative).resolve()  # the shipped models: a site's model imports "clarc.roqme"
         if path in self.reading:
             raise self.error(target, f"import cycle: {relative} imports this model back")
         if str(path) in self.imported:

@@ -129,7 +129,7 @@ def check_definition(definition: Any, where: str) -> Questionnaire:
     text(q.id, f"{where}.id", ID_MAX, empty=False)
     text(q.version, f"{where}.version", ID_MAX)
     for language in q.languages:
-        one_of(language, f"{where}.languages", SCREEN_LANGUAGES)
+        one_of(language, f"{where}.languages", tuple(SCREEN_LANGUAGES))
     ids = [i.id for i in q.items] + [p.id for p in q.familiarisation]
     if len(set(ids)) != len(ids):
         raise _fail(f"{where}.items", "two items or practice questions share an id")

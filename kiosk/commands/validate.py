@@ -1,5 +1,5 @@
-"""`kiosk validate [FILE...] [--words [DIR]]`: list every problem of questionnaire files and of the
-kiosk's words files, one per line as ``file:line:col: problem``.
+"""`kiosk validate [FILE...] [--words [DIR]] [--site DIR]`: list every problem of questionnaire files,
+of the kiosk's words files and of a site's folder, one per line as ``file:line:col: problem``.
 
 Exit status 0 when everything is valid, 1 when anything has a problem, 2 when a file cannot be read
 as YAML at all (missing, not UTF-8, binary, too big or deep, a syntax error) or on bad usage. The
@@ -34,10 +34,26 @@ def main(argv: list[str]) -> int:
         help=f"a directory of words files, <language>.yaml (default: the kiosk's own, {WORDS_DIR}); "
         "its languages are listed",
     )
+    parser.add_argument(
+        "--site",
+        metavar="DIR",
+        help="a site's folder (site_dir: in the configuration): its instruments/, words/ and qos/, "
+        "checked as `kiosk run` checks them at start",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="FILE",
+        help="a configuration file: its settings, its site's folder, its instruments and QoS models, "
+        "as `kiosk run` checks them at start (exit 2 on a problem, as every command)",
+    )
     args = parser.parse_args(argv)
-    if not args.files and args.words is None:
-        parser.error("give questionnaire FILEs, --words [DIR], or both")
+    if not args.files and args.words is None and args.site is None and args.config is None:
+        parser.error("give questionnaire FILEs, --words [DIR], --site DIR, --config FILE, or several")
+    if args.config is not None and (status := _config(Path(args.config))):
+        return status
     status = _words(Path(args.words or WORDS_DIR), listed=args.words is not None)
+    if args.site is not None:
+        status = max(status, _site(Path(args.site)))
     for file in args.files:
         readable, problems = check_questionnaire(file)
         for problem in problems:
@@ -62,3 +78,44 @@ def _words(directory: Path, listed: bool) -> int:
     if listed and not problems:
         print(f"{directory}: ok, languages {', '.join(words)}", file=sys.stderr)
     return 2 if not readable else 1 if problems else 0
+
+
+def _site(directory: Path) -> int:
+    """Check a site's folder; print its problems, or what it holds."""
+    from kiosk.config.site_folder import check_site_folder
+
+    if not directory.is_dir():
+        print(f"{directory}: not a folder (a site's folder holds instruments/, words/ and qos/)")
+        return 2
+    site, problems, readable = check_site_folder(directory)
+    for problem in problems:
+        print(problem)
+    if not problems:
+        held = {"instruments": site.instruments, "languages": site.languages, "QoS models": site.models}
+        print(
+            f"{directory}: ok, " + "; ".join(f"{what} {', '.join(names) or 'none'}" for what, names in held.items()),
+            file=sys.stderr,
+        )
+    return 2 if not readable else 1 if problems else 0
+
+
+def _config(path: Path) -> int:
+    """Check a configuration as `kiosk run` does at start (its instruments and models loaded)."""
+    from kiosk.config import ConfigError, configured_instruments, load_config
+    from kiosk.core.qos_model import load_kiosk_model
+    from kiosk.core.questionnaire import QuestionnaireError
+    from qos import ModelError
+
+    try:
+        config = load_config(path, environ={})
+        instruments = configured_instruments(config)
+        for model in {config.qos_model, *(name for _, name in instruments if name is not None)}:
+            load_kiosk_model(model)
+    except QuestionnaireError as error:
+        print("\n".join(map(str, error.problems)) or str(error))
+        return 2
+    except (ConfigError, ModelError) as error:
+        print(error)
+        return 2
+    print(f"{path}: ok, instruments {', '.join(q.id for q, _ in instruments)}", file=sys.stderr)
+    return 0

@@ -18,6 +18,7 @@ Example ``config.yaml`` (every key optional)::
     questionnaire: /etc/kiosk/barthel.yaml
     instruments: [barthel, lawton, gds15]   # or a battery, in order (instead of questionnaire:): shipped
                                       # ids or files; {id: gds15, qos_model: FILE} gives one its own model
+    site_dir: /etc/kiosk/site         # the site's instruments/, words/ (new languages), qos/: see README
     bands: spanish                    # a band set of the questionnaire (default: the file's default)
     accept_unvalidated_translations: [de]   # or true: unvalidated translations this site accepts
                                       # for clinical use (default none; see below)
@@ -119,6 +120,9 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     if path is None and default_config_path().is_file():
         path = default_config_path()
     values: dict[str, Any] = {}
+    from kiosk.core.words import use_site_words
+
+    use_site_words(None)  # a site's languages are those of the configuration read last
     if path is not None:
         values = _read(Path(path))
     overrides = {"KIOSK_DATA_DIR": "data_dir", "KIOSK_LANGUAGE": "language", "KIOSK_VOSK_MODEL": "vosk_model"}

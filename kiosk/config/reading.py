@@ -22,6 +22,7 @@ from kiosk.config.settings import (
     InstrumentChoice,
     Station,
 )
+from kiosk.config.site_folder import SiteFolder, check_site_folder
 from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.core.questionnaire import SCREEN_LANGUAGES, Timing
 from kiosk.core.questionnaire.loading import bundled_path
@@ -54,7 +55,8 @@ def _read(path: Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise fail((), "the configuration is a mapping of settings (key: value)")
     values: dict[str, Any] = {}
-    for key, value in data.items():
+    site: SiteFolder | None = None
+    for key, value in sorted(data.items(), key=lambda setting: setting[0] != "site_dir"):  # the site's first
         if key not in _KEYS:
             raise fail((key,), f"unknown setting {key!r} (known: {', '.join(sorted(_KEYS))})")
         if key in _PATHS:
@@ -64,6 +66,10 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), str(exc)) from None
             if not value.is_absolute():  # relative paths are relative to the config file
                 value = path.parent / value
+            if key == "site_dir":
+                if not value.is_dir():
+                    raise fail((key,), f"site_dir: {value} is not a folder (of instruments/, words/ and qos/)")
+                site = _site(value)  # its languages are in use from here on
         elif key in _BOOLS:
             if not isinstance(value, bool):
                 raise fail((key,), f"{key} must be true or false")
@@ -138,7 +144,7 @@ def _read(path: Path) -> dict[str, Any]:
                 raise fail((key,), "interrupt_after_minutes must be a number of minutes, 1 to 10080")
         elif key == "qos_model":
             try:
-                value = _model(value, path.parent)
+                value = _model(value, path.parent, site)
             except ConfigError as exc:
                 raise fail((key,), str(exc)) from None
         elif key == "instruments":
@@ -147,7 +153,7 @@ def _read(path: Path) -> dict[str, Any]:
                     (key,),
                     "give either questionnaire: (one instrument) or instruments: (a battery), not both",
                 )
-            value = _instruments(value, path.parent, fail)
+            value = _instruments(value, path.parent, fail, site)
         elif key == "next_patient_after_s":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 3600:
                 raise fail((key,), "next_patient_after_s must be a number of seconds, 5 to 3600")
@@ -162,7 +168,17 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "bands" and (not isinstance(value, str) or not value):
             raise fail((key,), "bands must name a band set of the questionnaire, such as spanish")
         values[key] = value
+    if site is not None and "barthel" in site.instruments and not {"questionnaire", "instruments"} & set(values):
+        values["questionnaire"] = site.instruments["barthel"]  # the default instrument, as the site replaced it
     return values
+
+
+def _site(folder: Path) -> SiteFolder:
+    """The site's folder, checked whole; ConfigError with every problem, one line each."""
+    site, problems, _ = check_site_folder(folder)
+    if problems:
+        raise ConfigError("\n".join(map(str, problems)))
+    return site
 
 
 def _accepted_languages(value: object, fail: Any) -> tuple[str, ...] | bool:
@@ -180,13 +196,18 @@ def _accepted_languages(value: object, fail: Any) -> tuple[str, ...] | bool:
     return tuple(dict.fromkeys(value))
 
 
-def _model(value: object, folder: Path) -> str:
-    """A ``qos_model:`` value resolved (see kiosk.core.qos_model.resolve_model); ConfigError if unusable."""
+def _model(value: object, folder: Path, site: SiteFolder | None = None) -> str:
+    """A ``qos_model:`` value resolved (see kiosk.core.qos_model.resolve_model; a bare name may be
+    one of the site's models); ConfigError if unusable, a file that is not there too."""
     from kiosk.core.qos_model import resolve_model
 
     if not isinstance(value, str) or not value.strip():
         raise ConfigError("qos_model must name a bundled model (clarc, kiosk_pace) or a .roqme file")
+    if site is not None and value in site.models:
+        return str(site.models[value])
     value = resolve_model(value, folder)
+    if "/" in value and not Path(value).is_file():
+        raise ConfigError(f"qos_model: no model file {value}")
     if "/" not in value and value not in bundled_models():
         raise ConfigError(
             f"no bundled model named {value!r} (bundled: {', '.join(bundled_models())}); "
@@ -195,9 +216,10 @@ def _model(value: object, folder: Path) -> str:
     return value
 
 
-def _instruments(value: object, folder: Path, fail: Any) -> tuple[InstrumentChoice, ...]:
+def _instruments(value: object, folder: Path, fail: Any, site: SiteFolder | None) -> tuple[InstrumentChoice, ...]:
     """``instruments:``: a non-empty list of shipped ids or files, each also as ``{id: ..., qos_model:
-    ...}`` (``file:`` for a file); ``fail(key, message)`` makes the positioned ConfigError."""
+    ...}`` (``file:`` for a file), an id the site's instrument of that id before a shipped one;
+    ``fail(key, message)`` makes the positioned ConfigError."""
     key = "instruments"
     if not isinstance(value, list) or not value:
         raise fail((key,), "instruments must be a list such as [barthel, lawton, gds15]")
@@ -214,7 +236,7 @@ def _instruments(value: object, folder: Path, fail: Any) -> tuple[InstrumentChoi
                 )
             if "qos_model" in entry:
                 try:
-                    model = _model(entry["qos_model"], folder)
+                    model = _model(entry["qos_model"], folder, site)
                 except ConfigError as exc:
                     raise fail((key, index, "qos_model"), str(exc)) from None
             entry = entry.get("id", entry.get("file"))
@@ -223,6 +245,8 @@ def _instruments(value: object, folder: Path, fail: Any) -> tuple[InstrumentChoi
         if "/" in entry or entry.endswith((".yaml", ".yml")):
             file = _path(entry, key)
             chosen.append(InstrumentChoice(entry, file if file.is_absolute() else folder / file, model))
+        elif site is not None and entry in site.instruments:
+            chosen.append(InstrumentChoice(entry, site.instruments[entry], model))
         elif not bundled_path(f"{entry}.yaml").is_file():
             shipped = sorted(p.stem for p in bundled_path().parent.glob("*.yaml"))
             raise fail(where, f"no shipped instrument {entry!r} (shipped: {', '.join(shipped)}); or give a file")

@@ -135,6 +135,9 @@ class Config:
     #: the site's rule for the patient identifiers staff type (a regular expression matched whole;
     #: kiosk.core.visits.DEFAULT_ID_PATTERN: digits with at most four letters in front)
     patient_id_pattern: str = DEFAULT_ID_PATTERN
+    #: the site's own folder of instruments/, words/ and qos/ (kiosk.config.site_folder), outside
+    #: the package so that upgrades keep it (None: none)
+    site_dir: Path | None = None
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)
@@ -151,7 +154,7 @@ class Config:
         return self.clinician_pin_hash or self.clinician_pin
 
 
-_PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
+_PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles", "site_dir"}
 _BOOLS = {"adaptation", "familiarisation", "show_score_to_patient", "walk_up"}
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}

@@ -15,6 +15,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from basis import record
+from kiosk.core.answerers import Answerer, answerer
 
 WALK_UP = "walk-up"
 STAFF = "staff"
@@ -40,6 +41,9 @@ class Order:
     language: str
     answered_by: str
     ordered_by: str = ""
+    #: how the person answering is related to the patient (the order's ``relationship`` and
+    #: ``relationship_text``), None when the patient answers or the station did not say
+    answerer: Answerer | None = None
 
     @property
     def visit(self) -> str:
@@ -119,10 +123,21 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
         elif answered_by not in ("patient", "relative", "caregiver"):
             problems.append(f"{where} ({order_id}): answered_by {answered_by!r}")
         else:
-            found.append(
-                Order(order_id, patient, tuple(wanted), language, answered_by, str(entry.get("ordered_by") or ""))
-            )
+            try:
+                related = _answerer(entry)
+            except ValueError as exc:
+                problems.append(f"{where} ({order_id}): {exc}")
+                continue
+            ordered_by = str(entry.get("ordered_by") or "")
+            found.append(Order(order_id, patient, tuple(wanted), language, answered_by, ordered_by, related))
     return found, problems
+
+
+def _answerer(entry: Mapping[str, Any]) -> Answerer | None:
+    """An order's ``relationship`` (and ``relationship_text``), or None without one."""
+    if entry.get("relationship") is None:
+        return None
+    return answerer(entry["relationship"], entry.get("relationship_text") or "")
 
 
 def visit_of(log: Iterable[Any]) -> str | None:
@@ -178,14 +193,22 @@ class VisitDesk:
         (the first one's session; the others follow it in the order's order)."""
         self.ready = tuple(o for o in self.ready if o.id != order.id)
         return self._make(
-            order.patient_id, order.language, order.answered_by, order.visit, instruments=order.instruments
+            order.patient_id,
+            order.language,
+            order.answered_by,
+            order.visit,
+            instruments=order.instruments,
+            answerer=order.answerer,
         )
 
-    def for_staff(self, patient_id: str, language: str, relative: bool) -> tuple[Any, str | None]:
+    def for_staff(
+        self, patient_id: str, language: str, relative: bool, answerer: Answerer | None = None
+    ) -> tuple[Any, str | None]:
         """The session of a visit staff start by typing the identifier: (session, None), or
-        (None, why not)."""
+        (None, why not); ``answerer``: how the relative answering is related to the patient."""
         patient_id = patient_id.strip()
         why = check_patient_id(patient_id, self.id_pattern)
         if why:
             return None, why
-        return self._make(patient_id, language, "relative" if relative else "patient", STAFF), None
+        answered_by = "relative" if relative else "patient"
+        return self._make(patient_id, language, answered_by, STAFF, answerer=answerer), None

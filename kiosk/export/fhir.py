@@ -65,6 +65,7 @@ from collections.abc import Mapping
 from datetime import UTC, datetime
 from typing import Any
 
+from kiosk.core.answerers import answerer_of
 from kiosk.core.questionnaire import Code, Questionnaire
 from kiosk.core.review import Review, ReviewState
 from kiosk.core.site import ExportSite
@@ -283,6 +284,18 @@ def _patient(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
     return {"type": "Patient", "identifier": {"system": site.patient_system, "value": stored.patient_id}}
 
 
+def _related_person(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
+    """The person who answered for the patient (R4 RelatedPerson: ``patient`` is required; its
+    ``relationship`` is the answerer the session logged, coded where the kiosk has a code)."""
+    related: dict[str, Any] = {"resourceType": "RelatedPerson", "id": "answerer", "patient": _patient(site, stored)}
+    who = answerer_of(stored.log)
+    if who is not None:
+        code = who.code
+        coding = [{"system": code.system, "code": code.code, "display": code.display}] if code else []
+        related["relationship"] = [{"coding": coding, "text": who.display} if coding else {"text": who.display}]
+    return related
+
+
 def practitioner(name: str, staff_system: str) -> dict[str, Any]:
     """A staff account as a logical Practitioner reference: its name as identifier in the
     station's staff system (and as display)."""
@@ -356,10 +369,11 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
         "subject": _patient(site, stored),
         "authored": _authored(r),
         "author": device_reference(site),
-        "source": _patient(site, stored)
-        if stored.answered_by.value == "patient"
-        else {"type": "RelatedPerson", "display": stored.answered_by.value},
+        "source": _patient(site, stored),
     }
+    if stored.answered_by.value != "patient":  # who answered, and how they are related, as a contained RelatedPerson
+        resource["contained"] = [_related_person(site, stored)]
+        resource["source"] = {"reference": "#answerer", "type": "RelatedPerson", "display": stored.answered_by.value}
     if items:  # FHIR JSON has no empty arrays
         resource["item"] = items
     if r.final:

@@ -16,6 +16,7 @@ import io
 from collections.abc import Sequence
 from typing import Any
 
+from kiosk.core.answerers import answerer_of
 from kiosk.core.questionnaire import Questionnaire, result_words
 from kiosk.core.review import Review
 from kiosk.core.site import ExportSite
@@ -70,6 +71,8 @@ CSV_COLUMNS = [
     "visit",
     # last, so the columns before keep their places: which instrument (the versions tell edits apart)
     "questionnaire",
+    # how the person who answered for the patient is related to them (kiosk.core.answerers)
+    "answerer",
 ]
 
 
@@ -100,6 +103,7 @@ def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str,
         "simulated": "true" if stored.simulated else "false",
         # how the visit began (kiosk.core.visits): "order <id>", "staff", "walk-up"; blank before visits existed
         "visit": visit_of(stored.log) or "",
+        "answerer": who.display if (who := answerer_of(stored.log)) is not None else "",
     }
 
 
@@ -199,6 +203,7 @@ def wide_columns(q: Questionnaire) -> list[str]:
         "signed_at",
         "simulated",
         "visit",
+        "answerer",
         "total",
         "answered_points",
         "missing",

@@ -20,10 +20,11 @@ from collections.abc import Mapping, Sequence
 
 from basis import record
 from kiosk.core.channels import Command
-from kiosk.core.words import Table, fill, languages
+from kiosk.core.words import LANGUAGES as KIOSK_LANGUAGES
+from kiosk.core.words import Table, fill
 
 #: the languages with speech words: every language with a words file
-LANGUAGES = languages()
+LANGUAGES = KIOSK_LANGUAGES
 
 #: below this recogniser confidence an utterance is not an answer (see kiosk.speech.asr for the scale)
 DEFAULT_MIN_CONFIDENCE = 0.6

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 from basis import record
 from kiosk.config import site_from_config
 from kiosk.core.adaptation import Adaptation, Policy, load_policy
+from kiosk.core.answerers import walk_up_instruments
 from kiosk.core.clock import Clock
 from kiosk.core.pin import PinGuard
 from kiosk.core.qos_model import load_kiosk_model
@@ -138,6 +139,8 @@ class SessionMaker:
         ``instruments``: an order's instruments (default: the configured battery); ``first``
         overrides the configuration for one session (``session_id``, ``familiarisation``)."""
         options = {"familiarisation": self.config.familiarisation, **first}
+        if instruments is None and visit is None and patient is None:  # a walk-up: never a caregiver's instrument
+            instruments = walk_up_instruments([i.questionnaire for i in self.parts.battery()]) or None
         return self._battery(ids=instruments).first(
             patient_id=patient or self.patient_ids(),
             language=language or self.config.language,

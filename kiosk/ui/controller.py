@@ -24,6 +24,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
+from kiosk.core.answerers import answerer
 from kiosk.core.channels import Channel, ChannelInput, Presence
 from kiosk.core.session import Finished, NextPatient, Phase, Session, SessionEvent
 from kiosk.core.visits import Order, VisitDesk
@@ -385,13 +386,17 @@ class KioskController:
         self._begin(self.resume(stored))
         return None
 
-    def start_staff_visit(self, patient_id: str, language: str, relative: bool) -> str | None:
-        """Staff start a visit for the identifier they typed (clinician screen): why not, or None."""
+    def start_staff_visit(
+        self, patient_id: str, language: str, relative: bool, relationship: str | None = None
+    ) -> str | None:
+        """Staff start a visit for the identifier they typed (clinician screen): why not, or None;
+        ``relationship``: how the person answering for the patient is related to them."""
         if self.visits is None:
             return "this kiosk cannot start visits for a patient identifier"
         if self._busy():
             return IN_PROGRESS
-        session, why = self.visits.for_staff(patient_id, language, relative)
+        related = answerer(relationship) if relationship is not None else None
+        session, why = self.visits.for_staff(patient_id, language, relative, related)
         if session is None:
             return why
         self._begin(session, session.answered_by)

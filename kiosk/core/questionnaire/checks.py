@@ -14,11 +14,11 @@ from typing import Any
 
 from fileio.positions import Positions, Problem, describe, schema_problems
 from kiosk.core.questionnaire.rules import check_items, check_scoring, check_stand_ins, reachable_totals
-from kiosk.core.words import languages, load_words
+from kiosk.core.words import LANGUAGES, load_words
 
 #: the languages the kiosk's own screens are written in (a words file each, kiosk/core/words): a
 #: questionnaire in another language would start a session its screens cannot show
-SCREEN_LANGUAGES = languages()
+SCREEN_LANGUAGES = LANGUAGES
 
 
 def check(

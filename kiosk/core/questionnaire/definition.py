@@ -97,6 +97,8 @@ def _v2(q: Questionnaire) -> dict[str, Any]:
         extra["translations"] = {lang: asdict(t) for lang, t in q.translations.items()}
     if q.formula is not None:
         extra["formula"] = asdict(q.formula)
+    if q.answered_by != PATIENT:
+        extra["answered_by"] = q.answered_by
     if q.subscales:
         extra["subscales"] = [
             {"id": s.id, "label": dict(s.label), "items": list(s.items), "code": _code(s.code)} for s in q.subscales
@@ -269,4 +271,5 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
             Subscale(id=str(s["id"]), label=texts(s["label"]), items=tuple(s["items"]), code=code(s["code"]))
             for s in d.get("subscales", [])
         ),
+        answered_by=str(d.get("answered_by", PATIENT)),
     )

@@ -16,7 +16,7 @@ from pathlib import Path
 from fileio.cache import code_digest, digest, keep, kept
 from kiosk.core.questionnaire.loading import bundled_path, load_questionnaire
 from kiosk.core.questionnaire.model import Questionnaire
-from kiosk.core.words import WORDS_DIR
+from kiosk.core.words import LANGUAGES, WORDS_DIR
 
 #: the cache folder's name under <user cache dir>/kiosk
 KIND = "questionnaires"
@@ -30,7 +30,8 @@ def load_questionnaire_kept(path: str | Path | None = None) -> Questionnaire:
     read = [file, *sorted(instruments.iterdir()), *sorted(Path(WORDS_DIR).glob("*.yaml"))]
     try:
         code = [code_digest(folder) for folder in (Path(__file__).parent, Path(WORDS_DIR), _fileio_dir())]
-        key = digest(KIND, str(path), str(file.resolve()), sys.version, *code, *map(str, read))
+        languages = ",".join(LANGUAGES)  # a site's words files add languages the checks accept
+        key = digest(KIND, str(path), str(file.resolve()), sys.version, languages, *code, *map(str, read))
     except OSError:  # what cannot be read is the load's to report
         return load_questionnaire(path)
     found = kept(KIND, key)

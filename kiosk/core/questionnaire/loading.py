@@ -180,6 +180,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
         },
         formula=formula,
         subscales=subscales,
+        answered_by=data.get("answered_by", PATIENT),
     )
 
 

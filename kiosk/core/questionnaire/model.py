@@ -178,6 +178,9 @@ class Questionnaire:
     #: what the patient's screens call it, in plain words (the file's ``patient_title:``; empty:
     #: the title): "Questions about how you feel", never "Geriatric Depression Scale"
     patient_title: Mapping[str, str] = field(default_factory=dict)
+    #: who answers the instrument (the file's ``answered_by:``): "patient", "caregiver" (about the
+    #: patient: never started by a walk-up patient) or "staff"
+    answered_by: str = PATIENT
 
     def title_for_patient(self, language: str) -> str:
         """The instrument's name on the patient's screens in ``language``."""

@@ -108,6 +108,7 @@ class Battery:
                 "language": session.language,
                 "answered_by": session.answered_by,
                 "visit": session.visit,
+                "answerer": session.opening.answerer,
                 "t_offset": session.now(),
                 "familiarisation": False,
             },

@@ -16,6 +16,7 @@ import uuid
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from kiosk.core.answerers import Answerer
 from kiosk.core.channels import Channel, ChannelInput, Command, Presence, PresenceSource
 from kiosk.core.clock import Clock
 from kiosk.core.questionnaire import Item, Questionnaire, Score, Timing
@@ -53,7 +54,8 @@ class Session:
     ``battery`` says where the session stands in a battery of instruments (see
     :mod:`kiosk.core.session.battery`); a later instrument starts with the rest screen.
     ``visit`` says how the visit began (``kiosk.core.visits``: an order, staff, a walk-up); it is
-    logged at the start, in the start's transaction, so the result is always marked.
+    logged at the start, in the start's transaction, so the result is always marked; so is ``answerer``
+    (:class:`kiosk.core.answerers.Answerer`), when someone other than the patient answers.
     ``watching`` is what the site sets about a patient who is not there (:class:`Watching`: the
     away alert, the wait for a touch after unanswered questions); ``None``: neither.
     ``room`` (:class:`kiosk.core.room.RoomHearing`, shared by a kiosk's sessions) is how well voice
@@ -82,6 +84,7 @@ class Session:
         battery: BatteryPlace | None = None,
         watching: Watching | None = None,
         room: RoomHearing | None = None,
+        answerer: Answerer | None = None,
     ) -> None:
         if language not in questionnaire.languages:
             raise ValueError(f"language {language!r} is not one of {', '.join(questionnaire.languages)}")
@@ -139,6 +142,7 @@ class Session:
             store=store,
             visit=visit,
             battery=battery.detail() if battery is not None else None,
+            answerer=answerer,
             open_practice=practice.open,
             schedule_next_item=flow.schedule_next_item,
         )

@@ -5,20 +5,26 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from kiosk.core.answerers import KIND as ANSWERER
+from kiosk.core.answerers import Answerer
 from kiosk.core.channels import ChannelInput
 from kiosk.core.clock import Clock
+from kiosk.core.questionnaire import PATIENT
 from kiosk.core.questionnaire.definition import canonical
-from kiosk.core.session.events import AnsweredBy, IgnoreReason, LanguageChanged, Phase
+from kiosk.core.session.events import AnsweredBy, IgnoreReason, LanguageChanged, Phase, Prompt
 from kiosk.core.session.ports import SessionStore
 from kiosk.core.session.prompts import Prompts
 from kiosk.core.session.publishing import Outputs
 from kiosk.core.session.state import SessionState
+from kiosk.core.session.words import CAREGIVER_ONLY_TEXT
+from kiosk.core.visits import WALK_UP
 
 
 class Opening:
     """Welcome, start, language and explanation.
 
-    ``visit`` says how the visit began (logged at the start); ``open_practice(t, 0)`` asks the
+    ``visit`` says how the visit began and ``answerer`` how the person answering is related to the
+    patient (both logged at the start); ``open_practice(t, 0)`` asks the
     first practice question; ``schedule_next_item(t, after)`` sets the first question's gap.
     """
 
@@ -32,6 +38,7 @@ class Opening:
         store: SessionStore | None,
         visit: str | None,
         battery: str | None = None,
+        answerer: Answerer | None = None,
         open_practice: Callable[[float, int], None],
         schedule_next_item: Callable[[float, float], None],
     ) -> None:
@@ -42,6 +49,7 @@ class Opening:
         self.store = store
         self.visit = visit
         self.battery = battery
+        self.answerer = answerer
         self._open_practice = open_practice
         self._schedule_next_item = schedule_next_item
 
@@ -58,8 +66,15 @@ class Opening:
         if state.phase is not Phase.WELCOME:
             out.ignore(t, None, IgnoreReason.FINISHED if state.finished else IgnoreReason.NO_OPEN_ATTEMPT, "start")
             return
+        if state.questionnaire.answered_by != PATIENT and self.visit == WALK_UP:
+            out.ignore(t, None, IgnoreReason.NOT_STARTED, "start: not by a walk-up patient")
+            text = CAREGIVER_ONLY_TEXT[state.language]  # in calm words: it is for the person who cares for them
+            self.prompts.publish(Prompt(t, "message", "caregiver_only", text, text, state.language))
+            return
         if answered_by is not None:
             state.answered_by = AnsweredBy(answered_by)
+        if state.questionnaire.answered_by == "caregiver" and state.answered_by is AnsweredBy.PATIENT:
+            state.answered_by = AnsweredBy.CAREGIVER  # about the patient, answered by who looks after them
         if self.store is not None and not state.resuming:
             self.store.create_session(
                 session_id=state.id,
@@ -79,6 +94,8 @@ class Opening:
             out.log(t, "visit", self.visit)
         if self.battery and not state.resuming:
             out.log(t, "battery", self.battery)
+        if self.answerer is not None and state.answered_by is not AnsweredBy.PATIENT and not state.resuming:
+            out.log(t, ANSWERER, self.answerer.detail)
         if not state.voice_out_available:  # said before the start, when nothing was stored yet
             out.log(t, "voice_out", "unavailable")
         if state.rest:

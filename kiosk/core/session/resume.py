@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from kiosk.core.answerers import answerer_of
 from kiosk.core.session.ports import QosEngine
 
 
@@ -27,6 +28,7 @@ def replay_into(engine: QosEngine | None, stored: Any) -> dict[str, Any]:
         "patient_id": stored.patient_id,
         "language": stored.language,
         "answered_by": stored.answered_by,
+        "answerer": answerer_of(stored.log),  # for the visit's later instruments
         "session_id": stored.id,
         # the crash took some time: resumed batches come a second after the stored ones
         "t_offset": max(last, last_timed) + 1.0,

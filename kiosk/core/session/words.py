@@ -51,3 +51,6 @@ GO_ON_LABEL: Mapping[str, str] = Table(lambda words: words.screen["go_on"])
 CALL_CONFIRM: Mapping[str, tuple[str, str]] = Table(
     lambda words: (words.screen["call_confirm"], words.screen["call_confirm_press"])
 )
+
+#: a walk-up patient's start of an instrument their caregiver answers: who it is for, calmly
+CAREGIVER_ONLY_TEXT: Mapping[str, str] = Table(lambda words: words.screen["caregiver_only"])

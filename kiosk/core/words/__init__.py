@@ -14,7 +14,7 @@ file and :func:`load_words` loads none. Pure (``fileio`` only), so every layer r
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import field
 from functools import cache
 from pathlib import Path
@@ -130,10 +130,73 @@ def language_files(directory: str | Path | None = None) -> dict[str, Path]:
     return {path.stem: path for path in files if LANGUAGE_CODE.fullmatch(path.stem)}
 
 
+#: a site's folder of words files in use (:func:`use_site_words`): its languages join the kiosk's
+_site: list[Path] = []
+
+
 @cache
 def languages() -> tuple[str, ...]:
-    """The kiosk's languages: the codes of its words files (a listing; the files are read on first use)."""
-    return tuple(language_files())
+    """The kiosk's languages: the codes of its words files and of the site's in use (a listing;
+    the files are read on first use)."""
+    return tuple(language_files()) + tuple(language_files(_site[0]) if _site else ())
+
+
+class _Languages(Sequence[str]):
+    """:func:`languages` at each use, so a site's words that join after import are counted."""
+
+    def __getitem__(self, index: Any) -> Any:
+        return languages()[index]
+
+    def __len__(self) -> int:
+        return len(languages())
+
+    def __repr__(self) -> str:
+        return repr(languages())
+
+
+#: the kiosk's languages, read at each use (see :func:`use_site_words`)
+LANGUAGES: Sequence[str] = _Languages()
+
+
+def use_site_words(directory: Path | None) -> None:
+    """Make a site's words files (checked by :func:`check_site_words`) the kiosk's languages beside
+    its own, or none with None; every table is read again on its next use."""
+    if _site == ([directory] if directory else []):
+        return
+    _site[:] = [directory] if directory else []
+    languages.cache_clear()
+    _kiosk_words.cache_clear()
+    Table.generation += 1
+
+
+def check_site_words(directory: Path) -> tuple[dict[str, Path], list[Problem], bool]:
+    """(code -> file, every problem, whether every file could be read as YAML) of a site's words
+    files: new languages only, each checked against the kiosk's ``en.yaml`` as its own files are."""
+    shipped = language_files()
+    problems: list[Problem] = []
+    for path in sorted(set(directory.glob("*.yaml")) - set(language_files(directory).values())):
+        problems.append(
+            Problem(str(path), 1, 1, f"{path.name!r} is not named by a language code (en.yaml, pt-BR.yaml)")
+        )
+    mine = {code: path for code, path in language_files(directory).items()}
+    for code in sorted(mine.keys() & shipped.keys()):
+        problems.append(
+            Problem(str(mine.pop(code)), 1, 1, f"the kiosk ships {code}.yaml: a site's words files add new languages")
+        )
+    template, positions, found = parse_file(shipped[TEMPLATE])
+    readable = not found
+    good: dict[str, Path] = {}
+    for code, path in mine.items():
+        data, positions, found = parse_file(path)
+        problems += found
+        readable = readable and not found
+        if positions is None:
+            continue
+        checked = _Check(str(path), positions, template, set(shipped) | set(mine)).problems(data, code)
+        problems += checked
+        if not found and not checked:
+            good[code] = path
+    return good, problems, readable
 
 
 def check_words(directory: str | Path | None = None) -> tuple[dict[str, Words], list[Problem], bool]:
@@ -208,7 +271,13 @@ def load_words(directory: str | Path | None = None) -> dict[str, Words]:
 
 @cache
 def _kiosk_words() -> dict[str, Words]:
-    return {code: _words(code, data) for code, data in kept_data(Path(WORDS_DIR)).items()}
+    words = {code: _words(code, data) for code, data in kept_data(Path(WORDS_DIR)).items()}
+    if _site:
+        good, problems, _ = check_site_words(_site[0])
+        if problems:
+            raise WordsError(problems)
+        words |= {code: _words(code, parse_file(path)[0]) for code, path in good.items()}
+    return words
 
 
 #: the cache folder's name under <user cache dir>/kiosk (see :func:`kept_data`)
@@ -249,13 +318,18 @@ class Table(Mapping[str, T]):
     """One thing from every language's words, by language code (``VOICES["es"]``), read from the
     kiosk's words files on first use, so importing a module with tables reads no file."""
 
+    #: bumped when the site's words change (:func:`use_site_words`): every table reads again
+    generation = 0
+
     def __init__(self, pick: Callable[[Words], T]) -> None:
         self._pick = pick
         self._values: dict[str, T] | None = None
+        self._generation = Table.generation
 
     def _all(self) -> dict[str, T]:
-        if self._values is None:
+        if self._values is None or self._generation != Table.generation:
             self._values = {code: self._pick(words) for code, words in load_words().items()}
+            self._generation = Table.generation
         return self._values
 
     def __getitem__(self, language: str) -> T:

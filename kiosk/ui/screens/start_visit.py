@@ -1,5 +1,6 @@
 """Staff start a visit for a patient identifier on the kiosk itself (no station, or no order):
-an on-screen keyboard for the identifier, the language, whether a relative answers. Behind the PIN."""
+an on-screen keyboard for the identifier, the language, whether a relative answers and how the
+person answering for the patient is related to them (kept with the result). Behind the PIN."""
 
 from __future__ import annotations
 
@@ -8,12 +9,21 @@ from textual.app import ComposeResult
 from textual.containers import Grid, Horizontal, Vertical
 from textual.widgets import Switch
 
+from kiosk.core.answerers import RELATIONSHIPS
 from kiosk.ui.screens.base import ClinicianScreen
 from kiosk.ui.widgets.keypad import pad_key
 from kiosk.ui.widgets.literal import Button, Label, Static
 from kiosk.ui.widgets.text import language_name
 
 _KEYS = tuple("1234567890ABCDEFGHIJKLMNOPQRSTUVWXYZ-_") + ("⌫",)
+
+
+#: the relationships staff choose from, and none ("other" needs free text: the station's order carries it)
+_CHOICES = ("", *(name for name in RELATIONSHIPS if name != "other"))
+
+
+def _answering(relationship: str) -> str:
+    return f"Answering for the patient: {relationship or 'nobody else'}"
 
 
 def _key_id(label: str) -> str:
@@ -36,6 +46,8 @@ class StartVisitScreen(ClinicianScreen):
         super().__init__()
         self._typed = ""
         self._language = ""
+        #: how the person answering for the patient is related to them (kiosk.core.answerers), or ""
+        self._relationship = ""
 
     def compose(self) -> ComposeResult:
         app = self.kiosk
@@ -59,6 +71,7 @@ class StartVisitScreen(ClinicianScreen):
             with Horizontal():
                 yield Button("Start the visit", id="start-visit-go", variant="success")
                 yield Button("Back", id="start-visit-back")
+                yield Button(_answering(""), id="visit-relationship")
             yield Label("", id="start-visit-error")
 
     def type_key(self, label: str) -> None:
@@ -80,11 +93,20 @@ class StartVisitScreen(ClinicianScreen):
         for button in self.query("#visit-languages Button").results(Button):
             button.variant = "primary" if button is event.button else "default"
 
+    @on(Button.Pressed, "#visit-relationship")
+    def _next_relationship(self, event: Button.Pressed) -> None:
+        """Each press shows the next relationship, then none again (one button fits any screen)."""
+        event.stop()
+        self._relationship = _CHOICES[(_CHOICES.index(self._relationship) + 1) % len(_CHOICES)]
+        event.button.label = _answering(self._relationship)
+
     @on(Button.Pressed, "#start-visit-go")
     def _go(self, event: Button.Pressed) -> None:
         event.stop()
         relative = self.query_one("#visit-relative", Switch).value
-        refused = self.kiosk.controller.start_staff_visit(self._typed, self._language, relative)
+        refused = self.kiosk.controller.start_staff_visit(
+            self._typed, self._language, relative, relationship=self._relationship or None
+        )
         if refused:
             self.query_one("#start-visit-error", Label).update(f"Not started: {refused}")
 

@@ -93,9 +93,11 @@ class WelcomeScreen(PatientScreen):
     def show(self, view: PatientView) -> None:
         """Also keep the welcome lines true to the channels on now."""
         super().show(view)
+        said = view.snapshot.prompt  # a walk-up's start of a caregiver's instrument: who it is for instead
+        said = said if said is not None and said.key == "caregiver_only" else None
         for language in view.questionnaire.languages:
             for line in self.query(f"#welcome-{language}").results(Static):
-                line.update(welcome_line(view, language))
+                line.update(welcome_line(view, language) if said is None else said.text * (language == said.language))
 
     def progress_text(self, view: PatientView) -> str:
         """The title in every language (the patient has not chosen one yet), as many as fit the
