@@ -12,6 +12,7 @@ from pathlib import Path
 import platformdirs
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.core.pin import DEFAULT_PIN
 from kiosk.core.site import ExportSite, default_kiosk_id
 from kiosk.core.visits import DEFAULT_ID_PATTERN
@@ -23,7 +24,7 @@ FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device
 SERVE_MAX_SESSIONS = 2
 
 
-class ConfigError(ValueError):
+class ConfigError(KioskError, ValueError):
     """The configuration file (or an environment override) is unusable.
 
     ``setting`` is the path of the setting at fault inside its mapping (such as ``("token",)``),

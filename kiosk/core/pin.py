@@ -36,6 +36,7 @@ from contextlib import AbstractContextManager
 from typing import Protocol
 
 from basis import record
+from basis.errors import KioskError
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
 DEFAULT_PIN = "1234"
@@ -78,7 +79,7 @@ class PinCount(Protocol):
         ...
 
 
-class PinError(ValueError):
+class PinError(KioskError, ValueError):
     """A PIN or a stored hash is unusable; the message says why in one sentence."""
 
 
