@@ -6,7 +6,7 @@ For every voice and condition, simulated patients answer Barthel questions (opti
 synonyms, numbers, "the first one", natural answers such as "I need a lot of help"), give
 commands, and say things that are not answers ("um", "what?", a cough, "is it time for lunch
 yet"). Each utterance is spoken by espeak-ng in that patient's voice, put in the room
-(:mod:`kiosk.speech.rooms`: white or babble noise at an SNR, reverb, telephone band, -20 dB, a
+(``bench/_rooms.py``: white or babble noise at an SNR, reverb, telephone band, -20 dB, a
 long silence first), and fed as one continuous microphone stream, the room's noise going on
 between answers and the channel muted while the kiosk speaks. A patient gets two attempts. When
 the channel asks for confirmation, the patient answers "yes" (in a few natural forms) only if the
@@ -62,6 +62,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import _rooms as rooms
 from _asr_cases import (
     BABBLE_TALKERS,
     BABBLE_TEXT,
@@ -81,7 +82,6 @@ from _vads import endpointer_factory
 
 from kiosk.core.channels import ChannelInput, Command
 from kiosk.core.questionnaire import load_questionnaire
-from kiosk.speech import rooms
 from kiosk.speech.asr import PocketSphinxRecogniser, open_whisper
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, read_wav
 from kiosk.speech.matching import START_WORDS, OptionWords

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from basis import record
+from basis.errors import KioskError
 
 
 @contextmanager
@@ -87,7 +88,7 @@ class Problem:
         return f"{self.file}:{self.line}:{self.column}: {self.message}"
 
 
-class BadFile(ValueError):
+class BadFile(KioskError, ValueError):
     """A file cannot be read as the text, YAML or JSON it should be; ``problem`` says where and what."""
 
     def __init__(self, problem: Problem) -> None:

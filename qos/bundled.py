@@ -9,13 +9,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from qos.errors import ModelError
+from qos.shipped import MODELS
 
 if TYPE_CHECKING:
     from qos.model import Model
-
-#: the bundled models' folder (the package is installed as files, never zipped; importlib.resources
-#: would cost a start zipfile and its readers for nothing)
-MODELS = Path(__file__).parent / "models"
 
 
 def bundled_models() -> list[str]:

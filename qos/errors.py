@@ -7,8 +7,10 @@ it as it is and exit with status 2.
 
 from __future__ import annotations
 
+from basis.errors import KioskError
 
-class QosError(ValueError):
+
+class QosError(KioskError, ValueError):
     """Base class of every error the engine raises for bad input."""
 
 

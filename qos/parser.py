@@ -14,7 +14,6 @@ from typing import cast
 
 from lark import Token, Tree
 
-from qos.bundled import MODELS
 from qos.errors import ModelError
 from qos.grammar import SyntaxProblem, children, parse_text
 from qos.model import (
@@ -41,6 +40,7 @@ from qos.model import (
     Variable,
     type_name,
 )
+from qos.shipped import MODELS
 from qos.source import MAX_IMPORT_DEPTH, Source, check_nesting, read_model
 from qos.terms import TermChecker, is_pattern, seconds_of
 from qos.timers import ScheduleError, parse_schedule

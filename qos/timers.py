@@ -25,6 +25,7 @@ from __future__ import annotations
 import re
 from datetime import UTC, datetime, timedelta
 
+from basis.errors import KioskError
 from qos.model import Schedule, Timer
 
 _FIELDS = (
@@ -39,7 +40,7 @@ _FIELDS = (
 _HORIZON_DAYS = 8 * 366
 
 
-class ScheduleError(ValueError):
+class ScheduleError(KioskError, ValueError):
     """A schedule string that does not say when to fire."""
 
 

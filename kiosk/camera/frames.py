@@ -15,6 +15,7 @@ from dataclasses import field
 from typing import TYPE_CHECKING, Any, Protocol
 
 from basis import record
+from basis.errors import KioskError
 
 if TYPE_CHECKING:  # numpy loads with the model, on the camera's thread, not with the package
     import numpy as np
@@ -49,7 +50,7 @@ class FrameSource(Protocol):
         """Release the device; safe to call twice."""
 
 
-class CameraUnavailable(Exception):
+class CameraUnavailable(KioskError):
     """The camera cannot be opened or read; the message says why, for the clinician screen."""
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import importlib.util
 from typing import Any, Protocol
 
+from basis.errors import KioskError
 from kiosk.camera.frames import Frame
 from kiosk.core.tug.landmarks import COUNT, Landmark
 
@@ -32,7 +33,7 @@ class PoseEstimator(Protocol):
         """Release the model; safe to call twice."""
 
 
-class ModelUnavailable(Exception):
+class ModelUnavailable(KioskError):
     """The pose model cannot be loaded; the message says why, for the clinician screen."""
 
 

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from basis.errors import KioskError
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus, InputSource, Sink
 from kiosk.ui.options import run_parser
 
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
     from kiosk.ui.app import KioskApp
 
 
-class SetupError(Exception):
+class SetupError(KioskError):
     """The kiosk cannot start: a bad configuration, questionnaire, data directory or profile file."""
 
 

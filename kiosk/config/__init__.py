@@ -69,10 +69,10 @@ from typing import Any
 import platformdirs
 
 from fileio.bounded import BadFile, open_private, read_text
+from kiosk.config.checks import PATH_SETTINGS, check_path, station_from
 from kiosk.config.instruments import configured_instruments, configured_questionnaire, offered_to_patients
-from kiosk.config.reading import _path, _read, _station
+from kiosk.config.reading import read_file
 from kiosk.config.settings import (
-    _PATHS,
     FHIR_KEYS,
     KIOSK_ID,
     SERVE_MAX_SESSIONS,
@@ -124,11 +124,11 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
 
     use_site_words(None)  # a site's languages are those of the configuration read last
     if path is not None:
-        values = _read(Path(path))
+        values = read_file(Path(path))
     overrides = {"KIOSK_DATA_DIR": "data_dir", "KIOSK_LANGUAGE": "language", "KIOSK_VOSK_MODEL": "vosk_model"}
     for var, key in overrides.items():
         if env.get(var):
-            values[key] = _path(env[var], var) if key in _PATHS else env[var]
+            values[key] = check_path(env[var], var) if key in PATH_SETTINGS else env[var]
     station = values.get("station") or {}
     # one kiosk id for exports and the station: kiosk_id, or station.kiosk_id, never two different ones
     if station.get("kiosk_id") and values.get("kiosk_id", station["kiosk_id"]) != station["kiosk_id"]:
@@ -141,7 +141,7 @@ def load_config(path: str | Path | None = None, environ: Mapping[str, str] | Non
     for var, key in (("KIOSK_STATION_URL", "url"), ("KIOSK_STATION_TOKEN", "token")):
         if env.get(var):
             station = {**station, key: env[var]}
-    values["station"] = _station(station, f"{path}: station" if path is not None else "KIOSK_STATION_URL")
+    values["station"] = station_from(station, f"{path}: station" if path is not None else "KIOSK_STATION_URL")
     from kiosk.core.words import WordsError, load_words
 
     try:  # the screens' words, read now so a bad words file stops the kiosk before any screen

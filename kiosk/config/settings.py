@@ -1,34 +1,30 @@
-"""The configuration's settings (:class:`Config`), its errors and the station it reports to; what
-they mean is the package's docstring (:mod:`kiosk.config`)."""
+"""The configuration's settings (:class:`Config`: each one's type and default), its errors and the
+station it reports to; what they mean is the package's docstring (:mod:`kiosk.config`), how each is
+checked its row in :data:`kiosk.config.checks.SETTINGS`."""
 
 from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import field, fields
+from dataclasses import field
 from pathlib import Path
 
 import platformdirs
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.core.pin import DEFAULT_PIN
 from kiosk.core.site import ExportSite, default_kiosk_id
 from kiosk.core.visits import DEFAULT_ID_PATTERN
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
-#: an absolute URI of visible ASCII: no space, control character or '|' (matched whole: fullmatch)
-_URI = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*:[!-{}~]+")
-#: a station address: http(s), a host of visible ASCII (IDN names in their xn-- form), an optional path
-_STATION_URL = re.compile(r'https?://[!"$-.0->@-~]+(/[!"$->@-~]*)?')
-#: a bearer token as RFC 6750 spells it (token68): it goes verbatim into an HTTP header
-_TOKEN = re.compile(r"[A-Za-z0-9._~+/-]{1,512}=*")
 #: browser connections `kiosk serve` runs at once unless configured: each is a kiosk process
 #: of about 55 MB, and a ward kiosk has one screen
 SERVE_MAX_SESSIONS = 2
 
 
-class ConfigError(ValueError):
+class ConfigError(KioskError, ValueError):
     """The configuration file (or an environment override) is unusable.
 
     ``setting`` is the path of the setting at fault inside its mapping (such as ``("token",)``),
@@ -152,12 +148,6 @@ class Config:
     def pin_secret(self) -> str:
         """What the PIN pad checks against: the hash, else the legacy plain PIN."""
         return self.clinician_pin_hash or self.clinician_pin
-
-
-_PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles", "site_dir"}
-_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient", "walk_up"}
-_SHA256 = re.compile(r"[0-9a-f]{64}")
-_KEYS = {f.name for f in fields(Config)} - {"source"}
 
 
 def site_from_config(config: Config) -> ExportSite:

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from fileio.positions import Problem, parse_file
 from kiosk.core.room import METRIC as ROOM_METRIC
 from qos import Model, load_model
@@ -33,7 +34,7 @@ _RULE_KEYS = {"name", "metric", "below", "count", "count_on", "recover_above", "
 _OPTIONAL = {"speech_rate": 1.0, "attempt_factor": 1.0}
 
 
-class PolicyError(ValueError):
+class PolicyError(KioskError, ValueError):
     """An adaptation policy file is unusable; the message names file, line and column."""
 
 

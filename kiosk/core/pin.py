@@ -1,9 +1,10 @@
 """The clinician PIN: stored as a salted scrypt hash, guarded by a growing delay and a lockout.
 
 The configuration holds ``clinician_pin_hash`` (written by `kiosk pin set`); a legacy plain
-``clinician_pin`` still works, with a warning. Failed attempts are counted in a 0600 file of the
-data directory, so killing and restarting the kiosk does not reset them, and every failure and
-lockout is appended to ``security.log`` beside it (one JSON object a line).
+``clinician_pin`` still works, with a warning. Failed attempts are counted through a
+:class:`PinCount` (a 0600 file of the data directory: :mod:`kiosk.store.pin_files`), so killing
+and restarting the kiosk does not reset them, and every failure and lockout is appended to the
+security log beside it (one JSON object a line).
 
 After :data:`FREE_FAILURES` wrong PINs in a row each further attempt must wait, twice as long each
 time (:data:`FIRST_DELAY_S`, doubling, at most :data:`MAX_DELAY_S`); after :data:`LOCKOUT_FAILURES`
@@ -12,31 +13,30 @@ this turns 12 guesses a second into about 20 guesses an hour.
 
 The count is the data directory's, not the process's: every kiosk process on one data directory (a
 `kiosk run` and the served page's `kiosk serve` sessions) reads, checks and updates it under one
-exclusive file lock (:data:`LOCK_FILE`), so two processes together get no more guesses than one.
+exclusive lock (:meth:`PinCount.held`), so two processes together get no more guesses than one.
 
 When the count cannot be written (a full disk) the process keeps counting in memory, never below
 what the file says, and a right PIN still lets staff in: the out-of-order screen sends them to the
 clinician screen to see why. What could not be written goes to the Python log.
+The core decides; the file lock and the file I/O are the store's.
 """
 
 from __future__ import annotations
 
 import base64
 import contextlib
-import fcntl
 import hashlib
 import hmac
 import json
-import logging
 import math
-import os
 import secrets
 import time
 from collections.abc import Callable, Iterator
-from pathlib import Path
+from contextlib import AbstractContextManager
+from typing import Protocol
 
 from basis import record
-from fileio.bounded import BadFile, load_json, open_private, read_text
+from basis.errors import KioskError
 
 #: the PIN a fresh install uses; the clinician screens warn while it is unchanged
 DEFAULT_PIN = "1234"
@@ -50,15 +50,36 @@ FIRST_DELAY_S = 5.0
 MAX_DELAY_S = 300.0
 LOCKOUT_FAILURES = 10
 LOCKOUT_S = 3600.0
-STATE_FILE = "pin_lockout.json"
-#: held (flock, exclusive) while a process reads, checks and rewrites the count
-LOCK_FILE = "pin_lockout.lock"
-LOG_FILE = "security.log"
-
-log = logging.getLogger(__name__)
 
 
-class PinError(ValueError):
+class DamagedCount(ValueError):
+    """The stored failure count cannot be read as one (the guard then locks the pad)."""
+
+
+class PinCount(Protocol):
+    """Where the failure count is shared between the processes of one data directory, and where
+    the security log goes: the port through which the core, which does no I/O, keeps them
+    (:class:`kiosk.store.pin_files.PinFiles` on disk). None of these raises :class:`OSError`."""
+
+    def held(self) -> AbstractContextManager[bool]:
+        """Hold the shared lock while the block runs; it gives False when no lock can be had."""
+        ...
+
+    def load(self) -> tuple[int, float] | None:
+        """The stored ``(failures, not_before)``, None when nothing is stored; raises
+        :class:`DamagedCount` when what is stored is not a count."""
+        ...
+
+    def save(self, failures: int, not_before: float) -> bool:
+        """Store the count; False when it could not be stored."""
+        ...
+
+    def append_log(self, line: str) -> None:
+        """Append one JSON line to the security log (best effort)."""
+        ...
+
+
+class PinError(KioskError, ValueError):
     """A PIN or a stored hash is unusable; the message says why in one sentence."""
 
 
@@ -125,14 +146,15 @@ class Verdict:
 class PinGuard:
     """Checks PIN attempts against the configured secret, counting failures across restarts.
 
-    ``secret`` is a hash from :func:`hash_pin` or a legacy plain PIN. ``data_dir`` holds the count
-    and the security log (None: in memory only, for tests of the screens). ``now`` gives wall-clock
-    seconds: the count must survive a restart, which a monotonic clock does not.
+    ``secret`` is a hash from :func:`hash_pin` or a legacy plain PIN. ``count`` keeps the count
+    and the security log (:class:`kiosk.store.pin_files.PinFiles` on the data directory; None: in
+    memory only, for tests of the screens). ``now`` gives wall-clock seconds: the count must
+    survive a restart, which a monotonic clock does not.
     """
 
-    def __init__(self, secret: str, data_dir: Path | None = None, now: Callable[[], float] = time.time) -> None:
+    def __init__(self, secret: str, count: PinCount | None = None, now: Callable[[], float] = time.time) -> None:
         self.secret = secret
-        self._dir = Path(data_dir) if data_dir is not None else None
+        self._count = count
         self._now = now
         #: the count as last read from the data directory (another process may have moved it since)
         self.failures, self.not_before = 0, 0.0
@@ -189,29 +211,22 @@ class PinGuard:
 
     @contextlib.contextmanager
     def _shared_count(self) -> Iterator[None]:
-        """Hold the data directory's PIN lock and read the count into ``failures``/``not_before``
-        (in memory only without a data directory)."""
-        if self._dir is None:
+        """Hold the shared count's lock and read the count into ``failures``/``not_before``
+        (in memory only without a :class:`PinCount`, or when no lock can be had)."""
+        if self._count is None:
             yield
             return
-        try:
-            self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
-            descriptor = os.open(self._dir / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o600)
-        except OSError as error:  # no lock to be had (disk full): this process's count alone
-            log.warning("PIN lock file %s cannot be opened (%s); counting failures in memory", LOCK_FILE, error)
-            if self._unsaved is not None:
-                self.failures, self.not_before = self._unsaved
-            yield
-            return
-        try:
-            fcntl.flock(descriptor, fcntl.LOCK_EX)
+        with self._count.held() as held:
+            if not held:  # no lock to be had (disk full): this process's count alone
+                if self._unsaved is not None:
+                    self.failures, self.not_before = self._unsaved
+                yield
+                return
             self.failures, self.not_before = self._load()
             if self._unsaved is not None:  # what this process counted and could not write still holds
                 self.failures = max(self.failures, self._unsaved[0])
                 self.not_before = max(self.not_before, self._unsaved[1])
             yield
-        finally:
-            os.close(descriptor)  # closing releases the lock
 
     @staticmethod
     def _delay(failures: int) -> float:
@@ -222,57 +237,35 @@ class PinGuard:
         return min(FIRST_DELAY_S * 2 ** (failures - FREE_FAILURES), MAX_DELAY_S)
 
     def _load(self) -> tuple[int, float]:
-        if self._dir is None or not (self._dir / STATE_FILE).exists():
+        if self._count is None:
             return 0, 0.0
         try:
-            state = load_json(read_text(self._dir / STATE_FILE, 4096), STATE_FILE)
-            failures, not_before = int(state["failures"]), float(state["not_before"])
-        except (BadFile, KeyError, TypeError, ValueError):
+            stored = self._count.load()
+        except DamagedCount:
             # a damaged count must not open the pad: treat it as a lockout starting now, written
             # back so that every process (and every later read) sees the same lockout
             self._log("pin_state_damaged", "the failure count could not be read; locking the PIN pad")
             self.failures, self.not_before = LOCKOUT_FAILURES, self._now() + LOCKOUT_S
             self._save()
             return self.failures, self.not_before
+        if stored is None:
+            return 0, 0.0
+        failures, not_before = stored
         # a clock set back must not shorten a lockout by more than its own length
         return max(0, failures), min(not_before, self._now() + LOCKOUT_S)
 
     def _save(self) -> None:
-        """Write the count; when it cannot be written it is kept in memory (and logged)."""
-        if self._dir is None:
+        """Write the count; when it cannot be written it is kept in memory."""
+        if self._count is None:
             return
-        temporary = self._dir / f".{STATE_FILE}.{os.getpid()}"
-        try:
-            self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
-            with open_private(temporary) as handle:
-                json.dump({"failures": self.failures, "not_before": self.not_before}, handle)
-            os.replace(temporary, self._dir / STATE_FILE)  # never half-written: a reader sees old or new
-        except OSError as error:
-            with contextlib.suppress(OSError):
-                temporary.unlink(missing_ok=True)
-            log.warning(
-                "PIN failure count (%d) cannot be written to %s (%s); counting in memory",
-                self.failures,
-                STATE_FILE,
-                error,
-            )
-            self._unsaved = (self.failures, self.not_before)
-        else:
-            self._unsaved = None
+        saved = self._count.save(self.failures, self.not_before)
+        self._unsaved = None if saved else (self.failures, self.not_before)
 
     def _log(self, event: str, detail: str) -> None:
-        if self._dir is None:
+        if self._count is None:
             return
-        line = json.dumps(
-            {"at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(self._now())), "event": event, "detail": detail}
-        )
-        try:
-            self._dir.mkdir(mode=0o700, parents=True, exist_ok=True)
-            descriptor = os.open(self._dir / LOG_FILE, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-            with os.fdopen(descriptor, "a", encoding="utf-8") as handle:
-                handle.write(line + "\n")
-        except OSError as error:  # a full disk must not keep staff out: the event goes to the Python log
-            log.warning("%s cannot be written (%s): %s", LOG_FILE, error, line)
+        at = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(self._now()))
+        self._count.append_log(json.dumps({"at": at, "event": event, "detail": detail}))
 
 
 #: staff open the PIN pad by touch alone: this many taps in the top-left corner of a patient screen,

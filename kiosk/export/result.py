@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from fileio.bounded import write_error, write_private  # the one owner-only writer; exports use it from here too
 from kiosk.core.questionnaire import Questionnaire, Score
 from kiosk.core.review import Review, ReviewState, review_state
@@ -22,7 +23,7 @@ from kiosk.store.database import PracticeRecord, StoredSession
 TOTAL_LINK = "total"
 
 
-class ExportError(ValueError):
+class ExportError(KioskError, ValueError):
     """A stored session does not fit the questionnaire (unknown item, option or points), a
     review does not fit the session, or an export cannot be written."""
 

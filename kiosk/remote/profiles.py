@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from fileio.positions import Positions, Problem, parse_file
 from kiosk.remote.buttons import KIOSK_KEYS, Button, button_name, parse_button
 from kiosk.remote.decoders import ReportMatch
@@ -33,7 +34,7 @@ _FIELDS = {
 }
 
 
-class ProfileError(ValueError):
+class ProfileError(KioskError, ValueError):
     """A device profile file cannot be used; the message names the file, profile and field."""
 
 

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterator
 from typing import Protocol
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
 from kiosk.remote.buttons import to_input
 from kiosk.remote.decoders import Press
@@ -46,7 +47,7 @@ class Backoff:
             delay = min(delay * self.factor, self.maximum)
 
 
-class DeviceUnavailable(Exception):
+class DeviceUnavailable(KioskError):
     """Connecting failed. ``state`` is OFF when no device is there, CONNECTING when one is there
     but cannot be opened yet (busy, permissions); ``reason`` is one sentence for the clinician."""
 
@@ -56,7 +57,7 @@ class DeviceUnavailable(Exception):
         self.reason = reason
 
 
-class DeviceLost(Exception):
+class DeviceLost(KioskError):
     """The open device went away (read error, port gone); the message is the reason."""
 
 

@@ -29,6 +29,8 @@ import zipfile
 from collections.abc import Sequence
 from pathlib import Path, PurePosixPath
 
+from basis.errors import KioskError
+
 #: the official small models (about 40-50 MB each), from https://alphacephei.com/vosk/models
 OFFICIAL_MODELS = {
     "en": "https://alphacephei.com/vosk/models/vosk-model-small-en-us-0.15.zip",
@@ -47,8 +49,9 @@ OFFLINE_ROUTES = (
 )
 
 
-class ModelError(Exception):
-    """A model could not be installed or found; the message says where and what."""
+class SpeechModelError(KioskError):
+    """A speech-recognition model could not be installed or found; the message says where and
+    what. (Not :class:`qos.ModelError`, a malformed QoS model: the two had one name.)"""
 
 
 def models_dir() -> Path:
@@ -110,7 +113,7 @@ def _download(url: str, into: Path) -> tuple[Path, str, str]:
                 out.write(chunk)
     except (urllib.error.URLError, OSError) as exc:
         os.unlink(name)
-        raise ModelError(
+        raise SpeechModelError(
             f"cannot download {url}: {getattr(exc, 'reason', exc)}"
             + ("" if url.startswith("file:") else OFFLINE_ROUTES)
         ) from None
@@ -123,13 +126,13 @@ def _official_md5(url: str, index_url: str) -> str:
         with urllib.request.urlopen(index_url, timeout=DOWNLOAD_TIMEOUT_S) as response:
             index = json.load(response)
     except (urllib.error.URLError, OSError, ValueError) as exc:
-        raise ModelError(
+        raise SpeechModelError(
             f"cannot read the model index {index_url}: {getattr(exc, 'reason', exc)}" + OFFLINE_ROUTES
         ) from None
     for entry in index if isinstance(index, list) else []:
         if isinstance(entry, dict) and entry.get("name") == name and entry.get("md5"):
             return str(entry["md5"]).lower()
-    raise ModelError(f"the model index {index_url} has no checksum for {name}")
+    raise SpeechModelError(f"the model index {index_url} has no checksum for {name}")
 
 
 def _unpack(archive: Path, into: Path) -> Path:
@@ -140,12 +143,12 @@ def _unpack(archive: Path, into: Path) -> Path:
             for member in zf.namelist():
                 path = PurePosixPath(member)
                 if path.is_absolute() or ".." in path.parts:
-                    raise ModelError(f"{archive.name}: unsafe path {member!r} in the archive")
+                    raise SpeechModelError(f"{archive.name}: unsafe path {member!r} in the archive")
             zf.extractall(folder)
     except zipfile.BadZipFile as exc:
         shutil.rmtree(folder)
-        raise ModelError(f"the download is not a zip archive ({exc})") from None
-    except ModelError:
+        raise SpeechModelError(f"the download is not a zip archive ({exc})") from None
+    except SpeechModelError:
         shutil.rmtree(folder)
         raise
     # official archives hold one top folder named after the model
@@ -153,7 +156,7 @@ def _unpack(archive: Path, into: Path) -> Path:
     model = entries[0] if len(entries) == 1 and entries[0].is_dir() else folder
     if not is_vosk_model(model):
         shutil.rmtree(folder)
-        raise ModelError("the archive does not contain a Vosk model (no am/final.mdl and conf/)")
+        raise SpeechModelError("the archive does not contain a Vosk model (no am/final.mdl and conf/)")
     return model
 
 
@@ -165,14 +168,14 @@ def install(language: str, url: str | None = None, sha256: str | None = None, in
     """
     if url is None:
         if language not in OFFICIAL_MODELS:
-            raise ModelError(
+            raise SpeechModelError(
                 f"no official model known for language {language!r} "
                 f"(known: {', '.join(OFFICIAL_MODELS)}); give --url and --sha256"
             )
         url = OFFICIAL_MODELS[language]
         expected, algorithm = (sha256, "sha256") if sha256 else (_official_md5(url, index_url), "md5")
     elif not sha256:
-        raise ModelError("a model from --url needs --sha256 to check it")
+        raise SpeechModelError("a model from --url needs --sha256 to check it")
     else:
         expected, algorithm = sha256, "sha256"
     expected = expected.strip().lower()
@@ -186,7 +189,7 @@ def install(language: str, url: str | None = None, sha256: str | None = None, in
     try:
         got = got_sha256 if algorithm == "sha256" else got_md5
         if got != expected:
-            raise ModelError(
+            raise SpeechModelError(
                 f"checksum mismatch for {url}: expected {algorithm} {expected}, got {got}; nothing was installed"
             )
         model = _unpack(archive, parent)
@@ -245,7 +248,7 @@ def main(argv: Sequence[str]) -> int:
         return 0
     try:
         path = install(args.language, url=args.url, sha256=args.sha256)
-    except ModelError as exc:
+    except SpeechModelError as exc:
         print(f"kiosk models: {str(exc).replace('{language}', args.language)}", file=sys.stderr)
         return 1
     print(f"installed the {args.language} model in {path}")

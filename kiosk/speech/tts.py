@@ -44,6 +44,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus
 from kiosk.core.words import Table
 
@@ -67,7 +68,7 @@ DEFAULT_VOLUME, VOLUME_STEP, MIN_VOLUME, MAX_VOLUME = 1.0, 0.25, 0.25, 2.0
 SYNTH_TIMEOUT_S = 30.0
 
 
-class TtsUnavailable(RuntimeError):
+class TtsUnavailable(KioskError, RuntimeError):
     """Voice out cannot work here; the message is one sentence for the UI."""
 
 

@@ -40,6 +40,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 from kiosk.core.channels import Channel, ChannelState, ChannelStatus, Sink
+from kiosk.core.session import (
+    AnswerNotConfirmed,
+    AnswerRecorded,
+    Finished,
+    ListeningChanged,
+    Paused,
+    Prompt,
+    Resumed,
+    SessionEvent,
+)
 from kiosk.speech.listening import Listening
 from kiosk.speech.matching import DEFAULT_MIN_CONFIDENCE, OptionWords
 
@@ -193,20 +203,21 @@ class VoiceChannel:
 
     # -- what the session and the voice out tell it (UI / TTS threads) ------------------------
 
-    def on_session_event(self, event: Any) -> None:
-        """Follow every session event: grammars, the listening gate, and pause (commands only)."""
-        kind = type(event).__name__
-        if kind == "Prompt":
+    def on_session_event(self, event: SessionEvent) -> None:
+        """Follow every session event: grammars, the listening gate, and pause (commands only).
+        Dispatched by class, as :meth:`kiosk.ui.channels.KioskChannels.follow` does, so a
+        renamed event is a type error, not a silently ignored string."""
+        if isinstance(event, Prompt):
             self.expect(event)
-        elif kind == "ListeningChanged":
+        elif isinstance(event, ListeningChanged):
             self.listen(event.listening)
-        elif kind == "Paused":
+        elif isinstance(event, Paused):
             self._set_paused(True)
-        elif kind in ("Resumed", "Finished"):
+        elif isinstance(event, (Resumed, Finished)):
             self._set_paused(False)
-        elif kind == "AnswerRecorded":
+        elif isinstance(event, AnswerRecorded):
             self.expect_undo()
-        elif kind == "AnswerNotConfirmed" and event.why in ("declined", "undone"):
+        elif isinstance(event, AnswerNotConfirmed) and event.why in ("declined", "undone"):
             self.declined(event.item_id, event.option)
 
     def expect(self, prompt: Any) -> None:

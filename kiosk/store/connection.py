@@ -9,6 +9,7 @@ import sqlite3
 from collections.abc import Callable
 from pathlib import Path
 
+from basis.errors import KioskError
 from kiosk.store.migrations import InForce, SchemaError, migrate
 
 DB_NAME = "kiosk.sqlite3"
@@ -16,7 +17,7 @@ DB_NAME = "kiosk.sqlite3"
 BUSY_TIMEOUT_S = 10.0
 
 
-class StorageError(RuntimeError):
+class StorageError(KioskError, RuntimeError):
     """The data directory or database cannot be used (message says where and why)."""
 
 

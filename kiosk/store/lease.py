@@ -16,12 +16,13 @@ import socket
 from dataclasses import field
 
 from basis import record
+from basis.errors import KioskError
 
 #: a lease not renewed for this long has lapsed; the kiosk renews every third of it
 LEASE_TTL_S = 30.0
 
 
-class SessionTaken(RuntimeError):
+class SessionTaken(KioskError, RuntimeError):
     """The session is held by another running kiosk (or was taken over from this one)."""
 
 

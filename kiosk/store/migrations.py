@@ -19,6 +19,7 @@ from datetime import UTC, datetime
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, canonical_json, digest
 
@@ -239,7 +240,7 @@ def attach_in_force(db: sqlite3.Connection, in_force: InForce) -> None:
         db.execute("UPDATE outbox SET payload = ? WHERE seq = ?", (json.dumps(body, ensure_ascii=False), seq))
 
 
-class SchemaError(RuntimeError):
+class SchemaError(KioskError, RuntimeError):
     """The database's schema cannot be used by this code (message says which file and what to do)."""
 
 

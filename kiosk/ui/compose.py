@@ -26,6 +26,7 @@ from kiosk.core.session import Session, Watching
 from kiosk.core.session.battery import Battery, Instrument
 from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
 from kiosk.store.database import Store, StoredSession, new_patient_id
+from kiosk.store.pin_files import PinFiles
 from kiosk.ui.app import POLL_INTERVAL, KioskApp
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.controller import KioskController
@@ -217,7 +218,7 @@ def make_kiosk(
     app = KioskApp(
         controller,
         channels,
-        clinician_pin=clinician_pin or PinGuard(config.pin_secret, config.data_dir),
+        clinician_pin=clinician_pin or PinGuard(config.pin_secret, PinFiles(config.data_dir)),
         export_dir=config.data_dir / "exports",
         export_site=site_from_config(config),
         poll_interval=poll_interval,

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from fileio.positions import Problem, describe, parse_file, schema_problems
 from kiosk.core.channels import Channel, Command, PresenceSource
 from kiosk.core.questionnaire import Item, PracticeQuestion, Questionnaire, load_questionnaire
@@ -34,7 +35,7 @@ COMMANDS = {
 }
 
 
-class ScriptError(ValueError):
+class ScriptError(KioskError, ValueError):
     """A script is malformed, or declares something that does not happen under the session's rules."""
 
 

@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from dataclasses import asdict
 from typing import Any
 
+from basis.errors import KioskError
 from kiosk.core.questionnaire import (
     PATIENT,
     Band,
@@ -42,7 +43,7 @@ __all__ = ["FORMAT", "DefinitionError", "canonical", "canonical_json", "digest",
 FORMAT = 1
 
 
-class DefinitionError(ValueError):
+class DefinitionError(KioskError, ValueError):
     """A captured definition that does not rebuild a questionnaire (message says where and what)."""
 
 

@@ -13,6 +13,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from basis.errors import KioskError
 from fileio.positions import Problem, parse, parse_file
 from kiosk.core.questionnaire.checks import check
 from kiosk.core.questionnaire.model import (
@@ -37,7 +38,7 @@ DEFAULT_FILE = "barthel.yaml"
 SCHEMA_FILE = "questionnaire.schema.json"
 
 
-class QuestionnaireError(ValueError):
+class QuestionnaireError(KioskError, ValueError):
     """A questionnaire file is unusable; ``problems`` lists every reason with its position."""
 
     def __init__(self, problems: list[Problem]) -> None:

@@ -19,11 +19,12 @@ from decimal import Decimal
 from typing import Any, Protocol
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.core.questionnaire.formula import ITEM_WEIGHT, EvaluationError, compute
 from kiosk.core.questionnaire.parts import Band, BandSet, Code, Entry, Option
 
 
-class ScoringError(ValueError):
+class ScoringError(KioskError, ValueError):
     """A total formula gave no whole number in its declared range for some answers."""
 
 

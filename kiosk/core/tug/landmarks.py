@@ -17,6 +17,7 @@ from dataclasses import field
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from fileio.bounded import BadFile, load_json
 
 FORMAT = "pose-landmarks/1"
@@ -83,7 +84,7 @@ class PoseSequence:
     frames: tuple[PoseFrame, ...] = field(repr=False)
 
 
-class PoseFileError(ValueError):
+class PoseFileError(KioskError, ValueError):
     """A pose-landmarks file cannot be read; the message names the file and line."""
 
 

@@ -22,6 +22,7 @@ from types import MappingProxyType
 from typing import Any, TypeVar
 
 from basis import record
+from basis.errors import KioskError
 from fileio.positions import Positions, Problem, describe, parse_file
 from kiosk.core.words.placeholders import fill as fill  # the one way words are filled in
 from kiosk.core.words.placeholders import placeholders
@@ -114,7 +115,7 @@ class Words:
     answers: Mapping[str, Any] = field(default_factory=dict)
 
 
-class WordsError(ValueError):
+class WordsError(KioskError, ValueError):
     """The words files cannot be used; ``problems`` lists every reason with its position."""
 
     def __init__(self, problems: list[Problem]) -> None:

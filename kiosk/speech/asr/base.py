@@ -7,10 +7,11 @@ from collections.abc import Callable, Hashable, Sequence
 from typing import Protocol
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.speech.grammar import Grammar
 
 
-class AsrUnavailable(RuntimeError):
+class AsrUnavailable(KioskError, RuntimeError):
     """Voice in cannot work for this language here; the message is one sentence for the UI."""
 
 

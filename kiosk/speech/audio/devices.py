@@ -12,12 +12,13 @@ from collections.abc import Callable
 from typing import Any
 
 from basis import record
+from basis.errors import KioskError
 from kiosk.speech.audio.pcm import FRAME_SAMPLES, SAMPLE_RATE, PcmConsumer
 
 log = logging.getLogger(__name__)
 
 
-class AudioUnavailable(RuntimeError):
+class AudioUnavailable(KioskError, RuntimeError):
     """Audio input cannot work on this machine; the message is one sentence for the UI."""
 
 

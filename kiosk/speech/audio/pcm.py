@@ -55,7 +55,7 @@ def read_wav(path: str | Path) -> np.ndarray:
 
 def frame_powers(samples: np.ndarray) -> np.ndarray:
     """Mean power of each whole 10 ms frame of int16 samples (int16 units squared): the frame
-    rate of the recognisers' features and of :mod:`kiosk.speech.rooms`' levels."""
+    rate of the recognisers' features and of the simulated rooms' levels (``bench/_rooms.py``)."""
     x = samples.astype(np.float64)
     step = SAMPLE_RATE // 100
     return (x[: len(x) - len(x) % step].reshape(-1, step) ** 2).mean(axis=1)

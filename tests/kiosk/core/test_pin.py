@@ -14,14 +14,13 @@ from kiosk.config import ConfigError, load_config
 from kiosk.core.pin import (
     FREE_FAILURES,
     LOCKOUT_FAILURES,
-    LOG_FILE,
-    STATE_FILE,
     CornerTaps,
     PinError,
     PinGuard,
     hash_pin,
     matches,
 )
+from kiosk.store.pin_files import LOG_FILE, STATE_FILE, PinFiles
 
 
 class WallClock:
@@ -50,7 +49,7 @@ def test_a_new_pin_has_six_to_twelve_digits_and_is_not_trivial(pin):
 
 def test_failures_grow_the_delay_then_lock_and_a_restart_does_not_reset_them(tmp_path):
     now = WallClock()
-    guard = PinGuard(hash_pin("482193"), tmp_path, now=now)
+    guard = PinGuard(hash_pin("482193"), PinFiles(tmp_path), now=now)
     waits = []
     for _ in range(LOCKOUT_FAILURES):
         if waits and waits[-1] > 0:
@@ -65,13 +64,13 @@ def test_failures_grow_the_delay_then_lock_and_a_restart_does_not_reset_them(tmp
     assert verdict.locked and waits[-1] >= 3600
 
     # the kiosk is killed and restarted: the lockout is still there
-    restarted = PinGuard(hash_pin("482193"), tmp_path, now=now)
+    restarted = PinGuard(hash_pin("482193"), PinFiles(tmp_path), now=now)
     assert restarted.wait_left() == pytest.approx(waits[-1])
     early = restarted.attempt("482193")
     assert not early.ok and early.early and early.locked, "the right PIN is not even checked while locked"
     now.t += restarted.wait_left()
     assert restarted.attempt("482193").ok
-    assert PinGuard(hash_pin("482193"), tmp_path, now=now).failures == 0
+    assert PinGuard(hash_pin("482193"), PinFiles(tmp_path), now=now).failures == 0
 
     log = [json.loads(line) for line in (tmp_path / LOG_FILE).read_text().splitlines()]
     assert [entry["event"] for entry in log].count("pin_failed") == LOCKOUT_FAILURES
@@ -83,9 +82,10 @@ def test_failures_grow_the_delay_then_lock_and_a_restart_does_not_reset_them(tmp
 GUESSER = """
 import sys
 from kiosk.core.pin import PinGuard
+from kiosk.store.pin_files import PinFiles
 # a kiosk process's PIN pad on the shared data directory; its wall clock stands still, so no wait
 # ever runs out and every attempt after the free ones must come back early, unchecked
-guard = PinGuard(sys.argv[2], sys.argv[1], now=lambda: 1_800_000_000.0)
+guard = PinGuard(sys.argv[2], PinFiles(sys.argv[1]), now=lambda: 1_800_000_000.0)
 print("ready", guard.failures, flush=True)
 sys.stdin.readline()
 verdicts = [guard.attempt("000000") for _ in range(int(sys.argv[3]))]
@@ -125,7 +125,7 @@ def test_two_kiosk_processes_on_one_data_directory_share_one_failure_count(tmp_p
 
 def test_a_damaged_failure_count_locks_instead_of_opening(tmp_path):
     (tmp_path / STATE_FILE).write_text('{"failures": "many"')
-    guard = PinGuard("482193", tmp_path, now=WallClock())
+    guard = PinGuard("482193", PinFiles(tmp_path), now=WallClock())
     assert guard.wait_left() > 0 and not guard.attempt("482193").ok
 
 

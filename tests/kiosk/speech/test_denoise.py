@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kiosk.speech import rooms
+from bench import _rooms as rooms
 from kiosk.speech.asr import PocketSphinxRecogniser
 from kiosk.speech.audio import SAMPLE_RATE
 from kiosk.speech.denoise import reduce_steady_noise

@@ -95,10 +95,10 @@ def test_official_model_is_checked_against_the_index_md5(models_served, tmp_path
     path = models.install("en", index_url=f"{base}/model-list.json")
     assert models.is_vosk_model(path)
     (served / "model-list.json").write_text(json.dumps([{"name": "vosk-model-small-en-us-0.15", "md5": "0" * 32}]))
-    with pytest.raises(models.ModelError, match="checksum mismatch .* expected md5 0000"):
+    with pytest.raises(models.SpeechModelError, match="checksum mismatch .* expected md5 0000"):
         models.install("en", index_url=f"{base}/model-list.json")
     (served / "model-list.json").write_text("[]")
-    with pytest.raises(models.ModelError, match="has no checksum for vosk-model-small-en-us-0.15"):
+    with pytest.raises(models.SpeechModelError, match="has no checksum for vosk-model-small-en-us-0.15"):
         models.install("en", index_url=f"{base}/model-list.json")
     assert _leftovers(tmp_path) == ["en"]
 
@@ -117,7 +117,7 @@ def test_official_model_is_checked_against_the_index_md5(models_served, tmp_path
 def test_bad_archives_install_nothing(models_served, tmp_path, build, message):
     served, base = models_served
     digest = build(served / "m.zip")
-    with pytest.raises(models.ModelError, match=message):
+    with pytest.raises(models.SpeechModelError, match=message):
         models.install("es", url=f"{base}/m.zip", sha256=digest)
     assert _leftovers(tmp_path) == []
     assert not (tmp_path / "escape.txt").exists()
@@ -184,7 +184,7 @@ def test_offline_install_names_the_routes_that_work_and_the_file_route_works(mod
     """No network: the official download fails (here: an index nobody serves), and the message
     names the two offline routes; the file:// route then installs the same model."""
     _, base = models_served
-    with pytest.raises(models.ModelError) as failure:
+    with pytest.raises(models.SpeechModelError) as failure:
         models.install("fr", index_url=f"{base}/no-index.json")
     assert "--url file://" in str(failure.value) and "KIOSK_VOSK_MODEL" in str(failure.value)
     assert models.main(["install", "fr", "--url", f"{base}/gone.zip", "--sha256", "ab"]) == 1

@@ -1,6 +1,6 @@
 """Voice answers in a real room: espeak-ng patients (voices other than the kiosk's own) answer
 through the real pipeline (endpointer → pocketsphinx → matcher → VoiceChannel) with noise,
-babble and effects added in numpy (:mod:`kiosk.speech.rooms`).
+babble and effects added in numpy (``bench/_rooms.py``).
 
 What must hold in every room: nothing runs to the cut-off in steady noise, and no option is
 ever sent as sure (without ``needs_confirmation``) unless it is the one the patient meant; a
@@ -13,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from bench import _rooms as rooms
 from kiosk.core.channels import ChannelInput, Command
 from kiosk.core.questionnaire import load_questionnaire
 from kiosk.core.session.words import LANGUAGE_NAMES, OWN_NAME, START_WORDS
-from kiosk.speech import rooms
 from kiosk.speech.asr import PocketSphinxRecogniser
 from kiosk.speech.asr.levels import above_room, gate_talk, voiced_frames
 from kiosk.speech.audio import SAMPLE_RATE, feed_samples, frame_powers, read_wav

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from kiosk.core.pin import FREE_FAILURES, STATE_FILE, PinGuard
+from kiosk.core.pin import FREE_FAILURES, PinGuard
 from kiosk.core.session import Phase
+from kiosk.store.pin_files import STATE_FILE, PinFiles
 from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
 
 from .conftest import UI_PIN, UiKiosk
@@ -132,7 +133,7 @@ async def test_a_full_filesystem_shows_one_calm_screen_and_recovers_when_space_i
 def test_on_a_full_disk_the_pin_lockout_holds_in_memory_and_the_right_pin_gets_in(tmp_path):
     now = [1_800_000_000.0]
     with small_filesystem(tmp_path / "small") as small:
-        guard = PinGuard(UI_PIN, small, now=lambda: now[0])  # its lock file is made while there is room
+        guard = PinGuard(UI_PIN, PinFiles(small), now=lambda: now[0])  # its lock file is made while there is room
         fill(small)
         verdicts = [guard.attempt("0000") for _ in range(FREE_FAILURES)]
         assert [v.wait_s > 0 for v in verdicts] == [False] * (FREE_FAILURES - 1) + [True]

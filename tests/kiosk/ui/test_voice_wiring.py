@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bench import _rooms as rooms
 from kiosk.core.channels import Channel, ChannelState
-from kiosk.speech import rooms
 from kiosk.speech.audio import SAMPLE_RATE, feed_wav, read_wav
 from kiosk.speech.tts import Synthesiser
 from kiosk.speech.voice import VoiceChannel

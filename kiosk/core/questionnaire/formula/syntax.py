@@ -17,6 +17,8 @@ from decimal import Decimal
 from functools import lru_cache
 from typing import Any
 
+from basis.errors import KioskError
+
 #: the longest formula (characters): a published score fits in a few hundred
 MAX_LENGTH = 2000
 #: the most tokens a formula may have
@@ -95,7 +97,7 @@ _TOKEN = re.compile(
 _ESCAPES = {"'": "'", "\\": "\\", "/": "/", "n": "\n", "t": "\t", "r": "\r", "f": "\f", '"': '"', "`": "`"}
 
 
-class FormulaError(ValueError):
+class FormulaError(KioskError, ValueError):
     """A formula outside the kiosk's formula language; ``at`` is its 1-based character."""
 
     def __init__(self, message: str, at: int) -> None:

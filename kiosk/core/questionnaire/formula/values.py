@@ -14,11 +14,13 @@ from dataclasses import dataclass
 from decimal import ROUND_HALF_UP, Decimal, DivisionByZero, InvalidOperation, localcontext
 from typing import Any
 
+from basis.errors import KioskError
+
 #: the largest number a formula may compute with (a clinical score is far smaller)
 LIMIT = Decimal(10) ** 12
 
 
-class EvaluationError(ValueError):
+class EvaluationError(KioskError, ValueError):
     """A formula that cannot give a value on these answers (message says what and where)."""
 
 

@@ -1,7 +1,8 @@
 """Simulated rooms for measuring and testing voice in: the audio a kiosk's microphone would
 record when a patient answers in a noisy ward, made from clean speech with numpy.
 
-There is no microphone here, so ``bench/asr.py`` and the speech tests make the conditions the
+There is no microphone here, so ``bench/asr.py`` and the speech tests (its only users: the kiosk
+itself never simulates a room) make the conditions the
 kiosk meets -- a fan (steady noise), people talking nearby (babble), a reverberant room, a
 telephone-band microphone, a quiet speaker -- from espeak-ng speech, deterministically (every
 random draw comes from a seeded generator). All audio is 16 kHz mono int16, as the pipeline
