@@ -35,7 +35,7 @@ from kiosk.core.session.publishing import Listener, Operation, Outputs
 from kiosk.core.session.questions import QuestionFlow
 from kiosk.core.session.resume import replay_into, restore_adaptation
 from kiosk.core.session.routing import Router
-from kiosk.core.session.snapshot import Answer, Snapshot
+from kiosk.core.session.snapshot import Answer, Snapshot, picture
 from kiosk.core.session.state import BatteryPlace, SessionState
 from kiosk.core.session.timers import AttemptClock
 
@@ -306,35 +306,11 @@ class Session:
 
     def snapshot(self) -> Snapshot:
         """A frozen picture of the session for a screen to render."""
-        state = self.state
-        open_ = state.open
-        practice = self.questionnaire.familiarisation[open_.index] if open_ and open_.practice else None
-        item = self.current_item
-        return Snapshot(
-            phase=state.phase,
-            language=state.language,
-            item=item,
-            number=self.state.patient_items().index(item) + 1 if item else None,
-            count=len(self.state.patient_items()),
-            practice=practice,
-            attempt=self.current_attempt,
-            remaining=self.remaining(),
-            paused=self.paused,
-            halted=self.halted,
-            person_present=state.person_present,
-            listening=state.listening,
-            adaptations=state.active_adaptations(),
-            speech_rate=state.speech_rate(),
-            answers=dict(state.answers),
-            not_answered=tuple(state.not_answered),
-            score=state.score,
-            prompt=state.prompt,
-            interlude=state.interlude(self.timers.kind),
-            **self.practice.progress(),
-            confirming=open_.unconfirmed.option if open_ and open_.unconfirmed else None,
-            can_undo=self.corrections.can_undo() and not self.timers.frozen and state.call is None,
-            unattended=state.unattended,
-            calling=state.call.text if state.call is not None else None,
+        return picture(
+            self.state,
+            self.timers,
+            progress=self.practice.progress(),
+            can_undo=self.corrections.can_undo(),
         )
 
     # -- inputs ------------------------------------------------------------------------------------
