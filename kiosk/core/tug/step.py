@@ -194,17 +194,20 @@ class TugStep:
         if t - self._since < (SEATED_HELD_S if self._up else UP_HELD_S):
             return
         self._up, self._since = not self._up, None
-        self._set(t, "PersonGetsUp", self._up)
-        self._set(t, "PersonIsSeated", not self._up)
+        self._set(t, "PersonGetsUp", self._up, PersonIsSeated=not self._up)
 
-    def _set(self, t: float, name: str, value: bool) -> None:
-        if self._published.get(name) is value:
-            return
-        if name != "Scored" and name not in self._published and not value:
-            self._published[name] = value  # nothing to say before it was ever true
-            return
-        self._published[name] = value
-        self._publish(t, {name: value})
+    def _set(self, t: float, name: str, value: bool, **more: bool) -> None:
+        """Publish the values that changed, as one batch at ``t`` (a false before any true is not news)."""
+        changed = {}
+        for key, new in {name: value, **more}.items():
+            if self._published.get(key) is new:
+                continue
+            first = key not in self._published
+            self._published[key] = new
+            if new or not first or key == "Scored":
+                changed[key] = new
+        if changed:
+            self._publish(t, changed)
 
     @property
     def seated_again(self) -> bool:
@@ -294,6 +297,11 @@ class TugStep:
         self.stage = TugStage.DONE
         self._set(self._clock.now(), "Scored", decision != "rejected")
         return self._result
+
+    @property
+    def go_t(self) -> float | None:
+        """When the kiosk said "Go" (None: not yet)."""
+        return self._go_t
 
     @property
     def result(self) -> TugResult | None:
