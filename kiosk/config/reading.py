@@ -154,6 +154,9 @@ def _read(path: Path) -> dict[str, Any]:
         elif key == "away_alert_after_s":
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 10 <= value <= 3600:
                 raise fail((key,), "away_alert_after_s must be a number of seconds, 10 to 3600")
+        elif key == "tug_threshold_s":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 5 <= value <= 60:
+                raise fail((key,), "tug_threshold_s must be a number of seconds, 5 to 60")
         elif key == "unattended_after":
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10:
                 raise fail((key,), "unattended_after must be a whole number of questions, 1 to 10")

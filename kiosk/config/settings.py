@@ -7,6 +7,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import field, fields
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import platformdirs
 
@@ -14,6 +15,9 @@ from basis import record
 from kiosk.core.pin import DEFAULT_PIN
 from kiosk.core.site import ExportSite, default_kiosk_id
 from kiosk.core.visits import DEFAULT_ID_PATTERN
+
+if TYPE_CHECKING:
+    from kiosk.core.tug.step import TugSettings
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
@@ -135,6 +139,11 @@ class Config:
     #: the site's rule for the patient identifiers staff type (a regular expression matched whole;
     #: kiosk.core.visits.DEFAULT_ID_PATTERN: digits with at most four letters in front)
     patient_id_pattern: str = DEFAULT_ID_PATTERN
+    #: the site's fall-risk threshold for the Timed Up and Go (s): a time over it is shown "above the
+    #: site's threshold", never as a diagnosis (13.5 s: Barry et al. 2014, docs/tug.md)
+    tug_threshold_s: float = 13.5
+    #: keep a Timed Up and Go's pose landmarks (never pictures) with its result (default: not kept)
+    tug_keep_landmarks: bool = False
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)
@@ -152,9 +161,16 @@ class Config:
 
 
 _PATHS = {"data_dir", "adaptation_policy", "questionnaire", "vosk_model", "remote_profiles"}
-_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient", "walk_up"}
+_BOOLS = {"adaptation", "familiarisation", "show_score_to_patient", "walk_up", "tug_keep_landmarks"}
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 _KEYS = {f.name for f in fields(Config)} - {"source"}
+
+
+def tug_settings(config: Config) -> TugSettings:
+    """The site's Timed Up and Go settings: its threshold and whether landmarks are kept."""
+    from kiosk.core.tug.step import TugSettings  # the analysis' numpy loads with a test, not at start
+
+    return TugSettings(threshold_s=config.tug_threshold_s, keep_landmarks=config.tug_keep_landmarks)
 
 
 def site_from_config(config: Config) -> ExportSite:

@@ -103,7 +103,7 @@ def main(argv: list[str]) -> int:
         parser.error("--trace takes one script")
     if args.order_code and (len(args.files) != 1 or not args.data_dir):
         parser.error("--order-code takes one script and --data-dir")
-    from kiosk.config import ConfigError, configured_instruments, load_config
+    from kiosk.config import ConfigError, configured_instruments, load_config, tug_settings
     from kiosk.core.adaptation import PolicyError, load_policy
     from kiosk.core.qos_model import load_kiosk_model
 
@@ -142,7 +142,7 @@ def main(argv: list[str]) -> int:
         order = _take_order(args.order_code, config, battery) if args.order_code else None
         for file in args.files:
             if is_tug_script(file):  # a visit's Timed Up and Go from a landmark file
-                tug = load_tug_script(file)
+                tug = load_tug_script(file, tug_settings(config))
                 tug = replace(tug, patient=order.patient_id) if order is not None else tug
                 results.append(run_tug_script(tug, store=store, model=config.qos_model))
                 continue

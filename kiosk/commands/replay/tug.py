@@ -103,8 +103,10 @@ def is_tug_script(path: str | Path) -> bool:
     return isinstance(data, dict) and "tug" in data
 
 
-def load_tug_script(path: str | Path) -> TugScript:
-    """Read and check a TUG script and its landmark file; :class:`TugScriptError` for the first problem."""
+def load_tug_script(path: str | Path, site: TugSettings | None = None) -> TugScript:
+    """Read and check a TUG script and its landmark file; :class:`TugScriptError` for the first problem.
+    ``site``: the configuration's settings, which the script's ``threshold_s``/``keep_landmarks`` override."""
+    site = site or TugSettings()
     name = str(path)
     data, positions, problems = parse_file(path)
     if positions is None or not isinstance(data, dict):
@@ -146,7 +148,10 @@ def load_tug_script(path: str | Path) -> TugScript:
         stopwatch_s=tug.get("stopwatch_s"),
         get_up_go=tug.get("get_up_go"),
         walking_aid=tug.get("walking_aid"),
-        settings=TugSettings(threshold_s=tug.get("threshold_s", 13.5), keep_landmarks=tug.get("keep_landmarks", False)),
+        settings=TugSettings(
+            threshold_s=tug.get("threshold_s", site.threshold_s),
+            keep_landmarks=tug.get("keep_landmarks", site.keep_landmarks),
+        ),
     )
 
 

@@ -104,3 +104,19 @@ def test_a_broken_landmark_file_names_its_line(tmp_path, capsys):
     assert main([str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"{tmp_path / 'walk.jsonl'}:4:") and "\n" not in err
+
+
+def test_the_site_threshold_and_landmarks_come_from_the_configuration(tmp_path, monkeypatch, capsys):
+    config = tmp_path / "site.yaml"
+    config.write_text("tug_threshold_s: 9\ntug_keep_landmarks: true\n", encoding="utf-8")
+    monkeypatch.setenv("KIOSK_CONFIG", str(config))
+    data = tmp_path / "data"
+    assert main([str(TUG / "normal.yaml"), "--json", "--data-dir", str(data)]) == 0
+    assert json.loads(capsys.readouterr().out)["tug"]["wording"].endswith("above the site's threshold (9 s).")
+    with Store.open(data, create=False) as store:
+        [stored] = store.tug.all()
+    assert stored.result.threshold_s == 9 and stored.landmarks_text is not None
+    config.write_text("tug_threshold_s: 200\n", encoding="utf-8")
+    assert main([str(TUG / "normal.yaml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert f"{config}:1:" in err and "tug_threshold_s must be a number of seconds, 5 to 60" in err and "\n" not in err
