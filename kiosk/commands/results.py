@@ -207,6 +207,9 @@ def main(argv: list[str]) -> int:
                 summaries = store.sessions()
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
+                for tug in store.tug.all():
+                    r = tug.result
+                    print(f"{tug.id}  {tug.patient_id:<10} {tug.at}  tug      {r.decision:<9} {r.wording()}")
                 for s in summaries:
                     print(
                         f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "

@@ -102,3 +102,8 @@ def test_stored_times_go_out_as_valid_observations_and_csv(tmp_path, monkeypatch
         "accepted_by": "nurse-7",
     }
     assert "all-tug.csv" in capsys.readouterr().err
+    assert results_main(["--data-dir", str(data)]) == 0
+    listed = [line for line in capsys.readouterr().out.splitlines() if " tug " in line]
+    assert [line.split()[0] for line in listed] == ids
+    assert listed[1].endswith("stopwatch 15.5 s, above the site's threshold (13.5 s).")
+    assert listed[2].endswith("rejected  No time taken (rejected).")
