@@ -120,3 +120,14 @@ def test_the_site_threshold_and_landmarks_come_from_the_configuration(tmp_path, 
     assert main([str(TUG / "normal.yaml")]) == 2
     err = capsys.readouterr().err.strip()
     assert f"{config}:1:" in err and "tug_threshold_s must be a number of seconds, 5 to 60" in err and "\n" not in err
+
+
+def test_the_trace_replays_to_the_same_metrics(tmp_path, capsys):
+    from qos import replay
+
+    out = tmp_path / "tug.trace.yaml"
+    assert main([str(TUG / "normal.yaml"), "--json", "--trace", str(out)]) == 0
+    metrics = json.loads(capsys.readouterr().out)["metrics"]
+    summary = replay(out)
+    assert {name: m["last"] for name, m in summary["metrics"].items()} == pytest.approx(metrics)
+    assert "PersonGetsUp: true" in out.read_text(encoding="utf-8")
