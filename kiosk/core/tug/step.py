@@ -20,6 +20,7 @@ Never a picture: frames are landmarks only, and the result keeps them only when 
 from __future__ import annotations
 
 import statistics
+from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from enum import Enum
@@ -154,6 +155,7 @@ class TugStep:
         self._seat: tuple[float, float] | None = None  # seated lift and the torso at the chair
         self._since: float | None = None  # when the live posture started to differ
         self._up = False
+        self._levels: deque[float] = deque(maxlen=max(3, round(0.2 * fps)))
         self.framing = "nobody in the picture"
         self.analysis: TugAnalysis | None = None
         self._result: TugResult | None = None
@@ -185,7 +187,9 @@ class TugStep:
             self._seat = lift
             return
         seat, torso = self._seat
-        level = (lift[0] - seat) / torso
+        # a running median over 0.2 s: one frame with a landmark thrown off decides nothing
+        self._levels.append((lift[0] - seat) / torso)
+        level = statistics.median(self._levels)
         changed = level > MIN_RISE if not self._up else level < SEATED_BAND
         if not changed:
             self._since = None

@@ -91,3 +91,29 @@ def test_the_step_refuses_out_of_order_and_walk_up() -> None:
         step.rate(get_up_go=6)
     with pytest.raises(TugStepError, match="walking aid"):
         step.rate(walking_aid="wheelchair")
+
+
+POSITIVES = ("normal", "frail", "hesitant", "fps15", "fps60", "noisy", "mirrored", "walking_aid")
+
+
+@pytest.mark.parametrize("family", [*POSITIVES, "never_stands", "stands_no_walk", "leaves_frame", "legs_cut"])
+def test_gets_up_and_seated_again_follow_every_family(family: str) -> None:
+    """One rise after the onset and before the walk out, one sit after the true landing; none for a
+    patient who never stands or whose legs are out of the picture (seeds 0-2 each)."""
+    for seed in range(3):
+        sequence, truth = generate(family, seed)
+        go_t = go_of(sequence, truth.onset_t) if truth.onset_t is not None else sequence.go_t or 1.0
+        step, published, _ = run(sequence, go_t)
+        gets_up = [(t, values["PersonGetsUp"]) for t, values in published if "PersonGetsUp" in values]
+        if family in POSITIVES:
+            assert truth.onset_t is not None and truth.seated_t is not None
+            [(up_t, up), (down_t, down)] = gets_up
+            assert up and not down, (family, seed)
+            assert truth.onset_t < up_t < truth.phases["walk_out"][1], (family, seed)
+            assert truth.seated_t <= down_t < truth.seated_t + 1.5, (family, seed)
+        elif family in ("never_stands", "legs_cut"):
+            assert gets_up == [], (family, seed)
+        elif family == "stands_no_walk":
+            assert [up for _, up in gets_up] == [True, False], (family, seed)
+        else:  # leaves_frame: up, never seen seated again
+            assert [up for _, up in gets_up] == [True], (family, seed)
