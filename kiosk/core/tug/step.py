@@ -49,6 +49,8 @@ UP_HELD_S = 0.3
 #: ...and seated again within this of the seated height, held this long
 SEATED_BAND = 0.15
 SEATED_HELD_S = 0.5
+#: frames kept from before "Go": the analysis reads the seated rest there (docs/tug.md), not the set-up
+PRE_GO_S = 2.0
 
 Publish = Callable[[float, Mapping[str, Any]], None]
 
@@ -174,6 +176,8 @@ class TugStep:
         marks = tuple(landmarks) if landmarks is not None else None
         self._frames.append(PoseFrame(t=t, landmarks=marks))
         if self.stage is not TugStage.RUNNING:
+            if self._frames[0].t < t - PRE_GO_S:  # the set-up (staff placing the camera, the patient
+                self._frames = [f for f in self._frames if f.t >= t - PRE_GO_S]  # walking to the chair)
             self.framing = framing_problem(marks)
             self._set(t, "PersonIsNextToChair", not self.framing)
             return

@@ -69,7 +69,9 @@ def test_rejected_publishes_scored_false_and_the_site_threshold_and_landmarks_ap
     assert published[-1][1] == {"Scored": False}
     assert result.total_s is None and result.above_threshold is None and result.wording() == "No time taken (rejected)."
     assert result.get_up_go == 2 and result.walking_aid == "stick"
-    assert result.landmarks is not None and len(result.landmarks.frames) == len(sequence.frames)
+    go_t = go_of(sequence, truth.onset_t)
+    kept = [f for f in sequence.frames if f.t >= go_t - 2.0]  # from the seated rest before Go
+    assert result.landmarks is not None and result.landmarks.frames == tuple(kept)
     camera = result.camera_total_s
     assert camera is not None and camera < 30
     assert replace(result, total_s=camera).wording() == f"{camera:.1f} s, not above the site's threshold (30 s)."
@@ -117,3 +119,21 @@ def test_gets_up_and_seated_again_follow_every_family(family: str) -> None:
             assert [up for _, up in gets_up] == [True, False], (family, seed)
         else:  # leaves_frame: up, never seen seated again
             assert [up for _, up in gets_up] == [True], (family, seed)
+
+
+def test_a_long_set_up_with_the_patient_walking_about_does_not_move_the_time() -> None:
+    """Staff set the camera up for 20 s while the patient walks to the chair: only the seated rest
+    before "Go" is analysed with the test."""
+    walking, _ = generate("normal", 8)
+    sequence, truth = generate("normal", 9)
+    assert truth.onset_t is not None and truth.seated_t is not None
+    middle = [f for f in walking.frames if 4.0 <= f.t < 24.0]  # up and walking
+    shift = 21.0
+    before = [replace(f, t=f.t - 4.0) for f in middle]
+    after = [replace(f, t=f.t + shift) for f in sequence.frames]
+    long = replace(sequence, frames=(*before, *after))
+    go_t = go_of(sequence, truth.onset_t) + shift
+    step, _, _ = run(long, go_t)
+    analysis = step.analysis
+    assert analysis is not None and analysis.valid, analysis and analysis.reasons
+    assert analysis.total_s == pytest.approx(truth.seated_t + shift - go_t, abs=0.3)
