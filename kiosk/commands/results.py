@@ -14,7 +14,10 @@ it refused (parked). For each SESSION it shows how the
 practice questions went (hearing, reading, selecting: right, wrong, not answered or skipped and
 why), its answers, the total recomputed from them, band (from the band set it was scored with) and
 completeness, adaptations and QoS metrics at the end.
-Exports are written readable by their owner only. Exit 2 on an unknown session or unusable store.
+Without SESSION, the stored Timed Up and Go results with a time go out too (issue 34): Observations
+LOINC 89423-8 in the ``--fhir`` Bundle, and with ``--csv FILE`` their rows in ``FILE-tug.csv``
+(:mod:`kiosk.export.tug`). Exports are written readable by their owner only. Exit 2 on an unknown
+session or unusable store.
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ from kiosk.export import (
 )
 from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, result_line, wide_csv_tables
 from kiosk.export.opening import in_force_of, open_store
+from kiosk.export.tug import tug_csv, tug_entries, tug_times
 from kiosk.store.database import StorageError, StoredSession
 
 
@@ -113,6 +117,12 @@ def wide_paths(file: str, instruments: list[str]) -> dict[Path, str]:
     }
 
 
+def tug_csv_path(file: str) -> Path:
+    """Where ``--csv FILE`` writes the Timed Up and Go times (their own columns): ``STEM-tug.csv``."""
+    path = Path(file)
+    return path.with_name(f"{path.stem}-tug{path.suffix or '.csv'}")
+
+
 def main(argv: list[str]) -> int:
     """List, show or export stored sessions; returns the exit status."""
     parser = argparse.ArgumentParser(
@@ -172,10 +182,17 @@ def main(argv: list[str]) -> int:
                 else []
             )
             empty = None if chosen or not exporting else (configured_questionnaire(config), site)
+            tugs = tug_times(store.tug.all()) if exporting and not refs else []  # a visit's TUG, not a session's
             if args.fhir:
-                write_json(args.fhir, bundle_of(chosen, empty=empty))
+                bundle = bundle_of(chosen, empty=empty)
+                if tugs:
+                    bundle["entry"] = [*bundle.get("entry", []), *tug_entries(tugs, site)]
+                write_json(args.fhir, bundle)
             if args.csv:
                 write_export(args.csv, csv_of(chosen, bom=args.bom, empty=empty))
+                if tugs:
+                    write_export(tug_csv_path(args.csv), tug_csv(tugs, bom=args.bom))
+                    print(f"Timed Up and Go times: {tug_csv_path(args.csv)}", file=sys.stderr)
             if args.csv_wide:
                 tables = wide_csv_tables(chosen, bom=args.bom, empty=empty)
                 for path, qid in wide_paths(args.csv_wide, list(tables)).items():
@@ -190,6 +207,9 @@ def main(argv: list[str]) -> int:
                 summaries = store.sessions()
                 if not summaries:
                     print("no sessions stored", file=sys.stderr)
+                for tug in store.tug.all():
+                    r = tug.result
+                    print(f"{tug.id}  {tug.patient_id:<10} {tug.at}  tug      {r.decision:<9} {r.wording()}")
                 for s in summaries:
                     print(
                         f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "

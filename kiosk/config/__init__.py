@@ -39,6 +39,8 @@ Example ``config.yaml`` (every key optional)::
     unattended_after: 2               # this many questions in a row unanswered: the ward is alerted and
                                       # the kiosk waits for a touch instead of asking on
     show_score_to_patient: false      # the end screen shows the patient their total and band
+    tug_threshold_s: 13.5             # Timed Up and Go: a time over it is "above the site's threshold"
+    tug_keep_landmarks: false         # keep a TUG's pose landmarks (never pictures) with its result
     walk_up: true                     # anyone may start a test at the welcome (marked walk-up); false:
                                       # only ordered visits and visits staff start on the clinician screen
     station:                          # report to a ward station (docs/station-protocol.md)
@@ -81,6 +83,7 @@ from kiosk.config.settings import (
     InstrumentChoice,
     Station,
     site_from_config,
+    tug_settings,
 )
 from kiosk.core.pin import DEFAULT_PIN
 from kiosk.core.questionnaire import SCREEN_LANGUAGES
@@ -101,6 +104,7 @@ __all__ = [
     "load_config",
     "offered_to_patients",
     "site_from_config",
+    "tug_settings",
     "write_settings",
 ]
 

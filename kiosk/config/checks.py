@@ -383,6 +383,8 @@ SETTINGS: dict[str, Check] = {
     "patient_id_pattern": _patient_id_pattern,
     "station": _station,
     "site_dir": _site_dir,
+    "tug_threshold_s": _number(5, 60, "tug_threshold_s must be a number of seconds, 5 to 60"),
+    "tug_keep_landmarks": _flag("tug_keep_landmarks"),
 }
 #: the settings that are paths (the environment's overrides of them are checked as paths too)
 PATH_SETTINGS = frozenset(name for name, check in SETTINGS.items() if isinstance(check, PathCheck))

@@ -8,6 +8,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import platformdirs
 
@@ -16,6 +17,9 @@ from basis.errors import KioskError
 from kiosk.core.pin import DEFAULT_PIN
 from kiosk.core.site import ExportSite, default_kiosk_id
 from kiosk.core.visits import DEFAULT_ID_PATTERN
+
+if TYPE_CHECKING:
+    from kiosk.core.tug.step import TugSettings
 
 #: the FHIR settings a site may give (see kiosk.export.ExportSite for their defaults)
 FHIR_KEYS = ("patient_system", "questionnaire_url", "identifier_system", "device_system")
@@ -134,6 +138,11 @@ class Config:
     #: the site's own folder of instruments/, words/ and qos/ (kiosk.config.site_folder), outside
     #: the package so that upgrades keep it (None: none)
     site_dir: Path | None = None
+    #: the site's fall-risk threshold for the Timed Up and Go (s): a time over it is shown "above the
+    #: site's threshold", never as a diagnosis (13.5 s: Barry et al. 2014, docs/tug.md)
+    tug_threshold_s: float = 13.5
+    #: keep a Timed Up and Go's pose landmarks (never pictures) with its result (default: not kept)
+    tug_keep_landmarks: bool = False
     #: the ward station this kiosk reports to (None: none; the kiosk works alone, as it always did)
     station: Station | None = None
     #: the file this was read from (None: defaults only)
@@ -148,6 +157,13 @@ class Config:
     def pin_secret(self) -> str:
         """What the PIN pad checks against: the hash, else the legacy plain PIN."""
         return self.clinician_pin_hash or self.clinician_pin
+
+
+def tug_settings(config: Config) -> TugSettings:
+    """The site's Timed Up and Go settings: its threshold and whether landmarks are kept."""
+    from kiosk.core.tug.step import TugSettings  # the analysis' numpy loads with a test, not at start
+
+    return TugSettings(threshold_s=config.tug_threshold_s, keep_landmarks=config.tug_keep_landmarks)
 
 
 def site_from_config(config: Config) -> ExportSite:

@@ -39,8 +39,9 @@ def _secure_file(path: Path) -> None:
 
 def _damaged(path: Path, exc: BaseException | str) -> StorageError:
     """The one message for a database that is not one, or is corrupt: which file, what to do."""
+    detail = " ".join(str(exc).split())  # one line: SQLite's checks can span several
     return StorageError(
-        f"{path} is damaged ({exc}); nothing was changed. Stop the kiosk, keep a copy of {path.name} "
+        f"{path} is damaged ({detail}); nothing was changed. Stop the kiosk, keep a copy of {path.name} "
         f"(and {path.name}-wal, -shm if present) for the engineers, then move them out of {path.parent} "
         "and restore a backup, or start with an empty database"
     )
@@ -60,6 +61,7 @@ TABLES = (
     "leases",
     "outbox",
     "definitions",
+    "tug_results",
 )
 
 

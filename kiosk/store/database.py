@@ -55,6 +55,7 @@ from kiosk.store.records import (
 )
 from kiosk.store.staff_answers import record_staff_answer
 from kiosk.store.transactions import ALERT_EVENTS, Transactions
+from kiosk.store.tug import TugResults
 
 __all__ = [
     "ALERT_EVENTS",
@@ -117,6 +118,8 @@ class Store:
             self._tx, owner=owner or Owner(), lease_ttl_s=lease_ttl_s, interrupt_after_s=interrupt_after_s, wall=wall
         )
         self._reader = Reader(connection, path)
+        #: Timed Up and Go results (:mod:`kiosk.store.tug`)
+        self.tug = TugResults(self._tx, connection)
 
     @classmethod
     def open(cls, data_dir: str | Path, create: bool = True, **options: Any) -> Store:

@@ -180,8 +180,36 @@ ALTER TABLE sessions ADD COLUMN identity TEXT;
 ALTER TABLE sessions ADD COLUMN identity_attached_later INTEGER NOT NULL DEFAULT 0;
 """
 
+# Version 4: Timed Up and Go results (issue 34, kiosk.store.tug): times, phases, quality flags, who
+# confirmed and who decided; never pictures, landmarks (pose-landmarks/1 text) only where a site keeps them.
+V4 = """
+CREATE TABLE tug_results (
+    id TEXT PRIMARY KEY,
+    patient_id TEXT NOT NULL REFERENCES patients(id),
+    visit_id TEXT,
+    at TEXT NOT NULL,
+    confirmed_by TEXT NOT NULL,
+    confirmed_t REAL NOT NULL,
+    go_t REAL,
+    decision TEXT NOT NULL CHECK (decision IN ('accepted', 'stopwatch', 'rejected')),
+    decided_by TEXT NOT NULL,
+    total_s REAL,
+    method TEXT CHECK (method IN ('camera', 'stopwatch')),
+    camera_total_s REAL,
+    phases TEXT NOT NULL,
+    reasons TEXT NOT NULL,
+    person_share REAL NOT NULL,
+    body_cut_off INTEGER NOT NULL,
+    turn_seen INTEGER NOT NULL,
+    threshold_s REAL NOT NULL,
+    get_up_go INTEGER CHECK (get_up_go BETWEEN 1 AND 5),
+    walking_aid TEXT,
+    landmarks TEXT
+);
+"""
+
 #: (version, script) in order; a database at version v runs every script after v
-MIGRATIONS: tuple[tuple[int, str], ...] = ((1, V1), (2, V2), (3, V3))
+MIGRATIONS: tuple[tuple[int, str], ...] = ((1, V1), (2, V2), (3, V3), (4, V4))
 LATEST = MIGRATIONS[-1][0]
 
 

@@ -11,6 +11,7 @@ from typing import Any
 from fileio.bounded import BadFile
 from kiosk.commands.replay.driver import ReplayResult, run_battery, run_script
 from kiosk.commands.replay.script import ScriptError, is_battery_script, load_battery_script, load_script
+from kiosk.commands.replay.tug import TugReplay, is_tug_script, load_tug_script, run_tug_script
 from kiosk.core.questionnaire import Questionnaire, QuestionnaireError
 from kiosk.store.lease import SessionTaken
 from qos.errors import QosError
@@ -102,7 +103,7 @@ def main(argv: list[str]) -> int:
         parser.error("--trace takes one script")
     if args.order_code and (len(args.files) != 1 or not args.data_dir):
         parser.error("--order-code takes one script and --data-dir")
-    from kiosk.config import ConfigError, configured_instruments, load_config
+    from kiosk.config import ConfigError, configured_instruments, load_config, tug_settings
     from kiosk.core.adaptation import PolicyError, load_policy
     from kiosk.core.qos_model import load_kiosk_model
 
@@ -136,10 +137,15 @@ def main(argv: list[str]) -> int:
         except StorageError as exc:
             print(f"kiosk replay: {exc}", file=sys.stderr)
             return 2
-    results = []
+    results: list[ReplayResult | TugReplay] = []
     try:
         order = _take_order(args.order_code, config, battery) if args.order_code else None
         for file in args.files:
+            if is_tug_script(file):  # a visit's Timed Up and Go from a landmark file
+                tug = load_tug_script(file, tug_settings(config))
+                tug = replace(tug, patient=order.patient_id) if order is not None else tug
+                results.append(run_tug_script(tug, store=store, model=config.qos_model))
+                continue
             if is_battery_script(file):  # a visit of several instruments: one result each
                 battery_script = load_battery_script(file, {q.id: q for q, _ in battery})
                 if order is not None:
@@ -204,6 +210,8 @@ def main(argv: list[str]) -> int:
     for result in results:
         if args.json:
             print(json.dumps(result.to_dict(), ensure_ascii=False))
+        elif isinstance(result, TugReplay):
+            print(result.human())
         else:
             _print_human(result)
     return 0

@@ -28,6 +28,7 @@ from kiosk.core.session.events import AnsweredBy, Phase
 from kiosk.core.session.incidents import Incidents
 from kiosk.core.session.live import LiveAdaptation
 from kiosk.core.session.opening import Opening
+from kiosk.core.session.picture import picture
 from kiosk.core.session.ports import QosEngine, SessionStore
 from kiosk.core.session.practice import Practice
 from kiosk.core.session.prompts import Prompts
@@ -35,7 +36,7 @@ from kiosk.core.session.publishing import Listener, Operation, Outputs
 from kiosk.core.session.questions import QuestionFlow
 from kiosk.core.session.resume import replay_into, restore_adaptation
 from kiosk.core.session.routing import Router
-from kiosk.core.session.snapshot import Answer, Snapshot, picture
+from kiosk.core.session.snapshot import Answer, Snapshot
 from kiosk.core.session.state import BatteryPlace, SessionState
 from kiosk.core.session.timers import AttemptClock
 
