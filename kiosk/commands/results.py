@@ -45,7 +45,16 @@ from kiosk.export import (
 from kiosk.export.captured import bundle_of, csv_of, questionnaire_of, result_line, wide_csv_tables
 from kiosk.export.opening import in_force_of, open_store
 from kiosk.export.tug import tug_csv, tug_entries, tug_times
-from kiosk.store.database import StorageError, StoredSession
+from kiosk.store.database import StorageError, Store, StoredSession
+
+
+def _listed_result(store: Store, session_id: str) -> str:
+    """A session's result line in the list; a session whose stored rows this kiosk cannot read is
+    listed as such (the list goes on: ``kiosk results ID`` names the damage)."""
+    try:
+        return result_line(store.session(session_id))
+    except StorageError:
+        return f"cannot be read (kiosk results {session_id} says why)"
 
 
 def _show(stored: StoredSession) -> None:
@@ -213,7 +222,7 @@ def main(argv: list[str]) -> int:
                 for s in summaries:
                     print(
                         f"{s.id}  {s.patient_id:<10} {s.started_at}  {s.questionnaire_id:<8} {s.label:<9} "
-                        f"{s.language}  {result_line(store.session(s.id))}"
+                        f"{s.language}  {_listed_result(store, s.id)}"
                     )
                 waiting, parked = store.outbox_waiting()
                 if waiting or parked:
