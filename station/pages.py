@@ -20,9 +20,8 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, Response, StreamingResponse
 from starlette.routing import Route
 
-from kiosk.core.questionnaire import Questionnaire, Score
+from kiosk.core.questionnaire import Questionnaire, Score, pending_words
 from kiosk.core.review import review_state, state_once_signed
-from kiosk.core.staff import waiting_line
 from kiosk.export import ExportError, practice_outcomes
 from kiosk.store.database import StoredSession
 from station import db, exports, order_progress, staff_items, validation, ward
@@ -208,7 +207,7 @@ async def session_page(request: Request) -> Response:
         items=_items(q, stored, current),
         score=score,
         entered=entered,
-        awaiting=waiting_line(score.awaiting_staff),
+        awaiting=pending_words(q, score) if score.awaiting_staff else "",
         practice=_practice(q, stored),
         plot=qos_svg(stored),
         incidents=[e for e in stored.log if e.kind in INCIDENTS],

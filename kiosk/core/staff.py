@@ -93,12 +93,6 @@ def waiting_for_staff(q: Questionnaire, options: Mapping[str, int], values: Mapp
     return tuple(i.id for i in q.items if i.staff and i.id not in options and i.id not in values)
 
 
-def waiting_line(waiting: Iterable[str]) -> str:
-    """How a result with unanswered staff items says so: "waiting for staff: weight, height"."""
-    names = list(waiting)
-    return f"waiting for staff: {', '.join(names)}" if names else ""
-
-
 class EnteredStep(Protocol):
     """A row of the station's audit trail as :func:`entered_at_station` reads it."""
 

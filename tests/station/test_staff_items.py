@@ -80,12 +80,12 @@ def _a_nurse_completes_the_staff_items(station, ward, tmp_path: Path) -> None:
     staff = Staff(station.url, name="nurse.kim", role="nurse")
     page = staff.http.get(f"/sessions/{session_id}")
     assert page.status_code == 200, page.text[:2000]
-    assert _total(page.text).startswith("No total yet: waiting for staff: weight, aid")
+    assert _total(page.text).startswith("No total yet: waiting for staff: Weight (kg), Uses a walking aid")
     refused = staff.post(f"/sessions/{session_id}/staff/weight", value="300")
     assert refused.status_code == 303
     back = staff.http.get(refused.headers["location"])
     assert "weight: &#39;300&#39; is not a number from 20 to 250 kg" in back.text, back.text[:3000]
-    assert _total(back.text).startswith("No total yet: waiting for staff: weight, aid")
+    assert _total(back.text).startswith("No total yet: waiting for staff: Weight (kg), Uses a walking aid")
     entered = staff.post(f"/sessions/{session_id}/staff/weight", value="71,5")
     assert entered.status_code == 303
     filled = staff.post(f"/sessions/{session_id}/items/aid", option="1", reason="no aid seen on the ward")
@@ -102,5 +102,5 @@ def test_a_weight_entered_at_the_kiosk_reaches_the_station(shared_station, tmp_p
     session_id = _sync(station, ward, _rows(tmp_path, kiosk_weight=64.0))
     staff = Staff(station.url, name="nurse.kim", role="nurse")
     page = staff.http.get(f"/sessions/{session_id}")
-    assert _total(page.text).startswith("No total yet: waiting for staff: aid"), _total(page.text)
+    assert _total(page.text).startswith("No total yet: waiting for staff: Uses a walking aid"), _total(page.text)
     assert "64 kg" in page.text
