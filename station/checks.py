@@ -21,9 +21,10 @@ from datetime import datetime
 from typing import Any
 
 from kiosk.core.channels import Channel
-from kiosk.core.questionnaire import SCREEN_LANGUAGES, Questionnaire, Timing
+from kiosk.core.questionnaire import Questionnaire, Timing
 from kiosk.core.questionnaire.definition import DefinitionError, questionnaire_from
 from kiosk.core.session import AnsweredBy
+from kiosk.core.words import LANGUAGE_CODE
 from kiosk.export import ExportError, ExportSite, fhir_questionnaire
 from kiosk.store.database import PATIENT_ID
 
@@ -128,8 +129,9 @@ def check_definition(definition: Any, where: str) -> Questionnaire:
         raise _fail(where, str(exc)) from None
     text(q.id, f"{where}.id", ID_MAX, empty=False)
     text(q.version, f"{where}.version", ID_MAX)
-    for language in q.languages:
-        one_of(language, f"{where}.languages", tuple(SCREEN_LANGUAGES))
+    for language in q.languages:  # a site's own language too (its words file is the kiosk's)
+        if not isinstance(language, str) or not LANGUAGE_CODE.fullmatch(language):
+            raise _fail(f"{where}.languages", f"must be language codes such as en or pt-BR, got {language!r:.40}")
     ids = [i.id for i in q.items] + [p.id for p in q.familiarisation]
     if len(set(ids)) != len(ids):
         raise _fail(f"{where}.items", "two items or practice questions share an id")
