@@ -8,7 +8,8 @@ always be traced to who did it and why.
 
 from __future__ import annotations
 
-from typing import Any, cast
+from collections.abc import Mapping
+from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
@@ -87,12 +88,22 @@ def reviews(engine: Engine, session_ids: list[str]) -> dict[str, Review]:
 
 def reviews_in(connection: Connection, session_ids: list[str]) -> dict[str, Review]:
     """:func:`reviews` on an open connection."""
+    return {session_id: review_of(found) for session_id, found in trails_in(connection, session_ids).items()}
+
+
+def trail_in(connection: Connection, session_id: str) -> list[AuditEntry]:
+    """The session's audit trail, oldest first, on an open connection."""
+    return _entries(connection, session_id)
+
+
+def trails_in(connection: Connection, session_ids: list[str]) -> dict[str, list[AuditEntry]]:
+    """The audit trails of several sessions (oldest first each), read in one query."""
     entries: dict[str, list[AuditEntry]] = {session_id: [] for session_id in session_ids}
     if session_ids:
         query = sa.select(audit).where(audit.c.session_id.in_(session_ids)).order_by(audit.c.id)
         for r in connection.execute(query):
             entries[r.session_id].append(AuditEntry.of(r))
-    return {session_id: review_of(found) for session_id, found in entries.items()}
+    return entries
 
 
 def change_item(
@@ -185,9 +196,10 @@ def _check_open(stored: StoredSession, current: Review) -> None:
         )
 
 
-def corrected(stored: StoredSession, q: Questionnaire, current: Review) -> dict[str, Any]:
-    """The items' options after corrections, and the score they give (for the page and exports)."""
+def corrected(
+    stored: StoredSession, q: Questionnaire, current: Review, values: Mapping[str, float] | None = None
+) -> dict[str, Any]:
+    """The items' options after corrections, and the score they give with the numbers staff
+    entered (``values``, :func:`kiosk.core.staff.every_entered`) (for the pages and exports)."""
     options = current.options({a.item_id: a.option for a in stored.answers})
-    points = {item_id: q.item(item_id).option(option).points for item_id, option in options.items()}
-    # score() checks every value: an option without points is refused there, as it always was
-    return {"options": options, "score": q.score(cast(dict[str, int], points))}
+    return {"options": options, "score": q.score_answers(options, values=values or {})}

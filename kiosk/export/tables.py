@@ -70,6 +70,9 @@ CSV_COLUMNS = [
     "visit",
     # last, so the columns before keep their places: which instrument (the versions tell edits apart)
     "questionnaire",
+    # a number staff entered (an ``input:`` item) as entered, and its UCUM unit
+    "value",
+    "unit",
 ]
 
 
@@ -118,10 +121,22 @@ def csv_text(
     bom: bool = False,
 ) -> str:
     """The long CSV (see :data:`CSV_COLUMNS`) of sessions with their reviews (None: unreviewed)."""
+    return result_rows(q, results(q, sessions, reviews), site, bom=bom)
+
+
+def entered_text(value: float) -> str:
+    """A number staff entered as the CSV writes it: an integer without a point, a decimal as
+    Python keeps it (shortest exact form: 72.123456, 1234567.5; never rounded, never ``%g``)."""
+    return str(value)
+
+
+def result_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None = None, *, bom: bool = False) -> str:
+    """The long CSV of :class:`Result`s (what :func:`csv_text` writes, and the station for a
+    result it described with the numbers staff entered there)."""
     site = site or ExportSite()
     out = io.StringIO()
     writer = _writer(out, CSV_COLUMNS)
-    for r in results(q, sessions, reviews):
+    for r in rs:
         stored = r.stored
         common = _session_columns(q, r, site)
         for record, outcome in zip(stored.practice, practice_outcomes(q, stored)):
@@ -142,6 +157,13 @@ def csv_text(
         for item in q.items:
             row = common | {"item": item.id, "kind": "item", "answered_by": ""}
             number = r.options.get(item.id)
+            if item.entry is not None and item.id in r.values:
+                unit = item.entry.unit or ""
+                text = entered_text(r.values[item.id])
+                writer.writerow(
+                    row | {"label": f"{text} {unit}".strip(), "value": text, "unit": unit, "answered_by": "staff"}
+                )
+                continue
             if number is None:
                 writer.writerow(row | {"label": "not answered"})
                 continue
@@ -181,7 +203,8 @@ def csv_text(
 
 
 def wide_columns(q: Questionnaire) -> list[str]:
-    """The wide CSV's columns: the session's, then each item's option number and points."""
+    """The wide CSV's columns: the session's, then each item's option number and points (for a
+    number staff enter, its ``_value`` as entered)."""
     return [
         "session",
         "patient",
@@ -204,7 +227,11 @@ def wide_columns(q: Questionnaire) -> list[str]:
         "missing",
         "band",
         "band_set",
-    ] + [f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
+    ] + [
+        f"{item.id}_{part}"
+        for item in q.items
+        for part in (("value",) if item.entry is not None else ("option", "points"))
+    ]
 
 
 def wide_csv_text(
@@ -217,10 +244,15 @@ def wide_csv_text(
 ) -> str:
     """One row per session (see :func:`wide_columns`): ``total`` only when complete, the points of
     the answered items apart in ``answered_points`` and the unanswered items in ``missing``."""
+    return wide_rows(q, results(q, sessions, reviews), site, bom=bom)
+
+
+def wide_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None = None, *, bom: bool = False) -> str:
+    """The wide CSV of :class:`Result`s (see :func:`wide_csv_text`)."""
     site = site or ExportSite()
     out = io.StringIO()
     writer = _writer(out, wide_columns(q))
-    for r in results(q, sessions, reviews):
+    for r in rs:
         row: dict[str, Any] = _session_columns(q, r, site) | {
             "signed_by": r.review.signed_by or "",
             "signed_at": r.review.signed_at or "",
@@ -232,7 +264,9 @@ def wide_csv_text(
         }
         for item in q.items:
             number = r.options.get(item.id)
-            if number is not None:
+            if item.entry is not None and item.id in r.values:
+                row[f"{item.id}_value"] = entered_text(r.values[item.id])
+            elif number is not None:
                 row |= {f"{item.id}_option": number, f"{item.id}_points": item.option(number).points}
         writer.writerow(row)
     return ("\ufeff" if bom else "") + out.getvalue()
