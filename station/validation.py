@@ -17,10 +17,13 @@ from sqlalchemy.engine import Connection, Engine
 from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review, review_from_steps
+from kiosk.core.staff import every_entered
+from kiosk.export import ExportError
 from kiosk.store.database import StoredSession
 from station import db, order_progress
 from station.auth import User
 from station.db import audit, sessions
+from station.definitions import questionnaire_for
 from station.sessions import load
 
 #: a session that is over (only these can be validated)
@@ -139,27 +142,63 @@ def change_item(
         )
 
 
-def sign_off(engine: Engine, session_id: str, by: User) -> None:
+def sign_off(
+    engine: Engine, session_id: str, by: User, *, incomplete: str = "", fallback: Questionnaire | None = None
+) -> str:
     """A doctor makes the result final (as recorded, or with the corrections made): the audit
     row, the session's review state and its order change in one transaction, so a result and its
-    order never disagree."""
+    order never disagree. A result with unanswered items is signed off only as incomplete, with
+    the reason ``incomplete`` (ValidationError naming the items without one); ``fallback``: the
+    questionnaire of a session that captured none. Returns the reason stored ('' : complete)."""
     with engine.begin() as connection:
-        sign_off_in(connection, session_id, by)
+        return sign_off_in(connection, session_id, by, incomplete=incomplete, fallback=fallback)
 
 
-def sign_off_in(connection: Connection, session_id: str, by: User, at: str | None = None) -> None:
+def unanswered(stored: StoredSession, q: Questionnaire, entries: list[AuditEntry]) -> tuple[str, ...]:
+    """The items the result still lacks (after corrections and every number staff entered); an
+    answer an older station stored without checking it (an item or option ``q`` lacks) counts
+    as none, as the pages show it."""
+    items = {item.id: item for item in q.items}
+    options = {
+        item_id: option
+        for item_id, option in review_of(entries).options({a.item_id: a.option for a in stored.answers}).items()
+        if item_id in items and items[item_id].entry is None and 1 <= option <= len(items[item_id].options)
+    }
+    return tuple(q.score_answers(options, values=every_entered(q, stored.log, entries)).missing)
+
+
+def sign_off_in(
+    connection: Connection,
+    session_id: str,
+    by: User,
+    at: str | None = None,
+    *,
+    incomplete: str = "",
+    fallback: Questionnaire | None = None,
+) -> str:
     """:func:`sign_off` in the caller's transaction (``at``: when, default now; a history loaded
     in bulk signs many in one transaction, bench/_history.py)."""
     if not by.is_doctor:
         raise ValidationError("only a doctor can sign off a result")
     stored, entries = _locked(connection, session_id)
     _check_open(stored, review_of(entries))
+    try:
+        missing = unanswered(stored, questionnaire_for(stored, fallback=fallback), entries)
+    except (ExportError, ValueError) as exc:
+        raise ValidationError(f"the result cannot be scored, so it cannot be signed off: {exc}") from None
+    reason = incomplete.strip()[:1000] if missing else ""
+    if missing and not reason:
+        raise ValidationError(
+            f"{len(missing)} item{'s' if len(missing) != 1 else ''} not answered ({', '.join(missing)}): "
+            "sign off as incomplete, saying why (e.g. 'patient too tired to go on; not to be repeated')"
+        )
     at = at or db.now_iso()
     connection.execute(
-        audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason="")
+        audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason=reason)
     )
     connection.execute(sessions.update().where(sessions.c.id == session_id).values(signed_at=at))
     order_progress.signed_off(connection, session_id, by)
+    return reason
 
 
 def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:

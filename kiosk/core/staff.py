@@ -108,6 +108,12 @@ def entered_values(q: Questionnaire, log: Iterable[LogLine]) -> dict[str, float]
     return values
 
 
+def number_text(value: float) -> str:
+    """A number staff entered as every page and export shows it: whole without a point (``64``,
+    ``1234567``), else the shortest exact form (``72.123456``): never rounded, never ``%g``."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
+
+
 def waiting_for_staff(q: Questionnaire, options: Mapping[str, int], values: Mapping[str, float]) -> tuple[str, ...]:
     """The staff items with neither a chosen option nor an entered value, in order."""
     return tuple(i.id for i in q.items if i.staff and i.id not in options and i.id not in values)

@@ -19,6 +19,7 @@ from typing import Any
 from kiosk.core.questionnaire import Questionnaire, result_words
 from kiosk.core.review import Review
 from kiosk.core.site import ExportSite
+from kiosk.core.staff import number_text
 from kiosk.core.visits import visit_of
 from kiosk.export.result import (
     TOTAL_LINK,
@@ -73,6 +74,8 @@ CSV_COLUMNS = [
     # a number staff entered (an ``input:`` item) as entered, and its UCUM unit
     "value",
     "unit",
+    # a result signed off with items unanswered: the doctor's reason (blank otherwise)
+    "incomplete_reason",
 ]
 
 
@@ -103,6 +106,7 @@ def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str,
         "simulated": "true" if stored.simulated else "false",
         # how the visit began (kiosk.core.visits): "order <id>", "staff", "walk-up"; blank before visits existed
         "visit": visit_of(stored.log) or "",
+        "incomplete_reason": r.review.incomplete if r.final and not r.complete else "",
     }
 
 
@@ -122,12 +126,6 @@ def csv_text(
 ) -> str:
     """The long CSV (see :data:`CSV_COLUMNS`) of sessions with their reviews (None: unreviewed)."""
     return result_rows(q, results(q, sessions, reviews), site, bom=bom)
-
-
-def entered_text(value: float) -> str:
-    """A number staff entered as the CSV writes it: an integer without a point, a decimal as
-    Python keeps it (shortest exact form: 72.123456, 1234567.5; never rounded, never ``%g``)."""
-    return str(value)
 
 
 def result_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None = None, *, bom: bool = False) -> str:
@@ -159,7 +157,7 @@ def result_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None 
             number = r.options.get(item.id)
             if item.entry is not None and item.id in r.values:
                 unit = item.entry.unit or ""
-                text = entered_text(r.values[item.id])
+                text = number_text(r.values[item.id])
                 writer.writerow(
                     row | {"label": f"{text} {unit}".strip(), "value": text, "unit": unit, "answered_by": "staff"}
                 )
@@ -227,6 +225,7 @@ def wide_columns(q: Questionnaire) -> list[str]:
         "missing",
         "band",
         "band_set",
+        "incomplete_reason",
     ] + [
         f"{item.id}_{part}"
         for item in q.items
@@ -265,7 +264,7 @@ def wide_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None = 
         for item in q.items:
             number = r.options.get(item.id)
             if item.entry is not None and item.id in r.values:
-                row[f"{item.id}_value"] = entered_text(r.values[item.id])
+                row[f"{item.id}_value"] = number_text(r.values[item.id])
             elif number is not None:
                 row |= {f"{item.id}_option": number, f"{item.id}_points": item.option(number).points}
         writer.writerow(row)
