@@ -5,7 +5,8 @@ transaction Bundles, and one result as CSV, all through the kiosk's own export c
 Each result is described with what its session captured as it started (:mod:`kiosk.export.captured`):
 the questionnaire definition it ran and the identity it was recorded under (site, kiosk id, FHIR
 systems), so a hospital importing the kiosk's and the station's exports gets one result, not two;
-the station's review (:mod:`station.validation`) says where it stands. The caller's questionnaire
+the station's review (:mod:`station.validation`) says where it stands, and the numbers staff entered
+(at the kiosk or here) are the result's, in its FHIR and its CSV alike. The caller's questionnaire
 only stands in for a session that captured none.
 """
 
@@ -19,12 +20,15 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
 from kiosk.core.questionnaire import Questionnaire
-from kiosk.export import Described, bundle_of, csv_text, result
+from kiosk.core.staff import every_entered
+from kiosk.export import Described, bundle_of, result, result_rows
 from kiosk.export.captured import site_of
+from kiosk.store.database import StoredSession
 from station import validation
 from station.db import sessions
 from station.definitions import questionnaire_for
 from station.sessions import SAMPLE_KINDS, load, load_many
+from station.validation import AuditEntry
 
 
 class PeriodError(ValueError):
@@ -33,9 +37,15 @@ class PeriodError(ValueError):
 
 def _described(connection: Connection, fallback: Questionnaire, session_id: str) -> Described:
     kiosk, stored = load(connection, session_id)
-    review = validation.review_in(connection, session_id)
+    return _describe(fallback, kiosk, stored, validation.trail_in(connection, session_id))
+
+
+def _describe(fallback: Questionnaire, kiosk: str, stored: StoredSession, trail: list[AuditEntry]) -> Described:
+    """A session as every station export states it: its review and every number staff entered
+    (at the kiosk and here, :func:`kiosk.core.staff.every_entered`) from its audit trail."""
     q = questionnaire_for(stored, fallback=fallback)
-    return Described(q, result(q, stored, review), site_of(stored, kiosk))
+    values = every_entered(q, stored.log, trail)
+    return Described(q, result(q, stored, validation.review_of(trail), values), site_of(stored, kiosk))
 
 
 def result_bundle(engine: Engine, q: Questionnaire, session_id: str) -> dict:
@@ -48,7 +58,7 @@ def result_csv(engine: Engine, q: Questionnaire, session_id: str) -> str:
     """One result as the long CSV (the same review state as its FHIR)."""
     with engine.connect() as connection:
         d = _described(connection, q, session_id)
-    return csv_text(d.questionnaire, [d.result.stored], [d.result.review], d.site)
+    return result_rows(d.questionnaire, [d.result], d.site)
 
 
 def period(start: str, end: str) -> tuple[date, date]:
@@ -102,11 +112,10 @@ def _signed_batches(connection: Connection, first: date, last: date, size: int =
 
 def _described_batch(connection: Connection, fallback: Questionnaire, ids: list[str]) -> Iterator[Described]:
     loaded = load_many(connection, ids, without=SAMPLE_KINDS)
-    reviews = validation.reviews_in(connection, ids)
+    trails = validation.trails_in(connection, ids)
     for session_id in ids:
         kiosk, stored = loaded[session_id]
-        q = questionnaire_for(stored, fallback=fallback)
-        yield Described(q, result(q, stored, reviews[session_id]), site_of(stored, kiosk))
+        yield _describe(fallback, kiosk, stored, trails[session_id])
 
 
 def period_bundle(engine: Engine, q: Questionnaire, first: date, last: date) -> dict:

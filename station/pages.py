@@ -12,6 +12,7 @@ from __future__ import annotations
 import itertools
 import json
 from collections.abc import Iterator, Mapping
+from functools import partial
 from typing import Any
 
 from starlette.applications import Starlette
@@ -22,6 +23,7 @@ from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire, Score, pending_words
 from kiosk.core.review import review_state, state_once_signed
+from kiosk.core.staff import number_text
 from kiosk.export import ExportError, practice_outcomes
 from kiosk.store.database import StoredSession
 from station import db, exports, order_progress, staff_items, validation, ward
@@ -206,7 +208,7 @@ async def session_page(request: Request) -> Response:
         q=q,
         items=_items(q, stored, current),
         score=score,
-        entered=entered,
+        entered={item_id: number_text(v) for item_id, v in entered.items()},  # as typed, never %g
         awaiting=pending_words(q, score) if score.awaiting_staff else "",
         practice=_practice(q, stored),
         plot=qos_svg(stored),
@@ -255,15 +257,23 @@ async def change_item(request: Request) -> Response:
 
 
 async def sign_off(request: Request) -> Response:
-    await checked_form(request)
+    """POST the sign-off (a result with unanswered items only as incomplete, with the form's
+    ``incomplete_reason``: :func:`station.validation.sign_off`)."""
+    form = await checked_form(request)
     session_id = request.path_params["session_id"]
     page = f"/sessions/{session_id}"
+    reason = str(form.get("incomplete_reason", ""))
     try:
-        await run_in_threadpool(validation.sign_off, request.app.state.engine, session_id, request.state.user)
+        stored_reason = await run_in_threadpool(
+            partial(validation.sign_off, incomplete=reason, fallback=request.app.state.questionnaire),
+            request.app.state.engine,
+            session_id,
+            request.state.user,
+        )
     except (validation.ValidationError, NotFound) as exc:
         return _back(request, str(exc), to=page)
     await run_in_threadpool(request.app.state.bus.publish, {"type": "result", "session": session_id})
-    return _back(request, "Signed off.", to=page)
+    return _back(request, "Signed off as incomplete." if stored_reason else "Signed off.", to=page)
 
 
 async def amend(request: Request) -> Response:

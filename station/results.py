@@ -17,6 +17,7 @@ from sqlalchemy.engine import Connection, Engine
 from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import review_state
+from kiosk.core.staff import every_entered
 from kiosk.export import ExportError
 from station import order_progress, validation
 from station.db import sessions
@@ -94,22 +95,24 @@ def results_of(engine: Engine, q: Questionnaire, rows: Sequence[Any]) -> list[Re
     """The results of these session rows (anything with an ``id``), in their order: a handful of
     queries for the whole list (:func:`station.sessions.load_many`), each definition parsed once."""
     ids = [r.id for r in rows]
-    reviews = validation.reviews(engine, ids)
     kinds = order_progress.visit_kinds(engine, ids)
     found = []
     with engine.connect() as connection:
         loaded = load_many(connection, ids, RESULT_KINDS)
+        trails = validation.trails_in(connection, ids)
     for session_id in ids:
         if session_id not in loaded:
             continue
         kiosk, stored = loaded[session_id]
-        review = reviews[session_id]
+        review = validation.review_of(trails[session_id])
         try:  # scored on the questionnaire the session ran, not the one the station bundles
             ran = questionnaire_for(stored, fallback=q)
         except ExportError:
             ran = None
         score = (
-            validation.corrected(stored, ran, review)["score"] if ran and stored.questionnaire_id == ran.id else None
+            validation.corrected(stored, ran, review, every_entered(ran, stored.log, trails[session_id]))["score"]
+            if ran and stored.questionnaire_id == ran.id
+            else None
         )
         state = review_state(review, {a.item_id: a.option for a in stored.answers})
         kind, order_id = kinds.get(session_id, ("", None))

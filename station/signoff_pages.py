@@ -15,6 +15,7 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from kiosk.core.review import state_once_signed
+from kiosk.core.staff import every_entered
 from kiosk.export import ExportError
 from kiosk.store.records import StoredSession
 from station import validation
@@ -35,7 +36,8 @@ async def confirm_page(request: Request) -> Response:
         kiosk, stored = await run_in_threadpool(read)
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
-    current = await run_in_threadpool(validation.review, engine, session_id)
+    trail = await run_in_threadpool(validation.trail, engine, session_id)
+    current = validation.review_of(trail)
     if current.final or stored.status not in validation.REVIEWABLE:
         return RedirectResponse(f"/sessions/{session_id}", status_code=303)
     if not request.state.user.is_doctor:
@@ -46,7 +48,8 @@ async def confirm_page(request: Request) -> Response:
         q = questionnaire_for(stored, fallback=q)
     except ExportError as exc:
         return PlainTextResponse(f"session {session_id} cannot be described: {exc}", status_code=422)
-    score = (await run_in_threadpool(validation.corrected, stored, q, current))["score"]  # off the event loop
+    values = every_entered(q, stored.log, trail)
+    score = (await run_in_threadpool(validation.corrected, stored, q, current, values))["score"]  # off the event loop
     language = stored.language
     labels = {item.id: item.text.get(language) or item.text.get("en") or item.id for item in q.items}
     # what the result will be called once signed: the one review-state function's answer, so the

@@ -2,8 +2,8 @@
 
 A staff item with options is filled like any unanswered item (the corrections form, audited with
 a reason). A number (``input:``, a weight in kg) is entered here: checked against the item's
-range (:func:`kiosk.core.staff.parse_entry`) and stored as one audit row, action
-:data:`kiosk.core.staff.ENTER`, its ``reason`` column holding the number (no schema change: the
+range (:func:`kiosk.core.staff.entry_text`) and stored as one audit row, action
+:data:`kiosk.core.staff.ENTER`, its ``reason`` column holding the number as typed (no schema change: the
 audit already says who and when). The session's numbers are those the kiosk's staff entered (its
 log) overlaid by the station's (:func:`values`).
 """
@@ -20,7 +20,7 @@ from starlette.responses import Response
 from starlette.routing import Route
 
 from kiosk.core.questionnaire import Questionnaire
-from kiosk.core.staff import ENTER, EnteredStep, entered_at_station, entered_values, parse_entry
+from kiosk.core.staff import ENTER, EnteredStep, entry_text, every_entered
 from kiosk.store.database import StoredSession
 from station import db
 from station.auth import User
@@ -33,7 +33,7 @@ from station.validation import ValidationError, _check_open, _locked, review_of
 
 def values(q: Questionnaire, stored: StoredSession, trail: Iterable[EnteredStep]) -> dict[str, float]:
     """Every number staff entered for the session: at the kiosk, then at the station (later wins)."""
-    return {**entered_values(q, stored.log), **entered_at_station(q, trail)}
+    return every_entered(q, stored.log, trail)
 
 
 def enter_value(engine: Engine, q: Questionnaire, session_id: str, item_id: str, typed: str, by: User) -> None:
@@ -46,7 +46,7 @@ def enter_value(engine: Engine, q: Questionnaire, session_id: str, item_id: str,
     if not item.staff or item.entry is None:
         raise ValidationError(f"{item_id} is not a number staff enter")
     try:
-        value = parse_entry(item, typed)
+        text = entry_text(item, typed)
     except ValueError as exc:
         raise ValidationError(str(exc)) from None
     with engine.begin() as connection:
@@ -59,7 +59,7 @@ def enter_value(engine: Engine, q: Questionnaire, session_id: str, item_id: str,
                 author=by.name,
                 action=ENTER,
                 item_id=item_id,
-                reason=f"{value:g}",
+                reason=text,  # as entered (never %g: 1234567 stays 1234567)
             )
         )
 

@@ -8,7 +8,8 @@ always be traced to who did it and why.
 
 from __future__ import annotations
 
-from typing import Any, cast
+from collections.abc import Mapping
+from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
@@ -16,10 +17,13 @@ from sqlalchemy.engine import Connection, Engine
 from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review, review_from_steps
+from kiosk.core.staff import every_entered
+from kiosk.export import ExportError
 from kiosk.store.database import StoredSession
 from station import db, order_progress
 from station.auth import User
 from station.db import audit, sessions
+from station.definitions import questionnaire_for
 from station.sessions import load
 
 #: a session that is over (only these can be validated)
@@ -87,12 +91,22 @@ def reviews(engine: Engine, session_ids: list[str]) -> dict[str, Review]:
 
 def reviews_in(connection: Connection, session_ids: list[str]) -> dict[str, Review]:
     """:func:`reviews` on an open connection."""
+    return {session_id: review_of(found) for session_id, found in trails_in(connection, session_ids).items()}
+
+
+def trail_in(connection: Connection, session_id: str) -> list[AuditEntry]:
+    """The session's audit trail, oldest first, on an open connection."""
+    return _entries(connection, session_id)
+
+
+def trails_in(connection: Connection, session_ids: list[str]) -> dict[str, list[AuditEntry]]:
+    """The audit trails of several sessions (oldest first each), read in one query."""
     entries: dict[str, list[AuditEntry]] = {session_id: [] for session_id in session_ids}
     if session_ids:
         query = sa.select(audit).where(audit.c.session_id.in_(session_ids)).order_by(audit.c.id)
         for r in connection.execute(query):
             entries[r.session_id].append(AuditEntry.of(r))
-    return {session_id: review_of(found) for session_id, found in entries.items()}
+    return entries
 
 
 def change_item(
@@ -128,27 +142,63 @@ def change_item(
         )
 
 
-def sign_off(engine: Engine, session_id: str, by: User) -> None:
+def sign_off(
+    engine: Engine, session_id: str, by: User, *, incomplete: str = "", fallback: Questionnaire | None = None
+) -> str:
     """A doctor makes the result final (as recorded, or with the corrections made): the audit
     row, the session's review state and its order change in one transaction, so a result and its
-    order never disagree."""
+    order never disagree. A result with unanswered items is signed off only as incomplete, with
+    the reason ``incomplete`` (ValidationError naming the items without one); ``fallback``: the
+    questionnaire of a session that captured none. Returns the reason stored ('' : complete)."""
     with engine.begin() as connection:
-        sign_off_in(connection, session_id, by)
+        return sign_off_in(connection, session_id, by, incomplete=incomplete, fallback=fallback)
 
 
-def sign_off_in(connection: Connection, session_id: str, by: User, at: str | None = None) -> None:
+def unanswered(stored: StoredSession, q: Questionnaire, entries: list[AuditEntry]) -> tuple[str, ...]:
+    """The items the result still lacks (after corrections and every number staff entered); an
+    answer an older station stored without checking it (an item or option ``q`` lacks) counts
+    as none, as the pages show it."""
+    items = {item.id: item for item in q.items}
+    options = {
+        item_id: option
+        for item_id, option in review_of(entries).options({a.item_id: a.option for a in stored.answers}).items()
+        if item_id in items and items[item_id].entry is None and 1 <= option <= len(items[item_id].options)
+    }
+    return tuple(q.score_answers(options, values=every_entered(q, stored.log, entries)).missing)
+
+
+def sign_off_in(
+    connection: Connection,
+    session_id: str,
+    by: User,
+    at: str | None = None,
+    *,
+    incomplete: str = "",
+    fallback: Questionnaire | None = None,
+) -> str:
     """:func:`sign_off` in the caller's transaction (``at``: when, default now; a history loaded
     in bulk signs many in one transaction, bench/_history.py)."""
     if not by.is_doctor:
         raise ValidationError("only a doctor can sign off a result")
     stored, entries = _locked(connection, session_id)
     _check_open(stored, review_of(entries))
+    try:
+        missing = unanswered(stored, questionnaire_for(stored, fallback=fallback), entries)
+    except (ExportError, ValueError) as exc:
+        raise ValidationError(f"the result cannot be scored, so it cannot be signed off: {exc}") from None
+    reason = incomplete.strip()[:1000] if missing else ""
+    if missing and not reason:
+        raise ValidationError(
+            f"{len(missing)} item{'s' if len(missing) != 1 else ''} not answered ({', '.join(missing)}): "
+            "sign off as incomplete, saying why (e.g. 'patient too tired to go on; not to be repeated')"
+        )
     at = at or db.now_iso()
     connection.execute(
-        audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason="")
+        audit.insert().values(session_id=session_id, at=at, author=by.name, action="sign_off", reason=reason)
     )
     connection.execute(sessions.update().where(sessions.c.id == session_id).values(signed_at=at))
     order_progress.signed_off(connection, session_id, by)
+    return reason
 
 
 def amend(engine: Engine, session_id: str, reason: str, by: User) -> None:
@@ -185,9 +235,10 @@ def _check_open(stored: StoredSession, current: Review) -> None:
         )
 
 
-def corrected(stored: StoredSession, q: Questionnaire, current: Review) -> dict[str, Any]:
-    """The items' options after corrections, and the score they give (for the page and exports)."""
+def corrected(
+    stored: StoredSession, q: Questionnaire, current: Review, values: Mapping[str, float] | None = None
+) -> dict[str, Any]:
+    """The items' options after corrections, and the score they give with the numbers staff
+    entered (``values``, :func:`kiosk.core.staff.every_entered`) (for the pages and exports)."""
     options = current.options({a.item_id: a.option for a in stored.answers})
-    points = {item_id: q.item(item_id).option(option).points for item_id, option in options.items()}
-    # score() checks every value: an option without points is refused there, as it always was
-    return {"options": options, "score": q.score(cast(dict[str, int], points))}
+    return {"options": options, "score": q.score_answers(options, values=values or {})}

@@ -74,6 +74,9 @@ class Review:
     reopenings: tuple[Reopening, ...] = ()
     #: the system of the staff names above (FHIR Practitioner identifiers)
     staff_system: str = STAFF_SYSTEM
+    #: signed off with items unanswered: the doctor's reason ('' for a complete result, or none
+    #: signed); exports say the result is incomplete and why
+    incomplete: str = ""
 
     @classmethod
     def unreviewed(cls) -> Review:
@@ -103,7 +106,8 @@ class Step(Protocol):
     def at(self) -> str: ...
     @property
     def author(self) -> str: ...
-    #: "correct", "fill", "sign_off", "amend" (reopen a signed result); other actions are ignored
+    #: "correct", "fill", "sign_off" (its reason: why a result with unanswered items was signed
+    #: off as incomplete, '' otherwise), "amend" (reopen a signed result); others are ignored
     @property
     def action(self) -> str: ...
     @property
@@ -138,7 +142,7 @@ def review_from_steps(steps: Iterable[Step], staff_system: str = STAFF_SYSTEM) -
         state = ReviewState.CORRECTED if corrections or reopenings else ReviewState.UNREVIEWED
         return Review(state, tuple(corrections), reopenings=tuple(reopenings), staff_system=staff_system)
     state = ReviewState.AMENDED if corrections else ReviewState.SIGNED_OFF
-    return Review(state, tuple(corrections), sign.author, sign.at, tuple(reopenings), staff_system)
+    return Review(state, tuple(corrections), sign.author, sign.at, tuple(reopenings), staff_system, sign.reason)
 
 
 def review_state(review: Review, recorded: Mapping[str, int]) -> ReviewState:

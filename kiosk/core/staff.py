@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Iterable, Mapping
 from typing import Any, Protocol
 
@@ -29,12 +30,17 @@ class LogLine(Protocol):
     def detail(self) -> str: ...
 
 
+def _bound(value: float) -> str:
+    """A range's end as staff read it: 9999999, not %g's 1e+07; 0.5 as it is."""
+    return str(int(value)) if float(value).is_integer() else str(value)
+
+
 def _number_words(item: Item) -> str:
     entry = item.entry
     assert entry is not None
     unit = f" {entry.unit}" if entry.unit else ""
     kind = "a whole number" if entry.type == "integer" else "a number"
-    return f"{kind} from {entry.min:g} to {entry.max:g}{unit}"
+    return f"{kind} from {_bound(entry.min)} to {_bound(entry.max)}{unit}"
 
 
 def entry_hint(item: Item) -> str:
@@ -42,20 +48,34 @@ def entry_hint(item: Item) -> str:
     return _number_words(item)
 
 
-def parse_entry(item: Item, typed: str) -> int | float:
-    """The number staff typed for ``item`` (decimal comma accepted); ValueError with one sentence
-    naming the item and what it takes when it is no such number or out of range."""
+#: what staff may type: digits, at most one decimal point (or comma), a sign; no exponent
+_DECIMAL = re.compile(r"[+-]?[0-9]+(?:\.[0-9]+)?")
+_INTEGER = re.compile(r"[+-]?[0-9]+")
+
+
+def entry_text(item: Item, typed: str) -> str:
+    """The number staff typed for ``item`` as the text to keep (stripped, a decimal comma made a
+    point, nothing rounded: ``72.123456`` stays so, ``1234567`` never becomes ``1.23457e+06``);
+    ValueError with one sentence naming the item and what it takes when it is no such number
+    (an integer item takes no decimals, no item takes an exponent) or out of range."""
     entry = item.entry
     if entry is None:
         raise ValueError(f"{item.id}: staff choose one of its options, not a number")
     text = typed.strip().replace(",", ".")
-    try:
-        value: int | float = int(text) if entry.type == "integer" else float(text)
-    except ValueError:
-        raise ValueError(f"{item.id}: {typed.strip()!r:.30} is not {_number_words(item)}") from None
+    pattern = _INTEGER if entry.type == "integer" else _DECIMAL
+    if not pattern.fullmatch(text) or len(text) > 40:
+        raise ValueError(f"{item.id}: {typed.strip()!r:.30} is not {_number_words(item)}")
+    value: int | float = int(text) if entry.type == "integer" else float(text)
     if isinstance(value, float) and not math.isfinite(value) or not entry.fits(value):
         raise ValueError(f"{item.id}: {typed.strip()!r:.30} is not {_number_words(item)}")
-    return value
+    return text
+
+
+def parse_entry(item: Item, typed: str) -> int | float:
+    """The number staff typed for ``item`` (:func:`entry_text`'s rules; ValueError likewise)."""
+    text = entry_text(item, typed)
+    assert item.entry is not None
+    return int(text) if item.entry.type == "integer" else float(text)
 
 
 def answer_detail(item_id: str, *, option: int | None, value: float | None, by: str) -> str:
@@ -88,6 +108,12 @@ def entered_values(q: Questionnaire, log: Iterable[LogLine]) -> dict[str, float]
     return values
 
 
+def number_text(value: float) -> str:
+    """A number staff entered as every page and export shows it: whole without a point (``64``,
+    ``1234567``), else the shortest exact form (``72.123456``): never rounded, never ``%g``."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
+
+
 def waiting_for_staff(q: Questionnaire, options: Mapping[str, int], values: Mapping[str, float]) -> tuple[str, ...]:
     """The staff items with neither a chosen option nor an entered value, in order."""
     return tuple(i.id for i in q.items if i.staff and i.id not in options and i.id not in values)
@@ -109,8 +135,9 @@ ENTER = "enter"
 
 
 def entered_at_station(q: Questionnaire, steps: Iterable[EnteredStep]) -> dict[str, float]:
-    """The numbers staff entered at the station (audit rows :data:`ENTER`, oldest first; the
-    latest per item counts), for ``q``'s ``input`` items."""
+    """The numbers staff entered at the station (audit rows :data:`ENTER`, oldest first, their
+    ``reason`` the text as entered, :func:`entry_text`; the latest per item counts), for ``q``'s
+    ``input`` items. (Rows written before the text was kept hold ``%g``: read as they parse.)"""
     values: dict[str, float] = {}
     entries = {item.id: item for item in q.items if item.entry is not None}
     for step in steps:
@@ -122,3 +149,9 @@ def entered_at_station(q: Questionnaire, steps: Iterable[EnteredStep]) -> dict[s
         except ValueError:
             continue
     return values
+
+
+def every_entered(q: Questionnaire, log: Iterable[LogLine], steps: Iterable[EnteredStep]) -> dict[str, float]:
+    """Every number staff entered for a session: at the kiosk (its log), then at the station
+    (its audit trail; later wins). The one reading every station page and export uses."""
+    return {**entered_values(q, log), **entered_at_station(q, steps)}

@@ -50,14 +50,13 @@ if TYPE_CHECKING:
         fhir_device,
         fhir_questionnaire,
         fhir_response,
-        fhir_total,
-        observation_status,
         practitioner,
         questionnaire_canonical,
         response_status,
     )
     from kiosk.export.provenance import REPLACED_ANSWER, fhir_provenances
-    from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, wide_columns, wide_csv_text
+    from kiosk.export.tables import CSV_COLUMNS, ID_TAGS, csv_text, result_rows, wide_columns, wide_csv_text, wide_rows
+    from kiosk.export.total import fhir_total, observation_status
 
 #: each public name -> the module that defines it: imported on first use, so the kiosk's first
 #: screen (which needs only kiosk.export.result, imported above) does not wait for FHIR, bundles and CSV
@@ -73,12 +72,14 @@ _MODULES: dict[str, str] = {
     "WORDING": "kiosk.export.fhir",
     "bundle_of": "kiosk.export.bundle",
     "csv_text": "kiosk.export.tables",
+    "result_rows": "kiosk.export.tables",
+    "wide_rows": "kiosk.export.tables",
     "fhir_device": "kiosk.export.fhir",
     "fhir_provenances": "kiosk.export.provenance",
     "fhir_questionnaire": "kiosk.export.fhir",
     "fhir_response": "kiosk.export.fhir",
-    "fhir_total": "kiosk.export.fhir",
-    "observation_status": "kiosk.export.fhir",
+    "fhir_total": "kiosk.export.total",
+    "observation_status": "kiosk.export.total",
     "practitioner": "kiosk.export.fhir",
     "questionnaire_bundle": "kiosk.export.bundle",
     "questionnaire_canonical": "kiosk.export.fhir",
@@ -108,6 +109,8 @@ __all__ = [
     "PracticeOutcome",
     "Result",
     "csv_text",
+    "result_rows",
+    "wide_rows",
     "export_identity",
     "fhir_device",
     "fhir_questionnaire",

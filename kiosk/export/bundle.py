@@ -24,9 +24,10 @@ from basis import record
 from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.review import Review
 from kiosk.core.site import ExportSite
-from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of, total_of
+from kiosk.export.fhir import fhir_device, fhir_questionnaire, questionnaire_canonical, response_of
 from kiosk.export.provenance import fhir_provenances
 from kiosk.export.result import Result, questionnaire_version, results
+from kiosk.export.total import total_of
 from kiosk.store.database import StoredSession
 
 

@@ -42,8 +42,9 @@ Choices, each from the R4 specification:
   takes the questionnaire and the identity (:class:`ExportSite`) it is given: it reads no file
   and no configuration.
 - **Total Observation** (LOINC 96761-2, ``derivedFrom`` the response, ``device`` the kiosk, the
-  band and its band set as ``interpretation``) only for a complete result: ``preliminary`` until
-  signed off, then ``final`` (``amended`` with corrections, each correction as a ``note``).
+  band and its band set as ``interpretation``) for every complete result (an instrument with no
+  standard total code is coded in the site's own system, :func:`site_total_code`): ``preliminary``
+  until signed off, then ``final`` (``amended`` with corrections, each correction as a ``note``).
 - **Test data**: a session stored by ``kiosk replay`` (a scripted patient) is labelled ``HTEST``
   (``meta.security``, "test health data") on its response and total, so no EHR takes it for a
   patient's result.
@@ -77,7 +78,6 @@ from kiosk.export.calculated import (
     entry_fields,
     staff_mark,
     subscale_code,
-    subscale_components,
     subscale_expression,
     subscale_items,
     total_expression,
@@ -110,6 +110,10 @@ TEST_DATA = {
 SURVEY = {"system": "http://terminology.hl7.org/CodeSystem/observation-category", "code": "survey", "display": "Survey"}
 #: the total's label per language (``export.total_score`` in its words file)
 TOTAL_TEXT: Mapping[str, str] = Table(lambda words: words.export["total_score"])
+#: why a result with unanswered items was signed off as incomplete (the doctor's words), on its response
+INCOMPLETE = "urn:barthel-kiosk:fhir:StructureDefinition:incomplete-reason"
+#: R4's reasons for a missing value: "unknown", with the doctor's reason as text
+DATA_ABSENT = "http://terminology.hl7.org/CodeSystem/data-absent-reason"
 #: the words the kiosk used beside a code (see the module docstring): ``clinical``, ``patient``, ``spoken``
 WORDING = "urn:barthel-kiosk:fhir:StructureDefinition:wording"
 
@@ -144,7 +148,7 @@ def _text(key: str, texts: Mapping[str, str], language: str) -> dict[str, Any]:
     return {key: texts[language]} | ({f"_{key}": {"extension": others}} if others else {})
 
 
-def _coding(code: Code, display: str | None = None) -> dict[str, str]:
+def code_coding(code: Code, display: str | None = None) -> dict[str, str]:
     shown = code.display or display
     return {"system": code.system, "code": code.code} | ({"display": shown} if shown else {})
 
@@ -154,7 +158,7 @@ def option_coding(q: Questionnaire, item_id: str, number: int, language: str) ->
     one) shows the option's label, with the other languages as translations."""
     option = q.item(item_id).option(number)
     if option.code is not None and option.code.display:
-        return _coding(option.code)
+        return code_coding(option.code)
     code = option.code or Code(f"urn:barthel-kiosk:option:{q.id}:{item_id}", str(number))
     return {"system": code.system, "code": code.code} | _text("display", option.label, language)
 
@@ -198,7 +202,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
             "required": True,
         }
         if item.code:
-            entry["code"] = [_coding(item.code)]
+            entry["code"] = [code_coding(item.code)]
         if item.entry is not None:
             fields = entry_fields(item)
             entry |= {"type": fields["type"], "extension": entry["extension"] + fields["extension"]}
@@ -235,7 +239,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
         "readOnly": True,
     }
     if q.total_code:
-        total["code"] = [_coding(q.total_code)]
+        total["code"] = [code_coding(q.total_code)]
     items.append(total)
     resource: dict[str, Any] = {
         "resourceType": "Questionnaire",
@@ -250,7 +254,7 @@ def fhir_questionnaire(q: Questionnaire, language: str = "en", site: ExportSite 
         "item": items,
     }
     if q.code:
-        resource["code"] = [_coding(q.code)]
+        resource["code"] = [code_coding(q.code)]
     return resource
 
 
@@ -280,14 +284,18 @@ def fhir_device(site: ExportSite) -> dict[str, Any]:
     }
 
 
-def _patient(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
+def patient_reference(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
     return {"type": "Patient", "identifier": {"system": site.patient_system, "value": stored.patient_id}}
 
 
 def _related_person(site: ExportSite, stored: StoredSession) -> dict[str, Any]:
     """The person who answered for the patient (R4 RelatedPerson: ``patient`` is required; its
     ``relationship`` is the answerer the session logged, coded where the kiosk has a code)."""
-    related: dict[str, Any] = {"resourceType": "RelatedPerson", "id": "answerer", "patient": _patient(site, stored)}
+    related: dict[str, Any] = {
+        "resourceType": "RelatedPerson",
+        "id": "answerer",
+        "patient": patient_reference(site, stored),
+    }
     who = answerer_of(stored.log)
     if who is not None:
         code = who.code
@@ -366,10 +374,10 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
         "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
         "questionnaire": f"{questionnaire_canonical(q, site, language)}|{questionnaire_version(q)}",
         "status": response_status(r),
-        "subject": _patient(site, stored),
+        "subject": patient_reference(site, stored),
         "authored": _authored(r),
         "author": device_reference(site),
-        "source": _patient(site, stored),
+        "source": patient_reference(site, stored),
     }
     if stored.answered_by.value != "patient":  # who answered, and how they are related, as a contained RelatedPerson
         resource["contained"] = [_related_person(site, stored)]
@@ -378,14 +386,16 @@ def response_of(q: Questionnaire, r: Result, site: ExportSite) -> dict[str, Any]
         resource["item"] = items
     if r.final:
         resource["extension"] = [_signature(r.review)]
-    return _labelled(resource, stored)
+        if not r.complete:
+            resource["extension"].append({"url": INCOMPLETE, "valueString": r.incomplete_words})
+    return labelled(resource, stored)
 
 
 #: how the visit began (kiosk.core.visits), as a meta tag: "order", "staff" or "walk-up"
 VISIT_SYSTEM = "urn:barthel-kiosk:visit"
 
 
-def _labelled(resource: dict[str, Any], stored: StoredSession) -> dict[str, Any]:
+def labelled(resource: dict[str, Any], stored: StoredSession) -> dict[str, Any]:
     meta: dict[str, Any] = {}
     if stored.simulated:
         meta["security"] = [TEST_DATA]
@@ -408,87 +418,3 @@ def _signature(review: Review) -> dict[str, Any]:
             "who": practitioner(review.signed_by, review.staff_system),
         },
     }
-
-
-def observation_status(r: Result) -> str:
-    """``preliminary`` until a clinician signs off; then ``final``, or ``amended`` with corrections."""
-    return {ReviewState.AMENDED: "amended", ReviewState.SIGNED_OFF: "final"}.get(r.state, "preliminary")
-
-
-def fhir_total(
-    q: Questionnaire,
-    stored: StoredSession,
-    review: Review | None = None,
-    site: ExportSite | None = None,
-    values: Mapping[str, float] | None = None,
-) -> dict[str, Any] | None:
-    """The total as an R4 Observation (coded with the instrument's ``total_code``, the Barthel's
-    LOINC 96761-2) derived from the response; None when the result is incomplete, so a partial sum
-    is never charted as a total."""
-    site = site or ExportSite()
-    response = {
-        "type": "QuestionnaireResponse",
-        "identifier": {"system": site.identifier_system, "value": site.result_id(stored.id)},
-    }
-    return total_of(q, result(q, stored, review, values), site, response)
-
-
-def total_of(q: Questionnaire, r: Result, site: ExportSite, response: dict[str, Any]) -> dict[str, Any] | None:
-    """A :class:`Result`'s total as an Observation derived from ``response`` (a Reference); None
-    when incomplete."""
-    if not r.complete or q.total_code is None:
-        return None
-    stored, language = r.stored, r.stored.language
-    observation: dict[str, Any] = {
-        "resourceType": "Observation",
-        "language": language,
-        "identifier": [{"system": site.identifier_system, "value": site.result_id(stored.id) + "/total"}],
-        "status": observation_status(r),
-        "category": [{"coding": [SURVEY]}],
-        "code": {
-            "coding": [_coding(q.total_code)],
-            "text": f"{q.title[language]}: {TOTAL_TEXT.get(language, 'Total')}",
-        },
-        "subject": _patient(site, stored),
-        "effectiveDateTime": instant(stored.finished_at or stored.started_at),
-        "device": device_reference(site),
-        "derivedFrom": [response],
-        "valueQuantity": {
-            "value": r.score.total,
-            "unit": "{score}",
-            "system": "http://unitsofmeasure.org",
-            "code": "{score}",
-        },
-    }
-    components = subscale_components(q, r, language)
-    if components:
-        observation["component"] = components
-    band_set = q.bands_named(r.score.band_set)
-    if r.score.band is not None:
-        observation["interpretation"] = [
-            {
-                "coding": [
-                    {
-                        # the instrument's id too: two instruments' "normal" bands are not one code
-                        "system": f"urn:barthel-kiosk:band-set:{q.id}:{band_set.id}",
-                        "code": r.score.band.id,
-                        "display": r.score.band.label["en"],
-                    }
-                ],
-                "text": f"{r.score.band.label[language]} ({band_set.id}: {band_set.source})",
-            }
-        ]
-    if r.final:
-        observation["issued"] = instant(r.review.signed_at or "")
-        observation["performer"] = [practitioner(r.review.signed_by or "", r.review.staff_system)]
-    notes = [
-        {
-            "authorString": c.author,
-            "time": instant(c.at),
-            "text": f"{c.item_id}: option {c.previous_option or 'none'} -> {c.option} ({c.reason})",
-        }
-        for c in r.review.corrections
-    ]
-    if notes:
-        observation["note"] = notes
-    return _labelled(observation, stored)

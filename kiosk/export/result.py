@@ -126,6 +126,12 @@ class Result:
         return next((a.option for a in self.stored.answers if a.item_id == item_id), None)
 
     @property
+    def incomplete_words(self) -> str:
+        """A result signed off incomplete, in words: what it lacks and the doctor's reason."""
+        reason = self.review.incomplete or "no reason recorded (signed off before a reason was required)"
+        return f"signed off incomplete ({self.pending}): {reason}"
+
+    @property
     def answered_points(self) -> int:
         """Points of the answered items: the total only when complete."""
         return self.score.total

@@ -20,6 +20,7 @@ from kiosk.core.answerers import answerer_of
 from kiosk.core.questionnaire import Questionnaire, result_words
 from kiosk.core.review import Review
 from kiosk.core.site import ExportSite
+from kiosk.core.staff import number_text
 from kiosk.core.visits import visit_of
 from kiosk.export.result import (
     TOTAL_LINK,
@@ -73,6 +74,11 @@ CSV_COLUMNS = [
     "questionnaire",
     # how the person who answered for the patient is related to them (kiosk.core.answerers)
     "answerer",
+    # a number staff entered (an ``input:`` item) as entered, and its UCUM unit
+    "value",
+    "unit",
+    # a result signed off with items unanswered: the doctor's reason (blank otherwise)
+    "incomplete_reason",
 ]
 
 
@@ -104,6 +110,7 @@ def _session_columns(q: Questionnaire, r: Result, site: ExportSite) -> dict[str,
         # how the visit began (kiosk.core.visits): "order <id>", "staff", "walk-up"; blank before visits existed
         "visit": visit_of(stored.log) or "",
         "answerer": who.display if (who := answerer_of(stored.log)) is not None else "",
+        "incomplete_reason": r.review.incomplete if r.final and not r.complete else "",
     }
 
 
@@ -122,10 +129,16 @@ def csv_text(
     bom: bool = False,
 ) -> str:
     """The long CSV (see :data:`CSV_COLUMNS`) of sessions with their reviews (None: unreviewed)."""
+    return result_rows(q, results(q, sessions, reviews), site, bom=bom)
+
+
+def result_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None = None, *, bom: bool = False) -> str:
+    """The long CSV of :class:`Result`s (what :func:`csv_text` writes, and the station for a
+    result it described with the numbers staff entered there)."""
     site = site or ExportSite()
     out = io.StringIO()
     writer = _writer(out, CSV_COLUMNS)
-    for r in results(q, sessions, reviews):
+    for r in rs:
         stored = r.stored
         common = _session_columns(q, r, site)
         for record, outcome in zip(stored.practice, practice_outcomes(q, stored)):
@@ -146,6 +159,13 @@ def csv_text(
         for item in q.items:
             row = common | {"item": item.id, "kind": "item", "answered_by": ""}
             number = r.options.get(item.id)
+            if item.entry is not None and item.id in r.values:
+                unit = item.entry.unit or ""
+                text = number_text(r.values[item.id])
+                writer.writerow(
+                    row | {"label": f"{text} {unit}".strip(), "value": text, "unit": unit, "answered_by": "staff"}
+                )
+                continue
             if number is None:
                 writer.writerow(row | {"label": "not answered"})
                 continue
@@ -185,7 +205,8 @@ def csv_text(
 
 
 def wide_columns(q: Questionnaire) -> list[str]:
-    """The wide CSV's columns: the session's, then each item's option number and points."""
+    """The wide CSV's columns: the session's, then each item's option number and points (for a
+    number staff enter, its ``_value`` as entered)."""
     return [
         "session",
         "patient",
@@ -209,7 +230,12 @@ def wide_columns(q: Questionnaire) -> list[str]:
         "missing",
         "band",
         "band_set",
-    ] + [f"{item.id}_{part}" for item in q.items for part in ("option", "points")]
+        "incomplete_reason",
+    ] + [
+        f"{item.id}_{part}"
+        for item in q.items
+        for part in (("value",) if item.entry is not None else ("option", "points"))
+    ]
 
 
 def wide_csv_text(
@@ -222,10 +248,15 @@ def wide_csv_text(
 ) -> str:
     """One row per session (see :func:`wide_columns`): ``total`` only when complete, the points of
     the answered items apart in ``answered_points`` and the unanswered items in ``missing``."""
+    return wide_rows(q, results(q, sessions, reviews), site, bom=bom)
+
+
+def wide_rows(q: Questionnaire, rs: Sequence[Result], site: ExportSite | None = None, *, bom: bool = False) -> str:
+    """The wide CSV of :class:`Result`s (see :func:`wide_csv_text`)."""
     site = site or ExportSite()
     out = io.StringIO()
     writer = _writer(out, wide_columns(q))
-    for r in results(q, sessions, reviews):
+    for r in rs:
         row: dict[str, Any] = _session_columns(q, r, site) | {
             "signed_by": r.review.signed_by or "",
             "signed_at": r.review.signed_at or "",
@@ -237,7 +268,9 @@ def wide_csv_text(
         }
         for item in q.items:
             number = r.options.get(item.id)
-            if number is not None:
+            if item.entry is not None and item.id in r.values:
+                row[f"{item.id}_value"] = number_text(r.values[item.id])
+            elif number is not None:
                 row |= {f"{item.id}_option": number, f"{item.id}_points": item.option(number).points}
         writer.writerow(row)
     return ("\ufeff" if bom else "") + out.getvalue()

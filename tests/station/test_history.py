@@ -49,7 +49,7 @@ def test_waiting_count_is_stored_with_each_change(engine, template) -> None:
     _load(engine, template)
     assert results.waiting_count(engine) == 6
     doctor = auth.User("dr.lopez", "doctor")
-    validation.sign_off(engine, "history-0000011", doctor)
+    validation.sign_off(engine, "history-0000011", doctor, incomplete="a generated result with a gap")
     assert results.waiting_count(engine) == 5
     validation.amend(engine, "history-0000000", "new information", doctor)
     assert results.waiting_count(engine) == 6

@@ -12,7 +12,7 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable
 
 from kiosk.core.questionnaire import result_words
-from kiosk.core.staff import entered_values
+from kiosk.core.staff import entered_values, number_text
 from kiosk.export import ExportError, csv_text, fhir_response, practice_outcomes, rescore, write_json, write_private
 from kiosk.export.captured import questionnaire_of, site_of
 from kiosk.store.database import StoredSession
@@ -111,7 +111,7 @@ class SessionDetailScreen(ClinicianScreen):
         for item in q.items:
             a = answers.get(item.id)
             if a is None and item.id in values and item.entry is not None:
-                entered = f"{values[item.id]:g} {item.entry.unit}".strip()
+                entered = f"{number_text(values[item.id])} {item.entry.unit}".strip()
                 table.add_row(*map(cell, (item.number, item.id, "", entered, "", "", "staff")))
             elif a is None:
                 outcome = "not answered" if item.id in self.stored.not_answered else "-"

@@ -161,7 +161,12 @@ def test_a_sign_off_of_an_incomplete_result_stays_without_a_total(replayed):
     response = fhir_response(QUESTIONNAIRE, replayed["TB-0006"], signed(), SITE)
     check_fhir(response)
     assert response["status"] == "stopped" and total_answer(response) is None
-    assert fhir_total(QUESTIONNAIRE, replayed["TB-0006"], signed(), SITE) is None
+    # a final Observation without a value, saying why (R4 obs-6), never a partial sum
+    total = fhir_total(QUESTIONNAIRE, replayed["TB-0006"], signed(), SITE)
+    check_fhir(total)
+    assert total["status"] == "final" and "valueQuantity" not in total and "interpretation" not in total
+    assert total["dataAbsentReason"]["coding"][0]["code"] == "unknown"
+    assert total["dataAbsentReason"]["text"].startswith("signed off incomplete (not answered: ")
 
 
 def test_responses_match_their_questionnaire_word_for_word_in_every_language(replayed):

@@ -17,7 +17,8 @@ from kiosk.core.questionnaire import evaluate
 from kiosk.core.session import Answer, AnsweredBy
 from kiosk.export import ExportSite, fhir_questionnaire, result
 from kiosk.export.calculated import ANSWERED_BY, CALCULATED, MAX_VALUE, MIN_VALUE, UNIT
-from kiosk.export.fhir import response_of, total_of
+from kiosk.export.fhir import response_of
+from kiosk.export.total import total_of
 from kiosk.store.records import StoredSession
 from tests.kiosk.core.instruments_v2 import GDS, MEASURED, MIXED, STAFFED, STOOD_IN, load
 from tests.prerequisites import JS, ensure_npm_packages
