@@ -8,11 +8,13 @@ calls them on its own thread (a command arrives on the client's thread and is ha
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from kiosk.core.room import STAFF_NOTICE
 from kiosk.core.session import Phase, Session
-from kiosk.sync.client import Outcome
+
+if TYPE_CHECKING:  # the client (http.client, threads) is not imported with the live status
+    from kiosk.sync.client import Outcome
 
 
 class Kiosk(Protocol):

@@ -230,29 +230,81 @@ def make_kiosk(
 def _station(config: Config, parts: KioskParts, store: Store, app: Callable[[], KioskApp]) -> tuple[Any, Any, Any]:
     """The ward station's client, the watcher of this kiosk's ordered visits and the call that
     starts one with its code; (None, None, None) without a station (staff then start visits on
-    the clinician screen). Both report to the app from their own threads."""
+    the clinician screen). Both report to the app from their own threads. The client and the
+    watcher are built when the app starts them, after the welcome is drawn (:class:`LateStart`):
+    their modules (``http.client``, the outbox) are not imported before it."""
     station = config.station
     if station is None:
         return None, None, None
-    from kiosk.sync import SyncClient
-    from kiosk.sync.http import Station
-    from kiosk.sync.orders import OrderWatcher, held_orders, start_order
-
-    client = SyncClient(
-        store.path,
-        url=station.url,
-        token=station.token,
-        kiosk_id=station.kiosk_id,
-        on_command=lambda command: app().station_command(command),
-    )
-    store.on_outbox = client.wake
     instruments, languages = parts.ids, parts.languages
-    watcher = OrderWatcher(
-        Station(station.url, station.token),
-        instruments=instruments,
-        languages=languages,
-        on_orders=lambda *found: app().call_from_thread(app().controller.orders_changed, *found),
-        held=lambda: held_orders(store.path),
-    )
-    starter = Station(station.url, station.token)
-    return client, watcher, lambda code: start_order(starter, code, instruments=instruments, languages=languages)
+
+    def client() -> Any:
+        from kiosk.sync.client import SyncClient
+
+        made = SyncClient(
+            store.path,
+            url=station.url,
+            token=station.token,
+            kiosk_id=station.kiosk_id,
+            on_command=lambda command: app().station_command(command),
+        )
+        store.on_outbox = made.wake
+        return made
+
+    def watcher() -> Any:
+        from kiosk.sync.http import Station
+        from kiosk.sync.orders import OrderWatcher, held_orders
+
+        return OrderWatcher(
+            Station(station.url, station.token),
+            instruments=instruments,
+            languages=languages,
+            on_orders=lambda *found: app().call_from_thread(app().controller.orders_changed, *found),
+            held=lambda: held_orders(store.path),
+        )
+
+    def start(code: str) -> Any:
+        from kiosk.sync.http import Station
+        from kiosk.sync.orders import start_order
+
+        return start_order(Station(station.url, station.token), code, instruments=instruments, languages=languages)
+
+    return LateStart(client), LateStart(watcher), start
+
+
+class LateStart:
+    """A station part (client or order watcher) built by ``make()`` when first started or asked
+    for anything else; before that a status is held for it (the client sends it once started) and
+    a stop stops nothing. The client delivers what the outbox holds as soon as it starts."""
+
+    def __init__(self, make: Callable[[], Any]) -> None:
+        self._make = make
+        self._made: Any = None
+        self._status: Any = None
+
+    def _part(self) -> Any:
+        if self._made is None:
+            self._made = self._make()
+            if self._status is not None:
+                self._made.set_status(self._status)
+        return self._made
+
+    def start(self) -> None:
+        self._part().start()
+
+    def stop(self) -> None:
+        if self._made is not None:
+            self._made.stop()
+
+    def set_status(self, status: Any) -> None:
+        if self._made is None:
+            self._status = status
+        else:
+            self._made.set_status(status)
+
+    def wake(self, alert: bool = False) -> None:
+        if self._made is not None:
+            self._made.wake(alert)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._part(), name)

@@ -80,9 +80,9 @@ NOT_WHILE_BUILDING = (
 )
 
 
-def _run(tmp_path, body: str) -> dict[str, Any]:
+def _run(tmp_path, body: str, more: str = "") -> dict[str, Any]:
     config = tmp_path / "config.yaml"
-    config.write_text(f"data_dir: {tmp_path / 'data'}\n")
+    config.write_text(f"data_dir: {tmp_path / 'data'}\n{more}")
     code = textwrap.dedent(
         f"""
         import asyncio, json, sys
@@ -126,6 +126,43 @@ def test_the_welcome_is_drawn_before_exports_plots_and_the_station_are_imported(
         m for m in modules if m.split(".")[0] in NOT_BEFORE_THE_WELCOME or m.startswith(NOT_BEFORE_THE_WELCOME)
     )
     assert early == []
+
+
+#: a ward kiosk's client of the station is built after the welcome is drawn (issue 32, part 7)
+NOT_BEFORE_A_WARD_WELCOME = ("kiosk.sync.client", "kiosk.sync.http", "kiosk.sync.orders", "kiosk.sync.outbox", "http")
+
+
+def test_a_ward_kiosk_draws_its_welcome_before_it_imports_the_station_client(tmp_path):
+    import socket
+
+    with socket.socket() as sock:  # a port nothing listens on
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    station = f'station: {{url: "http://127.0.0.1:{port}", token: "t0123456789abcdef", kiosk_id: bed1}}\n'
+    found = _run(
+        tmp_path,
+        """
+        app, close = build_app(config_path=config, voice=False, remote=False)
+
+        async def welcome():
+            async with app.run_test(size=KIOSK_SIZE) as pilot:
+                while not (type(app.screen).__name__ == "WelcomeScreen" and app.screen.query("Button")):
+                    await pilot.pause()
+                early = sorted(sys.modules)
+                while "kiosk.sync.client" not in sys.modules:  # started once the welcome is drawn
+                    await pilot.pause()
+                return early, type(app.controller.sync.station).__name__
+
+        try:
+            early, station = asyncio.run(welcome())
+        finally:
+            close()
+        print(json.dumps({"early": early, "station": station}))
+        """,
+        more=station,
+    )
+    assert found["station"] == "Station"
+    assert sorted(m for m in found["early"] if m.split(".")[0] == "http" or m in NOT_BEFORE_A_WARD_WELCOME) == []
 
 
 def test_building_the_kiosk_with_voice_and_remotes_loads_no_speech_stack(tmp_path):
