@@ -209,6 +209,9 @@ def parser() -> Lark:
     Building the LALR tables takes longer than starting Textual, so they are kept between runs in
     the user's cache directory (``<user cache dir>/kiosk/qos``, 0700), keyed by the grammar, lark's
     version and Python's; a missing, stale or unreadable cache only means building them again.
+    A first start (after an install or upgrade) copies the tables shipped beside this module
+    (:data:`SHIPPED_TABLES`, written by :func:`write_shipped_tables`) instead of building them:
+    lark checks their key as it checks its cache's, and builds them on a mismatch.
     """
     options = dict(_OPTIONS, lexer_callbacks={"DESCRIPTION": _keep_description})
     cache = _cache_file()
@@ -221,9 +224,74 @@ def parser() -> Lark:
     try:
         # one process at a time reads, or builds and writes, the cache: none sees half a file
         fcntl.flock(lock, fcntl.LOCK_EX)
+        if not cache.exists():
+            _copy_shipped(cache)
         return Lark(GRAMMAR, cache=str(cache), **options)  # lark checks the key inside, rebuilds on a mismatch
     finally:
         os.close(lock)
+
+
+#: the LALR tables as lark's cache keeps them, shipped with the code (a first start copies them)
+SHIPPED_TABLES = Path(__file__).with_name("roqme-tables.lark")
+
+
+def write_shipped_tables() -> Path:
+    """Build the tables and write them to :data:`SHIPPED_TABLES`, headed by :func:`_tables_key`
+    (after the grammar, lark or the Python changes:
+    ``uv run python -c "import qos.grammar as g; g.write_shipped_tables()"``)."""
+    from lark.lark import _LOAD_ALLOWED_OPTIONS
+
+    built = Lark(GRAMMAR, **dict(_OPTIONS, lexer_callbacks={"DESCRIPTION": _keep_description}))
+    with SHIPPED_TABLES.open("wb") as f:
+        f.write(_tables_key().encode() + b"\n")
+        built.save(f, _LOAD_ALLOWED_OPTIONS)
+    return SHIPPED_TABLES
+
+
+def _tables_key() -> str:
+    """What the tables depend on: the grammar, how it is compiled, lark's version and Python's."""
+    import hashlib
+
+    import lark
+
+    text = f"{GRAMMAR}{sorted(_OPTIONS.items())}{lark.__version__}{sys.version_info[:2]}"
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _copy_shipped(cache: Path) -> None:
+    """Write the shipped tables to ``cache`` as lark keeps its cache (its key for that file, no
+    grammar files to re-check: the key covers lark's own), when they were built for this grammar,
+    lark and Python; lark builds them itself on any mismatch."""
+    import hashlib
+    import pickle
+
+    try:
+        with SHIPPED_TABLES.open("rb") as f:
+            if f.readline().rstrip(b"\n").decode() != _tables_key():
+                return
+            tables = f.read()
+    except (OSError, UnicodeDecodeError):
+        return
+    # lark's cache key (lark.Lark.__init__): the grammar, the options as given, its version, Python's
+    given = {"cache": str(cache), **_OPTIONS}
+    key = hashlib.sha256(
+        (GRAMMAR + "".join(k + str(v) for k, v in given.items()) + _lark_version() + str(sys.version_info[:2])).encode()
+    ).hexdigest()
+    temporary = cache.with_name(f".{cache.name}.{os.getpid()}")
+    try:
+        with temporary.open("wb") as f:
+            f.write(key.encode() + b"\n")
+            pickle.dump({}, f)
+            f.write(tables)
+        os.replace(temporary, cache)
+    except OSError:
+        temporary.unlink(missing_ok=True)
+
+
+def _lark_version() -> str:
+    from lark import __version__
+
+    return __version__
 
 
 def _cache_file() -> Path | None:

@@ -53,3 +53,17 @@ def test_a_cache_directory_others_may_write_is_not_used(cache_home):
     cache_home.chmod(0o777)
     assert _tree().data == "start"  # parsed all the same
     assert list(cache_home.iterdir()) == []
+
+
+def test_a_first_start_takes_the_shipped_tables_without_building_them(cache_home, monkeypatch):
+    assert grammar.SHIPPED_TABLES.read_bytes().split(b"\n", 1)[0].decode() == grammar._tables_key(), (
+        "the grammar, lark or Python changed: run grammar.write_shipped_tables()"
+    )
+    tree_from_shipped = _tree()
+    (kept,) = cache_home.glob("*.lark")
+    copied = kept.read_bytes()
+    assert copied.endswith(grammar.SHIPPED_TABLES.read_bytes().split(b"\n", 1)[1])  # lark did not rebuild it
+    monkeypatch.setattr(grammar, "SHIPPED_TABLES", cache_home / "none.lark")  # nothing shipped: built
+    kept.unlink()
+    assert _tree() == tree_from_shipped
+    assert kept.read_bytes() != copied  # built by lark: its own key and grammar files head it
