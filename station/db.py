@@ -187,6 +187,10 @@ orders = sa.Table(
     sa.Column("ordered_at", sa.String(40), nullable=False),
     sa.Column("session_id", sa.String(64)),
     sa.Column("updated_at", sa.String(40), nullable=False),
+    #: how the person answering is related to the patient (kiosk.core.answerers), None: not said
+    sa.Column("relationship", sa.String(16)),
+    #: the relationship in words, for "other" only (at most 60 characters)
+    sa.Column("relationship_text", sa.String(60)),
 )
 
 #: how each session at the station began: "order" (with its order), "staff" (started by staff at the

@@ -15,6 +15,7 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
+from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
 from station import orders, validation, ward
 from station.api_orders import ORDER_LANE
 from station.redirects import see_other
@@ -44,6 +45,8 @@ async def orders_page(request: Request) -> Response:
         state=state,
         kiosk=kiosk,
         words=orders.WORDS,
+        relationships=list(RELATIONSHIPS),
+        text_max=TEXT_MAX,
         form=dict(request.query_params),
         error=request.query_params.get("error"),
         message=request.query_params.get("message"),
@@ -71,6 +74,8 @@ async def create_order(request: Request) -> Response:
             instruments=chosen,
             language=form.get("language", ""),
             relative=form.get("relative") == "yes",
+            relationship=str(form.get("relationship", "")),
+            relationship_text=str(form.get("relationship_text", "")),
             by=request.state.user,
             known_instruments=list(offered),
             languages=languages,
@@ -82,7 +87,8 @@ async def create_order(request: Request) -> Response:
         # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
         order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
     except orders.OrderError as exc:
-        keep = {k: str(form.get(k, "")) for k in ("kiosk", "patient_id", "language")}
+        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text")
+        keep = {k: str(form.get(k, "")) for k in kept}
         return see_other("/orders", error=str(exc), fields=keep)
     return RedirectResponse(f"/orders/{order.id}", status_code=303)
 

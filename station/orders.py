@@ -3,7 +3,8 @@ way from ``ordered`` to ``signed off``.
 
 An order names the patient by the identifier the hospital gives (pseudonymous: see
 :func:`check_patient_id`), one kiosk, the instruments (a list, so a battery fits; today the
-station's one questionnaire), the language and whether a relative answers. Its states::
+station's one questionnaire), the language, whether a relative answers and, optionally, how the
+person answering is related to the patient (:func:`check_relationship`). Its states::
 
     ordered -> in_progress -> awaiting_validation -> signed_off
        |            |
@@ -30,6 +31,7 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
 from basis import record
+from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
 from kiosk.core.visits import DEFAULT_ID_PATTERN, HOSPITAL_ID
 from kiosk.core.visits import check_patient_id as identifier_problem
 from station import db
@@ -102,6 +104,10 @@ class Order:
     ordered_at: str
     session_id: str | None
     updated_at: str
+    #: how the person answering is related to the patient (kiosk.core.answerers), None: not said
+    relationship: str | None = None
+    #: the relationship in words, for "other" only
+    relationship_text: str | None = None
 
     @classmethod
     def of(cls, row: Any) -> Order:
@@ -117,9 +123,19 @@ class Order:
     def relative(self) -> bool:
         return self.answered_by == "relative"
 
+    @property
+    def answerer(self) -> str:
+        """Who answers, in words: "the patient", "a relative", "their daughter", "other: lodger"."""
+        if self.relationship == "other":
+            return f"other: {self.relationship_text}"
+        if self.relationship:
+            return f"their {self.relationship}"
+        return "a relative" if self.relative else "the patient"
+
     def for_kiosk(self) -> dict[str, Any]:
-        """What the kiosk is told of the order (never the code: staff bring it from the station)."""
-        return {
+        """What the kiosk is told of the order (never the code: staff bring it from the station);
+        ``relationship`` (and, for "other", ``relationship_text``) only when staff said (§4)."""
+        told: dict[str, Any] = {
             "id": self.id,
             "patient_id": self.patient_id,
             "instruments": list(self.instruments),
@@ -128,6 +144,11 @@ class Order:
             "ordered_by": self.ordered_by,
             "ordered_at": self.ordered_at,
         }
+        if self.relationship:
+            told["relationship"] = self.relationship
+            if self.relationship == "other":
+                told["relationship_text"] = self.relationship_text or ""
+        return told
 
 
 def check_patient_id(value: str, pattern: str = DEFAULT_ID_PATTERN) -> str:
@@ -140,6 +161,30 @@ def check_patient_id(value: str, pattern: str = DEFAULT_ID_PATTERN) -> str:
     if problem is not None:
         raise OrderError(f"patient identifier: {problem}")
     return value
+
+
+def check_relationship(relationship: str, text: str) -> tuple[str | None, str | None]:
+    """Who answers for the patient, as the order form gives it: ``(relationship, text)``, both
+    None when not said; OrderError when the relationship is not one of
+    kiosk.core.answerers.RELATIONSHIPS, or the text is given without "other", missing with it,
+    longer than :data:`TEXT_MAX` or more than one line (the kiosk refuses such an order)."""
+    relationship, text = relationship.strip(), text.strip()
+    where = "who answers for the patient"
+    if not relationship:
+        if text:
+            raise OrderError(f'{where}: choose "other" to describe the relationship in words')
+        return None, None
+    if relationship not in RELATIONSHIPS:
+        raise OrderError(f"{where}: {relationship[:40]!r} is not one of {', '.join(RELATIONSHIPS)}")
+    if relationship != "other":
+        if text:
+            raise OrderError(f'{where}: words are only for "other" (you chose {relationship})')
+        return relationship, None
+    if not text:
+        raise OrderError(f'{where}: say in words how they are related to the patient (for "other")')
+    if len(text) > TEXT_MAX or any(ord(c) < 32 for c in text):
+        raise OrderError(f"{where}: the relationship in words must be one line of at most {TEXT_MAX} characters")
+    return relationship, text
 
 
 def audit_order(connection: Connection, order_id: str, author: str, action: str, reason: str) -> None:
@@ -197,12 +242,17 @@ def create(
     known_instruments: Sequence[str],
     languages: Sequence[str],
     id_pattern: str = DEFAULT_ID_PATTERN,
+    relationship: str = "",
+    relationship_text: str = "",
 ) -> Order:
     """Order a visit (a nurse or a doctor) for a patient whose identifier ``id_pattern`` (the
-    site's rule) matches; returns it with its confirmation code."""
+    site's rule) matches; returns it with its confirmation code. A ``relationship``
+    (:func:`check_relationship`) says who answers for the patient, so a relative does."""
     if by.role not in ORDER_ROLES:
         raise OrderError("only nurses and doctors may order a visit")
     patient_id = check_patient_id(patient_id, id_pattern)
+    relationship_code, words = check_relationship(relationship, relationship_text)
+    relative = relative or relationship_code is not None
     chosen = [i for i in dict.fromkeys(instruments) if i]
     if not chosen:
         raise OrderError("instruments: choose at least one")
@@ -249,6 +299,8 @@ def create(
                 ordered_by=by.name,
                 ordered_at=now,
                 updated_at=now,
+                relationship=relationship_code,
+                relationship_text=words,
             )
         )
         audit_order(
@@ -257,7 +309,8 @@ def create(
             by.name,
             "order",
             f"{', '.join(chosen)} for {patient_id} on {kiosk_id} ({language}"
-            f"{', a relative answers' if relative else ''})",
+            f"{', a relative answers' if relative else ''}"
+            f"{f', related: {relationship_code}' if relationship_code else ''}{f': {words}' if words else ''})",
         )
         return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
 
