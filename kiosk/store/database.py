@@ -36,7 +36,7 @@ import sqlite3
 import time
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from kiosk.store.connection import DB_NAME, StorageError, connect
 from kiosk.store.connection import TABLES as _TABLES
@@ -55,7 +55,9 @@ from kiosk.store.records import (
 )
 from kiosk.store.staff_answers import record_staff_answer
 from kiosk.store.transactions import ALERT_EVENTS, Transactions
-from kiosk.store.tug import TugResults
+
+if TYPE_CHECKING:  # its analysis imports numpy: loaded when the store first reads a TUG
+    from kiosk.store.tug import TugResults
 
 __all__ = [
     "ALERT_EVENTS",
@@ -118,8 +120,16 @@ class Store:
             self._tx, owner=owner or Owner(), lease_ttl_s=lease_ttl_s, interrupt_after_s=interrupt_after_s, wall=wall
         )
         self._reader = Reader(connection, path)
-        #: Timed Up and Go results (:mod:`kiosk.store.tug`)
-        self.tug = TugResults(self._tx, connection)
+        self._tug: TugResults | None = None
+
+    @property
+    def tug(self) -> TugResults:
+        """Timed Up and Go results (:mod:`kiosk.store.tug`), loaded on first use (numpy: not at start)."""
+        if self._tug is None:
+            from kiosk.store.tug import TugResults
+
+            self._tug = TugResults(self._tx, self._db)
+        return self._tug
 
     @classmethod
     def open(cls, data_dir: str | Path, create: bool = True, **options: Any) -> Store:
