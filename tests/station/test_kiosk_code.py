@@ -111,15 +111,16 @@ def test_a_kiosk_formula_never_runs_in_the_station(database: str, request, stati
         target=lambda: answered.append(doctor.http.get(f"/sessions/{evil_session}", timeout=PATIENCE_S))
     )
     page_thread.start()
-    health, during = [], []
+    health = []
     while page_thread.is_alive():
         health.append(httpx.get(station.url + "/healthz", timeout=PATIENCE_S))
-        during.append(page_thread.is_alive())  # answered while the page still waited
     page_thread.join()
     assert health and all(h.status_code == 200 for h in health)
-    assert any(during)
+    # the formula language (kiosk.core.questionnaire.formula) refuses a regular expression before
+    # anything runs, so the page answers with why, however long the regex would have taken; the
+    # formula process's time budget stays behind it for whatever the language lets through
     assert answered[0].status_code == 200
-    assert f"took longer than {BUDGET_S:g} s" in answered[0].text
+    assert "runs a regular expression" in answered[0].text
     # and it is not run again: its export answers at once, with no total
     exported = doctor.http.get(f"/sessions/{evil_session}/export.json")
     assert exported.status_code == 200
