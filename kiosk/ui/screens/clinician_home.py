@@ -105,8 +105,9 @@ class ClinicianHomeScreen(ClinicianScreen):
 
     def on_screen_resume(self) -> None:
         """Back from a session's detail, where staff may have entered its staff items: every
-        result is read again."""
+        result is read again, and the list shows it at once rather than at the next refresh."""
         self._results.clear()
+        self._fill_sessions()
 
     def _result(self, s: SessionSummary) -> str:
         """A session's result line, read from the store only when its answers or status changed."""

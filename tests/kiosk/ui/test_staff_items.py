@@ -47,6 +47,10 @@ async def _click(pilot, selector: str) -> None:
     await pilot.click(selector)
 
 
+def _first_row(kiosk) -> list:
+    return kiosk.app.screen.query_one("#sessions", DataTable).get_row_at(0)
+
+
 def _total(kiosk) -> str:
     return text_of(kiosk.app.screen.query_one("#total", Label))
 
@@ -88,8 +92,8 @@ async def test_staff_enter_the_weight_and_the_aid_and_the_result_completes(ui_ki
         assert _total(kiosk).startswith("Total 6 of 9 (complete)")
         await pilot.press("escape")
         await settle(pilot, lambda: screen_name(kiosk) == "ClinicianHomeScreen")
-        row = kiosk.app.screen.query_one("#sessions", DataTable).get_row_at(0)
-        assert row[4].startswith("Total 6 of 9"), row
+        # the list is drawn again on the way back: wait on what it shows, not on a refresh tick
+        await settle(pilot, lambda: str(_first_row(kiosk)[4]).startswith("Total 6 of 9"))
 
     stored = kiosk.store.session(kiosk.session.id)
     aid = _stored(kiosk, "aid")
