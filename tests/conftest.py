@@ -18,6 +18,9 @@ from tests.prerequisites import DEVELOPER_HOME, ensure_npm_packages, require_deb
 SEALED_PREFIXES = ("KIOSK_", "TEXTUAL", "PG")
 #: the tests' own switches, which a developer sets on purpose
 KEPT = frozenset({"KIOSK_E2E_SCREENSHOT"})
+#: what the run's controller hands its xdist workers (pytest-textual-snapshot's report folder, set
+#: in the controller after it cleared the developer's own): kept in a worker, cleared elsewhere
+FROM_CONTROLLER = frozenset({"TEXTUAL_SNAPSHOT_TEMPDIR"})
 #: the user directories platformdirs (data, configuration, cache, models) and Chromium derive from
 USER_DIRS = ("HOME", "XDG_CACHE_HOME", "XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_STATE_HOME")
 
@@ -34,8 +37,9 @@ def pytest_configure(config: pytest.Config) -> None:
     folder = tempfile.mkdtemp(prefix="kiosk-tests-home-")
     seal = pytest.MonkeyPatch()
     seal.setenv(DEVELOPER_HOME, os.environ.get(DEVELOPER_HOME) or str(Path.home()))  # xdist's workers inherit it
+    kept = KEPT | FROM_CONTROLLER if os.environ.get("PYTEST_XDIST_WORKER") else KEPT
     for name in list(os.environ):
-        if name.startswith(SEALED_PREFIXES) and name not in KEPT:
+        if name.startswith(SEALED_PREFIXES) and name not in kept:
             seal.delenv(name)
     seal.delenv("XDG_RUNTIME_DIR", raising=False)
     for name in USER_DIRS:
