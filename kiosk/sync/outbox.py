@@ -53,9 +53,10 @@ class Outbox:
         """Close this connection."""
         self._db.close()
 
-    def pending(self, limit: int, alerts_only: bool = False) -> list[Row]:
-        """Up to ``limit`` rows not yet delivered nor parked, in ``seq`` order."""
-        where = "parked IS NULL" + (" AND alert = 1" if alerts_only else "")
+    def pending(self, limit: int, alerts_only: bool = False, routine_only: bool = False) -> list[Row]:
+        """Up to ``limit`` rows not yet delivered nor parked, in ``seq`` order (only the alerts, or
+        only the other rows, when asked)."""
+        where = "parked IS NULL" + (" AND alert = 1" if alerts_only else " AND alert = 0" if routine_only else "")
         rows = self._db.execute(
             f"SELECT seq, kind, session_id, payload, at, alert FROM outbox WHERE {where} ORDER BY seq LIMIT ?", (limit,)
         ).fetchall()

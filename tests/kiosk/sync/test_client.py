@@ -99,6 +99,36 @@ def test_a_station_down_then_up_gets_everything_once_with_the_alerts_first(tmp_p
         server.stop()
 
 
+def test_a_doctor_call_does_not_wait_for_a_routine_batch_the_station_is_slow_to_store(tmp_path):
+    """Under load a batch of 500 rows can take the station seconds; the call goes meanwhile."""
+    store = Store.open(tmp_path, outbox=True)
+    server = Server().start()
+    server.ward.hold_kind = "create_session"  # the first routine batch hangs at the station
+    sync = client(store, server)
+    sync.start()
+    try:
+        rig = at_first_question(store, patient_id="P-SYNC02")
+        server.until(lambda w: w.held, "the routine batch arrive")
+        rig.answer(2)
+        rig.at(rig.session.now() + 3)
+        rig.session.call_doctor()
+        call = next(seq for seq, kind, json in outbox_rows(store) if kind == "record_event" and "doctor_called" in json)
+        server.until(lambda w: (KIOSK, call) in w.stored, "the doctor call while the batch was held")
+        # stored while the routine batch was still held, its request not given up (the client's
+        # request timeout is 15 s; before the alerts' own lane the call went only after it)
+        assert (len(server.ward.held), server.ward.abandoned) == (1, 0)
+        everything = {seq for seq, _, _ in outbox_rows(store)}
+        server.ward.release.set()
+        server.until(lambda w: {s for _, s in w.stored} >= everything, "every row once the station caught up")
+        sent = [seq for request in server.ward.requests for seq in request]
+        assert sent.count(call) == 1  # the call went once, on its own lane
+        server.until(lambda w: not waiting(store), "the outbox emptied")
+    finally:
+        server.ward.release.set()
+        sync.stop()
+        server.stop()
+
+
 @pytest.mark.parametrize("fault", ["dropped after storing", "500s"])
 def test_a_connection_cut_after_the_station_stored_or_a_500_loses_and_duplicates_nothing(tmp_path, fault):
     store = Store.open(tmp_path, outbox=True)

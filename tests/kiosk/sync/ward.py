@@ -9,6 +9,7 @@ faults a real station cannot be made to produce on cue."""
 from __future__ import annotations
 
 import json
+import select
 import socket
 import threading
 import time
@@ -35,8 +36,24 @@ class Ward:
         self.drop_after_store = 0
         self.fail_500 = 0
         self.refuse: set[int] = set()
+        #: a slow station: a batch holding a row of this kind waits until ``release`` is set
+        self.hold_kind: str | None = None
+        self.release = threading.Event()
+        #: seqs of the batches held, and how many of them the client gave up waiting for
+        self.held: list[list[int]] = []
+        self.abandoned = 0
 
-    def sync(self, body: dict[str, Any]) -> tuple[int, dict[str, Any] | None]:
+    def sync(self, body: dict[str, Any], gone: Any = lambda: False) -> tuple[int, dict[str, Any] | None]:
+        if self.hold_kind is not None and any(e["kind"] == self.hold_kind for e in body["events"]):
+            with self.lock:
+                self.held.append([e["seq"] for e in body["events"]])
+                self.lock.notify_all()
+            while not self.release.wait(0.05):
+                if gone():  # the client closed the connection: it gave this request up
+                    with self.lock:
+                        self.abandoned += 1
+                        self.lock.notify_all()
+                    return 0, None
         with self.lock:
             seqs = [e["seq"] for e in body["events"]]
             self.requests.append(seqs)
@@ -92,6 +109,11 @@ class Handler(BaseHTTPRequestHandler):
         self.end_headers()
         self.wfile.write(data)
 
+    def _gone(self) -> bool:
+        """Whether the client closed this connection (its end read as end-of-file)."""
+        ready, _, _ = select.select([self.connection], [], [], 0)
+        return bool(ready) and self.connection.recv(1, socket.MSG_PEEK) == b""
+
     def _authorised(self) -> bool:
         if self.headers.get("Authorization") != f"Bearer {TOKEN}":
             self._reply(401, {"error": "unknown or revoked kiosk token"})
@@ -104,7 +126,7 @@ class Handler(BaseHTTPRequestHandler):
         body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
         path = urlsplit(self.path).path
         if path == "/api/v1/sync":
-            self._reply(*self.ward.sync(body))
+            self._reply(*self.ward.sync(body, self._gone))
         elif path == "/api/v1/status":
             with self.ward.lock:
                 self.ward.statuses.append(body)
