@@ -83,7 +83,7 @@ def _in_worker(request: Request, work: Any, urgent: bool = False, status: str | 
     def run() -> Any:
         if token is None:
             raise _Unauthorised
-        with bus.transaction() as (connection, messages):
+        with bus.transaction(urgent) as (connection, messages):
             kiosk = auth.touch_kiosk(connection, token, status)
             if kiosk is None:
                 raise _Unauthorised

@@ -22,6 +22,7 @@ import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
 from station.db import is_postgres
+from station.write_gate import WriteGate
 
 CHANNEL = "station"
 log = logging.getLogger("station.bus")
@@ -41,6 +42,8 @@ class Bus:
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
         self._listening = threading.Event()
+        #: SQLite's one writer at a time, alerts first (none on PostgreSQL)
+        self._gate = None if is_postgres(engine) else WriteGate()
 
     # -- lifecycle -------------------------------------------------------------------------------
 
@@ -60,12 +63,14 @@ class Bus:
     # -- publishing ------------------------------------------------------------------------------
 
     @contextlib.contextmanager
-    def transaction(self) -> Iterator[tuple[Connection, list[dict[str, Any]]]]:
+    def transaction(self, urgent: bool = False) -> Iterator[tuple[Connection, list[dict[str, Any]]]]:
         """A write transaction and the list of messages to publish if it commits: on PostgreSQL
         they are NOTIFYed in the transaction itself (sent by the commit, never without it), on
-        SQLite delivered right after the commit."""
+        SQLite delivered right after the commit. On SQLite an ``urgent`` one (alerts) is begun
+        before every routine one waiting (:mod:`station.write_gate`)."""
         messages: list[dict[str, Any]] = []
-        with self._engine.begin() as connection:
+        gate = self._gate.held(urgent) if self._gate is not None else contextlib.nullcontext()
+        with gate, self._engine.begin() as connection:
             yield connection, messages
             if is_postgres(self._engine):
                 for message in messages:
