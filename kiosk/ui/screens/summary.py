@@ -19,8 +19,9 @@ class SummaryScreen(PatientScreen):
     NOTICES = False
 
     def progress_text(self, view: PatientView) -> str:
-        """The title: the questions are over."""
-        return view.questionnaire.title.get(self.language, "")
+        """The title the patient saw all along (the plain one: "Questions about how you feel",
+        never the clinical "Geriatric Depression Scale"): the questions are over."""
+        return view.questionnaire.title_for_patient(self.language)
 
     def compose(self) -> ComposeResult:
         """Bars, thanks, the total and band."""

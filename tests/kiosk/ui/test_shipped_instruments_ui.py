@@ -52,6 +52,9 @@ async def test_gds15_in_german_by_keys_scores_as_published(monkeypatch, ui_kiosk
         assert "epress" not in drawn_text(kiosk.app)
         # "Ja" to every question: one point on each item scored on Yes (10 of the 15)
         await _answer_all(kiosk, pilot, lambda item: 1, drawn=("Ja", "Nein"))
+        # the end screen keeps the plain title, not the clinical one (the band is staff's words)
+        await until_drawn(pilot, "Fragen zu Ihrem Befinden")
+        assert kiosk.questionnaire.title["de"] not in drawn_text(kiosk.app)
     score = kiosk.session.score()
     assert (score.total, score.band.id) == (10, "suggests_depression")
 
