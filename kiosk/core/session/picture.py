@@ -44,4 +44,5 @@ def picture(state: SessionState, timers: AttemptClock, *, progress: Mapping[str,
         can_undo=can_undo and not timers.frozen and state.call is None,
         unattended=state.unattended,
         calling=state.call.text if state.call is not None else None,
+        practice_chosen=open_.chosen if open_ and open_.practice else None,
     )

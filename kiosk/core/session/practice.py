@@ -110,6 +110,7 @@ class Practice:
         open_ = self.state.open
         assert open_ is not None and event.option is not None
         open_.outcome = "answered"
+        open_.chosen = event.option
         self.timers.cancel()
         question = self.state.questionnaire.familiarisation[open_.index]
         correct = event.option == question.expected

@@ -70,3 +70,6 @@ class Snapshot:
     #: "Shall I call the nurse?" (its text) while a call heard by voice waits for Yes or No
     #: (options 1 and 2); None otherwise
     calling: str | None = None
+    #: the option chosen for the practice question on screen (shown chosen, as a scored answer
+    #: is, until the next question opens); None before an answer and outside practice
+    practice_chosen: int | None = None

@@ -65,6 +65,8 @@ class OpenQuestion:
     correcting: bool = False
     #: practice: the message that answered it ("practice_right"/"practice_wrong"), shown meanwhile
     feedback: str | None = None
+    #: practice: the option the patient chose, shown chosen until the next question opens
+    chosen: int | None = None
 
 
 @record

@@ -57,6 +57,8 @@ class FamiliarisationScreen(PatientScreen):
             line.display = bool(feedback or intro)
         for heading in self.query("#practice-intro").results(Static):
             heading.update(self._intro(view))
+        for panel in self.query(QuestionPanel):  # the answer given stays marked, as on a question
+            panel.mark_chosen(snap.practice_chosen)
 
     def _intro(self, view: PatientView) -> str:
         """ "First, a few practice questions…": the questionnaire's words, which promise a hearing

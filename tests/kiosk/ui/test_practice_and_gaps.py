@@ -45,8 +45,12 @@ async def test_a_kiosk_without_voice_out_never_asks_which_word_was_heard(ui_kios
         kiosk.to_next_deadline()
         await settle(pilot, lambda: _question_text(kiosk) == "Please choose answer number 3.")
         assert _progress(kiosk) == "Practice 2 of 2"
+        assert not kiosk.app.screen.query(".-chosen")  # nothing marked before an answer
         await pilot.press("3")
         await settle(pilot, lambda: _interlude(kiosk) == "Well done.")
+        # the practice answer is shown chosen, as a real one is, until the next screen
+        await settle(pilot, lambda: kiosk.app.screen.query_one("#answer-3").has_class("-chosen"))
+        assert [b.id for b in kiosk.app.screen.query(".-chosen")] == ["answer-3"]
         kiosk.to_next_deadline()
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
     outcomes = [(p.question_id, p.outcome, p.detail) for p in kiosk.store.session(kiosk.session.id).practice]
