@@ -3,6 +3,12 @@ or waiting visit over calendar time, with the questionnaire's bands shaded behin
 the instrument's own total range (:attr:`Questionnaire.total_range`: 0-15, 0-8, -10-30...), so each
 instrument plots on its own scale.
 
+A band is coloured by what it says about the patient, as the instrument declares it (a band's
+``concern``: none, low, moderate, high), never by its place in the list: before, the first band
+was red, so a normal GDS-15 and a fully independent Lawton sat on red. A band that declares
+nothing (the Lawton's "no cut-off", or a file that does not say) is grey. A legend under the
+plot names each band in words with its range and colour.
+
 Steps, not lines: a total holds until the next visit measures it again, and a line between visits
 would invent values nobody measured. Incomplete visits have no total and are not drawn; a visit
 whose result is not yet signed off is drawn hollow. Everything is escaped.
@@ -13,12 +19,27 @@ from __future__ import annotations
 from datetime import datetime
 from html import escape
 
-from kiosk.core.questionnaire import Questionnaire
+from kiosk.core.questionnaire import Band, Questionnaire
 from station.results import Result
 
 WIDTH, HEIGHT = 480, 220
 LEFT, RIGHT, TOP, BOTTOM = 44, 16, 12, 34
-BAND_FILLS = ("#fde8e7", "#fff1d6", "#fff7d6", "#eaf5e4", "#dff0e6")
+#: a band's fill by its declared concern (None: declared nothing)
+CONCERN_FILLS = {
+    "none": "#dff0e6",
+    "low": "#fff7d6",
+    "moderate": "#ffe6c7",
+    "high": "#fde2e0",
+    None: "#eef0f3",
+}
+#: the legend's words for each concern
+CONCERN_WORDS = {
+    "none": "no concern",
+    "low": "low concern",
+    "moderate": "moderate concern",
+    "high": "high concern",
+    None: "not graded by the instrument",
+}
 
 
 def _when(result: Result) -> datetime:
@@ -52,14 +73,16 @@ def course_svg(q: Questionnaire, results: list[Result]) -> str:
         f'<svg class="course-plot" viewBox="0 0 {WIDTH} {HEIGHT}" role="img" '
         f'aria-label="{escape(name)} totals over time" xmlns="http://www.w3.org/2000/svg">'
     ]
-    for index, band in enumerate(q.bands_named(None).bands):
+    bands = q.bands_named(None).bands
+    for band in bands:
         if band.max < low or band.min > high:
             continue
         y1, y2 = y(min(band.max + 0.5, high)), y(max(band.min - 0.5, low))
         parts.append(
             f'<rect x="{LEFT}" y="{max(TOP, y1):.1f}" width="{plot_w}" '
             f'height="{max(0.0, min(TOP + plot_h, y2) - max(TOP, y1)):.1f}" '
-            f'fill="{BAND_FILLS[index % len(BAND_FILLS)]}"><title>{escape(band.id)}</title></rect>'
+            f'fill="{CONCERN_FILLS[band.concern]}" class="band band-{band.concern or "undeclared"}">'
+            f"<title>{escape(_band_words(band))}</title></rect>"
         )
     for tick in sorted({low, (low + high) // 2, high}):
         parts.append(f'<text x="{LEFT - 6}" y="{y(tick) + 4:.1f}" text-anchor="end">{tick}</text>')
@@ -85,4 +108,18 @@ def course_svg(q: Questionnaire, results: list[Result]) -> str:
     if len(points) > 1:
         parts.append(f'<text x="{LEFT + plot_w}" y="{HEIGHT - 10}" text-anchor="end">{last:%Y-%m-%d}</text>')
     parts.append("</svg>")
-    return "".join(parts)
+    return "".join(parts) + _legend(bands)
+
+
+def _band_words(band: Band) -> str:
+    return f"{band.label.get('en') or band.id} ({band.min}-{band.max})"
+
+
+def _legend(bands: tuple[Band, ...]) -> str:
+    """Each band in words, its range, and its colour with what the colour means."""
+    rows = "".join(
+        f'<li><span class="swatch" style="background:{CONCERN_FILLS[b.concern]}"></span>'
+        f"{escape(_band_words(b))}: {escape(CONCERN_WORDS[b.concern])}</li>"
+        for b in bands
+    )
+    return f'<ul class="band-legend">{rows}</ul>'

@@ -43,7 +43,7 @@ from kiosk.core.questionnaire.model import (
     Translation,
 )
 from kiosk.core.questionnaire.outcome import item_name, pending_words, result_words
-from kiosk.core.questionnaire.parts import PATIENT, STAFF, Band, BandSet, Code, Entry, Option
+from kiosk.core.questionnaire.parts import CONCERNS, PATIENT, STAFF, Band, BandSet, Code, Entry, Option
 from kiosk.core.questionnaire.scoring import (
     ITEM_WEIGHT,
     Formula,
@@ -63,6 +63,7 @@ __all__ = [
     "SCREEN_LANGUAGES",
     "STAFF",
     "Band",
+    "CONCERNS",
     "BandSet",
     "Code",
     "Entry",

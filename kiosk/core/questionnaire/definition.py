@@ -22,6 +22,7 @@ from typing import Any
 
 from basis.errors import KioskError
 from kiosk.core.questionnaire import (
+    CONCERNS,
     PATIENT,
     Band,
     BandSet,
@@ -107,6 +108,15 @@ def _v2(q: Questionnaire) -> dict[str, Any]:
     return extra
 
 
+def _band(b: Band) -> dict[str, Any]:
+    """A band as captured; ``concern`` only when declared (a definition captured before it
+    existed keeps its digest)."""
+    band: dict[str, Any] = {"id": b.id, "min": b.min, "max": b.max, "label": dict(b.label)}
+    if b.concern is not None:
+        band["concern"] = b.concern
+    return band
+
+
 def canonical(q: Questionnaire) -> dict[str, Any]:
     """Everything ``q`` says, as plain JSON values (``source``, a file path, is not part of it;
     ``reference``, the published source, is, as ``source``)."""
@@ -122,7 +132,7 @@ def canonical(q: Questionnaire) -> dict[str, Any]:
             {
                 "id": s.id,
                 "source": s.source,
-                "bands": [{"id": b.id, "min": b.min, "max": b.max, "label": dict(b.label)} for b in s.bands],
+                "bands": [_band(b) for b in s.bands],
             }
             for s in q.band_sets.values()
         ],
@@ -166,6 +176,12 @@ def questionnaire_from(definition: Mapping[str, Any], source: str = "") -> Quest
         raise DefinitionError(
             f"the captured definition does not describe a questionnaire ({type(exc).__name__}: {exc})"
         ) from None
+
+
+def _concern(value: Any) -> str | None:
+    if value is None or value in CONCERNS:
+        return value  # type: ignore[no-any-return]
+    raise DefinitionError(f"a band's concern must be one of {', '.join(CONCERNS)}, got {value!r:.40}")
 
 
 def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
@@ -228,7 +244,14 @@ def _build(d: Mapping[str, Any], source: str) -> Questionnaire:
             id=str(s["id"]),
             source=str(s["source"]),
             bands=tuple(
-                Band(id=str(b["id"]), min=int(b["min"]), max=int(b["max"]), label=texts(b["label"])) for b in s["bands"]
+                Band(
+                    id=str(b["id"]),
+                    min=int(b["min"]),
+                    max=int(b["max"]),
+                    label=texts(b["label"]),
+                    concern=_concern(b.get("concern")),
+                )
+                for b in s["bands"]
             ),
         )
         for s in d["band_sets"]

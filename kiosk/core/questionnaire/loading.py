@@ -153,7 +153,7 @@ def _build(data: dict[str, Any], source: str) -> Questionnaire:
             id=name,
             source=v.get("source", ""),
             bands=tuple(
-                Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]))
+                Band(id=b["id"], min=b["min"], max=b["max"], label=dict(b["label"]), concern=b.get("concern"))
                 for b in sorted(v["ranges"], key=lambda b: b["min"])
             ),
         )

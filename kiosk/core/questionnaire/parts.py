@@ -78,12 +78,20 @@ class Entry:
 
 @record
 class Band:
-    """An interpretation band: totals from ``min`` to ``max`` inclusive."""
+    """An interpretation band: totals from ``min`` to ``max`` inclusive, and what it means for
+    the patient (``concern``, one of :data:`CONCERNS`, as the instrument's author declared it;
+    None: not declared, or a band that judges nothing, such as "no cut-off")."""
 
     id: str
     min: int
     max: int
     label: Mapping[str, str]
+    concern: str | None = None
+
+
+#: what a band may say about the patient, from nothing to worry about to a lot: staff's plots
+#: colour a band by this, never by its place in the list
+CONCERNS = ("none", "low", "moderate", "high")
 
 
 @record
