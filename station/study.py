@@ -39,8 +39,8 @@ from station.agreement import (
     table_of,
     weighted_kappa,
 )
-from station.db import reference_results, sessions
-from station.definitions import questionnaire_for
+from station.db import definitions, reference_results, sessions
+from station.definitions import parsed, questionnaire_for
 from station.reference import FINISHED, answers_in, asked
 from station.sessions import RESULT_KINDS, load_many
 
@@ -111,13 +111,25 @@ def period(start: str, end: str, today: date) -> tuple[date, date]:
     return days[0], days[1]
 
 
-def instruments(engine: Engine) -> list[str]:
-    """The instruments some clinician's result was entered for (the page's choice)."""
+def instruments(engine: Engine) -> list[tuple[str, str]]:
+    """The instruments some clinician's result was entered for, with the title staff read (the
+    page's choice): (id, title), by title."""
     with engine.connect() as connection:
-        query = (
-            sa.select(reference_results.c.questionnaire_id).distinct().order_by(reference_results.c.questionnaire_id)
+        query = sa.select(reference_results.c.questionnaire_id).distinct()
+        ids = list(connection.execute(query).scalars())
+        shas = dict(
+            connection.execute(
+                sa.select(definitions.c.questionnaire_id, sa.func.max(definitions.c.sha256))
+                .where(definitions.c.questionnaire_id.in_(ids))
+                .group_by(definitions.c.questionnaire_id)
+            ).all()
         )
-        return list(connection.execute(query).scalars())
+        found = parsed(connection, shas.values())
+    titles = {}
+    for instrument in ids:
+        q = found[shas[instrument]].questionnaire if instrument in shas and shas[instrument] in found else None
+        titles[instrument] = (q.title.get("en") or next(iter(q.title.values()), instrument)) if q else instrument
+    return sorted(titles.items(), key=lambda pair: pair[1].lower())
 
 
 def _chosen(engine: Engine, instrument: str, first: date, last: date) -> list[str]:

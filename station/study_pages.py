@@ -112,7 +112,7 @@ async def _study(request: Request) -> tuple[study.Study | None, dict[str, Any]]:
     """The study the query names (None with an error when it cannot be read) and the form's state."""
     engine = request.app.state.engine
     names = await run_in_threadpool(study.instruments, engine)
-    instrument = request.query_params.get("instrument") or (names[0] if names else "")
+    instrument = request.query_params.get("instrument") or (names[0][0] if names else "")
     start, end = request.query_params.get("from", ""), request.query_params.get("to", "")
     state: dict[str, Any] = {"instruments": names, "instrument": instrument, "error": None}
     try:

@@ -106,7 +106,7 @@ def test_entries_the_station_refuses(engine) -> None:
 def test_the_study_of_the_barthel(engine) -> None:
     visits = store_study_visits(engine)
     _enter_all(engine, visits)
-    assert study.instruments(engine) == ["barthel"]
+    assert study.instruments(engine) == [("barthel", "Barthel Index")]
     found = study.study(engine, load_questionnaire(), "barthel", FIRST, LAST)
     # the first patient's earlier result and the one after the last day are left out
     assert [p.session_id for p in found.pairs] == ["study-0", "study-1", "study-2", "study-3"]

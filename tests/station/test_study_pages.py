@@ -126,6 +126,7 @@ def test_the_form_and_the_study_page_in_chromium(browser, sqlite_url, station_fa
         page.goto(station.url + STUDY)
         page.wait_for_selector("#study-icc")
         fits(page, viewport)
+        assert page.locator('select[name="instrument"] option:checked').inner_text() == "Barthel Index"
         engine = db.make_engine(sqlite_url)
         try:
             found = study.study(engine, q, "barthel", date(2026, 11, 1), date(2026, 11, 20))
