@@ -5,7 +5,7 @@ against published worked examples (tests/station/test_agreement.py).
 * :func:`weighted_kappa`: Cohen's (1968) weighted kappa of two ratings on ordered categories, with
   quadratic (Fleiss-Cohen) weights by default, and its large-sample standard error (Fleiss, Cohen &
   Everitt 1969, the non-null variance; what SAS PROC FREQ's AGREE prints as ASE); the interval is
-  kappa ± z·SE.
+  kappa ± z·SE, kept within [−1, 1].
 * :func:`icc_2_1`: ICC(2,1), two-way random effects, absolute agreement, single measures (Shrout &
   Fleiss 1979 case 2; McGraw & Wong 1996 ICC(A,1)), with the F-distribution interval of McGraw &
   Wong 1996 (Satterthwaite's degrees of freedom for the denominator).
@@ -169,8 +169,8 @@ def table_of(pairs: Sequence[tuple[int, int]], k: int) -> list[list[int]]:
 def weighted_kappa(table: Sequence[Sequence[float]], weights: str = "quadratic") -> Estimate:
     """Weighted kappa of a square table of counts (rows: the first rating, columns: the second),
     categories in their order; the interval is kappa ± z·SE with the Fleiss-Cohen-Everitt (1969)
-    large-sample SE. AgreementError when it is not defined (fewer than 2 ratings, or chance
-    agreement already 1: both ratings always in one category)."""
+    large-sample SE, kept within kappa's range [-1, 1]. AgreementError when it is not defined or
+    tells nothing (fewer than 2 ratings; one side, or both, always in one category)."""
     k = len(table)
     if any(len(row) != k for row in table):
         raise AgreementError("the table of ratings must be square")
@@ -185,13 +185,16 @@ def weighted_kappa(table: Sequence[Sequence[float]], weights: str = "quadratic")
     chance = sum(w[i][j] * rows[i] * cols[j] for i in range(k) for j in range(k))
     if chance >= 1.0 - 1e-12:
         raise AgreementError("weighted kappa is not defined: every rating on both sides is in the same category")
+    if sum(1 for r in rows if r > 0) == 1 or sum(1 for c in cols if c > 0) == 1:
+        # kappa is 0 by construction and its standard error 0: no interval to give
+        raise AgreementError("weighted kappa says nothing here: one side gave every patient the same answer")
     kappa = (observed - chance) / (1.0 - chance)
     w_row = [sum(cols[j] * w[i][j] for j in range(k)) for i in range(k)]  # w̄_i.
     w_col = [sum(rows[i] * w[i][j] for i in range(k)) for j in range(k)]  # w̄_.j
     spread = sum(p[i][j] * (w[i][j] - (w_row[i] + w_col[j]) * (1.0 - kappa)) ** 2 for i in range(k) for j in range(k))
     variance = max(spread - (kappa - chance * (1.0 - kappa)) ** 2, 0.0) / (n * (1.0 - chance) ** 2)
     se = math.sqrt(variance)
-    return Estimate(kappa, kappa - _z() * se, kappa + _z() * se, se)
+    return Estimate(kappa, max(kappa - _z() * se, -1.0), min(kappa + _z() * se, 1.0), se)
 
 
 # -- ICC(2,1) -----------------------------------------------------------------------------------

@@ -68,6 +68,10 @@ def test_quadratic_weights_and_the_undefined_cases() -> None:
     assert weighted_kappa(table_of([(1, 1), (2, 2), (3, 3)], 3)).value == pytest.approx(1.0)
     with pytest.raises(AgreementError, match="same category"):
         weighted_kappa(table_of([(2, 2), (2, 2), (2, 2)], 3))
+    with pytest.raises(AgreementError, match="one side gave every patient the same answer"):
+        weighted_kappa(table_of([(1, 2), (2, 2), (3, 2)], 3))
+    wide = weighted_kappa(table_of([(1, 1), (2, 2), (3, 3), (3, 2)], 3))  # few pairs: a wide interval
+    assert wide.high == 1.0 and wide.value + 1.959964 * wide.se > 1.0  # kept within kappa's range
     with pytest.raises(AgreementError, match="at least two pairs"):
         weighted_kappa(table_of([(2, 2)], 3))
     with pytest.raises(AgreementError, match="outside the categories 1 to 3"):

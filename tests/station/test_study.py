@@ -118,9 +118,11 @@ def test_the_study_of_the_barthel(engine) -> None:
     assert found.icc.estimate == icc_2_1([[float(k), float(c)] for k, c in complete]).estimate
     assert found.limits.bias.value == pytest.approx(sum(k - c for k, c in complete) / 3)
     by_item = {i.item_id: i for i in found.items}
-    transfers = [(visits.kiosk[n]["transfers"], visits.clinician[n]["transfers"]) for n in range(4)]
-    assert by_item["transfers"].n == 4
-    assert by_item["transfers"].kappa == weighted_kappa(table_of(transfers, 4))
+    stairs = [(visits.kiosk[n]["stairs"], visits.clinician[n]["stairs"]) for n in range(4)]
+    assert by_item["stairs"].n == 4
+    assert by_item["stairs"].kappa == weighted_kappa(table_of(stairs, 3))
+    # the clinicians answered "minor help" to every patient's transfers: no kappa, and why
+    assert by_item["transfers"].kappa is None and "same answer" in by_item["transfers"].problem
     assert by_item["grooming"].n == 3  # the fourth patient's kiosk never answered it
     assert by_item["feeding"].kappa.value == pytest.approx(1.0)  # the same answers on both sides
 
@@ -155,9 +157,10 @@ def test_the_csv_reads_back_to_the_studys_figures(engine) -> None:
         round(found.icc.estimate.high, 4),
     )
     assert "McGraw & Wong" in icc[6]
-    kappa = stats[("kappa", "transfers")]
-    assert float(kappa[3]) == round(next(i for i in found.items if i.item_id == "transfers").kappa.value, 4)
+    kappa = stats[("kappa", "stairs")]
+    assert float(kappa[3]) == round(next(i for i in found.items if i.item_id == "stairs").kappa.value, 4)
     assert "quadratic" in kappa[6]
+    assert stats[("kappa", "transfers")][3:6] == ["", "", ""] and "same answer" in stats[("kappa", "transfers")][6]
     assert float(stats[("bland_altman_lower", "total")][3]) == round(found.limits.lower.value, 4)
     patients = rows[rows.index(["session", "patient", "started_at", "kiosk_total", "clinician_total"]) + 1 :]
     assert [(r[0], r[3], r[4]) for r in patients] == [

@@ -135,9 +135,10 @@ def test_the_form_and_the_study_page_in_chromium(browser, sqlite_url, station_fa
         assert page.locator("#study-patients").inner_text() == "3" and page.locator("#study-totals").inner_text() == "3"
         assert page.locator("#icc-value").inner_text() == f"{found.icc.estimate.value:.2f}"
         assert "0.89" in page.locator("#study-icc").inner_text()
-        transfers_row = page.locator('#study-items li[data-item="transfers"]').inner_text()
-        kappa = next(i for i in found.items if i.item_id == "transfers").kappa
-        assert f"κw {kappa.value:.2f}" in transfers_row and "n = 3" in transfers_row
+        stairs_row = page.locator('#study-items li[data-item="stairs"]').inner_text()
+        kappa = next(i for i in found.items if i.item_id == "stairs").kappa
+        assert f"κw {kappa.value:.2f}" in stairs_row and "n = 3" in stairs_row
+        assert "same answer" in page.locator('#study-items li[data-item="transfers"]').inner_text()
         assert "Bias" in page.locator("#study-bias").inner_text()
         csv_text = page.request.get(station.url + page.locator("#study-csv").get_attribute("href")).text()
         assert next(r for r in csv.reader(io.StringIO(csv_text)) if r and r[0] == "icc_2_1")[3] == (
