@@ -41,8 +41,8 @@ def _session(engine: Any, session_id: str) -> tuple[StoredSession, list[referenc
 
 
 def _questions(q: Questionnaire, stored: StoredSession, current: dict[str, reference.ReferenceAnswer]) -> list[dict]:
-    """One row per item the clinician answers: the question, the kiosk's answer, the options."""
-    kiosk = {a.item_id: a.option for a in stored.answers}
+    """One row per item the clinician answers: the question, its options, the answer entered
+    (never the kiosk's: the clinician's result is entered blind to it)."""
     rows = []
     for item in reference.asked(q):
         labels = [(o.number, _in(o.label, stored.language)) for o in item.options]
@@ -51,7 +51,6 @@ def _questions(q: Questionnaire, stored: StoredSession, current: dict[str, refer
                 "id": item.id,
                 "text": _in(item.text, stored.language),
                 "options": labels,
-                "kiosk": dict(labels).get(kiosk.get(item.id, 0), ""),
                 "chosen": current[item.id].option if item.id in current else None,
             }
         )
