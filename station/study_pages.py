@@ -76,6 +76,7 @@ async def reference_page(request: Request) -> Response:
         questions=_questions(q, stored, current),
         trail=trail,
         labels={item.id: {o.number: _in(o.label, stored.language) for o in item.options} for item in q.items},
+        texts={item.id: _in(item.text, stored.language) for item in q.items},
         finished=stored.status == reference.FINISHED,
         message=request.query_params.get("message"),
     )

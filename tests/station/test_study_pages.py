@@ -119,7 +119,8 @@ def test_the_form_and_the_study_page_in_chromium(browser, sqlite_url, station_fa
         page.wait_for_selector("#reference-trail")
         assert "10 clinician's answers stored." in page.locator(".message").inner_text()
         assert page.locator("#reference-trail li").count() == 10
-        assert "nurse.kim" in page.locator("#reference-trail").inner_text()
+        entry = page.locator('#reference-trail li[data-item="transfers"]').inner_text()
+        assert "nurse.kim" in entry and q.item("transfers").text["en"] in entry and transfers in entry
         assert page.locator('select[name="item-transfers"] option:checked').inner_text() == transfers
 
         page.click("nav >> text=Validation")
