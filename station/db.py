@@ -203,6 +203,20 @@ visits = sa.Table(
     sa.Column("order_id", sa.String(32)),
 )
 
+#: a clinician's own answers for a session's items (a validation study, station.reference): apart
+#: from what the kiosk sent, append-only (a change is a newer row; the latest per item counts)
+reference_results = sa.Table(
+    "reference_results",
+    metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("session_id", sa.String(64), nullable=False),
+    sa.Column("questionnaire_id", sa.String(64), nullable=False),
+    sa.Column("item_id", sa.String(64), nullable=False),
+    sa.Column("option", sa.Integer, nullable=False),
+    sa.Column("entered_by", sa.String(64), nullable=False),
+    sa.Column("entered_at", sa.String(40), nullable=False),
+)
+
 code_failures = sa.Table(
     "order_code_failures",
     metadata,

@@ -48,6 +48,7 @@ from station import (
     results,
     signoff_pages,
     staff_items,
+    study_pages,
     throttle,
 )
 from station.bodylimit import BodyLimit
@@ -263,6 +264,7 @@ def create_app(
         *signoff_pages.routes,
         *definition_pages.routes,
         *staff_items.routes,
+        *study_pages.routes,
         *api.routes,
         *api_orders.routes,
         Mount("/static", StaticFiles(directory=HERE / "static"), name="static"),
