@@ -191,10 +191,10 @@ class KioskController:
     def forward(self, item: ChannelInput | Presence) -> None:
         """Hand an input to the session (what a number means on each screen is the session's call);
         nothing while the kiosk is out of order, and none starts a test while the welcome waits for
-        staff (an ordered visit, no walk-ups). A presence report (the camera's) goes straight on."""
+        staff (an ordered visit, no walk-ups). A presence report goes straight on (none in a TUG)."""
         if self.out_of_order is not None:
             return
-        if isinstance(item, Presence):
+        if isinstance(item, Presence) and not self.tug_busy:  # a TUG's walk is no leaving
             self.drive(self.session.handle, item)
             return
         if (self.session.phase is Phase.WELCOME and self.welcome_held()) or self.tug_busy:
