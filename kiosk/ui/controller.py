@@ -194,8 +194,9 @@ class KioskController:
         staff (an ordered visit, no walk-ups). A presence report goes straight on (none in a TUG)."""
         if self.out_of_order is not None:
             return
-        if isinstance(item, Presence) and not self.tug_busy:  # a TUG's walk is no leaving
-            self.drive(self.session.handle, item)
+        if isinstance(item, Presence):
+            if not self.tug_busy:  # a TUG's walk is no leaving
+                self.drive(self.session.handle, item)
             return
         if (self.session.phase is Phase.WELCOME and self.welcome_held()) or self.tug_busy:
             return
@@ -285,9 +286,8 @@ class KioskController:
     tug_busy = property(lambda self: self.tugs is not None and self.tugs.busy, doc="A TUG is under way.")
 
     def next_instrument(self) -> None:
-        """The running instrument finished: the visit's next one (a battery) starts on its rest
-        screen, after a Timed Up and Go due between them; after the last, nothing (the end screen
-        stays; after a last TUG, the welcome for the next patient)."""
+        """The running instrument finished: the visit's next one starts on its rest screen, after a
+        TUG due between them; after the last, nothing (the end screen; after a TUG, the welcome)."""
         finished = self.session
         if finished.finished and self.tugs is not None and self.tugs.due(finished, finished, self._after_tug):
             self._screens().redraw(rebuild=True)
