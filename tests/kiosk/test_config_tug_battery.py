@@ -48,3 +48,17 @@ def test_a_staff_visit_counts_the_tug_and_a_walk_up_never_has_it(tmp_path):
     # an order naming the TUG is one this kiosk can run, in the order's order
     assert KioskParts.load(config).ids == ["barthel", "mini", "tug"]
     assert KioskParts.load(config).visit_steps(["mini", "tug"]) == ("mini", "tug")
+
+
+def test_a_station_order_may_name_the_tug_but_not_the_tug_alone():
+    from kiosk.core.visits import parse_orders
+
+    body = {
+        "orders": [
+            {"id": "o1", "patient_id": "P-1234", "instruments": ["barthel", "tug"], "language": "en"},
+            {"id": "o2", "patient_id": "P-1235", "instruments": ["tug"], "language": "en"},
+        ]
+    }
+    found, problems = parse_orders(body, ["barthel", "tug"], ["en"])
+    assert [(o.id, o.instruments) for o in found] == [("o1", ("barthel", "tug"))]
+    assert problems == ["orders[1] (o2): the Timed Up and Go alone: this kiosk gives it within a visit"]

@@ -8,6 +8,7 @@ wait on what is drawn or stored."""
 
 from __future__ import annotations
 
+import shutil
 import threading
 
 import numpy as np
@@ -16,15 +17,18 @@ import pytest
 from kiosk.camera import CameraChannel, Frame
 from kiosk.camera.feed import PoseFeed
 from kiosk.config import InstrumentChoice
+from kiosk.core.channels import ChannelState
 from kiosk.core.session import Phase
 from kiosk.core.tug.families import generate
 from kiosk.core.tug.step import TugStage
 from kiosk.ui.app import CLINICIAN_CHORD, KIOSK_SIZE
+from kiosk.ui.widgets.channel_board import VOICE_OUT
 from kiosk.ui.widgets.literal import Label, Static
 from tests.kiosk.battery_instruments import write_mini
 
 from .conftest import UI_PIN
-from .helpers import drawn_text, screen_name, settle, text_of
+from .helpers import drawn_text, screen_name, settle, text_of, until_thread
+from .test_speaker_wiring import RecordingPlayer, SaidSpeaker
 
 WAIT_S = 60  # a guard against a hang, not a timing assertion
 
@@ -269,3 +273,36 @@ async def test_a_walk_up_visit_never_gives_the_tug(ui_kiosk, tmp_path):
         await settle(pilot, lambda: screen_name(kiosk) == "SummaryScreen")
         assert not app.controller.tug_busy
     assert kiosk.store.tug.all() == []
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("espeak-ng") is None, reason="espeak-ng is not installed")
+async def test_the_instructions_and_go_are_said_in_the_patients_language(ui_kiosk, tmp_path):
+    """The real espeak-ng speaker (the sound card stands in): Spanish words, said once each."""
+    player = RecordingPlayer()
+    speaker = SaidSpeaker(player_factory=lambda: player)
+    mini = write_mini(tmp_path)
+    kiosk = ui_kiosk(
+        instruments=(InstrumentChoice("tug"), InstrumentChoice(str(mini), mini)), visits=True, speaker=speaker
+    )
+    app = kiosk.app
+    async with app.run_test(size=KIOSK_SIZE) as pilot:
+        await until_thread(lambda: app.board.state(VOICE_OUT)[0] is ChannelState.ON, "the speaker's worker")
+        app.controller.start_staff_visit("P-0818", "es", False)
+        await settle(
+            pilot, lambda: "Una breve prueba de marcha" in drawn_text(app) and "Parte 1 de 2" in drawn_text(app)
+        )
+        played = player.played
+        await open_staff(kiosk, pilot)
+        await type_into(pilot, "#tug-staff", "nurse-7")
+        await touch(pilot, "#tug-confirm")
+        await settle(pilot, lambda: "Cuando diga Ya, levántese" in drawn_text(app))
+        await touch(pilot, "#tug-go")
+        await settle(pilot, lambda: "¡Ya!" in drawn_text(app))
+        said = [text for text in speaker.said if text.startswith(("Cuando diga Ya", "¡Ya!"))]
+        assert said == [
+            "Cuando diga Ya, levántese, camine hasta la línea del suelo a su paso habitual, dé la vuelta, "
+            "vuelva y siéntese otra vez. Use su ayuda para caminar si la usa normalmente.",
+            "¡Ya!",
+        ]
+        await until_thread(lambda: player.played >= played + 2, "the speaker's worker")
