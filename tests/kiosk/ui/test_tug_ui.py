@@ -186,6 +186,10 @@ async def test_without_a_camera_staff_time_it_by_stopwatch_before_the_first_inst
         await open_staff(kiosk, pilot)
         camera = text_of(app.screen.query_one("#tug-camera", Label))
         assert camera.startswith("Camera off (") and "stopwatch" in camera
+        home = app.screen_stack[-2]  # the clinician home under it says so too
+        assert "Timed Up and Go: no camera, so a stopwatch time or a skip" in text_of(
+            home.query_one("#channel-reasons")
+        )
         assert not app.screen.query_one("#tug-check-chair").display
         await type_into(pilot, "#tug-staff", "nurse-7")
         await touch(pilot, "#tug-confirm")
