@@ -28,6 +28,11 @@ class PoseFeed:
         with self._lock:
             self._readings.append(reading)
 
+    def clear(self) -> None:
+        """Drop the readings not handed over (no test is under way: nothing keeps them)."""
+        with self._lock:
+            self._readings.clear()
+
     def into(self, step: TugStep, before: float | None = None) -> int:
         """Feed the readings so far (only those earlier than ``before`` when given; the rest wait)
         to ``step``, oldest first; returns how many."""

@@ -74,8 +74,10 @@ def build_app(
         raise SetupError(str(error)) from None
     statuses: list[ChannelStatus] = []
     keyboard, sources = _remotes(config.remote_profiles, remote, statuses, store)
-    sources.append(_LateCamera())
+    camera = _LateCamera()
+    sources.append(camera)
     channels = KioskChannels(
+        poses=camera,
         speaker=_speaker() if voice else None,
         voice=_voice_in(config, voice, statuses),
         sources=sources,
@@ -102,21 +104,32 @@ def _in_force(config: Config) -> InForce:
 class _LateCamera:
     """The camera channel, looked for only when the app starts its channels (after the first frame):
     nothing of :mod:`kiosk.camera` loads before the welcome. Without a camera or the pose model it
-    reports the camera off with why, and the kiosk runs as without it."""
+    reports the camera off with why, and the kiosk runs as without it. Its landmarks go to a
+    :class:`~kiosk.camera.feed.PoseFeed` a visit's Timed Up and Go drains (``into``, ``clear``)."""
 
     name = "camera"
 
     def __init__(self) -> None:
         self._channel: Any = None
         self._stopped = False
+        self._feed: Any = None
+
+    def into(self, step: Any, before: float | None = None) -> int:
+        return self._feed.into(step, before) if self._feed is not None else 0
+
+    def clear(self) -> None:
+        if self._feed is not None:
+            self._feed.clear()
 
     def start(self, sink: Sink) -> None:
         from kiosk.camera import camera_channel, camera_status, presence_reports
+        from kiosk.camera.feed import PoseFeed
 
         status = camera_status()
         sink(status)
         if status.state is not ChannelState.OFF and not self._stopped:
-            self._channel = camera_channel(on_presence=presence_reports(sink))
+            self._feed = PoseFeed()
+            self._channel = camera_channel(on_pose=self._feed, on_presence=presence_reports(sink))
             if self._channel is not None:
                 self._channel.start(sink)
 

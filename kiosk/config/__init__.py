@@ -72,7 +72,12 @@ import platformdirs
 
 from fileio.bounded import BadFile, open_private, read_text
 from kiosk.config.checks import PATH_SETTINGS, check_path, station_from
-from kiosk.config.instruments import configured_instruments, configured_questionnaire, offered_to_patients
+from kiosk.config.instruments import (
+    configured_instruments,
+    configured_questionnaire,
+    configured_steps,
+    offered_to_patients,
+)
 from kiosk.config.reading import read_file
 from kiosk.config.settings import (
     FHIR_KEYS,
@@ -99,6 +104,7 @@ __all__ = [
     "InstrumentChoice",
     "Station",
     "configured_instruments",
+    "configured_steps",
     "configured_questionnaire",
     "default_config_path",
     "load_config",

@@ -23,7 +23,7 @@ from kiosk.core.pin import DEFAULT_PIN, MIN_DIGITS, hash_problem
 from kiosk.core.questionnaire import SCREEN_LANGUAGES, Timing
 from kiosk.core.questionnaire.loading import bundled_path
 from kiosk.core.site import default_kiosk_id
-from kiosk.core.visits import pattern_problem
+from kiosk.core.visits import TUG, pattern_problem
 from qos import bundled_models
 
 #: an absolute URI of visible ASCII: no space, control character or '|' (matched whole: fullmatch)
@@ -290,6 +290,10 @@ def _instruments(value: object, context: Context) -> tuple[InstrumentChoice, ...
         raise Invalid("give either questionnaire: (one instrument) or instruments: (a battery), not both")
     if not isinstance(value, list) or not value:
         raise Invalid("instruments must be a list such as [barthel, lawton, gds15]")
+    if all(entry == TUG for entry in value):
+        raise Invalid(f"instruments: {TUG} is given within a visit with at least one questionnaire")
+    if value.count(TUG) > 1:
+        raise Invalid(f"instruments: {TUG!r} is given twice; a visit gives it once")
     return tuple(_instrument(entry, index, context.folder, context.site) for index, entry in enumerate(value))
 
 
@@ -315,6 +319,8 @@ def _instrument(entry: object, index: int, folder: Path, site: SiteFolder | None
         return InstrumentChoice(entry, file if file.is_absolute() else folder / file, model)
     if site is not None and entry in site.instruments:
         return InstrumentChoice(entry, site.instruments[entry], model)
+    if entry == TUG:  # the Timed Up and Go: a step of the visit, not a questionnaire (issue 34)
+        return InstrumentChoice(entry, None, model)
     if not bundled_path(f"{entry}.yaml").is_file():
         shipped = sorted(p.stem for p in bundled_path().parent.glob("*.yaml"))
         raise Invalid(f"no shipped instrument {entry!r} (shipped: {', '.join(shipped)}); or give a file", (index,))

@@ -14,6 +14,7 @@ from kiosk.config.settings import (
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.questionnaire.kept import load_questionnaire_kept
 from kiosk.core.questionnaire.loading import bundled_path
+from kiosk.core.visits import TUG
 
 
 def configured_instruments(config: Config) -> list[tuple[Questionnaire, str | None]]:
@@ -25,6 +26,8 @@ def configured_instruments(config: Config) -> list[tuple[Questionnaire, str | No
     found: list[tuple[Questionnaire, str | None]] = []
     where = f"{config.source}: " if config.source else ""
     for choice in config.instruments:
+        if choice.name == TUG and choice.path is None:
+            continue  # a step of the visit, not a questionnaire (configured_steps)
         questionnaire = load_questionnaire(choice.path or bundled_path(f"{choice.name}.yaml"))
         if questionnaire.id in (q.id for q, _ in found):
             raise ConfigError(f"{where}instruments: {questionnaire.id!r} is given twice; a visit gives it once")
@@ -32,6 +35,15 @@ def configured_instruments(config: Config) -> list[tuple[Questionnaire, str | No
     if config.bands is not None and not any(config.bands in q.band_sets for q, _ in found):
         raise ConfigError(f"{where}bands: {config.bands!r} is not a band set of any of the instruments")
     return found
+
+
+def configured_steps(config: Config, instruments: list[tuple[Questionnaire, str | None]]) -> tuple[str, ...]:
+    """The visit's steps in order: the ids of ``instruments`` (:func:`configured_instruments`),
+    with the Timed Up and Go's id where ``instruments:`` names it."""
+    ids = iter(q.id for q, _ in instruments)
+    if not config.instruments:
+        return tuple(ids)
+    return tuple(TUG if c.name == TUG and c.path is None else next(ids) for c in config.instruments)
 
 
 def configured_questionnaire(config: Config) -> Questionnaire:

@@ -19,6 +19,9 @@ from kiosk.core.answerers import Answerer, answerer
 
 WALK_UP = "walk-up"
 STAFF = "staff"
+#: the Timed Up and Go's id among a visit's instruments (a configured battery's, a station order's):
+#: a step of the visit given by staff, never at a walk-up (issue 34; kiosk.core.tug.visit)
+TUG = "tug"
 #: what every patient identifier is, whatever the site: 2-64 letters, digits, '-' or '_' with at
 #: least one digit (what the store and the station's rows accept)
 HOSPITAL_ID = re.compile(r"^(?=.*[0-9])[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
@@ -118,6 +121,8 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
             problems.append(f"{where} ({order_id}): {check_patient_id(patient, None)}")
         elif not isinstance(wanted, list) or not wanted or any(i not in instruments for i in wanted):
             problems.append(f"{where} ({order_id}): instruments {wanted!r}: this kiosk gives {', '.join(instruments)}")
+        elif all(i == TUG for i in wanted):
+            problems.append(f"{where} ({order_id}): the Timed Up and Go alone: this kiosk gives it within a visit")
         elif language not in known_languages:
             problems.append(f"{where} ({order_id}): language {language!r} is not one this kiosk speaks")
         elif answered_by not in ("patient", "relative", "caregiver"):

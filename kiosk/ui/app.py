@@ -307,7 +307,13 @@ class KioskApp(App[int], inherit_bindings=False):
         can still fire while the app is closing (as when another kiosk holds the test)."""
         if not self.screen_stack:
             return
-        self.controller.drive(self.session.poll)
+        if self.controller.tugs is not None:
+            self.controller.tugs.poll()
+        if self.controller.tug_busy:  # the session waits (not yet started, or finished)
+            for screen in self.screen_stack:
+                getattr(screen, "tick", lambda: None)()  # the TUG's screens follow the run
+        else:
+            self.controller.drive(self.session.poll)
         self._staff_idle()
         if isinstance(self.screen, PatientScreen):
             for sign in self.screen.query(WaitingSign):
@@ -360,7 +366,9 @@ class KioskApp(App[int], inherit_bindings=False):
         """Show the screens the session's state calls for (none over the clinician's)."""
         if self.is_running and not self.clinician_open:
             held = self.controller.visits if self.controller.welcome_held() else None
-            self.stage.show(self._view(), out_of_order=self.controller.out_of_order is not None, held_visits=held)
+            tug = self.controller.tugs if self.controller.tug_busy else None
+            broken = self.controller.out_of_order is not None
+            self.stage.show(self._view(), out_of_order=broken, held_visits=held, tug=tug)
 
     # -- the clinician side -------------------------------------------------------------------
 
@@ -379,6 +387,10 @@ class KioskApp(App[int], inherit_bindings=False):
                 from kiosk.ui.screens.clinician_home import ClinicianHomeScreen
 
                 self.push_screen(ClinicianHomeScreen())
+                if (tugs := self.controller.tugs) is not None and tugs.busy:  # the visit's TUG waits for staff
+                    from kiosk.ui.screens.tug_staff import TugStaffScreen
+
+                    self.push_screen(TugStaffScreen(tugs))
             else:
                 self.controller.release()
 

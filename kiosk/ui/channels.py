@@ -26,7 +26,7 @@ from kiosk.core.session import (
 )
 from kiosk.remote.buttons import KIOSK_KEY_BUTTONS
 from kiosk.ui.screens.base import Ways, spoken_with_ways
-from kiosk.ui.widgets.channel_board import REMOTE, VOICE_IN, VOICE_OUT, ChannelBoard
+from kiosk.ui.widgets.channel_board import CAMERA, REMOTE, VOICE_IN, VOICE_OUT, ChannelBoard
 
 #: the source name the voice-out statuses carry when no speaker is wired
 VOICE_OUT_SOURCE = "espeak-ng"
@@ -37,7 +37,9 @@ class KioskChannels:
     ``kiosk.speech.voice.VoiceChannel`` (an input source that also follows the session's events)
     or None; ``sources`` the remotes' input sources; ``keyboard`` a ``kiosk.remote.KeyboardRemote``
     for remotes that type keys; ``statuses`` the channel states known before start-up, such as
-    "voice in off: no microphone found". :attr:`board` keeps the latest status of each."""
+    "voice in off: no microphone found". :attr:`board` keeps the latest status of each. ``poses``:
+    the camera's landmarks for a Timed Up and Go (a :class:`kiosk.camera.feed.PoseFeed`, or an
+    object with its ``into`` and ``clear``), None without a camera."""
 
     def __init__(
         self,
@@ -46,8 +48,10 @@ class KioskChannels:
         sources: Iterable[InputSource] = (),
         keyboard: Any = None,
         statuses: Iterable[ChannelStatus] = (),
+        poses: Any = None,
     ) -> None:
         self.speaker, self.voice, self.sources, self.keyboard = speaker, voice, list(sources), keyboard
+        self.poses = poses
         self.board = ChannelBoard(getattr(speaker, "source", VOICE_OUT_SOURCE))
         if speaker is None:
             self.board.update(ChannelStatus(Channel.VOICE, ChannelState.OFF, VOICE_OUT_SOURCE, "voice out turned off"))
@@ -72,6 +76,18 @@ class KioskChannels:
     def on(self, indicator: str) -> bool:
         """The channel behind ``indicator`` (VOICE_IN, VOICE_OUT, REMOTE) is on."""
         return self.board.state(indicator)[0] is ChannelState.ON
+
+    def camera_off(self) -> str | None:
+        """Why the camera cannot time a Timed Up and Go now (None: it can)."""
+        state, reason = self.board.state(CAMERA)
+        if state is ChannelState.ON and self.poses is not None:
+            return None
+        return reason or ("the camera is not on" if state is not ChannelState.ON else "no landmarks reach the kiosk")
+
+    def say(self, text: str, language: str) -> None:
+        """Speak ``text`` (the kiosk's voice, when it has one)."""
+        if self.speaker is not None:
+            self.speaker.say(text, language)
 
     def about_voice(self, status: ChannelStatus) -> bool:
         """``status`` changes whether voice in or voice out is on."""

@@ -14,7 +14,7 @@ from dataclasses import field
 from typing import TYPE_CHECKING, Any
 
 from basis import record
-from kiosk.config import site_from_config
+from kiosk.config import site_from_config, tug_settings
 from kiosk.core.adaptation import Adaptation, Policy, load_policy
 from kiosk.core.answerers import walk_up_instruments
 from kiosk.core.clock import Clock
@@ -24,12 +24,14 @@ from kiosk.core.questionnaire import Questionnaire
 from kiosk.core.room import RoomHearing
 from kiosk.core.session import Session, Watching
 from kiosk.core.session.battery import Battery, Instrument
-from kiosk.core.visits import STAFF, WALK_UP, VisitDesk
+from kiosk.core.visits import STAFF, TUG, WALK_UP, VisitDesk
 from kiosk.store.database import Store, StoredSession, new_patient_id
 from kiosk.store.pin_files import PinFiles
 from kiosk.ui.app import POLL_INTERVAL, KioskApp
 from kiosk.ui.channels import KioskChannels
 from kiosk.ui.controller import KioskController
+from kiosk.ui.tug_desk import TugDesk
+from kiosk.ui.widgets.text import ui_text
 
 if TYPE_CHECKING:
     from kiosk.config import Config
@@ -41,26 +43,29 @@ class KioskParts:
     """What a configuration names and every session shares: the questionnaire (a battery's
     first instrument), the QoS model and the adaptation policy (None: adaptation off); and the
     battery: every instrument in order with the name of its own QoS model (None: ``model``),
-    ``models`` holding each such model loaded."""
+    ``models`` holding each such model loaded; ``steps``: the configured visit's ids in order, the
+    Timed Up and Go's among them (empty: the instruments')."""
 
     questionnaire: Questionnaire
     model: Model
     policy: Policy | None
     instruments: tuple[tuple[Questionnaire, str | None], ...] = ()
     models: Mapping[str, Model] = field(default_factory=dict)
+    steps: tuple[str, ...] = ()
 
     @classmethod
     def load(cls, config: Config) -> KioskParts:
         """Load them; raises QuestionnaireError, ConfigError, ModelError or PolicyError (one
         sentence, with the file and where) for a bad file."""
-        from kiosk.config import configured_instruments, offered_to_patients
+        from kiosk.config import configured_instruments, configured_steps, offered_to_patients
 
         # a site offers patients only validated translations and those it accepts, per instrument
-        instruments = tuple((offered_to_patients(config, q), name) for q, name in configured_instruments(config))
+        configured = configured_instruments(config)
+        instruments = tuple((offered_to_patients(config, q), name) for q, name in configured)
         model = load_kiosk_model(config.qos_model)
         models = {name: load_kiosk_model(name) for _, name in instruments if name is not None}
         policy = load_policy(config.adaptation_policy, model=model) if config.adaptation else None
-        return cls(instruments[0][0], model, policy, instruments, models)
+        return cls(instruments[0][0], model, policy, instruments, models, configured_steps(config, configured))
 
     def battery(self, ids: Sequence[str] | None = None) -> list[Instrument]:
         """The instruments of a visit, in order (a battery of one without ``instruments:``);
@@ -71,10 +76,19 @@ class KioskParts:
         by_id = {i.questionnaire.id: i for i in given}
         return [by_id[i] for i in ids if i in by_id] or given
 
+    def visit_steps(self, ids: Sequence[str] | None = None) -> tuple[str, ...]:
+        """The steps of a visit: ``ids`` (an order's) as far as this kiosk gives them, the Timed Up
+        and Go's id kept in its place; without ``ids`` the configured visit's."""
+        given = [i.questionnaire.id for i in self.battery(ids)]
+        if ids is None:
+            return self.steps or tuple(given)
+        return tuple(i for i in ids if i in given or i == TUG) if any(i in given for i in ids) else tuple(given)
+
     @property
     def ids(self) -> list[str]:
-        """The ids of the instruments this kiosk gives."""
-        return [i.questionnaire.id for i in self.battery()]
+        """The ids of the instruments this kiosk gives (an order's instruments are checked against
+        them), the Timed Up and Go's always among them: staff can time it at least by stopwatch."""
+        return [*(i.questionnaire.id for i in self.battery()), TUG]
 
     @property
     def languages(self) -> list[str]:
@@ -107,7 +121,9 @@ class SessionMaker:
         #: how well voice is heard in this kiosk's room, over all its patients (kiosk.core.room)
         self.room = RoomHearing()
 
-    def _battery(self, visit_id: str | None = None, ids: Sequence[str] | None = None) -> Battery:
+    def _battery(
+        self, visit_id: str | None = None, ids: Sequence[str] | None = None, *, walk_up: bool = False
+    ) -> Battery:
         from qos import Engine
 
         policy, config, parts = self.parts.policy, self.config, self.parts
@@ -124,6 +140,8 @@ class SessionMaker:
                 "room": self.room,
             },
             visit_id=visit_id,
+            # a walk-up never has the Timed Up and Go: it needs staff beside the patient
+            steps=[s for s in parts.visit_steps(ids) if not (walk_up and s == TUG)],
         )
         return self.battery
 
@@ -140,9 +158,10 @@ class SessionMaker:
         ``instruments``: an order's instruments (default: the configured battery); ``first``
         overrides the configuration for one session (``session_id``, ``familiarisation``)."""
         options = {"familiarisation": self.config.familiarisation, **first}
-        if instruments is None and visit is None and patient is None:  # a walk-up: never a caregiver's instrument
+        walk_up = instruments is None and visit is None and patient is None
+        if walk_up:  # never a caregiver's instrument
             instruments = walk_up_instruments([i.questionnaire for i in self.parts.battery()]) or None
-        return self._battery(ids=instruments).first(
+        return self._battery(ids=instruments, walk_up=walk_up).first(
             patient_id=patient or self.patient_ids(),
             language=language or self.config.language,
             answered_by=answered_by,
@@ -214,6 +233,15 @@ def make_kiosk(
         sync=sync,
         orders=orders,
         start_order=start_order,
+        tugs=TugDesk(
+            clock,
+            store,
+            battery=lambda: maker.battery,
+            settings=lambda: tug_settings(config),
+            camera=lambda: app.channels.camera_off(),
+            poses=lambda: app.channels.poses,
+            say=lambda key, language: app.channels.say(ui_text(language, key), language),
+        ),
     )
     app = KioskApp(
         controller,

@@ -18,7 +18,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import logging
-import os
 import sqlite3
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -30,11 +29,10 @@ from kiosk.core.session import Finished, NextPatient, Phase, Session, SessionEve
 from kiosk.core.visits import Order, VisitDesk
 from kiosk.store.database import Store, StoredSession
 from kiosk.store.lease import SessionTaken
+from kiosk.store.space import can_write
 from kiosk.ui.paging import PAGE_BUTTON, RemotePager, needs_paging
+from kiosk.ui.tug_desk import TugDesk
 
-#: bytes the kiosk must be able to write beside its database before an out-of-order kiosk takes
-#: patients again (a test's rows, its QoS trace and the WAL need room to grow)
-PROBE_BYTES = 256 * 1024
 log = logging.getLogger(__name__)
 #: what staff read when they try to replace a test that is still going
 IN_PROGRESS = "a test is in progress on this kiosk: finish it, or start a new patient, first"
@@ -72,7 +70,8 @@ class KioskController:
     ``after(session)`` the session of a battery's next instrument (None: the visit is over).
     ``visits`` is a :class:`kiosk.core.visits.VisitDesk` (None: every welcome is a walk-up);
     ``sync`` the station's client, ``orders`` its order watcher and ``start_order(code)`` the call
-    that starts an ordered visit (all None without a station). Call :meth:`attach` before use.
+    that starts an ordered visit (all None without a station); ``tugs`` gives a battery's Timed Up
+    and Go in its place (:mod:`kiosk.ui.tug_desk`). Call :meth:`attach` before use.
     """
 
     def __init__(
@@ -87,6 +86,7 @@ class KioskController:
         sync: Any = None,
         orders: Any = None,
         start_order: Callable[[str], Any] | None = None,
+        tugs: TugDesk | None = None,
     ) -> None:
         self.session = session
         self.store = store
@@ -97,6 +97,8 @@ class KioskController:
         self.sync = sync
         self.orders = orders
         self.start_order = start_order
+        #: the visit's Timed Up and Go when its battery has one (None: never)
+        self.tugs = tugs
         #: every session event received, in order (the clinician screens and tests read it)
         self.events: list[SessionEvent] = []
         #: why the kiosk cannot store (a full disk, a failing drive); None while it can
@@ -189,13 +191,14 @@ class KioskController:
     def forward(self, item: ChannelInput | Presence) -> None:
         """Hand an input to the session (what a number means on each screen is the session's call);
         nothing while the kiosk is out of order, and none starts a test while the welcome waits for
-        staff (an ordered visit, no walk-ups). A presence report (the camera's) goes straight on."""
+        staff (an ordered visit, no walk-ups). A presence report goes straight on (none in a TUG)."""
         if self.out_of_order is not None:
             return
         if isinstance(item, Presence):
-            self.drive(self.session.handle, item)
+            if not self.tug_busy:  # a TUG's walk is no leaving
+                self.drive(self.session.handle, item)
             return
-        if self.session.phase is Phase.WELCOME and self.welcome_held():
+        if (self.session.phase is Phase.WELCOME and self.welcome_held()) or self.tug_busy:
             return
         if item.option is not None and self._paged_input(item) and (key := self.paged_item()) is not None:
             option = self.pager.press(key, key[2], item.option)
@@ -280,13 +283,26 @@ class KioskController:
         if fresh is not None:
             self.greet()
 
+    tug_busy = property(lambda self: self.tugs is not None and self.tugs.busy, doc="A TUG is under way.")
+
     def next_instrument(self) -> None:
-        """The running instrument finished: the visit's next one (a battery) starts on its rest
-        screen, in the same visit; after the last, nothing (the end screen stays)."""
+        """The running instrument finished: the visit's next one starts on its rest screen, after a
+        TUG due between them; after the last, nothing (the end screen; after a TUG, the welcome)."""
         finished = self.session
+        if finished.finished and self.tugs is not None and self.tugs.due(finished, finished, self._after_tug):
+            self._screens().redraw(rebuild=True)
+            return
+        self._next_after(finished)
+
+    def _after_tug(self) -> None:
+        if not self._next_after(self.session):
+            self.next_patient()
+        self._screens().redraw(rebuild=True)
+
+    def _next_after(self, finished: Session) -> bool:
         after = self.after(finished) if self.after is not None and finished.finished else None
         if after is None:
-            return
+            return False
         self.session = after
         self._unsubscribe()
         if self.store is not None:
@@ -295,11 +311,12 @@ class KioskController:
         self._unsubscribe = after.subscribe(self._on_event)
         self._screens().tell_channels()
         self.drive(after.start)
+        return True
 
     def next_patient(self) -> None:
         """The end screen was shown long enough (the session's :class:`NextPatient`): the welcome
         for the next patient; the finished result stays in the store for staff."""
-        if self.fresh is not None and self.session.finished:
+        if self.fresh is not None and self.session.finished and not self.tug_busy:
             self.start_over()
 
     @property
@@ -405,7 +422,15 @@ class KioskController:
     def _begin(self, session: Session, *start: object) -> None:
         self.swap(session)
         self._screens().close_clinician()
-        self.drive(self.session.start, *start)
+        self._start(*start)
+
+    def _start(self, *start: object) -> None:
+        """Start the visit's session, after a Timed Up and Go due before its first instrument."""
+        session, begin = self.session, lambda: self.drive(self.session.start, *start)
+        if self.tugs is not None and session.phase is Phase.WELCOME and self.tugs.due(None, session, begin):
+            self._screens().redraw(rebuild=True)
+        else:
+            begin()
 
     def welcome_held(self) -> bool:
         """The welcome waits for staff to confirm an ordered visit (or the site allows no walk-up)."""
@@ -420,7 +445,7 @@ class KioskController:
         """The station started the visit: a session for its patient, in its language, begins."""
         if self.visits is not None and self.session.phase is Phase.WELCOME:
             self.swap(self.visits.for_order(order))
-            self.drive(self.session.start, order.answered_by)
+            self._start(order.answered_by)
 
     def walk_up(self) -> None:
         """Staff let a walk-up patient start at the welcome."""
@@ -459,7 +484,7 @@ class KioskController:
             return  # the database is busy or failing: the next round tries again
         if why is not None:
             self.session_lost(why)
-        elif self.store_fault is not None and self._can_write():
+        elif self.store_fault is not None and can_write(Path(self.store.path).parent):
             self.store_fault = None  # space was freed (or the lock let go): the welcome is back
             self._screens().redraw(rebuild=True)
             self.report_status()
@@ -472,21 +497,3 @@ class KioskController:
         self.store_fault = f"the kiosk could not store its last step ({failed})"
         self.session_lost(self.store_fault, tell_patient=False)
         self.report_status()
-
-    def _can_write(self) -> bool:
-        """The data directory takes :data:`PROBE_BYTES` more (written, synced and removed)."""
-        assert self.store is not None
-        probe = Path(self.store.path).parent / ".kiosk-write-probe"
-        try:
-            handle = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-            try:
-                os.write(handle, bytes(PROBE_BYTES))
-                os.fsync(handle)
-            finally:
-                os.close(handle)
-            return True
-        except OSError:
-            return False
-        finally:
-            with contextlib.suppress(OSError):
-                probe.unlink()

@@ -87,9 +87,10 @@ class PatientStage:
         """Rebuild the phase's screen on the next :meth:`show`, even if it looks the same."""
         self.key = None
 
-    def show(self, view: PatientView, *, out_of_order: bool = False, held_visits: Any = None) -> None:
+    def show(self, view: PatientView, *, out_of_order: bool = False, held_visits: Any = None, tug: Any = None) -> None:
         """Show the screens ``view`` calls for, or refresh the ones shown. ``out_of_order``: one
-        calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff."""
+        calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff;
+        ``tug``: the TUG desk while a visit's Timed Up and Go is under way (its screen instead)."""
         app, snap = self.app, view.snapshot
         base_cls = phase_screen(snap.phase)
         overlay_cls = _overlay_screen(snap.halted, snap.paused, snap.unattended, snap.calling is not None)
@@ -101,7 +102,12 @@ class PatientStage:
         base, overlay = (shown + [None, None])[:2]
         key = (base_cls, base_cls.key(view))
         make: Callable[[], PatientScreen] = partial(base_cls, view)
-        if base_cls is WelcomeScreen and held_visits is not None:  # kiosk.core.visits: staff confirm first
+        if tug is not None and not out_of_order:
+            from kiosk.ui.screens.tug import TugScreen
+
+            base_cls, overlay_cls = TugScreen, None
+            key, make = (TugScreen, TugScreen.key(view)), partial(TugScreen, view, tug)
+        elif base_cls is WelcomeScreen and held_visits is not None:  # kiosk.core.visits: staff confirm first
             from kiosk.ui.screens.visit_ready import VisitReadyScreen
 
             base_cls, key = VisitReadyScreen, (VisitReadyScreen, held_visits.ready)

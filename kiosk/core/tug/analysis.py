@@ -144,6 +144,9 @@ def _measure(
     sequence: PoseSequence, s: Signals, quality: dict[str, Any], found: dict[str, float], reasons: list[str]
 ) -> None:
     t = s.t
+    if not len(t):
+        quality.update(person_share=0.0, legs_share=0.0)
+        raise _Refused("no frames: the camera saw nothing of the test")
     fps = 1.0 / float(np.median(np.diff(t))) if len(t) > 1 else sequence.fps
     people = int(s.person.sum())
     quality["person_share"] = round(people / len(t), 3)

@@ -218,6 +218,16 @@ class TugStep:
             self._publish(t, changed)
 
     @property
+    def last_landmarks(self) -> tuple[Landmark, ...] | None:
+        """The latest frame's landmarks (None: no frame yet, or nobody in it): the live preview."""
+        return self._frames[-1].landmarks if self._frames else None
+
+    @property
+    def up(self) -> bool:
+        """The live posture: the patient is up (risen and not yet seated back)."""
+        return self._up
+
+    @property
     def seated_again(self) -> bool:
         """The patient rose and sat back down (the run can be finished)."""
         return self.stage is TugStage.RUNNING and self._published.get("PersonGetsUp") is False

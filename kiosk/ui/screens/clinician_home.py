@@ -15,6 +15,7 @@ from textual.widgets import DataTable, Switch
 from kiosk.core.channels import ChannelState
 from kiosk.core.room import STAFF_NOTICE
 from kiosk.core.session import Phase
+from kiosk.core.visits import TUG
 from kiosk.export.captured import questionnaire_of, result_line
 from kiosk.store.records import SessionSummary
 from kiosk.ui.screens.base import ClinicianScreen, staff_nav
@@ -23,6 +24,14 @@ from kiosk.ui.widgets.literal import Button, Label, Static, cell
 
 #: how often the running session's line is redrawn (seconds)
 REFRESH_S = 1.0
+
+
+#: a visit whose battery has the Timed Up and Go, on a kiosk that cannot time it (issue 34)
+_TUG_BY_STOPWATCH = "; this visit's Timed Up and Go: no camera, so a stopwatch time or a skip"
+
+
+def _has_tug(place: object) -> bool:
+    return TUG in getattr(place, "instruments", ())
 
 
 class ClinicianHomeScreen(ClinicianScreen):
@@ -214,6 +223,7 @@ class ClinicianHomeScreen(ClinicianScreen):
                 for line in lines
             )
             + f"; {camera}"
+            + (_TUG_BY_STOPWATCH if state is not ChannelState.ON and _has_tug(self.kiosk.session.battery) else "")
         )
 
     @on(Button.Pressed, "#continue")

@@ -54,6 +54,9 @@ class UiKiosk:
         instruments: tuple = (),
         unattended_after: int | None = None,
         away_alert_after_s: float | None = 60.0,
+        poses=None,
+        patient: str | None = None,
+        visits: bool = False,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -78,6 +81,7 @@ class UiKiosk:
             voice=voice,
             sources=sources,
             keyboard=keyboard,
+            poses=poses,  # a camera's landmark feed (a visit's Timed Up and Go)
             statuses=[
                 ChannelStatus(Channel.VOICE, ChannelState.OFF, "voice in", "no microphone found"),
                 ChannelStatus(Channel.REMOTE, ChannelState.OFF, "serial", "no serial remote on /dev/ttyUSB*"),
@@ -89,12 +93,13 @@ class UiKiosk:
             store=self.store,
             channels=channels,
             parts=parts,
-            first={"language": language, "session_id": session_id, "familiarisation": familiarisation},
+            first={"language": language, "session_id": session_id, "familiarisation": familiarisation}
+            | ({"patient": patient} if patient else {}),
             patient_ids=lambda: next(patients, "P-TEST02"),
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
             # of the real timer never finds anything due
             poll_interval=poll_interval,
-            visits=False,  # the snapshots show "Start a visit" off, as before visits existed
+            visits=visits,  # by default off: the snapshots show "Start a visit" off, as before visits existed
             # failed attempts counted in memory, or (pin_on_disk) the kiosk's own guard, counting
             # them in the data directory
             clinician_pin=None if pin_on_disk else UI_PIN,
@@ -126,7 +131,8 @@ class UiKiosk:
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
     voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model,
-    questionnaire, pin_on_disk, instruments, unattended_after, away_alert_after_s)."""
+    questionnaire, pin_on_disk, instruments, unattended_after, away_alert_after_s, poses, patient,
+    visits)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
