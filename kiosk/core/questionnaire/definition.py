@@ -180,7 +180,7 @@ def questionnaire_from(definition: Mapping[str, Any], source: str = "") -> Quest
 
 def _concern(value: Any) -> str | None:
     if value is None or value in CONCERNS:
-        return value  # type: ignore[no-any-return]
+        return value
     raise DefinitionError(f"a band's concern must be one of {', '.join(CONCERNS)}, got {value!r:.40}")
 
 
