@@ -49,6 +49,7 @@ from station import (
     signoff_pages,
     staff_items,
     throttle,
+    tug_pages,
 )
 from station.bodylimit import BodyLimit
 from station.bus import Bus
@@ -259,6 +260,7 @@ def create_app(
         *order_pages.routes,
         *result_pages.routes,
         *print_pages.routes,
+        *tug_pages.routes,
         *handover_pages.routes,
         *signoff_pages.routes,
         *definition_pages.routes,

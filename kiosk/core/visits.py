@@ -19,6 +19,9 @@ from kiosk.core.answerers import Answerer, answerer
 
 WALK_UP = "walk-up"
 STAFF = "staff"
+#: the Timed Up and Go's id in an order's instruments (kiosk.core.tug.step): every kiosk with
+#: staff beside the patient gives it (by camera or stopwatch), so an order naming it is taken
+TUG = "tug"
 #: what every patient identifier is, whatever the site: 2-64 letters, digits, '-' or '_' with at
 #: least one digit (what the store and the station's rows accept)
 HOSPITAL_ID = re.compile(r"^(?=.*[0-9])[A-Za-z0-9][A-Za-z0-9_-]{1,63}$")
@@ -116,7 +119,7 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
             problems.append(f"{where}: without an id or a patient identifier")
         elif check_patient_id(patient, None):  # the station's own rule was applied where it was typed
             problems.append(f"{where} ({order_id}): {check_patient_id(patient, None)}")
-        elif not isinstance(wanted, list) or not wanted or any(i not in instruments for i in wanted):
+        elif not isinstance(wanted, list) or not wanted or any(i not in (*instruments, TUG) for i in wanted):
             problems.append(f"{where} ({order_id}): instruments {wanted!r}: this kiosk gives {', '.join(instruments)}")
         elif language not in known_languages:
             problems.append(f"{where} ({order_id}): language {language!r} is not one this kiosk speaks")
