@@ -5,13 +5,19 @@ from __future__ import annotations
 
 import json
 import sqlite3
+from dataclasses import dataclass, replace
+from datetime import UTC, datetime
 from pathlib import Path
 
+from sqlalchemy.engine import Engine
+
+from bench._history import clone
 from kiosk.core.tug.families import generate
 from kiosk.core.tug.step import TugResult
 from kiosk.store.database import DB_NAME, Store
+from station import auth, orders, sync
 from tests.kiosk.core.tug.stepping import go_of, run
-from tests.station.helpers import Row
+from tests.station.helpers import PATIENTS, Row, record_patient
 
 
 def camera_result(seed: int = 11) -> TugResult:
@@ -51,3 +57,49 @@ def tug_rows(
         for patient, result, at in results:
             store.tug.record(patient, result, at=at, visit=visit, visit_id=visit_id)
     return [r for r in outbox(data_dir / DB_NAME) if r.kind == "record_tug"]
+
+
+#: when the ordered visit's Barthel began
+BARTHEL_AT = datetime(2026, 11, 20, 10, 15, tzinfo=UTC)
+
+
+@dataclass
+class TugVisits:
+    """A patient's visits with Timed Up and Go results, stored through the station's own code."""
+
+    patient_id: str
+    order_id: str
+    barthel: str
+    #: the ordered visit's TUG (camera, accepted) and an earlier staff visit's (stopwatch)
+    camera: str
+    stopwatch: str
+
+
+def store_tug_visits(engine: Engine, tmp_path: Path, patient: str = "NHC-0034100") -> TugVisits:
+    """On a ward made by :func:`tests.station.conftest.make_ward` (kiosk ward3-bed2): a staff
+    visit's stopwatch TUG (15.5 s, above the threshold) on 2026-11-02, then an ordered visit of a
+    Barthel and a camera TUG (about 10.6 s) on 2026-11-20, each from a real kiosk store's outbox."""
+    kiosk = "ward3-bed2"
+    order = orders.create(
+        engine,
+        kiosk_id=kiosk,
+        patient_id=patient,
+        instruments=["barthel", "tug"],
+        language="en",
+        relative=False,
+        by=auth.User("nurse.kim", "nurse"),
+        known_instruments=["barthel", "tug"],
+        languages=["en"],
+    )
+    with engine.begin() as connection:
+        assert orders.start(connection, kiosk, order.code) is not None
+    visit = f"order {order.id}"
+    early = tug_rows(tmp_path / "k-early", [(patient, stopwatch_result(), "2026-11-02T08:00:00Z")], visit="staff")
+    template = record_patient(PATIENTS / "barthel1.yaml", patient=patient, visit=visit)
+    barthel = clone(template, f"tug-barthel-{patient}", patient, BARTHEL_AT, len(early) + 1)
+    late = tug_rows(tmp_path / "k-late", [(patient, camera_result(), "2026-11-20T10:40:00Z")], visit=visit)
+    late = [replace(r, seq=len(early) + len(barthel) + 1 + i) for i, r in enumerate(late)]
+    with engine.begin() as connection:
+        events = [*[r.event() for r in early], *barthel, *[r.event() for r in late]]
+        sync.intake(connection, kiosk, sync.parse({"events": events}))
+    return TugVisits(patient, order.id, barthel[0]["session_id"], late[0].session_id, early[0].session_id)

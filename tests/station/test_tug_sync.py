@@ -127,3 +127,44 @@ def test_a_tug_row_without_its_fields_is_refused(shared_station, tmp_path):
     finally:
         client.close()
     assert response.status_code == 422 and "record_tug without decided_by" in response.json()["error"]
+
+
+def test_the_kiosks_own_client_delivers_tugs_and_parks_a_bad_one(shared_station, tmp_path):
+    """The kiosk's real sync client (kiosk.sync.client) over its real outbox: a questionnaire
+    visit and its TUGs arrive; a row a kiosk could only have sent wrongly (a rating of 9, which its
+    own table refuses: written into the outbox here) is parked with the station's reason, and
+    nothing waits behind it."""
+    import sqlite3
+
+    from kiosk.commands.replay import load_script, run_script
+    from kiosk.store.database import DB_NAME, Store
+    from kiosk.sync.client import SyncClient
+    from tests.station.helpers import PATIENTS
+
+    station, ward = shared_station
+    kiosk, token = new_kiosk(ward.db_url)
+    data = tmp_path / "kiosk"
+    with Store.open(data, outbox=True) as store:
+        session = run_script(load_script(PATIENTS / "barthel5.yaml"), store=store).session.id
+        good = store.tug.record("P-0090", camera_result(), visit="staff", visit_id="v-90")
+        bad = store.tug.record("P-0090", stopwatch_result(), visit="staff")
+    with sqlite3.connect(data / DB_NAME) as kiosk_db:
+        kiosk_db.execute("UPDATE outbox SET payload = json_set(payload, '$.get_up_go', 9) WHERE session_id = ?", (bad,))
+    client = SyncClient(data / DB_NAME, url=station.url, token=token, kiosk_id=kiosk, backoff=(0.02, 0.2))
+    try:
+        assert client.deliver_all(within_s=120) == 0
+        parked = client.outbox.parked()
+    finally:
+        client.stop()
+    assert len(parked) == 1 and "record_tug.get_up_go: must be a whole number from 1 to 5" in parked[0][1]
+    found = [t for t in stored(ward.db_url) if t.kiosk_id == kiosk]
+    assert [t.id for t in found] == [good] and bad not in {t.id for t in found}
+    engine = db.make_engine(ward.db_url)
+    try:
+        with engine.connect() as connection:
+            status = connection.execute(sa.select(db.sessions.c.status).where(db.sessions.c.id == session)).scalar()
+            assert status == "finished"
+            # the TUG's id is no session at the station
+            assert connection.execute(sa.select(db.sessions.c.id).where(db.sessions.c.id == good)).first() is None
+    finally:
+        engine.dispose()
