@@ -23,7 +23,7 @@ from basis import record
 from kiosk.core.tug.analysis import Phase
 from kiosk.export.tug import PHASE_NAMES, TugTime
 from station import db
-from station.db import tug_results, visits
+from station.db import sessions, tug_results, visits
 from station.sessions import rows_of
 from station.tug_checks import CheckedTug
 
@@ -123,6 +123,8 @@ class StationTug:
 def store(connection: Connection, kiosk_id: str, seq: int, tug: CheckedTug, received: float) -> None:
     """Store a checked result from ``kiosk_id``'s row ``seq`` (in the sync's transaction); the
     same row again stores nothing, the same id from another row is :class:`TugClash`."""
+    if connection.execute(sa.select(sessions.c.id).where(sessions.c.id == tug.tug_id)).first() is not None:
+        raise TugClash(f"seq {seq}: record_tug.tug_id: {tug.tug_id} is a session's id, not a new result's")
     known = connection.execute(
         sa.select(tug_results.c.kiosk_id, tug_results.c.seq).where(tug_results.c.id == tug.tug_id)
     ).first()

@@ -95,3 +95,23 @@ def test_the_exports_give_the_kiosks_observation(stored) -> None:
         (visits.camera, "camera", "total"),
     ]
     assert len(rows) == 2 + 5 and rows[0]["seconds"] == "15.50" and rows[0]["accepted_by"] == "nurse-7"
+
+
+def test_a_patient_with_only_tugs_is_found_and_a_tug_never_takes_a_sessions_id(stored, tmp_path) -> None:
+    from dataclasses import replace
+
+    from station import results, sync
+    from tests.station._tug import stopwatch_result, tug_rows
+
+    engine, _, visits = stored
+    (row,) = tug_rows(tmp_path / "k", [("NHC-0034999", stopwatch_result(), "2026-11-25T09:00:00Z")])
+    with engine.begin() as connection:
+        sync.intake(connection, "ward3-bed2", sync.parse({"events": [replace(row, seq=900).event()]}))
+    assert results.search(engine, "nhc-003499") == [("NHC-0034999", 1, "2026-11-25T09:00:00Z")]
+    found = dict((p, n) for p, n, _ in results.search(engine, "NHC-00341"))
+    assert found == {visits.patient_id: 3}  # the Barthel and two TUGs
+    clash = replace(row, seq=901, session_id=visits.barthel)
+    clash.payload["tug_id"] = visits.barthel
+    with pytest.raises(sync.Conflict, match=r"seq 901: record_tug.tug_id: .* is a session's id"):
+        with engine.begin() as connection:
+            sync.intake(connection, "ward3-bed2", sync.parse({"events": [clash.event()]}))
