@@ -217,6 +217,43 @@ reference_results = sa.Table(
     sa.Column("entered_at", sa.String(40), nullable=False),
 )
 
+#: Timed Up and Go results (station.tugs), one per record_tug row a kiosk sent
+tug_results = sa.Table(
+    "tug_results",
+    metadata,
+    sa.Column("id", sa.String(64), primary_key=True),
+    sa.Column("kiosk_id", sa.String(64), nullable=False),
+    sa.Column("seq", sa.BigInteger, nullable=False),
+    sa.Column("patient_id", sa.String(64), nullable=False),
+    sa.Column("at", sa.String(40), nullable=False),
+    #: how the visit began ("order", "staff"), and its order; None: the kiosk did not say
+    sa.Column("visit_kind", sa.String(16)),
+    sa.Column("order_id", sa.String(32)),
+    #: the kiosk's visit (a battery's id), which its questionnaire sessions name in their log
+    sa.Column("visit_id", sa.String(64)),
+    sa.Column("confirmed_by", sa.String(64), nullable=False),
+    #: accepted (the camera's time), stopwatch (staff's time), rejected (no time)
+    sa.Column("decision", sa.String(16), nullable=False),
+    sa.Column("decided_by", sa.String(64), nullable=False),
+    sa.Column("total_s", sa.Float),
+    sa.Column("method", sa.String(16)),
+    sa.Column("camera_total_s", sa.Float),
+    sa.Column("threshold_s", sa.Float, nullable=False),
+    #: JSON: [{"name", "start_t", "end_t"}], and the analysis' reasons (text list)
+    sa.Column("phases", sa.Text, nullable=False),
+    sa.Column("reasons", sa.Text, nullable=False),
+    sa.Column("person_share", sa.Float, nullable=False),
+    sa.Column("body_cut_off", sa.Boolean, nullable=False),
+    sa.Column("turn_seen", sa.Boolean, nullable=False),
+    sa.Column("get_up_go", sa.Integer),
+    sa.Column("walking_aid", sa.String(16)),
+    sa.Column("simulated", sa.Boolean, nullable=False, server_default=sa.false()),
+    #: the kiosk's export identity (JSON), as a create_session's
+    sa.Column("export", sa.Text),
+    sa.Column("received_at", sa.Float, nullable=False),
+    sa.UniqueConstraint("kiosk_id", "seq"),
+)
+
 code_failures = sa.Table(
     "order_code_failures",
     metadata,

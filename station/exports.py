@@ -24,7 +24,7 @@ from kiosk.core.staff import every_entered
 from kiosk.export import Described, bundle_of, result, result_rows
 from kiosk.export.captured import site_of
 from kiosk.store.database import StoredSession
-from station import validation
+from station import tug_exports, tugs, validation
 from station.db import sessions
 from station.definitions import questionnaire_for
 from station.sessions import SAMPLE_KINDS, load, load_many
@@ -49,9 +49,14 @@ def _describe(fallback: Questionnaire, kiosk: str, stored: StoredSession, trail:
 
 
 def result_bundle(engine: Engine, q: Questionnaire, session_id: str) -> dict:
-    """One result as it stands, as a transaction Bundle (NotFound if it never arrived)."""
+    """One result as it stands, as a transaction Bundle (NotFound if it never arrived), with the
+    Timed Up and Go times of its visit (:mod:`station.tug_exports`)."""
     with engine.connect() as connection:
-        return bundle_of([_described(connection, q, session_id)])
+        bundle = bundle_of([_described(connection, q, session_id)])
+        more = tug_exports.entries(tugs.of_sessions(connection, [session_id]))
+    if more:
+        bundle["entry"] = [*bundle.get("entry", []), *more]
+    return bundle
 
 
 def result_csv(engine: Engine, q: Questionnaire, session_id: str) -> str:
@@ -119,8 +124,9 @@ def _described_batch(connection: Connection, fallback: Questionnaire, ids: list[
 
 
 def period_bundle(engine: Engine, q: Questionnaire, first: date, last: date) -> dict:
-    """Every result signed off from ``first`` to ``last`` (:func:`signed_off_in`) in one
-    transaction Bundle (no entry when there is none): :func:`period_chunks`, read whole."""
+    """Every result signed off from ``first`` to ``last`` (:func:`signed_off_in`), and every Timed
+    Up and Go time taken then, in one transaction Bundle (no entry when there is none):
+    :func:`period_chunks`, read whole."""
     return json.loads("".join(period_chunks(engine, q, first, last)))
 
 
@@ -134,9 +140,10 @@ def period_chunks(engine: Engine, q: Questionnaire, first: date, last: date) -> 
     answer; a later one ends the stream unfinished (invalid JSON), never a Bundle silently short."""
     seen: set[str] = set()
     with engine.connect() as connection:
+        timed = tug_exports.entries(tug_exports.in_period(connection, first, last))  # a few per patient
         batches = _signed_batches(connection, first, last)
         pending = list(_described_batch(connection, q, next(batches, [])))
-        if not pending:
+        if not pending and not timed:
             yield json.dumps({"resourceType": "Bundle", "type": "transaction"})
             return
         yield '{"resourceType": "Bundle", "type": "transaction", "entry": [\n'
@@ -151,4 +158,7 @@ def period_chunks(engine: Engine, q: Questionnaire, first: date, last: date) -> 
                     yield comma + json.dumps(entry, ensure_ascii=False)
                     comma = ",\n"
             pending = list(_described_batch(connection, q, next(batches, [])))
+        for entry in timed:  # the Timed Up and Go times taken in the period (staff decided them at the kiosk)
+            yield comma + json.dumps(entry, ensure_ascii=False)
+            comma = ",\n"
         yield "\n]}"

@@ -16,7 +16,7 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
-from station import orders, validation, ward
+from station import orders, tugs, validation, ward
 from station.api_orders import ORDER_LANE
 from station.redirects import see_other
 from station.rendering import checked_form, render
@@ -62,7 +62,7 @@ async def create_order(request: Request) -> Response:
         offered = {i.id: i for i in orders.instruments(engine, q)}
         chosen = [str(v) for v in multi.getlist("instrument")]
         # a language every chosen instrument has (all of them when none is known yet: create says why)
-        spoken = [set(offered[i].languages) for i in chosen if i in offered]
+        spoken = [set(offered[i].languages) for i in chosen if i in offered and offered[i].languages]
         languages = (
             sorted(set.intersection(*spoken)) if spoken else sorted({x for i in offered.values() for x in i.languages})
         )
@@ -99,7 +99,10 @@ async def order_page(request: Request) -> Response:
     if order is None:
         return PlainTextResponse(f"no order {request.path_params['order_id']}", status_code=404)
     trail = await run_in_threadpool(validation.trail, engine, order.id)
-    return render(request, "order.html", order=order, trail=trail, message=request.query_params.get("message"))
+    found = await run_in_threadpool(tugs.of_order, engine, order.id)
+    return render(
+        request, "order.html", order=order, trail=trail, tugs=found, message=request.query_params.get("message")
+    )
 
 
 async def cancel_order(request: Request) -> Response:

@@ -14,8 +14,9 @@ from typing import Any
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
 
+from kiosk.core.visits import TUG
 from station import db
-from station.db import orders, sessions, visits
+from station.db import audit, orders, sessions, tug_results, visits
 from station.orders import LinkRefused, audit_order
 from station.sessions import LIFECYCLE
 
@@ -112,6 +113,56 @@ def _sessions_of(connection: Connection, order: Any) -> list[str]:
     return list(dict.fromkeys([*linked, *([order.session_id] if order.session_id else [])]))
 
 
+def _done(connection: Connection, order: Any) -> int:
+    """The order's instruments done: its finished sessions, and its Timed Up and Go results (as
+    many as it names ``tug``; staff decided each at the kiosk, a rejection included)."""
+    finished = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+    tugs = connection.execute(
+        sa.select(sa.func.count()).select_from(tug_results).where(tug_results.c.order_id == order.id)
+    ).scalar_one()
+    return finished + min(int(tugs), list(json.loads(order.instruments)).count(TUG))
+
+
+def on_tug(connection: Connection, kiosk_id: str, seq: int, order_id: str, patient_id: str) -> list[dict[str, Any]]:
+    """A Timed Up and Go of an ordered visit arrived (stored in the sync's transaction): refused
+    (LinkRefused) when the order is another kiosk's or patient's, or was never started with its
+    code; else the order moves on as a finished session moves it (a kiosk that stopped holding
+    the order meanwhile is forgiven: the result is the visit's). An order of Timed Up and Go
+    tests only is complete then: staff decided each at the kiosk, nothing waits for a doctor."""
+    row = connection.execute(sa.select(orders).where(orders.c.id == order_id)).first()
+    if row is None or row.kiosk_id != kiosk_id:
+        raise LinkRefused(f"seq {seq}: record_tug.visit: no order {order_id} for kiosk {kiosk_id}")
+    if row.patient_id != patient_id:
+        raise LinkRefused(
+            f"seq {seq}: record_tug.patient_id: order {order_id} is for patient {row.patient_id}, not {patient_id}"
+        )
+    started = connection.execute(
+        sa.select(audit.c.id).where(audit.c.session_id == order_id, audit.c.action == "order_start").limit(1)
+    ).first()
+    if started is None:
+        raise LinkRefused(f"seq {seq}: record_tug.visit: order {order_id} was not started with its code at the kiosk")
+    if row.state not in ("ordered", "in_progress"):
+        return []  # cancelled, or its results wait already: the result is kept under it
+    done, wanted = _done(connection, row), len(json.loads(row.instruments))
+    if done < wanted:
+        words = f"Timed Up and Go stored: {done} of {wanted} instruments done"
+        audit_order(connection, row.id, f"kiosk {kiosk_id}", "order_instrument", words)
+        return [{"type": "order", "kiosk": kiosk_id}]
+    only_tugs = all(i == TUG for i in json.loads(row.instruments))
+    target = "signed_off" if only_tugs else "awaiting_validation"
+    connection.execute(orders.update().where(orders.c.id == row.id).values(state=target, updated_at=db.now_iso()))
+    audit_order(
+        connection,
+        row.id,
+        f"kiosk {kiosk_id}",
+        "order_signed" if only_tugs else "order_result",
+        "Timed Up and Go stored: decided by staff at the kiosk, nothing waits for validation"
+        if only_tugs
+        else f"Timed Up and Go stored: the results wait for validation ({wanted} instruments)",
+    )
+    return [{"type": "order", "kiosk": kiosk_id}]
+
+
 def _is_finished(connection: Connection, session_id: str) -> bool:
     status = connection.execute(sa.select(db.sessions.c.status).where(db.sessions.c.id == session_id)).scalar()
     return status == "finished"
@@ -123,7 +174,7 @@ def _finished(connection: Connection, kiosk_id: str, session_id: str) -> None:
     order = _order_of(connection, session_id)
     if order is None or order.state != "in_progress":
         return
-    done = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+    done = _done(connection, order)
     wanted = len(json.loads(order.instruments))
     if done < wanted:
         audit_order(
@@ -151,7 +202,7 @@ def _abandoned(connection: Connection, kiosk_id: str, session_id: str) -> bool:
     order = _order_of(connection, session_id)
     if order is None or order.state != "in_progress":
         return False
-    done = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+    done = _done(connection, order)
     if done:
         return _move(
             connection,
@@ -256,7 +307,7 @@ def release_unheld(connection: Connection, kiosk_id: str, held: set[str]) -> lis
     for order in stuck:
         if order.id in held:
             continue
-        done = sum(_is_finished(connection, s) for s in _sessions_of(connection, order))
+        done = _done(connection, order)
         wanted = len(json.loads(order.instruments))
         target = "awaiting_validation" if done else "ordered"
         values: dict[str, Any] = {"state": target, "updated_at": db.now_iso()}

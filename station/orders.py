@@ -32,7 +32,7 @@ from sqlalchemy.engine import Connection, Engine
 
 from basis import record
 from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
-from kiosk.core.visits import DEFAULT_ID_PATTERN, HOSPITAL_ID
+from kiosk.core.visits import DEFAULT_ID_PATTERN, HOSPITAL_ID, TUG
 from kiosk.core.visits import check_patient_id as identifier_problem
 from station import db
 from station.db import audit, code_failures, kiosks, orders
@@ -52,6 +52,9 @@ WORDS = {
     "cancelled": "cancelled",
 }
 OPEN = ("ordered", "in_progress")
+#: the Timed Up and Go as staff order it (id ``tug``): no language of its own (the kiosk speaks
+#: the visit's), staff beside the patient -- as at every ordered visit, whose code staff type
+TUG_TITLE = "Timed Up and Go"
 #: digits of the confirmation code typed at the kiosk
 CODE_DIGITS = 4
 #: wrong codes are throttled by spacing the kiosk's checks, never by refusing its right code
@@ -207,7 +210,8 @@ class Instrument:
 def instruments(engine: Engine, bundled: Any) -> list[Instrument]:
     """What staff may order: the station's bundled questionnaire, then every other one a kiosk
     has run here (its latest stored definition), so a site running its own questionnaire can
-    order it; the kiosks still take only orders for instruments they give."""
+    order it, then the Timed Up and Go (no languages: it takes the visit's); the kiosks still
+    take only orders for instruments they give."""
     found = {bundled.id: Instrument(bundled.id, bundled.title.get("en") or bundled.id, tuple(bundled.languages))}
     with engine.connect() as connection:
         rows = connection.execute(
@@ -227,6 +231,7 @@ def instruments(engine: Engine, bundled: Any) -> list[Instrument]:
         found[row.questionnaire_id] = Instrument(
             row.questionnaire_id, str(name or row.questionnaire_id), tuple(languages)
         )
+    found[TUG] = Instrument(TUG, TUG_TITLE, ())
     return list(found.values())
 
 
@@ -256,6 +261,8 @@ def create(
     chosen = [i for i in dict.fromkeys(instruments) if i]
     if not chosen:
         raise OrderError("instruments: choose at least one")
+    if all(i == TUG for i in chosen):  # the kiosk gives it within a visit, beside a questionnaire
+        raise OrderError(f"instruments: the {TUG_TITLE} is given within a visit: choose an instrument with it")
     unknown = [i for i in chosen if i not in known_instruments]
     if unknown:
         raise OrderError(

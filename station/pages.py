@@ -26,7 +26,7 @@ from kiosk.core.review import review_state, state_once_signed
 from kiosk.core.staff import number_text
 from kiosk.export import ExportError, practice_outcomes
 from kiosk.store.database import StoredSession
-from station import db, exports, order_progress, staff_items, validation, ward
+from station import db, exports, order_progress, staff_items, tugs, validation, ward
 from station.definitions import questionnaire_for
 from station.download import attachment
 from station.formulas import GuardedQuestionnaire
@@ -219,6 +219,7 @@ async def session_page(request: Request) -> Response:
         reviewable=stored.status in validation.REVIEWABLE and not current.final,
         reopened=bool(current.reopenings) and not current.final,
         visit=(await run_in_threadpool(order_progress.visit_kinds, engine, [session_id])).get(session_id),
+        tugs=await run_in_threadpool(tugs.of_session, engine, session_id),
         unknown_definition=isinstance(q, GuardedQuestionnaire) and not q.known,
         message=request.query_params.get("message"),
     )

@@ -24,6 +24,7 @@ from kiosk.core.review import review_state
 from kiosk.core.staff import entered_at_station, entered_values
 from kiosk.export import ExportError
 from kiosk.store.database import StoredSession
+from station import tugs
 from station.db import audit, orders, sessions, visits
 from station.definitions import questionnaire_for
 from station.sessions import RESULT_KINDS, NotFound, load_many
@@ -70,14 +71,25 @@ class PrintedResult:
 
 
 @record
+class PrintedTug:
+    """A Timed Up and Go of a printed visit: the result and when, as staff read it."""
+
+    tug: tugs.StationTug
+    when: str
+
+
+@record
 class PrintedVisit:
-    """One visit as printed: the patient, when and where, and each instrument in the order run."""
+    """One visit as printed: the patient, when and where, each instrument in the order run, and
+    its Timed Up and Go results; ``at`` (ISO 8601) orders visits."""
 
     patient_id: str
     kiosk_id: str
     date: str
     order_id: str | None
     results: list[PrintedResult]
+    tugs: tuple[PrintedTug, ...] = ()
+    at: str = ""
 
 
 def _trails(connection: Connection, ids: list[str]) -> dict[str, list[AuditEntry]]:
@@ -160,6 +172,7 @@ def visits_of(connection: Connection, q: Questionnaire, ids: Sequence[str], zone
         run = ordered.get(key, [])
         members.sort(key=lambda m: (_index(run, m[1].questionnaire_id), m[1].started_at or ""))
         kiosk, first = min(members, key=lambda m: m[1].started_at or "")
+        timed = tugs.of_sessions(connection, [stored.id for _, stored in members])
         found.append(
             PrintedVisit(
                 first.patient_id,
@@ -167,10 +180,34 @@ def visits_of(connection: Connection, q: Questionnaire, ids: Sequence[str], zone
                 shown_time(first.started_at, zone),
                 key if order_of.get(first.id) else None,
                 [_printed(stored, q, trails[stored.id], zone) for _, stored in members],
+                tuple(PrintedTug(t, shown_time(t.at, zone)) for t in timed),
+                first.started_at or "",
             )
         )
-    found.sort(key=lambda v: min(loaded[r.session_id][1].started_at or "" for r in v.results))
+    found.sort(key=lambda v: v.at)
     return found
+
+
+def _tug_only(tug: tugs.StationTug, zone: tzinfo | None) -> PrintedVisit:
+    """A visit of Timed Up and Go results alone (no questionnaire session of it reached the station)."""
+    when = shown_time(tug.at, zone)
+    return PrintedVisit(tug.patient_id, tug.kiosk_id, when, tug.order_id, [], (PrintedTug(tug, when),), tug.at)
+
+
+def tug_visit(engine: Engine, q: Questionnaire, tug_id: str, zone: tzinfo | None = None) -> PrintedVisit | None:
+    """The visit a Timed Up and Go belongs to: its order's sessions with it, else the result alone
+    (None when it never arrived)."""
+    found = tugs.get(engine, tug_id)
+    if found is None:
+        return None
+    with engine.connect() as connection:
+        ids: list[str] = []
+        if found.order_id:
+            ids = list(
+                connection.execute(sa.select(visits.c.session_id).where(visits.c.order_id == found.order_id)).scalars()
+            )
+        printed = visits_of(connection, q, ids, zone) if ids else []
+    return next((v for v in printed if tug_id in {t.tug.id for t in v.tugs}), None) or _tug_only(found, zone)
 
 
 def visit(engine: Engine, q: Questionnaire, session_id: str, zone: tzinfo | None = None) -> PrintedVisit:
@@ -189,11 +226,15 @@ def visit(engine: Engine, q: Questionnaire, session_id: str, zone: tzinfo | None
 
 
 def course(engine: Engine, q: Questionnaire, patient_id: str, zone: tzinfo | None = None) -> list[PrintedVisit]:
-    """Every visit of one patient that reached the station, oldest first."""
+    """Every visit of one patient that reached the station, oldest first (a Timed Up and Go of no
+    questionnaire session's visit as a visit of its own)."""
     with engine.connect() as connection:
         ids = connection.execute(
             sa.select(sessions.c.id)
             .where(sessions.c.patient_id == patient_id, sessions.c.status != "pending")
             .order_by(sessions.c.started_at)
         ).scalars()
-        return visits_of(connection, q, list(ids), zone)
+        found = visits_of(connection, q, list(ids), zone)
+        shown = {t.tug.id for v in found for t in v.tugs}
+        found += [_tug_only(t, zone) for t in tugs.of_patient(connection, patient_id) if t.id not in shown]
+    return sorted(found, key=lambda v: v.at)

@@ -13,9 +13,10 @@ from starlette.requests import Request
 from starlette.responses import HTMLResponse, PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from station import db, orders, results
+from station import db, orders, results, tugs
 from station.course_plot import course_svg
 from station.rendering import render, templates
+from station.tug_plot import tug_svg
 
 #: sessions in the ward page's Results list
 RECENT = 50
@@ -62,7 +63,8 @@ async def patient_page(request: Request) -> Response:
     patient_id = request.path_params["patient_id"]
     visits = await run_in_threadpool(results.course, engine, q, patient_id)
     ordered = await run_in_threadpool(lambda: orders.listing(engine, patient_id=patient_id))
-    if not visits and not ordered:
+    timed = await run_in_threadpool(tugs.patient_course, engine, patient_id)
+    if not visits and not ordered and not timed:
         return PlainTextResponse(f"no visit of patient {patient_id} has reached this station", status_code=404)
     ran = await run_in_threadpool(results.instruments, engine, q, visits)
     return render(
@@ -72,6 +74,8 @@ async def patient_page(request: Request) -> Response:
         visits=visits,
         orders=ordered,
         plots=[(i.id, i.title.get("en", i.id), course_svg(i, visits)) for i in ran],
+        tugs=timed,
+        tug_plot=tug_svg(timed) if timed else "",
     )
 
 

@@ -20,7 +20,7 @@ from kiosk.core.review import review_state
 from kiosk.core.staff import every_entered
 from kiosk.export import ExportError
 from station import order_progress, validation
-from station.db import sessions
+from station.db import sessions, tug_results
 from station.definitions import questionnaire_for
 from station.sessions import LIFECYCLE, RESULT_KINDS, load_many
 
@@ -223,8 +223,7 @@ def prefix_range(text: str) -> tuple[str, str]:
     return text, text[:-1] + chr(ord(text[-1]) + 1)
 
 
-def _starts_with(text: str, postgres: bool) -> Any:
-    column = sessions.c.patient_id
+def _starts_with(text: str, postgres: bool, column: Any = sessions.c.patient_id) -> Any:
     if postgres:  # the text_pattern_ops index answers LIKE 'prefix%' (Alembic 0006_history)
         escaped = text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
         return column.like(escaped + "%", escape="\\")
@@ -247,5 +246,18 @@ def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, s
         .order_by(sa.func.max(sessions.c.started_at).desc())
         .limit(limit)
     )
+    # and the patients whose only visits at this station were Timed Up and Go tests
+    column = tug_results.c.patient_id
+    timed = (
+        sa.select(column, sa.func.count(), sa.func.max(tug_results.c.at))
+        .where(sa.or_(*(_starts_with(p, postgres, column) for p in prefixes)))
+        .group_by(column)
+        .limit(limit)
+    )
     with engine.connect() as connection:
-        return [(p, int(n), last or "") for p, n, last in connection.execute(query)]
+        found = {p: (int(n), last or "") for p, n, last in connection.execute(query)}
+        for patient, n, last in connection.execute(timed):
+            seen, latest = found.get(patient, (0, ""))
+            found[patient] = (seen + int(n), max(latest, last or ""))
+    ranked = sorted(found.items(), key=lambda kv: kv[1][1], reverse=True)[:limit]
+    return [(p, n, last) for p, (n, last) in ranked]

@@ -25,7 +25,7 @@ from sqlalchemy.engine import Connection
 from basis import record
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
-from station import alert_rules, db, order_progress
+from station import alert_rules, db, order_progress, tugs
 from station.checks import (
     ID_MAX,
     NEEDS_DEFINITION,
@@ -38,7 +38,9 @@ from station.checks import (
     text,
 )
 from station.db import alerts, definitions, inbox, sessions
+from station.orders import LinkRefused
 from station.sessions import LIFECYCLE, rows_of, status_of
+from station.tug_checks import CheckedTug, check_tug
 
 MAX_BATCH = 500
 #: fields each known kind's payload must carry (the Store method's required keyword arguments)
@@ -54,7 +56,10 @@ REQUIRED: dict[str, tuple[str, ...]] = {
     "record_event": ("t", "kind"),
     "finish_session": ("finished_at",),
     "abandon": (),
+    "record_tug": ("tug_id", "patient_id"),
 }
+#: rows that are results of their own, not of a session (their session_id is the result's id)
+OWN_RESULTS = ("record_tug",)
 #: session-log kinds that raise an alert, and the kinds that end one. The protocol names them
 #: doctor_called/doctor_continued; today's session log says call_doctor/clinician_continue. A
 #: patient away raises the alert only once away as long as the kiosk's site says (away_alert; the
@@ -111,6 +116,8 @@ class Event:
     at: str
     #: the definition a create_session carried, checked (None: none sent)
     definition: dict[str, Any] | None = None
+    #: a record_tug row's result, checked
+    tug: CheckedTug | None = None
 
 
 def _bundled() -> tuple[dict[str, Any], str]:
@@ -165,9 +172,10 @@ def parse(body: Any) -> list[Event]:
                         f"{where}: create_session.definition_sha256: is not the SHA-256 of the "
                         "definition's canonical JSON"
                     )
+            tug = check_tug(payload, f"{where}: record_tug", session_id) if kind == "record_tug" else None
         except RowRefused as exc:
             raise Refused(str(exc), seq) from None
-        events.append(Event(seq, kind, session_id, payload, at, definition))
+        events.append(Event(seq, kind, session_id, payload, at, definition, tug))
     return events
 
 
@@ -199,8 +207,9 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
                 event.seq,
             )
     new = [e for e in events if e.seq not in known]
-    _claim_sessions(connection, kiosk_id, new, received)
-    _check_against_definitions(connection, new)
+    of_sessions = [e for e in new if e.kind not in OWN_RESULTS]
+    _claim_sessions(connection, kiosk_id, of_sessions, received)
+    _check_against_definitions(connection, of_sessions)
     db.insert_ignore(
         connection,
         inbox,
@@ -224,11 +233,32 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
             .where(sessions.c.id == session_id)
             .values(updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE)))
         )
-    if new:
-        messages += _alerts(connection, kiosk_id, new, received)
-        messages += alert_rules.settle(connection, kiosk_id, new)  # staff's own doing, situations ended
-        messages += order_progress.on_rows(connection, kiosk_id, new)  # visits, orders, results waiting
+    if of_sessions:
+        messages += _alerts(connection, kiosk_id, of_sessions, received)
+        messages += alert_rules.settle(connection, kiosk_id, of_sessions)  # staff's own doing, situations ended
+        messages += order_progress.on_rows(connection, kiosk_id, of_sessions)  # visits, orders, results waiting
+    messages += _tugs(connection, kiosk_id, [e for e in new if e.tug is not None], received)
     return seqs, messages
+
+
+def _tugs(connection: Connection, kiosk_id: str, new: Sequence[Event], received: float) -> list[dict[str, Any]]:
+    """Store the Timed Up and Go results (station.tugs) and move their orders on."""
+    messages: list[dict[str, Any]] = []
+    for event in sorted(new, key=lambda e: e.seq):
+        assert event.tug is not None
+        try:
+            tugs.store(connection, kiosk_id, event.seq, event.tug, received)
+        except tugs.TugClash as exc:
+            raise Conflict(str(exc), event.seq) from None
+        if event.tug.order_id is not None:
+            try:
+                messages += order_progress.on_tug(
+                    connection, kiosk_id, event.seq, event.tug.order_id, event.tug.patient_id
+                )
+            except LinkRefused as exc:
+                raise Refused(str(exc), event.seq) from None
+        messages.append({"type": "sessions", "kiosk": kiosk_id})
+    return messages
 
 
 def _definition_of(connection: Connection, session_id: str) -> str | None:

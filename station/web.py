@@ -50,6 +50,7 @@ from station import (
     staff_items,
     study_pages,
     throttle,
+    tug_pages,
 )
 from station.bodylimit import BodyLimit
 from station.bus import Bus
@@ -260,6 +261,7 @@ def create_app(
         *order_pages.routes,
         *result_pages.routes,
         *print_pages.routes,
+        *tug_pages.routes,
         *handover_pages.routes,
         *signoff_pages.routes,
         *definition_pages.routes,

@@ -119,7 +119,7 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
             problems.append(f"{where}: without an id or a patient identifier")
         elif check_patient_id(patient, None):  # the station's own rule was applied where it was typed
             problems.append(f"{where} ({order_id}): {check_patient_id(patient, None)}")
-        elif not isinstance(wanted, list) or not wanted or any(i not in instruments for i in wanted):
+        elif not isinstance(wanted, list) or not wanted or any(i not in (*instruments, TUG) for i in wanted):
             problems.append(f"{where} ({order_id}): instruments {wanted!r}: this kiosk gives {', '.join(instruments)}")
         elif all(i == TUG for i in wanted):
             problems.append(f"{where} ({order_id}): the Timed Up and Go alone: this kiosk gives it within a visit")

@@ -128,7 +128,7 @@ class Store:
         if self._tug is None:
             from kiosk.store.tug import TugResults
 
-            self._tug = TugResults(self._tx, self._db)
+            self._tug = TugResults(self._tx, self._db, export=self.export, simulated=self.simulated)
         return self._tug
 
     @classmethod

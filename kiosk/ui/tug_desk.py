@@ -156,7 +156,8 @@ class TugDesk:
         stored = None
         if self._store is not None and session is not None:
             visit = battery.visit_id if battery is not None else None
-            stored = self._store.tug.record(session.patient_id, result, visit_id=visit)
+            # how the visit began (an order's id), so the station files the TUG under that order
+            stored = self._store.tug.record(session.patient_id, result, visit_id=visit, visit=session.visit)
         self.stored = (stored, result)
         self.run, then = None, self._then
         then()

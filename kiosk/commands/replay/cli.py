@@ -144,7 +144,8 @@ def main(argv: list[str]) -> int:
             if is_tug_script(file):  # a visit's Timed Up and Go from a landmark file
                 tug = load_tug_script(file, tug_settings(config))
                 tug = replace(tug, patient=order.patient_id) if order is not None else tug
-                results.append(run_tug_script(tug, store=store, model=config.qos_model))
+                visit = order.visit if order is not None else None
+                results.append(run_tug_script(tug, store=store, model=config.qos_model, visit=visit))
                 continue
             if is_battery_script(file):  # a visit of several instruments: one result each
                 battery_script = load_battery_script(file, {q.id: q for q, _ in battery})

@@ -155,9 +155,12 @@ def load_tug_script(path: str | Path, site: TugSettings | None = None) -> TugScr
     )
 
 
-def run_tug_script(script: TugScript, *, store: Any = None, model: str = "clarc") -> TugReplay:
+def run_tug_script(
+    script: TugScript, *, store: Any = None, model: str = "clarc", visit: str | None = None
+) -> TugReplay:
     """Play ``script`` through a :class:`TugStep` and the QoS engine of ``model`` on a simulated clock
-    (store the result in ``store`` when given). TugScriptError when the step refuses (a walk-up visit)."""
+    (store the result in ``store`` when given, as a visit that began as ``visit`` says: an order's
+    ``order <id>``, else staff's). TugScriptError when the step refuses (a walk-up visit)."""
     from kiosk.core.qos_model import load_kiosk_model
     from qos import Engine, replay
 
@@ -193,5 +196,5 @@ def run_tug_script(script: TugScript, *, store: Any = None, model: str = "clarc"
         raise TugScriptError(f"{script.source}:1:1: {exc}") from None
     events = Trace.from_events(model, trace, description=f"Timed Up and Go of {script.source}")
     summary = replay(events, model=loaded) if trace else {}
-    stored = store.tug.record(script.patient, result) if store is not None else None
+    stored = store.tug.record(script.patient, result, visit=visit or "staff") if store is not None else None
     return TugReplay(script, result, trace, events, summary, stored)

@@ -12,7 +12,7 @@ import sqlalchemy as sa
 from alembic import op
 
 revision = "0010_reference_results"
-down_revision = "0008_order_relationship"
+down_revision = "0009_tug_results"
 branch_labels = None
 depends_on = None
 

@@ -65,6 +65,16 @@ def test_orders_the_kiosk_cannot_run_are_left_out_with_why():
     assert parse_orders({"oops": 1}, ["barthel"], ["en"]) == ([], ["the station's answer has no 'orders' list"])
 
 
+def test_an_order_of_the_timed_up_and_go_is_taken_beside_the_kiosks_instruments():
+    """Issue 34: the station orders the TUG as the instrument id ``tug``; every kiosk takes it."""
+    entry = {"id": "order-5", "patient_id": "NHC-1", "language": "en", "answered_by": "patient"}
+    body = {"orders": [entry | {"instruments": ["barthel", "tug"]}, entry | {"id": "order-6", "instruments": ["tug"]}]}
+    found, problems = parse_orders(body, ["barthel"], ["en"])
+    assert problems == [] and [o.instruments for o in found] == [("barthel", "tug"), ("tug",)]
+    found, problems = parse_orders({"orders": [entry | {"instruments": ["tug", "moca"]}]}, ["barthel"], ["en"])
+    assert found == [] and "this kiosk gives barthel" in problems[0]  # an unknown one beside it is still refused
+
+
 def test_the_welcome_is_held_for_ordered_visits_and_where_walk_ups_are_not_allowed():
     made = []
     # the desk's make_session: (patient, language, answered_by, visit) and an order's instruments
