@@ -18,16 +18,16 @@ from station.rendering import render
 
 
 async def handover_page(request: Request) -> Response:
-    engine, q = request.app.state.engine, request.app.state.questionnaire
+    engine, q, zone = request.app.state.engine, request.app.state.questionnaire, request.app.state.zone
     now = datetime.fromtimestamp(db.now(), UTC)
     start, end = request.query_params.get("from", ""), request.query_params.get("to", "")
     error = None
     try:
-        chosen = handover.window(start, end, now)
+        chosen = handover.window(start, end, now, zone)
     except handover.HandoverError as exc:
-        error, chosen = str(exc), handover.window("", "", now)
-    found = await run_in_threadpool(handover.shift, engine, q, chosen, now)
-    typed_from, typed_to = chosen.typed()
+        error, chosen = str(exc), handover.window("", "", now, zone)
+    found = await run_in_threadpool(handover.shift, engine, q, chosen, now, zone)
+    typed_from, typed_to = chosen.typed(zone)
     return render(
         request,
         "handover.html",
@@ -37,7 +37,7 @@ async def handover_page(request: Request) -> Response:
         typed_to=typed_to,
         error=error,
         hours=handover.DEFAULT_HOURS,
-        today=now.astimezone().strftime("%A %d %B %Y"),
+        today=now.astimezone(zone).strftime("%A %d %B %Y"),
     )
 
 

@@ -17,29 +17,31 @@ from station.rendering import render
 from station.sessions import NotFound
 
 
-def _now() -> str:
-    return printing.shown_time(db.now_iso())
+def _now(request: Request) -> str:
+    return printing.shown_time(db.now_iso(), request.app.state.zone)
 
 
 async def visit_print(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     session_id = request.path_params["session_id"]
     try:
-        found = await run_in_threadpool(printing.visit, engine, q, session_id)
+        found = await run_in_threadpool(printing.visit, engine, q, session_id, request.app.state.zone)
     except NotFound:
         return PlainTextResponse(f"no session {session_id} has reached this station", status_code=404)
     return render(
-        request, "print_visit.html", visits=[found], patient_id=found.patient_id, course=False, printed_at=_now()
+        request, "print_visit.html", visits=[found], patient_id=found.patient_id, course=False, printed_at=_now(request)
     )
 
 
 async def course_print(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     patient_id = request.path_params["patient_id"]
-    found = await run_in_threadpool(printing.course, engine, q, patient_id)
+    found = await run_in_threadpool(printing.course, engine, q, patient_id, request.app.state.zone)
     if not found:
         return PlainTextResponse(f"no visit of patient {patient_id} has reached this station", status_code=404)
-    return render(request, "print_visit.html", visits=found, patient_id=patient_id, course=True, printed_at=_now())
+    return render(
+        request, "print_visit.html", visits=found, patient_id=patient_id, course=True, printed_at=_now(request)
+    )
 
 
 routes = [

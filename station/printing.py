@@ -2,8 +2,8 @@
 
 A visit is the sessions of one order (a battery: one session per instrument); a session that
 no order started is a visit of its own. Each instrument shows its title, total, band, who
-answered and who signed it and when; times are shown in the station's local time zone (the
-station has no site time-zone setting yet: :func:`shown_time` takes one when it comes). Read in
+answered and who signed it and when; times are shown in the site's time zone
+(``--time-zone``, :mod:`station.times`). Read in
 one connection, scored as the session page scores (corrections and staff-entered numbers
 applied, on the definition the session ran). The PDF is the browser's print of this view
 (``@media print`` in ``station.css``): no PDF library on the server.
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from datetime import datetime, tzinfo
+from datetime import tzinfo
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
@@ -24,7 +24,7 @@ from kiosk.core.review import review_state
 from kiosk.core.staff import entered_at_station, entered_values
 from kiosk.export import ExportError
 from kiosk.store.database import StoredSession
-from station import tugs
+from station import times, tugs
 from station.db import audit, orders, sessions, visits
 from station.definitions import questionnaire_for
 from station.sessions import RESULT_KINDS, NotFound, load_many
@@ -37,14 +37,7 @@ ANSWERED_WORDS = {"patient": "the patient", "relative": "a relative", "caregiver
 def shown_time(iso: str | None, zone: tzinfo | None = None) -> str:
     """A stored ISO-8601 time as staff read it: ``YYYY-MM-DD HH:MM`` and the zone's name, in
     ``zone`` (the station's local zone when None); "" for none, the text itself if unreadable."""
-    if not iso:
-        return ""
-    try:
-        when = datetime.fromisoformat(iso.replace("Z", "+00:00"))
-    except ValueError:
-        return iso
-    local = when.astimezone(zone) if when.tzinfo else when
-    return local.strftime("%Y-%m-%d %H:%M %Z").strip()
+    return times.shown(iso, zone)
 
 
 @record

@@ -9,14 +9,25 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
+from jinja2 import pass_context
 from starlette.requests import Request
 from starlette.responses import Response
 from starlette.templating import Jinja2Templates
 
-from station import auth, logins, ward
+from station import auth, logins, times, ward
 
 templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
 templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
+
+
+@pass_context
+def _when(context: Any, iso: Any, form: str = "minute") -> str:
+    """``{{ r.finished_at|when }}``: a stored time in the site's zone (:mod:`station.times`)."""
+    request = context.get("request")
+    return times.shown(iso, getattr(request.app.state, "zone", None) if request is not None else None, form)
+
+
+templates.env.filters["when"] = _when
 #: a command as staff name it (the buttons' words), never its protocol name
 templates.env.globals["command_labels"] = {
     "continue": "Continue session",

@@ -13,6 +13,7 @@ import math
 from collections.abc import AsyncIterator
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
+from datetime import tzinfo
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
@@ -233,9 +234,11 @@ def create_app(
     https: bool = False,
     trusted_proxies: tuple[throttle.Network, ...] = (),
     id_pattern: str = DEFAULT_ID_PATTERN,
+    zone: tzinfo | None = None,
 ) -> Starlette:
     """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
-    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole."""
+    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole;
+    times are shown in ``zone`` (None: the machine's own)."""
     bus = Bus(engine)
     q = questionnaire or load_questionnaire()
 
@@ -293,6 +296,7 @@ def create_app(
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
     app.state.id_pattern = id_pattern
+    app.state.zone = zone
     app.state.live = Live(
         bus,
         lambda name: pages.kiosk_event(app, name),
