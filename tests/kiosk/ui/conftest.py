@@ -54,6 +54,7 @@ class UiKiosk:
         instruments: tuple = (),
         unattended_after: int | None = None,
         away_alert_after_s: float | None = 60.0,
+        visits: bool = False,
     ) -> None:
         self.clock = SimClock()
         self.config = Config(
@@ -94,7 +95,8 @@ class UiKiosk:
             # by default tests drive time themselves (the timer's callback, `advance`), so a tick
             # of the real timer never finds anything due
             poll_interval=poll_interval,
-            visits=False,  # the snapshots show "Start a visit" off, as before visits existed
+            # off by default: the snapshots show "Start a visit" off, as before visits existed
+            visits=visits,
             # failed attempts counted in memory, or (pin_on_disk) the kiosk's own guard, counting
             # them in the data directory
             clinician_pin=None if pin_on_disk else UI_PIN,
@@ -126,7 +128,7 @@ class UiKiosk:
 def ui_kiosk(tmp_path: Path) -> Iterator[Callable[..., UiKiosk]]:
     """Build a :class:`UiKiosk` (keyword options: familiarisation, adaptation, language, session_id,
     voice, keyboard, sources, poll_interval, speaker, show_score, next_patient_after_s, model,
-    questionnaire, pin_on_disk, instruments, unattended_after, away_alert_after_s)."""
+    questionnaire, pin_on_disk, instruments, unattended_after, away_alert_after_s, visits)."""
     made: list[UiKiosk] = []
 
     def make(**options: Any) -> UiKiosk:
