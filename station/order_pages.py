@@ -48,6 +48,9 @@ async def orders_page(request: Request) -> Response:
         relationships=list(RELATIONSHIPS),
         text_max=TEXT_MAX,
         form=dict(request.query_params),
+        # a double booking's form again: what was chosen (never the default) and what to confirm
+        chosen=request.query_params.get("instruments", "").split(",") if "warn" in request.query_params else None,
+        warn=request.query_params.get("warn"),
         error=request.query_params.get("error"),
         message=request.query_params.get("message"),
     )
@@ -79,6 +82,7 @@ async def create_order(request: Request) -> Response:
             by=request.state.user,
             known_instruments=list(offered),
             languages=languages,
+            anyway=form.get("anyway") == "yes",
         )
         request.app.state.bus.publish({"type": "order", "kiosk": order.kiosk_id})
         return order
@@ -87,8 +91,11 @@ async def create_order(request: Request) -> Response:
         # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
         order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
     except orders.OrderError as exc:
-        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text")
+        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text", "relative")
         keep = {k: str(form.get(k, "")) for k in kept}
+        if isinstance(exc, orders.DoubleBooking):  # the same form again, to confirm: "Order anyway"
+            keep["instruments"] = ",".join(str(v) for v in multi.getlist("instrument"))
+            return see_other("/orders", warn=str(exc), fields=keep)
         return see_other("/orders", error=str(exc), fields=keep)
     return RedirectResponse(f"/orders/{order.id}", status_code=303)
 
@@ -109,7 +116,9 @@ async def cancel_order(request: Request) -> Response:
         order = await run_in_threadpool(orders.cancel, engine, order_id, request.state.user, form.get("reason", ""))
     except orders.OrderError as exc:
         return see_other(f"/orders/{quote(order_id)}", message=str(exc))
-    await run_in_threadpool(request.app.state.bus.publish, {"type": "order", "kiosk": order.kiosk_id})
+    # the kiosk's orders poll (it ends a running visit) and the ward's tile of it (it says "cancelled")
+    kiosk = {"kiosk": order.kiosk_id}
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "order", **kiosk}, {"type": "kiosk", **kiosk})
     return RedirectResponse(f"/orders/{quote(order_id)}?message={quote('Cancelled.')}", status_code=303)
 
 
