@@ -27,7 +27,7 @@ from pathlib import Path
 
 from fileio.bounded import BadFile, read_text
 from kiosk.core.visits import DEFAULT_ID_PATTERN, pattern_problem
-from station import auth, db, known, roles, throttle
+from station import auth, batteries, db, known, roles, throttle
 
 ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate", "add-definition")
 
@@ -82,6 +82,14 @@ def _parser() -> argparse.ArgumentParser:
         default=DEFAULT_ID_PATTERN,
         help="the site's patient identifiers, matched whole (default: digits with at most four letters "
         "in front, such as NHC-0012345); the kiosks' patient_id_pattern should say the same",
+    )
+    parser.add_argument(
+        "--battery",
+        action="append",
+        default=[],
+        metavar="NAME=ID,ID,...",
+        help="a battery the site runs, its instruments in the order patients do them (as the kiosks' "
+        "instruments:); the order form offers it by name and keeps that order; repeat for each",
     )
     parser.add_argument(
         "--formula-timeout",
@@ -226,6 +234,10 @@ def _serve(argv: list[str]) -> int:
         raise UsageError(str(exc)) from None
     if (problem := pattern_problem(args.patient_id_pattern)) is not None:
         raise UsageError(problem.replace("patient_id_pattern", "--patient-id-pattern", 1))
+    try:
+        site_batteries = batteries.parse_all(args.battery)
+    except ValueError as exc:
+        raise UsageError(f"--battery {exc}") from None
     import sqlalchemy as sa
     import uvicorn
 
@@ -244,7 +256,13 @@ def _serve(argv: list[str]) -> int:
         known.register_shipped(engine)
     except sa.exc.SQLAlchemyError as exc:  # a database that takes no write: /healthz says so too
         print(f"kiosk station: cannot register the shipped instruments: {errors.reason(exc)}", file=sys.stderr)
-    app = create_app(engine, https=bool(args.tls_cert), trusted_proxies=proxies, id_pattern=args.patient_id_pattern)
+    app = create_app(
+        engine,
+        https=bool(args.tls_cert),
+        trusted_proxies=proxies,
+        id_pattern=args.patient_id_pattern,
+        batteries=site_batteries,
+    )
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})", flush=True)
     # failed and refused logins are logged here (station.security), one line each

@@ -16,10 +16,16 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
-from station import orders, validation, ward
+from station import batteries, orders, validation, ward
 from station.api_orders import ORDER_LANE
 from station.redirects import see_other
 from station.rendering import checked_form, render
+
+
+def _in_site_order(offered: list[orders.Instrument], site: Any) -> list[orders.Instrument]:
+    """The instruments staff may order, listed in the site's order (:func:`batteries.site_order`)."""
+    by_id = {i.id: i for i in offered}
+    return [by_id[i] for i in batteries.site_order(list(by_id), site)]
 
 
 def _kiosk_names(engine: Any) -> list[str]:
@@ -33,14 +39,17 @@ async def orders_page(request: Request) -> Response:
     kiosk = request.query_params.get("kiosk") or ""
     states = [state] if state in orders.STATES else (list(orders.OPEN) if state == "" else None)
     found = await run_in_threadpool(lambda: orders.listing(engine, kiosk_id=kiosk or None, states=states))
-    offered = await run_in_threadpool(orders.instruments, engine, q)
+    offered = _in_site_order(await run_in_threadpool(orders.instruments, engine, q), request.app.state.batteries)
     languages = list(dict.fromkeys(lang for i in offered for lang in i.languages))
+    titles = {i.id: i.title for i in offered}
     return render(
         request,
         "orders.html",
         orders=found,
         kiosks=await run_in_threadpool(_kiosk_names, engine),
         instruments=[(i.id, i.title) for i in offered],
+        # the site's batteries by name, each with its instruments' titles in its order
+        batteries=[(b.name, " → ".join(titles.get(i, i) for i in b.instruments)) for b in request.app.state.batteries],
         languages=languages,
         state=state,
         kiosk=kiosk,
@@ -63,7 +72,11 @@ async def create_order(request: Request) -> Response:
 
     def place() -> orders.Order:
         offered = {i.id: i for i in orders.instruments(engine, q)}
-        chosen = [str(v) for v in multi.getlist("instrument")]
+        try:  # the site's battery in its order, then the boxes ticked, in the site's order
+            ticked = [str(v) for v in multi.getlist("instrument")]
+            chosen = batteries.chosen(str(form.get("battery", "")), ticked, list(offered), request.app.state.batteries)
+        except ValueError as exc:
+            raise orders.OrderError(f"battery: {exc}") from None
         # a language every chosen instrument has (all of them when none is known yet: create says why)
         spoken = [set(offered[i].languages) for i in chosen if i in offered]
         languages = (
@@ -91,7 +104,7 @@ async def create_order(request: Request) -> Response:
         # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
         order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
     except orders.OrderError as exc:
-        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text", "relative")
+        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text", "relative", "battery")
         keep = {k: str(form.get(k, "")) for k in kept}
         if isinstance(exc, orders.DoubleBooking):  # the same form again, to confirm: "Order anyway"
             keep["instruments"] = ",".join(str(v) for v in multi.getlist("instrument"))

@@ -51,6 +51,7 @@ from station import (
     staff_items,
     throttle,
 )
+from station.batteries import Battery
 from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
@@ -232,9 +233,11 @@ def create_app(
     https: bool = False,
     trusted_proxies: tuple[throttle.Network, ...] = (),
     id_pattern: str = DEFAULT_ID_PATTERN,
+    batteries: tuple[Battery, ...] = (),
 ) -> Starlette:
     """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
-    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole."""
+    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole,
+    and offer the site's ``batteries`` (:mod:`station.batteries`)."""
     bus = Bus(engine)
     q = questionnaire or load_questionnaire()
 
@@ -291,6 +294,7 @@ def create_app(
     app.state.engine, app.state.bus, app.state.questionnaire = engine, bus, q
     app.state.trusted_proxies = trusted_proxies
     app.state.id_pattern = id_pattern
+    app.state.batteries = batteries
     app.state.live = Live(
         bus,
         lambda name: pages.kiosk_event(app, name),
