@@ -29,12 +29,15 @@ from station.bus import long_poll
 ORDER_LANE = ThreadPoolExecutor(max_workers=2, thread_name_prefix="station-orders")
 
 
-def _ready(engine: Any, kiosk: str) -> dict[str, Any]:
-    """The kiosk's waiting visits and a version of the list (the long poll answers when it changes)."""
+def _ready(engine: Any, kiosk: str, held: set[str]) -> dict[str, Any]:
+    """The kiosk's waiting visits, the cancelled ones it may be running (it ends those:
+    :func:`orders.cancelled_for`) and a version of both (the long poll answers when it changes)."""
     with engine.connect() as connection:
         ready = [o.for_kiosk() for o in orders.ready_for(connection, kiosk)]
-    version = hashlib.sha256(json.dumps(ready, sort_keys=True).encode()).hexdigest()[:16]
-    return {"version": version, "orders": ready}
+        cancelled = orders.cancelled_for(connection, kiosk, held)
+    listed = {"orders": ready, "cancelled": cancelled}
+    version = hashlib.sha256(json.dumps(listed, sort_keys=True).encode()).hexdigest()[:16]
+    return {"version": version, **listed}
 
 
 def _release(bus: Any, kiosk: str, held: set[str]) -> None:
@@ -48,7 +51,8 @@ async def get_orders(request: Request) -> Response:
     """Long poll: the list at once when its version differs from ``version`` (or none was given),
     else when an order of this kiosk changes (by any station process) or ``wait`` seconds pass.
     Subscribing before looking means a change in between is not missed. ``held`` (comma-separated
-    order ids): the orders the kiosk still runs; its other orders in progress are released first."""
+    order ids): the orders the kiosk still runs; its other orders in progress are released first,
+    and the cancelled ones among them are listed (``cancelled``) for the kiosk to end."""
     token = _token(request)
     loop = asyncio.get_running_loop()
     # the whole poll on the urgent lane (cheap reads): a waiting visit never queues behind the
@@ -62,13 +66,14 @@ async def get_orders(request: Request) -> Response:
         return _error(400, "'wait' must be a number of seconds")
     known = request.query_params.get("version")
     engine, bus = request.app.state.engine, request.app.state.bus
-    if (held := request.query_params.get("held")) is not None:
-        await loop.run_in_executor(ORDER_LANE, _release, bus, kiosk, {h for h in held.split(",") if h})
+    held = {h for h in (request.query_params.get("held") or "").split(",") if h}
+    if request.query_params.get("held") is not None:
+        await loop.run_in_executor(ORDER_LANE, _release, bus, kiosk, held)
     queue = bus.subscribe(kiosk, ("order", "resync"))
     try:
 
         def fetch() -> Awaitable[dict[str, Any]]:
-            return loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk)
+            return loop.run_in_executor(ORDER_LANE, _ready, engine, kiosk, held)
 
         current = await long_poll(queue, wait, await fetch(), fetch, lambda listed: listed["version"] != known)
     finally:

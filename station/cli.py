@@ -27,7 +27,7 @@ from pathlib import Path
 
 from fileio.bounded import BadFile, read_text
 from kiosk.core.visits import DEFAULT_ID_PATTERN, pattern_problem
-from station import auth, db, known, roles, throttle, times
+from station import auth, batteries, db, known, roles, throttle, times
 
 ADMIN = ("add-user", "passwd", "remove-user", "add-kiosk", "revoke-kiosk", "migrate", "add-definition")
 
@@ -89,6 +89,14 @@ def _parser() -> argparse.ArgumentParser:
         default="",
         help="the site's time zone, in which staff read every time (an IANA name such as Europe/Madrid; "
         "default: the machine's own)",
+    )
+    parser.add_argument(
+        "--battery",
+        action="append",
+        default=[],
+        metavar="NAME=ID,ID,...",
+        help="a battery the site runs, its instruments in the order patients do them (as the kiosks' "
+        "instruments:); the order form offers it by name and keeps that order; repeat for each",
     )
     parser.add_argument(
         "--formula-timeout",
@@ -237,6 +245,10 @@ def _serve(argv: list[str]) -> int:
         zone = times.zone_named(args.time_zone)
     except times.ZoneError as exc:
         raise UsageError(str(exc)) from None
+    try:
+        site_batteries = batteries.parse_all(args.battery)
+    except ValueError as exc:
+        raise UsageError(f"--battery {exc}") from None
     import sqlalchemy as sa
     import uvicorn
 
@@ -256,7 +268,12 @@ def _serve(argv: list[str]) -> int:
     except sa.exc.SQLAlchemyError as exc:  # a database that takes no write: /healthz says so too
         print(f"kiosk station: cannot register the shipped instruments: {errors.reason(exc)}", file=sys.stderr)
     app = create_app(
-        engine, https=bool(args.tls_cert), trusted_proxies=proxies, id_pattern=args.patient_id_pattern, zone=zone
+        engine,
+        https=bool(args.tls_cert),
+        trusted_proxies=proxies,
+        id_pattern=args.patient_id_pattern,
+        batteries=site_batteries,
+        zone=zone,
     )
     scheme = "https" if args.tls_cert else "http"
     print(f"ward station on {scheme}://{args.host}:{args.port}/ (database {engine.url.render_as_string()})", flush=True)

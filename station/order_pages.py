@@ -16,10 +16,16 @@ from starlette.responses import PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
-from station import orders, tugs, validation, ward
+from station import batteries, orders, tugs, validation, ward
 from station.api_orders import ORDER_LANE
 from station.redirects import see_other
 from station.rendering import checked_form, render
+
+
+def _in_site_order(offered: list[orders.Instrument], site: Any) -> list[orders.Instrument]:
+    """The instruments staff may order, listed in the site's order (:func:`batteries.site_order`)."""
+    by_id = {i.id: i for i in offered}
+    return [by_id[i] for i in batteries.site_order(list(by_id), site)]
 
 
 def _kiosk_names(engine: Any) -> list[str]:
@@ -33,14 +39,17 @@ async def orders_page(request: Request) -> Response:
     kiosk = request.query_params.get("kiosk") or ""
     states = [state] if state in orders.STATES else (list(orders.OPEN) if state == "" else None)
     found = await run_in_threadpool(lambda: orders.listing(engine, kiosk_id=kiosk or None, states=states))
-    offered = await run_in_threadpool(orders.instruments, engine, q)
+    offered = _in_site_order(await run_in_threadpool(orders.instruments, engine, q), request.app.state.batteries)
     languages = list(dict.fromkeys(lang for i in offered for lang in i.languages))
+    titles = {i.id: i.title for i in offered}
     return render(
         request,
         "orders.html",
         orders=found,
         kiosks=await run_in_threadpool(_kiosk_names, engine),
         instruments=[(i.id, i.title) for i in offered],
+        # the site's batteries by name, each with its instruments' titles in its order
+        batteries=[(b.name, " → ".join(titles.get(i, i) for i in b.instruments)) for b in request.app.state.batteries],
         languages=languages,
         state=state,
         kiosk=kiosk,
@@ -48,6 +57,9 @@ async def orders_page(request: Request) -> Response:
         relationships=list(RELATIONSHIPS),
         text_max=TEXT_MAX,
         form=dict(request.query_params),
+        # a double booking's form again: what was chosen (never the default) and what to confirm
+        chosen=request.query_params.get("instruments", "").split(",") if "warn" in request.query_params else None,
+        warn=request.query_params.get("warn"),
         error=request.query_params.get("error"),
         message=request.query_params.get("message"),
     )
@@ -60,7 +72,11 @@ async def create_order(request: Request) -> Response:
 
     def place() -> orders.Order:
         offered = {i.id: i for i in orders.instruments(engine, q)}
-        chosen = [str(v) for v in multi.getlist("instrument")]
+        try:  # the site's battery in its order, then the boxes ticked, in the site's order
+            ticked = [str(v) for v in multi.getlist("instrument")]
+            chosen = batteries.chosen(str(form.get("battery", "")), ticked, list(offered), request.app.state.batteries)
+        except ValueError as exc:
+            raise orders.OrderError(f"battery: {exc}") from None
         # a language every chosen instrument has (all of them when none is known yet: create says why)
         spoken = [set(offered[i].languages) for i in chosen if i in offered and offered[i].languages]
         languages = (
@@ -79,6 +95,7 @@ async def create_order(request: Request) -> Response:
             by=request.state.user,
             known_instruments=list(offered),
             languages=languages,
+            anyway=form.get("anyway") == "yes",
         )
         request.app.state.bus.publish({"type": "order", "kiosk": order.kiosk_id})
         return order
@@ -87,8 +104,11 @@ async def create_order(request: Request) -> Response:
         # on the orders' own lane: the kiosk's welcome must not wait behind routine rows
         order = await asyncio.get_running_loop().run_in_executor(ORDER_LANE, place)
     except orders.OrderError as exc:
-        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text")
+        kept = ("kiosk", "patient_id", "language", "relationship", "relationship_text", "relative", "battery")
         keep = {k: str(form.get(k, "")) for k in kept}
+        if isinstance(exc, orders.DoubleBooking):  # the same form again, to confirm: "Order anyway"
+            keep["instruments"] = ",".join(str(v) for v in multi.getlist("instrument"))
+            return see_other("/orders", warn=str(exc), fields=keep)
         return see_other("/orders", error=str(exc), fields=keep)
     return RedirectResponse(f"/orders/{order.id}", status_code=303)
 
@@ -112,7 +132,9 @@ async def cancel_order(request: Request) -> Response:
         order = await run_in_threadpool(orders.cancel, engine, order_id, request.state.user, form.get("reason", ""))
     except orders.OrderError as exc:
         return see_other(f"/orders/{quote(order_id)}", message=str(exc))
-    await run_in_threadpool(request.app.state.bus.publish, {"type": "order", "kiosk": order.kiosk_id})
+    # the kiosk's orders poll (it ends a running visit) and the ward's tile of it (it says "cancelled")
+    kiosk = {"kiosk": order.kiosk_id}
+    await run_in_threadpool(request.app.state.bus.publish, {"type": "order", **kiosk}, {"type": "kiosk", **kiosk})
     return RedirectResponse(f"/orders/{quote(order_id)}?message={quote('Cancelled.')}", status_code=303)
 
 

@@ -198,8 +198,18 @@ def _finished(connection: Connection, kiosk_id: str, session_id: str) -> None:
 
 def _abandoned(connection: Connection, kiosk_id: str, session_id: str) -> bool:
     """A session of an order ended without a result: with nothing finished the visit can be
-    started again; after some of a battery's instruments, their results wait for validation."""
+    started again; after some of a battery's instruments, their results wait for validation; a
+    cancelled order stays so, its trail saying the kiosk ended the session."""
     order = _order_of(connection, session_id)
+    if order is not None and order.state == "cancelled":  # the kiosk ended the cancelled visit
+        audit_order(
+            connection,
+            order.id,
+            f"kiosk {kiosk_id}",
+            "order_ended",
+            f"session {session_id} of the cancelled visit ended on {kiosk_id} (what was answered is kept)",
+        )
+        return True
     if order is None or order.state != "in_progress":
         return False
     done = _done(connection, order)

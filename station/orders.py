@@ -34,7 +34,7 @@ from basis import record
 from kiosk.core.answerers import RELATIONSHIPS, TEXT_MAX
 from kiosk.core.visits import DEFAULT_ID_PATTERN, HOSPITAL_ID, TUG
 from kiosk.core.visits import check_patient_id as identifier_problem
-from station import db
+from station import bookings, db
 from station.db import audit, code_failures, kiosks, orders
 
 #: a hospital's patient identifier: letters, digits, '-' and '_', 2 to 64, and at least one digit,
@@ -84,6 +84,17 @@ class TooManyCodes(OrderError):
     def __init__(self, retry_after_s: int) -> None:
         self.retry_after_s = retry_after_s
         super().__init__(f"after wrong codes the station checks the next one in {retry_after_s} seconds")
+
+
+class DoubleBooking(OrderError):
+    """The order would double-book a patient or a kiosk (:mod:`station.bookings`): ordered only
+    when staff confirm, ``anyway``; :attr:`warnings` say what they confirm."""
+
+    status = 409
+
+    def __init__(self, warnings: list[str]) -> None:
+        self.warnings = warnings
+        super().__init__("; ".join(warnings))
 
 
 class LinkRefused(OrderError):
@@ -249,10 +260,13 @@ def create(
     id_pattern: str = DEFAULT_ID_PATTERN,
     relationship: str = "",
     relationship_text: str = "",
+    anyway: bool = False,
 ) -> Order:
     """Order a visit (a nurse or a doctor) for a patient whose identifier ``id_pattern`` (the
     site's rule) matches; returns it with its confirmation code. A ``relationship``
-    (:func:`check_relationship`) says who answers for the patient, so a relative does."""
+    (:func:`check_relationship`) says who answers for the patient, so a relative does. A double
+    booking (:mod:`station.bookings`) is refused, or raises :class:`DoubleBooking` unless staff
+    order ``anyway`` (the trail then says what they confirmed)."""
     if by.role not in ORDER_ROLES:
         raise OrderError("only nurses and doctors may order a visit")
     patient_id = check_patient_id(patient_id, id_pattern)
@@ -286,6 +300,11 @@ def create(
         row = connection.execute(sa.select(kiosks.c.revoked_at).where(kiosks.c.name == kiosk_id)).first()
         if row is None or row.revoked_at is not None:
             raise OrderError(f"kiosk {kiosk_id!r}: no such kiosk with a valid token")
+        refusal, warnings = bookings.check(connection, kiosk_id, patient_id)
+        if refusal is not None:
+            raise OrderError(refusal)
+        if warnings and not anyway:
+            raise DoubleBooking(warnings)
         taken = set(
             connection.execute(
                 sa.select(orders.c.code).where(orders.c.kiosk_id == kiosk_id, orders.c.state.in_(OPEN))
@@ -317,7 +336,8 @@ def create(
             "order",
             f"{', '.join(chosen)} for {patient_id} on {kiosk_id} ({language}"
             f"{', a relative answers' if relative else ''}"
-            f"{f', related: {relationship_code}' if relationship_code else ''}{f': {words}' if words else ''})",
+            f"{f', related: {relationship_code}' if relationship_code else ''}{f': {words}' if words else ''})"
+            + (f"; ordered anyway: {'; '.join(warnings)}" if warnings else ""),
         )
         return Order.of(connection.execute(sa.select(orders).where(orders.c.id == order_id)).one())
 
@@ -366,6 +386,24 @@ def ready_for(connection: Connection, kiosk_id: str) -> list[Order]:
             .order_by(orders.c.ordered_at)
         )
     ]
+
+
+#: the kiosk's latest cancelled orders told on every orders poll beside the held ones: a visit
+#: cancelled just after its code started it, before the kiosk's poll could say it holds it
+RECENT_CANCELLED = 5
+
+
+def cancelled_for(connection: Connection, kiosk_id: str, held: set[str]) -> list[str]:
+    """The kiosk's cancelled orders it may still be running (protocol §4, ``cancelled``): those it
+    says it holds, and its :data:`RECENT_CANCELLED` latest; the kiosk ends a running one."""
+    mine = sa.and_(orders.c.kiosk_id == kiosk_id, orders.c.state == "cancelled")
+    recent = connection.execute(
+        sa.select(orders.c.id).where(mine).order_by(orders.c.updated_at.desc()).limit(RECENT_CANCELLED)
+    ).scalars()
+    found = set(recent)
+    if held:
+        found |= set(connection.execute(sa.select(orders.c.id).where(mine, orders.c.id.in_(sorted(held)))).scalars())
+    return sorted(found)
 
 
 def cancel(engine: Engine, order_id: str, by: Any, reason: str) -> Order:

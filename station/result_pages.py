@@ -5,6 +5,7 @@ instrument). Read-only: validating a result stays on its session page (:mod:`sta
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import sqlalchemy as sa
@@ -138,7 +139,22 @@ def ward_results(engine: Any, q: Any) -> list[results.Result]:
             .order_by(db.sessions.c.started_at.desc())
             .limit(RECENT)
         ).all()
-    return results.results_of(engine, q, ids)
+    return _cancelled_shown(engine, results.results_of(engine, q, ids))
+
+
+def _cancelled_shown(engine: Any, found: list[results.Result]) -> list[results.Result]:
+    """A session of a cancelled order, not finished, reads "cancelled" (running: the kiosk is
+    ending it; abandoned: it ended it), not "abandoned": staff see the cancellation took."""
+    order_ids = {r.order_id for r in found if r.order_id and r.status != "finished"}
+    if not order_ids:
+        return found
+    with engine.connect() as connection:
+        cancelled = set(
+            connection.execute(
+                sa.select(db.orders.c.id).where(db.orders.c.id.in_(sorted(order_ids)), db.orders.c.state == "cancelled")
+            ).scalars()
+        )
+    return [replace(r, status="cancelled") if r.order_id in cancelled and r.status != "finished" else r for r in found]
 
 
 async def ward_rows(request: Request) -> Response:

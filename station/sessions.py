@@ -205,13 +205,22 @@ def _apply(
 
 def _heads(connection: Connection, session_ids: list[str]) -> dict[str, Any]:
     """The sessions' rows of ``sessions`` (kiosk and definition), by id, in one query."""
-    columns = (sessions.c.id, sessions.c.kiosk_id, sessions.c.definition_sha256, sessions.c.definition_attached_later)
+    columns = (
+        sessions.c.id,
+        sessions.c.kiosk_id,
+        sessions.c.definition_sha256,
+        sessions.c.definition_attached_later,
+        sessions.c.patient_id,
+    )
     return {r.id: r for r in connection.execute(sa.select(*columns).where(sessions.c.id.in_(session_ids)))}
 
 
 def _with_definition(stored: StoredSession, head: Any, kept: dict[str, Any]) -> StoredSession:
-    """``stored`` with the definition it runs (None if its create_session never arrived), and only
-    what fits it (see :func:`fitted`)."""
+    """``stored`` with the definition it runs (None if its create_session never arrived), only
+    what fits it (see :func:`fitted`), and the patient identifier of its row (staff may have
+    given a walk-up its hospital identifier: station.identify)."""
+    if head.patient_id and head.patient_id != stored.patient_id:
+        stored = replace(stored, patient_id=head.patient_id)
     found = kept.get(head.definition_sha256) if head.definition_sha256 else None
     if found is None:
         return stored

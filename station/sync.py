@@ -25,7 +25,7 @@ from sqlalchemy.engine import Connection
 from basis import record
 from kiosk.core.questionnaire import Questionnaire, load_questionnaire
 from kiosk.core.questionnaire.definition import canonical, canonical_json, digest, questionnaire_from
-from station import alert_rules, db, order_progress, tugs
+from station import alert_rules, db, identify, order_progress, tugs
 from station.checks import (
     ID_MAX,
     NEEDS_DEFINITION,
@@ -227,12 +227,13 @@ def intake(connection: Connection, kiosk_id: str, events: Sequence[Event]) -> tu
         ],
         ["kiosk_id", "seq"],
     )
-    for session_id in {e.session_id for e in new if e.kind in LIFECYCLE}:
-        connection.execute(
-            sessions.update()
-            .where(sessions.c.id == session_id)
-            .values(updated_at=received, **status_of(rows_of(connection, session_id, LIFECYCLE)))
-        )
+    touched = {e.session_id for e in new if e.kind in LIFECYCLE}
+    given = identify.kept_in(connection, touched)  # staff gave these their identifier: it stays
+    for session_id in touched:
+        status = status_of(rows_of(connection, session_id, LIFECYCLE))
+        if session_id in given:
+            del status["patient_id"]
+        connection.execute(sessions.update().where(sessions.c.id == session_id).values(updated_at=received, **status))
     if of_sessions:
         messages += _alerts(connection, kiosk_id, of_sessions, received)
         messages += alert_rules.settle(connection, kiosk_id, of_sessions)  # staff's own doing, situations ended

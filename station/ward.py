@@ -16,7 +16,7 @@ from sqlalchemy.engine import Engine
 
 from basis import record
 from station import db
-from station.db import alerts, audit, commands, inbox, kiosks
+from station.db import alerts, audit, commands, inbox, kiosks, orders, visits
 
 #: a kiosk without a heartbeat for this long shows offline (the kiosk sends one at least every 10 s)
 OFFLINE_AFTER_S = 30.0
@@ -114,6 +114,8 @@ class KioskView:
     revoked: bool
     status: dict[str, Any] = field(default_factory=dict)
     alerts: tuple[Alert, ...] = ()
+    #: the session it reports runs a visit staff cancelled (the kiosk is ending it)
+    cancelled: bool = False
 
     def online(self, now: float) -> bool:
         return self.last_seen is not None and now - self.last_seen <= OFFLINE_AFTER_S and not self.revoked
@@ -212,16 +214,33 @@ def kiosk_views(engine: Engine, name: str | None = None) -> list[KioskView]:
         rows = connection.execute(query).all()
     pending = open_alerts(engine, name)
     now = db.now()
+    shown = {r.name: shown_status(r.status, now) for r in rows}
+    cancelled = _cancelled_sessions(engine, [s["session_id"] for s in shown.values() if s.get("session_id")])
     return [
         KioskView(
             r.name,
             r.last_seen,
             r.revoked_at is not None,
-            shown_status(r.status, now),
+            shown[r.name],
             tuple(a for a in pending if a.kiosk_id == r.name),
+            shown[r.name].get("session_id") in cancelled,
         )
         for r in rows
     ]
+
+
+def _cancelled_sessions(engine: Engine, session_ids: list[str]) -> set[str]:
+    """Which of these sessions run a visit whose order staff cancelled (its ``visit`` entry)."""
+    if not session_ids:
+        return set()
+    with engine.connect() as connection:
+        return set(
+            connection.execute(
+                sa.select(visits.c.session_id)
+                .join(orders, orders.c.id == visits.c.order_id)
+                .where(visits.c.session_id.in_(session_ids), orders.c.state == "cancelled")
+            ).scalars()
+        )
 
 
 def acknowledge(engine: Engine, alert_id: int, by: str) -> str:

@@ -41,6 +41,7 @@ from station import (
     errors,
     formulas,
     handover_pages,
+    identify_pages,
     logins,
     order_pages,
     pages,
@@ -53,6 +54,7 @@ from station import (
     throttle,
     tug_pages,
 )
+from station.batteries import Battery
 from station.bodylimit import BodyLimit
 from station.bus import Bus
 from station.live import Live
@@ -235,10 +237,12 @@ def create_app(
     trusted_proxies: tuple[throttle.Network, ...] = (),
     id_pattern: str = DEFAULT_ID_PATTERN,
     zone: tzinfo | None = None,
+    batteries: tuple[Battery, ...] = (),
 ) -> Starlette:
     """The station application on ``engine`` (already migrated); ``X-Forwarded-For`` counts only
-    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole;
-    times are shown in ``zone`` (None: the machine's own)."""
+    from ``trusted_proxies``; orders take the patient identifiers ``id_pattern`` matches whole,
+    and offer the site's ``batteries`` (:mod:`station.batteries`); times are shown in ``zone``
+    (None: the machine's own)."""
     bus = Bus(engine)
     q = questionnaire or load_questionnaire()
 
@@ -267,6 +271,7 @@ def create_app(
         *tug_pages.routes,
         *handover_pages.routes,
         *signoff_pages.routes,
+        *identify_pages.routes,
         *definition_pages.routes,
         *staff_items.routes,
         *study_pages.routes,
@@ -297,6 +302,7 @@ def create_app(
     app.state.trusted_proxies = trusted_proxies
     app.state.id_pattern = id_pattern
     app.state.zone = zone
+    app.state.batteries = batteries
     app.state.live = Live(
         bus,
         lambda name: pages.kiosk_event(app, name),

@@ -138,6 +138,24 @@ def parse_orders(body: Any, instruments: Sequence[str], languages: Iterable[str]
     return found, problems
 
 
+#: why a visit the ward cancelled while it ran ended (its session's log and the station's trail)
+CANCELLED = "the visit was cancelled at the ward station"
+
+
+def parse_cancelled(body: Any) -> tuple[str, ...]:
+    """The ids in a ``GET /api/v1/orders`` answer's ``cancelled`` list (protocol §4): visits the
+    ward cancelled that this kiosk may be running; anything but a list of ids is none."""
+    entries = body.get("cancelled") if isinstance(body, Mapping) else None
+    if not isinstance(entries, list):
+        return ()
+    return tuple(e for e in entries if isinstance(e, str) and e)
+
+
+def runs_cancelled(visit: str | None, order_ids: Iterable[str]) -> bool:
+    """The session whose ``visit`` entry this is runs one of the cancelled orders."""
+    return visit is not None and visit in {order_visit(i) for i in order_ids}
+
+
 def _answerer(entry: Mapping[str, Any]) -> Answerer | None:
     """An order's ``relationship`` (and ``relationship_text``), or None without one."""
     if entry.get("relationship") is None:

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from kiosk.core.room import STAFF_NOTICE
 from kiosk.core.session import Phase, Session
+from kiosk.core.visits import CANCELLED, runs_cancelled
 
 if TYPE_CHECKING:  # the client (http.client, threads) is not imported with the live status
     from kiosk.sync.client import Outcome
@@ -82,3 +83,16 @@ def apply_command(kiosk: Kiosk, command: Mapping[str, Any]) -> Outcome | None:
     else:
         return "refused", f"unknown command {kind!r}"
     return "done", None
+
+
+def end_cancelled(kiosk: Kiosk, order_ids: tuple[str, ...]) -> str | None:
+    """The ward cancelled these orders (protocol §4, the orders poll's ``cancelled``): a running
+    session of one of them ends as staff's "End session" ends one (stored as abandoned with
+    why, every answer given kept; a battery's next instruments never start). Returns the ended
+    visit's language (its patient reads a calm end in it), None when nothing here ran one."""
+    session = kiosk.session
+    if session.phase is Phase.WELCOME or session.finished or not runs_cancelled(session.visit, order_ids):
+        return None
+    language = session.language
+    kiosk.end_session(CANCELLED)
+    return language

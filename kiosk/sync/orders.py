@@ -14,7 +14,7 @@ from contextlib import closing
 from pathlib import Path
 from urllib.parse import quote
 
-from kiosk.core.visits import Order, parse_orders
+from kiosk.core.visits import Order, parse_cancelled, parse_orders
 from kiosk.sync.client import Backoff
 from kiosk.sync.http import Station, Unreachable
 
@@ -60,13 +60,17 @@ class OrderWatcher:
         poll_wait_s: float = POLL_WAIT_S,
         backoff: tuple[float, float] = (0.5, 30.0),
         held: Callable[[], list[str]] | None = None,
+        on_cancelled: Callable[[tuple[str, ...]], None] | None = None,
     ) -> None:
         """``held()``: the orders this kiosk can still go on with (:func:`held_orders`), told to
-        the station on every poll so an order whose kiosk stopped mid-visit heals (None: not told)."""
+        the station on every poll so an order whose kiosk stopped mid-visit heals (None: not told).
+        ``on_cancelled(ids)``: the station's cancelled orders this kiosk may run, with each new list
+        (the kiosk ends a running visit among them)."""
         self.station = station
         self._held = held
         self._instruments, self._languages = list(instruments), list(languages)
         self._on_orders = on_orders
+        self._on_cancelled = on_cancelled
         self._poll_wait_s = poll_wait_s
         self._backoff = backoff
         self._stopping = threading.Event()
@@ -106,6 +110,8 @@ class OrderWatcher:
             if body.get("version") != version and not self._stopping.is_set():
                 version = str(body.get("version"))
                 self._on_orders(*parse_orders(body, self._instruments, self._languages))
+                if self._on_cancelled is not None:
+                    self._on_cancelled(parse_cancelled(body))
 
 
 def start_order(station: Station, code: str, *, instruments: Sequence[str], languages: Sequence[str]) -> Order:

@@ -24,7 +24,7 @@ from textual.reactive import Reactive
 
 from kiosk.core.channels import Channel, ChannelInput, ChannelStatus, Command, Presence
 from kiosk.core.pin import CornerTaps, PinGuard
-from kiosk.core.session import Session, SessionEvent
+from kiosk.core.session import Phase, Session, SessionEvent
 from kiosk.core.site import ExportSite
 from kiosk.store.lease import LEASE_TTL_S
 from kiosk.ui.channels import KioskChannels
@@ -40,6 +40,7 @@ if TYPE_CHECKING:  # message types of screens loaded when first shown (kiosk.ui.
     from kiosk.ui.screens.doctor_called import DoctorCalledScreen
     from kiosk.ui.screens.explanation import ExplanationScreen
     from kiosk.ui.screens.unattended import UnattendedScreen
+    from kiosk.ui.screens.visit_ended import VisitEndedScreen
     from kiosk.ui.screens.visit_ready import VisitReadyScreen
     from kiosk.ui.widgets.answer_button import AnswerButton
     from kiosk.ui.widgets.change_answer import ChangeAnswerButton
@@ -137,6 +138,8 @@ class KioskApp(App[int], inherit_bindings=False):
         self._staff_seen = 0.0
         #: the app is unmounting: threads not started by now are never started
         self._unmounted = False
+        #: the language of a visit the ward cancelled while it ran: its calm end shows until a touch
+        self.visit_ended: str | None = None
         #: called once the welcome is drawn, before the channels start (`kiosk run` resumes the
         #: garbage collector it paused for the start)
         self.after_first_frame: list[Callable[[], None]] = []
@@ -215,6 +218,19 @@ class KioskApp(App[int], inherit_bindings=False):
     def station_command(self, command: Any) -> tuple[str, str | None] | None:
         """A command from the ward station (called on the client's thread): applied on the UI thread."""
         return self.call_from_thread(self.controller.station_command, command)
+
+    def visit_cancelled(self, order_ids: tuple[str, ...]) -> None:
+        """The ward cancelled these visits (the order watcher, handed over to the UI thread): a
+        running one ends and its patient reads a calm end until someone touches the screen."""
+        from kiosk.sync.commands import end_cancelled
+
+        if (language := end_cancelled(self.controller, order_ids)) is not None:
+            self.visit_ended = language
+            self.redraw(rebuild=True)
+
+    def on_visit_ended_screen_dismissed(self, message: VisitEndedScreen.Dismissed) -> None:
+        self.visit_ended = None
+        self.redraw(rebuild=True)
 
     def on_channel_received(self, message: ChannelReceived) -> None:
         """An input goes to the session; a status change to the channel bar."""
@@ -367,8 +383,15 @@ class KioskApp(App[int], inherit_bindings=False):
         if self.is_running and not self.clinician_open:
             held = self.controller.visits if self.controller.welcome_held() else None
             tug = self.controller.tugs if self.controller.tug_busy else None
-            broken = self.controller.out_of_order is not None
-            self.stage.show(self._view(), out_of_order=broken, held_visits=held, tug=tug)
+            if self.session.phase is not Phase.WELCOME:
+                self.visit_ended = None  # a new visit began (staff started one): its screens show
+            self.stage.show(
+                self._view(),
+                out_of_order=self.controller.out_of_order is not None,
+                held_visits=held,
+                tug=tug,
+                ended=self.visit_ended,
+            )
 
     # -- the clinician side -------------------------------------------------------------------
 

@@ -289,6 +289,7 @@ def _station(config: Config, parts: KioskParts, store: Store, app: Callable[[], 
             languages=languages,
             on_orders=lambda *found: app().call_from_thread(app().controller.orders_changed, *found),
             held=lambda: held_orders(store.path),
+            on_cancelled=lambda ids: app().call_from_thread(app().visit_cancelled, ids),
         )
 
     def start(code: str) -> Any:

@@ -87,10 +87,19 @@ class PatientStage:
         """Rebuild the phase's screen on the next :meth:`show`, even if it looks the same."""
         self.key = None
 
-    def show(self, view: PatientView, *, out_of_order: bool = False, held_visits: Any = None, tug: Any = None) -> None:
+    def show(
+        self,
+        view: PatientView,
+        *,
+        out_of_order: bool = False,
+        held_visits: Any = None,
+        tug: Any = None,
+        ended: str | None = None,
+    ) -> None:
         """Show the screens ``view`` calls for, or refresh the ones shown. ``out_of_order``: one
         calm screen instead; ``held_visits``: the visits desk when the welcome waits for staff;
-        ``tug``: the TUG desk while a visit's Timed Up and Go is under way (its screen instead)."""
+        ``tug``: the TUG desk while a visit's Timed Up and Go is under way (its screen instead);
+        ``ended``: the language of a visit the ward cancelled, whose calm end replaces the welcome."""
         app, snap = self.app, view.snapshot
         base_cls = phase_screen(snap.phase)
         overlay_cls = _overlay_screen(snap.halted, snap.paused, snap.unattended, snap.calling is not None)
@@ -112,6 +121,11 @@ class PatientStage:
 
             base_cls, key = VisitReadyScreen, (VisitReadyScreen, held_visits.ready)
             make = partial(VisitReadyScreen, view, held_visits.ready, held_visits.walk_up)
+        if snap.phase is Phase.WELCOME and ended is not None and not out_of_order:
+            from kiosk.ui.screens.visit_ended import VisitEndedScreen
+
+            base_cls, key = VisitEndedScreen, (VisitEndedScreen, ended)
+            make = partial(VisitEndedScreen, view, ended)
         if overlay is not None and (type(overlay) is not overlay_cls or key != self.key):
             app.pop_screen()
             overlay = None

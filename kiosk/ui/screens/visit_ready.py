@@ -1,6 +1,7 @@
-"""The welcome when a visit is ordered for this kiosk (or when the site allows no walk-up): who the
-visit is for, and a pad for staff to type the code the ward station shows on the order's page.
-The code is staff's confirmation that the patient in front of the kiosk is the ordered one.
+"""The welcome when a visit is ordered for this kiosk (or when the site allows no walk-up): that a
+visit is ready, and a pad for staff to type the code the ward station shows on the order's page.
+The code is staff's confirmation that the patient in front of the kiosk is the ordered one; the
+screen never names the patient (anyone passing by reads it), only something neutral of each visit.
 
 The screen only renders and forwards: a typed code goes to the app (:class:`CodeEntered`), which
 asks the station; the answer comes back through :meth:`refused` or a new session.
@@ -22,10 +23,11 @@ from kiosk.ui.widgets.text import language_name
 CODE_DIGITS = 4
 
 
-def order_line(order: Order) -> str:
-    """One ordered visit as staff read it: patient, instruments, language, who answers."""
-    who = "a relative answers" if order.relative else "the patient answers"
-    return f"Patient {order.patient_id} · {', '.join(order.instruments)} · {language_name(order.language)} · {who}"
+def order_line(number: int, order: Order) -> str:
+    """One ordered visit as anyone passing may read it: its place, how many questionnaires, the
+    language; never the patient's identifier nor the instruments (issue 36: passers-by)."""
+    count = len(order.instruments)
+    return f"Visit {number} · {count} questionnaire{'s' if count != 1 else ''} · {language_name(order.language)}"
 
 
 class VisitReadyScreen(PatientScreen):
@@ -63,8 +65,8 @@ class VisitReadyScreen(PatientScreen):
         with Vertical(id="visit-ready"):
             if self.orders:
                 yield Static("A visit is ready", classes="visit-heading", id="visit-heading")
-                for order in self.orders:
-                    yield Static(order_line(order), classes="visit-order")
+                for number, order in enumerate(self.orders, 1):
+                    yield Static(order_line(number, order), classes="visit-order")
                 yield Static("Staff: with the patient here, type the code the ward station shows for this visit.")
                 yield Static(" ", id="visit-code")
                 yield Label("", id="visit-error")

@@ -6,7 +6,16 @@ from __future__ import annotations
 
 import pytest
 
-from kiosk.core.visits import DEFAULT_ID_PATTERN, Order, VisitDesk, check_patient_id, parse_orders, pattern_problem
+from kiosk.core.visits import (
+    DEFAULT_ID_PATTERN,
+    Order,
+    VisitDesk,
+    check_patient_id,
+    parse_cancelled,
+    parse_orders,
+    pattern_problem,
+    runs_cancelled,
+)
 
 
 @pytest.mark.parametrize("identifier", ["NHC-0012345", "12345678", "MRN_77", "p2"])
@@ -91,3 +100,12 @@ def test_the_welcome_is_held_for_ordered_visits_and_where_walk_ups_are_not_allow
     assert desk.for_staff(" NHC-2 ", "en", True)[0] == ("NHC-2", "en", "relative", "staff", None)
     closed = VisitDesk(lambda *args: args, walk_up=False)
     assert closed.holds_welcome() and not closed.choose_walk_up() and closed.holds_welcome()
+
+
+def test_the_cancelled_orders_of_a_poll_are_read_and_matched_to_the_running_visit():
+    assert parse_cancelled({"orders": [], "cancelled": ["order-1", 7, "", None, "order-2"]}) == ("order-1", "order-2")
+    for junk in ({"orders": []}, {"cancelled": "order-1"}, ["order-1"], None):
+        assert parse_cancelled(junk) == ()  # a station from before, or a wrong answer: nothing ends
+    assert runs_cancelled("order order-1", ("order-2", "order-1"))
+    assert not runs_cancelled("walk-up", ("order-1",)) and not runs_cancelled(None, ("order-1",))
+    assert not runs_cancelled("order order-10", ("order-1",))

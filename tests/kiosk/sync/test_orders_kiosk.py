@@ -74,9 +74,9 @@ async def test_an_ordered_visit_starts_at_the_kiosk_only_with_its_code(tmp_path)
 
             await until_thread(lambda: screen(app) == "VisitReadyScreen", "the visit on the kiosk's welcome")
             await pilot.pause()  # the keypad laid out
-            assert "Patient NHC-4242" in text_of(app, ".visit-order") and "a relative answers" in text_of(
-                app, ".visit-order"
-            )
+            # nothing of the patient for passers-by to read: a neutral line of the visit only
+            assert text_of(app, ".visit-order") == "Visit 1 · 1 questionnaire · Español"
+            assert "NHC-4242" not in "".join(str(w.render()) for w in app.screen.query("Static, Label"))
             await pilot.press("1")  # a remote's 1 (a keyboard remote): a digit of the code, nothing starts
             await pilot.pause()
             assert app.session.phase is Phase.WELCOME and screen(app) == "VisitReadyScreen"
