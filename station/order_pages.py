@@ -120,8 +120,16 @@ async def order_page(request: Request) -> Response:
         return PlainTextResponse(f"no order {request.path_params['order_id']}", status_code=404)
     trail = await run_in_threadpool(validation.trail, engine, order.id)
     found = await run_in_threadpool(tugs.of_order, engine, order.id)
+    offered = await run_in_threadpool(orders.instruments, engine, request.app.state.questionnaire)
+    titles = {i.id: i.title for i in offered}  # staff read the instruments' titles, never their ids
     return render(
-        request, "order.html", order=order, trail=trail, tugs=found, message=request.query_params.get("message")
+        request,
+        "order.html",
+        order=order,
+        trail=trail,
+        tugs=found,
+        titles=titles,
+        message=request.query_params.get("message"),
     )
 
 

@@ -72,7 +72,7 @@ def test_the_order_form_offers_the_sites_battery_and_keeps_its_order(sqlite_url,
     cga = '<option value="CGA">CGA: Geriatric Depression Scale (GDS-15) → Lawton Instrumental Activities'
     assert cga in form and '<option value="Mood">Mood: Geriatric Depression Scale (GDS-15) → mood4</option>' in form
     boxes = re.findall(r'name="instrument" value="([^"]+)"', form)
-    assert boxes == ["gds15", "lawton", "barthel", "sarc_f"]  # the site's order, then the others
+    assert boxes == ["gds15", "lawton", "barthel", "sarc_f", "tug"]  # the site's order, then the others
     assert 'name="instrument" value="gds15" checked' not in form  # a battery or boxes: nothing ticked for staff
 
     # a battery's instrument the station has not seen a kiosk run is named and refused, never dropped

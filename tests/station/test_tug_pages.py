@@ -80,8 +80,12 @@ def test_the_tug_on_the_visit_course_print_and_order_pages(browser, sqlite_url, 
         page.fill("input[name=patient_id]", "NHC-0034200")
         page.uncheck("input[name=instrument][value=barthel]")
         page.check("#instrument-tug")
+        page.click("#place-order")  # the TUG alone: the kiosk gives it within a visit
+        page.wait_for_selector("text=the Timed Up and Go is given within a visit: choose an instrument with it")
+        page.check("input[name=instrument][value=barthel]")
+        page.check("#instrument-tug")
         page.click("#place-order")
         page.wait_for_selector("#order-code")
-        assert page.inner_text("#order-instruments") == "Timed Up and Go"
+        assert page.inner_text("#order-instruments") == "Barthel Index → Timed Up and Go"
     finally:
         context.close()
