@@ -14,9 +14,12 @@ from starlette.responses import Response
 from starlette.templating import Jinja2Templates
 
 from station import auth, logins, ward
+from station.printing import shown_time
 
 templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
 templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
+#: a stored ISO time as staff read it, in the station's zone (the visit pages, the inbox)
+templates.env.filters["shown"] = shown_time
 #: a command as staff name it (the buttons' words), never its protocol name
 templates.env.globals["command_labels"] = {
     "continue": "Continue session",

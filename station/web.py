@@ -49,6 +49,7 @@ from station import (
     signoff_pages,
     staff_items,
     throttle,
+    visit_pages,
 )
 from station.bodylimit import BodyLimit
 from station.bus import Bus
@@ -261,6 +262,7 @@ def create_app(
         *print_pages.routes,
         *handover_pages.routes,
         *signoff_pages.routes,
+        *visit_pages.routes,
         *definition_pages.routes,
         *staff_items.routes,
         *api.routes,
