@@ -12,11 +12,12 @@ import pytest
 import sqlalchemy as sa
 
 from kiosk.core.questionnaire import load_questionnaire
-from station import db, results, staff_items, validation, visit_inbox, visit_review
+from station import db, results, staff_items, sync, validation, visit_inbox, visit_review
 from station.sessions import NotFound
 from tests.station._battery import DOCTOR, NURSE, store_battery
 from tests.station._visits import PATIENT
 from tests.station.conftest import make_ward
+from tests.station.test_staff_items import _rows
 
 REASON = "patient too tired to be weighed; not to be repeated"
 
@@ -158,3 +159,18 @@ def test_a_patients_visits_and_search_count_visits(engine, tmp_path) -> None:
         ("Mood check (4 items)", "20 of 25", "Suggests depression"),
         ("Walking", "incomplete", ""),
     ]
+
+
+def test_a_number_staff_entered_at_the_kiosk_counts_on_the_visit_and_in_the_lists(engine, tmp_path) -> None:
+    """The weight staff typed at the kiosk is a line of the session's log: the visit, the inbox and
+    the patient's course score with it (they read the log's events, not only the answers)."""
+    rows = _rows(tmp_path, kiosk_weight=64.0)
+    with engine.begin() as connection:
+        sync.intake(connection, "ward3-bed2", sync.parse({"events": [r.event() for r in rows]}))
+    session_id, q = rows[0].session_id, load_questionnaire()
+    validation.change_item(engine, load_questionnaire(tmp_path / "walking.yaml"), session_id, "aid", 2, "stick", NURSE)
+    (walking,) = visit_review.read(engine, q, session_id).results
+    assert walking.staff == ["Weight: 64 kg (entered by kiosk staff at the kiosk)", "Uses a walking aid: “An aid”"]
+    assert (walking.printed.total_words, walking.missing) == ("6 of 9", [])
+    (listed,) = visit_inbox.inbox(engine, q).visits
+    assert [r.total_words for r in listed.results] == ["6 of 9"]
