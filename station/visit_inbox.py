@@ -106,6 +106,38 @@ def _listed(table: Any, state: str, kiosk_id: str | None) -> list[Any]:
     return where
 
 
+def anchor_query(state: str, kiosk_id: str | None, after: str, limit: int) -> Any:
+    """The inbox page's anchors: each listed visit's newest session in the filter, newest first."""
+    later, sibling, mine = sessions.alias("later"), visits.alias("sibling"), visits.alias("mine")
+    # one table scanned in the inbox's order (the index on status, finish time and id), each row
+    # kept unless a later session of its order is in the filter: a few primary-key and order-id
+    # lookups a row, and the scan stops at the page's end
+    newer_of_its_order = sa.exists(
+        sa.select(sa.literal(1))
+        .select_from(
+            mine.join(sibling, sibling.c.order_id == mine.c.order_id).join(later, later.c.id == sibling.c.session_id)
+        )
+        .where(
+            mine.c.session_id == sessions.c.id,
+            *_listed(later, state, kiosk_id),
+            sa.tuple_(later.c.finished_at, later.c.id) > sa.tuple_(sessions.c.finished_at, sessions.c.id),
+        )
+    )
+    order_of = (
+        sa.select(visits.c.order_id).where(visits.c.session_id == sessions.c.id).scalar_subquery().label("order_id")
+    )
+    anchors = (
+        sa.select(sessions.c.id, sessions.c.finished_at, order_of)
+        .where(*_listed(sessions, state, kiosk_id), ~newer_of_its_order)
+        .order_by(sessions.c.finished_at.desc(), sessions.c.id.desc())
+        .limit(limit + 1)
+    )
+    finished_at, _, session_id = after.partition("|")
+    if finished_at:
+        anchors = anchors.where(sa.tuple_(sessions.c.finished_at, sessions.c.id) < sa.tuple_(finished_at, session_id))
+    return anchors
+
+
 def inbox(
     engine: Engine,
     q: Questionnaire,
@@ -121,32 +153,7 @@ def inbox(
     page costs what the first does (an index range, never an OFFSET); the database picks the
     anchors (a later finished session of the same order in the filter makes a session none), so
     its order of rows, not Python's, decides what a page holds."""
-    later, sibling = sessions.alias("later"), visits.alias("sibling")
-    mine = visits.alias("mine")
-    anchors = (
-        sa.select(sessions.c.id, sessions.c.finished_at, mine.c.order_id)
-        .select_from(sessions.outerjoin(mine, mine.c.session_id == sessions.c.id))
-        .where(*_listed(sessions, state, kiosk_id))
-        .where(
-            sa.or_(
-                mine.c.order_id.is_(None),
-                ~sa.exists(
-                    sa.select(sa.literal(1))
-                    .select_from(sibling.join(later, later.c.id == sibling.c.session_id))
-                    .where(
-                        sibling.c.order_id == mine.c.order_id,
-                        *_listed(later, state, kiosk_id),
-                        sa.tuple_(later.c.finished_at, later.c.id) > sa.tuple_(sessions.c.finished_at, sessions.c.id),
-                    )
-                ),
-            )
-        )
-        .order_by(sessions.c.finished_at.desc(), sessions.c.id.desc())
-        .limit(limit + 1)
-    )
-    finished_at, _, session_id = after.partition("|")
-    if finished_at:
-        anchors = anchors.where(sa.tuple_(sessions.c.finished_at, sessions.c.id) < sa.tuple_(finished_at, session_id))
+    anchors = anchor_query(state, kiosk_id, after, limit)
     with engine.connect() as connection:
         rows = connection.execute(anchors).all()
         more = len(rows) > limit
