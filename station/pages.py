@@ -278,9 +278,11 @@ async def sign_off(request: Request) -> Response:
 
 
 async def amend(request: Request) -> Response:
+    """POST a reopening; back to the result's page, or to its visit's when the visit's page sent it."""
     form = await checked_form(request)
     session_id = request.path_params["session_id"]
-    page = f"/sessions/{session_id}"
+    back = form.get("back", "")
+    page = back if back.startswith("/visits/") and "//" not in back else f"/sessions/{session_id}"
     try:
         await run_in_threadpool(
             validation.amend, request.app.state.engine, session_id, form.get("reason", ""), request.state.user

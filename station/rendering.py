@@ -28,6 +28,8 @@ def _when(context: Any, iso: Any, form: str = "minute") -> str:
 
 
 templates.env.filters["when"] = _when
+#: the same, as the visit pages name it (``{{ x|shown }}``, minutes)
+templates.env.filters["shown"] = _when
 #: a command as staff name it (the buttons' words), never its protocol name
 templates.env.globals["command_labels"] = {
     "continue": "Continue session",

@@ -1,6 +1,6 @@
-"""The clinician's pages of results: the inbox of results waiting for validation (filter by kiosk
-and review state), patient search, and one patient's course (every visit, a step plot per
-instrument). Read-only: validating a result stays on its session page (:mod:`station.pages`).
+"""The clinician's pages of results: the inbox of visits waiting for validation (filter by kiosk
+and review state), patient search, and one patient's course (every visit, newest first, and a
+step plot per instrument). Read-only: a visit is validated on its page (:mod:`station.visit_pages`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from starlette.requests import Request
 from starlette.responses import HTMLResponse, PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Route
 
-from station import db, orders, results, tugs
+from station import db, orders, results, tugs, visit_inbox
 from station.course_plot import course_svg
 from station.rendering import render, templates
 from station.tug_plot import tug_svg
@@ -31,16 +31,18 @@ def _kiosk_names(engine: Any) -> list[str]:
 async def inbox_page(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     state = request.query_params.get("state", "waiting")
-    if state not in results.INBOX_STATES:
+    if state not in visit_inbox.INBOX_STATES:
         state = "waiting"
     kiosk = request.query_params.get("kiosk") or ""
     after = request.query_params.get("after") or ""
-    found = await run_in_threadpool(lambda: results.inbox(engine, q, state=state, kiosk_id=kiosk or None, after=after))
+    found = await run_in_threadpool(
+        lambda: visit_inbox.inbox(engine, q, state=state, kiosk_id=kiosk or None, after=after)
+    )
     names = await run_in_threadpool(_kiosk_names, engine)
     return render(
         request,
         "inbox.html",
-        results=found.results,
+        visits=found.visits,
         more=found.after,
         after=after,
         state=state,
@@ -72,7 +74,7 @@ async def patient_page(request: Request) -> Response:
         request,
         "patient.html",
         patient_id=patient_id,
-        visits=visits,
+        visits=visit_inbox.patient_visits(visits),
         orders=ordered,
         plots=[(i.id, i.title.get("en", i.id), course_svg(i, visits)) for i in ran],
         tugs=timed,
@@ -105,7 +107,7 @@ def results_event(app: Any, finished: list[str]) -> dict[str, Any]:
         rung = [
             {
                 "session": r.id,
-                "href": f"/sessions/{r.id}",
+                "href": visit_inbox.visit_href(r.id),
                 "text": f"Result waiting: {r.patient_id}, kiosk {r.kiosk_id}",
             }
             for r in rows
@@ -119,14 +121,15 @@ async def inbox_rows(request: Request) -> Response:
     kiosk = request.query_params.get("kiosk") or None
     after = request.query_params.get("after") or ""
     found = await run_in_threadpool(
-        lambda: results.inbox(
-            engine, q, state=state if state in results.INBOX_STATES else "waiting", kiosk_id=kiosk, after=after
+        lambda: visit_inbox.inbox(
+            engine, q, state=state if state in visit_inbox.INBOX_STATES else "waiting", kiosk_id=kiosk, after=after
         )
     )
-    template = templates.get_template("_result_row.html")
+    template = templates.get_template("_visit_row.html")
     html = (
-        "".join(template.render(r=r) for r in found.results) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
+        "".join(template.render(v=v) for v in found.visits) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
     )
+
     return HTMLResponse(html)
 
 

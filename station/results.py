@@ -1,5 +1,6 @@
-"""Results as the clinician follows them: the inbox of results waiting for validation, and one
-patient's course across visits (each instrument's total, band and review state per visit).
+"""Results as the clinician follows them: each session's result as a row (total, band, review
+state), one patient's course, the count of results waiting and the patient search. The inbox
+lists them by visit (:mod:`station.visit_inbox`).
 
 Read-only views over what the kiosks sent (:mod:`station.sessions`) and the audit trail
 (:mod:`station.validation`); scores are the session core's (the questionnaire scores the
@@ -21,12 +22,10 @@ from kiosk.core.staff import every_entered
 from kiosk.export import ExportError
 from station import order_progress, validation
 from station.db import sessions, tug_results
+from station.db import visits as visit_table
 from station.definitions import questionnaire_for
 from station.sessions import LIFECYCLE, RESULT_KINDS, load_many
 
-#: inbox filters: which review states each shows
-INBOX_STATES = {"waiting": ("unreviewed", "corrected"), "signed": ("signed_off", "amended"), "all": None}
-INBOX_LIMIT = 50
 VISIT_WORDS = {"order": "ordered", "staff": "started by staff", "walk-up": "walk-up"}
 
 
@@ -51,6 +50,8 @@ class Result:
     order_id: str | None
     #: the instrument's title as the session's captured definition gives it ("" if it has none)
     title: str = ""
+    #: the band's label in the session's language, as staff read it ("" without a band)
+    band_label: str = ""
 
     @property
     def instrument(self) -> str:
@@ -62,16 +63,15 @@ class Result:
         return self.review.replace("_", " ")
 
     @property
+    def total_words(self) -> str:
+        """The total as staff read it ("5 of 14"), else why there is none."""
+        if self.total is not None:
+            return f"{self.total} of {self.max_total}"
+        return "incomplete" if self.status == "finished" else self.status.replace("_", " ")
+
+    @property
     def visit_words(self) -> str:
         return VISIT_WORDS.get(self.visit, "not recorded")
-
-
-def _signed() -> Any:
-    """Whether a result stands signed off: its latest sign-off or reopening is a sign-off (a
-    result a doctor reopened to amend waits for validation again, as
-    :func:`kiosk.core.review.review_from_steps` says), stored on the session by the transaction
-    that changed it (:mod:`station.validation`), never recomputed over the trail."""
-    return sessions.c.signed_at.is_not(None)
 
 
 def waiting_count(engine: Engine) -> int:
@@ -134,52 +134,14 @@ def results_of(engine: Engine, q: Questionnaire, rows: Sequence[Any]) -> list[Re
                 kind,
                 order_id,
                 (ran.title.get(stored.language) or ran.title.get("en") or "") if ran else "",
+                _label(score.band.label, stored.language, score.band.id) if score and score.band else "",
             )
         )
     return found
 
 
-@record
-class Page:
-    """One page of a long list, newest first, and where the next (older) one starts."""
-
-    results: list[Result]
-    #: the ``after`` of the next page ("" when this is the last)
-    after: str = ""
-
-
-def inbox(
-    engine: Engine,
-    q: Questionnaire,
-    *,
-    state: str = "waiting",
-    kiosk_id: str | None = None,
-    after: str = "",
-    limit: int = INBOX_LIMIT,
-) -> Page:
-    """Finished results, newest first, in the review states of ``state`` (:data:`INBOX_STATES`),
-    of one kiosk or all. Keyset pages: ``after`` is the previous page's last (finish time, id), so
-    the hundredth page costs what the first does (an index range, never an OFFSET)."""
-    query = (
-        sa.select(sessions.c.id, sessions.c.finished_at)
-        .where(sessions.c.status == "finished")
-        .order_by(sessions.c.finished_at.desc(), sessions.c.id.desc())
-        .limit(limit + 1)
-    )
-    if kiosk_id:
-        query = query.where(sessions.c.kiosk_id == kiosk_id)
-    if state == "waiting":
-        query = query.where(sa.not_(_signed()))
-    elif state == "signed":
-        query = query.where(_signed())
-    finished_at, _, session_id = after.partition("|")
-    if finished_at:
-        query = query.where(sa.tuple_(sessions.c.finished_at, sessions.c.id) < sa.tuple_(finished_at, session_id))
-    with engine.connect() as connection:
-        rows = connection.execute(query).all()
-    more = len(rows) > limit
-    rows = rows[:limit]
-    return Page(results_of(engine, q, rows), f"{rows[-1].finished_at}|{rows[-1].id}" if more else "")
+def _label(texts: Any, language: str, fallback: str) -> str:
+    return str(texts.get(language) or texts.get("en") or fallback)
 
 
 def course(engine: Engine, q: Questionnaire, patient_id: str) -> list[Result]:
@@ -233,14 +195,20 @@ def _starts_with(text: str, postgres: bool, column: Any = sessions.c.patient_id)
 
 def search(engine: Engine, text: str, limit: int = 50) -> list[tuple[str, int, str]]:
     """Patients whose identifier starts with ``text`` as typed or in capitals (hospital numbers
-    are written in capitals, staff type in either): (id, visits, last visit), latest first."""
+    are written in capitals, staff type in either): (id, visits, last visit), latest first. A
+    visit is the sessions of one order (a battery), or a session no order started."""
     text = text.strip()
     if not text:
         return []
     postgres = engine.dialect.name == "postgresql"
     prefixes = list(dict.fromkeys((text, text.upper())))
     query = (
-        sa.select(sessions.c.patient_id, sa.func.count(), sa.func.max(sessions.c.started_at))
+        sa.select(
+            sessions.c.patient_id,
+            sa.func.count(sa.distinct(sa.func.coalesce(visit_table.c.order_id, sessions.c.id))),
+            sa.func.max(sessions.c.started_at),
+        )
+        .select_from(sessions.outerjoin(visit_table, visit_table.c.session_id == sessions.c.id))
         .where(sa.or_(*(_starts_with(p, postgres) for p in prefixes)), sessions.c.status != "pending")
         .group_by(sessions.c.patient_id)
         .order_by(sa.func.max(sessions.c.started_at).desc())

@@ -284,8 +284,10 @@ def load(connection: Connection, session_id: str) -> tuple[str, StoredSession]:
     return found[session_id]
 
 
-#: the rows a result's score, state and list entry need (no metrics, contexts or log)
-RESULT_KINDS = (*LIFECYCLE, "record_answer", "withdraw_answer", "record_not_answered")
+#: the rows a result's score, state and list entry need (no metrics or contexts): the log's
+#: events too, as a number staff entered at the kiosk is a log line (kiosk.core.staff.STAFF_ANSWER)
+#: and without it the lists and the print view gave such a result no total
+RESULT_KINDS = (*LIFECYCLE, "record_answer", "withdraw_answer", "record_not_answered", "record_event")
 
 
 #: the rows no export reads (the QoS engine's samples and context, its adaptations): two thirds of

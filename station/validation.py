@@ -60,11 +60,16 @@ def trail(engine: Engine, session_id: str) -> list[AuditEntry]:
         return _entries(connection, session_id)
 
 
+def lock(connection: Connection, session_id: str) -> None:
+    """Hold the session's lock until the transaction ends (PostgreSQL; SQLite serialises writers)."""
+    if connection.dialect.name == "postgresql":
+        connection.execute(sa.text("SELECT pg_advisory_xact_lock(hashtext(:s))"), {"s": session_id})
+
+
 def _locked(connection: Connection, session_id: str) -> tuple[StoredSession, list[AuditEntry]]:
     """The session and its trail, read under a per-session lock on PostgreSQL, so two clinicians
     changing one session at once go one after the other (SQLite writers are serialised anyway)."""
-    if connection.dialect.name == "postgresql":
-        connection.execute(sa.text("SELECT pg_advisory_xact_lock(hashtext(:s))"), {"s": session_id})
+    lock(connection, session_id)
     _, stored = load(connection, session_id)
     return stored, _entries(connection, session_id)
 

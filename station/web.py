@@ -53,6 +53,7 @@ from station import (
     study_pages,
     throttle,
     tug_pages,
+    visit_pages,
 )
 from station.batteries import Battery
 from station.bodylimit import BodyLimit
@@ -272,6 +273,7 @@ def create_app(
         *handover_pages.routes,
         *signoff_pages.routes,
         *identify_pages.routes,
+        *visit_pages.routes,
         *definition_pages.routes,
         *staff_items.routes,
         *study_pages.routes,

@@ -61,7 +61,7 @@ def test_a_station_describes_each_instrument_by_its_own_definition(database, req
         assert page.status_code == 200, (path, page.text)
         assert MOOD_TITLE in page.text and "Barthel Index" in page.text, path
     inbox = staff.http.get("/inbox").text
-    assert "20/25 · suggests" in inbox and "100/100 · independent" in inbox
+    assert "20 of 25 · Suggests depression" in inbox and "100 of 100 · Independent" in inbox
     page = staff.http.get(f"/sessions/{mood}")
     assert page.status_code == 200
     assert MOOD_TITLE in page.text and "How is your energy?" in page.text and "Feeding" not in page.text
@@ -135,9 +135,10 @@ def test_a_doctor_corrects_and_signs_off_a_non_barthel_result_in_chromium(
     page = _login(browser, station.url, viewport)
     page.goto(station.url + "/inbox")
     row = page.locator(f"#inbox li.result:has-text('{MOOD_TITLE}')")
-    assert row.locator(".score").inner_text() == "20/25 · suggests"
-    assert page.locator("#inbox li.result:has-text('Barthel Index') .score").inner_text() == "100/100 · independent"
-    row.locator("a.open-result").click()
+    assert row.locator(".score").inner_text() == "20 of 25 · Suggests depression"
+    assert page.locator("#inbox li.result:has-text('Barthel Index') .score").inner_text() == "100 of 100 · Independent"
+    row.locator("a.open-result").click()  # the visit, then its result's own page
+    page.locator(".visit-result a.open-session").click()
     page.wait_for_selector("#instrument")
     assert page.locator("#instrument").inner_text() == MOOD_TITLE
     page.locator("#item-energy summary").click()
@@ -228,8 +229,8 @@ def test_the_kiosks_own_sync_delivers_two_instruments_to_a_postgresql_station(pg
         assert ran.returncode == 0 and ran.stderr == "", ran.stderr  # delivered before it exited
     staff = Staff(station.url)
     inbox = staff.http.get("/inbox").text
-    assert "20/25 · suggests" in inbox and "100/100 · independent" in inbox
-    (mood,) = re.findall(r'data-session="(\w+)">\s*<a[^>]*><b>TB-0900</b>', inbox)
+    assert "20 of 25 · Suggests depression" in inbox and "100 of 100 · Independent" in inbox
+    (mood,) = re.findall(r'data-visit="(\w+)">\s*<a[^>]*><b>TB-0900</b>', inbox)  # a visit of its own
     page = staff.http.get(f"/sessions/{mood}")
     assert page.status_code == 200 and MOOD_TITLE in page.text
     bundle = staff.http.get(f"/sessions/{mood}/export.json").json()

@@ -18,7 +18,7 @@ from alembic.config import Config
 from bench._history import load_history
 from kiosk.core.questionnaire import load_questionnaire
 from kiosk.export import bundle_of
-from station import auth, db, exports, results, validation
+from station import auth, db, exports, results, validation, visit_inbox
 from tests.station.conftest import make_ward
 from tests.station.helpers import PATIENTS, Staff, record_patient
 
@@ -81,7 +81,7 @@ def test_inbox_keyset_pages_lose_and_repeat_nothing(engine, template) -> None:
     q = load_questionnaire()
     seen, after, pages = [], "", 0
     while True:
-        page = results.inbox(engine, q, state="all", after=after, limit=4)
+        page = visit_inbox.inbox(engine, q, state="all", after=after, limit=4)
         seen += [r.session_id for r in page.results]
         pages += 1
         if not page.after:

@@ -66,6 +66,8 @@ def test_no_station_page_scrolls_sideways_on_a_phone(browser, shared_station):
             f"/sessions/{session_id}",
             f"/sessions/{session_id}/sign-off",
             f"/sessions/{session_id}/print",
+            f"/visits/{session_id}",
+            f"/visits/{session_id}/sign-off",
             f"/patients/{quote(PATIENT)}/print",
             "/handover",
             "/orders",

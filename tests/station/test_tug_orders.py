@@ -82,6 +82,8 @@ def test_an_ordered_tug_reaches_the_kiosk_and_completes_its_order(database, requ
     synced = kiosk.sync(barthel)
     assert synced.status_code == 200, synced.text
     assert state(db_url, battery_id)[0] == "awaiting_validation"
+    visit = nurse.http.get(f"/visits/{battery_id}").text  # the visit's page: its questionnaire and its TUG
+    assert 'id="tug-results"' in visit and "Barthel Index" in visit and "the site&#39;s threshold" in visit
     kiosk.close()
 
 

@@ -136,21 +136,28 @@ def test_order_greet_confirm_answer_ring_sign_off_course(
     assert nurse.locator("#order-code").count() == 0
     fits(doctor, viewport)
 
-    # the doctor opens it, asks to sign off, sees the total, confirms
+    # the doctor opens the visit, asks to sign it off, sees each total, confirms once
     doctor.click("#inbox li.result a.open-result")
-    doctor.wait_for_selector("#total")
-    assert doctor.locator("#visit-line").inner_text().startswith("Ordered visit")  # the result links to its order
-    assert doctor.get_attribute("#visit-order", "href").startswith("/orders/order-")
+    doctor.wait_for_selector(".visit-result .total")
+    assert doctor.get_attribute("#visit-order", "href").startswith("/orders/order-")  # the visit links to its order
     fits(doctor, viewport)
-    total = doctor.locator("#total").inner_text()
-    doctor.click("#sign-off")
-    assert total in doctor.locator("#confirm-total").inner_text()
-    assert doctor.locator("#confirm-state").inner_text() == "signed off"
+    total = doctor.locator(".visit-result .total").inner_text()
+    assert total.endswith(" of 100")
+    doctor.click("#sign-off-visit")
+    assert total in doctor.locator(".confirm-total").inner_text()
+    assert doctor.locator(".confirm-state").inner_text() == "signed off"
     fits(doctor, viewport)
-    doctor.click("#confirm-sign-off")
-    assert doctor.locator("#review-words").inner_text().startswith("Signed off as recorded by dr.lopez")
-    assert doctor.locator("h1 .badge[class*=review-]").inner_text() == "signed off"
+    doctor.click("#confirm-sign-off-visit")
+    doctor.wait_for_selector("#visit-final")
+    assert doctor.locator("p.message[role=status]").inner_text() == "Signed off: 1 result of the visit."
+    assert doctor.locator(".visit-result .result-state").inner_text() == "signed off"
+    assert doctor.locator(".visit-result .signed").inner_text().startswith("dr.lopez, ")
     doctor.wait_for_selector("#waiting-count:not(.some)", state="attached")
+    # the result's own page still says it, and links back to its visit
+    doctor.click(".visit-result a.open-session")
+    assert doctor.locator("#review-words").inner_text().startswith("Signed off as recorded by dr.lopez")
+    assert doctor.locator("#visit-line").inner_text().startswith("Ordered visit")
+    assert doctor.get_attribute("#open-visit", "href").startswith("/visits/")
 
     # the patient's course shows the visit: total, band, review state, ordered, and the plot's point
     doctor.goto(station.url + "/patients")
@@ -160,7 +167,7 @@ def test_order_greet_confirm_answer_ring_sign_off_course(
     doctor.click("#patients a:has-text('NHC-0042')")
     doctor.wait_for_selector("#visits")
     visit = doctor.locator("#visits tbody tr").first.inner_text()
-    assert f"{total}/100" in visit and "signed off" in visit and "ordered" in visit
+    assert total in visit and "signed off" in visit and "ordered" in visit
     assert doctor.locator("svg.course-plot circle.visit-point").count() == 1
     fits(doctor, viewport)
     nurse.wait_for_selector("#order-state:text-is('signed off')")
