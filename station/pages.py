@@ -40,14 +40,18 @@ from station.sessions import NotFound, load
 def kiosk_event(app: Starlette, name: str) -> dict[str, Any]:
     """A kiosk's tile, rendered for the live feed."""
     views = ward.kiosk_views(app.state.engine, name)
-    html = templates.get_template("_tile.html").render(k=views[0], now=db.now(), csrf="__CSRF__") if views else ""
+    html = (
+        templates.get_template("_tile.html").render(k=views[0], now=db.now(), csrf="__CSRF__", zone=app.state.zone)
+        if views
+        else ""
+    )
     return {"name": name, "html": html}
 
 
 def alerts_event(app: Starlette) -> dict[str, Any]:
     """The open alerts, rendered for the live feed, with their ids (the page sounds new ones)."""
     pending = ward.open_alerts(app.state.engine)
-    html = templates.get_template("_alerts.html").render(alerts=pending, csrf="__CSRF__")
+    html = templates.get_template("_alerts.html").render(alerts=pending, csrf="__CSRF__", zone=app.state.zone)
     return {
         "ids": [a.id for a in pending],
         "html": html,

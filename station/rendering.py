@@ -23,8 +23,9 @@ templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
 @pass_context
 def _when(context: Any, iso: Any, form: str = "minute") -> str:
     """``{{ r.finished_at|when }}``: a stored time in the site's zone (:mod:`station.times`)."""
-    request = context.get("request")
-    return times.shown(iso, getattr(request.app.state, "zone", None) if request is not None else None, form)
+    request = context.get("request")  # a page; a fragment for the live feed passes its ``zone``
+    zone = getattr(request.app.state, "zone", None) if request is not None else context.get("zone")
+    return times.shown(iso, zone, form)
 
 
 templates.env.filters["when"] = _when

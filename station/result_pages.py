@@ -127,7 +127,8 @@ async def inbox_rows(request: Request) -> Response:
     )
     template = templates.get_template("_visit_row.html")
     html = (
-        "".join(template.render(v=v) for v in found.visits) or '<li class="muted" id="inbox-empty">Nothing here.</li>'
+        "".join(template.render(v=v, zone=request.app.state.zone) for v in found.visits)
+        or '<li class="muted" id="inbox-empty">Nothing here.</li>'
     )
 
     return HTMLResponse(html)
@@ -163,7 +164,7 @@ def _cancelled_shown(engine: Any, found: list[results.Result]) -> list[results.R
 async def ward_rows(request: Request) -> Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     found = await run_in_threadpool(ward_results, engine, q)
-    return HTMLResponse(templates.get_template("_ward_results.html").render(results=found))
+    return HTMLResponse(templates.get_template("_ward_results.html").render(results=found, zone=request.app.state.zone))
 
 
 routes += [

@@ -30,7 +30,7 @@ async def _read(request: Request) -> visit_review.Visit | Response:
     engine, q = request.app.state.engine, request.app.state.questionnaire
     key = request.path_params["key"]
     try:
-        return await run_in_threadpool(visit_review.read, engine, q, key)
+        return await run_in_threadpool(visit_review.read, engine, q, key, request.app.state.zone)
     except NotFound:
         return PlainTextResponse(f"no visit {key} has reached this station", status_code=404)
 
