@@ -38,9 +38,10 @@ from typing import Any
 import numpy as np
 
 from kiosk.speech.asr.base import AsrUnavailable, Recognition
-from kiosk.speech.asr.levels import voiced_frames
+from kiosk.speech.asr.levels import gate_talk, voiced_frames
 from kiosk.speech.asr.whisper_files import model_folder
 from kiosk.speech.audio import SAMPLE_RATE
+from kiosk.speech.denoise import reduce_steady_noise
 from kiosk.speech.grammar import Grammar, build_grammar
 from kiosk.speech.matching import normalise
 
@@ -67,6 +68,8 @@ WHISPER_MAX_WORDS_PER_S = 6.0
 #: silence): Whisper was trained on 30 s windows and invents more on much shorter ones, while
 #: the encoder's cost grows with the window (docs/speech-tuning.md)
 WHISPER_MIN_FRAMES = 1000
+#: hypotheses kept while decoding (1: greedy)
+WHISPER_BEAM = 1
 #: CPU threads for one decode (the kiosk's UI and the audio thread share the rest)
 WHISPER_THREADS = 1
 #: at most this many prompt tokens (Whisper's own limit is 223)
@@ -203,6 +206,7 @@ class WhisperRecogniser:
             if self._detector is not None:
                 self._detector.close()
             return Recognition("", 0.0)
+        pcm = self._front_end(pcm)
         encoded, frames = self._encode(pcm)
         text, logprob, no_speech = self._generate(encoded, len(pcm) / 2 / SAMPLE_RATE)
         result = self._judge(pcm, encoded, frames, text, logprob, no_speech)
@@ -251,6 +255,14 @@ class WhisperRecogniser:
         log.debug("whisper: %r; the detector heard %r (%.2f)", heard, second.text, second.confidence)
         return second
 
+    @staticmethod
+    def _front_end(pcm: bytes) -> bytes:
+        """The utterance as PocketSphinx's own scoring gets it: a steady noise subtracted, else
+        other people's talk around the patient's words turned down (each leaves a quiet room's
+        audio as it is)."""
+        cleaned = reduce_steady_noise(pcm)
+        return gate_talk(pcm) if cleaned is pcm else cleaned
+
     def transcribe(self, pcm: bytes) -> tuple[str, float, float]:
         """Whisper's transcript of 16 kHz int16 audio, its mean token log-probability and its
         no-speech probability."""
@@ -271,7 +283,7 @@ class WhisperRecogniser:
         result = self._model.generate(
             encoded,
             [[*self._prompt, *self._start]],
-            beam_size=1,
+            beam_size=WHISPER_BEAM,
             max_length=len(self._prompt) + len(self._start) + int(8 + 5 * seconds),
             return_scores=True,
             return_no_speech_prob=True,
@@ -281,7 +293,7 @@ class WhisperRecogniser:
         return self._tokenizer.decode(ids).strip(), float(result.scores[0]), float(result.no_speech_prob)
 
     def _judge(self, pcm: bytes, encoded: Any, frames: int, text: str, logprob: float, no_speech: float) -> Recognition:
-        plain = _collapse(normalise(re.sub(r"[\(\[\*♪][^\)\]\*♪]*[\)\]\*♪]?", " ", text)))
+        plain = _once(_collapse(normalise(re.sub(r"[\(\[\*♪][^\)\]\*♪]*[\)\]\*♪]?", " ", text))))
         confidence = self._confidence(logprob, no_speech)
         log.debug("whisper: %r logprob %.2f no-speech %.2f", text, logprob, no_speech)
         if not plain or no_speech > WHISPER_NO_SPEECH_MAX or plain in HALLUCINATIONS:
@@ -351,6 +363,17 @@ def _is_command(meaning: Hashable) -> bool:
     """Whether a phrase's meaning is a command (an enum member; options are numbers, anything
     else is the phrase itself)."""
     return isinstance(meaning, Enum)
+
+
+def _once(plain: str) -> str:
+    """A transcript that is one phrase said over and over, said once: Whisper loops on a short
+    answer in a reverberant room ("yes yes yes" from one "yes"), and a repeated phrase means what
+    it means once ("no no" is no)."""
+    words = plain.split()
+    for n in range(1, len(words) // 2 + 1):
+        if len(words) % n == 0 and words == words[:n] * (len(words) // n):
+            return " ".join(words[:n])
+    return plain
 
 
 def _collapse(plain: str) -> str:

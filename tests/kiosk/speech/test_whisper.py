@@ -15,7 +15,7 @@ import pytest
 from kiosk.core.channels import Channel
 from kiosk.speech import models
 from kiosk.speech.asr import AsrUnavailable, WhisperRecogniser, open_recogniser
-from kiosk.speech.asr.whisper import _collapse
+from kiosk.speech.asr.whisper import _collapse, _once
 from kiosk.speech.asr.whisper_files import BASE_SHA256, joined_base, sha256_of, whisper_status
 from kiosk.speech.matching import YES_NO, Matcher, OptionWords
 
@@ -51,6 +51,17 @@ def test_a_phrase_whisper_loops_on_is_kept_once_and_no_no_as_said():
     assert _collapse("no no no no no") == "no"
     assert _collapse("no no") == "no no"
     assert _collapse("i need a lot of help") == "i need a lot of help"
+
+
+def test_a_transcript_that_is_one_phrase_over_and_over_is_that_phrase_once():
+    # tiny.en loops on a short answer in a reverberant room: "Yes. Yes. Yes." from one "yes"
+    assert _once(_collapse("yes yes yes yes yes yes yes yes")) == "yes"
+    assert _once("no no") == "no"
+    assert _once("the third one the third one") == "the third one"
+    # anything else is left as said: a no after a yes is no repetition, nor a partial loop
+    assert _once("yes no") == "yes no"
+    assert _once("yes yes no") == "yes yes no"
+    assert _once("i can t i") == "i can t i"
 
 
 def test_models_list_says_which_recogniser_each_language_uses_and_why(capsys, monkeypatch, tmp_path):
