@@ -173,7 +173,11 @@ class WhisperRecogniser:
         self._whole = {normalise(p): p for p in grammar.phrases}
         for lead in grammar.lead_ins:
             self._whole.update({normalise(f"{lead} {p}"): p for p in grammar.answers})
-        words = " ".join(dict.fromkeys(p.capitalize() + "." for p in (*grammar.answers, *grammar.phrases)))
+        # the answers last, nearest the audio, and kept whole when the prompt is cut to its last
+        # WHISPER_PROMPT_TOKENS: a Spanish "Is that right?" with its commands first lost every
+        # "Sí." ("sí" was heard as "C.", "es correcto" as "es el médico")
+        said = [*(p for p in grammar.phrases if p not in grammar.answers), *grammar.answers]
+        words = " ".join(dict.fromkeys(p.capitalize() + "." for p in said))
         ids = self._tokenizer.encode(" " + words, add_special_tokens=False).ids[-WHISPER_PROMPT_TOKENS:]
         self._prompt = [self._previous, *ids] if self._prompt_on else []
         self.reset()

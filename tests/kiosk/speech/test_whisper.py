@@ -177,6 +177,8 @@ def _options(item_id: str, language: str) -> list[OptionWords]:
     [
         ("en", "independent", 2, "yes", True),
         ("es", "independiente", 2, "no", False),
+        # heard as "C." while the prompt's answers were cut off behind its commands
+        ("es", None, None, "sí", True),
         ("fr", None, None, "oui", True),
         ("de", None, None, "ja", True),
     ],
