@@ -242,13 +242,20 @@ class WhisperRecogniser:
         """Where Whisper heard no answer, the detector's own hearing of an option (PocketSphinx,
         with its own checks), unless Whisper's transcript holds a word only another option's
         phrases have, or, for a reply taken at once, a negation (:data:`NEGATIONS`: "yes not right"
-        is no yes). tiny.en hears espeak-ng's "that's right" as "next slide"."""
+        is no yes); a reply taken at once only if it declines (its phrases hold a negation).
+        tiny.en hears espeak-ng's "that's right" as "next slide"."""
         assert self._grammar is not None and self._detector is not None
         second = self._detector.finish()
         option = self._meaning(second.text) if second.confidence > 0 else None
         if not _is_option(option):
             return result
         mine = {w for p in self._grammar.phrases if self._meaning(p) == option for w in normalise(p).split()}
+        if self._taken_as_heard and not mine & NEGATIONS:
+            # a reply acted on at once on the detector's word alone only if it declines: in a
+            # reverberant room "no it isn't", which Whisper heard as "and now you do that", was
+            # "yes it is" (0.98) to PocketSphinx, and stored a wrong answer
+            log.debug("whisper: %r; the detector alone heard %r: not taken", heard, second.text)
+            return result
         others = {w for p in self._grammar.phrases if self._meaning(p) != option for w in normalise(p).split()}
         if self._taken_as_heard:  # a reply acted on at once: any negation refuses it
             others |= NEGATIONS

@@ -14,7 +14,7 @@ import pytest
 
 from kiosk.core.channels import Channel
 from kiosk.speech import models
-from kiosk.speech.asr import AsrUnavailable, WhisperRecogniser, open_recogniser
+from kiosk.speech.asr import AsrUnavailable, Recognition, WhisperRecogniser, open_recogniser
 from kiosk.speech.asr.whisper import _collapse, _once
 from kiosk.speech.asr.whisper_files import BASE_SHA256, joined_base, sha256_of, whisper_status
 from kiosk.speech.matching import YES_NO, Matcher, OptionWords
@@ -246,3 +246,39 @@ def test_a_spoken_no_is_never_taken_as_yes(spoken, reply, monkeypatch):
     recogniser.accept(silence + read_wav(spoken(reply)).tobytes() + silence)
     result = recogniser.finish()
     assert matcher.match(result.text, result.confidence).option != 1
+
+
+class _Detector:
+    """PocketSphinx's place as the second hearing, saying what it is told to have heard."""
+
+    name, language = "scripted", "en"
+
+    def __init__(self, heard: str, confidence: float) -> None:
+        self.heard = Recognition(heard, confidence)
+
+    def set_grammar(self, *args, **kwargs) -> None:
+        """Any grammar."""
+
+    def reset(self) -> None:
+        """Nothing kept."""
+
+    def close(self) -> None:
+        """Nothing kept."""
+
+    def finish(self) -> Recognition:
+        return self.heard
+
+
+@pytest.mark.slow  # loads tiny.en
+@pytest.mark.parametrize(("detector_heard", "option"), [("yes it is", None), ("no it isn't", 2)])
+def test_a_reply_heard_by_the_detector_alone_is_taken_only_if_it_declines(detector_heard, option):
+    """Bench, reverberant room: "no it isn't", Whisper "and now you do that", PocketSphinx "yes
+    it is" (0.98): a wrong answer was stored. A no on the detector's word alone still declines."""
+    matcher = Matcher([OptionWords("Yes"), OptionWords("No")], "en")
+    recogniser = WhisperRecogniser("en", _Detector(detector_heard, 0.98))
+    recogniser.set_grammar(
+        matcher.phrases(), matcher.meaning, matcher.lead_ins(), matcher.fillers(), taken_as_heard=True
+    )
+    whisper = Recognition("and now you do that", 0.0)
+    result = recogniser._second_hearing(whisper, "and now you do that")
+    assert matcher.match(result.text, result.confidence).option == option
