@@ -38,9 +38,10 @@ from typing import Any
 import numpy as np
 
 from kiosk.speech.asr.base import AsrUnavailable, Recognition
-from kiosk.speech.asr.levels import voiced_frames
+from kiosk.speech.asr.levels import gate_talk, voiced_frames
 from kiosk.speech.asr.whisper_files import model_folder
 from kiosk.speech.audio import SAMPLE_RATE
+from kiosk.speech.denoise import reduce_steady_noise
 from kiosk.speech.grammar import Grammar, build_grammar
 from kiosk.speech.matching import normalise
 
@@ -67,6 +68,8 @@ WHISPER_MAX_WORDS_PER_S = 6.0
 #: silence): Whisper was trained on 30 s windows and invents more on much shorter ones, while
 #: the encoder's cost grows with the window (docs/speech-tuning.md)
 WHISPER_MIN_FRAMES = 1000
+#: hypotheses kept while decoding (1: greedy)
+WHISPER_BEAM = 1
 #: CPU threads for one decode (the kiosk's UI and the audio thread share the rest)
 WHISPER_THREADS = 1
 #: at most this many prompt tokens (Whisper's own limit is 223)
@@ -170,7 +173,11 @@ class WhisperRecogniser:
         self._whole = {normalise(p): p for p in grammar.phrases}
         for lead in grammar.lead_ins:
             self._whole.update({normalise(f"{lead} {p}"): p for p in grammar.answers})
-        words = " ".join(dict.fromkeys(p.capitalize() + "." for p in (*grammar.answers, *grammar.phrases)))
+        # the answers last, nearest the audio, and kept whole when the prompt is cut to its last
+        # WHISPER_PROMPT_TOKENS: a Spanish "Is that right?" with its commands first lost every
+        # "Sí." ("sí" was heard as "C.", "es correcto" as "es el médico")
+        said = [*(p for p in grammar.phrases if p not in grammar.answers), *grammar.answers]
+        words = " ".join(dict.fromkeys(p.capitalize() + "." for p in said))
         ids = self._tokenizer.encode(" " + words, add_special_tokens=False).ids[-WHISPER_PROMPT_TOKENS:]
         self._prompt = [self._previous, *ids] if self._prompt_on else []
         self.reset()
@@ -203,6 +210,7 @@ class WhisperRecogniser:
             if self._detector is not None:
                 self._detector.close()
             return Recognition("", 0.0)
+        pcm = self._front_end(pcm)
         encoded, frames = self._encode(pcm)
         text, logprob, no_speech = self._generate(encoded, len(pcm) / 2 / SAMPLE_RATE)
         result = self._judge(pcm, encoded, frames, text, logprob, no_speech)
@@ -234,13 +242,20 @@ class WhisperRecogniser:
         """Where Whisper heard no answer, the detector's own hearing of an option (PocketSphinx,
         with its own checks), unless Whisper's transcript holds a word only another option's
         phrases have, or, for a reply taken at once, a negation (:data:`NEGATIONS`: "yes not right"
-        is no yes). tiny.en hears espeak-ng's "that's right" as "next slide"."""
+        is no yes); a reply taken at once only if it declines (its phrases hold a negation).
+        tiny.en hears espeak-ng's "that's right" as "next slide"."""
         assert self._grammar is not None and self._detector is not None
         second = self._detector.finish()
         option = self._meaning(second.text) if second.confidence > 0 else None
         if not _is_option(option):
             return result
         mine = {w for p in self._grammar.phrases if self._meaning(p) == option for w in normalise(p).split()}
+        if self._taken_as_heard and not mine & NEGATIONS:
+            # a reply acted on at once on the detector's word alone only if it declines: in a
+            # reverberant room "no it isn't", which Whisper heard as "and now you do that", was
+            # "yes it is" (0.98) to PocketSphinx, and stored a wrong answer
+            log.debug("whisper: %r; the detector alone heard %r: not taken", heard, second.text)
+            return result
         others = {w for p in self._grammar.phrases if self._meaning(p) != option for w in normalise(p).split()}
         if self._taken_as_heard:  # a reply acted on at once: any negation refuses it
             others |= NEGATIONS
@@ -250,6 +265,14 @@ class WhisperRecogniser:
             return result
         log.debug("whisper: %r; the detector heard %r (%.2f)", heard, second.text, second.confidence)
         return second
+
+    @staticmethod
+    def _front_end(pcm: bytes) -> bytes:
+        """The utterance as PocketSphinx's own scoring gets it: a steady noise subtracted, else
+        other people's talk around the patient's words turned down (each leaves a quiet room's
+        audio as it is)."""
+        cleaned = reduce_steady_noise(pcm)
+        return gate_talk(pcm) if cleaned is pcm else cleaned
 
     def transcribe(self, pcm: bytes) -> tuple[str, float, float]:
         """Whisper's transcript of 16 kHz int16 audio, its mean token log-probability and its
@@ -271,7 +294,7 @@ class WhisperRecogniser:
         result = self._model.generate(
             encoded,
             [[*self._prompt, *self._start]],
-            beam_size=1,
+            beam_size=WHISPER_BEAM,
             max_length=len(self._prompt) + len(self._start) + int(8 + 5 * seconds),
             return_scores=True,
             return_no_speech_prob=True,
@@ -281,7 +304,7 @@ class WhisperRecogniser:
         return self._tokenizer.decode(ids).strip(), float(result.scores[0]), float(result.no_speech_prob)
 
     def _judge(self, pcm: bytes, encoded: Any, frames: int, text: str, logprob: float, no_speech: float) -> Recognition:
-        plain = _collapse(normalise(re.sub(r"[\(\[\*♪][^\)\]\*♪]*[\)\]\*♪]?", " ", text)))
+        plain = _once(_collapse(normalise(re.sub(r"[\(\[\*♪][^\)\]\*♪]*[\)\]\*♪]?", " ", text))))
         confidence = self._confidence(logprob, no_speech)
         log.debug("whisper: %r logprob %.2f no-speech %.2f", text, logprob, no_speech)
         if not plain or no_speech > WHISPER_NO_SPEECH_MAX or plain in HALLUCINATIONS:
@@ -351,6 +374,17 @@ def _is_command(meaning: Hashable) -> bool:
     """Whether a phrase's meaning is a command (an enum member; options are numbers, anything
     else is the phrase itself)."""
     return isinstance(meaning, Enum)
+
+
+def _once(plain: str) -> str:
+    """A transcript that is one phrase said over and over, said once: Whisper loops on a short
+    answer in a reverberant room ("yes yes yes" from one "yes"), and a repeated phrase means what
+    it means once ("no no" is no)."""
+    words = plain.split()
+    for n in range(1, len(words) // 2 + 1):
+        if len(words) % n == 0 and words == words[:n] * (len(words) // n):
+            return " ".join(words[:n])
+    return plain
 
 
 def _collapse(plain: str) -> str:

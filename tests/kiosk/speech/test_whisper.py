@@ -14,8 +14,8 @@ import pytest
 
 from kiosk.core.channels import Channel
 from kiosk.speech import models
-from kiosk.speech.asr import AsrUnavailable, WhisperRecogniser, open_recogniser
-from kiosk.speech.asr.whisper import _collapse
+from kiosk.speech.asr import AsrUnavailable, Recognition, WhisperRecogniser, open_recogniser
+from kiosk.speech.asr.whisper import _collapse, _once
 from kiosk.speech.asr.whisper_files import BASE_SHA256, joined_base, sha256_of, whisper_status
 from kiosk.speech.matching import YES_NO, Matcher, OptionWords
 
@@ -51,6 +51,17 @@ def test_a_phrase_whisper_loops_on_is_kept_once_and_no_no_as_said():
     assert _collapse("no no no no no") == "no"
     assert _collapse("no no") == "no no"
     assert _collapse("i need a lot of help") == "i need a lot of help"
+
+
+def test_a_transcript_that_is_one_phrase_over_and_over_is_that_phrase_once():
+    # tiny.en loops on a short answer in a reverberant room: "Yes. Yes. Yes." from one "yes"
+    assert _once(_collapse("yes yes yes yes yes yes yes yes")) == "yes"
+    assert _once("no no") == "no"
+    assert _once("the third one the third one") == "the third one"
+    # anything else is left as said: a no after a yes is no repetition, nor a partial loop
+    assert _once("yes no") == "yes no"
+    assert _once("yes yes no") == "yes yes no"
+    assert _once("i can t i") == "i can t i"
 
 
 def test_models_list_says_which_recogniser_each_language_uses_and_why(capsys, monkeypatch, tmp_path):
@@ -166,6 +177,8 @@ def _options(item_id: str, language: str) -> list[OptionWords]:
     [
         ("en", "independent", 2, "yes", True),
         ("es", "independiente", 2, "no", False),
+        # heard as "C." while the prompt's answers were cut off behind its commands
+        ("es", None, None, "sí", True),
         ("fr", None, None, "oui", True),
         ("de", None, None, "ja", True),
     ],
@@ -233,3 +246,39 @@ def test_a_spoken_no_is_never_taken_as_yes(spoken, reply, monkeypatch):
     recogniser.accept(silence + read_wav(spoken(reply)).tobytes() + silence)
     result = recogniser.finish()
     assert matcher.match(result.text, result.confidence).option != 1
+
+
+class _Detector:
+    """PocketSphinx's place as the second hearing, saying what it is told to have heard."""
+
+    name, language = "scripted", "en"
+
+    def __init__(self, heard: str, confidence: float) -> None:
+        self.heard = Recognition(heard, confidence)
+
+    def set_grammar(self, *args, **kwargs) -> None:
+        """Any grammar."""
+
+    def reset(self) -> None:
+        """Nothing kept."""
+
+    def close(self) -> None:
+        """Nothing kept."""
+
+    def finish(self) -> Recognition:
+        return self.heard
+
+
+@pytest.mark.slow  # loads tiny.en
+@pytest.mark.parametrize(("detector_heard", "option"), [("yes it is", None), ("no it isn't", 2)])
+def test_a_reply_heard_by_the_detector_alone_is_taken_only_if_it_declines(detector_heard, option):
+    """Bench, reverberant room: "no it isn't", Whisper "and now you do that", PocketSphinx "yes
+    it is" (0.98): a wrong answer was stored. A no on the detector's word alone still declines."""
+    matcher = Matcher([OptionWords("Yes"), OptionWords("No")], "en")
+    recogniser = WhisperRecogniser("en", _Detector(detector_heard, 0.98))
+    recogniser.set_grammar(
+        matcher.phrases(), matcher.meaning, matcher.lead_ins(), matcher.fillers(), taken_as_heard=True
+    )
+    whisper = Recognition("and now you do that", 0.0)
+    result = recogniser._second_hearing(whisper, "and now you do that")
+    assert matcher.match(result.text, result.confidence).option == option
