@@ -18,6 +18,13 @@ from station import auth, logins, times, ward
 
 templates = Jinja2Templates(directory=Path(__file__).with_name("templates"))
 templates.env.globals["offline_after"] = ward.OFFLINE_AFTER_S
+#: who answered, as staff write it
+templates.env.globals["answered_words"] = {
+    "patient": "the patient",
+    "relative": "a relative",
+    "caregiver": "a caregiver",
+    "staff": "staff",
+}
 
 
 @pass_context
@@ -31,6 +38,25 @@ def _when(context: Any, iso: Any, form: str = "minute") -> str:
 templates.env.filters["when"] = _when
 #: the same, as the visit pages name it (``{{ x|shown }}``, minutes)
 templates.env.filters["shown"] = _when
+
+#: a language as staff read it (``{{ s.language|language }}``), never its code; one the list does
+#: not have shows its code
+LANGUAGE_WORDS = {
+    "en": "English",
+    "es": "Spanish",
+    "fr": "French",
+    "de": "German",
+    "it": "Italian",
+    "pt": "Portuguese",
+    "ca": "Catalan",
+    "eu": "Basque",
+    "gl": "Galician",
+    "nl": "Dutch",
+    "ar": "Arabic",
+    "ro": "Romanian",
+    "pl": "Polish",
+}
+templates.env.filters["language"] = lambda code: LANGUAGE_WORDS.get(str(code), str(code))
 #: a command as staff name it (the buttons' words), never its protocol name
 templates.env.globals["command_labels"] = {
     "continue": "Continue session",
