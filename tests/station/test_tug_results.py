@@ -117,42 +117,27 @@ def test_a_patient_with_only_tugs_is_found_and_a_tug_never_takes_a_sessions_id(s
             sync.intake(connection, "ward3-bed2", sync.parse({"events": [clash.event()]}))
 
 
-def test_a_tug_only_order_healed_while_the_tug_ran_still_takes_its_result(stored, tmp_path) -> None:
-    """A TUG-only visit holds no session at the kiosk, so its order may heal back to ordered while
-    the test runs; the result then still completes it (it was started with its code)."""
-    from dataclasses import replace
-
+def test_an_order_of_the_tug_alone_is_refused_by_the_use_case(stored) -> None:
+    """The kiosk gives the TUG within a visit (beside a questionnaire): the order use case refuses
+    the TUG alone, whatever form or client asks, and stores nothing."""
     import sqlalchemy as sa
 
-    from station import auth, order_progress, orders, sync
-    from tests.station._tug import camera_result, tug_rows
+    from station import auth, orders
 
-    engine, url, _ = stored
-    order = orders.create(
-        engine,
-        kiosk_id="ward3-bed2",
-        patient_id="NHC-0034600",
-        instruments=["tug"],
-        language="en",
-        relative=False,
-        by=auth.User("nurse.kim", "nurse"),
-        known_instruments=["tug"],
-        languages=["en"],
-    )
-    with engine.begin() as connection:
-        assert orders.start(connection, "ward3-bed2", order.code) is not None
-        connection.execute(
-            db.orders.update().where(db.orders.c.id == order.id).values(updated_at="2026-01-01T00:00:00+00:00")
+    engine, _, _ = stored
+    with engine.connect() as connection:
+        before = connection.execute(sa.select(sa.func.count()).select_from(db.orders)).scalar_one()
+    with pytest.raises(orders.OrderError, match="the Timed Up and Go is given within a visit"):
+        orders.create(
+            engine,
+            kiosk_id="ward3-bed2",
+            patient_id="NHC-0034600",
+            instruments=["tug"],
+            language="en",
+            relative=False,
+            by=auth.User("nurse.kim", "nurse"),
+            known_instruments=["barthel", "tug"],
+            languages=["en"],
         )
-        assert order_progress.release_unheld(connection, "ward3-bed2", set()) == [order.id]
-    assert state(url, order.id)[0] == "ordered"
-    (row,) = tug_rows(
-        tmp_path / "k", [("NHC-0034600", camera_result(), "2026-11-25T09:00:00Z")], visit=f"order {order.id}"
-    )
-    with engine.begin() as connection:
-        sync.intake(connection, "ward3-bed2", sync.parse({"events": [replace(row, seq=950).event()]}))
-        trail = connection.execute(
-            sa.select(db.audit.c.action).where(db.audit.c.session_id == order.id).order_by(db.audit.c.id)
-        ).scalars()
-        assert list(trail)[-2:] == ["order_ready", "order_signed"]
-    assert state(url, order.id)[0] == "signed_off"
+    with engine.connect() as connection:
+        assert connection.execute(sa.select(sa.func.count()).select_from(db.orders)).scalar_one() == before
