@@ -312,6 +312,7 @@ class Session:
             self.timers,
             progress=self.practice.progress(),
             can_undo=self.corrections.can_undo(),
+            part=(self.battery.index + 1, len(self.battery.instruments)) if self.battery is not None else None,
         )
 
     # -- inputs ------------------------------------------------------------------------------------

@@ -10,7 +10,14 @@ from kiosk.core.session.state import SessionState
 from kiosk.core.session.timers import AttemptClock
 
 
-def picture(state: SessionState, timers: AttemptClock, *, progress: Mapping[str, Any], can_undo: bool) -> Snapshot:
+def picture(
+    state: SessionState,
+    timers: AttemptClock,
+    *,
+    progress: Mapping[str, Any],
+    can_undo: bool,
+    part: tuple[int, int] | None = None,
+) -> Snapshot:
     """The :class:`Snapshot` of a session's ``state`` and ``timers`` (``Session.snapshot``):
     ``progress`` is the practice's, ``can_undo`` whether the last answer could be taken back now
     (it is offered only while no clock is frozen and no call is being asked back)."""
@@ -45,4 +52,5 @@ def picture(state: SessionState, timers: AttemptClock, *, progress: Mapping[str,
         unattended=state.unattended,
         calling=state.call.text if state.call is not None else None,
         practice_chosen=open_.chosen if open_ and open_.practice else None,
+        part=part,
     )

@@ -73,3 +73,6 @@ class Snapshot:
     #: the option chosen for the practice question on screen (shown chosen, as a scored answer
     #: is, until the next question opens); None before an answer and outside practice
     practice_chosen: int | None = None
+    #: (k, n): this instrument is part k of the n of its visit's battery ("Part 2 of 3" between
+    #: instruments); None for a visit of one instrument
+    part: tuple[int, int] | None = None

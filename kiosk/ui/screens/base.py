@@ -14,7 +14,7 @@ from textual.screen import Screen
 from basis import record
 from kiosk.core.adaptation import VOICE_OFF
 from kiosk.core.questionnaire import Questionnaire
-from kiosk.core.session import ATTEMPTS, Snapshot
+from kiosk.core.session import ATTEMPTS, Phase, Snapshot
 from kiosk.ui.widgets.bars import AdaptationBanner, VoiceAgainButton
 from kiosk.ui.widgets.literal import Button, Label
 from kiosk.ui.widgets.text import join_or, ui_text, ways_sentence
@@ -230,7 +230,11 @@ class PatientScreen(KioskScreen):
         paused and doctor-called screens over it), else the questionnaire's title."""
         snap = view.snapshot
         if snap.number is None:
-            return view.questionnaire.title_for_patient(self.language)
+            title = view.questionnaire.title_for_patient(self.language)
+            if snap.part is not None and snap.phase is not Phase.WELCOME:  # between a visit's instruments
+                part = ui_text(self.language, "part_of", number=snap.part[0], total=snap.part[1])
+                return f"{part} · {title}"
+            return title
         return ui_text(self.language, "question_of", number=snap.number, total=snap.count)
 
     def on_key(self, event: events.Key) -> None:

@@ -39,6 +39,8 @@ async def test_a_battery_of_two_instruments_through_the_app(ui_kiosk, tmp_path):
         second = app.session
         assert first.finished and second is not first and second.questionnaire.id == "mini"
         assert "Well done. Next: Two questions. Take a breath." in drawn_text(app)
+        # between instruments the patient reads where the visit stands
+        await settle(pilot, lambda: text_of(app.screen.query_one("#progress", Label)) == "Part 2 of 2 · Two questions")
         # call the doctor on the rest screen: the visit waits; the clinician lets it go on
         await pilot.press("d")
         await settle(pilot, lambda: screen_name(kiosk) == "DoctorCalledScreen")
@@ -46,6 +48,7 @@ async def test_a_battery_of_two_instruments_through_the_app(ui_kiosk, tmp_path):
         await settle(pilot, lambda: screen_name(kiosk) == "RestScreen")
         await pilot.click("#understood")  # Continue
         await settle(pilot, lambda: screen_name(kiosk) == "ExplanationScreen")
+        assert text_of(app.screen.query_one("#progress", Label)) == "Part 2 of 2 · Two questions"
         await pilot.press("1")
         await settle(pilot, lambda: second.phase is Phase.QUESTIONS)
         # the first question, answered, then taken back and answered again
