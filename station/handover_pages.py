@@ -13,7 +13,7 @@ from starlette.requests import Request
 from starlette.responses import Response
 from starlette.routing import Route
 
-from station import db, handover
+from station import db, handover, orders
 from station.rendering import render
 
 
@@ -27,6 +27,7 @@ async def handover_page(request: Request) -> Response:
     except handover.HandoverError as exc:
         error, chosen = str(exc), handover.window("", "", now, zone)
     found = await run_in_threadpool(handover.shift, engine, q, chosen, now, zone)
+    offered = await run_in_threadpool(orders.instruments, engine, q)
     typed_from, typed_to = chosen.typed(zone)
     return render(
         request,
@@ -38,6 +39,7 @@ async def handover_page(request: Request) -> Response:
         error=error,
         hours=handover.DEFAULT_HOURS,
         today=now.astimezone(zone).strftime("%A %d %B %Y"),
+        titles={i.id: i.title for i in offered},  # staff read titles, never ids
     )
 
 

@@ -123,6 +123,8 @@ def test_handover_page_in_chromium_on_a_phone_and_a_desk(browser, sqlite_url, st
             done = page.locator("#visits-done li").inner_text()
             assert "Barthel Index: 100 of 100 (Independent)" in done and "Mood check (4 items): 20 of 25" in done
             assert page.locator(f'#orders-open li[data-order="{waiting.id}"]').is_visible()
+            # the order's instruments by their titles, never their ids
+            assert "· Barthel Index ·" in page.locator(f'#orders-open li[data-order="{waiting.id}"]').inner_text()
             assert page.locator("#unsigned-count").inner_text() == "2"
             assert page.locator(f'#unsigned li[data-session="{visits.mood}"]').is_visible()
             assert page.locator('#shift-window input[name="from"]').input_value() == "2026-11-20T07:00"
