@@ -70,7 +70,12 @@ async def test_cancelling_a_running_visit_ends_it_at_the_kiosk_and_keeps_its_ans
             cancelled = nurse.post(f"/orders/{order_id}/cancel", reason="patient discharged")
             assert cancelled.status_code == 303
 
-            await until_thread(lambda: screen(app) == "VisitEndedScreen", "the kiosk ending the visit", patience_s=60)
+            # wait on what is drawn: the screen is current a moment before its widgets are mounted
+            await until_thread(
+                lambda: screen(app) == "VisitEndedScreen" and bool(app.screen.query("#visit-ended-title")),
+                "the kiosk ending the visit",
+                patience_s=60,
+            )
             assert "This visit has ended." in text_of(app, "#visit-ended-title")
             assert app.session is not session and app.session.phase is Phase.WELCOME  # nothing more is asked
             stored = app.controller.store.session(session.id)
